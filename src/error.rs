@@ -1,0 +1,52 @@
+//! User-facing errors. Everything a user can cause (a bad file, a bad setting, a part too thin
+//! to print) is an [`Error`] with a message that says what is wrong and what to do. Bugs are
+//! reported as [`Error::Internal`].
+
+use std::fmt;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Error {
+    /// The file could not be read as an STL mesh.
+    Import(String),
+    /// A setting is unknown or out of range.
+    Setting { name: String, message: String },
+    /// The mesh was read but there is nothing a droplet printer could print.
+    NothingToPrint(String),
+    /// Reading or writing a file failed.
+    Io(String),
+    /// A bug in dropslice.
+    Internal(String),
+}
+
+impl Error {
+    /// A short machine-readable tag: "import", "setting", "nothing_to_print", "io", "internal".
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Error::Import(_) => "import",
+            Error::Setting { .. } => "setting",
+            Error::NothingToPrint(_) => "nothing_to_print",
+            Error::Io(_) => "io",
+            Error::Internal(_) => "internal",
+        }
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Import(m) => write!(f, "cannot read the STL file: {m}"),
+            Error::Setting { name, message } if name.is_empty() => {
+                write!(f, "bad settings: {message}")
+            }
+            Error::Setting { name, message } => write!(f, "bad setting {name}: {message}"),
+            Error::NothingToPrint(m) => write!(f, "nothing to print: {m}"),
+            Error::Io(m) => write!(f, "{m}"),
+            Error::Internal(m) => write!(
+                f,
+                "internal error (a bug in dropslice, please report it): {m}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Error {}

@@ -1,0 +1,129 @@
+//! Write code, stage 6 (SPEC.md 4.5, 5.3.6): the header and each [`LayerPlan`] as `.gco` text.
+//! Coordinates have exactly 4 decimals; `G01` travel, `G25` a line of droplets, `G26` one
+//! droplet. The header lists every setting, the input file, the version and a summary; it is
+//! written before any layer, with fixed-width placeholders for the droplet counts that
+//! [`header`] fills in once the slice is done (same length, so a file can be patched in place).
+
+use crate::plan::{Counts, LayerPlan, MoveKind};
+use crate::settings::Settings;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write;
+
+/// Totals of a finished slice.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    pub layers: usize,
+    pub counts: Counts,
+    /// Length of all moves without material, in mm.
+    pub travel_mm: f64,
+}
+
+/// What the header says about the input.
+#[derive(Clone, Debug)]
+pub struct HeaderInput<'a> {
+    pub file_name: &'a str,
+    pub facets: usize,
+    pub layers: usize,
+    /// Bounding box of the placed part (min, max).
+    pub bounds: ([f64; 3], [f64; 3]),
+    pub warnings: &'a [String],
+}
+
+/// Width of the droplet count fields in the header.
+const COUNT_WIDTH: usize = 12;
+
+/// `x` with 4 decimals, never `-0.0000`.
+pub fn coord(x: f64) -> String {
+    let s = format!("{x:.4}");
+    if s == "-0.0000" { "0.0000".into() } else { s }
+}
+
+/// The header comment block. With `summary = None` the droplet counts are placeholders of
+/// the same width, so the final header has exactly the same length.
+pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> String {
+    let mut h = String::new();
+    let field = |v: Option<u64>| match v {
+        Some(v) => format!("{v:>COUNT_WIDTH$}"),
+        None => format!("{:>COUNT_WIDTH$}", "pending"),
+    };
+    let c = summary.map(|s| s.counts);
+    let b = s.droplet_width();
+    let _ = writeln!(
+        h,
+        "; dropslice {} — droplet machine code (G01 travel, G25 droplet line, G26 droplet)",
+        crate::VERSION
+    );
+    let _ = writeln!(
+        h,
+        "; input = {}",
+        input.file_name.replace(['\n', '\r'], " ")
+    );
+    let _ = writeln!(h, "; facets = {}", input.facets);
+    let (lo, hi) = input.bounds;
+    let _ = writeln!(
+        h,
+        "; bounding box = X{}..{} Y{}..{} Z{}..{} mm",
+        coord(lo[0]),
+        coord(hi[0]),
+        coord(lo[1]),
+        coord(hi[1]),
+        coord(lo[2]),
+        coord(hi[2])
+    );
+    let _ = writeln!(h, "; layers = {}", input.layers);
+    let _ = writeln!(
+        h,
+        "; droplet width B = {} mm, height H = {} mm",
+        coord(b),
+        coord(s.layer_height)
+    );
+    let _ = writeln!(h, "; droplets outer loops = {}", field(c.map(|c| c.outer)));
+    let _ = writeln!(h, "; droplets inner loops = {}", field(c.map(|c| c.inner)));
+    let _ = writeln!(h, "; droplets fill        = {}", field(c.map(|c| c.fill)));
+    let _ = writeln!(
+        h,
+        "; droplets total       = {}",
+        field(c.map(|c| c.total()))
+    );
+    for w in input.warnings {
+        let _ = writeln!(h, "; warning: {}", w.replace(['\n', '\r'], " "));
+    }
+    let _ = writeln!(h, "; settings:");
+    for (name, value, unit) in s.entries() {
+        if unit.is_empty() {
+            let _ = writeln!(h, "; {name} = {value}");
+        } else {
+            let _ = writeln!(h, "; {name} = {value} ({unit})");
+        }
+    }
+    let _ = writeln!(h, "; end of header");
+    h
+}
+
+/// One layer's commands.
+pub fn layer_text(plan: &LayerPlan) -> String {
+    let mut t = String::with_capacity(plan.moves.len() * 34 + 40);
+    let z = coord(plan.z);
+    let _ = writeln!(t, "; layer {} z = {}", plan.index + 1, z);
+    for m in &plan.moves {
+        let code = match m.kind {
+            MoveKind::Travel => "G01",
+            MoveKind::Droplet => "G26",
+            MoveKind::Line => "G25",
+        };
+        let _ = writeln!(t, "{code} X{} Y{} Z{z}", coord(m.to[0]), coord(m.to[1]));
+    }
+    t
+}
+
+/// Closing comment with the totals.
+pub fn footer(summary: &Summary) -> String {
+    format!(
+        "; end of code: {} layers, {} droplets ({} outer loops, {} inner loops, {} fill)\n",
+        summary.layers,
+        summary.counts.total(),
+        summary.counts.outer,
+        summary.counts.inner,
+        summary.counts.fill
+    )
+}

@@ -1,0 +1,234 @@
+//! Fill, stage 4 (SPEC.md 5.3.4): a fill region → hatch segments at the layer's angle, spaced
+//! B / fill_density, clipped to the region (non-zero rule), then ordered greedily: after each
+//! segment, go to the nearest end of an unprinted segment, reversing it if that end is its end.
+//!
+//! Hatch lines lie at (j + ½)·spacing from the origin across the hatch direction, for whole j,
+//! so two layers with the same angle have their lines in the same places.
+
+use crate::mesh::sin_cos_deg;
+use crate::slice::{Point, Shapes, dist};
+
+/// One hatch segment: a `G25` line from `a` to `b`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HatchLine {
+    pub a: Point,
+    pub b: Point,
+}
+
+/// Segments shorter than this are dropped (tangent touches of a scanline).
+const MIN_LENGTH_MM: f64 = 1e-6;
+
+/// Unordered hatch segments of a region.
+pub fn hatch(region: &Shapes, angle_deg: f64, spacing: f64) -> Vec<HatchLine> {
+    let (s, c) = sin_cos_deg(angle_deg);
+    // Into the hatch frame (rotate by −angle): the lines become horizontal.
+    let to = |p: Point| [c * p[0] + s * p[1], -s * p[0] + c * p[1]];
+    let back = |p: Point| [c * p[0] - s * p[1], s * p[0] + c * p[1]];
+    // (line j, x, winding)
+    let mut hits: Vec<(i64, f64, i32)> = Vec::new();
+    for contour in region.iter().flatten() {
+        let n = contour.len();
+        for i in 0..n {
+            let p = to(contour[i]);
+            let q = to(contour[(i + 1) % n]);
+            if p[1] == q[1] {
+                continue;
+            }
+            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
+            // Lines with lo.y <= y < hi.y, y = (j + ½)·spacing.
+            let mut j = (lo[1] / spacing - 0.5).ceil() as i64;
+            loop {
+                let y = (j as f64 + 0.5) * spacing;
+                if y < lo[1] {
+                    j += 1;
+                    continue;
+                }
+                if y >= hi[1] {
+                    break;
+                }
+                let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
+                hits.push((j, x, w));
+                j += 1;
+            }
+        }
+    }
+    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut lines = Vec::new();
+    for row in hits.chunk_by(|a, b| a.0 == b.0) {
+        let y = (row[0].0 as f64 + 0.5) * spacing;
+        let mut winding = 0;
+        let mut start = 0.0;
+        for &(_, x, w) in row {
+            let before = winding;
+            winding += w;
+            if before == 0 && winding != 0 {
+                start = x;
+            } else if before != 0 && winding == 0 && x - start >= MIN_LENGTH_MM {
+                lines.push(HatchLine {
+                    a: back([start, y]),
+                    b: back([x, y]),
+                });
+            }
+        }
+    }
+    lines
+}
+
+/// Greedy order from `from`: always the nearest unprinted segment end next.
+pub fn order_greedy(lines: Vec<HatchLine>, from: Point) -> Vec<HatchLine> {
+    if lines.len() <= 1 {
+        return lines;
+    }
+    let mut grid = EndGrid::new(&lines);
+    let mut out = Vec::with_capacity(lines.len());
+    let mut at = from;
+    while let Some(end) = grid.take_nearest(at) {
+        let l = lines[end / 2];
+        let l = if end % 2 == 0 {
+            l
+        } else {
+            HatchLine { a: l.b, b: l.a }
+        };
+        at = l.b;
+        out.push(l);
+    }
+    out
+}
+
+/// Uniform grid over segment ends for nearest-end queries (end id = 2·segment + {0: a, 1: b}).
+struct EndGrid {
+    ends: Vec<Point>,
+    alive: Vec<bool>,
+    cells: Vec<Vec<u32>>,
+    min: Point,
+    cell: f64,
+    nx: i64,
+    ny: i64,
+}
+
+impl EndGrid {
+    fn new(lines: &[HatchLine]) -> EndGrid {
+        let ends: Vec<Point> = lines.iter().flat_map(|l| [l.a, l.b]).collect();
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for p in &ends {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        let (w, h) = ((max[0] - min[0]).max(1e-9), (max[1] - min[1]).max(1e-9));
+        let cell = ((w * h) / ends.len() as f64).sqrt().max(w.max(h) / 4096.0);
+        let nx = (w / cell).floor() as i64 + 1;
+        let ny = (h / cell).floor() as i64 + 1;
+        let mut grid = EndGrid {
+            alive: vec![true; ends.len()],
+            cells: vec![Vec::new(); (nx * ny) as usize],
+            ends,
+            min,
+            cell,
+            nx,
+            ny,
+        };
+        for i in 0..grid.ends.len() {
+            let (cx, cy) = grid.cell_of(grid.ends[i]);
+            grid.cells[(cy * nx + cx) as usize].push(i as u32);
+        }
+        grid
+    }
+
+    fn cell_of(&self, p: Point) -> (i64, i64) {
+        let cx = ((p[0] - self.min[0]) / self.cell).floor() as i64;
+        let cy = ((p[1] - self.min[1]) / self.cell).floor() as i64;
+        (cx.clamp(0, self.nx - 1), cy.clamp(0, self.ny - 1))
+    }
+
+    /// Removes the segment with the end nearest to `p` and returns that end's id.
+    fn take_nearest(&mut self, p: Point) -> Option<usize> {
+        let (cx, cy) = self.cell_of(p);
+        // Distance from p to the grid's cell (cx, cy) box, to bound rings when p is outside.
+        let mut best: Option<(f64, usize)> = None;
+        let max_r = self.nx.max(self.ny);
+        for r in 0..=max_r {
+            let mut any_cell = false;
+            for y in (cy - r)..=(cy + r) {
+                if y < 0 || y >= self.ny {
+                    continue;
+                }
+                let step = if y == cy - r || y == cy + r {
+                    1
+                } else {
+                    2 * r.max(1)
+                };
+                let mut x = cx - r;
+                while x <= cx + r {
+                    if x >= 0 && x < self.nx {
+                        any_cell = true;
+                        let cell = &mut self.cells[(y * self.nx + x) as usize];
+                        let alive = &self.alive;
+                        cell.retain(|&e| alive[e as usize]);
+                        for &e in cell.iter() {
+                            let d = dist(p, self.ends[e as usize]);
+                            if best.is_none_or(|(bd, be)| d < bd || (d == bd && (e as usize) < be))
+                            {
+                                best = Some((d, e as usize));
+                            }
+                        }
+                    }
+                    x += step;
+                }
+            }
+            // Every end outside rings 0..=r is at least max(r·cell, how far p lies outside the
+            // grid) away; stop once the best is at most that.
+            let bound = (r as f64 * self.cell).max(self.outside_distance(p));
+            if !any_cell || best.is_some_and(|(bd, _)| bd <= bound) {
+                break;
+            }
+        }
+        let (_, e) = best?;
+        self.alive[e] = false;
+        self.alive[e ^ 1] = false;
+        Some(e)
+    }
+
+    /// How far `p` lies outside the grid's box (0 inside).
+    fn outside_distance(&self, p: Point) -> f64 {
+        let maxx = self.min[0] + self.nx as f64 * self.cell;
+        let maxy = self.min[1] + self.ny as f64 * self.cell;
+        let dx = (self.min[0] - p[0]).max(p[0] - maxx).max(0.0);
+        let dy = (self.min[1] - p[1]).max(p[1] - maxy).max(0.0);
+        dx.max(dy)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(a: f64) -> Shapes {
+        vec![vec![vec![[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]]]]
+    }
+
+    #[test]
+    fn horizontal_hatch_of_a_square() {
+        let lines = hatch(&square(10.0), 0.0, 1.0);
+        assert_eq!(lines.len(), 10);
+        for l in &lines {
+            assert!((dist(l.a, l.b) - 10.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn greedy_is_a_boustrophedon_on_a_square() {
+        let lines = hatch(&square(10.0), 45.0, 0.5);
+        let total: f64 = lines.iter().map(|l| dist(l.a, l.b)).sum();
+        // Area / spacing.
+        assert!((total - 200.0).abs() < 1.0, "{total}");
+        let ordered = order_greedy(lines.clone(), [0.0, 0.0]);
+        assert_eq!(ordered.len(), lines.len());
+        // Each next segment starts at the nearest remaining end: consecutive lines are neighbours.
+        for w in ordered.windows(2) {
+            assert!(dist(w[0].b, w[1].a) < 1.0, "{:?}", w);
+        }
+    }
+}

@@ -1,0 +1,270 @@
+//! dropslice: a slicer for droplet-based plastic 3D printing.
+//!
+//! The pipeline (SPEC.md 5.3), one module per stage, each a plain function from one named
+//! type to the next:
+//!
+//! `&[u8]` —[`stl::parse`]→ triangles —[`mesh::Mesh::weld`], [`mesh::Mesh::transform`]→
+//! [`mesh::Mesh`] —[`slice::slice_layer`]→ [`slice::Section`] (region: outer CCW + holes CW)
+//! —[`contours::contours`] (via [`offset::inset`])→ loops + fill region
+//! —[`droplets::loop_droplets`], [`hatch::hatch`]→ droplet centres + hatch segments
+//! —[`plan::plan_layer`]→ [`plan::LayerPlan`] —[`gcode::layer_text`]→ `.gco` text, and
+//! [`preview::PreviewLayer`] for the canvas.
+//!
+//! Layers are independent: [`Job::plan_layer`] plans any layer on any thread. Natively,
+//! [`write_gcode`] plans them in parallel and writes them in ascending order, a window at a
+//! time, so memory stays bounded however tall the part is.
+
+pub mod contours;
+pub mod droplets;
+pub mod error;
+pub mod gcode;
+pub mod hatch;
+pub mod mesh;
+pub mod offset;
+pub mod plan;
+pub mod preview;
+pub mod settings;
+pub mod slice;
+pub mod stl;
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
+
+pub use error::Error;
+pub use gcode::Summary;
+pub use settings::Settings;
+
+use mesh::{Bounds, Mesh, MeshStats};
+use plan::LayerPlan;
+use slice::{FacetBuckets, Section};
+
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Most layers a job may have (a guard against settings that would run for hours).
+pub const MAX_LAYERS: usize = 200_000;
+/// Largest part extent in x or y, in droplet widths (hatch lines per layer).
+pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
+
+/// What the import found, for the CLI summary, the header and the page.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct JobInfo {
+    pub file_name: String,
+    pub format: stl::Format,
+    pub mesh: MeshStats,
+    /// Bounding box of the placed part, in mm.
+    pub bounds: Bounds,
+    pub layers: usize,
+    /// Droplet width B in mm.
+    pub droplet_width: f64,
+    /// Problems found in the mesh and what was done about them.
+    pub warnings: Vec<String>,
+}
+
+/// One prepared slicing job: the placed mesh, its plane heights and a facet index per layer.
+pub struct Job {
+    settings: Settings,
+    mesh: Mesh,
+    buckets: FacetBuckets,
+    zs: Vec<f64>,
+    info: JobInfo,
+}
+
+impl Job {
+    /// Reads the STL bytes, validates the settings and places the part.
+    pub fn new(stl_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
+        settings.validate()?;
+        let (tris, format) = stl::parse(stl_bytes)?;
+        let (mut mesh, degenerate) = Mesh::weld(&tris);
+        if mesh.facets.is_empty() {
+            return Err(Error::Import(format!(
+                "all {} triangles are degenerate (their corners coincide): the mesh has no surface",
+                tris.len()
+            )));
+        }
+        drop(tris);
+        mesh.transform(&settings);
+        let bounds = mesh.bounds();
+        let size = bounds.size();
+        let h = settings.layer_height;
+        if size[2] <= 0.0 {
+            return Err(Error::NothingToPrint(
+                "the part is flat (0 mm tall after rotation): check rotate_x/rotate_y".into(),
+            ));
+        }
+        let layers_needed = size[2] / h;
+        if layers_needed > MAX_LAYERS as f64 {
+            return Err(Error::Setting {
+                name: "layer_height".into(),
+                message: format!(
+                    "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
+                    size[2], layers_needed
+                ),
+            });
+        }
+        let b = settings.droplet_width();
+        if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
+            return Err(Error::Setting {
+                name: "scale_x".into(),
+                message: format!(
+                    "the part is {:.0} mm wide, more than {MAX_WIDTH_IN_DROPLETS} droplets of {b:.4} mm; check the scale (is the file in micrometres?)",
+                    size[0].max(size[1])
+                ),
+            });
+        }
+        let zs = slice::layer_heights(size[2], h, settings.slice_plane);
+        if zs.is_empty() {
+            return Err(Error::NothingToPrint(format!(
+                "the part is {:.4} mm tall, less than half a layer ({} mm): scale it up or lower layer_height",
+                size[2],
+                h / 2.0
+            )));
+        }
+        let buckets = FacetBuckets::new(&mesh, &zs);
+        let stats = mesh.stats(tris_len(stl_bytes, &mesh, degenerate), degenerate);
+        let warnings = warnings(&stats, &size);
+        let info = JobInfo {
+            file_name: file_name.to_string(),
+            format,
+            mesh: stats,
+            bounds,
+            layers: zs.len(),
+            droplet_width: b,
+            warnings,
+        };
+        Ok(Job {
+            settings,
+            mesh,
+            buckets,
+            zs,
+            info,
+        })
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    pub fn info(&self) -> &JobInfo {
+        &self.info
+    }
+
+    pub fn layer_count(&self) -> usize {
+        self.zs.len()
+    }
+
+    /// Plane height of layer `i` above the part's bottom.
+    pub fn plane_z(&self, i: usize) -> f64 {
+        self.zs[i]
+    }
+
+    /// The cross-section of layer `i`.
+    pub fn section(&self, i: usize) -> Section {
+        slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i])
+    }
+
+    /// Every move of layer `i`.
+    pub fn plan_layer(&self, i: usize) -> LayerPlan {
+        plan::plan_layer(&self.section(i).region, i, &self.settings)
+    }
+
+    /// The header; with `None` the droplet counts are fixed-width placeholders.
+    pub fn header(&self, summary: Option<&Summary>) -> String {
+        let b = &self.info.bounds;
+        gcode::header(
+            &self.settings,
+            &gcode::HeaderInput {
+                file_name: &self.info.file_name,
+                facets: self.info.mesh.facets_in_file,
+                layers: self.zs.len(),
+                bounds: (b.min, b.max),
+                warnings: &self.info.warnings,
+            },
+            summary,
+        )
+    }
+}
+
+fn tris_len(_bytes: &[u8], mesh: &Mesh, degenerate: usize) -> usize {
+    mesh.facets.len() + degenerate
+}
+
+/// Plain-language warnings about the mesh.
+fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
+    let mut w = Vec::new();
+    if m.open_edges > 0 {
+        w.push(format!(
+            "the mesh is not closed: {} open edges (holes in the surface); open sections are closed by joining their ends",
+            m.open_edges
+        ));
+    }
+    if m.nonmanifold_edges > 0 {
+        w.push(format!(
+            "{} non-manifold edges (shared by more than two facets); overlapping parts are printed as their union",
+            m.nonmanifold_edges
+        ));
+    }
+    if m.misoriented_edges > 0 {
+        w.push(format!(
+            "{} edges between facets of opposite orientation (flipped facets); loops are oriented by the majority",
+            m.misoriented_edges
+        ));
+    }
+    if m.degenerate_facets > 0 {
+        w.push(format!(
+            "{} degenerate facets (zero area) were ignored",
+            m.degenerate_facets
+        ));
+    }
+    if m.signed_volume < 0.0 {
+        w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
+    }
+    let largest = size[0].max(size[1]).max(size[2]);
+    if largest < 10.0 {
+        w.push(format!(
+            "the part is only {largest:.3} mm across: if the file is in inches, scale it by 25.4 (--set scale_x=25.4 --set scale_y=25.4 --set scale_z=25.4)"
+        ));
+    } else if largest > 2000.0 {
+        w.push(format!(
+            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by 0.001 (--set scale_x=0.001 --set scale_y=0.001 --set scale_z=0.001)"
+        ));
+    }
+    w
+}
+
+/// Plans every layer in parallel and writes header, layers (ascending) and footer to `out`.
+/// The header carries placeholders for the droplet counts (see [`gcode::header`]).
+/// `progress(done, total)` is called after each written batch of layers.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn write_gcode<W: std::io::Write + ?Sized>(
+    job: &Job,
+    out: &mut W,
+    mut progress: impl FnMut(usize, usize),
+) -> std::io::Result<Summary> {
+    use rayon::prelude::*;
+    out.write_all(job.header(None).as_bytes())?;
+    let n = job.layer_count();
+    let window = (rayon::current_num_threads() * 4).max(8);
+    let mut summary = Summary {
+        layers: n,
+        ..Summary::default()
+    };
+    let mut start = 0;
+    while start < n {
+        let end = (start + window).min(n);
+        let done: Vec<(String, plan::Counts, f64)> = (start..end)
+            .into_par_iter()
+            .map(|i| {
+                let p = job.plan_layer(i);
+                (gcode::layer_text(&p), p.counts, p.travel_mm)
+            })
+            .collect();
+        for (text, counts, travel) in done {
+            out.write_all(text.as_bytes())?;
+            summary.counts.add(&counts);
+            summary.travel_mm += travel;
+        }
+        progress(end, n);
+        start = end;
+    }
+    out.write_all(gcode::footer(&summary).as_bytes())?;
+    Ok(summary)
+}

@@ -1,0 +1,222 @@
+//! Import, stage 1b: triangle soup → [`Mesh`] (welded vertex list + facet list), its
+//! transforms (SPEC.md: rotate, scale, bounding box minimum to the origin, placement) and its
+//! diagnostics (open and non-manifold edges).
+
+use crate::settings::Settings;
+use crate::stl::Triangles;
+use std::collections::HashMap;
+
+/// A welded triangle mesh in millimetres.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub vertices: Vec<[f64; 3]>,
+    /// Vertex indices in the file's order (which gives the orientation).
+    pub facets: Vec<[u32; 3]>,
+}
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Bounds {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl Bounds {
+    pub fn size(&self) -> [f64; 3] {
+        [0, 1, 2].map(|k| self.max[k] - self.min[k])
+    }
+}
+
+/// What the import found in the mesh.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct MeshStats {
+    pub facets_in_file: usize,
+    pub facets: usize,
+    pub vertices: usize,
+    /// Facets dropped because two of their corners are the same vertex.
+    pub degenerate_facets: usize,
+    /// Edges used by only one facet (holes in the surface).
+    pub open_edges: usize,
+    /// Edges used by more than two facets.
+    pub nonmanifold_edges: usize,
+    /// Edges whose two facets run along them in the same direction (a flipped facet).
+    pub misoriented_edges: usize,
+    /// Signed volume from the facets' orientation (negative: the mesh is inside out).
+    pub signed_volume: f64,
+}
+
+impl Mesh {
+    /// Welds corners whose float32 coordinates are bit-identical (−0 = +0) and drops facets
+    /// that collapse to a line or a point.
+    pub fn weld(tris: &Triangles) -> (Mesh, usize) {
+        let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(tris.len() / 2 + 16);
+        let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
+        let mut facets = Vec::with_capacity(tris.len());
+        let mut degenerate = 0;
+        for t in tris {
+            let ids = t.map(|p| {
+                let key = p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() });
+                *index.entry(key).or_insert_with(|| {
+                    vertices.push(p.map(f64::from));
+                    (vertices.len() - 1) as u32
+                })
+            });
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                degenerate += 1;
+            } else {
+                facets.push(ids);
+            }
+        }
+        (Mesh { vertices, facets }, degenerate)
+    }
+
+    pub fn bounds(&self) -> Bounds {
+        let mut min = [f64::INFINITY; 3];
+        let mut max = [f64::NEG_INFINITY; 3];
+        for v in &self.vertices {
+            for k in 0..3 {
+                min[k] = min[k].min(v[k]);
+                max[k] = max[k].max(v[k]);
+            }
+        }
+        Bounds { min, max }
+    }
+
+    /// Applies SPEC.md's transforms: rotate about x, y, z (in that order), scale, move the
+    /// bounding box minimum to the origin, then rotate by `place_angle` about the z axis
+    /// through the origin and move by (`place_x`, `place_y`).
+    pub fn transform(&mut self, s: &Settings) {
+        let r = mat_mul(
+            rot(2, s.rotate_z),
+            mat_mul(rot(1, s.rotate_y), rot(0, s.rotate_x)),
+        );
+        let scale = [s.scale_x, s.scale_y, s.scale_z];
+        for v in &mut self.vertices {
+            let p = apply(&r, *v);
+            *v = [0, 1, 2].map(|k| p[k] * scale[k]);
+        }
+        let b = self.bounds();
+        let place = rot(2, s.place_angle);
+        for v in &mut self.vertices {
+            let p = [v[0] - b.min[0], v[1] - b.min[1], v[2] - b.min[2]];
+            let q = apply(&place, p);
+            *v = [q[0] + s.place_x, q[1] + s.place_y, q[2]];
+        }
+    }
+
+    /// Edge statistics and signed volume.
+    pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
+        // Directed edges, sorted by their undirected key.
+        let mut edges: Vec<(u64, bool)> = Vec::with_capacity(self.facets.len() * 3);
+        for f in &self.facets {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                edges.push((edge_key(a, b), a < b));
+            }
+        }
+        edges.sort_unstable();
+        let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
+        for group in edges.chunk_by(|x, y| x.0 == y.0) {
+            match group.len() {
+                1 => open += 1,
+                2 => {
+                    if group[0].1 == group[1].1 {
+                        misoriented += 1
+                    }
+                }
+                _ => nonmanifold += 1,
+            }
+        }
+        let signed_volume = self
+            .facets
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| self.vertices[i as usize]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum();
+        MeshStats {
+            facets_in_file,
+            facets: self.facets.len(),
+            vertices: self.vertices.len(),
+            degenerate_facets: degenerate,
+            open_edges: open,
+            nonmanifold_edges: nonmanifold,
+            misoriented_edges: misoriented,
+            signed_volume,
+        }
+    }
+}
+
+/// Undirected edge key of two vertex ids.
+pub fn edge_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}
+
+type Mat = [[f64; 3]; 3];
+
+/// Rotation about axis `axis` (0 x, 1 y, 2 z) by `deg` degrees; exact for multiples of 90°.
+fn rot(axis: usize, deg: f64) -> Mat {
+    let (s, c) = sin_cos_deg(deg);
+    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    let mut m = [[0.0; 3]; 3];
+    m[axis][axis] = 1.0;
+    m[i][i] = c;
+    m[j][j] = c;
+    m[i][j] = -s;
+    m[j][i] = s;
+    m
+}
+
+/// sin and cos of an angle in degrees, exact at multiples of 90°.
+pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
+    let q = deg / 90.0;
+    if q == q.round() {
+        match (q.round() as i64).rem_euclid(4) {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        }
+    } else {
+        deg.to_radians().sin_cos()
+    }
+}
+
+fn mat_mul(a: Mat, b: Mat) -> Mat {
+    let mut m = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
+        }
+    }
+    m
+}
+
+fn apply(m: &Mat, v: [f64; 3]) -> [f64; 3] {
+    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_is_exact_at_right_angles() {
+        let mut m = Mesh {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]],
+            facets: vec![],
+        };
+        let s = Settings {
+            rotate_x: 90.0,
+            ..Settings::default()
+        };
+        m.transform(&s);
+        // (1,2,3) about x by 90°: (1,-3,2); then min (0,-3,0) moves to the origin.
+        assert_eq!(m.vertices[1], [1.0, 0.0, 2.0]);
+        assert_eq!(m.vertices[0], [0.0, 3.0, 0.0]);
+    }
+}

@@ -1,0 +1,186 @@
+//! Plan, stage 5b: a layer's region → its [`LayerPlan`], every move in print order
+//! (SPEC.md `contour_order`, `print_order`).
+
+use crate::contours::{Loop, contours};
+use crate::droplets::loop_droplets;
+use crate::hatch::{hatch, order_greedy};
+use crate::settings::{ContourOrder, PrintOrder, Settings};
+use crate::slice::{Point, Shapes, dist};
+use serde::{Deserialize, Serialize};
+
+/// What a move does (the machine command it becomes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MoveKind {
+    /// `G01`: travel, no material.
+    Travel,
+    /// `G26`: travel, then one droplet at the point.
+    Droplet,
+    /// `G25`: droplets every B on the line from the current position to the point.
+    Line,
+}
+
+/// What a droplet belongs to (for the preview's colours and the statistics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[repr(u8)]
+pub enum Role {
+    /// The outermost loop along a boundary (k = 0).
+    Outer = 0,
+    /// The other contour loops.
+    Inner = 1,
+    /// Hatch fill.
+    Fill = 2,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Move {
+    pub kind: MoveKind,
+    pub role: Role,
+    pub to: Point,
+}
+
+/// Droplet counts by role.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counts {
+    pub outer: u64,
+    pub inner: u64,
+    pub fill: u64,
+}
+
+impl Counts {
+    pub fn total(&self) -> u64 {
+        self.outer + self.inner + self.fill
+    }
+
+    pub fn add(&mut self, o: &Counts) {
+        self.outer += o.outer;
+        self.inner += o.inner;
+        self.fill += o.fill;
+    }
+}
+
+/// Every move of one layer, in print order.
+#[derive(Clone, Debug, Default)]
+pub struct LayerPlan {
+    /// Layer number from 0.
+    pub index: usize,
+    /// Z written in the code: the layer's top, (index + 1)·H.
+    pub z: f64,
+    pub moves: Vec<Move>,
+    pub counts: Counts,
+    /// Length of all moves without material (G01 and the travel part of G26), in mm.
+    pub travel_mm: f64,
+}
+
+/// Number of droplets a `G25` line of this length sets: one at its start, then one every B.
+pub fn line_droplets(length: f64, b: f64) -> u64 {
+    (length / b + 1e-9).floor() as u64 + 1
+}
+
+/// Hatch angle of a layer (from 0): α_s + index·α_v.
+pub fn hatch_angle(s: &Settings, index: usize) -> f64 {
+    (s.hatch_angle + index as f64 * s.hatch_angle_step).rem_euclid(360.0)
+}
+
+/// Plans one layer from its region.
+pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
+    let b = s.droplet_width();
+    let layer = contours(region, s);
+    let mut plan = LayerPlan {
+        index,
+        z: (index + 1) as f64 * s.layer_height,
+        ..LayerPlan::default()
+    };
+    let mut at: Point = [0.0, 0.0];
+    let add_contours = |plan: &mut LayerPlan, at: &mut Point| {
+        let mut loops: Vec<&Loop> = layer.loops.iter().collect();
+        loops.sort_by_key(|l| match s.contour_order {
+            ContourOrder::InsideOut => u32::MAX - l.k,
+            ContourOrder::OutsideIn => l.k,
+        });
+        let shift = index as f64 * s.start_jitter;
+        // Within one ring (same k), the loop whose start is nearest goes next.
+        for ring in loops.chunk_by(|a, b| a.k == b.k) {
+            let mut pending: Vec<(Vec<Point>, Role)> = ring
+                .iter()
+                .map(|l| {
+                    let role = if l.k == 0 { Role::Outer } else { Role::Inner };
+                    (loop_droplets(&l.points, b, shift, s.close_loops), role)
+                })
+                .filter(|(d, _)| !d.is_empty())
+                .collect();
+            while !pending.is_empty() {
+                let next = (0..pending.len())
+                    .min_by(|&i, &j| {
+                        dist(*at, pending[i].0[0]).total_cmp(&dist(*at, pending[j].0[0]))
+                    })
+                    .expect("non-empty");
+                let (drops, role) = pending.swap_remove(next);
+                for p in drops {
+                    plan.travel_mm += dist(*at, p);
+                    plan.moves.push(Move {
+                        kind: MoveKind::Droplet,
+                        role,
+                        to: p,
+                    });
+                    *at = p;
+                }
+            }
+        }
+    };
+    let add_fill = |plan: &mut LayerPlan, at: &mut Point| {
+        if s.fill_density <= 0.0 {
+            return;
+        }
+        let lines = hatch(
+            &layer.fill_region,
+            hatch_angle(s, index),
+            b / s.fill_density,
+        );
+        for l in order_greedy(lines, *at) {
+            plan.travel_mm += dist(*at, l.a);
+            plan.moves.push(Move {
+                kind: MoveKind::Travel,
+                role: Role::Fill,
+                to: l.a,
+            });
+            plan.moves.push(Move {
+                kind: MoveKind::Line,
+                role: Role::Fill,
+                to: l.b,
+            });
+            *at = l.b;
+        }
+    };
+    match s.print_order {
+        PrintOrder::ContoursFirst => {
+            add_contours(&mut plan, &mut at);
+            add_fill(&mut plan, &mut at);
+        }
+        PrintOrder::FillFirst => {
+            add_fill(&mut plan, &mut at);
+            add_contours(&mut plan, &mut at);
+        }
+    }
+    plan.counts = count(&plan.moves, b);
+    plan
+}
+
+/// Droplet counts of a move list.
+pub fn count(moves: &[Move], b: f64) -> Counts {
+    let mut c = Counts::default();
+    let mut at = [0.0, 0.0];
+    for m in moves {
+        let n = match m.kind {
+            MoveKind::Travel => 0,
+            MoveKind::Droplet => 1,
+            MoveKind::Line => line_droplets(dist(at, m.to), b),
+        };
+        match m.role {
+            Role::Outer => c.outer += n,
+            Role::Inner => c.inner += n,
+            Role::Fill => c.fill += n,
+        }
+        at = m.to;
+    }
+    c
+}

@@ -1,0 +1,54 @@
+//! Preview: a [`LayerPlan`] → flat arrays for the page's canvas (no object per point).
+
+use crate::plan::{LayerPlan, MoveKind, line_droplets};
+use crate::slice::dist;
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PreviewLayer {
+    /// x, y of every droplet (each droplet of a `G25` line too), in print order.
+    pub droplets: Vec<f32>,
+    /// Role of each droplet: 0 outermost loop, 1 inner loops, 2 fill.
+    pub roles: Vec<u8>,
+    /// x0, y0, x1, y1 of every move without material (G01, and G26's way to its droplet).
+    pub travel: Vec<f32>,
+}
+
+impl PreviewLayer {
+    pub fn from_plan(plan: &LayerPlan, b: f64) -> PreviewLayer {
+        let n = plan.counts.total() as usize;
+        let mut p = PreviewLayer {
+            droplets: Vec::with_capacity(2 * n),
+            roles: Vec::with_capacity(n),
+            travel: Vec::new(),
+        };
+        let mut at = [0.0f64, 0.0];
+        for m in &plan.moves {
+            match m.kind {
+                MoveKind::Travel | MoveKind::Droplet => {
+                    if dist(at, m.to) > 0.0 {
+                        p.travel
+                            .extend([at[0], at[1], m.to[0], m.to[1]].map(|v| v as f32));
+                    }
+                    if m.kind == MoveKind::Droplet {
+                        p.droplets.extend([m.to[0] as f32, m.to[1] as f32]);
+                        p.roles.push(m.role as u8);
+                    }
+                }
+                MoveKind::Line => {
+                    let l = dist(at, m.to);
+                    let k = line_droplets(l, b);
+                    for j in 0..k {
+                        let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
+                        p.droplets.extend(
+                            [at[0] + t * (m.to[0] - at[0]), at[1] + t * (m.to[1] - at[1])]
+                                .map(|v| v as f32),
+                        );
+                        p.roles.push(m.role as u8);
+                    }
+                }
+            }
+            at = m.to;
+        }
+        p
+    }
+}

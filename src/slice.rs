@@ -1,0 +1,411 @@
+//! Slice, stage 2 (SPEC.md 5.3.2): a [`Mesh`] and a plane height → the layer's [`Section`]:
+//! its material region as shapes (outer boundary counter-clockwise, holes clockwise).
+//!
+//! Rules:
+//! - A vertex exactly on the plane counts as *above* it (the plane is taken infinitesimally
+//!   below z). Every crossing facet then has exactly one below→above and one above→below edge,
+//!   faces lying in the plane contribute nothing, and no loop breaks on a vertex hit.
+//! - A segment runs from the point on the facet's above→below edge to the point on its
+//!   below→above edge, which leaves the material on its left for outward-wound facets: the
+//!   orientation comes from the facets' vertex order, never from stored normals.
+//! - The point on an edge is computed from the edge's lower to its upper vertex, so the two
+//!   facets sharing the edge produce bit-identical points.
+//! - Segments are chained through shared mesh edges (exact topology). Segments left over
+//!   (flipped facets, non-manifold or open meshes) are chained ignoring direction, and chains
+//!   that still do not close are joined end to start, nearest ends first (as CuraEngine and
+//!   Slic3r do); those repairs are counted in [`Section`].
+//! - Overlapping shells are merged with the non-zero fill rule (their union), as PrusaSlicer
+//!   and CuraEngine do.
+
+use crate::mesh::{Mesh, edge_key};
+use crate::settings::SlicePlane;
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::float::simplify::SimplifyShape;
+
+pub type Point = [f64; 2];
+/// A closed polygon (the last point connects to the first).
+pub type Contour = Vec<Point>;
+/// A shape: its outer boundary (counter-clockwise) followed by its holes (clockwise).
+pub type Shape = Vec<Contour>;
+/// A region of one layer: disjoint shapes.
+pub type Shapes = Vec<Shape>;
+
+/// Points closer than this to their predecessor on a loop are dropped (SPEC.md 5.3.2).
+pub const MIN_POINT_DISTANCE_MM: f64 = 0.001;
+
+/// Plane heights are rounded to this grid so they do not drift (0.1 + 42·0.2 = 8.5 exactly).
+const Z_GRID_MM: f64 = 1e-9;
+
+/// The plane height of every layer, measured from the part's lowest point (z = 0).
+pub fn layer_heights(part_height: f64, layer_height: f64, plane: SlicePlane) -> Vec<f64> {
+    let round = |z: f64| (z / Z_GRID_MM).round() * Z_GRID_MM;
+    let mut zs = Vec::new();
+    for i in 0.. {
+        let z = match plane {
+            // Planes at mid-layer below the top (the oracle's and the peers' rule).
+            SlicePlane::Middle => round((i as f64 + 0.5) * layer_height),
+            // The layer's top, clamped to the part's top for a last, thinner layer.
+            SlicePlane::Top => {
+                let bottom = round(i as f64 * layer_height);
+                if bottom >= part_height {
+                    break;
+                }
+                round(((i + 1) as f64 * layer_height).min(part_height))
+            }
+        };
+        if z >= part_height && plane == SlicePlane::Middle {
+            break;
+        }
+        zs.push(z);
+    }
+    zs
+}
+
+/// Facet ids per layer: the facets crossing each plane, found once for the whole part
+/// (compressed rows: layer i's facets are `facets[offsets[i]..offsets[i+1]]`).
+pub struct FacetBuckets {
+    offsets: Vec<u32>,
+    facets: Vec<u32>,
+}
+
+impl FacetBuckets {
+    pub fn new(mesh: &Mesh, zs: &[f64]) -> FacetBuckets {
+        let ranges: Vec<(u32, u32)> = mesh
+            .facets
+            .iter()
+            .map(|f| {
+                let z = f.map(|i| mesh.vertices[i as usize][2]);
+                let lo = z[0].min(z[1]).min(z[2]);
+                let hi = z[0].max(z[1]).max(z[2]);
+                // Crosses plane z iff lo < z <= hi.
+                let a = zs.partition_point(|&p| p <= lo) as u32;
+                let b = zs.partition_point(|&p| p <= hi) as u32;
+                (a, b.max(a))
+            })
+            .collect();
+        let mut counts = vec![0u32; zs.len() + 1];
+        for &(a, b) in &ranges {
+            for i in a..b {
+                counts[i as usize + 1] += 1;
+            }
+        }
+        for i in 1..counts.len() {
+            counts[i] += counts[i - 1];
+        }
+        let offsets = counts.clone();
+        let mut fill = counts;
+        let mut facets = vec![0u32; *offsets.last().unwrap_or(&0) as usize];
+        for (f, &(a, b)) in ranges.iter().enumerate() {
+            for i in a..b {
+                facets[fill[i as usize] as usize] = f as u32;
+                fill[i as usize] += 1;
+            }
+        }
+        FacetBuckets { offsets, facets }
+    }
+
+    pub fn layer(&self, i: usize) -> &[u32] {
+        &self.facets[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+}
+
+/// One layer's cross-section.
+#[derive(Clone, Debug, Default)]
+pub struct Section {
+    pub z: f64,
+    /// The material (union of all shells).
+    pub region: Shapes,
+    /// Loops closed by plain topology.
+    pub closed_loops: usize,
+    /// Loops that needed segments chained against their direction (flipped facets).
+    pub reoriented_loops: usize,
+    /// Open chains that were joined end to start to close the section.
+    pub open_chains: usize,
+    /// Total length of the gaps bridged to close open chains, in mm.
+    pub gap_length: f64,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Segment {
+    a: Point,
+    b: Point,
+    /// Edge the segment starts on (the facet's above→below edge).
+    start: u64,
+    /// Edge the segment ends on (the facet's below→above edge).
+    end: u64,
+}
+
+/// Cuts the mesh at height `z`, using only the given facets (those that may cross it).
+pub fn slice_layer(mesh: &Mesh, facets: &[u32], z: f64) -> Section {
+    let segments = segments(mesh, facets, z);
+    let mut section = Section {
+        z,
+        ..Section::default()
+    };
+    let loops = chain(&segments, &mut section);
+    let contours: Vec<Contour> = loops
+        .into_iter()
+        .map(clean_loop)
+        .filter(|c| c.len() >= 3)
+        .collect();
+    section.region = union(&contours);
+    section
+}
+
+/// The non-zero union of closed loops: shapes with outer boundaries CCW and holes CW.
+pub fn union(contours: &[Contour]) -> Shapes {
+    if contours.is_empty() {
+        return Shapes::new();
+    }
+    contours.simplify_shape(FillRule::NonZero)
+}
+
+fn segments(mesh: &Mesh, facets: &[u32], z: f64) -> Vec<Segment> {
+    let mut out = Vec::with_capacity(facets.len());
+    for &f in facets {
+        let ids = mesh.facets[f as usize];
+        let p = ids.map(|i| mesh.vertices[i as usize]);
+        let above = p.map(|v| v[2] >= z);
+        let (mut down, mut up) = (None, None);
+        for k in 0..3 {
+            let n = (k + 1) % 3;
+            if above[k] && !above[n] {
+                down = Some((k, n));
+            } else if !above[k] && above[n] {
+                up = Some((k, n));
+            }
+        }
+        let (Some(down), Some(up)) = (down, up) else {
+            continue;
+        };
+        let point = |(i, j): (usize, usize)| {
+            // From the lower (below) vertex to the upper one: identical in both facets.
+            let (lo, hi) = if above[i] { (p[j], p[i]) } else { (p[i], p[j]) };
+            let t = (z - lo[2]) / (hi[2] - lo[2]);
+            [lo[0] + t * (hi[0] - lo[0]), lo[1] + t * (hi[1] - lo[1])]
+        };
+        out.push(Segment {
+            a: point(down),
+            b: point(up),
+            start: edge_key(ids[down.0], ids[down.1]),
+            end: edge_key(ids[up.0], ids[up.1]),
+        });
+    }
+    out
+}
+
+/// Chains segments into closed loops (see the module docs for the three passes).
+fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
+    let mut used = vec![false; segs.len()];
+    let mut by_start: Vec<(u64, u32)> = segs
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.start, i as u32))
+        .collect();
+    by_start.sort_unstable();
+    let find_start = |key: u64, used: &[bool]| -> Option<usize> {
+        let from = by_start.partition_point(|e| e.0 < key);
+        by_start[from..]
+            .iter()
+            .take_while(|e| e.0 == key)
+            .map(|e| e.1 as usize)
+            .find(|&i| !used[i])
+    };
+
+    let mut loops = Vec::new();
+    let mut leftovers: Vec<usize> = Vec::new();
+    // Pass 1: directed chaining through shared edges.
+    for s0 in 0..segs.len() {
+        if used[s0] {
+            continue;
+        }
+        used[s0] = true;
+        let mut chain = vec![s0];
+        let mut cur = s0;
+        let closed = loop {
+            if segs[cur].end == segs[s0].start {
+                break true;
+            }
+            match find_start(segs[cur].end, &used) {
+                Some(n) => {
+                    used[n] = true;
+                    chain.push(n);
+                    cur = n;
+                }
+                None => break false,
+            }
+        };
+        if closed {
+            section.closed_loops += 1;
+            loops.push(chain.iter().map(|&i| segs[i].a).collect());
+        } else {
+            leftovers.extend(chain);
+        }
+    }
+    if leftovers.is_empty() {
+        return loops;
+    }
+
+    // Pass 2: chain the leftovers ignoring direction (flipped facets reverse a segment).
+    let mut by_key: Vec<(u64, u32)> = leftovers
+        .iter()
+        .flat_map(|&i| [(segs[i].start, i as u32), (segs[i].end, i as u32)])
+        .collect();
+    by_key.sort_unstable();
+    let mut free = vec![false; segs.len()];
+    for &i in &leftovers {
+        free[i] = true;
+    }
+    let neighbour = |key: u64, not: usize, free: &[bool]| -> Option<usize> {
+        let from = by_key.partition_point(|e| e.0 < key);
+        by_key[from..]
+            .iter()
+            .take_while(|e| e.0 == key)
+            .map(|e| e.1 as usize)
+            .find(|&i| i != not && free[i])
+    };
+    let mut open: Vec<Vec<Point>> = Vec::new();
+    for &s0 in &leftovers {
+        if !free[s0] {
+            continue;
+        }
+        free[s0] = false;
+        // Oriented steps: (segment, forward?)
+        let mut steps = vec![(s0, true)];
+        let mut tail = segs[s0].end;
+        let mut closed = false;
+        while let Some(n) = neighbour(tail, usize::MAX, &free) {
+            free[n] = false;
+            let fwd = segs[n].start == tail;
+            tail = if fwd { segs[n].end } else { segs[n].start };
+            steps.push((n, fwd));
+            if tail == segs[s0].start {
+                closed = true;
+                break;
+            }
+        }
+        if !closed {
+            // Grow the chain backwards from its head as well.
+            let mut head = segs[s0].start;
+            while let Some(n) = neighbour(head, usize::MAX, &free) {
+                free[n] = false;
+                let fwd = segs[n].end == head;
+                head = if fwd { segs[n].start } else { segs[n].end };
+                steps.insert(0, (n, fwd));
+            }
+        }
+        // Orientation: the majority (by length) of the facets decides.
+        let (mut with, mut against) = (0.0, 0.0);
+        for &(i, fwd) in &steps {
+            let l = dist(segs[i].a, segs[i].b);
+            if fwd { with += l } else { against += l }
+        }
+        let mut pts: Vec<Point> = steps
+            .iter()
+            .map(|&(i, fwd)| if fwd { segs[i].a } else { segs[i].b })
+            .collect();
+        let last = steps.last().expect("non-empty");
+        pts.push(if last.1 {
+            segs[last.0].b
+        } else {
+            segs[last.0].a
+        });
+        if against > with {
+            pts.reverse();
+        }
+        if closed {
+            pts.pop();
+            section.reoriented_loops += 1;
+            loops.push(pts);
+        } else {
+            open.push(pts);
+        }
+    }
+
+    // Pass 3: join open chains end to start, nearest ends first.
+    section.open_chains += open.len();
+    while !open.is_empty() {
+        let (mut bi, mut bj, mut bd) = (0, 0, f64::INFINITY);
+        for (i, a) in open.iter().enumerate() {
+            let end = *a.last().expect("non-empty");
+            for (j, b) in open.iter().enumerate() {
+                let d = dist(end, b[0]);
+                if d < bd {
+                    (bi, bj, bd) = (i, j, d);
+                }
+            }
+        }
+        section.gap_length += bd;
+        if bi == bj {
+            let mut c = open.swap_remove(bi);
+            if c.len() > 1 && dist(c[0], *c.last().unwrap()) == 0.0 {
+                c.pop();
+            }
+            loops.push(c);
+        } else {
+            let b = std::mem::take(&mut open[bj]);
+            open[bi].extend(b);
+            open.swap_remove(bj);
+        }
+    }
+    loops
+}
+
+/// Drops points closer than [`MIN_POINT_DISTANCE_MM`] to the previous kept point.
+fn clean_loop(points: Vec<Point>) -> Contour {
+    let mut out: Contour = Vec::with_capacity(points.len());
+    for p in points {
+        if out
+            .last()
+            .is_none_or(|&q| dist(p, q) >= MIN_POINT_DISTANCE_MM)
+        {
+            out.push(p);
+        }
+    }
+    while out.len() > 1 && dist(out[0], *out.last().unwrap()) < MIN_POINT_DISTANCE_MM {
+        out.pop();
+    }
+    out
+}
+
+pub fn dist(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// Signed area of a closed contour (positive = counter-clockwise).
+pub fn signed_area(c: &[Point]) -> f64 {
+    let n = c.len();
+    (0..n)
+        .map(|i| {
+            let (p, q) = (c[i], c[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// Area of a region (outer boundaries minus holes).
+pub fn region_area(shapes: &Shapes) -> f64 {
+    shapes
+        .iter()
+        .flat_map(|s| s.iter())
+        .map(|c| signed_area(c))
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn heights_do_not_drift() {
+        let zs = layer_heights(20.0, 0.2, SlicePlane::Middle);
+        assert_eq!(zs.len(), 100);
+        assert_eq!(zs[42], 8.5);
+        let zs = layer_heights(28.31, 0.2, SlicePlane::Middle);
+        assert_eq!(zs.len(), 142);
+        let zs = layer_heights(20.0, 0.2, SlicePlane::Top);
+        assert_eq!(zs.len(), 100);
+        assert_eq!(*zs.last().unwrap(), 20.0);
+    }
+}
