@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Everything CI runs (npm test, .ci/run): setup, format and lint checks, the native core tests,
+# the wasm facade tests in Node, the page build and the browser end-to-end tests.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+step() { echo; echo "=== $* ($(date +%T))" >&2; }
+
+step setup
+bash scripts/setup.sh
+
+step "cargo fmt --check"
+cargo fmt --check
+
+step "cargo clippy"
+cargo clippy --all-targets -- -D warnings
+cargo clippy --target wasm32-unknown-unknown --lib --test wasm_session -- -D warnings
+
+step "cargo test --release (native)"
+cargo test --release
+
+step "wasm facade tests (Node, wasm-bindgen-test-runner)"
+CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner \
+  cargo test --release --target wasm32-unknown-unknown --test wasm_session
+
+step "build the page"
+bash scripts/build.sh
+
+step "CLI for the comparison"
+cargo build --release --bin dropslice
+
+step "browser end-to-end tests (Chromium)"
+node --test --test-concurrency=1 tests/e2e/
+echo; echo "all tests passed" >&2

@@ -1,0 +1,152 @@
+//! The wasm facade (src/wasm.rs) in Node: `wasm-bindgen-test-runner` runs these when
+//! `cargo test --target wasm32-unknown-unknown --test wasm_session` is given it as the runner.
+#![cfg(target_arch = "wasm32")]
+
+use dropslice::wasm::{Session, default_settings_json, settings_schema, version};
+use wasm_bindgen_test::wasm_bindgen_test;
+
+/// A closed axis-aligned box as an ASCII STL.
+fn box_stl(w: f64, d: f64, h: f64) -> String {
+    let v = |x: f64, y: f64, z: f64| format!("vertex {x} {y} {z}\n");
+    let quads = [
+        // bottom (normal -z), top (+z), then the four sides, counter-clockwise from outside
+        [(0.0, 0.0, 0.0), (0.0, d, 0.0), (w, d, 0.0), (w, 0.0, 0.0)],
+        [(0.0, 0.0, h), (w, 0.0, h), (w, d, h), (0.0, d, h)],
+        [(0.0, 0.0, 0.0), (w, 0.0, 0.0), (w, 0.0, h), (0.0, 0.0, h)],
+        [(w, 0.0, 0.0), (w, d, 0.0), (w, d, h), (w, 0.0, h)],
+        [(w, d, 0.0), (0.0, d, 0.0), (0.0, d, h), (w, d, h)],
+        [(0.0, d, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, h), (0.0, d, h)],
+    ];
+    let mut s = String::from("solid box\n");
+    for q in quads {
+        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            s.push_str("facet normal 0 0 0\nouter loop\n");
+            for p in t {
+                s.push_str(&v(p.0, p.1, p.2));
+            }
+            s.push_str("endloop\nendfacet\n");
+        }
+    }
+    s.push_str("endsolid box\n");
+    s
+}
+
+fn message(e: wasm_bindgen::JsError) -> String {
+    let v: wasm_bindgen::JsValue = e.into();
+    js_sys::Error::from(v).message().into()
+}
+
+#[wasm_bindgen_test]
+fn schema_defaults_and_version() {
+    let schema: serde_json::Value = serde_json::from_str(&settings_schema()).unwrap();
+    let names: Vec<&str> = schema
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert!(names.contains(&"layer_height") && names.contains(&"droplet_aspect"));
+    let defaults: serde_json::Value = serde_json::from_str(&default_settings_json()).unwrap();
+    assert_eq!(defaults["layer_height"], 0.2);
+    assert_eq!(defaults["contours"], 2);
+    assert_eq!(version(), dropslice::VERSION);
+}
+
+#[wasm_bindgen_test]
+fn slices_a_box() {
+    let stl = box_stl(10.0, 6.0, 2.0);
+    let s = Session::new(stl.as_bytes(), "box.stl", "{}").unwrap();
+    assert_eq!(s.layer_count(), 10);
+    let info: serde_json::Value = serde_json::from_str(&s.info_json()).unwrap();
+    assert_eq!(info["layers"], 10);
+    let mut totals = [0.0f64; 3];
+    let mut text = String::new();
+    for i in 0..s.layer_count() {
+        let l = s.slice_layer(i).unwrap();
+        assert_eq!(l.index(), i);
+        assert!((l.z() - 0.2 * (i + 1) as f64).abs() < 1e-9);
+        let n = (l.outer() + l.inner() + l.fill()) as u32;
+        assert!(n > 100, "layer {i}: only {n} droplets");
+        assert_eq!(l.droplets().length(), 2 * n);
+        assert_eq!(l.roles().length(), n);
+        assert_eq!(l.travel().length() % 4, 0);
+        // every droplet inside the box
+        let d = l.droplets().to_vec();
+        assert!(
+            d.chunks(2)
+                .all(|p| (0.0..=10.0).contains(&p[0]) && (0.0..=6.0).contains(&p[1]))
+        );
+        // roles: 0 outer, 1 inner, 2 fill, in the counted numbers
+        let roles = l.roles().to_vec();
+        for (k, t) in totals.iter_mut().enumerate() {
+            *t += roles.iter().filter(|&&r| r as usize == k).count() as f64;
+        }
+        text.push_str(&l.gcode());
+    }
+    assert!(text.contains("G26 ") && text.contains("G25 ") && text.contains("G01 "));
+    let summary = format!(
+        r#"{{"layers":10,"counts":{{"outer":{},"inner":{},"fill":{}}},"travel_mm":0}}"#,
+        totals[0], totals[1], totals[2]
+    );
+    let header = s.header(&summary).unwrap();
+    assert!(header.contains("; layer_height = 0.2"), "{header}");
+    assert!(header.contains("box.stl"));
+    let placeholder = s.header("").unwrap();
+    assert_eq!(placeholder.len(), header.len());
+    let footer = s.footer(&summary).unwrap();
+    assert!(footer.contains("10 layers"), "{footer}");
+    assert!(s.slice_layer(10).is_err());
+}
+
+#[wasm_bindgen_test]
+fn settings_change_the_slice() {
+    let stl = box_stl(10.0, 6.0, 2.0);
+    let s = Session::new(
+        stl.as_bytes(),
+        "box.stl",
+        r#"{"layer_height":0.25,"contours":3}"#,
+    )
+    .unwrap();
+    assert_eq!(s.layer_count(), 8);
+    let l = s.slice_layer(0).unwrap();
+    assert!((l.z() - 0.25).abs() < 1e-9);
+}
+
+#[wasm_bindgen_test]
+fn errors_name_their_kind() {
+    let garbage = b"this is not an STL file at all, just some words";
+    let e = message(Session::new(garbage, "x.stl", "{}").err().unwrap());
+    assert!(e.starts_with("import: "), "{e}");
+
+    let stl = box_stl(10.0, 6.0, 2.0);
+    let e = message(
+        Session::new(stl.as_bytes(), "box.stl", r#"{"layer_height":-1}"#)
+            .err()
+            .unwrap(),
+    );
+    assert!(
+        e.starts_with("setting: ") && e.contains("layer_height"),
+        "{e}"
+    );
+    let e = message(
+        Session::new(stl.as_bytes(), "box.stl", r#"{"no_such_setting":1}"#)
+            .err()
+            .unwrap(),
+    );
+    assert!(e.starts_with("setting: "), "{e}");
+    let e = message(
+        Session::new(stl.as_bytes(), "box.stl", "not json")
+            .err()
+            .unwrap(),
+    );
+    assert!(e.starts_with("setting: "), "{e}");
+
+    let e = message(Session::new(&[], "empty.stl", "{}").err().unwrap());
+    assert!(e.starts_with("import: "), "{e}");
+    // a truncated binary STL
+    let mut bin = vec![0u8; 84];
+    bin[80] = 5;
+    bin.extend_from_slice(&[0u8; 60]);
+    let e = message(Session::new(&bin, "cut.stl", "{}").err().unwrap());
+    assert!(e.starts_with("import: "), "{e}");
+}

@@ -1,0 +1,204 @@
+// The worker pool: min(hardwareConcurrency - 1, 4) workers (at least 1), each with its own
+// wasm instance. A slice opens the model in every worker and hands each one a contiguous range
+// of layers; layers come back as progress replies (buffers transferred) and are stored by index,
+// so the page sees them in layer order however the workers finish. Cancel terminates every
+// worker at once, rejects what was pending and starts fresh workers.
+
+import type { GcodeParseResult, InitResult, LayerData, OpenResult, Reply, Request, RequestKind } from "./protocol";
+
+export class SliceError extends Error {
+  constructor(
+    readonly kind: string,
+    message: string,
+  ) {
+    super(message);
+  }
+}
+
+export class Cancelled extends Error {
+  constructor() {
+    super("cancelled");
+  }
+}
+
+interface Pending {
+  resolve: (v: unknown) => void;
+  reject: (e: Error) => void;
+  progress?: (layer: LayerData) => void;
+}
+
+class WorkerHandle {
+  private worker: Worker;
+  private pending = new Map<number, Pending>();
+  private nextId = 1;
+  /** A crashed wasm instance cannot be trusted again. */
+  broken = false;
+  /** Whether the worker holds the current model. */
+  hasModel = false;
+
+  constructor() {
+    this.worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module", name: "dropslice" });
+    this.worker.onmessage = (ev: MessageEvent<Reply>) => this.receive(ev.data);
+    this.worker.onerror = (ev: ErrorEvent) => {
+      ev.preventDefault();
+      this.broken = true;
+      this.failAll(new SliceError("crash", `the slicer worker failed: ${ev.message || "could not start"}`));
+    };
+  }
+
+  get load(): number {
+    return this.pending.size;
+  }
+
+  call<T>(kind: RequestKind, data: unknown, progress?: (layer: LayerData) => void, transfer: Transferable[] = []): Promise<T> {
+    const id = this.nextId++;
+    return new Promise<T>((resolve, reject) => {
+      this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, progress });
+      this.worker.postMessage({ id, kind, data } as Request, transfer);
+    });
+  }
+
+  private receive(reply: Reply): void {
+    const p = this.pending.get(reply.id);
+    if (!p) return;
+    if (reply.kind === "progress") {
+      p.progress?.(reply.data);
+      return;
+    }
+    this.pending.delete(reply.id);
+    if (reply.kind === "result") p.resolve(reply.data);
+    else {
+      if (reply.data.kind === "crash") this.broken = true;
+      p.reject(new SliceError(reply.data.kind, reply.data.message));
+    }
+  }
+
+  private failAll(e: Error): void {
+    const all = [...this.pending.values()];
+    this.pending.clear();
+    for (const p of all) p.reject(e);
+  }
+
+  terminate(reason: Error): void {
+    this.worker.terminate();
+    this.failAll(reason);
+  }
+}
+
+export function defaultPoolSize(): number {
+  const n = (navigator.hardwareConcurrency || 2) - 1;
+  return Math.max(1, Math.min(n, 4));
+}
+
+export interface SliceCallbacks {
+  opened(result: OpenResult): void;
+  layer(layer: LayerData): void;
+}
+
+export class Pool {
+  private handles: WorkerHandle[] = [];
+
+  constructor(readonly size = defaultPoolSize()) {
+    this.respawn();
+  }
+
+  private respawn(): void {
+    this.handles = Array.from({ length: this.size }, () => new WorkerHandle());
+  }
+
+  /** Replaces crashed workers; returns true if any was replaced (their models are gone). */
+  private heal(): boolean {
+    let healed = false;
+    this.handles = this.handles.map((h) => {
+      if (!h.broken) return h;
+      healed = true;
+      h.terminate(new SliceError("crash", "worker replaced"));
+      return new WorkerHandle();
+    });
+    return healed;
+  }
+
+  /** Stops everything at once and starts fresh workers. */
+  cancel(): void {
+    const old = this.handles;
+    this.respawn();
+    for (const h of old) h.terminate(new Cancelled());
+  }
+
+  private async guarded<T>(run: () => Promise<T>): Promise<T> {
+    try {
+      return await run();
+    } catch (e) {
+      if (e instanceof SliceError && e.kind === "crash") {
+        // A crashed instance may be half-way through anything: start over with fresh workers.
+        this.cancel();
+      }
+      throw e;
+    }
+  }
+
+  init(): Promise<InitResult> {
+    this.heal();
+    return this.guarded(() => this.handles[0].call<InitResult>("init", null));
+  }
+
+  /** Slices a model: opens it in every worker and streams all layers through `cb.layer`. */
+  slice(stl: Uint8Array, name: string, settings: string, cb: SliceCallbacks): Promise<OpenResult> {
+    this.heal();
+    return this.guarded(async () => {
+      const buffer = stl.slice().buffer;
+      // The first worker validates the model and settings; on failure every worker keeps its
+      // previous model, so the previous slice can still be browsed.
+      const first = await this.handles[0].call<OpenResult>("open", { stl: buffer, name, settings });
+      for (const h of this.handles) h.hasModel = false;
+      this.handles[0].hasModel = true;
+      cb.opened(first);
+      const n = first.layers;
+      const used = this.handles.slice(0, Math.max(1, Math.min(this.handles.length, n)));
+      await Promise.all(
+        used.slice(1).map(async (h) => {
+          await h.call<OpenResult>("open", { stl: buffer, name, settings });
+          h.hasModel = true;
+        }),
+      );
+      const per = Math.ceil(n / used.length);
+      await Promise.all(
+        used.map((h, k) => {
+          const from = Math.min(n, k * per);
+          const to = Math.min(n, from + per);
+          return from < to ? h.call<null>("slice", { from, to }, cb.layer) : Promise.resolve(null);
+        }),
+      );
+      return first;
+    });
+  }
+
+  private pick(): WorkerHandle {
+    const ready = this.handles.filter((h) => h.hasModel && !h.broken);
+    if (ready.length === 0) throw new SliceError("internal", "no worker holds the model any more; slice again");
+    return ready.reduce((a, b) => (b.load < a.load ? b : a));
+  }
+
+  /** Re-plans one layer of the current model (for layers evicted from the page's cache). */
+  preview(index: number): Promise<LayerData> {
+    return this.guarded(() => this.pick().call<LayerData>("preview", { index }));
+  }
+
+  header(summary: string): Promise<string> {
+    return this.guarded(() => this.pick().call<string>("header", { summary }));
+  }
+
+  footer(summary: string): Promise<string> {
+    return this.guarded(() => this.pick().call<string>("footer", { summary }));
+  }
+
+  parseGcode(file: Blob, layer: (l: LayerData) => void): Promise<GcodeParseResult> {
+    this.heal();
+    return this.guarded(() => this.handles[0].call<GcodeParseResult>("parse_gcode", { file }, layer));
+  }
+
+  /** For tests: makes the wasm panic in one worker. */
+  crash(): Promise<void> {
+    return this.guarded(() => this.handles[this.handles.length - 1].call<void>("crash", null));
+  }
+}

@@ -1,0 +1,188 @@
+// The settings form, generated from the core's schema (settings_schema()). The page's relaxed
+// text input ("0,2", " 3 ") is translated into the strict values the core expects in one place
+// (parse), and invalid values are flagged before anything is sliced.
+
+import type { SettingSpec } from "./protocol";
+
+export type Value = number | boolean | string;
+
+const OPEN_GROUPS = new Set(["Droplet", "Contours", "Fill"]);
+
+function fmt(v: Value): string {
+  return typeof v === "number" ? String(+v.toPrecision(12)) : String(v);
+}
+
+export function parse(spec: SettingSpec, raw: string | boolean): { value?: Value; error?: string } {
+  if (spec.kind === "bool") return { value: Boolean(raw) };
+  if (spec.kind === "enum") {
+    return spec.choices.includes(String(raw)) ? { value: String(raw) } : { error: `choose one of ${spec.choices.join(", ")}` };
+  }
+  const text = String(raw).trim().replace(",", ".");
+  if (text === "") return { error: "a value is needed" };
+  const x = Number(text);
+  if (!Number.isFinite(x)) return { error: `"${String(raw).trim()}" is not a number` };
+  if (spec.kind === "integer" && !Number.isInteger(x)) return { error: "must be a whole number" };
+  const unit = spec.unit ? ` ${spec.unit}` : "";
+  if (spec.min !== null && (spec.min_exclusive ? x <= spec.min : x < spec.min)) {
+    return { error: spec.min_exclusive ? `must be greater than ${spec.min}${unit}` : `must be at least ${spec.min}${unit}` };
+  }
+  if (spec.max !== null && x > spec.max) return { error: `must be at most ${spec.max}${unit}` };
+  return { value: x };
+}
+
+interface Field {
+  spec: SettingSpec;
+  input: HTMLInputElement | HTMLSelectElement;
+  row: HTMLElement;
+  message: HTMLElement;
+  error?: string;
+  value: Value;
+}
+
+export class SettingsForm {
+  private fields = new Map<string, Field>();
+
+  constructor(
+    container: HTMLElement,
+    readonly schema: SettingSpec[],
+    private onChange: () => void,
+  ) {
+    container.replaceChildren();
+    const groups = new Map<string, HTMLElement>();
+    for (const spec of schema) {
+      let body = groups.get(spec.group);
+      if (!body) {
+        const details = document.createElement("details");
+        details.className = "group";
+        details.open = OPEN_GROUPS.has(spec.group);
+        const summary = document.createElement("summary");
+        summary.textContent = spec.group;
+        details.append(summary);
+        body = document.createElement("div");
+        body.className = "group-body";
+        details.append(body);
+        container.append(details);
+        groups.set(spec.group, body);
+      }
+      body.append(this.build(spec));
+    }
+  }
+
+  private build(spec: SettingSpec): HTMLElement {
+    const row = document.createElement("div");
+    row.className = "field";
+    row.title = spec.description;
+    const id = `set-${spec.name}`;
+    const label = document.createElement("label");
+    label.htmlFor = id;
+    label.textContent = spec.name.replace(/_/g, " ");
+    let input: HTMLInputElement | HTMLSelectElement;
+    if (spec.kind === "enum") {
+      const sel = document.createElement("select");
+      for (const c of spec.choices) sel.add(new Option(c.replace(/_/g, " "), c));
+      input = sel;
+    } else {
+      const inp = document.createElement("input");
+      if (spec.kind === "bool") inp.type = "checkbox";
+      else {
+        inp.type = "text";
+        inp.inputMode = spec.kind === "integer" ? "numeric" : "decimal";
+        inp.autocomplete = "off";
+        inp.spellcheck = false;
+      }
+      input = inp;
+    }
+    input.id = id;
+    input.name = spec.name;
+    const unit = document.createElement("span");
+    unit.className = "unit";
+    unit.textContent = spec.unit;
+    const control = document.createElement("div");
+    control.className = "control";
+    control.append(input, unit);
+    const message = document.createElement("div");
+    message.className = "message";
+    const help = document.createElement("div");
+    help.className = "help";
+    const range = spec.min !== null && spec.max !== null ? ` (${spec.min_exclusive ? ">" : ""}${spec.min} … ${spec.max})` : "";
+    help.textContent = spec.description + range;
+    row.append(label, control, message, help);
+    const field: Field = { spec, input, row, message, value: spec.default };
+    this.fields.set(spec.name, field);
+    this.write(field, spec.default);
+    const update = () => {
+      this.read(field);
+      this.onChange();
+    };
+    input.addEventListener("input", update);
+    input.addEventListener("change", update);
+    return row;
+  }
+
+  private write(f: Field, v: Value): void {
+    if (f.input instanceof HTMLInputElement && f.input.type === "checkbox") f.input.checked = Boolean(v);
+    else f.input.value = fmt(v);
+    this.read(f);
+  }
+
+  private read(f: Field): void {
+    const raw = f.input instanceof HTMLInputElement && f.input.type === "checkbox" ? f.input.checked : f.input.value;
+    const r = parse(f.spec, raw);
+    f.error = r.error;
+    if (r.value !== undefined) f.value = r.value;
+    f.row.classList.toggle("invalid", Boolean(r.error));
+    f.row.classList.toggle("changed", !r.error && f.value !== f.spec.default);
+    f.input.setAttribute("aria-invalid", r.error ? "true" : "false");
+    f.message.textContent = r.error ?? "";
+  }
+
+  /** Names and messages of invalid fields. */
+  errors(): { name: string; message: string }[] {
+    return [...this.fields.values()].filter((f) => f.error).map((f) => ({ name: f.spec.name, message: f.error! }));
+  }
+
+  values(): Record<string, Value> {
+    const out: Record<string, Value> = {};
+    for (const [name, f] of this.fields) out[name] = f.value;
+    return out;
+  }
+
+  /** Only the settings that differ from the defaults (for links). */
+  changed(): Record<string, Value> {
+    const out: Record<string, Value> = {};
+    for (const [name, f] of this.fields) if (f.value !== f.spec.default) out[name] = f.value;
+    return out;
+  }
+
+  json(): string {
+    return JSON.stringify(this.values());
+  }
+
+  /** Applies values (unknown names are ignored and returned). */
+  set(values: Record<string, Value>): string[] {
+    const unknown: string[] = [];
+    for (const [name, v] of Object.entries(values)) {
+      const f = this.fields.get(name);
+      if (f) this.write(f, v);
+      else unknown.push(name);
+    }
+    return unknown;
+  }
+
+  reset(): void {
+    for (const f of this.fields.values()) this.write(f, f.spec.default);
+    this.onChange();
+  }
+
+  get(name: string): Value | undefined {
+    return this.fields.get(name)?.value;
+  }
+
+  focusFirstError(): void {
+    const f = [...this.fields.values()].find((x) => x.error);
+    if (f) {
+      (f.row.closest("details") as HTMLDetailsElement | null)?.setAttribute("open", "");
+      f.input.focus();
+    }
+  }
+}

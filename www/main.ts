@@ -1,0 +1,803 @@
+// Page wiring only: events -> worker pool -> layer store -> renderer and statistics.
+
+import { Cancelled, Pool, SliceError } from "./client";
+import { SettingsForm, type Value } from "./form";
+import type { Counts, GcodeParseResult, InitResult, JobInfo, LayerData } from "./protocol";
+import { Renderer, type Bounds, type View } from "./render";
+import { sampleStl } from "./sample";
+import { makeLink, readLink, sha256Hex, type SharedLink } from "./share";
+
+const $ = <T extends HTMLElement = HTMLElement>(id: string) => document.getElementById(id) as T;
+
+/** Layer previews kept in the page; beyond this, layers far from the one shown are dropped
+ *  and re-planned by a worker when they are shown again. */
+const CACHE_BUDGET_BYTES = 384 * 2 ** 20;
+
+interface Model {
+  bytes: Uint8Array;
+  name: string;
+  sha256: string;
+}
+
+/** Everything known about one slice (or one opened .gco file). */
+class Slice {
+  layers = 0;
+  info: JobInfo = {};
+  z: number[] = [];
+  counts: (Counts | undefined)[] = [];
+  travelMm: number[] = [];
+  gcode: (Blob | undefined)[] = [];
+  cache = new Map<number, LayerData>();
+  cacheBytes = 0;
+  done = 0;
+  complete = false;
+  bbox: Bounds = { minX: Infinity, minY: Infinity, maxX: -Infinity, maxY: -Infinity };
+  totals: Counts = { outer: 0, inner: 0, fill: 0 };
+  travelTotal = 0;
+
+  constructor(
+    readonly source: "stl" | "gco",
+    readonly name: string,
+    public dropletWidth: number,
+    public layerHeight: number,
+    readonly settings: Record<string, Value>,
+    readonly model: Model | null,
+  ) {}
+
+  open(layers: number, info: JobInfo): void {
+    this.layers = layers;
+    this.info = info;
+  }
+
+  put(l: LayerData, current: number): void {
+    if (this.counts[l.index] === undefined) {
+      this.done++;
+      this.counts[l.index] = l.counts;
+      this.z[l.index] = l.z;
+      this.travelMm[l.index] = l.travelMm;
+      this.totals.outer += l.counts.outer;
+      this.totals.inner += l.counts.inner;
+      this.totals.fill += l.counts.fill;
+      this.travelTotal += l.travelMm;
+      const d = l.droplets;
+      const b = this.bbox;
+      for (let i = 0; i < d.length; i += 2) {
+        const x = d[i];
+        const y = d[i + 1];
+        if (x < b.minX) b.minX = x;
+        if (x > b.maxX) b.maxX = x;
+        if (y < b.minY) b.minY = y;
+        if (y > b.maxY) b.maxY = y;
+      }
+    }
+    if (l.gcode) this.gcode[l.index] = l.gcode;
+    const { gcode: _, ...preview } = l;
+    if (!this.cache.has(l.index)) {
+      this.cache.set(l.index, preview);
+      this.cacheBytes += l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength;
+    }
+    if (this.source === "stl") this.evict(current);
+  }
+
+  private evict(current: number): void {
+    if (this.cacheBytes <= CACHE_BUDGET_BYTES) return;
+    const far = [...this.cache.keys()].sort((a, b) => Math.abs(b - current) - Math.abs(a - current));
+    for (const i of far) {
+      if (this.cacheBytes <= CACHE_BUDGET_BYTES * 0.8 || Math.abs(i - current) <= 1) break;
+      const l = this.cache.get(i)!;
+      this.cacheBytes -= l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength;
+      this.cache.delete(i);
+    }
+  }
+
+  get droplets(): number {
+    return this.totals.outer + this.totals.inner + this.totals.fill;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// state
+
+const pool = new Pool();
+const renderer = new Renderer($<HTMLCanvasElement>("view"));
+let form: SettingsForm;
+let init: InitResult;
+let model: Model | null = null;
+let slice: Slice | null = null;
+let current = 0;
+let generation = 0;
+let busy = false;
+let viewTouched = false;
+let pendingLink: SharedLink | null = null;
+let slicedSettings = "";
+const previewRequests = new Set<number>();
+
+const slider = $<HTMLInputElement>("layer");
+
+function setState(state: "loading" | "idle" | "slicing" | "done" | "error" | "cancelled"): void {
+  document.body.dataset.state = state;
+}
+
+// ---------------------------------------------------------------------------------------------
+// messages
+
+const TITLES: Record<string, string> = {
+  import: "Cannot read this file.",
+  setting: "Bad setting.",
+  nothing_to_print: "Nothing to print.",
+  crash: "The slicer crashed.",
+  internal: "Internal error.",
+  link: "Cannot open this preview link.",
+};
+
+function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error"): void {
+  const b = $("banner");
+  b.className = `banner ${tone === "error" ? "" : tone}`;
+  $("banner-title").textContent = title;
+  $("banner-message").textContent = message;
+  b.hidden = false;
+  b.dataset.kind = tone;
+}
+
+function hideBanner(): void {
+  $("banner").hidden = true;
+}
+
+function showError(e: unknown): void {
+  if (e instanceof SliceError) {
+    showBanner(TITLES[e.kind] ?? "Error.", capitalize(e.message));
+  } else if (e instanceof Error) {
+    showBanner("Something went wrong.", e.message);
+  } else {
+    showBanner("Something went wrong.", String(e));
+  }
+  setState("error");
+}
+
+function capitalize(s: string): string {
+  return s.charAt(0).toUpperCase() + s.slice(1);
+}
+
+function note(text: string, tone: "warn" | "ok" | "none"): void {
+  const n = $("link-note");
+  n.hidden = tone === "none";
+  n.textContent = text;
+  n.className = tone === "ok" ? "banner ok" : "note";
+}
+
+// ---------------------------------------------------------------------------------------------
+// progress
+
+function progress(fraction: number | null, label = "Slicing…"): void {
+  const p = $("progress");
+  if (fraction === null) {
+    p.hidden = true;
+    return;
+  }
+  p.hidden = false;
+  const pct = Math.floor(fraction * 100);
+  $("progress-label").textContent = label;
+  $("progress-pct").textContent = `${pct} %`;
+  $("progress-fill").style.width = `${pct}%`;
+  p.dataset.percent = String(pct);
+}
+
+// ---------------------------------------------------------------------------------------------
+// statistics
+
+const nf = new Intl.NumberFormat("en-US");
+const fmtMm = (x: number) => `${x.toFixed(1)}`;
+
+function duration(seconds: number): string {
+  if (!Number.isFinite(seconds)) return "–";
+  const h = Math.floor(seconds / 3600);
+  const m = Math.floor((seconds % 3600) / 60);
+  const s = Math.round(seconds % 60);
+  if (h > 0) return `${h} h ${m} min`;
+  if (m > 0) return `${m} min ${s} s`;
+  return `${s} s`;
+}
+
+function num(name: string, fallback: number): number {
+  const v = slice?.settings[name] ?? form?.get(name);
+  return typeof v === "number" ? v : fallback;
+}
+
+let statsFrame = 0;
+function updateStats(): void {
+  if (statsFrame) return;
+  statsFrame = requestAnimationFrame(() => {
+    statsFrame = 0;
+    writeStats();
+  });
+}
+
+function roleLabels(source: "stl" | "gco"): void {
+  const gco = source === "gco";
+  $("legend-0").textContent = $("stat-label-0").textContent = gco ? "Loop droplets (G26)" : "Outer loop";
+  $("legend-2").textContent = $("stat-label-2").textContent = gco ? "Fill lines (G25)" : "Fill";
+  $("legend-1-wrap").hidden = gco;
+}
+
+function writeStats(): void {
+  const s = slice;
+  roleLabels(s?.source ?? "stl");
+  const set = (id: string, text: string) => ($(id).textContent = text);
+  if (!s) {
+    for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) set(id, "–");
+    $("warnings").hidden = true;
+    return;
+  }
+  set("stat-model", s.name);
+  const b = s.info.bounds;
+  if (b) set("stat-size", `${fmtMm(b.max[0] - b.min[0])} × ${fmtMm(b.max[1] - b.min[1])} × ${fmtMm(b.max[2] - b.min[2])} mm`);
+  else if (Number.isFinite(s.bbox.minX)) set("stat-size", `${fmtMm(s.bbox.maxX - s.bbox.minX)} × ${fmtMm(s.bbox.maxY - s.bbox.minY)} mm (droplets)`);
+  else set("stat-size", "–");
+  const facets = s.info.mesh?.facets_in_file;
+  set("stat-facets", facets !== undefined ? nf.format(facets) : s.source === "gco" ? "(G-code file)" : "–");
+  set("stat-layers", s.complete || s.done === s.layers ? nf.format(s.layers) : `${nf.format(s.done)} of ${nf.format(s.layers)}`);
+  set("stat-droplet", `${s.dropletWidth.toFixed(3)} × ${s.layerHeight.toFixed(3)} mm`);
+  set("stat-outer", nf.format(s.totals.outer));
+  set("stat-inner", nf.format(s.totals.inner));
+  set("stat-fill", nf.format(s.totals.fill));
+  set("stat-droplets", nf.format(s.droplets));
+  const volume = s.droplets * s.dropletWidth * s.dropletWidth * s.layerHeight; // mm³
+  set("stat-volume", `${(volume / 1000).toFixed(2)} cm³`);
+  set("stat-mass", `${((volume / 1000) * num("material_density", 1.04)).toFixed(2)} g`);
+  const seconds = s.droplets / num("droplet_rate", 100) + s.travelTotal / num("travel_speed", 50);
+  set("stat-time", (s.complete ? "" : "≥ ") + duration(seconds));
+  set("stat-travel", `${(s.travelTotal / 1000).toFixed(2)} m`);
+  const c = s.counts[current];
+  set("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
+  set("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
+  const warnings = (s.info.warnings ?? []) as string[];
+  $("warnings").hidden = warnings.length === 0;
+  $("warning-list").replaceChildren(
+    ...warnings.map((w) => {
+      const li = document.createElement("li");
+      li.textContent = w;
+      return li;
+    }),
+  );
+}
+
+// ---------------------------------------------------------------------------------------------
+// layers
+
+function layerLabel(): void {
+  const s = slice;
+  const out = $("layer-label");
+  if (!s || s.layers === 0) {
+    out.textContent = "–";
+    return;
+  }
+  const z = s.z[current];
+  out.textContent = `Layer ${current + 1} / ${s.layers}` + (z !== undefined ? ` · z ${z.toFixed(2)} mm` : "");
+}
+
+function show(i: number): void {
+  const s = slice;
+  if (!s || s.layers === 0) return;
+  current = Math.max(0, Math.min(s.layers - 1, Math.round(i)));
+  slider.value = String(current);
+  layerLabel();
+  renderer.current = s.cache.get(current) ?? null;
+  renderer.below = current > 0 ? (s.cache.get(current - 1) ?? null) : null;
+  renderer.dropletWidth = s.dropletWidth;
+  renderer.request();
+  writeStats();
+  for (const k of [current, current - 1]) {
+    if (k >= 0 && !s.cache.has(k) && s.complete && s.source === "stl") fetchPreview(s, k);
+  }
+}
+
+function fetchPreview(s: Slice, k: number): void {
+  if (previewRequests.has(k)) return;
+  previewRequests.add(k);
+  pool
+    .preview(k)
+    .then((l) => {
+      if (slice !== s) return;
+      s.put(l, current);
+      if (k === current || k === current - 1) show(current);
+    })
+    .catch((e) => {
+      if (!(e instanceof Cancelled)) showError(e);
+    })
+    .finally(() => previewRequests.delete(k));
+}
+
+// ---------------------------------------------------------------------------------------------
+// slicing
+
+interface Target {
+  layer?: number;
+  view?: View;
+}
+
+function settingsProblem(): boolean {
+  const errors = form.errors();
+  if (errors.length === 0) return false;
+  showBanner(TITLES.setting, `Fix ${errors.map((e) => `${e.name.replace(/_/g, " ")} (${e.message})`).join(", ")} before slicing.`);
+  form.focusFirstError();
+  return true;
+}
+
+function cancelRunning(): void {
+  if (busy) {
+    pool.cancel();
+    busy = false;
+  }
+}
+
+async function startSlice(m: Model, target: Target = {}): Promise<void> {
+  if (settingsProblem()) return;
+  cancelRunning();
+  hideBanner();
+  const gen = ++generation;
+  const values = form.values();
+  const json = form.json();
+  const H = Number(values.layer_height);
+  const B = H * Number(values.droplet_aspect);
+  const s = new Slice("stl", m.name, B, H, values, m);
+  const sameModel = slice?.model?.sha256 === m.sha256;
+  busy = true;
+  setState("slicing");
+  progress(0);
+  updateButtons();
+  try {
+    await pool.slice(m.bytes, m.name, json, {
+      opened: (r) => {
+        if (gen !== generation) return;
+        s.open(r.layers, r.info);
+        model = m;
+        slice = s;
+        slicedSettings = json;
+        slider.max = String(Math.max(0, r.layers - 1));
+        $("model-name").textContent = m.name;
+        $("empty").hidden = true;
+        current = target.layer ?? (sameModel ? Math.min(current, r.layers - 1) : Math.floor((r.layers - 1) * 0.3));
+        if (target.view) {
+          renderer.view = { ...target.view };
+          viewTouched = true;
+        } else if (!sameModel || !viewTouched) {
+          viewTouched = false;
+          const b = r.info.bounds;
+          renderer.fit(b ? { minX: b.min[0], minY: b.min[1], maxX: b.max[0], maxY: b.max[1] } : null);
+        }
+        show(current);
+      },
+      layer: (l) => {
+        if (gen !== generation) return;
+        s.put(l, current);
+        progress(s.done / Math.max(1, s.layers));
+        if (l.index === current || l.index === current - 1) show(current);
+        updateStats();
+      },
+    });
+    if (gen !== generation) return;
+    s.complete = true;
+    busy = false;
+    progress(null);
+    if (!viewTouched && !s.info.bounds) renderer.fit(s.bbox);
+    show(current);
+    setState("done");
+  } catch (e) {
+    if (gen !== generation) return;
+    busy = false;
+    progress(null);
+    if (e instanceof Cancelled) {
+      setState("cancelled");
+      showBanner("Slicing cancelled.", "Change the settings or open another file, then slice again.", "info");
+    } else {
+      if (slice === s) {
+        // the slice broke half-way: nothing of it can be downloaded
+        slice = null;
+        renderer.current = renderer.below = null;
+        renderer.request();
+        writeStats();
+      }
+      showError(e);
+    }
+  } finally {
+    if (gen === generation) updateButtons();
+  }
+}
+
+async function openGcode(file: File): Promise<void> {
+  cancelRunning();
+  hideBanner();
+  const gen = ++generation;
+  const s = new Slice("gco", file.name, NaN, NaN, form.values(), null);
+  busy = true;
+  setState("slicing");
+  progress(0, "Reading G-code…");
+  updateButtons();
+  let read = 0;
+  try {
+    const r: GcodeParseResult = await pool.parseGcode(file, (l) => {
+      if (gen !== generation) return;
+      s.put(l, 0);
+      read++;
+      progress(Math.min(0.99, read / Math.max(read + 1, 1)), `Reading G-code… ${read} layers`);
+    });
+    if (gen !== generation) return;
+    s.open(r.layers, {});
+    s.dropletWidth = r.dropletWidth;
+    s.layerHeight = r.layerHeight;
+    s.complete = true;
+    slice = s;
+    model = null;
+    slider.max = String(Math.max(0, r.layers - 1));
+    $("model-name").textContent = file.name;
+    $("empty").hidden = true;
+    busy = false;
+    progress(null);
+    viewTouched = false;
+    renderer.fit(s.bbox);
+    show(Math.floor((r.layers - 1) * 0.3));
+    setState("done");
+  } catch (e) {
+    if (gen !== generation) return;
+    busy = false;
+    progress(null);
+    if (e instanceof Cancelled) setState("cancelled");
+    else showError(e);
+  } finally {
+    if (gen === generation) updateButtons();
+  }
+}
+
+function updateButtons(): void {
+  const s = slice;
+  const ready = !busy && s !== null && s.complete;
+  ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl");
+  ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && model !== null);
+  ($("btn-slice") as HTMLButtonElement).disabled = model === null || form === undefined;
+  settingsStatus();
+}
+
+function settingsStatus(): void {
+  if (!form) return;
+  const st = $("settings-status");
+  const errors = form.errors();
+  const btn = $("btn-slice");
+  if (errors.length) {
+    st.textContent = `${errors.length} setting${errors.length > 1 ? "s are" : " is"} invalid.`;
+    st.className = "hint bad";
+    ($("btn-slice") as HTMLButtonElement).disabled = true;
+    btn.classList.remove("attention");
+    return;
+  }
+  const stale = model !== null && slice?.source === "stl" && form.json() !== slicedSettings;
+  st.className = "hint";
+  st.textContent = stale ? "Settings changed: press Slice (or Enter) to update." : "";
+  btn.classList.toggle("attention", stale);
+}
+
+// ---------------------------------------------------------------------------------------------
+// files
+
+async function openFile(file: File): Promise<void> {
+  if (/\.(gco|gcode)$/i.test(file.name)) {
+    pendingLink = null;
+    note("", "none");
+    await openGcode(file);
+    return;
+  }
+  let bytes: Uint8Array;
+  try {
+    bytes = new Uint8Array(await file.arrayBuffer());
+  } catch (e) {
+    showBanner(TITLES.import, `The browser could not read “${file.name}”: ${String(e)}`);
+    return;
+  }
+  const m: Model = { bytes, name: file.name, sha256: await sha256Hex(bytes) };
+  const link = pendingLink;
+  if (link) {
+    pendingLink = null;
+    if (link.state.sha256 === m.sha256) {
+      note(`“${m.name}” matches the model of the preview link.`, "ok");
+      await startSlice(m, { layer: link.state.layer, view: link.state.view });
+      return;
+    }
+    note(
+      `“${m.name}” does not match the model of the preview link (“${link.state.name}”, SHA-256 ${link.state.sha256.slice(0, 12)}…): this is a different file. It is sliced with the link's settings.`,
+      "warn",
+    );
+  } else {
+    note("", "none");
+  }
+  await startSlice(m);
+}
+
+function sample(): Model {
+  const s = sampleStl();
+  return { bytes: s.bytes, name: s.name, sha256: "" };
+}
+
+async function openSample(): Promise<void> {
+  const m = sample();
+  m.sha256 = await sha256Hex(m.bytes);
+  pendingLink = null;
+  note("", "none");
+  await startSlice(m);
+}
+
+// ---------------------------------------------------------------------------------------------
+// download and links
+
+function baseName(name: string): string {
+  return name.replace(/\.[^.]*$/, "") || "model";
+}
+
+async function download(): Promise<void> {
+  const s = slice;
+  if (!s || !s.complete || s.source !== "stl") return;
+  const summary = JSON.stringify({ layers: s.layers, counts: s.totals });
+  try {
+    const [header, footer] = await Promise.all([pool.header(summary), pool.footer(summary)]);
+    const parts: BlobPart[] = [header];
+    for (let i = 0; i < s.layers; i++) {
+      const g = s.gcode[i];
+      if (!g) throw new SliceError("internal", `layer ${i + 1} has no G-code`);
+      parts.push(g);
+    }
+    parts.push(footer);
+    const blob = new Blob(parts, { type: "text/plain" });
+    const a = document.createElement("a");
+    a.href = URL.createObjectURL(blob);
+    a.download = `${baseName(s.name)}.gco`;
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 60_000);
+  } catch (e) {
+    showError(e);
+  }
+}
+
+async function share(): Promise<void> {
+  const s = slice;
+  if (!s || !model || s.source !== "stl") return;
+  const { url, embedded } = await makeLink(location.href, {
+    settings: changedFrom(s.settings),
+    layer: current,
+    view: { ...renderer.view },
+    name: model.name,
+    sha256: model.sha256,
+    showTravel: renderer.showTravel,
+  }, model.bytes);
+  let copied = false;
+  try {
+    await navigator.clipboard.writeText(url);
+    copied = true;
+  } catch {
+    // clipboard refused (permissions, insecure context): the dialog shows the link to copy
+  }
+  $("share-text").textContent =
+    (copied ? "Copied to the clipboard. " : "Copy this link. ") +
+    (embedded
+      ? `The model is inside the link (${Math.round(url.length / 1024)} KB), so it opens the same slice anywhere.`
+      : `“${model.name}” is too big to embed, so the link carries its SHA-256: whoever opens it drops in the same file and the page checks that it matches.`);
+  const input = $<HTMLInputElement>("share-url");
+  input.value = url;
+  $<HTMLDialogElement>("share-dialog").showModal();
+  input.select();
+}
+
+function changedFrom(values: Record<string, Value>): Record<string, Value> {
+  const out: Record<string, Value> = {};
+  for (const [k, v] of Object.entries(values)) if (init.defaults[k] !== v) out[k] = v;
+  return out;
+}
+
+async function openLink(): Promise<boolean> {
+  let link: SharedLink | null;
+  try {
+    link = await readLink(location.hash);
+  } catch (e) {
+    showBanner(TITLES.link, `The link is damaged or incomplete (${e instanceof Error ? e.message : String(e)}). Showing the sample part instead.`);
+    return false;
+  }
+  if (!link) return false;
+  form.set({ ...init.defaults, ...link.state.settings });
+  renderer.showTravel = Boolean(link.state.showTravel);
+  $<HTMLInputElement>("opt-travel").checked = renderer.showTravel;
+  if (link.model) {
+    const m: Model = { bytes: link.model, name: link.state.name, sha256: await sha256Hex(link.model) };
+    if (m.sha256 !== link.state.sha256) {
+      showBanner(TITLES.link, "The model inside the link is damaged (its SHA-256 does not match).");
+      return true;
+    }
+    await startSlice(m, { layer: link.state.layer, view: link.state.view });
+    return true;
+  }
+  pendingLink = link;
+  $("empty").hidden = false;
+  note(
+    `This preview link is for “${link.state.name}” (SHA-256 ${link.state.sha256.slice(0, 12)}…), which was too big to put in the link. Drop that file here to see layer ${link.state.layer + 1} with the link's settings.`,
+    "warn",
+  );
+  setState("idle");
+  updateButtons();
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// events
+
+function wire(): void {
+  $("btn-sample").addEventListener("click", () => void openSample());
+  $<HTMLInputElement>("file-input").addEventListener("change", (ev) => {
+    const input = ev.target as HTMLInputElement;
+    const f = input.files?.[0];
+    input.value = "";
+    if (f) void openFile(f);
+  });
+  $("btn-download").addEventListener("click", () => void download());
+  $("btn-share").addEventListener("click", () => void share().catch(showError));
+  $("btn-slice").addEventListener("click", () => model && void startSlice(model));
+  $("btn-reset").addEventListener("click", () => form.reset());
+  $("btn-cancel").addEventListener("click", () => {
+    if (!busy) return;
+    generation++;
+    pool.cancel();
+    busy = false;
+    progress(null);
+    setState("cancelled");
+    showBanner("Slicing cancelled.", "Change the settings or open another file, then slice again.", "info");
+    if (slice && !slice.complete) {
+      slice = null;
+      renderer.current = renderer.below = null;
+      renderer.request();
+      writeStats();
+      layerLabel();
+    }
+    updateButtons();
+  });
+  $("banner-close").addEventListener("click", hideBanner);
+  $("settings").addEventListener("keydown", (ev) => {
+    if ((ev as KeyboardEvent).key === "Enter" && model) {
+      ev.preventDefault();
+      void startSlice(model);
+    }
+  });
+
+  slider.addEventListener("input", () => show(Number(slider.value)));
+  $("btn-up").addEventListener("click", () => show(current + 1));
+  $("btn-down").addEventListener("click", () => show(current - 1));
+  $("btn-fit").addEventListener("click", fit);
+  $<HTMLInputElement>("opt-travel").addEventListener("change", (ev) => {
+    renderer.showTravel = (ev.target as HTMLInputElement).checked;
+    renderer.request();
+  });
+  $<HTMLInputElement>("opt-below").addEventListener("change", (ev) => {
+    renderer.showBelow = (ev.target as HTMLInputElement).checked;
+    renderer.request();
+  });
+
+  document.addEventListener("keydown", (ev) => {
+    const t = ev.target as HTMLElement;
+    if (t === slider || t.closest("form, dialog") || t instanceof HTMLInputElement || t instanceof HTMLSelectElement) return;
+    const step: Record<string, number> = { ArrowUp: 1, ArrowRight: 1, ArrowDown: -1, ArrowLeft: -1, PageUp: 10, PageDown: -10 };
+    if (ev.key in step) show(current + step[ev.key]);
+    else if (ev.key === "Home") show(0);
+    else if (ev.key === "End") show(slice ? slice.layers - 1 : 0);
+    else if (ev.key === "f" || ev.key === "F") fit();
+    else return;
+    ev.preventDefault();
+  });
+
+  const canvas = renderer.canvas;
+  canvas.addEventListener(
+    "wheel",
+    (ev) => {
+      ev.preventDefault();
+      const r = canvas.getBoundingClientRect();
+      const dy = ev.deltaMode === 1 ? ev.deltaY * 16 : ev.deltaY;
+      renderer.zoomAt(ev.clientX - r.left, ev.clientY - r.top, Math.exp(-dy * 0.0015));
+      viewTouched = true;
+    },
+    { passive: false },
+  );
+  let drag: { x: number; y: number; id: number } | null = null;
+  canvas.addEventListener("pointerdown", (ev) => {
+    drag = { x: ev.clientX, y: ev.clientY, id: ev.pointerId };
+    canvas.setPointerCapture(ev.pointerId);
+    canvas.classList.add("dragging");
+    canvas.focus();
+  });
+  canvas.addEventListener("pointermove", (ev) => {
+    if (!drag || ev.pointerId !== drag.id) return;
+    renderer.panBy(ev.clientX - drag.x, ev.clientY - drag.y);
+    drag.x = ev.clientX;
+    drag.y = ev.clientY;
+    viewTouched = true;
+  });
+  const end = () => {
+    drag = null;
+    canvas.classList.remove("dragging");
+  };
+  canvas.addEventListener("pointerup", end);
+  canvas.addEventListener("pointercancel", end);
+  canvas.addEventListener("dblclick", fit);
+  renderer.onDraw = () => {
+    $("zoom").textContent = `${renderer.view.scale >= 10 ? Math.round(renderer.view.scale) : renderer.view.scale.toFixed(1)} px/mm`;
+  };
+
+  // drag and drop anywhere on the page
+  const overlay = $("drop-overlay");
+  let depth = 0;
+  window.addEventListener("dragenter", (ev) => {
+    if (!ev.dataTransfer?.types.includes("Files")) return;
+    depth++;
+    overlay.hidden = false;
+  });
+  window.addEventListener("dragleave", () => {
+    depth = Math.max(0, depth - 1);
+    if (depth === 0) overlay.hidden = true;
+  });
+  window.addEventListener("dragover", (ev) => ev.preventDefault());
+  window.addEventListener("drop", (ev) => {
+    ev.preventDefault();
+    depth = 0;
+    overlay.hidden = true;
+    const f = ev.dataTransfer?.files[0];
+    if (f) void openFile(f);
+  });
+
+  window.addEventListener("error", (ev) => showError(ev.error ?? ev.message));
+  window.addEventListener("unhandledrejection", (ev) => {
+    if (!(ev.reason instanceof Cancelled)) showError(ev.reason);
+  });
+}
+
+function fit(): void {
+  const s = slice;
+  if (!s) return;
+  const b = s.info.bounds;
+  viewTouched = false;
+  renderer.fit(b ? { minX: b.min[0], minY: b.min[1], maxX: b.max[0], maxY: b.max[1] } : s.bbox);
+}
+
+// hooks for the browser tests
+declare global {
+  interface Window {
+    dropslice: unknown;
+  }
+}
+window.dropslice = {
+  status: () => ({
+    state: document.body.dataset.state,
+    layers: slice?.layers ?? 0,
+    done: slice?.done ?? 0,
+    complete: slice?.complete ?? false,
+    layer: current,
+    droplets: slice?.droplets ?? 0,
+    counts: slice ? { ...slice.totals } : null,
+    layerDroplets: slice?.counts[current] ?? null,
+    view: { ...renderer.view },
+    name: slice?.name ?? null,
+    workers: pool.size,
+  }),
+  crash: () => pool.crash(),
+  show,
+};
+
+async function main(): Promise<void> {
+  setState("loading");
+  wire();
+  try {
+    init = await pool.init();
+  } catch (e) {
+    showError(e);
+    return;
+  }
+  $("version").textContent = init.version;
+  form = new SettingsForm($("settings"), init.schema, () => updateButtons());
+  updateButtons();
+  if (!(await openLink())) await openSample();
+}
+
+void main();

@@ -1,0 +1,94 @@
+// Messages between the page (client.ts) and a worker (worker.ts).
+// Every request is {id, kind, data}; the worker answers with any number of
+// "progress" replies and then exactly one "result" or "error" reply with the same id.
+
+export interface Counts {
+  outer: number;
+  inner: number;
+  fill: number;
+}
+
+/** Where a slice came from and what the core said about the mesh. */
+export interface JobInfo {
+  file_name?: string;
+  mesh?: { facets_in_file: number; facets: number; vertices: number; open_edges: number };
+  droplet_width?: number;
+  bounds?: { min: [number, number, number]; max: [number, number, number] };
+  layers?: number;
+  warnings?: string[];
+  [key: string]: unknown;
+}
+
+/** One layer as drawn: flat arrays, never an object per droplet. */
+export interface LayerData {
+  index: number;
+  z: number;
+  counts: Counts;
+  travelMm: number;
+  /** x,y pairs in mm, every droplet (each one of a G25 line too). */
+  droplets: Float32Array;
+  /** 0 outermost loop, 1 inner loops, 2 fill; one per droplet. */
+  roles: Uint8Array;
+  /** x0,y0,x1,y1 per travel move, mm. */
+  travel: Float32Array;
+  /** The layer's G-code (slices only; absent for preview re-requests). */
+  gcode?: Blob;
+}
+
+export interface SettingSpec {
+  name: string;
+  kind: "number" | "integer" | "bool" | "enum";
+  unit: string;
+  min: number | null;
+  max: number | null;
+  min_exclusive?: boolean;
+  choices: string[];
+  group: string;
+  description: string;
+  default: number | boolean | string;
+}
+
+export interface InitResult {
+  version: string;
+  schema: SettingSpec[];
+  defaults: Record<string, number | boolean | string>;
+}
+
+export interface OpenResult {
+  layers: number;
+  info: JobInfo;
+}
+
+export interface GcodeParseResult {
+  layers: number;
+  dropletWidth: number;
+  layerHeight: number;
+  header: Record<string, string>;
+}
+
+export type Request =
+  | { id: number; kind: "init"; data: null }
+  | { id: number; kind: "open"; data: { stl: ArrayBuffer; name: string; settings: string } }
+  | { id: number; kind: "slice"; data: { from: number; to: number } }
+  | { id: number; kind: "preview"; data: { index: number } }
+  | { id: number; kind: "header"; data: { summary: string } }
+  | { id: number; kind: "footer"; data: { summary: string } }
+  | { id: number; kind: "parse_gcode"; data: { file: Blob } }
+  | { id: number; kind: "crash"; data: null };
+
+export type RequestKind = Request["kind"];
+
+export type Reply =
+  | { id: number; kind: "progress"; data: LayerData }
+  | { id: number; kind: "result"; data: unknown }
+  | { id: number; kind: "error"; data: { kind: string; message: string } };
+
+/** Splits "kind: message" as produced by src/wasm.rs. */
+export function splitError(text: string): { kind: string; message: string } {
+  const m = /^(import|setting|nothing_to_print|io|internal): ([\s\S]*)$/.exec(text);
+  return m ? { kind: m[1], message: m[2] } : { kind: "internal", message: text };
+}
+
+export function transferablesOf(layer: LayerData): Transferable[] {
+  return [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
+}

@@ -1,0 +1,228 @@
+// Draws one layer on a 2D canvas: every droplet a disc of diameter B coloured by role, the
+// layer below faintly, travel moves on demand, a millimetre grid and a scale bar.
+// Droplets are batched by role into one Path2D per colour (one fill call each); when a disc
+// would be smaller than ~1.5 device pixels they are drawn as small squares instead, and
+// droplets outside the view are skipped, so hundreds of thousands per layer stay fast.
+
+import type { LayerData } from "./protocol";
+
+export const ROLE_COLORS = ["#d9480f", "#f59f00", "#1c7ed6"] as const;
+export const ROLE_NAMES = ["Outer loop", "Inner loops", "Fill"] as const;
+const BELOW_COLOR = "rgba(120, 130, 150, 0.22)";
+const TRAVEL_COLOR = "rgba(60, 60, 70, 0.55)";
+
+export interface View {
+  /** CSS pixels per mm. */
+  scale: number;
+  /** mm at the canvas centre. */
+  cx: number;
+  cy: number;
+}
+
+export interface Bounds {
+  minX: number;
+  minY: number;
+  maxX: number;
+  maxY: number;
+}
+
+export class Renderer {
+  view: View = { scale: 10, cx: 0, cy: 0 };
+  current: LayerData | null = null;
+  below: LayerData | null = null;
+  dropletWidth = 0.208;
+  showTravel = false;
+  showBelow = true;
+  /** Called after every draw (for the zoom read-out). */
+  onDraw: (() => void) | null = null;
+  private frame = 0;
+  private cssW = 1;
+  private cssH = 1;
+  private dpr = 1;
+
+  constructor(readonly canvas: HTMLCanvasElement) {
+    new ResizeObserver(() => this.resize()).observe(canvas);
+    this.resize();
+  }
+
+  private resize(): void {
+    const r = this.canvas.getBoundingClientRect();
+    this.dpr = window.devicePixelRatio || 1;
+    this.cssW = Math.max(1, r.width);
+    this.cssH = Math.max(1, r.height);
+    this.canvas.width = Math.round(this.cssW * this.dpr);
+    this.canvas.height = Math.round(this.cssH * this.dpr);
+    this.draw();
+  }
+
+  /** Schedules a redraw on the next animation frame. */
+  request(): void {
+    if (this.frame) return;
+    this.frame = requestAnimationFrame(() => {
+      this.frame = 0;
+      this.draw();
+    });
+  }
+
+  fit(b: Bounds | null): void {
+    if (!b || !(b.maxX > b.minX) || !(b.maxY > b.minY)) return;
+    const margin = 36;
+    const sx = (this.cssW - 2 * margin) / (b.maxX - b.minX);
+    const sy = (this.cssH - 2 * margin) / (b.maxY - b.minY);
+    this.view = { scale: Math.max(0.05, Math.min(sx, sy)), cx: (b.minX + b.maxX) / 2, cy: (b.minY + b.maxY) / 2 };
+    this.request();
+  }
+
+  /** Zooms by `factor` keeping the mm under the CSS pixel (px, py) in place. */
+  zoomAt(px: number, py: number, factor: number): void {
+    const v = this.view;
+    const [mx, my] = this.toMm(px, py);
+    const scale = Math.min(5000, Math.max(0.05, v.scale * factor));
+    v.cx = mx - (px - this.cssW / 2) / scale;
+    v.cy = my + (py - this.cssH / 2) / scale;
+    v.scale = scale;
+    this.request();
+  }
+
+  panBy(dxPx: number, dyPx: number): void {
+    this.view.cx -= dxPx / this.view.scale;
+    this.view.cy += dyPx / this.view.scale;
+    this.request();
+  }
+
+  toMm(px: number, py: number): [number, number] {
+    const v = this.view;
+    return [v.cx + (px - this.cssW / 2) / v.scale, v.cy - (py - this.cssH / 2) / v.scale];
+  }
+
+  draw(): void {
+    const ctx = this.canvas.getContext("2d", { alpha: false });
+    if (!ctx) return;
+    const { scale, cx, cy } = this.view;
+    const k = scale * this.dpr; // device px per mm
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.fillStyle = "#fbfcfd";
+    ctx.fillRect(0, 0, this.canvas.width, this.canvas.height);
+    this.drawGrid(ctx, k);
+
+    // mm -> device px: x' = (x - cx) k + W/2, y' = -(y - cy) k + H/2
+    const W = this.canvas.width;
+    const H = this.canvas.height;
+    ctx.setTransform(k, 0, 0, -k, W / 2 - cx * k, H / 2 + cy * k);
+    const half = this.dropletWidth / 2;
+    const vis = {
+      minX: cx - W / 2 / k - half,
+      maxX: cx + W / 2 / k + half,
+      minY: cy - H / 2 / k - half,
+      maxY: cy + H / 2 / k + half,
+    };
+    if (this.showBelow && this.below) this.drawDroplets(ctx, this.below, k, vis, true);
+    if (this.current) {
+      this.drawDroplets(ctx, this.current, k, vis, false);
+      if (this.showTravel) this.drawTravel(ctx, this.current, k);
+    }
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    this.drawScaleBar(ctx);
+    this.onDraw?.();
+  }
+
+  private drawDroplets(ctx: CanvasRenderingContext2D, layer: LayerData, k: number, vis: Bounds, faint: boolean): void {
+    const d = layer.droplets;
+    const roles = layer.roles;
+    const r = this.dropletWidth / 2;
+    const small = r * k < 1.5;
+    // squares of at least one device pixel when zoomed far out
+    const s = small ? Math.max(this.dropletWidth, 1 / k) : 0;
+    const paths = faint ? [new Path2D()] : [new Path2D(), new Path2D(), new Path2D()];
+    const n = roles.length;
+    for (let i = 0; i < n; i++) {
+      const x = d[2 * i];
+      const y = d[2 * i + 1];
+      if (x < vis.minX || x > vis.maxX || y < vis.minY || y > vis.maxY) continue;
+      const p = faint ? paths[0] : paths[Math.min(roles[i], 2)];
+      if (small) p.rect(x - s / 2, y - s / 2, s, s);
+      else {
+        p.moveTo(x + r, y);
+        p.arc(x, y, r, 0, 2 * Math.PI);
+      }
+    }
+    if (faint) {
+      ctx.fillStyle = BELOW_COLOR;
+      ctx.fill(paths[0]);
+      return;
+    }
+    // fill first, then inner loops, then the outer loop on top
+    for (const role of [2, 1, 0]) {
+      ctx.fillStyle = ROLE_COLORS[role];
+      ctx.fill(paths[role]);
+    }
+  }
+
+  private drawTravel(ctx: CanvasRenderingContext2D, layer: LayerData, k: number): void {
+    const t = layer.travel;
+    const p = new Path2D();
+    for (let i = 0; i + 3 < t.length; i += 4) {
+      p.moveTo(t[i], t[i + 1]);
+      p.lineTo(t[i + 2], t[i + 3]);
+    }
+    ctx.strokeStyle = TRAVEL_COLOR;
+    ctx.lineWidth = 1 / k;
+    ctx.setLineDash([4 / k, 3 / k]);
+    ctx.stroke(p);
+    ctx.setLineDash([]);
+  }
+
+  private gridStep(): number {
+    // about 60 CSS px between grid lines, 1-2-5 steps
+    const target = 60 / this.view.scale;
+    const p = Math.pow(10, Math.floor(Math.log10(target)));
+    for (const m of [1, 2, 5, 10]) if (m * p >= target) return m * p;
+    return 10 * p;
+  }
+
+  private drawGrid(ctx: CanvasRenderingContext2D, k: number): void {
+    const W = this.canvas.width;
+    const H = this.canvas.height;
+    const { cx, cy } = this.view;
+    const step = this.gridStep();
+    const x0 = cx - W / 2 / k;
+    const x1 = cx + W / 2 / k;
+    const y0 = cy - H / 2 / k;
+    const y1 = cy + H / 2 / k;
+    const minor = new Path2D();
+    const axes = new Path2D();
+    for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+      const px = Math.round((x - cx) * k + W / 2) + 0.5;
+      if (Math.abs(x) < step / 2) { axes.moveTo(px, 0); axes.lineTo(px, H); } else { minor.moveTo(px, 0); minor.lineTo(px, H); }
+    }
+    for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+      const py = Math.round(-(y - cy) * k + H / 2) + 0.5;
+      if (Math.abs(y) < step / 2) { axes.moveTo(0, py); axes.lineTo(W, py); } else { minor.moveTo(0, py); minor.lineTo(W, py); }
+    }
+    ctx.lineWidth = 1;
+    ctx.strokeStyle = "#e9ecf1";
+    ctx.stroke(minor);
+    ctx.strokeStyle = "#c9ced8";
+    ctx.stroke(axes);
+  }
+
+  private drawScaleBar(ctx: CanvasRenderingContext2D): void {
+    const step = this.gridStep();
+    const dpr = this.dpr;
+    const len = step * this.view.scale * dpr;
+    const x = 16 * dpr;
+    const y = this.canvas.height - 18 * dpr;
+    ctx.strokeStyle = "#495057";
+    ctx.lineWidth = 2 * dpr;
+    ctx.beginPath();
+    ctx.moveTo(x, y - 5 * dpr);
+    ctx.lineTo(x, y);
+    ctx.lineTo(x + len, y);
+    ctx.lineTo(x + len, y - 5 * dpr);
+    ctx.stroke();
+    ctx.fillStyle = "#495057";
+    ctx.font = `${12 * dpr}px system-ui, sans-serif`;
+    ctx.textBaseline = "bottom";
+    ctx.fillText(`${+step.toPrecision(3)} mm`, x + len + 6 * dpr, y + 5 * dpr);
+  }
+}
