@@ -1,0 +1,544 @@
+//! Shared helpers for the integration tests: locating the shared models, running the CLI with
+//! a timeout in a temporary directory, a small G-code parser (SPEC.md "Machine code"), and
+//! geometry on a layer's section (non-zero winding point-in-region, distance to the boundary).
+#![allow(dead_code)]
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+pub type Point = [f64; 2];
+
+/// Default layer height H and droplet width B = 1.04·H (SPEC.md defaults).
+pub const H: f64 = 0.2;
+pub const B: f64 = 0.2 * 1.04;
+
+// ---------------------------------------------------------------------------------------------
+// Files and processes
+
+/// The shared folder: `$DROPSLICE_SHARED`, else `<CARGO_MANIFEST_DIR>/../shared`.
+pub fn shared_dir() -> PathBuf {
+    match std::env::var_os("DROPSLICE_SHARED") {
+        Some(d) if !d.is_empty() => PathBuf::from(d),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared"),
+    }
+}
+
+/// Path of a model in `shared/models` (panics with a clear message if it is missing).
+pub fn model(name: &str) -> PathBuf {
+    let p = shared_dir().join("models").join(name);
+    assert!(
+        p.is_file(),
+        "model {} not found (set DROPSLICE_SHARED to the shared folder)",
+        p.display()
+    );
+    p
+}
+
+pub fn model_bytes(name: &str) -> Vec<u8> {
+    std::fs::read(model(name)).expect("read model")
+}
+
+/// The CLI binary built by cargo for these tests.
+pub fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_dropslice")
+}
+
+/// A fresh, empty directory under the system temp dir, removed on drop.
+pub struct TempDir(PathBuf);
+
+impl TempDir {
+    pub fn new(tag: &str) -> TempDir {
+        static N: AtomicUsize = AtomicUsize::new(0);
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos())
+            .unwrap_or(0);
+        let p = std::env::temp_dir().join(format!(
+            "dropslice-test-{tag}-{}-{}-{nanos}",
+            std::process::id(),
+            N.fetch_add(1, Ordering::SeqCst)
+        ));
+        std::fs::create_dir_all(&p).expect("create temp dir");
+        TempDir(p)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+
+    pub fn join(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+
+    /// Names of the files in the directory, sorted.
+    pub fn files(&self) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(&self.0)
+            .map(|rd| {
+                rd.filter_map(|e| e.ok())
+                    .map(|e| e.file_name().to_string_lossy().into_owned())
+                    .collect()
+            })
+            .unwrap_or_default();
+        v.sort();
+        v
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// Result of one CLI run.
+#[derive(Debug)]
+pub struct Run {
+    /// Exit code; `None` if killed by a signal or by the timeout.
+    pub code: Option<i32>,
+    pub timed_out: bool,
+    pub stdout: String,
+    pub stderr: String,
+    pub seconds: f64,
+}
+
+/// Runs the CLI with `args` in `cwd`, killing it after `timeout`.
+pub fn run_cli<S: AsRef<OsStr>>(args: &[S], cwd: &Path, timeout: Duration) -> Run {
+    let t0 = Instant::now();
+    let out_path = cwd.join(format!(
+        ".stdout-{}",
+        t0.elapsed().as_nanos() ^ std::process::id() as u128
+    ));
+    let err_path = out_path.with_extension("stderr");
+    let mut child = Command::new(bin())
+        .args(args)
+        .current_dir(cwd)
+        .stdin(Stdio::null())
+        .stdout(std::fs::File::create(&out_path).expect("stdout file"))
+        .stderr(std::fs::File::create(&err_path).expect("stderr file"))
+        .spawn()
+        .expect("spawn dropslice");
+    let mut timed_out = false;
+    let status = loop {
+        if let Some(s) = child.try_wait().expect("wait") {
+            break Some(s);
+        }
+        if t0.elapsed() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            timed_out = true;
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    let read = |p: &Path| {
+        let s = String::from_utf8_lossy(&std::fs::read(p).unwrap_or_default()).into_owned();
+        let _ = std::fs::remove_file(p);
+        s
+    };
+    Run {
+        code: status.and_then(|s| s.code()),
+        timed_out,
+        stdout: read(&out_path),
+        stderr: read(&err_path),
+        seconds: t0.elapsed().as_secs_f64(),
+    }
+}
+
+/// Slices `model` through the CLI with `--set` options and returns the G-code text.
+pub fn slice_cli(model: &Path, sets: &[&str]) -> String {
+    let dir = TempDir::new("slice");
+    let out = dir.join("out.gco");
+    let mut args: Vec<String> = vec![
+        model.display().to_string(),
+        "-q".into(),
+        "-o".into(),
+        out.display().to_string(),
+    ];
+    for s in sets {
+        args.push("--set".into());
+        args.push((*s).into());
+    }
+    let r = run_cli(&args, dir.path(), Duration::from_secs(120));
+    assert_eq!(
+        r.code,
+        Some(0),
+        "dropslice {args:?} failed: {r:?}",
+        args = args
+    );
+    std::fs::read_to_string(&out).expect("read output")
+}
+
+// ---------------------------------------------------------------------------------------------
+// G-code
+
+/// One command: `G01`, `G25` or `G26` with its coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cmd {
+    pub code: String,
+    pub x: f64,
+    pub y: f64,
+    pub z: f64,
+}
+
+impl Cmd {
+    pub fn p(&self) -> Point {
+        [self.x, self.y]
+    }
+}
+
+/// The commands of one layer (consecutive commands with the same Z).
+#[derive(Clone, Debug)]
+pub struct Layer {
+    pub z: f64,
+    pub cmds: Vec<Cmd>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Gcode {
+    /// `; name = value` comment lines before the first command, in order; the value without
+    /// a trailing ` (unit)`.
+    pub header: Vec<(String, String)>,
+    pub layers: Vec<Layer>,
+    /// Lines that break SPEC.md's format (not a comment, not `G01/G25/G26 Xx Yy Zz` with
+    /// exactly 4 decimals), with their line numbers.
+    pub bad_lines: Vec<String>,
+}
+
+impl Gcode {
+    /// The header value of `name`.
+    pub fn get(&self, name: &str) -> Option<&str> {
+        self.header
+            .iter()
+            .find(|(k, _)| k == name)
+            .map(|(_, v)| v.as_str())
+    }
+
+    pub fn count(&self, code: &str) -> usize {
+        self.layers
+            .iter()
+            .flat_map(|l| &l.cmds)
+            .filter(|c| c.code == code)
+            .count()
+    }
+}
+
+/// A coordinate: optional minus, digits, a point and exactly 4 digits.
+fn parse_coord(tok: &str, axis: char) -> Option<f64> {
+    let num = tok.strip_prefix(axis)?;
+    let digits = num.strip_prefix('-').unwrap_or(num);
+    let (int, frac) = digits.split_once('.')?;
+    let ok = !int.is_empty()
+        && int.bytes().all(|c| c.is_ascii_digit())
+        && frac.len() == 4
+        && frac.bytes().all(|c| c.is_ascii_digit());
+    if !ok {
+        return None;
+    }
+    num.parse().ok()
+}
+
+/// Parses G-code text (strictly; see [`Gcode::bad_lines`]).
+pub fn parse_gcode(text: &str) -> Gcode {
+    let mut g = Gcode::default();
+    let mut seen_command = false;
+    for (n, line) in text.lines().enumerate() {
+        if let Some(c) = line.strip_prefix(';') {
+            if !seen_command && let Some((k, v)) = c.split_once(" = ") {
+                let v = v.trim();
+                let v = match v.rfind(" (") {
+                    Some(i) if v.ends_with(')') => &v[..i],
+                    _ => v,
+                };
+                g.header.push((k.trim().to_string(), v.trim().to_string()));
+            }
+            continue;
+        }
+        let toks: Vec<&str> = line.split(' ').collect();
+        let cmd = match toks.as_slice() {
+            [code @ ("G01" | "G25" | "G26"), x, y, z] => {
+                match (
+                    parse_coord(x, 'X'),
+                    parse_coord(y, 'Y'),
+                    parse_coord(z, 'Z'),
+                ) {
+                    (Some(x), Some(y), Some(z)) => Some(Cmd {
+                        code: code.to_string(),
+                        x,
+                        y,
+                        z,
+                    }),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        let Some(cmd) = cmd else {
+            g.bad_lines.push(format!("line {}: {line:?}", n + 1));
+            continue;
+        };
+        seen_command = true;
+        match g.layers.last_mut() {
+            Some(l) if l.z == cmd.z => l.cmds.push(cmd),
+            _ => g.layers.push(Layer {
+                z: cmd.z,
+                cmds: vec![cmd],
+            }),
+        }
+    }
+    g
+}
+
+/// Layer index (from 0) of a G-code layer: Z = (i + 1)·H.
+pub fn layer_index(z: f64, h: f64) -> usize {
+    let i = (z / h).round() as i64 - 1;
+    assert!(
+        i >= 0 && (z - (i + 1) as f64 * h).abs() < 1e-6,
+        "Z {z} is not a multiple of H = {h}"
+    );
+    i as usize
+}
+
+/// Droplets of one `G25` line of length `l` (SPEC.md: one at the start, then one every B).
+pub fn line_droplets(l: f64, b: f64) -> u64 {
+    (l / b + 1e-9).floor() as u64 + 1
+}
+
+/// `G25` lines of a layer as (start, end): the start is the position before the command.
+pub fn g25_lines(layer: &Layer) -> Vec<(Point, Point)> {
+    let mut at: Option<Point> = None;
+    let mut out = Vec::new();
+    for c in &layer.cmds {
+        if c.code == "G25" {
+            out.push((
+                at.expect("G25 as a layer's first command has no start"),
+                c.p(),
+            ));
+        }
+        at = Some(c.p());
+    }
+    out
+}
+
+/// Maximal runs of consecutive `G26` commands of a layer.
+pub fn g26_runs(layer: &Layer) -> Vec<Vec<Point>> {
+    let mut runs: Vec<Vec<Point>> = Vec::new();
+    let mut in_run = false;
+    for c in &layer.cmds {
+        if c.code == "G26" {
+            if !in_run {
+                runs.push(Vec::new());
+                in_run = true;
+            }
+            runs.last_mut().unwrap().push(c.p());
+        } else {
+            in_run = false;
+        }
+    }
+    runs
+}
+
+pub fn dist(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// Splits a run of `G26` droplets (with closed loops, `close_loops = true`) into loops: a
+/// loop ends where a droplet equals the loop's first droplet (that closing droplet is kept
+/// as the loop's last point). A first droplet whose successor is not B away is a loop of one
+/// droplet (a loop too small for two). `b_tol` is the spacing tolerance.
+pub fn split_loops(run: &[Point], b: f64, b_tol: f64) -> Vec<Vec<Point>> {
+    let mut loops: Vec<Vec<Point>> = Vec::new();
+    let mut cur: Vec<Point> = Vec::new();
+    for &p in run {
+        if cur.len() == 1 && (dist(cur[0], p) - b).abs() > b_tol {
+            loops.push(std::mem::take(&mut cur));
+        }
+        let closes = !cur.is_empty() && dist(cur[0], p) < 1e-9;
+        cur.push(p);
+        if closes {
+            loops.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        loops.push(cur);
+    }
+    loops
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry on a section (dropslice::slice::Shapes: shapes of contours)
+
+pub type Shapes = Vec<Vec<Vec<Point>>>;
+
+/// Non-zero winding number of `p` over every contour of the region.
+pub fn winding(region: &Shapes, p: Point) -> i32 {
+    region.iter().flatten().map(|c| contour_winding(c, p)).sum()
+}
+
+/// Winding number of one closed contour around `p`.
+pub fn contour_winding(c: &[Point], p: Point) -> i32 {
+    let mut wn = 0;
+    {
+        let n = c.len();
+        for i in 0..n {
+            let (a, b) = (c[i], c[(i + 1) % n]);
+            let left = (b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1]);
+            if a[1] <= p[1] {
+                if b[1] > p[1] && left > 0.0 {
+                    wn += 1;
+                }
+            } else if b[1] <= p[1] && left < 0.0 {
+                wn -= 1;
+            }
+        }
+    }
+    wn
+}
+
+fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(p, [a[0] + t * d[0], a[1] + t * d[1]])
+}
+
+/// Distance from `p` to the region's boundary (its nearest contour edge).
+pub fn boundary_distance(region: &Shapes, p: Point) -> f64 {
+    let mut best = f64::INFINITY;
+    for c in region.iter().flatten() {
+        let n = c.len();
+        for i in 0..n {
+            best = best.min(seg_dist(p, c[i], c[(i + 1) % n]));
+        }
+    }
+    best
+}
+
+/// `p` lies inside the region (non-zero winding) or within `tol` mm of its boundary.
+pub fn in_region(region: &Shapes, p: Point, tol: f64) -> bool {
+    winding(region, p) != 0 || boundary_distance(region, p) <= tol
+}
+
+/// A region with a bounding box per contour, for faster repeated queries.
+pub struct IndexedRegion {
+    contours: Vec<(Vec<Point>, [f64; 4])>,
+}
+
+impl IndexedRegion {
+    pub fn new(region: &Shapes) -> IndexedRegion {
+        let contours = region
+            .iter()
+            .flatten()
+            .map(|c| {
+                let mut bb = [f64::INFINITY, f64::INFINITY, -f64::INFINITY, -f64::INFINITY];
+                for p in c {
+                    bb[0] = bb[0].min(p[0]);
+                    bb[1] = bb[1].min(p[1]);
+                    bb[2] = bb[2].max(p[0]);
+                    bb[3] = bb[3].max(p[1]);
+                }
+                (c.clone(), bb)
+            })
+            .collect();
+        IndexedRegion { contours }
+    }
+
+    pub fn winding(&self, p: Point) -> i32 {
+        let mut wn = 0;
+        for (c, bb) in &self.contours {
+            // A contour only winds around points within its y-range and left of its max x.
+            if p[1] < bb[1] || p[1] > bb[3] || p[0] > bb[2] {
+                continue;
+            }
+            wn += contour_winding(c, p);
+        }
+        wn
+    }
+
+    pub fn boundary_distance(&self, p: Point) -> f64 {
+        let mut best = f64::INFINITY;
+        for (c, bb) in &self.contours {
+            let dx = (bb[0] - p[0]).max(p[0] - bb[2]).max(0.0);
+            let dy = (bb[1] - p[1]).max(p[1] - bb[3]).max(0.0);
+            if dx.hypot(dy) > best {
+                continue;
+            }
+            let n = c.len();
+            for i in 0..n {
+                best = best.min(seg_dist(p, c[i], c[(i + 1) % n]));
+            }
+        }
+        best
+    }
+
+    pub fn contains(&self, p: Point, tol: f64) -> bool {
+        self.winding(p) != 0 || self.boundary_distance(p) <= tol
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// STL writing
+
+/// A binary STL of the given triangles (zero normals).
+pub fn binary_stl(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    let n = header.len().min(80);
+    b[..n].copy_from_slice(&header[..n]);
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        b.extend([0u8; 12]);
+        for v in t {
+            for c in v {
+                b.extend(c.to_le_bytes());
+            }
+        }
+        b.extend([0u8; 2]);
+    }
+    b
+}
+
+/// An ASCII STL of the given triangles, coordinates written with `{}`.
+pub fn ascii_stl(tris: &[[[String; 3]; 3]]) -> Vec<u8> {
+    let mut s = String::from("solid test\n");
+    for t in tris {
+        s.push_str("facet normal 0 0 0\n  outer loop\n");
+        for v in t {
+            s.push_str(&format!("    vertex {} {} {}\n", v[0], v[1], v[2]));
+        }
+        s.push_str("  endloop\nendfacet\n");
+    }
+    s.push_str("endsolid test\n");
+    s.into_bytes()
+}
+
+/// A tiny deterministic random generator (xorshift64*), so tests need no extra crate.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+
+    pub fn next_u64(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.0 = x;
+        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n
+    }
+
+    pub fn bytes(&mut self, n: usize) -> Vec<u8> {
+        (0..n).map(|_| self.next_u64() as u8).collect()
+    }
+}
