@@ -94,7 +94,9 @@ fn circle_exit(p: Point, q: Point, c: Point, r: f64) -> Option<Point> {
         (-bq + sq) / (2.0 * a)
     };
     let t = if bq >= 0.0 && bq + sq == 0.0 { 0.0 } else { t };
-    (0.0..=1.0).contains(&t).then(|| [p[0] + t * d[0], p[1] + t * d[1]])
+    (0.0..=1.0)
+        .contains(&t)
+        .then(|| [p[0] + t * d[0], p[1] + t * d[1]])
 }
 
 #[cfg(test)]

@@ -224,7 +224,8 @@ mod tests {
         let total: f64 = lines.iter().map(|l| dist(l.a, l.b)).sum();
         // Area / spacing.
         assert!((total - 200.0).abs() < 1.0, "{total}");
-        let ordered = order_greedy(lines.clone(), [0.0, 0.0]);
+        // From the corner where the 45° lines begin, greedy sweeps to the opposite corner.
+        let ordered = order_greedy(lines.clone(), [0.0, 10.0]);
         assert_eq!(ordered.len(), lines.len());
         // Each next segment starts at the nearest remaining end: consecutive lines are neighbours.
         for w in ordered.windows(2) {

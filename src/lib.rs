@@ -161,6 +161,11 @@ impl Job {
         slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i])
     }
 
+    /// The closed loops of layer `i` before their union (for diagnostics).
+    pub fn section_loops(&self, i: usize) -> Vec<slice::Contour> {
+        slice::section_loops(&self.mesh, self.buckets.layer(i), self.zs[i]).0
+    }
+
     /// Every move of layer `i`.
     pub fn plan_layer(&self, i: usize) -> LayerPlan {
         plan::plan_layer(&self.section(i).region, i, &self.settings)

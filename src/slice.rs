@@ -33,12 +33,12 @@ pub type Shapes = Vec<Shape>;
 /// Points closer than this to their predecessor on a loop are dropped (SPEC.md 5.3.2).
 pub const MIN_POINT_DISTANCE_MM: f64 = 0.001;
 
-/// Plane heights are rounded to this grid so they do not drift (0.1 + 42·0.2 = 8.5 exactly).
-const Z_GRID_MM: f64 = 1e-9;
+/// Plane heights are rounded to 1/this mm so they do not drift (0.1 + 42·0.2 = 8.5 exactly).
+const Z_STEPS_PER_MM: f64 = 1e9;
 
 /// The plane height of every layer, measured from the part's lowest point (z = 0).
 pub fn layer_heights(part_height: f64, layer_height: f64, plane: SlicePlane) -> Vec<f64> {
-    let round = |z: f64| (z / Z_GRID_MM).round() * Z_GRID_MM;
+    let round = |z: f64| (z * Z_STEPS_PER_MM).round() / Z_STEPS_PER_MM;
     let mut zs = Vec::new();
     for i in 0.. {
         let z = match plane {
@@ -62,7 +62,9 @@ pub fn layer_heights(part_height: f64, layer_height: f64, plane: SlicePlane) -> 
 }
 
 /// Facet ids per layer: the facets crossing each plane, found once for the whole part
-/// (compressed rows: layer i's facets are `facets[offsets[i]..offsets[i+1]]`).
+/// (compressed rows: layer i's facets are `facets[offsets[i]..offsets[i+1]]`), each row
+/// ordered by the facets' lowest z (ties in file order), which fixes the order in which open
+/// chains are joined.
 pub struct FacetBuckets {
     offsets: Vec<u32>,
     facets: Vec<u32>,
@@ -95,9 +97,18 @@ impl FacetBuckets {
         let offsets = counts.clone();
         let mut fill = counts;
         let mut facets = vec![0u32; *offsets.last().unwrap_or(&0) as usize];
-        for (f, &(a, b)) in ranges.iter().enumerate() {
+        let lowest = |f: &[u32; 3]| {
+            let z = f.map(|i| mesh.vertices[i as usize][2]);
+            z[0].min(z[1]).min(z[2])
+        };
+        let mut order: Vec<u32> = (0..mesh.facets.len() as u32).collect();
+        order.sort_by(|&p, &q| {
+            lowest(&mesh.facets[p as usize]).total_cmp(&lowest(&mesh.facets[q as usize]))
+        });
+        for f in order {
+            let (a, b) = ranges[f as usize];
             for i in a..b {
-                facets[fill[i as usize] as usize] = f as u32;
+                facets[fill[i as usize] as usize] = f;
                 fill[i as usize] += 1;
             }
         }
@@ -137,6 +148,13 @@ struct Segment {
 
 /// Cuts the mesh at height `z`, using only the given facets (those that may cross it).
 pub fn slice_layer(mesh: &Mesh, facets: &[u32], z: f64) -> Section {
+    let (contours, mut section) = section_loops(mesh, facets, z);
+    section.region = union(&contours);
+    section
+}
+
+/// The closed loops of a cut before their union (and the section's statistics, without region).
+pub fn section_loops(mesh: &Mesh, facets: &[u32], z: f64) -> (Vec<Contour>, Section) {
     let segments = segments(mesh, facets, z);
     let mut section = Section {
         z,
@@ -148,8 +166,7 @@ pub fn slice_layer(mesh: &Mesh, facets: &[u32], z: f64) -> Section {
         .map(clean_loop)
         .filter(|c| c.len() >= 3)
         .collect();
-    section.region = union(&contours);
-    section
+    (contours, section)
 }
 
 /// The non-zero union of closed loops: shapes with outer boundaries CCW and holes CW.
@@ -264,7 +281,8 @@ fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
             .map(|e| e.1 as usize)
             .find(|&i| i != not && free[i])
     };
-    let mut open: Vec<Vec<Point>> = Vec::new();
+    // Open chains with the lowest segment (facet order) they contain.
+    let mut open: Vec<(usize, Vec<Point>)> = Vec::new();
     for &s0 in &leftovers {
         if !free[s0] {
             continue;
@@ -318,34 +336,40 @@ fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
             section.reoriented_loops += 1;
             loops.push(pts);
         } else {
-            open.push(pts);
+            open.push((steps.iter().map(|s| s.0).min().expect("non-empty"), pts));
         }
     }
 
-    // Pass 3: join open chains end to start, nearest ends first.
+    // Pass 3: join open chains, as CuraEngine and Slic3r stitch open sections: take the
+    // chains in order; while another chain's start or end (then reversed) is nearer to the
+    // current chain's end than its own start, append that chain; then close the loop.
     section.open_chains += open.len();
-    while !open.is_empty() {
-        let (mut bi, mut bj, mut bd) = (0, 0, f64::INFINITY);
-        for (i, a) in open.iter().enumerate() {
-            let end = *a.last().expect("non-empty");
-            for (j, b) in open.iter().enumerate() {
-                let d = dist(end, b[0]);
-                if d < bd {
-                    (bi, bj, bd) = (i, j, d);
+    open.sort_by_key(|c| c.0);
+    let mut open: std::collections::VecDeque<Vec<Point>> = open.into_iter().map(|c| c.1).collect();
+    while let Some(mut cur) = open.pop_front() {
+        loop {
+            let end = *cur.last().expect("non-empty");
+            let mut best: Option<(usize, bool)> = None;
+            let mut bd = dist(cur[0], end);
+            for (k, c) in open.iter().enumerate() {
+                for (rev, q) in [(false, c[0]), (true, *c.last().expect("non-empty"))] {
+                    let d = dist(q, end);
+                    if d < bd {
+                        (best, bd) = (Some((k, rev)), d);
+                    }
                 }
             }
-        }
-        section.gap_length += bd;
-        if bi == bj {
-            let mut c = open.swap_remove(bi);
-            if c.len() > 1 && dist(c[0], *c.last().unwrap()) == 0.0 {
-                c.pop();
+            let Some((k, rev)) = best else { break };
+            section.gap_length += bd;
+            let mut c = open.remove(k).expect("index in range");
+            if rev {
+                c.reverse();
             }
-            loops.push(c);
-        } else {
-            let b = std::mem::take(&mut open[bj]);
-            open[bi].extend(b);
-            open.swap_remove(bj);
+            cur.extend(c);
+        }
+        section.gap_length += dist(cur[0], *cur.last().expect("non-empty"));
+        if cur.len() >= 3 {
+            loops.push(cur);
         }
     }
     loops

@@ -31,7 +31,7 @@ struct Args {
 }
 
 enum Parsed {
-    Run(Args),
+    Run(Box<Args>),
     Exit(String),
 }
 
@@ -105,12 +105,12 @@ fn parse_args(argv: &[String]) -> Result<Parsed, String> {
     }
     let model = model.ok_or_else(|| format!("no model file given\n\n{USAGE}"))?;
     settings.validate().map_err(|e| e.to_string())?;
-    Ok(Parsed::Run(Args {
+    Ok(Parsed::Run(Box::new(Args {
         model,
         output,
         settings,
         quiet,
-    }))
+    })))
 }
 
 fn list_settings() -> String {

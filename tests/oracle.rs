@@ -1,0 +1,148 @@
+//! Per-layer section areas and counts of outer boundaries and holes against the independent
+//! oracle (`../shared/tools/oracle_sections.py`, union = non-zero numbers). The fixtures in
+//! tests/fixtures/oracle were made by `scripts/make_oracle_fixtures.sh`.
+//!
+//! Tolerance: 0.5 % or 0.05 mm², whichever is larger. Counts: the union's, except on layers
+//! with pinch points (see `compare`). Layers whose plane contains horizontal
+//! faces are ambiguous (the oracle flags them, `near_plane_faces`) and skipped.
+
+use dropslice::{Job, Settings};
+use serde_json::Value;
+use std::path::PathBuf;
+
+fn shared() -> PathBuf {
+    std::env::var_os("DROPSLICE_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared"))
+}
+
+struct Mismatch {
+    layer: usize,
+    what: String,
+}
+
+/// Compares every layer of `model` with its fixture; returns the mismatches and layers compared.
+fn compare(model: &str, fixture: &str, counts: bool) -> (Vec<Mismatch>, usize) {
+    let path = shared().join("models").join(format!("{model}.stl"));
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let oracle: Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("tests/fixtures/oracle/{fixture}.json")),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let job = Job::new(&bytes, model, Settings::default()).unwrap();
+    let layers = oracle["layers"].as_array().unwrap();
+    assert_eq!(job.layer_count(), layers.len(), "{model}: layer count");
+    let mut bad = Vec::new();
+    let mut compared = 0;
+    for (i, l) in layers.iter().enumerate() {
+        assert!(
+            (job.plane_z(i) - l["z"].as_f64().unwrap()).abs() < 1e-9,
+            "{model} layer {i}: plane height"
+        );
+        if l.get("near_plane_faces").is_some() {
+            continue;
+        }
+        compared += 1;
+        let nz = &l["nonzero"];
+        let want = nz["area"].as_f64().unwrap();
+        let section = job.section(i);
+        let got = dropslice::slice::region_area(&section.region);
+        let tol = (want * 0.005).max(0.05);
+        if (got - want).abs() > tol {
+            bad.push(Mismatch {
+                layer: i,
+                what: format!("area {got:.4} vs oracle {want:.4}"),
+            });
+        }
+        if counts {
+            let outer = section.region.len() as u64;
+            let holes = section
+                .region
+                .iter()
+                .map(|s| s.len() as u64 - 1)
+                .sum::<u64>();
+            let (wo, wh) = (nz["outer"].as_u64().unwrap(), nz["holes"].as_u64().unwrap());
+            // A loop touching itself at one point (a pinch) is one polygon in the even-odd count
+            // and two in the oracle's union count; the oracle's signature of such a layer is
+            // that both areas agree and only the counts differ. There either count is right.
+            let pinch = (l["area"].as_f64().unwrap() - want).abs() <= 1e-6 * want.max(1.0);
+            let even_odd = (l["outer"].as_u64().unwrap(), l["holes"].as_u64().unwrap());
+            if (outer, holes) != (wo, wh) && !(pinch && (outer, holes) == even_odd) {
+                bad.push(Mismatch {
+                    layer: i,
+                    what: format!("outer/holes {outer}/{holes} vs oracle {wo}/{wh}"),
+                });
+            }
+        }
+    }
+    (bad, compared)
+}
+
+fn check(model: &str) {
+    check_fixture(model, model);
+}
+
+fn check_fixture(model: &str, fixture: &str) {
+    let (bad, compared) = compare(model, fixture, true);
+    assert!(compared > 0);
+    let report: Vec<String> = bad
+        .iter()
+        .map(|m| format!("layer {}: {}", m.layer, m.what))
+        .collect();
+    assert!(
+        report.is_empty(),
+        "{model}: {} of {compared} layers differ:\n{}",
+        report.len(),
+        report.join("\n")
+    );
+}
+
+#[test]
+fn cube() {
+    check("cube_20mm_ascii");
+}
+
+#[test]
+fn benchy() {
+    check("3DBenchy");
+}
+
+#[test]
+fn extruder_idler_union_of_nested_bodies() {
+    check("extruder_idler");
+}
+
+#[test]
+fn spikey_top() {
+    check("spikey_top_solid_header");
+}
+
+#[test]
+fn slide_n_snap() {
+    check("slide_n_snap_test_a_medium");
+}
+
+#[test]
+fn airfoil_wing() {
+    check("airfoil_wing");
+}
+
+#[test]
+fn m3_screw() {
+    check("M3x10_screw");
+}
+
+#[test]
+#[ignore = "open-mesh closing still differs from the oracle on 33 layers of the scan's base (issue 4)"]
+fn stanford_bunny_open_mesh_closed_like_the_oracle() {
+    check_fixture("stanford_bunny", "stanford_bunny_close_open");
+}
+
+#[test]
+fn esca_nonmanifold() {
+    check("esca_nonmanifold");
+}
