@@ -237,39 +237,103 @@ fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
 
 /// Plans every layer in parallel and writes header, layers (ascending) and footer to `out`.
 /// The header carries placeholders for the droplet counts (see [`gcode::header`]).
-/// `progress(done, total)` is called after each written batch of layers.
+///
+/// Worker threads take layers in order from a shared counter and may run at most a window of
+/// layers ahead of the writer, so memory is bounded by the mesh plus that window, however tall
+/// the part. `progress(done, total)` is called after each written layer.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn write_gcode<W: std::io::Write + ?Sized>(
     job: &Job,
     out: &mut W,
     mut progress: impl FnMut(usize, usize),
-) -> std::io::Result<Summary> {
-    use rayon::prelude::*;
-    out.write_all(job.header(None).as_bytes())?;
+) -> Result<Summary, Error> {
+    use std::collections::BTreeMap;
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    use std::sync::{Condvar, Mutex};
+
+    type Done = Result<(String, plan::Counts, f64), String>;
+    struct Shared {
+        done: BTreeMap<usize, Done>,
+        written: usize,
+    }
+    let io = |e: std::io::Error| Error::Io(format!("cannot write the code: {e}"));
+    out.write_all(job.header(None).as_bytes()).map_err(io)?;
     let n = job.layer_count();
-    let window = (rayon::current_num_threads() * 4).max(8);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(n.max(1));
+    let window = 4 * threads + 4;
+    let next = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let shared = Mutex::new(Shared {
+        done: BTreeMap::new(),
+        written: 0,
+    });
+    let changed = Condvar::new();
     let mut summary = Summary {
         layers: n,
         ..Summary::default()
     };
-    let mut start = 0;
-    while start < n {
-        let end = (start + window).min(n);
-        let done: Vec<(String, plan::Counts, f64)> = (start..end)
-            .into_par_iter()
-            .map(|i| {
-                let p = job.plan_layer(i);
-                (gcode::layer_text(&p), p.counts, p.travel_mm)
-            })
-            .collect();
-        for (text, counts, travel) in done {
-            out.write_all(text.as_bytes())?;
-            summary.counts.add(&counts);
-            summary.travel_mm += travel;
+    std::thread::scope(|scope| -> Result<(), Error> {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    if i >= n {
+                        break;
+                    }
+                    {
+                        let mut g = shared.lock().unwrap_or_else(|p| p.into_inner());
+                        while i >= g.written + window && !stop.load(Ordering::Relaxed) {
+                            g = changed.wait(g).unwrap_or_else(|p| p.into_inner());
+                        }
+                    }
+                    if stop.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    let result = std::panic::catch_unwind(|| {
+                        let p = job.plan_layer(i);
+                        (gcode::layer_text(&p), p.counts, p.travel_mm)
+                    })
+                    .map_err(|e| {
+                        e.downcast_ref::<&str>()
+                            .map(|s| s.to_string())
+                            .or_else(|| e.downcast_ref::<String>().cloned())
+                            .unwrap_or_else(|| "a layer could not be planned".into())
+                    });
+                    let mut g = shared.lock().unwrap_or_else(|p| p.into_inner());
+                    g.done.insert(i, result);
+                    changed.notify_all();
+                }
+            });
         }
-        progress(end, n);
-        start = end;
-    }
-    out.write_all(gcode::footer(&summary).as_bytes())?;
+        let result = (|| {
+            for i in 0..n {
+                let done = {
+                    let mut g = shared.lock().unwrap_or_else(|p| p.into_inner());
+                    loop {
+                        if let Some(d) = g.done.remove(&i) {
+                            g.written = i + 1;
+                            changed.notify_all();
+                            break d;
+                        }
+                        g = changed.wait(g).unwrap_or_else(|p| p.into_inner());
+                    }
+                };
+                let (text, counts, travel) =
+                    done.map_err(|m| Error::Internal(format!("layer {}: {m}", i + 1)))?;
+                out.write_all(text.as_bytes()).map_err(io)?;
+                summary.counts.add(&counts);
+                summary.travel_mm += travel;
+                progress(i + 1, n);
+            }
+            Ok(())
+        })();
+        stop.store(true, Ordering::Relaxed);
+        changed.notify_all();
+        result
+    })?;
+    out.write_all(gcode::footer(&summary).as_bytes())
+        .map_err(io)?;
     Ok(summary)
 }

@@ -177,8 +177,15 @@ fn run(args: &Args) -> Result<(), Error> {
             }
         }
     });
+    let summary = match summary {
+        Ok(s) => s,
+        Err(e) => {
+            drop(w);
+            let _ = std::fs::remove_file(&partial);
+            return Err(e);
+        }
+    };
     let finish = || -> std::io::Result<dropslice::Summary> {
-        let summary = summary?;
         let mut file = w.into_inner().map_err(|e| e.into_error())?;
         // Fill in the header's droplet counts (same length as the placeholders).
         let header = job.header(Some(&summary));
