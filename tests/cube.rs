@@ -193,7 +193,6 @@ fn cube_outermost_loop_first_with_outside_in() {
 }
 
 #[test]
-#[ignore = "bug: slice_plane=top leaves the cube's last layer (plane at z = 20, the top face) empty: 99 layers with droplets, expected 100"]
 fn cube_top_slice_plane_has_100_layers() {
     let g = cube_gcode(&["slice_plane=top"]);
     assert_eq!(g.layers.len(), 100);
