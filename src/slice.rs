@@ -160,13 +160,33 @@ pub fn section_loops(mesh: &Mesh, facets: &[u32], z: f64) -> (Vec<Contour>, Sect
         z,
         ..Section::default()
     };
-    let loops = chain(&segments, &mut section);
-    let contours: Vec<Contour> = loops
+    let (loops, joined) = chain(&segments, &mut section);
+    let mut contours: Vec<Contour> = loops
         .into_iter()
         .map(clean_loop)
         .filter(|c| c.len() >= 3)
         .collect();
+    for c in joined.into_iter().map(clean_loop).filter(|c| c.len() >= 3) {
+        contours.extend(resolve_joined(&c));
+    }
     (contours, section)
+}
+
+/// A loop closed across gaps may cross itself, so its winding numbers mean little: its
+/// inside is taken by the even-odd rule, oriented as the loop's overall signed area says
+/// (counter-clockwise: material; clockwise: a hole in what surrounds it).
+fn resolve_joined(c: &Contour) -> Vec<Contour> {
+    let clockwise = signed_area(c) < 0.0;
+    c.simplify_shape(FillRule::EvenOdd)
+        .into_iter()
+        .flatten()
+        .map(|mut ring| {
+            if clockwise {
+                ring.reverse();
+            }
+            ring
+        })
+        .collect()
 }
 
 /// The non-zero union of closed loops: shapes with outer boundaries CCW and holes CW.
@@ -212,7 +232,8 @@ fn segments(mesh: &Mesh, facets: &[u32], z: f64) -> Vec<Segment> {
 }
 
 /// Chains segments into closed loops (see the module docs for the three passes).
-fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
+/// Returns the loops closed by topology and, apart, those joined across gaps (pass 3).
+fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>) {
     let mut used = vec![false; segs.len()];
     let mut by_start: Vec<(u64, u32)> = segs
         .iter()
@@ -260,7 +281,7 @@ fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
         }
     }
     if leftovers.is_empty() {
-        return loops;
+        return (loops, Vec::new());
     }
 
     // Pass 2: chain the leftovers ignoring direction (flipped facets reverse a segment).
@@ -344,6 +365,7 @@ fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
     // chains in order; while another chain's start or end (then reversed) is nearer to the
     // current chain's end than its own start, append that chain; then close the loop.
     section.open_chains += open.len();
+    let mut joined = Vec::new();
     open.sort_by_key(|c| c.0);
     let mut open: std::collections::VecDeque<Vec<Point>> = open.into_iter().map(|c| c.1).collect();
     while let Some(mut cur) = open.pop_front() {
@@ -369,10 +391,10 @@ fn chain(segs: &[Segment], section: &mut Section) -> Vec<Contour> {
         }
         section.gap_length += dist(cur[0], *cur.last().expect("non-empty"));
         if cur.len() >= 3 {
-            loops.push(cur);
+            joined.push(cur);
         }
     }
-    loops
+    (loops, joined)
 }
 
 /// Drops points closer than [`MIN_POINT_DISTANCE_MM`] to the previous kept point, then
