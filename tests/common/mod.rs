@@ -106,10 +106,12 @@ pub struct Run {
 
 /// Runs the CLI with `args` in `cwd`, killing it after `timeout`.
 pub fn run_cli<S: AsRef<OsStr>>(args: &[S], cwd: &Path, timeout: Duration) -> Run {
+    static N: AtomicUsize = AtomicUsize::new(0);
     let t0 = Instant::now();
     let out_path = cwd.join(format!(
-        ".stdout-{}",
-        t0.elapsed().as_nanos() ^ std::process::id() as u128
+        ".stdout-{}-{}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
     ));
     let err_path = out_path.with_extension("stderr");
     let mut child = Command::new(bin())
