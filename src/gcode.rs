@@ -16,6 +16,38 @@ pub struct Summary {
     pub counts: Counts,
     /// Length of all moves without material, in mm.
     pub travel_mm: f64,
+    /// Layers whose section had open chains that were joined across gaps.
+    pub layers_with_open_chains: usize,
+    /// Loops chained against the direction of some of their facets (flipped facets).
+    pub reoriented_loops: usize,
+}
+
+impl Summary {
+    /// Adds one finished layer.
+    pub fn add(&mut self, plan: &LayerPlan) {
+        self.counts.add(&plan.counts);
+        self.travel_mm += plan.travel_mm;
+        self.layers_with_open_chains += usize::from(plan.open_chains > 0);
+        self.reoriented_loops += plan.reoriented_loops;
+    }
+
+    /// Plain-language notes on what slicing repaired.
+    pub fn repairs(&self) -> Vec<String> {
+        let mut r = Vec::new();
+        if self.layers_with_open_chains > 0 {
+            r.push(format!(
+                "{} layers had open sections (holes in the mesh), closed by joining their ends",
+                self.layers_with_open_chains
+            ));
+        }
+        if self.reoriented_loops > 0 {
+            r.push(format!(
+                "{} loops crossed flipped facets and were oriented by the majority",
+                self.reoriented_loops
+            ));
+        }
+        r
+    }
 }
 
 /// What the header says about the input.
@@ -143,16 +175,20 @@ pub fn layer_text(plan: &LayerPlan) -> String {
     t
 }
 
-/// Closing comment with the totals.
+/// Closing comments: the totals and what slicing repaired.
 pub fn footer(summary: &Summary) -> String {
-    format!(
+    let mut f = format!(
         "; end of code: {} layers, {} droplets ({} outer loops, {} inner loops, {} fill)\n",
         summary.layers,
         summary.counts.total(),
         summary.counts.outer,
         summary.counts.inner,
         summary.counts.fill
-    )
+    );
+    for r in summary.repairs() {
+        let _ = writeln!(f, "; repaired: {r}");
+    }
+    f
 }
 
 #[cfg(test)]

@@ -57,6 +57,25 @@ pub struct JobInfo {
     pub droplet_width: f64,
     /// Problems found in the mesh and what was done about them.
     pub warnings: Vec<String>,
+    /// A scale factor for all three axes when the part's size suggests the file is not in
+    /// millimetres (25.4: inches; 0.001: micrometres); never applied silently.
+    pub suggested_scale: Option<f64>,
+}
+
+/// Vertices closer than this are merged when exact welding leaves the surface open.
+pub const WELD_TOLERANCE_MM: f64 = 1e-4;
+
+/// The unit rule: a part whose largest extent is under 10 mm is probably in inches; one over
+/// 2 m probably in micrometres.
+pub fn suggested_scale(size: &[f64; 3]) -> Option<f64> {
+    let largest = size[0].max(size[1]).max(size[2]);
+    if largest < 10.0 {
+        Some(25.4)
+    } else if largest > 2000.0 {
+        Some(0.001)
+    } else {
+        None
+    }
 }
 
 /// One prepared slicing job: the placed mesh, its plane heights and a facet index per layer.
@@ -118,9 +137,30 @@ impl Job {
                 h / 2.0
             )));
         }
+        let duplicates = mesh.remove_duplicate_facets();
+        let facets_in_file = tris_len(stl_bytes, &mesh, degenerate) + duplicates;
+        let mut stats = MeshStats {
+            duplicate_facets: duplicates,
+            ..mesh.stats(facets_in_file, degenerate)
+        };
+        if stats.open_edges > 0 {
+            // Cracks between near-coincident corners: try a tolerance weld, keep it if it helps.
+            let mut welded = mesh.clone();
+            let merged = welded.weld_tolerance(WELD_TOLERANCE_MM);
+            let dropped = mesh.facets.len() - welded.facets.len();
+            let better = welded.stats(facets_in_file, degenerate + dropped);
+            if merged > 0 && better.open_edges < stats.open_edges {
+                mesh = welded;
+                stats = MeshStats {
+                    tolerance_welded: merged,
+                    duplicate_facets: duplicates,
+                    ..better
+                };
+            }
+        }
         let buckets = FacetBuckets::new(&mesh, &zs);
-        let stats = mesh.stats(tris_len(stl_bytes, &mesh, degenerate), degenerate);
         let warnings = warnings(&stats, &size);
+        let suggested_scale = suggested_scale(&size);
         let info = JobInfo {
             file_name: file_name.to_string(),
             format,
@@ -129,6 +169,7 @@ impl Job {
             layers: zs.len(),
             droplet_width: b,
             warnings,
+            suggested_scale,
         };
         Ok(Job {
             settings,
@@ -168,7 +209,11 @@ impl Job {
 
     /// Every move of layer `i`.
     pub fn plan_layer(&self, i: usize) -> LayerPlan {
-        plan::plan_layer(&self.section(i).region, i, &self.settings)
+        let section = self.section(i);
+        let mut plan = plan::plan_layer(&section.region, i, &self.settings);
+        plan.open_chains = section.open_chains;
+        plan.reoriented_loops = section.reoriented_loops;
+        plan
     }
 
     /// The header; with `None` the droplet counts are fixed-width placeholders.
@@ -213,24 +258,42 @@ fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
             m.misoriented_edges
         ));
     }
+    if m.duplicate_facets > 0 {
+        w.push(format!(
+            "{} duplicate facets were ignored",
+            m.duplicate_facets
+        ));
+    }
     if m.degenerate_facets > 0 {
         w.push(format!(
             "{} degenerate facets (zero area) were ignored",
             m.degenerate_facets
         ));
     }
+    if m.tolerance_welded > 0 {
+        w.push(format!(
+            "{} near-coincident vertices (closer than {WELD_TOLERANCE_MM} mm) were merged to close cracks in the surface",
+            m.tolerance_welded
+        ));
+    }
+    if m.bodies > 1 {
+        w.push(format!(
+            "{} separate bodies; where they overlap they are printed as one",
+            m.bodies
+        ));
+    }
     if m.signed_volume < 0.0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
     }
     let largest = size[0].max(size[1]).max(size[2]);
-    if largest < 10.0 {
-        w.push(format!(
-            "the part is only {largest:.3} mm across: if the file is in inches, scale it by 25.4 (--set scale_x=25.4 --set scale_y=25.4 --set scale_z=25.4)"
-        ));
-    } else if largest > 2000.0 {
-        w.push(format!(
-            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by 0.001 (--set scale_x=0.001 --set scale_y=0.001 --set scale_z=0.001)"
-        ));
+    match suggested_scale(size) {
+        Some(f) if f > 1.0 => w.push(format!(
+            "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
+        )),
+        Some(f) => w.push(format!(
+            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
+        )),
+        None => {}
     }
     w
 }
@@ -251,7 +314,7 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     use std::sync::{Condvar, Mutex};
 
-    type Done = Result<(String, plan::Counts, f64), String>;
+    type Done = Result<(String, LayerPlan), String>;
     struct Shared {
         done: BTreeMap<usize, Done>,
         written: usize,
@@ -292,8 +355,10 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
                         break;
                     }
                     let result = std::panic::catch_unwind(|| {
-                        let p = job.plan_layer(i);
-                        (gcode::layer_text(&p), p.counts, p.travel_mm)
+                        let mut p = job.plan_layer(i);
+                        let text = gcode::layer_text(&p);
+                        p.moves = Vec::new();
+                        (text, p)
                     })
                     .map_err(|e| {
                         e.downcast_ref::<&str>()
@@ -320,11 +385,10 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
                         g = changed.wait(g).unwrap_or_else(|p| p.into_inner());
                     }
                 };
-                let (text, counts, travel) =
+                let (text, plan) =
                     done.map_err(|m| Error::Internal(format!("layer {}: {m}", i + 1)))?;
                 out.write_all(text.as_bytes()).map_err(io)?;
-                summary.counts.add(&counts);
-                summary.travel_mm += travel;
+                summary.add(&plan);
                 progress(i + 1, n);
             }
             Ok(())

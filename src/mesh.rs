@@ -43,6 +43,12 @@ pub struct MeshStats {
     pub misoriented_edges: usize,
     /// Signed volume from the facets' orientation (negative: the mesh is inside out).
     pub signed_volume: f64,
+    /// Connected pieces of the surface.
+    pub bodies: usize,
+    /// Vertices merged by the tolerance weld (0 when exact welding closed the surface).
+    pub tolerance_welded: usize,
+    /// Facets dropped because they repeat another facet.
+    pub duplicate_facets: usize,
 }
 
 impl Mesh {
@@ -104,6 +110,99 @@ impl Mesh {
         }
     }
 
+    /// Drops facets that repeat another facet's three vertices (in either orientation: two
+    /// opposite copies make a zero-thickness sheet that encloses nothing, so the copy is
+    /// dropped and the first kept). Returns how many were dropped.
+    pub fn remove_duplicate_facets(&mut self) -> usize {
+        let before = self.facets.len();
+        let mut seen = std::collections::HashSet::with_capacity(before);
+        self.facets.retain(|f| {
+            let mut k = *f;
+            k.sort_unstable();
+            seen.insert(k)
+        });
+        before - self.facets.len()
+    }
+
+    /// Merges vertices closer than `tol` (mm) to an earlier vertex (cracks left by exporters
+    /// that write near-coincident corners), drops facets that collapse, and returns how many
+    /// vertices were merged. Used only as a fallback when the exact weld leaves open edges.
+    pub fn weld_tolerance(&mut self, tol: f64) -> usize {
+        let cell = |p: &[f64; 3]| p.map(|c| (c / tol).floor() as i64);
+        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(self.vertices.len());
+        let mut remap: Vec<u32> = Vec::with_capacity(self.vertices.len());
+        let mut kept: Vec<[f64; 3]> = Vec::with_capacity(self.vertices.len());
+        let mut merged = 0;
+        for v in &self.vertices {
+            let c = cell(v);
+            let mut found = None;
+            'search: for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(ids) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                            for &id in ids {
+                                let w = kept[id as usize];
+                                let d2 = (0..3).map(|k| (w[k] - v[k]).powi(2)).sum::<f64>();
+                                if d2 <= tol * tol {
+                                    found = Some(id);
+                                    break 'search;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            let id = found.unwrap_or_else(|| {
+                kept.push(*v);
+                let id = (kept.len() - 1) as u32;
+                grid.entry(c).or_default().push(id);
+                id
+            });
+            if found.is_some() {
+                merged += 1;
+            }
+            remap.push(id);
+        }
+        self.vertices = kept;
+        self.facets = self
+            .facets
+            .iter()
+            .map(|f| f.map(|i| remap[i as usize]))
+            .filter(|f| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+            .collect();
+        merged
+    }
+
+    /// Number of connected bodies (facets sharing a vertex belong to one body).
+    pub fn bodies(&self) -> usize {
+        let mut parent: Vec<u32> = (0..self.vertices.len() as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        for f in &self.facets {
+            let a = find(&mut parent, f[0]);
+            for &v in &f[1..] {
+                let b = find(&mut parent, v);
+                if a != b {
+                    parent[b as usize] = a;
+                }
+            }
+        }
+        let mut used = vec![false; self.vertices.len()];
+        for f in &self.facets {
+            for &v in f {
+                used[v as usize] = true;
+            }
+        }
+        (0..self.vertices.len() as u32)
+            .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
+            .count()
+    }
+
     /// Edge statistics and signed volume.
     pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
         // Directed edges, sorted by their undirected key.
@@ -146,6 +245,9 @@ impl Mesh {
             nonmanifold_edges: nonmanifold,
             misoriented_edges: misoriented,
             signed_volume,
+            bodies: self.bodies(),
+            tolerance_welded: 0,
+            duplicate_facets: 0,
         }
     }
 }

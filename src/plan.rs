@@ -69,6 +69,10 @@ pub struct LayerPlan {
     pub counts: Counts,
     /// Length of all moves without material (G01 and the travel part of G26), in mm.
     pub travel_mm: f64,
+    /// Repairs the section needed: open chains joined across gaps, loops chained against
+    /// the direction of some of their facets.
+    pub open_chains: usize,
+    pub reoriented_loops: usize,
 }
 
 /// Number of droplets a `G25` line of this length sets: one at its start, then one every B.

@@ -1,7 +1,7 @@
 //! The command-line tool: `dropslice MODEL.stl [-o OUT.gco] [--set name=value]... [--settings FILE.json]`.
 
 use dropslice::{Error, Job, Settings, write_gcode};
-use std::io::{BufWriter, Seek, SeekFrom, Write};
+use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -165,16 +165,25 @@ fn run(args: &Args) -> Result<(), Error> {
     let mut w = BufWriter::with_capacity(1 << 20, file);
     let quiet = args.quiet;
     let mut last = Instant::now();
+    let terminal = std::io::stderr().is_terminal();
+    // Progress after the first second: in place on a terminal, a line every 2 s in a log.
+    let every_ms = if terminal { 250 } else { 2000 };
+    let mut shown = false;
     let summary = write_gcode(&job, &mut w, |done, total| {
-        if !quiet
-            && t0.elapsed().as_secs_f64() > 1.0
-            && (last.elapsed().as_millis() > 250 || done == total)
-        {
-            eprint!("\rdropslice: layer {done}/{total}");
-            last = Instant::now();
+        let due = last.elapsed().as_millis() >= every_ms || (done == total && shown);
+        if quiet || t0.elapsed().as_secs_f64() < 1.0 || !due {
+            return;
+        }
+        shown = true;
+        last = Instant::now();
+        let pct = 100 * done / total.max(1);
+        if terminal {
+            eprint!("\rdropslice: layer {done}/{total} ({pct} %)");
             if done == total {
                 eprintln!();
             }
+        } else {
+            eprintln!("dropslice: layer {done}/{total} ({pct} %)");
         }
     });
     let summary = match summary {
@@ -210,6 +219,9 @@ fn run(args: &Args) -> Result<(), Error> {
         )));
     }
     std::fs::rename(&partial, &output).map_err(|e| io("write", &output, e))?;
+    for r in summary.repairs() {
+        eprintln!("dropslice: repaired: {r}");
+    }
     if !args.quiet {
         let c = summary.counts;
         eprintln!(

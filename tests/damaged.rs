@@ -1,0 +1,215 @@
+//! Real-world damage: copies of closed shared models with facets removed, flipped or
+//! duplicated, vertices jittered, or the whole mesh turned inside out still slice into
+//! closed sections whose areas stay within 2 % of the undamaged part's.
+
+use dropslice::{Job, Settings};
+use std::path::PathBuf;
+
+type Tri = [[f32; 3]; 3];
+
+fn shared() -> PathBuf {
+    std::env::var_os("DROPSLICE_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared"))
+}
+
+fn load(model: &str) -> Vec<Tri> {
+    let bytes = std::fs::read(shared().join("models").join(format!("{model}.stl"))).unwrap();
+    dropslice::stl::parse(&bytes).unwrap().0
+}
+
+fn binary(tris: &[Tri]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        b.extend([0u8; 12]);
+        for v in t {
+            for c in v {
+                b.extend(c.to_le_bytes());
+            }
+        }
+        b.extend([0u8; 2]);
+    }
+    b
+}
+
+/// A small deterministic generator (xorshift64*), so failures reproduce.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn areas(tris: &[Tri]) -> Vec<f64> {
+    let job = Job::new(&binary(tris), "damaged", Settings::default()).unwrap();
+    (0..job.layer_count())
+        .map(|i| dropslice::slice::region_area(&job.section(i).region))
+        .collect()
+}
+
+/// Every layer's area within 2 % of the undamaged one (0.05 mm² for tiny sections); no
+/// layer of the part lost.
+fn assert_close(model: &str, what: &str, damaged: &[Tri]) {
+    let want = areas(&load(model));
+    let got = areas(damaged);
+    assert_eq!(got.len(), want.len(), "{model} {what}: layer count");
+    let mut bad = Vec::new();
+    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+        if (g - w).abs() > (0.02 * w).max(0.05) {
+            bad.push(format!("layer {i}: {g:.3} vs {w:.3}"));
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{model} {what}: {} layers differ:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+}
+
+const MODELS: [&str; 3] = [
+    "extruder_idler",
+    "slide_n_snap_test_a_medium",
+    "M3x10_screw",
+];
+
+#[test]
+fn flipped_facets() {
+    for (k, model) in MODELS.iter().enumerate() {
+        let mut rng = Rng(17 + k as u64);
+        let mut t = load(model);
+        for tri in &mut t {
+            if rng.unit() < 0.10 {
+                tri.swap(1, 2);
+            }
+        }
+        assert_close(model, "10 % flipped", &t);
+    }
+}
+
+#[test]
+fn inside_out() {
+    for model in MODELS {
+        let mut t = load(model);
+        for tri in &mut t {
+            tri.swap(1, 2);
+        }
+        assert_close(model, "inside out", &t);
+    }
+}
+
+#[test]
+fn duplicated_facets() {
+    for (k, model) in MODELS.iter().enumerate() {
+        let mut rng = Rng(99 + k as u64);
+        let mut t = load(model);
+        let extra: Vec<Tri> = t.iter().filter(|_| rng.unit() < 0.2).copied().collect();
+        t.extend(extra);
+        assert_close(model, "20 % duplicated", &t);
+    }
+}
+
+#[test]
+fn jittered_vertices() {
+    // Every corner of every facet moved by up to 1e-6 mm on its own: exact welding fails
+    // everywhere, the tolerance weld closes the cracks.
+    for (k, model) in MODELS.iter().enumerate() {
+        let mut rng = Rng(5 + k as u64);
+        let mut t = load(model);
+        for tri in &mut t {
+            for v in tri.iter_mut() {
+                for c in v.iter_mut() {
+                    *c += ((rng.unit() - 0.5) * 2e-6) as f32;
+                }
+            }
+        }
+        assert_close(model, "jittered 1e-6", &t);
+    }
+}
+
+#[test]
+fn removed_facets() {
+    for (k, model) in MODELS.iter().enumerate() {
+        let mut rng = Rng(31 + k as u64);
+        let t: Vec<Tri> = load(model)
+            .into_iter()
+            .filter(|_| rng.unit() >= 0.01)
+            .collect();
+        assert_close(model, "1 % removed", &t);
+    }
+}
+
+fn run_cli(model: &std::path::Path, extra: &[&str]) -> (String, String) {
+    let out = std::env::temp_dir().join(format!(
+        "dropslice-diag-{}-{}.gco",
+        std::process::id(),
+        model.file_stem().unwrap().to_string_lossy()
+    ));
+    let r = std::process::Command::new(env!("CARGO_BIN_EXE_dropslice"))
+        .arg(model)
+        .arg("-o")
+        .arg(&out)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let gco = std::fs::read_to_string(&out).unwrap();
+    let _ = std::fs::remove_file(&out);
+    (String::from_utf8_lossy(&r.stderr).into_owned(), gco)
+}
+
+#[test]
+fn diagnostics_in_summary_header_and_footer() {
+    // The open scan: open edges in the header and the CLI; the repaired layers at the end.
+    let (err, gco) = run_cli(&shared().join("models/stanford_bunny.stl"), &["-q"]);
+    assert!(
+        err.contains("warning: the mesh is not closed: 223 open edges"),
+        "{err}"
+    );
+    assert!(
+        err.contains("repaired: 50 layers had open sections"),
+        "{err}"
+    );
+    assert!(gco.contains("; warning: the mesh is not closed: 223 open edges"));
+    assert!(gco.contains("; repaired: 50 layers had open sections"));
+    // Non-manifold edges and several bodies.
+    let (err, gco) = run_cli(&shared().join("models/esca_nonmanifold.stl"), &["-q"]);
+    assert!(err.contains("16 non-manifold edges"), "{err}");
+    assert!(gco.contains("; warning: 6 separate bodies"), "{gco:.2000}");
+    // A part in inches: warned, with the fix, and not rescaled.
+    let inch: Vec<Tri> = load("cube_20mm_ascii")
+        .into_iter()
+        .map(|t| t.map(|v| v.map(|c| c / 25.4)))
+        .collect();
+    let path = std::env::temp_dir().join(format!("dropslice-inch-{}.stl", std::process::id()));
+    std::fs::write(&path, binary(&inch)).unwrap();
+    let (err, gco) = run_cli(&path, &[]);
+    assert!(
+        err.contains("scale it by 25.4 (--set scale_x=25.4"),
+        "{err}"
+    );
+    assert!(gco.contains("bounding box = X0.0000..0.7874"), "{gco:.600}");
+    let (_, gco) = run_cli(
+        &path,
+        &[
+            "--set",
+            "scale_x=25.4",
+            "--set",
+            "scale_y=25.4",
+            "--set",
+            "scale_z=25.4",
+        ],
+    );
+    assert!(
+        gco.contains("bounding box = X0.0000..20.0000"),
+        "{gco:.600}"
+    );
+    let _ = std::fs::remove_file(&path);
+}
