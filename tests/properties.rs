@@ -154,8 +154,10 @@ proptest! {
 fn rotating_by_special_angles() {
     for model in MODELS {
         for angle in [90.0, 180.0, -45.0, 45.0, 0.001] {
-            let mut s = Settings::default();
-            s.rotate_z = angle;
+            let s = Settings {
+                rotate_z: angle,
+                ..Settings::default()
+            };
             let got = measure(&job(&common::model_bytes(model), model, s));
             if let Err(e) = compare(
                 &format!("{model} rotated by {angle}°"),
