@@ -62,7 +62,17 @@ SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
 # ------------------------------------------------------------------ 1. build
 log "cargo build --release --bin dropslice"
 cargo build --release --bin dropslice >&2 || { echo "build failed" >&2; exit 1; }
-DS="$ROOT/target/release/dropslice"
+# A private copy: another build of target/release during the run must not change the binary.
+mkdir -p "$BENCH_DIR/bin"
+cp -f "$ROOT/target/release/dropslice" "$BENCH_DIR/bin/dropslice"
+DS="$BENCH_DIR/bin/dropslice"
+{
+  echo "commit: $(git -C "$ROOT" describe --always --dirty 2>/dev/null || echo unknown)"
+  echo "binary: $(sha256sum "$DS" | cut -c1-16)"
+  echo "date: $(date -u +%FT%TZ)"
+  echo "machine: $(nproc) cores, $(awk '/MemTotal/{printf "%.0f GiB", $2/1048576}' /proc/meminfo), $(lscpu | sed -n 's/^Model name: *//p' | head -1)"
+} >"$BENCH_DIR/meta.txt"
+log "$(tr '\n' ';' <"$BENCH_DIR/meta.txt")"
 
 # ------------------------------------------------------------------ 2. peers
 apt_install() {  # idempotent: only what is missing
@@ -255,4 +265,4 @@ fi
 # ------------------------------------------------------------------ 6. report
 args=("$RAW")
 [ -f "$BROWSER_TSV" ] && args+=(--browser "$BROWSER_TSV")
-python3 "$ROOT/scripts/bench_report.py" "${args[@]}" | tee "$BENCH_DIR/report.md"
+{ sed 's/^/    /' "$BENCH_DIR/meta.txt"; echo; python3 "$ROOT/scripts/bench_report.py" "${args[@]}"; } | tee "$BENCH_DIR/report.md"

@@ -2,7 +2,9 @@
 """Summarise scripts/bench.sh's raw.tsv: median wall time, peak RSS, dropslice/peer
 ratios, and the issue-5 targets (PASS / FAIL / n/a when a row is missing).
 
-usage: bench_report.py RAW.tsv [--browser BROWSER.tsv]
+usage: bench_report.py RAW.tsv [MORE.tsv ...] [--browser BROWSER.tsv]
+Rows of a later file replace the same (model, tool) rows of earlier ones, so a
+dropslice-only rerun (BENCH_PEERS=0) can be combined with an earlier run's peer rows.
 """
 import argparse
 import csv
@@ -12,11 +14,13 @@ from collections import defaultdict
 TOOL_RANK = {"dropslice": 0, "cura": 1, "prusa": 2}
 
 
-def load(path):
-    rows = list(csv.DictReader(open(path), delimiter="\t"))
+def load(paths):
     groups = defaultdict(list)
-    for r in rows:
-        groups[(r["model"], r["tool"])].append(r)
+    for path in paths:
+        fresh = defaultdict(list)
+        for r in csv.DictReader(open(path), delimiter="\t"):
+            fresh[(r["model"], r["tool"])].append(r)
+        groups.update(fresh)
     stats = {}
     for k, g in groups.items():
         ok = [r for r in g if r["rc"] == "0" and r["wall_s"]]
@@ -126,7 +130,7 @@ def browser(path):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("raw")
+    ap.add_argument("raw", nargs="+")
     ap.add_argument("--browser")
     a = ap.parse_args()
     stats = load(a.raw)
