@@ -116,9 +116,9 @@ impl Session {
         Ok(LayerResult::new(&plan, &self.settings))
     }
 
-    /// The header comment block; `summary_json` =
-    /// `{"layers":n,"counts":{"outer":..,"inner":..,"fill":..},"travel_mm":..}`,
-    /// or an empty string for the same-width placeholder.
+    /// The header comment block for a finished slice: `summary_json` is the sum of every
+    /// layer's `LayerResult::summary_json` with `layers` set; an empty string gives the
+    /// same-width placeholder header.
     pub fn header(&self, summary_json: &str) -> Result<String, JsError> {
         if summary_json.trim().is_empty() {
             return Ok(self.job.header(None));
@@ -141,6 +141,7 @@ pub struct LayerResult {
     z: f64,
     counts: Counts,
     travel_mm: f64,
+    summary: Summary,
     gcode: String,
     preview: PreviewLayer,
 }
@@ -152,6 +153,11 @@ impl LayerResult {
             z: plan.z,
             counts: plan.counts,
             travel_mm: plan.travel_mm,
+            summary: {
+                let mut s = Summary::default();
+                s.add(plan);
+                s
+            },
             gcode: gcode::layer_text(plan),
             preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
         }
@@ -187,6 +193,12 @@ impl LayerResult {
     #[wasm_bindgen(getter)]
     pub fn travel_mm(&self) -> f64 {
         self.travel_mm
+    }
+    /// This layer's share of the slice's [`Summary`] as JSON (`layers` is 0): the page adds
+    /// the numbers of all layers up, sets `layers`, and hands the sum to `Session::header`.
+    #[wasm_bindgen(getter)]
+    pub fn summary_json(&self) -> String {
+        serde_json::to_string(&self.summary).unwrap_or_default()
     }
     /// The layer's G-code lines.
     #[wasm_bindgen(getter)]

@@ -119,7 +119,9 @@ export class GcodeReader {
       const dx = x - this.x;
       const dy = y - this.y;
       const len = Math.hypot(dx, dy);
-      const n = Math.floor(len / this.width + 1e-6) + 1;
+      // As the core counts (plan::line_droplets). The coordinates were rounded to 4 decimals,
+      // so a line within ~1e-4 mm of a multiple of B may gain or lose its last droplet.
+      const n = Math.floor(len / this.width + 1e-9) + 1;
       for (let k = 0; k < n; k++) {
         const t = len > 0 ? (k * this.width) / len : 0;
         L.droplets.push(this.x + dx * t); L.droplets.push(this.y + dy * t); L.roles.push(2);

@@ -2,7 +2,7 @@
 
 import { Cancelled, Pool, SliceError } from "./client";
 import { SettingsForm, type Value } from "./form";
-import type { Counts, GcodeParseResult, InitResult, JobInfo, LayerData } from "./protocol";
+import { addNumbers, type Counts, type GcodeParseResult, type InitResult, type JobInfo, type LayerData } from "./protocol";
 import { Renderer, type Bounds, type View } from "./render";
 import { sampleStl } from "./sample";
 import { makeLink, readLink, sha256Hex, type SharedLink } from "./share";
@@ -34,6 +34,8 @@ class Slice {
   bbox: Bounds = { minX: Infinity, minY: Infinity, maxX: -Infinity, maxY: -Infinity };
   totals: Counts = { outer: 0, inner: 0, fill: 0 };
   travelTotal = 0;
+  /** Sum of the layers' summaries (the core's Summary, for the header and footer). */
+  summary: Record<string, unknown> = {};
 
   constructor(
     readonly source: "stl" | "gco",
@@ -59,6 +61,7 @@ class Slice {
       this.totals.inner += l.counts.inner;
       this.totals.fill += l.counts.fill;
       this.travelTotal += l.travelMm;
+      if (l.summary) addNumbers(this.summary, JSON.parse(l.summary) as Record<string, unknown>);
       const d = l.droplets;
       const b = this.bbox;
       for (let i = 0; i < d.length; i += 2) {
@@ -71,7 +74,7 @@ class Slice {
       }
     }
     if (l.gcode) this.gcode[l.index] = l.gcode;
-    const { gcode: _, ...preview } = l;
+    const { gcode: _g, summary: _s, ...preview } = l;
     if (!this.cache.has(l.index)) {
       this.cache.set(l.index, preview);
       this.cacheBytes += l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength;
@@ -114,7 +117,7 @@ const previewRequests = new Set<number>();
 
 const slider = $<HTMLInputElement>("layer");
 
-function setState(state: "loading" | "idle" | "slicing" | "done" | "error" | "cancelled"): void {
+function setState(state: "loading" | "reading" | "idle" | "slicing" | "done" | "error" | "cancelled"): void {
   document.body.dataset.state = state;
 }
 
@@ -479,6 +482,7 @@ function settingsStatus(): void {
 // files
 
 async function openFile(file: File): Promise<void> {
+  setState("reading");
   if (/\.(gco|gcode)$/i.test(file.name)) {
     pendingLink = null;
     note("", "none");
@@ -534,7 +538,7 @@ function baseName(name: string): string {
 async function download(): Promise<void> {
   const s = slice;
   if (!s || !s.complete || s.source !== "stl") return;
-  const summary = JSON.stringify({ layers: s.layers, counts: s.totals });
+  const summary = JSON.stringify({ ...s.summary, layers: s.layers });
   try {
     const [header, footer] = await Promise.all([pool.header(summary), pool.footer(summary)]);
     const parts: BlobPart[] = [header];
@@ -570,8 +574,11 @@ async function share(): Promise<void> {
   }, model.bytes);
   let copied = false;
   try {
-    await navigator.clipboard.writeText(url);
-    copied = true;
+    // some browsers never settle the promise when they do not grant the permission
+    copied = await Promise.race([
+      navigator.clipboard.writeText(url).then(() => true),
+      new Promise<boolean>((ok) => setTimeout(() => ok(false), 1500)),
+    ]);
   } catch {
     // clipboard refused (permissions, insecure context): the dialog shows the link to copy
   }
@@ -781,7 +788,7 @@ window.dropslice = {
     name: slice?.name ?? null,
     workers: pool.size,
   }),
-  crash: () => pool.crash(),
+  crash: () => pool.crash().catch(showError),
   show,
 };
 

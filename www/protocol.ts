@@ -31,6 +31,8 @@ export interface LayerData {
   roles: Uint8Array;
   /** x0,y0,x1,y1 per travel move, mm. */
   travel: Float32Array;
+  /** The layer's share of the core's Summary, JSON (slices only). */
+  summary?: string;
   /** The layer's G-code (slices only; absent for preview re-requests). */
   gcode?: Blob;
 }
@@ -91,4 +93,17 @@ export function splitError(text: string): { kind: string; message: string } {
 
 export function transferablesOf(layer: LayerData): Transferable[] {
   return [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
+}
+
+/** Adds every number of `b` into `a` (nested objects too): sums the layers' summaries
+ *  without the page having to know the core's Summary fields. */
+export function addNumbers(a: Record<string, unknown>, b: Record<string, unknown>): Record<string, unknown> {
+  for (const [k, v] of Object.entries(b)) {
+    if (typeof v === "number") a[k] = (typeof a[k] === "number" ? (a[k] as number) : 0) + v;
+    else if (v && typeof v === "object" && !Array.isArray(v)) {
+      const inner = a[k] && typeof a[k] === "object" ? (a[k] as Record<string, unknown>) : {};
+      a[k] = addNumbers(inner, v as Record<string, unknown>);
+    } else if (!(k in a)) a[k] = v;
+  }
+  return a;
 }

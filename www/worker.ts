@@ -60,6 +60,7 @@ function layerOf(s: Session, index: number, withGcode: boolean): LayerData {
       roles: r.roles,
       travel: r.travel,
       gcode: withGcode ? new Blob([r.gcode], { type: "text/plain" }) : undefined,
+      summary: withGcode ? r.summary_json : undefined,
     };
   } finally {
     r.free();

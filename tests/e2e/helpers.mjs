@@ -58,7 +58,7 @@ export const status = (page) => page.evaluate(() => window.dropslice.status());
 /** Waits until the page has finished a slice (or failed); returns its status. */
 export async function waitSettled(page, timeout = 240_000) {
   await page.waitForFunction(
-    () => ["done", "error", "cancelled", "idle"].includes(document.body.dataset.state ?? ""),
+    () => ["done", "error", "cancelled"].includes(document.body.dataset.state ?? ""),
     null,
     { timeout, polling: 100 },
   );

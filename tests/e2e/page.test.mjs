@@ -1,0 +1,263 @@
+// End-to-end tests of the page in headless Chromium (playwright-core + Debian's chromium).
+// Needs dist/ (scripts/build.sh) and, for the G-code comparison, target/release/dropslice.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { execFileSync } from "node:child_process";
+import { existsSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import { benchy, canvasPixels, openPage, parseGcode, repo, start, status, torusStl, waitSettled } from "./helpers.mjs";
+
+let env;
+let main; // the page most tests share
+const tmp = mkdtempSync(join(tmpdir(), "dropslice-e2e-"));
+const cli = join(repo, "target/release/dropslice");
+
+before(async () => {
+  env = await start();
+  main = await openPage(env.browser, env.url);
+});
+
+after(async () => {
+  await env?.close();
+  rmSync(tmp, { recursive: true, force: true });
+});
+
+/** Coloured (non-background, non-grid) pixels of the canvas. */
+function inkPixels(page) {
+  return page.evaluate(() => {
+    const c = document.getElementById("view");
+    const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
+      if (Math.max(r, g, b) - Math.min(r, g, b) > 60) n++; // saturated: a droplet colour
+    }
+    return n;
+  });
+}
+
+/** Opens a file through the file picker (same code path as drag and drop). */
+async function pick(page, file) {
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.setInputFiles("#file-input", file);
+}
+
+/** Clicks "Copy preview link" and reads the link from the dialog. */
+async function shareLink(page) {
+  await page.click("#btn-share");
+  await page.waitForSelector("#share-dialog[open]");
+  const url = await page.inputValue("#share-url");
+  await page.click("#share-dialog button");
+  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
+  return url;
+}
+
+async function waitDone(page, timeout) {
+  const s = await waitSettled(page, timeout);
+  const banner = await page.locator("#banner").innerText().catch(() => "");
+  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
+  return s;
+}
+
+test("the sample part is sliced and drawn on first visit", async () => {
+  const { page, errors } = main;
+  const s = await waitDone(page, 60_000);
+  assert.equal(s.name, "sample-block-with-boss.stl");
+  assert.ok(s.layers > 50, `layers ${s.layers}`);
+  assert.ok(s.counts.outer > 0 && s.counts.inner > 0 && s.counts.fill > 0, JSON.stringify(s.counts));
+  await page.waitForTimeout(100);
+  assert.ok((await inkPixels(page)) > 10_000, "droplets are drawn");
+  assert.match(await page.locator("#stat-droplets").innerText(), /^[\d,]+$/);
+  assert.deepEqual(errors, []);
+});
+
+test("invalid settings are flagged before slicing", async () => {
+  const { page } = main;
+  await page.fill("#set-layer_height", "-1");
+  assert.equal(await page.getAttribute("#set-layer_height", "aria-invalid"), "true");
+  assert.match(await page.locator(".field.invalid .message").first().innerText(), /greater than 0/);
+  assert.equal(await page.isDisabled("#btn-slice"), true);
+  await page.fill("#set-layer_height", "abc");
+  assert.match(await page.locator(".field.invalid .message").first().innerText(), /not a number/);
+  await page.fill("#set-layer_height", "0.2");
+  assert.equal(await page.isDisabled("#btn-slice"), false);
+  assert.equal(await page.locator(".field.invalid").count(), 0);
+});
+
+test("3DBenchy: progress reaches 100 %, the slider changes the canvas", async () => {
+  const { page } = main;
+  await page.evaluate(() => {
+    window.__pct = [];
+    const p = document.getElementById("progress");
+    new MutationObserver(() => window.__pct.push(Number(p.dataset.percent))).observe(p, { attributes: true, attributeFilter: ["data-percent"] });
+  });
+  const t0 = Date.now();
+  await pick(page, benchy);
+  await page.waitForFunction(() => document.body.dataset.state === "slicing");
+  const s = await waitDone(page, 240_000);
+  console.log(`# 3DBenchy sliced in the page in ${((Date.now() - t0) / 1000).toFixed(1)} s with ${s.workers} worker(s)`);
+  const pct = await page.evaluate(() => window.__pct);
+  assert.ok(pct.length > 3, `progress updates: ${pct}`);
+  assert.equal(Math.max(...pct), 100);
+  assert.equal(s.layers, 240);
+  assert.equal(s.done, 240);
+  assert.match(await page.locator("#stat-layers").innerText(), /^240$/);
+
+  await page.waitForTimeout(100);
+  const before = await canvasPixels(page);
+  await page.locator("#layer").fill("200");
+  await page.waitForTimeout(150);
+  assert.equal((await status(page)).layer, 200);
+  const after200 = await canvasPixels(page);
+  assert.notEqual(after200, before, "moving the slider redraws");
+  // arrow keys move one layer
+  await page.locator("#view").focus();
+  await page.keyboard.press("ArrowDown");
+  assert.equal((await status(page)).layer, 199);
+  await page.keyboard.press("ArrowUp");
+  assert.equal((await status(page)).layer, 200);
+  await page.waitForTimeout(100);
+  assert.ok((await inkPixels(page)) > 1000);
+});
+
+test("the downloaded .gco has the CLI's commands", async (t) => {
+  if (!existsSync(cli)) return t.skip("target/release/dropslice not built");
+  const { page } = main;
+  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
+  assert.equal(download.suggestedFilename(), "3DBenchy.gco");
+  const mine = join(tmp, "page.gco");
+  await download.saveAs(mine);
+  const theirs = join(tmp, "cli.gco");
+  execFileSync(cli, [benchy, "-o", theirs, "-q"], { stdio: "inherit" });
+  const a = parseGcode(readFileSync(mine, "utf8"));
+  const b = parseGcode(readFileSync(theirs, "utf8"));
+  assert.equal(a.length, b.length, "same number of commands");
+  for (let i = 0; i < a.length; i++) {
+    const p = a[i];
+    const q = b[i];
+    if (p.code !== q.code || Math.abs(p.x - q.x) > 1e-4 || Math.abs(p.y - q.y) > 1e-4 || Math.abs(p.z - q.z) > 1e-4) {
+      assert.fail(`command ${i}: page ${JSON.stringify(p)} vs CLI ${JSON.stringify(q)}`);
+    }
+  }
+  const text = readFileSync(mine, "utf8");
+  assert.match(text, /^; dropslice /);
+  assert.match(text, /; layer_height = 0\.2/);
+  assert.match(text, /; end of code: 240 layers/);
+  // the totals in the page's header equal the CLI's
+  const totals = (s) => s.split("\n").filter((l) => l.startsWith("; droplets ")).join("\n");
+  assert.equal(totals(text), totals(readFileSync(theirs, "utf8")));
+
+  // the page opens its own .gco back: same layers and droplets
+  const sliced = await status(page);
+  await pick(page, mine);
+  const viewed = await waitDone(page, 120_000);
+  assert.equal(viewed.layers, sliced.layers);
+  // G25 lines are re-expanded from 4-decimal coordinates, so a line whose length is within
+  // ~1e-4 mm of a multiple of B can gain or lose its last droplet: allow 1 in 10,000.
+  assert.ok(Math.abs(viewed.droplets - sliced.droplets) <= sliced.droplets * 1e-4, `${viewed.droplets} vs ${sliced.droplets}`);
+  assert.equal(viewed.counts.outer, sliced.counts.outer + sliced.counts.inner, "every G26 is a loop droplet");
+  assert.ok((await inkPixels(page)) > 1000);
+});
+
+test("a preview link with the embedded model reproduces the slice", async () => {
+  const { page } = main;
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click("#btn-sample");
+  await waitDone(page, 60_000);
+  await page.fill("#set-contours", "3");
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click("#btn-slice");
+  await waitDone(page, 60_000);
+  await page.locator("#layer").fill("70");
+  await page.waitForTimeout(100);
+  const here = await status(page);
+  const url = await shareLink(page);
+  assert.match(url, /#p=.*&m=/, "model embedded");
+
+  const other = await openPage(env.browser, url);
+  const there = await waitDone(other.page, 60_000);
+  assert.equal(there.layer, 70);
+  assert.equal(there.droplets, here.droplets);
+  assert.deepEqual(there.layerDroplets, here.layerDroplets);
+  assert.equal(await other.page.inputValue("#set-contours"), "3");
+  assert.ok(Math.abs(there.view.scale - here.view.scale) < 1e-9);
+  await other.context.close();
+  await page.fill("#set-contours", "2");
+});
+
+test("a preview link of a big model asks for the file and checks it", async () => {
+  const { page } = main;
+  await pick(page, benchy);
+  await waitDone(page, 240_000);
+  await page.locator("#layer").fill("120");
+  const here = await status(page);
+  const url = await shareLink(page);
+  assert.doesNotMatch(url, /&m=/, "3DBenchy is too big to embed");
+
+  const other = await openPage(env.browser, url);
+  await other.page.waitForFunction(() => !document.getElementById("link-note").hidden);
+  assert.match(await other.page.locator("#link-note").innerText(), /3DBenchy\.stl/);
+  // a different file is recognised as different
+  await pick(other.page, join(benchy, "../cube_20mm_ascii.stl"));
+  await waitDone(other.page, 60_000);
+  assert.match(await other.page.locator("#link-note").innerText(), /does not match/);
+  await other.context.close();
+
+  const third = await openPage(env.browser, url);
+  await third.page.waitForFunction(() => !document.getElementById("link-note").hidden);
+  await pick(third.page, benchy);
+  const there = await waitDone(third.page, 240_000);
+  assert.match(await third.page.locator("#link-note").innerText(), /matches/);
+  assert.equal(there.layer, 120);
+  assert.equal(there.droplets, here.droplets);
+  await third.context.close();
+});
+
+test("a garbage file shows an error and the next slice works", async () => {
+  const { page } = main;
+  const junk = Buffer.alloc(5000);
+  for (let i = 0; i < junk.length; i++) junk[i] = (i * 7919 + 13) % 251;
+  await pick(page, { name: "garbage.stl", mimeType: "model/stl", buffer: junk });
+  const s = await waitSettled(page, 30_000);
+  assert.equal(s.state, "error");
+  assert.equal(await page.isVisible("#banner"), true);
+  assert.match(await page.locator("#banner").innerText(), /Cannot read this file/);
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click("#btn-sample");
+  const ok = await waitDone(page, 60_000);
+  assert.equal(ok.name, "sample-block-with-boss.stl");
+  assert.equal(await page.isVisible("#banner"), false);
+});
+
+test("a crash in the wasm becomes a message and the page recovers", async () => {
+  const { page } = main;
+  await page.evaluate(() => window.dropslice.crash().catch(() => {}));
+  await page.waitForFunction(() => !document.getElementById("banner").hidden);
+  const text = await page.locator("#banner").innerText();
+  assert.match(text, /crashed/);
+  assert.match(text, /crash_for_test/);
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click("#btn-sample");
+  await waitDone(page, 60_000);
+});
+
+test("Cancel stops a large slice at once and a new slice works", async () => {
+  const { page } = main;
+  const torus = torusStl(600, 250, 40, 12); // 300,000 facets, 24 mm tall
+  await page.fill("#set-layer_height", "0.05");
+  await pick(page, { name: "torus.stl", mimeType: "model/stl", buffer: torus });
+  await page.waitForFunction(() => window.dropslice.status().done >= 2, null, { timeout: 120_000, polling: 50 });
+  const t0 = Date.now();
+  await page.click("#btn-cancel");
+  const s = await waitSettled(page, 5_000);
+  assert.equal(s.state, "cancelled");
+  assert.ok(Date.now() - t0 < 2000, "cancel is immediate");
+  assert.equal(await page.isVisible("#progress"), false);
+  await page.fill("#set-layer_height", "0.2");
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click("#btn-sample");
+  const ok = await waitDone(page, 60_000);
+  assert.equal(ok.name, "sample-block-with-boss.stl");
+  assert.ok(ok.droplets > 0);
+});
