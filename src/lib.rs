@@ -120,6 +120,12 @@ impl Job {
             });
         }
         let b = settings.droplet_width();
+        let volume = mesh.signed_volume().abs();
+        if size[0] <= 0.0 || size[1] <= 0.0 || volume <= 1e-9 * size[0] * size[1] * size[2] {
+            return Err(Error::NothingToPrint(
+                "the mesh encloses no volume (a surface without thickness): export the part as a solid".into(),
+            ));
+        }
         if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
             return Err(Error::Setting {
                 name: "scale_x".into(),

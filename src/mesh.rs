@@ -203,6 +203,19 @@ impl Mesh {
             .count()
     }
 
+    /// Volume enclosed by the facets, signed by their orientation (negative: inside out).
+    pub fn signed_volume(&self) -> f64 {
+        self.facets
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| self.vertices[i as usize]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum()
+    }
+
     /// Edge statistics and signed volume.
     pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
         // Directed edges, sorted by their undirected key.
@@ -226,16 +239,7 @@ impl Mesh {
                 _ => nonmanifold += 1,
             }
         }
-        let signed_volume = self
-            .facets
-            .iter()
-            .map(|f| {
-                let [a, b, c] = f.map(|i| self.vertices[i as usize]);
-                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                    / 6.0
-            })
-            .sum();
+        let signed_volume = self.signed_volume();
         MeshStats {
             facets_in_file,
             facets: self.facets.len(),

@@ -6,7 +6,7 @@
 //! overlaps with a winding-number rule — the thesis's step. Arcs are approximated by chords
 //! no farther than [`CHORD_TOLERANCE_MM`] from the true arc.
 
-use crate::slice::Shapes;
+use crate::slice::{Contour, Shapes, dist, signed_area};
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 
@@ -25,5 +25,57 @@ pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
         .outer_offset(-d_outer)
         .inner_offset(-d_hole)
         .line_join(LineJoin::Round(angle));
-    region.outline(&style)
+    region
+        .outline(&style)
+        .into_iter()
+        .filter_map(|shape| {
+            let mut contours = shape.into_iter().map(remove_spikes);
+            // The outer boundary decides whether the shape survives; holes that collapse go.
+            let outer = contours
+                .next()
+                .filter(|c| signed_area(c).abs() >= MIN_AREA_MM2)?;
+            let mut shape = vec![outer];
+            shape.extend(contours.filter(|c| signed_area(c).abs() >= MIN_AREA_MM2));
+            Some(shape)
+        })
+        .collect()
+}
+
+/// Two points closer than this on either side of a vertex make that vertex a spike.
+const SPIKE_BASE_MM: f64 = 1e-4;
+/// Loops enclosing less than this are slivers of rounding, not geometry.
+const MIN_AREA_MM2: f64 = 1e-6;
+
+/// Removes zero-width spikes (a vertex whose neighbours coincide within [`SPIKE_BASE_MM`]):
+/// the offset engine can leave such a spike running back to the original boundary where two
+/// nearly opposite edges meet, and a droplet walk would follow it out of the loop.
+pub fn remove_spikes(mut c: Contour) -> Contour {
+    let mut changed = true;
+    while changed && c.len() >= 3 {
+        changed = false;
+        let n = c.len();
+        let mut keep = vec![true; n];
+        let mut i = 0;
+        while i < n {
+            let (p, q) = ((i + n - 1) % n, (i + 1) % n);
+            if keep[p] && keep[i] && dist(c[p], c[q]) < SPIKE_BASE_MM {
+                // Drop the tip and one of the coinciding base points.
+                keep[i] = false;
+                keep[q] = false;
+                changed = true;
+                i += 2;
+            } else {
+                i += 1;
+            }
+        }
+        if changed {
+            c = c
+                .into_iter()
+                .zip(keep)
+                .filter(|(_, k)| *k)
+                .map(|(p, _)| p)
+                .collect();
+        }
+    }
+    if c.len() < 3 { Vec::new() } else { c }
 }

@@ -165,6 +165,10 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
             add_contours(&mut plan, &mut at);
         }
     }
+    // Positions as written (4 decimals), so counts, previews and the code agree exactly.
+    for m in &mut plan.moves {
+        m.to = m.to.map(|v| (v * 10_000.0).round() / 10_000.0);
+    }
     plan.counts = count(&plan.moves, b);
     plan
 }

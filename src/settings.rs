@@ -36,6 +36,17 @@ pub enum SlicePlane {
     Top,
 }
 
+/// The droplet's footprint in the coverage analysis ([`crate::analysis`]); no effect on the code.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Footprint {
+    /// A disc of diameter B: the droplet as measured (thesis 4.2).
+    Disc,
+    /// A disc of diameter 2B/√π ≈ 1.13 B, whose area is a B × B cell: the droplet spread flat
+    /// with the volume a dense part needs.
+    Spread,
+}
+
 /// Every parameter of a slice. `Default` gives the values of SPEC.md.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -50,6 +61,9 @@ pub struct Settings {
     pub hatch_angle: f64,
     pub hatch_angle_step: f64,
     pub start_jitter: f64,
+    /// Set each layer's droplets over the gaps of the layer below (loops by B/2 along the loop,
+    /// hatch lines by half the spacing where the hatch angle repeats).
+    pub stagger: bool,
     pub contour_order: ContourOrder,
     pub print_order: PrintOrder,
     pub close_loops: bool,
@@ -69,6 +83,8 @@ pub struct Settings {
     pub travel_speed: f64,
     /// Density of the material (for the mass estimate).
     pub material_density: f64,
+    /// Droplet footprint model of the coverage analysis.
+    pub footprint: Footprint,
 }
 
 impl Default for Settings {
@@ -84,6 +100,7 @@ impl Default for Settings {
             hatch_angle: 45.0,
             hatch_angle_step: 90.0,
             start_jitter: 0.07,
+            stagger: false,
             contour_order: ContourOrder::InsideOut,
             print_order: PrintOrder::ContoursFirst,
             close_loops: true,
@@ -100,6 +117,7 @@ impl Default for Settings {
             droplet_rate: 100.0,
             travel_speed: 50.0,
             material_density: 1.04,
+            footprint: Footprint::Disc,
         }
     }
 }
@@ -237,6 +255,13 @@ pub fn schema() -> Vec<SettingSpec> {
             1000.0,
             "Contours",
             "Each layer's loops start this much further along than the layer below, so loop seams do not stack",
+        ),
+        choice(
+            "stagger",
+            Kind::Bool,
+            NO_CHOICES,
+            "Contours",
+            "Set droplets over the gaps of the layer below: every layer's loop droplets half a droplet along from the layer below's (the start moves by start_jitter rounded to an odd multiple of B/2), hatch lines half a spacing across from the last layer with the same hatch direction",
         ),
         choice(
             "contour_order",
@@ -380,6 +405,13 @@ pub fn schema() -> Vec<SettingSpec> {
             "Machine",
             "Density of the material (mass estimate)",
         )),
+        choice(
+            "footprint",
+            Kind::Enum,
+            &["disc", "spread"],
+            "Analysis",
+            "Droplet footprint in the coverage report: disc = diameter B; spread = diameter 2B/sqrt(pi), the area of a B x B cell",
+        ),
     ];
     let defaults = serde_json::to_value(Settings::default()).expect("settings serialize");
     for spec in &mut specs {
@@ -394,20 +426,49 @@ pub fn schema_json() -> String {
 }
 
 impl Settings {
-    /// Parses settings from JSON; missing names take their defaults. The result is validated.
+    /// Parses settings from a JSON object `{"name": value, ...}`; missing names take their
+    /// defaults. The result is validated.
     pub fn from_json(text: &str) -> Result<Settings, Error> {
-        let settings: Settings = serde_json::from_str(text).map_err(|e| Error::Setting {
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::Setting {
             name: String::new(),
-            message: format!("the settings are not valid JSON for dropslice: {e}"),
+            message: format!("the settings are not valid JSON: {e}"),
         })?;
+        let serde_json::Value::Object(map) = value else {
+            return Err(Error::Setting {
+                name: String::new(),
+                message: "the settings must be a JSON object like {\"layer_height\": 0.2}".into(),
+            });
+        };
+        let mut settings = Settings::default();
+        for (name, v) in map {
+            settings.set_value(&name, v)?;
+        }
         settings.validate()?;
         Ok(settings)
     }
 
     /// Sets one value given as text (`--set name=value`). Not validated; call [`validate`](Self::validate).
     pub fn set(&mut self, name: &str, value: &str) -> Result<(), Error> {
+        let t = value.trim();
+        let v = match t {
+            "true" | "yes" | "on" => serde_json::Value::Bool(true),
+            "false" | "no" | "off" => serde_json::Value::Bool(false),
+            _ => match t.parse::<f64>() {
+                Ok(x) if x.is_finite() => serde_json::Number::from_f64(x)
+                    .map(serde_json::Value::Number)
+                    .unwrap_or(serde_json::Value::Null),
+                Ok(_) => serde_json::Value::Null,
+                Err(_) => serde_json::Value::String(t.to_string()),
+            },
+        };
+        self.set_value(name, v)
+    }
+
+    /// Sets one value given as JSON, with a message naming the setting when it does not fit.
+    pub fn set_value(&mut self, name: &str, value: serde_json::Value) -> Result<(), Error> {
+        use serde_json::Value;
         let mut map = serde_json::to_value(&*self).expect("settings serialize");
-        let Some(slot) = map.get_mut(name) else {
+        let Some(spec) = schema().into_iter().find(|s| s.name == name) else {
             return Err(Error::Setting {
                 name: name.to_string(),
                 message: format!(
@@ -416,41 +477,36 @@ impl Settings {
                 ),
             });
         };
-        let bad = |what: &str| Error::Setting {
-            name: name.to_string(),
-            message: format!("'{value}' is not {what}"),
+        let shown = match &value {
+            Value::String(s) => s.clone(),
+            other => other.to_string(),
         };
-        *slot = match slot {
-            serde_json::Value::Bool(_) => match value.trim() {
-                "true" | "1" | "yes" | "on" => serde_json::Value::Bool(true),
-                "false" | "0" | "no" | "off" => serde_json::Value::Bool(false),
-                _ => return Err(bad("true or false")),
-            },
-            serde_json::Value::String(_) => serde_json::Value::String(value.trim().to_string()),
-            _ => {
-                let x: f64 = value.trim().parse().map_err(|_| bad("a number"))?;
-                if !x.is_finite() {
-                    return Err(bad("a finite number"));
+        let bad = |what: String| Error::Setting {
+            name: name.to_string(),
+            message: format!("'{shown}' is not {what}"),
+        };
+        let value = match (spec.kind, value) {
+            (Kind::Bool, Value::Bool(b)) => Value::Bool(b),
+            (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(1.0) => Value::Bool(true),
+            (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(0.0) => Value::Bool(false),
+            (Kind::Bool, _) => return Err(bad("true or false".into())),
+            (Kind::Enum, Value::String(s)) if spec.choices.contains(&s.as_str()) => {
+                Value::String(s)
+            }
+            (Kind::Enum, _) => return Err(bad(format!("one of: {}", spec.choices.join(", ")))),
+            (Kind::Integer, Value::Number(n)) => match n.as_f64() {
+                Some(x) if x.fract() == 0.0 && x >= 0.0 && x <= u32::MAX as f64 => {
+                    Value::from(x as u64)
                 }
-                serde_json::Number::from_f64(x)
-                    .map(serde_json::Value::Number)
-                    .ok_or_else(|| bad("a number"))?
+                _ => return Err(bad("a whole number (0, 1, 2 …)".into())),
+            },
+            (Kind::Number, Value::Number(n)) if n.as_f64().is_some_and(f64::is_finite) => {
+                Value::Number(n)
             }
+            (Kind::Integer | Kind::Number, _) => return Err(bad("a finite number".into())),
         };
-        // Integers: serde refuses 2.0 for a u32, so pass whole numbers as integers.
-        if let Some(spec) = schema().into_iter().find(|s| s.name == name)
-            && spec.kind == Kind::Integer
-        {
-            let x = map[name].as_f64().unwrap_or(f64::NAN);
-            if x.fract() != 0.0 || x < 0.0 || x > u32::MAX as f64 {
-                return Err(bad("a whole number"));
-            }
-            map[name] = serde_json::Value::from(x as u64);
-        }
-        *self = serde_json::from_value(map).map_err(|e| Error::Setting {
-            name: name.to_string(),
-            message: format!("'{value}' is not allowed: {e}"),
-        })?;
+        map[name] = value;
+        *self = serde_json::from_value(map).map_err(|e| bad(format!("allowed: {e}")))?;
         Ok(())
     }
 
@@ -458,8 +514,15 @@ impl Settings {
     pub fn validate(&self) -> Result<(), Error> {
         let map = serde_json::to_value(self).expect("settings serialize");
         for spec in schema() {
-            let Some(x) = map[spec.name].as_f64() else {
+            if !matches!(spec.kind, Kind::Number | Kind::Integer) {
                 continue;
+            }
+            // NaN and infinity serialize as null.
+            let Some(x) = map[spec.name].as_f64() else {
+                return Err(Error::Setting {
+                    name: spec.name.to_string(),
+                    message: "is not a finite number".into(),
+                });
             };
             let (Some(min), Some(max)) = (spec.min, spec.max) else {
                 continue;

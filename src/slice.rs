@@ -40,6 +40,9 @@ const Z_STEPS_PER_MM: f64 = 1e9;
 pub fn layer_heights(part_height: f64, layer_height: f64, plane: SlicePlane) -> Vec<f64> {
     let round = |z: f64| (z * Z_STEPS_PER_MM).round() / Z_STEPS_PER_MM;
     let mut zs = Vec::new();
+    if !(layer_height > 0.0 && part_height.is_finite()) {
+        return zs;
+    }
     for i in 0.. {
         let z = match plane {
             // Planes at mid-layer below the top (the oracle's and the peers' rule).

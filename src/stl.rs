@@ -29,10 +29,21 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         (parse_binary(bytes, n), Format::Binary)
     } else if looks_ascii(bytes) {
         (parse_ascii(bytes)?, Format::Ascii)
+    } else if let Some(kind) = other_format(bytes) {
+        return Err(Error::Import(format!(
+            "this is not an STL file but {kind}; choose an STL file (export one from your modelling program)"
+        )));
     } else if bytes.len() >= 84 {
         let n = u32::from_le_bytes(bytes[80..84].try_into().expect("4 bytes")) as u64;
         let expected = 84 + 50 * n;
-        let msg = if (bytes.len() as u64) < expected {
+        // Real files rarely hold more than 20 million triangles (1 GB); a count beyond that
+        // is text or another format read as a binary header.
+        let msg = if n > 20_000_000 {
+            format!(
+                "this is not an STL file: it does not start with 'solid' (ASCII STL), and as a binary STL it would declare {n} triangles ({expected} bytes) in a file of {} bytes; choose an STL file",
+                bytes.len()
+            )
+        } else if (bytes.len() as u64) < expected {
             format!(
                 "it looks like a binary STL declaring {n} triangles ({expected} bytes), but the file has only {} bytes: it is truncated; download or export it again",
                 bytes.len()
@@ -62,6 +73,35 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         }
     }
     Ok((tris, format))
+}
+
+/// Names a few common non-STL formats by their first bytes.
+fn other_format(bytes: &[u8]) -> Option<&'static str> {
+    let start = bytes
+        .iter()
+        .position(|c| !c.is_ascii_whitespace())
+        .unwrap_or(0);
+    let b = &bytes[start..];
+    let kinds: [(&[u8], &str); 8] = [
+        (b"\x89PNG", "a PNG image"),
+        (b"\xFF\xD8\xFF", "a JPEG image"),
+        (b"%PDF", "a PDF document"),
+        (
+            b"PK\x03\x04",
+            "a ZIP archive (a 3MF file is one: export STL instead)",
+        ),
+        (b"{", "a JSON document"),
+        (b"[", "a JSON document"),
+        (
+            b"<",
+            "an XML or HTML document (AMF and X3D are not supported)",
+        ),
+        (b"ply", "a PLY mesh"),
+    ];
+    kinds
+        .iter()
+        .find(|(magic, _)| b.starts_with(magic))
+        .map(|(_, kind)| *kind)
 }
 
 /// The triangle count if the size matches the binary layout exactly.

@@ -249,19 +249,16 @@ fn rings_cube() {
 }
 
 #[test]
-#[ignore = "bug: offset loops have zero-width spikes back to the section boundary (e.g. M3x10_screw layer 10, k = 1 loop vertex [5.4844, 2.9881] on the boundary): droplets at 0.12 mm instead of 0.312 mm"]
 fn rings_m3x10_screw() {
     check_rings("M3x10_screw.stl", 1);
 }
 
 #[test]
-#[ignore = "bug: offset loops have zero-width spikes back to the section boundary (e.g. extruder_idler layer 82, k = 1 loop vertex [6.7609, 1.3300] on the boundary)"]
 fn rings_extruder_idler() {
     check_rings("extruder_idler.stl", 1);
 }
 
 #[test]
-#[ignore = "bug: offset loops have zero-width spikes back to the section boundary (e.g. slide_n_snap layer 8, a 3-point k = 0 loop through boundary vertex [3.1704, 11.6947])"]
 fn rings_slide_n_snap() {
     check_rings("slide_n_snap_test_a_medium.stl", 1);
 }
@@ -272,7 +269,6 @@ fn rings_3dbenchy() {
 }
 
 #[test]
-#[ignore = "bug: header droplet counts use unrounded coordinates; extruder_idler layer 26 has a G25 line of 22.000135·B exactly (23 droplets) written as 21.99986·B (22 droplets): header fill 501870 vs 501866 from the code"]
 fn header_fill_total_equals_written_lines_exactly() {
     for model in ["extruder_idler.stl", "3DBenchy.stl"] {
         let g = slice(model, &[]);

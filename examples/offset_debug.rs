@@ -1,0 +1,57 @@
+//! Finds offset loop vertices closer to the section boundary than the loop's offset:
+//! `cargo run --release --example offset_debug -- MODEL.stl LAYER`.
+use dropslice::slice::{Point, dist};
+
+fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist(p, [a[0] + t * d[0], a[1] + t * d[1]])
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().skip(1).collect();
+    let bytes = std::fs::read(&a[0]).unwrap();
+    let s = dropslice::Settings::default();
+    let job = dropslice::Job::new(&bytes, &a[0], s.clone()).unwrap();
+    let layers: Vec<usize> = if a.len() > 1 {
+        vec![a[1].parse().unwrap()]
+    } else {
+        (0..job.layer_count()).collect()
+    };
+    let b = s.droplet_width();
+    let mut bad = 0;
+    for i in layers {
+        let region = job.section(i).region;
+        let c = dropslice::contours::contours(&region, &s);
+        for l in &c.loops {
+            let want = (0.5 + l.k as f64) * b;
+            for (j, p) in l.points.iter().enumerate() {
+                let d = region
+                    .iter()
+                    .flatten()
+                    .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
+                    .map(|(x, y)| seg_dist(*p, x, y))
+                    .fold(f64::INFINITY, f64::min);
+                if d < want - 0.002 {
+                    bad += 1;
+                    if bad < 10 {
+                        let n = l.points.len();
+                        println!(
+                            "layer {i} k={} n={n} vertex {j} {:?} at {d:.4} (want {want:.4}); prev {:?} next {:?}",
+                            l.k,
+                            p,
+                            l.points[(j + n - 1) % n],
+                            l.points[(j + 1) % n]
+                        );
+                    }
+                }
+            }
+        }
+    }
+    println!("{bad} vertices too close");
+}
