@@ -226,6 +226,7 @@ function writeStats(): void {
   const s = slice;
   roleLabels(s?.source ?? "stl");
   const set = (id: string, text: string) => ($(id).textContent = text);
+  $("empty").hidden = s !== null;
   if (!s) {
     for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) set(id, "–");
     $("warnings").hidden = true;
@@ -346,7 +347,7 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
   const sameModel = slice?.model?.sha256 === m.sha256;
   busy = true;
   setState("slicing");
-  progress(0);
+  progress(0, `Reading ${m.name}…`);
   updateButtons();
   try {
     await pool.slice(m.bytes, m.name, json, {
@@ -357,6 +358,7 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
         slice = s;
         slicedSettings = json;
         slider.max = String(Math.max(0, r.layers - 1));
+        progress(0);
         $("model-name").textContent = m.name;
         $("empty").hidden = true;
         current = target.layer ?? (sameModel ? Math.min(current, r.layers - 1) : Math.floor((r.layers - 1) * 0.3));
@@ -611,6 +613,7 @@ async function openLink(): Promise<boolean> {
   form.set({ ...init.defaults, ...link.state.settings });
   renderer.showTravel = Boolean(link.state.showTravel);
   $<HTMLInputElement>("opt-travel").checked = renderer.showTravel;
+  $("legend-travel").hidden = !renderer.showTravel;
   if (link.model) {
     const m: Model = { bytes: link.model, name: link.state.name, sha256: await sha256Hex(link.model) };
     if (m.sha256 !== link.state.sha256) {
@@ -677,10 +680,12 @@ function wire(): void {
   $("btn-fit").addEventListener("click", fit);
   $<HTMLInputElement>("opt-travel").addEventListener("change", (ev) => {
     renderer.showTravel = (ev.target as HTMLInputElement).checked;
+    $("legend-travel").hidden = !renderer.showTravel;
     renderer.request();
   });
   $<HTMLInputElement>("opt-below").addEventListener("change", (ev) => {
     renderer.showBelow = (ev.target as HTMLInputElement).checked;
+    $("legend-below").hidden = !renderer.showBelow;
     renderer.request();
   });
 
@@ -789,6 +794,11 @@ window.dropslice = {
     workers: pool.size,
   }),
   crash: () => pool.crash().catch(showError),
+  setView: (v: View) => {
+    renderer.view = { ...v };
+    viewTouched = true;
+    renderer.request();
+  },
   show,
 };
 

@@ -6,7 +6,7 @@
 
 import type { LayerData } from "./protocol";
 
-export const ROLE_COLORS = ["#d9480f", "#f59f00", "#1c7ed6"] as const;
+export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
 export const ROLE_NAMES = ["Outer loop", "Inner loops", "Fill"] as const;
 const BELOW_COLOR = "rgba(120, 130, 150, 0.22)";
 const TRAVEL_COLOR = "rgba(60, 60, 70, 0.55)";
@@ -66,7 +66,7 @@ export class Renderer {
 
   fit(b: Bounds | null): void {
     if (!b || !(b.maxX > b.minX) || !(b.maxY > b.minY)) return;
-    const margin = 36;
+    const margin = 28;
     const sx = (this.cssW - 2 * margin) / (b.maxX - b.minX);
     const sy = (this.cssH - 2 * margin) / (b.maxY - b.minY);
     this.view = { scale: Math.max(0.05, Math.min(sx, sy)), cx: (b.minX + b.maxX) / 2, cy: (b.minY + b.maxY) / 2 };
@@ -212,6 +212,13 @@ export class Renderer {
     const len = step * this.view.scale * dpr;
     const x = 16 * dpr;
     const y = this.canvas.height - 18 * dpr;
+    const label = `${+step.toPrecision(3)} mm`;
+    ctx.font = `${12 * dpr}px system-ui, sans-serif`;
+    const w = len + ctx.measureText(label).width + 20 * dpr;
+    ctx.fillStyle = "rgba(255, 255, 255, 0.85)";
+    ctx.beginPath();
+    ctx.roundRect(x - 8 * dpr, y - 16 * dpr, w, 26 * dpr, 5 * dpr);
+    ctx.fill();
     ctx.strokeStyle = "#495057";
     ctx.lineWidth = 2 * dpr;
     ctx.beginPath();
@@ -221,8 +228,7 @@ export class Renderer {
     ctx.lineTo(x + len, y - 5 * dpr);
     ctx.stroke();
     ctx.fillStyle = "#495057";
-    ctx.font = `${12 * dpr}px system-ui, sans-serif`;
     ctx.textBaseline = "bottom";
-    ctx.fillText(`${+step.toPrecision(3)} mm`, x + len + 6 * dpr, y + 5 * dpr);
+    ctx.fillText(label, x + len + 6 * dpr, y + 5 * dpr);
   }
 }
