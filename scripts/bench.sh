@@ -11,7 +11,8 @@
 #   3. generates tori with shared/tools/gen_mesh.py (100k, 1M, 4M facets) and a copy of
 #      the 1M torus stretched 4x in z (30 -> 120 mm, 150 -> 600 layers) into the cache
 #      directory (reused on later runs);
-#   4. per model and tool: one untimed warm-up run, then BENCH_RUNS timed runs under
+#   4. per model and tool: one untimed warm-up run, then BENCH_RUNS timed runs (interleaved
+#      across the tools) under
 #      /usr/bin/time -v (wall time, peak RSS); the peers use the exact command lines of
 #      shared/bench/peers.sh (its run_cura / run_prusa / layers_of functions are read
 #      from that file, not copied);
@@ -187,18 +188,24 @@ one_run() {  # $1 tool, $2 model, $3 gcode, $4 time file, $5 log
 RAW="$BENCH_DIR/raw.tsv"
 printf 'model\tfacets\ttool\trun\trc\twall_s\tuser_s\tsys_s\tpeak_kb\tlayers\tgcode_bytes\tload1\n' >"$RAW"
 log "models: ${names[*]}; tools: $TOOLS; $WARMUP warm-up + $RUNS timed runs each"
+# Runs are interleaved (run 1 of every tool, then run 2, ...), so a burst of other work
+# on the machine does not land on one tool's runs only.
 for m in "${MODELS[@]}"; do
   name="$(basename "$m" .stl)"
   facets="$(facets_of "$m")"
+  tools=()
   for tool in $TOOLS; do
     if [ "$tool" != dropslice ] && [[ " $PEER_SKIP " == *" $name "* ]]; then
       log "$name: $tool skipped (BENCH_PEER_SKIP)"; continue
     fi
-    g="$BENCH_DIR/gcode/$name.$tool.gcode"
+    tools+=("$tool")
     for w in $(seq 1 "$WARMUP"); do
-      one_run "$tool" "$m" "$g" /dev/null /dev/null
+      one_run "$tool" "$m" "$BENCH_DIR/gcode/$name.$tool.gcode" /dev/null /dev/null
     done
-    for run in $(seq 1 "$RUNS"); do
+  done
+  for run in $(seq 1 "$RUNS"); do
+    for tool in "${tools[@]}"; do
+      g="$BENCH_DIR/gcode/$name.$tool.gcode"
       tf="$BENCH_DIR/logs/$name.$tool.$run.time"; lf="$BENCH_DIR/logs/$name.$tool.$run.log"
       rm -f "$g"
       load1=$(cut -d' ' -f1 /proc/loadavg)  # other work on the machine shows here
@@ -213,8 +220,8 @@ for m in "${MODELS[@]}"; do
       printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$facets" "$tool" "$run" "$rc" "$wall" "$user" "$sys" "$peak" "${lay:-0}" "$sz" "$load1" >>"$RAW"
       log "$name $tool run $run: rc=$rc wall=${wall}s peak=$((peak / 1024))MB layers=$lay load=$load1"
     done
-    rm -f "$g"  # G-code of big models is large; keep only the raw numbers
   done
+  for tool in "${tools[@]}"; do rm -f "$BENCH_DIR/gcode/$name.$tool.gcode"; done  # big; keep only the numbers
 done
 
 # ------------------------------------------------------------------ 5. browser (optional)
