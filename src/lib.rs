@@ -14,6 +14,7 @@
 //! [`write_gcode`] plans them in parallel and writes them in ascending order, a window at a
 //! time, so memory stays bounded however tall the part is.
 
+pub mod analysis;
 pub mod contours;
 pub mod droplets;
 pub mod error;

@@ -1,0 +1,48 @@
+//! Coverage and void figures with stagger off and on, and the analysis time against slicing:
+//! `cargo run --release --example quality -- MODEL.stl...` (the figures of docs/quality.md).
+use dropslice::analysis::analyse_job;
+use dropslice::{Job, Settings, write_gcode};
+use std::time::Instant;
+
+fn main() {
+    let paths: Vec<String> = std::env::args().skip(1).collect();
+    println!(
+        "| model | stagger | coverage | void area share | enclosed void share | overfill share | largest void mm² (layer) | max deviation mm | 3D void fraction | slicing s | analysis s (plan + analyse CPU s) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for path in &paths {
+        let bytes = std::fs::read(path).expect("read model");
+        let name = std::path::Path::new(path)
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        for stagger in [false, true] {
+            let s = Settings {
+                stagger,
+                ..Settings::default()
+            };
+            let job = Job::new(&bytes, &name, s).expect("job");
+            let t = Instant::now();
+            write_gcode(&job, &mut std::io::sink(), |_, _| {}).expect("slice");
+            let slicing = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let (r, [plan, analyse]) = analyse_job(&job);
+            let analysis = t.elapsed().as_secs_f64();
+            let p = &r.part;
+            println!(
+                "| {name} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} ({}) | {:.4} ({}) | {:.4} | {slicing:.3} | {analysis:.3} ({plan:.3} + {analyse:.3}) |",
+                if stagger { "on" } else { "off" },
+                p.coverage,
+                p.void_area / p.region_area,
+                p.enclosed_void_area / p.region_area,
+                p.overfill_area / p.region_area,
+                p.largest_void.map_or(0.0, |v| v.area),
+                p.largest_void_layer.map_or(0, |l| l + 1),
+                p.max_boundary_deviation,
+                p.max_deviation_layer.map_or(0, |l| l + 1),
+                p.void_fraction,
+            );
+        }
+    }
+}

@@ -1,0 +1,1258 @@
+//! Analysis: see the print before printing. A layer's droplets are rasterised against the
+//! layer's true region, giving coverage, voids, overfill and how far the printed outline strays
+//! from the boundary; over adjacent layers, a 3D estimate gives the part's void fraction.
+//!
+//! # The droplet model
+//! - **Footprint** (setting `footprint`): in the layer's plane a droplet covers a disc centred
+//!   on its position, of diameter D = B (`disc`, the droplet as measured, thesis 4.2) or
+//!   D = 2B/√π ≈ 1.13 B (`spread`: the disc whose area is a B × B cell, i.e. a droplet that
+//!   flattens with the volume a dense part needs). Discs of diameter B on a lattice of pitch B
+//!   only touch, so `disc` leaves at least 1 − π/4 ≈ 21 % of a filled area uncovered: its
+//!   figures are a pessimistic bound and best used to compare settings; real droplets flow
+//!   into part of those gaps.
+//! - **Volume** (3D estimate): a droplet is an oblate spheroid of horizontal diameter D, centred
+//!   at its layer's mid-height, whose volume is the cell a droplet must fill, B·B·H. Its height
+//!   is therefore 6B²H/(πD²) (1.91 H for `disc`): it reaches about 0.45 H into the layers above
+//!   and below, into their gaps, which is what staggering (setting `stagger`) exploits. A
+//!   point of the part (layer i's region × its slab) is filled when a spheroid of layer i − 1,
+//!   i or i + 1 contains it. Flow, surface tension and the shape of the surface a droplet lands
+//!   on are not modelled; spheroids below the first layer are cut by the bed.
+//!
+//! # The grid
+//! Rows every B/10 ([`ROWS_PER_B`]), columns every B/40 ([`COLS_PER_ROW`] per row). A droplet
+//! covers, in each row, as many columns around its centre as the average width of its disc
+//! over the row's band, rounded with the remainder carried from row to row (so one disc covers
+//! its exact area within half a cell, wherever it lies on the grid); the region covers the
+//! columns whose centres lie inside it at the row's centre (non-zero rule). Voids are the
+//! region's cells no droplet covers; two void cells in neighbouring rows are connected when
+//! their runs overlap by at least [`MIN_PASSAGE_COLS`] columns (B/20), so the voids on both
+//! sides of two touching droplets stay apart. The 3D estimate samples the part at cell centres
+//! every B/3 ([`GRID3_PER_B`]).
+//!
+//! # Boundary deviation
+//! The printed outline is the droplets' envelope with its enclosed voids filled. Its deviation
+//! from the region's boundary is measured one-sidedly: inward, the largest distance from the
+//! boundary of an uncovered point connected to the boundary (the depth of the scallops
+//! between droplets, or of a wall too thin for any droplet); outward, the largest distance from
+//! the region of a covered point outside it. Both are sampled at the ends and the middle of
+//! each run of cells, so they are exact to about a grid step.
+
+use crate::plan::{LayerPlan, MoveKind, line_droplets};
+use crate::settings::{Footprint, Settings};
+use crate::slice::{Point, Shapes, dist, region_area};
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// Grid rows per droplet width B.
+pub const ROWS_PER_B: f64 = 10.0;
+/// Grid columns per row height (columns every B/40).
+pub const COLS_PER_ROW: f64 = 4.0;
+/// Void runs in neighbouring rows connect when they overlap by at least this many columns.
+pub const MIN_PASSAGE_COLS: u32 = 2;
+/// The 3D estimate samples the part every B / this.
+pub const GRID3_PER_B: f64 = 3.0;
+/// Steps of the table of band-averaged half-widths (a droplet's offset within its first row).
+const PHASES: usize = 256;
+
+/// Footprint diameter D of a droplet, in mm.
+pub fn footprint_diameter(s: &Settings) -> f64 {
+    let b = s.droplet_width();
+    match s.footprint {
+        Footprint::Disc => b,
+        Footprint::Spread => 2.0 * b / PI.sqrt(),
+    }
+}
+
+/// Vertical semi-axis of the droplet spheroid (volume B·B·H), in mm.
+pub fn spheroid_half_height(s: &Settings) -> f64 {
+    let b = s.droplet_width();
+    let d = footprint_diameter(s);
+    3.0 * b * b * s.layer_height / (PI * d * d)
+}
+
+/// One connected void of a layer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Void {
+    /// mm².
+    pub area: f64,
+    pub centroid: Point,
+    /// Bounding box.
+    pub min: Point,
+    pub max: Point,
+    /// Whether it reaches the region's boundary (a gap in the outline rather than enclosed).
+    pub at_boundary: bool,
+}
+
+/// What one layer's droplets cover of its region. Areas in mm², lengths in mm.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct LayerAnalysis {
+    /// Layer number from 0.
+    pub index: usize,
+    /// Z written in the code (the layer's top).
+    pub z: f64,
+    pub droplets: u64,
+    /// The region's exact area.
+    pub region_area: f64,
+    /// Region area covered by droplets (on the grid).
+    pub covered_area: f64,
+    /// Share of the region covered by droplets (0 … 1).
+    pub coverage: f64,
+    /// Uncovered area inside the region.
+    pub void_area: f64,
+    /// The part of `void_area` in voids that do not reach the boundary (enclosed air).
+    pub enclosed_void_area: f64,
+    /// Connected voids.
+    pub voids: usize,
+    pub largest_void: Option<Void>,
+    /// Droplet area outside the region.
+    pub overfill_area: f64,
+    /// Largest distance from the boundary of an uncovered point connected to it.
+    pub deviation_inward: f64,
+    /// Largest distance from the region of a covered point outside it.
+    pub deviation_outward: f64,
+    /// max(inward, outward).
+    pub boundary_deviation: f64,
+    /// Where the larger deviation was found.
+    pub deviation_at: Option<Point>,
+}
+
+/// A coarse picture of a layer for an overlay: per square cell the share (0 … 255) of it that
+/// is void (region, uncovered), overfill (covered, outside the region) and covered region.
+/// Cell (col, row) spans x = origin.x + col·cell …, y = origin.y + row·cell …; index
+/// row·width + col.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CoverageMask {
+    pub origin: Point,
+    pub cell: f64,
+    pub width: usize,
+    pub height: usize,
+    pub void: Vec<u8>,
+    pub overfill: Vec<u8>,
+    pub covered: Vec<u8>,
+}
+
+/// Every droplet centre of a layer (each droplet of a `G25` line too), in print order.
+pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
+    let mut out = Vec::with_capacity(plan.counts.total() as usize);
+    let mut at: Point = [0.0, 0.0];
+    for m in &plan.moves {
+        match m.kind {
+            MoveKind::Travel => {}
+            MoveKind::Droplet => out.push(m.to),
+            MoveKind::Line => {
+                let l = dist(at, m.to);
+                for j in 0..line_droplets(l, b) {
+                    let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
+                    out.push([at[0] + t * (m.to[0] - at[0]), at[1] + t * (m.to[1] - at[1])]);
+                }
+            }
+        }
+        at = m.to;
+    }
+    out
+}
+
+/// Analyses one layer: its plan against its region (the section, before any offset).
+pub fn analyse_layer(plan: &LayerPlan, region: &Shapes, s: &Settings) -> LayerAnalysis {
+    Raster::new(plan, region, s).analysis()
+}
+
+/// [`analyse_layer`] and a [`CoverageMask`] with square cells of about `mask_cell` mm (at least
+/// B/10; rounded to whole grid rows).
+pub fn analyse_layer_with_mask(
+    plan: &LayerPlan,
+    region: &Shapes,
+    s: &Settings,
+    mask_cell: f64,
+) -> (LayerAnalysis, CoverageMask) {
+    let r = Raster::new(plan, region, s);
+    (r.analysis(), r.mask(mask_cell))
+}
+
+/// The rasterised layer: region and droplet bitmaps on one grid.
+pub struct Raster {
+    index: usize,
+    z: f64,
+    droplets: u64,
+    region_area: f64,
+    b: f64,
+    grid: Grid,
+    region_bits: Vec<u64>,
+    drop_bits: Vec<u64>,
+    /// Per row, the words [lo, hi) holding any bit.
+    extent: Vec<(u32, u32)>,
+    edges: Vec<(Point, Point)>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Grid {
+    x0: f64,
+    y0: f64,
+    gx: f64,
+    gy: f64,
+    nx: usize,
+    ny: usize,
+    nw: usize,
+}
+
+impl Grid {
+    fn cx(&self, c: usize) -> f64 {
+        self.x0 + (c as f64 + 0.5) * self.gx
+    }
+
+    fn ry(&self, k: usize) -> f64 {
+        self.y0 + (k as f64 + 0.5) * self.gy
+    }
+
+    /// Columns whose centres lie in [xa, xb], clamped to the grid.
+    fn cols(&self, xa: f64, xb: f64) -> Option<(usize, usize)> {
+        let c0 = ((xa - self.x0) / self.gx - 0.5).ceil().max(0.0);
+        let c1 = ((xb - self.x0) / self.gx - 0.5)
+            .floor()
+            .min(self.nx as f64 - 1.0);
+        (c0 <= c1).then_some((c0 as usize, c1 as usize))
+    }
+}
+
+fn set_range(row: &mut [u64], c0: usize, c1: usize) {
+    let (w0, w1) = (c0 >> 6, c1 >> 6);
+    let m0 = !0u64 << (c0 & 63);
+    let m1 = !0u64 >> (63 - (c1 & 63));
+    if w0 == w1 {
+        row[w0] |= m0 & m1;
+    } else {
+        row[w0] |= m0;
+        for w in &mut row[w0 + 1..w1] {
+            *w = !0;
+        }
+        row[w1] |= m1;
+    }
+}
+
+fn count_range(row: &[u64], c0: usize, c1: usize) -> u32 {
+    if c0 > c1 {
+        return 0;
+    }
+    let (w0, w1) = (c0 >> 6, c1 >> 6);
+    let m0 = !0u64 << (c0 & 63);
+    let m1 = !0u64 >> (63 - (c1 & 63));
+    if w0 == w1 {
+        (row[w0] & m0 & m1).count_ones()
+    } else {
+        (row[w0] & m0).count_ones()
+            + row[w0 + 1..w1].iter().map(|w| w.count_ones()).sum::<u32>()
+            + (row[w1] & m1).count_ones()
+    }
+}
+
+/// Calls `span(row, xa, xb)` for every inside span (non-zero rule) of `region` on rows at
+/// y0 + (k + ½)·gy, k < ny.
+fn region_spans(
+    region: &Shapes,
+    y0: f64,
+    gy: f64,
+    ny: usize,
+    mut span: impl FnMut(usize, f64, f64),
+) {
+    let mut hits: Vec<(u32, f64, i32)> = Vec::new();
+    for contour in region.iter().flatten() {
+        let n = contour.len();
+        for i in 0..n {
+            let (p, q) = (contour[i], contour[(i + 1) % n]);
+            if p[1] == q[1] {
+                continue;
+            }
+            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
+            let k0 = ((lo[1] - y0) / gy - 0.5).ceil().max(0.0) as usize;
+            let mut k = k0;
+            while k < ny {
+                let y = y0 + (k as f64 + 0.5) * gy;
+                if y >= hi[1] {
+                    break;
+                }
+                if y >= lo[1] {
+                    let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
+                    hits.push((k as u32, x, w));
+                }
+                k += 1;
+            }
+        }
+    }
+    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for row in hits.chunk_by(|a, b| a.0 == b.0) {
+        let mut winding = 0;
+        let mut start = 0.0;
+        for &(k, x, w) in row {
+            let before = winding;
+            winding += w;
+            if before == 0 && winding != 0 {
+                start = x;
+            } else if before != 0 && winding == 0 {
+                span(k as usize, start, x);
+            }
+        }
+    }
+}
+
+/// Band-averaged half-widths of a disc of radius `r` on rows of height `gy`: entry
+/// [phase][j] for the j-th row from the one holding the disc's lowest point, when that point
+/// lies `(phase + ½)/PHASES` of a row above the row's bottom.
+fn half_width_table(r: f64, gy: f64) -> (usize, Vec<f64>) {
+    let rows = (2.0 * r / gy).ceil() as usize + 2;
+    let g = |t: f64| {
+        let t = t.clamp(-r, r);
+        0.5 * (t * (r * r - t * t).max(0.0).sqrt() + r * r * (t / r).clamp(-1.0, 1.0).asin())
+    };
+    let mut table = vec![0.0; PHASES * rows];
+    for ph in 0..PHASES {
+        let phi = (ph as f64 + 0.5) / PHASES as f64;
+        for j in 0..rows {
+            // Band j relative to the disc's centre.
+            let lo = (j as f64 - phi) * gy - r;
+            let hi = lo + gy;
+            table[ph * rows + j] = (g(hi) - g(lo)) / gy;
+        }
+    }
+    (rows, table)
+}
+
+impl Raster {
+    /// Rasterises a layer's region and droplets.
+    pub fn new(plan: &LayerPlan, region: &Shapes, s: &Settings) -> Raster {
+        let b = s.droplet_width();
+        let centres = droplet_centres(plan, b);
+        Raster::from_centres(plan.index, plan.z, &centres, region, s)
+    }
+
+    /// Rasterises droplets at `centres` against `region`.
+    pub fn from_centres(
+        index: usize,
+        z: f64,
+        centres: &[Point],
+        region: &Shapes,
+        s: &Settings,
+    ) -> Raster {
+        let mut r = Raster::empty();
+        r.rebuild(index, z, centres, region, s);
+        r
+    }
+
+    /// A raster of nothing, to [`rebuild`](Self::rebuild) (reusing its memory).
+    pub fn empty() -> Raster {
+        Raster {
+            index: 0,
+            z: 0.0,
+            droplets: 0,
+            region_area: 0.0,
+            b: 1.0,
+            grid: Grid {
+                x0: 0.0,
+                y0: 0.0,
+                gx: 1.0,
+                gy: 1.0,
+                nx: 0,
+                ny: 0,
+                nw: 0,
+            },
+            region_bits: Vec::new(),
+            drop_bits: Vec::new(),
+            extent: Vec::new(),
+            edges: Vec::new(),
+        }
+    }
+
+    /// [`from_centres`](Self::from_centres) into this raster's memory.
+    pub fn rebuild(
+        &mut self,
+        index: usize,
+        z: f64,
+        centres: &[Point],
+        region: &Shapes,
+        s: &Settings,
+    ) {
+        let b = s.droplet_width();
+        let r = footprint_diameter(s) / 2.0;
+        let gy = b / ROWS_PER_B;
+        let gx = gy / COLS_PER_ROW;
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for p in region.iter().flatten().flatten() {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        for p in centres {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k] - r);
+                max[k] = max[k].max(p[k] + r);
+            }
+        }
+        self.edges.clear();
+        for c in region.iter().flatten() {
+            for i in 0..c.len() {
+                self.edges.push((c[i], c[(i + 1) % c.len()]));
+            }
+        }
+        if !min[0].is_finite() {
+            min = [0.0, 0.0];
+            max = [0.0, 0.0];
+        }
+        let margin = 2.0 * gy;
+        let x0 = min[0] - margin;
+        let y0 = min[1] - margin;
+        let nx = ((max[0] + margin - x0) / gx).ceil() as usize + 1;
+        let ny = ((max[1] + margin - y0) / gy).ceil() as usize + 1;
+        let nw = nx.div_ceil(64);
+        let grid = Grid {
+            x0,
+            y0,
+            gx,
+            gy,
+            nx,
+            ny,
+            nw,
+        };
+        self.region_bits.clear();
+        self.region_bits.resize(nw * ny, 0);
+        self.drop_bits.clear();
+        self.drop_bits.resize(nw * ny, 0);
+        self.extent.clear();
+        self.extent.resize(ny, (u32::MAX, 0));
+        let (region_bits, drop_bits, extent) =
+            (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
+        let mut mark = |k: usize, c0: usize, c1: usize| {
+            let e = &mut extent[k];
+            e.0 = e.0.min((c0 >> 6) as u32);
+            e.1 = e.1.max((c1 >> 6) as u32 + 1);
+        };
+        region_spans(region, y0, gy, ny, |k, xa, xb| {
+            if let Some((c0, c1)) = grid.cols(xa, xb) {
+                set_range(&mut region_bits[k * nw..(k + 1) * nw], c0, c1);
+                mark(k, c0, c1);
+            }
+        });
+        let (rows, table) = half_width_table(r, gy);
+        for p in centres {
+            let v = (p[1] - r - y0) / gy;
+            let k0 = v.floor();
+            let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
+            let k0 = k0 as usize;
+            let widths = &table[ph * rows..(ph + 1) * rows];
+            // Centre in column units (column c's centre at u = c).
+            let u = (p[0] - x0) / gx - 0.5;
+            let mut carry = 0.0;
+            for (j, &w) in widths.iter().enumerate() {
+                let k = k0 + j;
+                let want = 2.0 * w / gx + carry;
+                // Rounding by truncation: every value here is ≥ 0.
+                let n = (want + 0.5) as i64;
+                carry = want - n as f64;
+                if n < 1 || k >= ny {
+                    continue;
+                }
+                let c0 = (u - (n - 1) as f64 / 2.0 + 0.5) as i64;
+                let c1 = c0 + n - 1;
+                if c0 < 0 || c1 >= nx as i64 {
+                    continue;
+                }
+                let (c0, c1) = (c0 as usize, c1 as usize);
+                set_range(&mut drop_bits[k * nw..(k + 1) * nw], c0, c1);
+                mark(k, c0, c1);
+            }
+        }
+        self.index = index;
+        self.z = z;
+        self.droplets = centres.len() as u64;
+        self.region_area = region_area(region);
+        self.b = b;
+        self.grid = grid;
+    }
+
+    fn row<'b>(bits: &'b [u64], g: &Grid, k: usize) -> &'b [u64] {
+        &bits[k * g.nw..(k + 1) * g.nw]
+    }
+
+    /// Runs [start, end) of set bits of `mask(word)` in row `k`, appended to `out`.
+    fn runs(&self, k: usize, mask: impl Fn(u64, u64) -> u64, out: &mut Vec<(u32, u32)>) {
+        let g = &self.grid;
+        let (r, d) = (
+            Raster::row(&self.region_bits, g, k),
+            Raster::row(&self.drop_bits, g, k),
+        );
+        let mut carry = 0u64;
+        let mut start = 0u32;
+        let (lo, hi) = self.extent[k];
+        for w in lo as usize..hi as usize {
+            let v = mask(r[w], d[w]);
+            let prev = (v << 1) | carry;
+            let mut starts = v & !prev;
+            let mut ends = !v & prev;
+            let base = (w * 64) as u32;
+            while starts != 0 || ends != 0 {
+                let s = if starts != 0 {
+                    starts.trailing_zeros()
+                } else {
+                    64
+                };
+                let e = if ends != 0 { ends.trailing_zeros() } else { 64 };
+                if s < e {
+                    start = base + s;
+                    starts &= starts - 1;
+                } else {
+                    out.push((start, base + e));
+                    ends &= ends - 1;
+                }
+            }
+            carry = v >> 63;
+        }
+        if carry != 0 {
+            out.push((start, hi * 64));
+        }
+    }
+
+    /// The figures of the layer.
+    pub fn analysis(&self) -> LayerAnalysis {
+        let g = self.grid;
+        let cell = g.gx * g.gy;
+        let (mut n_region, mut n_covered, mut n_over) = (0u64, 0u64, 0u64);
+        let mut over_rows = Vec::new();
+        for k in 0..g.ny {
+            let (lo, hi) = self.extent[k];
+            if lo >= hi {
+                continue;
+            }
+            let range = k * g.nw + lo as usize..k * g.nw + hi as usize;
+            let before = n_over;
+            for (r, d) in self.region_bits[range.clone()]
+                .iter()
+                .zip(&self.drop_bits[range])
+            {
+                n_region += r.count_ones() as u64;
+                n_covered += (r & d).count_ones() as u64;
+                n_over += (d & !r).count_ones() as u64;
+            }
+            if n_over > before {
+                over_rows.push(k);
+            }
+        }
+        // Voids: runs of region & !droplets, joined across rows.
+        let mut runs: Vec<(u32, u32, u32)> = Vec::new(); // (row, start, end)
+        let mut touches: Vec<bool> = Vec::new();
+        let mut uf = UnionFind::new(0);
+        let mut buf = Vec::new();
+        let mut prev = 0..0;
+        // Region cells with a neighbour (left, right, above, below) outside the region.
+        let mut edge = vec![0u64; g.nw];
+        for k in 0..g.ny {
+            buf.clear();
+            self.runs(k, |r, d| r & !d, &mut buf);
+            if buf.is_empty() {
+                prev = runs.len()..runs.len();
+                continue;
+            }
+            let (lo, hi) = self.extent[k];
+            let row = Raster::row(&self.region_bits, &g, k);
+            let up = (k + 1 < g.ny).then(|| Raster::row(&self.region_bits, &g, k + 1));
+            let down = (k > 0).then(|| Raster::row(&self.region_bits, &g, k - 1));
+            for w in lo as usize..hi as usize {
+                let r = row[w];
+                let left = (r << 1) | if w > 0 { row[w - 1] >> 63 } else { 0 };
+                let right = (r >> 1) | if w + 1 < g.nw { row[w + 1] << 63 } else { 0 };
+                let u = up.map_or(0, |x| x[w]);
+                let d = down.map_or(0, |x| x[w]);
+                edge[w] = r & !(left & right & u & d);
+            }
+            let first = runs.len();
+            for &(s, e) in &buf {
+                let boundary = count_range(&edge, s as usize, e as usize - 1) > 0;
+                runs.push((k as u32, s, e));
+                touches.push(boundary);
+                uf.parent.push(uf.parent.len() as u32);
+            }
+            let cur = first..runs.len();
+            let (mut i, mut j) = (prev.start, cur.start);
+            while i < prev.end && j < cur.end {
+                let (_, s1, e1) = runs[i];
+                let (_, s2, e2) = runs[j];
+                if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                    uf.union(i, j);
+                }
+                if e1 < e2 { i += 1 } else { j += 1 }
+            }
+            prev = cur;
+        }
+        // Components, numbered in order of their first run (a root precedes its members).
+        #[derive(Clone, Copy)]
+        struct Acc {
+            cells: u64,
+            /// Sums of column·cells (twice, to stay whole) and row·cells.
+            sx2: u64,
+            sy: u64,
+            min: [u32; 2],
+            max: [u32; 2],
+            boundary: bool,
+        }
+        let mut comp = vec![0u32; runs.len()];
+        let mut accs: Vec<Acc> = Vec::new();
+        for (i, &(k, s, e)) in runs.iter().enumerate() {
+            let root = uf.find(i);
+            let id = if root == i {
+                accs.push(Acc {
+                    cells: 0,
+                    sx2: 0,
+                    sy: 0,
+                    min: [u32::MAX; 2],
+                    max: [0; 2],
+                    boundary: false,
+                });
+                accs.len() - 1
+            } else {
+                comp[root] as usize
+            };
+            comp[i] = id as u32;
+            let a = &mut accs[id];
+            let n = (e - s) as u64;
+            a.cells += n;
+            a.sx2 += n * (s + e - 1) as u64;
+            a.sy += n * k as u64;
+            a.min = [a.min[0].min(s), a.min[1].min(k)];
+            a.max = [a.max[0].max(e), a.max[1].max(k + 1)];
+            a.boundary |= touches[i];
+        }
+        let mut enclosed = 0u64;
+        let mut largest: Option<Void> = None;
+        for a in &accs {
+            if !a.boundary {
+                enclosed += a.cells;
+            }
+            let area = a.cells as f64 * cell;
+            if largest.is_none_or(|l| area > l.area) {
+                let n = a.cells as f64;
+                largest = Some(Void {
+                    area,
+                    centroid: [
+                        g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
+                        g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
+                    ],
+                    min: [g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy],
+                    max: [g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy],
+                    at_boundary: a.boundary,
+                });
+            }
+        }
+        // Inward deviation: runs of voids that reach the boundary; outward: overfill runs.
+        let index = EdgeIndex::new(&self.edges, self.b);
+        let mut dev_in = (0.0f64, None);
+        let mut dev_out = (0.0f64, None);
+        let probe = |best: &mut (f64, Option<Point>), k: usize, s: u32, e: u32| {
+            let y = g.ry(k);
+            for c in [s, (s + e - 1) / 2, e - 1] {
+                let p = [g.cx(c as usize), y];
+                let d = index.distance(p, best.0);
+                if d > best.0 {
+                    *best = (d, Some(p));
+                }
+            }
+        };
+        for (i, &(k, s, e)) in runs.iter().enumerate() {
+            if accs[comp[i] as usize].boundary {
+                probe(&mut dev_in, k as usize, s, e);
+            }
+        }
+        {
+            for &k in &over_rows {
+                buf.clear();
+                self.runs(k, |r, d| d & !r, &mut buf);
+                for &(s, e) in &buf {
+                    probe(&mut dev_out, k, s, e);
+                }
+            }
+        }
+        let coverage = if n_region > 0 {
+            n_covered as f64 / n_region as f64
+        } else {
+            0.0
+        };
+        let (boundary_deviation, deviation_at) = if dev_out.0 > dev_in.0 {
+            dev_out
+        } else {
+            dev_in
+        };
+        LayerAnalysis {
+            index: self.index,
+            z: self.z,
+            droplets: self.droplets,
+            region_area: self.region_area,
+            covered_area: n_covered as f64 * cell,
+            coverage,
+            void_area: (n_region - n_covered) as f64 * cell,
+            enclosed_void_area: enclosed as f64 * cell,
+            voids: accs.len(),
+            largest_void: largest,
+            overfill_area: n_over as f64 * cell,
+            deviation_inward: dev_in.0,
+            deviation_outward: dev_out.0,
+            boundary_deviation,
+            deviation_at,
+        }
+    }
+
+    /// A [`CoverageMask`] with square cells of about `cell` mm.
+    pub fn mask(&self, cell: f64) -> CoverageMask {
+        let g = self.grid;
+        let rows = ((cell / g.gy).round() as usize).max(1);
+        let cols = rows * COLS_PER_ROW as usize;
+        let width = g.nx.div_ceil(cols);
+        let height = g.ny.div_ceil(rows);
+        let mut counts = vec![[0u32; 3]; width * height];
+        let mut void = vec![0u64; g.nw];
+        let mut over = vec![0u64; g.nw];
+        let mut cov = vec![0u64; g.nw];
+        for k in 0..g.ny {
+            let (r, d) = (
+                Raster::row(&self.region_bits, &g, k),
+                Raster::row(&self.drop_bits, &g, k),
+            );
+            for w in 0..g.nw {
+                void[w] = r[w] & !d[w];
+                over[w] = d[w] & !r[w];
+                cov[w] = d[w] & r[w];
+            }
+            for cx in 0..width {
+                let (c0, c1) = (cx * cols, ((cx + 1) * cols).min(g.nx) - 1);
+                let slot = &mut counts[(k / rows) * width + cx];
+                slot[0] += count_range(&void, c0, c1);
+                slot[1] += count_range(&over, c0, c1);
+                slot[2] += count_range(&cov, c0, c1);
+            }
+        }
+        let full = (rows * cols) as f64;
+        let share = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
+        CoverageMask {
+            origin: [g.x0, g.y0],
+            cell: rows as f64 * g.gy,
+            width,
+            height,
+            void: counts.iter().map(|c| share(c[0])).collect(),
+            overfill: counts.iter().map(|c| share(c[1])).collect(),
+            covered: counts.iter().map(|c| share(c[2])).collect(),
+        }
+    }
+}
+
+struct UnionFind {
+    parent: Vec<u32>,
+}
+
+impl UnionFind {
+    fn new(n: usize) -> UnionFind {
+        UnionFind {
+            parent: (0..n as u32).collect(),
+        }
+    }
+
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.parent[i] as usize != i {
+            let p = self.parent[i] as usize;
+            self.parent[i] = self.parent[p];
+            i = p;
+        }
+        i
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra != rb {
+            let (lo, hi) = (ra.min(rb), ra.max(rb));
+            self.parent[hi] = lo as u32;
+        }
+    }
+}
+
+/// Region edges in a uniform grid, for the distance from a point to the boundary.
+struct EdgeIndex<'a> {
+    edges: &'a [(Point, Point)],
+    min: Point,
+    cell: f64,
+    nx: i64,
+    ny: i64,
+    offsets: Vec<u32>,
+    items: Vec<u32>,
+}
+
+/// Squared distance from `p` to the segment a–b.
+fn segment_distance2(p: Point, a: Point, b: Point) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (x, y) = (p[0] - a[0] - t * d[0], p[1] - a[1] - t * d[1]);
+    x * x + y * y
+}
+
+impl<'a> EdgeIndex<'a> {
+    fn new(edges: &'a [(Point, Point)], cell: f64) -> EdgeIndex<'a> {
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for (a, b) in edges {
+            for k in 0..2 {
+                min[k] = min[k].min(a[k]).min(b[k]);
+                max[k] = max[k].max(a[k]).max(b[k]);
+            }
+        }
+        if edges.is_empty() {
+            min = [0.0; 2];
+            max = [0.0; 2];
+        }
+        let nx = ((max[0] - min[0]) / cell).floor() as i64 + 1;
+        let ny = ((max[1] - min[1]) / cell).floor() as i64 + 1;
+        let cell_of = |p: Point| {
+            (
+                (((p[0] - min[0]) / cell).floor() as i64).clamp(0, nx - 1),
+                (((p[1] - min[1]) / cell).floor() as i64).clamp(0, ny - 1),
+            )
+        };
+        let mut counts = vec![0u32; (nx * ny) as usize + 1];
+        let each = |f: &mut dyn FnMut(usize, usize)| {
+            for (i, (a, b)) in edges.iter().enumerate() {
+                let (ax, ay) = cell_of(*a);
+                let (bx, by) = cell_of(*b);
+                for y in ay.min(by)..=ay.max(by) {
+                    for x in ax.min(bx)..=ax.max(bx) {
+                        f((y * nx + x) as usize, i);
+                    }
+                }
+            }
+        };
+        each(&mut |c, _| counts[c + 1] += 1);
+        for i in 1..counts.len() {
+            counts[i] += counts[i - 1];
+        }
+        let mut fill = counts.clone();
+        let mut items = vec![0u32; *counts.last().unwrap_or(&0) as usize];
+        each(&mut |c, i| {
+            items[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        });
+        EdgeIndex {
+            edges,
+            min,
+            cell,
+            nx,
+            ny,
+            offsets: counts,
+            items,
+        }
+    }
+
+    /// Distance from `p` to the nearest edge; may stop early (returning a value ≤ `enough`)
+    /// once the distance is known to be at most `enough`.
+    fn distance(&self, p: Point, enough: f64) -> f64 {
+        if self.edges.is_empty() {
+            return 0.0;
+        }
+        let cx = ((p[0] - self.min[0]) / self.cell).floor() as i64;
+        let cy = ((p[1] - self.min[1]) / self.cell).floor() as i64;
+        let mut best = f64::INFINITY;
+        let max_r = self.nx.max(self.ny) + cx.abs().max(cy.abs());
+        for r in 0..=max_r {
+            for y in (cy - r)..=(cy + r) {
+                if y < 0 || y >= self.ny {
+                    continue;
+                }
+                let step = if y == cy - r || y == cy + r {
+                    1
+                } else {
+                    2 * r.max(1)
+                };
+                let mut x = cx - r;
+                while x <= cx + r {
+                    if x >= 0 && x < self.nx {
+                        let c = (y * self.nx + x) as usize;
+                        for &e in
+                            &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize]
+                        {
+                            let (a, b) = self.edges[e as usize];
+                            best = best.min(segment_distance2(p, a, b));
+                        }
+                    }
+                    x += step;
+                }
+            }
+            // Edges outside rings 0..=r are at least r·cell away.
+            let bound = r as f64 * self.cell;
+            if best <= bound * bound || best <= enough * enough {
+                break;
+            }
+        }
+        best.sqrt()
+    }
+}
+
+/// Part-level figures. Areas in mm² summed over layers; volumes in mm³.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PartAnalysis {
+    pub layers: usize,
+    pub droplets: u64,
+    pub region_area: f64,
+    /// Area-weighted coverage over all layers.
+    pub coverage: f64,
+    pub void_area: f64,
+    pub enclosed_void_area: f64,
+    pub overfill_area: f64,
+    /// The largest connected void of any layer, and its layer (from 0).
+    pub largest_void: Option<Void>,
+    pub largest_void_layer: Option<usize>,
+    pub max_boundary_deviation: f64,
+    pub max_deviation_layer: Option<usize>,
+    /// The part's volume: each layer's region times H.
+    pub volume: f64,
+    /// Volume of the part no droplet spheroid fills (3D estimate).
+    pub void_volume: f64,
+    /// void_volume / volume.
+    pub void_fraction: f64,
+}
+
+impl PartAnalysis {
+    /// Adds one layer's figures (its 3D slab: `slab_volume`, `slab_void`).
+    pub fn add(&mut self, l: &LayerAnalysis, slab_volume: f64, slab_void: f64) {
+        self.layers += 1;
+        self.droplets += l.droplets;
+        let covered = self.coverage * self.region_area + l.coverage * l.region_area;
+        self.region_area += l.region_area;
+        self.coverage = if self.region_area > 0.0 {
+            covered / self.region_area
+        } else {
+            0.0
+        };
+        self.void_area += l.void_area;
+        self.enclosed_void_area += l.enclosed_void_area;
+        self.overfill_area += l.overfill_area;
+        if let Some(v) = l.largest_void
+            && self.largest_void.is_none_or(|b| v.area > b.area)
+        {
+            self.largest_void = Some(v);
+            self.largest_void_layer = Some(l.index);
+        }
+        if l.boundary_deviation > self.max_boundary_deviation {
+            self.max_boundary_deviation = l.boundary_deviation;
+            self.max_deviation_layer = Some(l.index);
+        }
+        self.volume += slab_volume;
+        self.void_volume += slab_void;
+        self.void_fraction = if self.volume > 0.0 {
+            self.void_volume / self.volume
+        } else {
+            0.0
+        };
+    }
+}
+
+/// The droplet spheroids of one layer on the 3D grid: per cell, the largest
+/// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
+/// droplets fill the cell's column within c·√q of the layer's mid-height.
+pub struct HeightMap {
+    x0: i64,
+    y0: i64,
+    w: usize,
+    h: usize,
+    q: Vec<f32>,
+}
+
+/// The 3D grid: square cells of `cell` mm from a fixed origin (the same for every layer).
+#[derive(Clone, Copy, Debug)]
+pub struct Grid3 {
+    pub origin: Point,
+    pub cell: f64,
+}
+
+impl HeightMap {
+    pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
+        let r = d / 2.0;
+        let mut min = [i64::MAX; 2];
+        let mut max = [i64::MIN; 2];
+        let idx = |v: f64, k: usize| ((v - grid.origin[k]) / grid.cell - 0.5).floor() as i64;
+        for p in centres {
+            for k in 0..2 {
+                min[k] = min[k].min(idx(p[k] - r, k));
+                max[k] = max[k].max(idx(p[k] + r, k) + 1);
+            }
+        }
+        if centres.is_empty() {
+            return HeightMap {
+                x0: 0,
+                y0: 0,
+                w: 0,
+                h: 0,
+                q: Vec::new(),
+            };
+        }
+        let (w, h) = (
+            (max[0] - min[0] + 1) as usize,
+            (max[1] - min[1] + 1) as usize,
+        );
+        let mut q = vec![0f32; w * h];
+        let inv = 1.0 / (r * r);
+        for p in centres {
+            let (ax, bx) = (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1);
+            let (ay, by) = (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1);
+            for iy in ay..=by {
+                let y = grid.origin[1] + (iy as f64 + 0.5) * grid.cell - p[1];
+                let row = (iy - min[1]) as usize * w;
+                for ix in ax..=bx {
+                    let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
+                    let v = (1.0 - (x * x + y * y) * inv) as f32;
+                    let slot = &mut q[row + (ix - min[0]) as usize];
+                    if v > *slot {
+                        *slot = v;
+                    }
+                }
+            }
+        }
+        HeightMap {
+            x0: min[0],
+            y0: min[1],
+            w,
+            h,
+            q,
+        }
+    }
+
+    fn get(&self, ix: i64, iy: i64) -> f32 {
+        let (x, y) = (ix - self.x0, iy - self.y0);
+        if x < 0 || y < 0 || x as usize >= self.w || y as usize >= self.h {
+            return 0.0;
+        }
+        self.q[y as usize * self.w + x as usize]
+    }
+}
+
+/// The 3D estimate for layer i's slab: (volume, void volume) in mm³ of its region × H, filled
+/// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`).
+pub fn slab_voids(
+    region: &Shapes,
+    grid: &Grid3,
+    below: Option<&HeightMap>,
+    this: &HeightMap,
+    above: Option<&HeightMap>,
+    s: &Settings,
+) -> (f64, f64) {
+    let h = s.layer_height;
+    let c = spheroid_half_height(s);
+    let half = h / 2.0;
+    let mut ymin = f64::INFINITY;
+    let mut ymax = f64::NEG_INFINITY;
+    for p in region.iter().flatten().flatten() {
+        ymin = ymin.min(p[1]);
+        ymax = ymax.max(p[1]);
+    }
+    if !ymin.is_finite() {
+        return (0.0, 0.0);
+    }
+    let k0 = ((ymin - grid.origin[1]) / grid.cell - 0.5).floor() as i64;
+    let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
+    let y0 = grid.origin[1] + k0 as f64 * grid.cell;
+    let (mut cells, mut filled) = (0u64, 0.0f64);
+    // A neighbour's droplet reaches into this slab where c·√q > H/2.
+    let q_reach = ((half / c) * (half / c)) as f32;
+    let ext = |m: Option<&HeightMap>, ix, iy| -> f64 {
+        m.map_or(0.0, |m| {
+            let q = m.get(ix, iy);
+            if q > q_reach {
+                (c * (q as f64).sqrt() - half).max(0.0)
+            } else {
+                0.0
+            }
+        })
+    };
+    region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
+        let iy = k0 + k as i64;
+        let c0 = ((xa - grid.origin[0]) / grid.cell - 0.5).ceil() as i64;
+        let c1 = ((xb - grid.origin[0]) / grid.cell - 0.5).floor() as i64;
+        for ix in c0..=c1 {
+            cells += 1;
+            // Local z from the slab's bottom: [0, lo] from below, the own droplet around h/2,
+            // [h − hi, h] from above.
+            let lo = ext(below, ix, iy).min(h);
+            let hi = ext(above, ix, iy).min(h);
+            let q = this.get(ix, iy);
+            let a = if q > 0.0 {
+                (c * (q as f64).sqrt()).min(half)
+            } else {
+                0.0
+            };
+            let (m0, m1) = (half - a, half + a);
+            // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
+            let mut len = 0.0;
+            let mut end = 0.0f64;
+            for (s0, s1) in [(0.0, lo), (m0, m1), (h - hi, h)] {
+                if s1 <= s0 {
+                    continue;
+                }
+                let s0 = s0.max(end);
+                if s1 > s0 {
+                    len += s1 - s0;
+                    end = s1;
+                }
+            }
+            filled += len;
+        }
+    });
+    let area = grid.cell * grid.cell;
+    let volume = cells as f64 * area * h;
+    (volume, (volume - filled * area).max(0.0))
+}
+
+/// The whole report of a job: settings, model, part figures and every layer's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub file_name: String,
+    pub settings: Settings,
+    pub model: Model,
+    pub part: PartAnalysis,
+    pub layers: Vec<LayerAnalysis>,
+}
+
+/// The analysis model as used, for the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Model {
+    pub footprint: crate::settings::Footprint,
+    /// Droplet width B, footprint diameter D, spheroid height, mm.
+    pub droplet_width: f64,
+    pub footprint_diameter: f64,
+    pub spheroid_height: f64,
+    /// Grid rows and columns, mm; 3D cells, mm.
+    pub grid_row: f64,
+    pub grid_column: f64,
+    pub grid_3d: f64,
+    pub description: &'static str,
+}
+
+impl Model {
+    pub fn new(s: &Settings) -> Model {
+        let b = s.droplet_width();
+        Model {
+            footprint: s.footprint,
+            droplet_width: b,
+            footprint_diameter: footprint_diameter(s),
+            spheroid_height: 2.0 * spheroid_half_height(s),
+            grid_row: b / ROWS_PER_B,
+            grid_column: b / ROWS_PER_B / COLS_PER_ROW,
+            grid_3d: b / GRID3_PER_B,
+            description: "2D: each droplet covers a disc of diameter D centred on it; 3D: an oblate spheroid of diameter D and volume B*B*H centred at its layer's mid-height (see docs/quality.md)",
+        }
+    }
+}
+
+/// Plans and analyses every layer of `job` in parallel (blocks of consecutive layers per
+/// thread, so each layer's spheroids are built once and shared with its neighbours).
+/// `timing` receives (seconds planning, seconds analysing), summed over threads.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn analyse_job(job: &crate::Job) -> (Report, [f64; 2]) {
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::time::Instant;
+    let s = job.settings();
+    let n = job.layer_count();
+    let b = s.droplet_width();
+    let d = footprint_diameter(s);
+    let bounds = job.info().bounds;
+    let grid = Grid3 {
+        origin: [bounds.min[0] - d, bounds.min[1] - d],
+        cell: b / GRID3_PER_B,
+    };
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(n.max(1));
+    let block = n.div_ceil(4 * threads).max(4);
+    let blocks = n.div_ceil(block);
+    let next = AtomicUsize::new(0);
+    type Out = (LayerAnalysis, f64, f64);
+    let results: Mutex<Vec<Option<Out>>> = Mutex::new(vec![None; n]);
+    let times = Mutex::new([0.0f64; 2]);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| {
+                let mut t_plan = 0.0;
+                let mut t_analyse = 0.0;
+                loop {
+                    let bi = next.fetch_add(1, Ordering::Relaxed);
+                    if bi >= blocks {
+                        break;
+                    }
+                    let (a, e) = (bi * block, ((bi + 1) * block).min(n));
+                    let layer = |i: usize, t_plan: &mut f64, t_analyse: &mut f64| {
+                        let t = Instant::now();
+                        let section = job.section(i);
+                        let plan = crate::plan::plan_layer(&section.region, i, s);
+                        *t_plan += t.elapsed().as_secs_f64();
+                        let t = Instant::now();
+                        let centres = droplet_centres(&plan, b);
+                        let map = HeightMap::new(&centres, &grid, d);
+                        *t_analyse += t.elapsed().as_secs_f64();
+                        (section.region, plan, centres, map)
+                    };
+                    let mut raster = Raster::empty();
+                    let mut below = (a > 0).then(|| layer(a - 1, &mut t_plan, &mut t_analyse).3);
+                    let mut cur = layer(a, &mut t_plan, &mut t_analyse);
+                    let mut out = Vec::with_capacity(e - a);
+                    for i in a..e {
+                        let above = (i + 1 < n).then(|| layer(i + 1, &mut t_plan, &mut t_analyse));
+                        let t = Instant::now();
+                        let (region, plan, centres, map) = &cur;
+                        raster.rebuild(i, plan.z, centres, region, s);
+                        let la = raster.analysis();
+                        let (vol, void) = slab_voids(
+                            region,
+                            &grid,
+                            below.as_ref(),
+                            map,
+                            above.as_ref().map(|x| &x.3),
+                            s,
+                        );
+                        t_analyse += t.elapsed().as_secs_f64();
+                        out.push((la, vol, void));
+                        let Some(next) = above else { break };
+                        below = Some(std::mem::replace(&mut cur, next).3);
+                        if i + 1 == e {
+                            break;
+                        }
+                    }
+                    let mut r = results.lock().unwrap_or_else(|p| p.into_inner());
+                    for (k, o) in out.into_iter().enumerate() {
+                        r[a + k] = Some(o);
+                    }
+                }
+                let mut t = times.lock().unwrap_or_else(|p| p.into_inner());
+                t[0] += t_plan;
+                t[1] += t_analyse;
+            });
+        }
+    });
+    let mut part = PartAnalysis::default();
+    let mut layers = Vec::with_capacity(n);
+    for (la, vol, void) in results
+        .into_inner()
+        .unwrap_or_else(|p| p.into_inner())
+        .into_iter()
+        .flatten()
+    {
+        part.add(&la, vol, void);
+        layers.push(la);
+    }
+    let report = Report {
+        file_name: job.info().file_name.clone(),
+        settings: s.clone(),
+        model: Model::new(s),
+        part,
+        layers,
+    };
+    (
+        report,
+        times.into_inner().unwrap_or_else(|p| p.into_inner()),
+    )
+}

@@ -1,0 +1,145 @@
+//! The coverage analysis against exact cases (disc area, square lattice, scallops along an
+//! edge, overfill across an edge) and the staggering of loops and hatch lines.
+
+use dropslice::Settings;
+use dropslice::analysis::{analyse_layer, analyse_layer_with_mask};
+use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
+use dropslice::slice::{Point, Shapes};
+use std::f64::consts::PI;
+
+fn plan_of(points: &[Point]) -> LayerPlan {
+    LayerPlan {
+        moves: points
+            .iter()
+            .map(|&to| Move {
+                kind: MoveKind::Droplet,
+                role: Role::Fill,
+                to,
+            })
+            .collect(),
+        ..LayerPlan::default()
+    }
+}
+
+fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Shapes {
+    vec![vec![vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]]]
+}
+
+#[test]
+fn one_disc_covers_its_area_within_one_percent() {
+    let s = Settings::default();
+    let b = s.droplet_width();
+    let want = PI * b * b / 4.0;
+    let region = rect(-1.0, -1.0, 1.0, 1.0);
+    // Many positions relative to the grid.
+    for i in 0..97 {
+        let p = [0.0137 * i as f64 % 0.3, 0.0291 * i as f64 % 0.3];
+        let a = analyse_layer(&plan_of(&[p]), &region, &s);
+        let got = a.covered_area;
+        assert!(
+            (got - want).abs() < 0.01 * want,
+            "disc at {p:?}: {got} vs {want}"
+        );
+        assert!(a.overfill_area == 0.0);
+        assert!((a.void_area + got - 4.0).abs() < 0.01, "{}", a.void_area);
+    }
+}
+
+#[test]
+fn square_lattice_at_pitch_b_leaves_one_minus_pi_over_four() {
+    let s = Settings::default();
+    let b = s.droplet_width();
+    let n = 40;
+    for (ox, oy) in [(0.0, 0.0), (0.0071, 0.0133), (0.31, 0.047)] {
+        let mut pts = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                pts.push([ox + (i as f64 + 0.5) * b, oy + (j as f64 + 0.5) * b]);
+            }
+        }
+        let side = n as f64 * b;
+        let region = rect(ox, oy, ox + side, oy + side);
+        let a = analyse_layer(&plan_of(&pts), &region, &s);
+        let share = a.void_area / a.region_area;
+        let want = 1.0 - PI / 4.0;
+        assert!(
+            (share - want).abs() < 0.01,
+            "offset ({ox}, {oy}): void share {share} vs {want}"
+        );
+        assert!(
+            a.overfill_area < 1e-3 * a.region_area,
+            "{}",
+            a.overfill_area
+        );
+        // The discs only touch: voids stay apart (about one per lattice cell, plus the
+        // scallops along the edges), none larger than a cell's gap.
+        assert!(a.voids as f64 > 0.9 * (n * n) as f64, "{} voids", a.voids);
+        let largest = a.largest_void.unwrap();
+        assert!(largest.area < 0.3 * b * b, "{largest:?}");
+    }
+}
+
+#[test]
+fn a_row_along_an_edge_gives_the_scallop_depth() {
+    let s = Settings::default();
+    let b = s.droplet_width();
+    let r = b / 2.0;
+    for pitch in [0.6 * b, 0.8 * b, 0.9 * b] {
+        // A strip one droplet wide, droplets on its centre line: scallops on both sides.
+        let n = 60;
+        let pts: Vec<Point> = (0..n).map(|k| [r + k as f64 * pitch, r]).collect();
+        let len = 2.0 * r + (n - 1) as f64 * pitch;
+        let a = analyse_layer(&plan_of(&pts), &rect(0.0, 0.0, len, b), &s);
+        let want = r - (r * r - pitch * pitch / 4.0).sqrt();
+        assert!(
+            (a.deviation_inward - want).abs() < b / 10.0,
+            "pitch {pitch}: inward {} vs {want}",
+            a.deviation_inward
+        );
+        // Scallop area: per gap, the strip's cell minus the disc's share.
+        assert!(a.deviation_outward < b / 20.0, "{}", a.deviation_outward);
+        assert_eq!(a.enclosed_void_area, 0.0);
+    }
+    // Droplets centred on the edge reach r outside it.
+    let pts: Vec<Point> = (0..50).map(|k| [1.0 + k as f64 * 0.8 * b, 0.0]).collect();
+    let a = analyse_layer(&plan_of(&pts), &rect(0.0, 0.0, 12.0, b), &s);
+    assert!(
+        (a.deviation_outward - r).abs() < b / 10.0,
+        "outward {} vs {r}",
+        a.deviation_outward
+    );
+    assert!(a.overfill_area > 0.0);
+}
+
+#[test]
+fn an_enclosed_void_is_found_with_its_position() {
+    let s = Settings::default();
+    let b = s.droplet_width();
+    // A filled square (pitch 0.6 B, no gaps) with a 3 x 3 hole of droplets missing.
+    let mut pts = Vec::new();
+    let p = 0.6 * b;
+    for i in 0..30 {
+        for j in 0..30 {
+            if (12..15).contains(&i) && (12..15).contains(&j) {
+                continue;
+            }
+            pts.push([i as f64 * p, j as f64 * p]);
+        }
+    }
+    let side = 29.0 * p;
+    let a = analyse_layer(&plan_of(&pts), &rect(0.0, 0.0, side, side), &s);
+    let v = a.largest_void.unwrap();
+    assert!(!v.at_boundary, "{v:?}");
+    let centre = 13.0 * p;
+    assert!((v.centroid[0] - centre).abs() < b / 10.0, "{v:?}");
+    assert!((v.centroid[1] - centre).abs() < b / 10.0, "{v:?}");
+    // Hole of 3 pitches minus the neighbours' reach: (4p − 2r)² roughly.
+    let want = (4.0 * p - b).powi(2);
+    assert!((v.area - want).abs() < 0.35 * want, "{} vs {want}", v.area);
+    assert!((a.enclosed_void_area - v.area).abs() < 1e-9);
+    let (_, mask) = analyse_layer_with_mask(&plan_of(&pts), &rect(0.0, 0.0, side, side), &s, b);
+    assert_eq!(mask.void.len(), mask.width * mask.height);
+    let col = ((centre - mask.origin[0]) / mask.cell) as usize;
+    let row = ((centre - mask.origin[1]) / mask.cell) as usize;
+    assert!(mask.void[row * mask.width + col] > 200);
+}
