@@ -17,6 +17,9 @@ G25 droplet line, G26 droplet).
   --settings FILE.json   read settings from a JSON object {\"name\": value, ...}
                          (--set options given later override it)
   --list-settings        print every setting with its default, unit, range and meaning
+  --report FILE.json     also analyse the droplets: coverage, voids, overfill, boundary
+                         deviation per layer and for the part, and the part's 3D void
+                         fraction (model: docs/quality.md); the summary line shows the latter
   -q, --quiet            no progress, only errors
   -h, --help             this text
   -V, --version          the version
@@ -28,6 +31,7 @@ struct Args {
     output: Option<PathBuf>,
     settings: Settings,
     quiet: bool,
+    report: Option<PathBuf>,
 }
 
 enum Parsed {
@@ -65,6 +69,7 @@ fn parse_args(argv: &[String]) -> Result<Parsed, String> {
     let mut output = None;
     let mut settings = Settings::default();
     let mut quiet = false;
+    let mut report = None;
     let mut it = argv.iter();
     let value = |it: &mut std::slice::Iter<String>, opt: &str| {
         it.next()
@@ -80,6 +85,7 @@ fn parse_args(argv: &[String]) -> Result<Parsed, String> {
             "--list-settings" => return Ok(Parsed::Exit(list_settings())),
             "-q" | "--quiet" => quiet = true,
             "-o" | "--output" => output = Some(PathBuf::from(value(&mut it, a)?)),
+            "--report" => report = Some(PathBuf::from(value(&mut it, a)?)),
             "--set" => {
                 let kv = value(&mut it, a)?;
                 let (k, v) = kv
@@ -110,6 +116,7 @@ fn parse_args(argv: &[String]) -> Result<Parsed, String> {
         output,
         settings,
         quiet,
+        report,
     })))
 }
 
@@ -222,10 +229,23 @@ fn run(args: &Args) -> Result<(), Error> {
     for r in summary.repairs() {
         eprintln!("dropslice: repaired: {r}");
     }
+    let mut voids = String::new();
+    if let Some(path) = &args.report {
+        let (report, _) = dropslice::analysis::analyse_job(&job);
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| Error::Internal(format!("the report does not serialize: {e}")))?;
+        std::fs::write(path, text + "\n").map_err(|e| io("write", path, e))?;
+        voids = format!(
+            ", void fraction {:.1} % (coverage {:.1} %; report {})",
+            100.0 * report.part.void_fraction,
+            100.0 * report.part.coverage,
+            path.display()
+        );
+    }
     if !args.quiet {
         let c = summary.counts;
         eprintln!(
-            "dropslice: {} → {}: {} layers, {} droplets ({} outer, {} inner, {} fill), {:.2} s",
+            "dropslice: {} → {}: {} layers, {} droplets ({} outer, {} inner, {} fill){voids}, {:.2} s",
             name,
             output.display(),
             summary.layers,
