@@ -42,6 +42,8 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Most layers a job may have (a guard against settings that would run for hours).
 pub const MAX_LAYERS: usize = 200_000;
+/// Most droplets a job may set (volume / B²H): beyond this the code would not fit on a disk.
+pub const MAX_DROPLETS: f64 = 2e9;
 /// Largest part extent in x or y, in droplet widths (hatch lines per layer).
 pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
 
@@ -126,6 +128,15 @@ impl Job {
             return Err(Error::NothingToPrint(
                 "the mesh encloses no volume (a surface without thickness): export the part as a solid".into(),
             ));
+        }
+        let droplets = volume / (b * b * settings.layer_height);
+        if droplets > MAX_DROPLETS {
+            return Err(Error::Setting {
+                name: "layer_height".into(),
+                message: format!(
+                    "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of {b:.4} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height) or check the scale"
+                ),
+            });
         }
         if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
             return Err(Error::Setting {

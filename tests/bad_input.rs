@@ -362,6 +362,12 @@ fn rows() -> Vec<Row> {
     );
     r.args.extend(["--set".into(), "layer_height=0.001".into()]);
     rows.push(r);
+    // Valid sizes but far too many droplets (hours of work, hundreds of GB of code).
+    rows.push(setting_row(
+        "layer_height=0.0002 on the cube (1e15 droplets)",
+        "layer_height=0.0002".into(),
+        &["droplets"],
+    ));
     // Lying flat after rotation.
     rows.push(setting_row(
         "a flat mesh is flat whatever the rotation",
