@@ -1,17 +1,6 @@
 //! Finds offset loop vertices closer to the section boundary than the loop's offset:
 //! `cargo run --release --example offset_debug -- MODEL.stl LAYER`.
-use dropslice::slice::{Point, dist};
-
-fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l2 = d[0] * d[0] + d[1] * d[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(p, [a[0] + t * d[0], a[1] + t * d[1]])
-}
+use dropslice::slice::segment_distance as seg_dist;
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();

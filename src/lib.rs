@@ -257,49 +257,20 @@ fn tris_len(_bytes: &[u8], mesh: &Mesh, degenerate: usize) -> usize {
 
 /// Plain-language warnings about the mesh.
 fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
-    let mut w = Vec::new();
-    if m.open_edges > 0 {
-        w.push(format!(
-            "the mesh is not closed: {} open edges (holes in the surface); open sections are closed by joining their ends",
-            m.open_edges
-        ));
-    }
-    if m.nonmanifold_edges > 0 {
-        w.push(format!(
-            "{} non-manifold edges (shared by more than two facets); overlapping parts are printed as their union",
-            m.nonmanifold_edges
-        ));
-    }
-    if m.misoriented_edges > 0 {
-        w.push(format!(
-            "{} edges between facets of opposite orientation (flipped facets); loops are oriented by the majority",
-            m.misoriented_edges
-        ));
-    }
-    if m.duplicate_facets > 0 {
-        w.push(format!(
-            "{} duplicate facets were ignored",
-            m.duplicate_facets
-        ));
-    }
-    if m.degenerate_facets > 0 {
-        w.push(format!(
-            "{} degenerate facets (zero area) were ignored",
-            m.degenerate_facets
-        ));
-    }
-    if m.tolerance_welded > 0 {
-        w.push(format!(
-            "{} near-coincident vertices (closer than {WELD_TOLERANCE_MM} mm) were merged to close cracks in the surface",
-            m.tolerance_welded
-        ));
-    }
-    if m.bodies > 1 {
-        w.push(format!(
-            "{} separate bodies; where they overlap they are printed as one",
-            m.bodies
-        ));
-    }
+    let counted: [(usize, &str, String); 7] = [
+        (m.open_edges, "the mesh is not closed: ", " open edges (holes in the surface); open sections are closed by joining their ends".into()),
+        (m.nonmanifold_edges, "", " non-manifold edges (shared by more than two facets); overlapping parts are printed as their union".into()),
+        (m.misoriented_edges, "", " edges between facets of opposite orientation (flipped facets); loops are oriented by the majority".into()),
+        (m.duplicate_facets, "", " duplicate facets were ignored".into()),
+        (m.degenerate_facets, "", " degenerate facets (zero area) were ignored".into()),
+        (m.tolerance_welded, "", format!(" near-coincident vertices (closer than {WELD_TOLERANCE_MM} mm) were merged to close cracks in the surface")),
+        (if m.bodies > 1 { m.bodies } else { 0 }, "", " separate bodies; where they overlap they are printed as one".into()),
+    ];
+    let mut w: Vec<String> = counted
+        .into_iter()
+        .filter(|(n, _, _)| *n > 0)
+        .map(|(n, before, after)| format!("{before}{n}{after}"))
+        .collect();
     if m.signed_volume < 0.0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
     }

@@ -75,6 +75,23 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
     Ok((tris, format))
 }
 
+/// A binary STL of the given triangles (zero normals; the header is cut to 80 bytes).
+pub fn write_binary(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    let n = header.len().min(80);
+    b[..n].copy_from_slice(&header[..n]);
+    b.reserve(4 + 50 * tris.len());
+    b.extend((tris.len() as u32).to_le_bytes());
+    for t in tris {
+        b.extend([0u8; 12]);
+        for c in t.iter().flatten() {
+            b.extend(c.to_le_bytes());
+        }
+        b.extend([0u8; 2]);
+    }
+    b
+}
+
 /// Names a few common non-STL formats by their first bytes.
 fn other_format(bytes: &[u8]) -> Option<&'static str> {
     let start = bytes
@@ -251,21 +268,7 @@ impl<'a> Tokens<'a, '_> {
 mod tests {
     use super::*;
 
-    fn binary(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
-        let mut b = vec![0u8; 80];
-        b[..header.len()].copy_from_slice(header);
-        b.extend((tris.len() as u32).to_le_bytes());
-        for t in tris {
-            b.extend([0u8; 12]);
-            for v in t {
-                for c in v {
-                    b.extend(c.to_le_bytes());
-                }
-            }
-            b.extend([0u8; 2]);
-        }
-        b
-    }
+    use super::write_binary as binary;
 
     const T: [[f32; 3]; 3] = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 1.0]];
 

@@ -19,18 +19,7 @@ fn load(model: &str) -> Vec<Tri> {
 }
 
 fn binary(tris: &[Tri]) -> Vec<u8> {
-    let mut b = vec![0u8; 80];
-    b.extend((tris.len() as u32).to_le_bytes());
-    for t in tris {
-        b.extend([0u8; 12]);
-        for v in t {
-            for c in v {
-                b.extend(c.to_le_bytes());
-            }
-        }
-        b.extend([0u8; 2]);
-    }
-    b
+    dropslice::stl::write_binary(b"damaged copy", tris)
 }
 
 /// A small deterministic generator (xorshift64*), so failures reproduce.

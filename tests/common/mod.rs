@@ -400,14 +400,7 @@ pub fn contour_winding(c: &[Point], p: Point) -> i32 {
 }
 
 fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l2 = d[0] * d[0] + d[1] * d[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    dist(p, [a[0] + t * d[0], a[1] + t * d[1]])
+    dropslice::slice::segment_distance(p, a, b)
 }
 
 /// Distance from `p` to the region's boundary (its nearest contour edge).
@@ -489,20 +482,7 @@ impl IndexedRegion {
 
 /// A binary STL of the given triangles (zero normals).
 pub fn binary_stl(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
-    let mut b = vec![0u8; 80];
-    let n = header.len().min(80);
-    b[..n].copy_from_slice(&header[..n]);
-    b.extend((tris.len() as u32).to_le_bytes());
-    for t in tris {
-        b.extend([0u8; 12]);
-        for v in t {
-            for c in v {
-                b.extend(c.to_le_bytes());
-            }
-        }
-        b.extend([0u8; 2]);
-    }
-    b
+    dropslice::stl::write_binary(header, tris)
 }
 
 /// An ASCII STL of the given triangles, coordinates written with `{}`.
