@@ -127,6 +127,13 @@ impl Session {
         Ok(self.job.header(Some(&summary)))
     }
 
+    /// What slicing repaired (open sections joined, flipped facets), as a JSON array of
+    /// sentences, for the summed summary of a finished slice.
+    pub fn repairs(&self, summary_json: &str) -> Result<String, JsError> {
+        let summary = parse_summary(summary_json)?;
+        Ok(serde_json::to_string(&summary.repairs()).unwrap_or_default())
+    }
+
     /// The closing comment block.
     pub fn footer(&self, summary_json: &str) -> Result<String, JsError> {
         let summary = parse_summary(summary_json)?;

@@ -31,6 +31,26 @@ fn box_stl(w: f64, d: f64, h: f64) -> String {
     s
 }
 
+/// Adds every number of `b` into `a`, as the page sums the layers' summaries.
+fn add_numbers(a: &mut serde_json::Value, b: &serde_json::Value) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Object(a), Value::Object(b)) => {
+            for (k, v) in b {
+                add_numbers(a.entry(k.clone()).or_insert(Value::Null), v);
+            }
+        }
+        (a @ Value::Null, b) => *a = b.clone(),
+        (a @ Value::Number(_), Value::Number(b)) => {
+            *a = match (a.as_u64(), b.as_u64()) {
+                (Some(x), Some(y)) => serde_json::json!(x + y),
+                _ => serde_json::json!(a.as_f64().unwrap() + b.as_f64().unwrap()),
+            };
+        }
+        _ => {}
+    }
+}
+
 fn message(e: wasm_bindgen::JsError) -> String {
     let v: wasm_bindgen::JsValue = e.into();
     js_sys::Error::from(v).message().into()
@@ -59,8 +79,9 @@ fn slices_a_box() {
     assert_eq!(s.layer_count(), 10);
     let info: serde_json::Value = serde_json::from_str(&s.info_json()).unwrap();
     assert_eq!(info["layers"], 10);
-    let mut totals = [0.0f64; 3];
+    let mut totals = [0u64; 3];
     let mut text = String::new();
+    let mut summary = serde_json::Value::Null;
     for i in 0..s.layer_count() {
         let l = s.slice_layer(i).unwrap();
         assert_eq!(l.index(), i);
@@ -79,15 +100,20 @@ fn slices_a_box() {
         // roles: 0 outer, 1 inner, 2 fill, in the counted numbers
         let roles = l.roles().to_vec();
         for (k, t) in totals.iter_mut().enumerate() {
-            *t += roles.iter().filter(|&&r| r as usize == k).count() as f64;
+            *t += roles.iter().filter(|&&r| r as usize == k).count() as u64;
         }
         text.push_str(&l.gcode());
+        add_numbers(
+            &mut summary,
+            &serde_json::from_str(&l.summary_json()).unwrap(),
+        );
     }
     assert!(text.contains("G26 ") && text.contains("G25 ") && text.contains("G01 "));
-    let summary = format!(
-        r#"{{"layers":10,"counts":{{"outer":{},"inner":{},"fill":{}}},"travel_mm":0}}"#,
-        totals[0], totals[1], totals[2]
-    );
+    assert_eq!(summary["counts"]["outer"], totals[0]);
+    assert_eq!(summary["counts"]["inner"], totals[1]);
+    assert_eq!(summary["counts"]["fill"], totals[2]);
+    summary["layers"] = 10.into();
+    let summary = summary.to_string();
     let header = s.header(&summary).unwrap();
     assert!(header.contains("; layer_height = 0.2"), "{header}");
     assert!(header.contains("box.stl"));
@@ -95,6 +121,8 @@ fn slices_a_box() {
     assert_eq!(placeholder.len(), header.len());
     let footer = s.footer(&summary).unwrap();
     assert!(footer.contains("10 layers"), "{footer}");
+    let repairs: Vec<String> = serde_json::from_str(&s.repairs(&summary).unwrap()).unwrap();
+    assert!(repairs.is_empty(), "{repairs:?}");
     assert!(s.slice_layer(10).is_err());
 }
 

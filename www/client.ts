@@ -188,6 +188,10 @@ export class Pool {
     return this.guarded(() => this.pick().call<string>("header", { summary }));
   }
 
+  repairs(summary: string): Promise<string[]> {
+    return this.guarded(() => this.pick().call<string[]>("repairs", { summary }));
+  }
+
   footer(summary: string): Promise<string> {
     return this.guarded(() => this.pick().call<string>("footer", { summary }));
   }

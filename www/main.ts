@@ -34,6 +34,8 @@ class Slice {
   bbox: Bounds = { minX: Infinity, minY: Infinity, maxX: -Infinity, maxY: -Infinity };
   totals: Counts = { outer: 0, inner: 0, fill: 0 };
   travelTotal = 0;
+  /** What slicing repaired (from the core, once the slice is complete). */
+  repairs: string[] = [];
   /** Sum of the layers' summaries (the core's Summary, for the header and footer). */
   summary: Record<string, unknown> = {};
 
@@ -254,7 +256,7 @@ function writeStats(): void {
   const c = s.counts[current];
   set("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
   set("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
-  const warnings = (s.info.warnings ?? []) as string[];
+  const warnings = [...((s.info.warnings ?? []) as string[]), ...s.repairs];
   $("warnings").hidden = warnings.length === 0;
   $("warning-list").replaceChildren(
     ...warnings.map((w) => {
@@ -387,6 +389,15 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
     if (!viewTouched && !s.info.bounds) renderer.fit(s.bbox);
     show(current);
     setState("done");
+    pool
+      .repairs(JSON.stringify({ ...s.summary, layers: s.layers }))
+      .then((r) => {
+        s.repairs = r;
+        if (slice === s) writeStats();
+      })
+      .catch(() => {
+        // only informative; a failure here must not disturb the finished slice
+      });
   } catch (e) {
     if (gen !== generation) return;
     busy = false;

@@ -75,6 +75,7 @@ export type Request =
   | { id: number; kind: "preview"; data: { index: number } }
   | { id: number; kind: "header"; data: { summary: string } }
   | { id: number; kind: "footer"; data: { summary: string } }
+  | { id: number; kind: "repairs"; data: { summary: string } }
   | { id: number; kind: "parse_gcode"; data: { file: Blob } }
   | { id: number; kind: "crash"; data: null };
 

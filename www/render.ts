@@ -43,6 +43,16 @@ export class Renderer {
   constructor(readonly canvas: HTMLCanvasElement) {
     new ResizeObserver(() => this.resize()).observe(canvas);
     this.resize();
+    this.watchPixelRatio();
+  }
+
+  /** Redraws crisply when the window moves to a screen with another pixel ratio (or zooms). */
+  private watchPixelRatio(): void {
+    const mq = matchMedia(`(resolution: ${window.devicePixelRatio || 1}dppx)`);
+    mq.addEventListener("change", () => {
+      this.resize();
+      this.watchPixelRatio();
+    }, { once: true });
   }
 
   private resize(): void {

@@ -111,6 +111,9 @@ async function handle(req: Request): Promise<void> {
     case "header":
       post({ id: req.id, kind: "result", data: need().header(req.data.summary) });
       return;
+    case "repairs":
+      post({ id: req.id, kind: "result", data: JSON.parse(need().repairs(req.data.summary)) });
+      return;
     case "footer":
       post({ id: req.id, kind: "result", data: need().footer(req.data.summary) });
       return;

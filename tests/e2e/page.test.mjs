@@ -261,3 +261,16 @@ test("Cancel stops a large slice at once and a new slice works", async () => {
   assert.equal(ok.name, "sample-block-with-boss.stl");
   assert.ok(ok.droplets > 0);
 });
+
+test("on a high-DPI screen the canvas has one pixel per device pixel", async () => {
+  const hi = await openPage(env.browser, env.url, { width: 1200, height: 800, scale: 2 });
+  await waitDone(hi.page, 60_000);
+  const dims = await hi.page.evaluate(() => {
+    const c = document.getElementById("view");
+    const r = c.getBoundingClientRect();
+    return { w: c.width, h: c.height, cw: r.width, ch: r.height };
+  });
+  assert.equal(dims.w, Math.round(dims.cw * 2));
+  assert.equal(dims.h, Math.round(dims.ch * 2));
+  await hi.context.close();
+});
