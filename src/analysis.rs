@@ -909,9 +909,10 @@ pub struct PartAnalysis {
     pub largest_void_layer: Option<usize>,
     pub max_boundary_deviation: f64,
     pub max_deviation_layer: Option<usize>,
-    /// The part's volume: each layer's region times H.
+    /// The part's volume: each layer's region (exact area) times H.
     pub volume: f64,
-    /// Volume of the part no droplet spheroid fills (3D estimate).
+    /// Volume of the part no droplet spheroid fills (3D estimate: each slab's void share, sampled
+    /// on the 3D grid, times its exact volume).
     pub void_volume: f64,
     /// void_volume / volume.
     pub void_fraction: f64,
@@ -1215,7 +1216,10 @@ pub fn analyse_job(job: &crate::Job) -> (Report, [f64; 2]) {
                             s,
                         );
                         t_analyse += t.elapsed().as_secs_f64();
-                        out.push((la, vol, void));
+                        // The slab's exact volume, with the void share sampled on the grid.
+                        let exact = la.region_area * s.layer_height;
+                        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
+                        out.push((la, exact, void));
                         let Some(next) = above else { break };
                         below = Some(std::mem::replace(&mut cur, next).3);
                         if i + 1 == e {

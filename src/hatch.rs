@@ -3,7 +3,8 @@
 //! segment, go to the nearest end of an unprinted segment, reversing it if that end is its end.
 //!
 //! Hatch lines lie at (j + ½)·spacing from the origin across the hatch direction, for whole j,
-//! so two layers with the same angle have their lines in the same places.
+//! so two layers with the same angle have their lines in the same places; with `stagger`, some
+//! layers use (j + 0)·spacing instead (see [`crate::plan::hatch_shifted`]).
 
 use crate::mesh::sin_cos_deg;
 use crate::slice::{Point, Shapes, dist};
@@ -18,8 +19,22 @@ pub struct HatchLine {
 /// Segments shorter than this are dropped (tangent touches of a scanline).
 const MIN_LENGTH_MM: f64 = 1e-6;
 
-/// Unordered hatch segments of a region.
+/// Unordered hatch segments of a region, lines at (j + ½)·spacing.
 pub fn hatch(region: &Shapes, angle_deg: f64, spacing: f64) -> Vec<HatchLine> {
+    hatch_at(region, angle_deg, spacing, 0.5, None)
+}
+
+/// Unordered hatch segments of a region, lines at (j + `phase`)·spacing across the hatch
+/// direction. With `lattice = Some((pitch, along))`, each segment's ends move outward to the
+/// next points (k + along)·pitch along the hatch direction (by less than a pitch each), so its
+/// droplets lie on that lattice whichever end it is printed from.
+pub fn hatch_at(
+    region: &Shapes,
+    angle_deg: f64,
+    spacing: f64,
+    phase: f64,
+    lattice: Option<(f64, f64)>,
+) -> Vec<HatchLine> {
     let (s, c) = sin_cos_deg(angle_deg);
     // Into the hatch frame (rotate by −angle): the lines become horizontal.
     let to = |p: Point| [c * p[0] + s * p[1], -s * p[0] + c * p[1]];
@@ -35,10 +50,10 @@ pub fn hatch(region: &Shapes, angle_deg: f64, spacing: f64) -> Vec<HatchLine> {
                 continue;
             }
             let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
-            // Lines with lo.y <= y < hi.y, y = (j + ½)·spacing.
-            let mut j = (lo[1] / spacing - 0.5).ceil() as i64;
+            // Lines with lo.y <= y < hi.y, y = (j + phase)·spacing.
+            let mut j = (lo[1] / spacing - phase).ceil() as i64;
             loop {
-                let y = (j as f64 + 0.5) * spacing;
+                let y = (j as f64 + phase) * spacing;
                 if y < lo[1] {
                     j += 1;
                     continue;
@@ -55,7 +70,7 @@ pub fn hatch(region: &Shapes, angle_deg: f64, spacing: f64) -> Vec<HatchLine> {
     hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let mut lines = Vec::new();
     for row in hits.chunk_by(|a, b| a.0 == b.0) {
-        let y = (row[0].0 as f64 + 0.5) * spacing;
+        let y = (row[0].0 as f64 + phase) * spacing;
         let mut winding = 0;
         let mut start = 0.0;
         for &(_, x, w) in row {
@@ -64,9 +79,18 @@ pub fn hatch(region: &Shapes, angle_deg: f64, spacing: f64) -> Vec<HatchLine> {
             if before == 0 && winding != 0 {
                 start = x;
             } else if before != 0 && winding == 0 && x - start >= MIN_LENGTH_MM {
+                let (mut x0, mut x1) = (start, x);
+                if let Some((pitch, along)) = lattice {
+                    // Outward: the ends move by less than a pitch, never leaving a gap.
+                    let s0 = ((x0 / pitch - along).floor() + along) * pitch;
+                    let s1 = ((x1 / pitch - along).ceil() + along) * pitch;
+                    if s1 >= s0 {
+                        (x0, x1) = (s0, s1);
+                    }
+                }
                 lines.push(HatchLine {
-                    a: back([start, y]),
-                    b: back([x, y]),
+                    a: back([x0, y]),
+                    b: back([x1, y]),
                 });
             }
         }

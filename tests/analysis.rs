@@ -143,3 +143,101 @@ fn an_enclosed_void_is_found_with_its_position() {
     let row = ((centre - mask.origin[1]) / mask.cell) as usize;
     assert!(mask.void[row * mask.width + col] > 200);
 }
+
+#[test]
+fn stagger_start_step_is_an_odd_multiple_of_half_a_droplet() {
+    use dropslice::plan::loop_start_step;
+    let mut s = Settings::default();
+    let b = s.droplet_width();
+    assert_eq!(loop_start_step(&s), 0.07);
+    s.stagger = true;
+    for (jitter, halves) in [(0.07, 1.0), (0.0, 1.0), (0.3, 3.0), (0.5, 5.0)] {
+        s.start_jitter = jitter;
+        assert!(
+            (loop_start_step(&s) - halves * b / 2.0).abs() < 1e-12,
+            "{jitter}"
+        );
+    }
+}
+
+#[test]
+fn stagger_shifts_hatch_lattices_only_where_directions_repeat() {
+    use dropslice::plan::hatch_shifted;
+    let mut s = Settings {
+        stagger: true,
+        ..Settings::default()
+    };
+    // 90° steps: the turned lattice already sits over the gaps; nothing shifts.
+    assert!((0..8).all(|i| !hatch_shifted(&s, i)));
+    s.hatch_angle_step = 0.0;
+    let got: Vec<bool> = (0..4).map(|i| hatch_shifted(&s, i)).collect();
+    assert_eq!(got, [false, true, false, true]);
+    s.hatch_angle_step = 60.0;
+    let got: Vec<bool> = (0..7).map(|i| hatch_shifted(&s, i)).collect();
+    assert_eq!(got, [false, false, false, true, true, true, false]);
+    s.stagger = false;
+    assert!((0..8).all(|i| !hatch_shifted(&s, i)));
+}
+
+fn cube() -> Vec<u8> {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/models/cube_20mm_ascii.stl");
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn staggered_fill_droplets_lie_on_the_lattice_and_interleave() {
+    use dropslice::analysis::droplet_centres;
+    let s = Settings {
+        stagger: true,
+        ..Settings::default()
+    };
+    let b = s.droplet_width();
+    let job = dropslice::Job::new(&cube(), "cube", s.clone()).unwrap();
+    for i in [3, 4] {
+        let plan = job.plan_layer(i);
+        let fill: Vec<Move> = plan
+            .moves
+            .iter()
+            .copied()
+            .filter(|m| m.role == Role::Fill)
+            .collect();
+        let fill_plan = LayerPlan {
+            moves: fill,
+            ..LayerPlan::default()
+        };
+        let angle = dropslice::plan::hatch_angle(&s, i).to_radians();
+        let (sn, c) = angle.sin_cos();
+        for p in droplet_centres(&fill_plan, b) {
+            // Hatch frame: along = x', across = y'.
+            let along = (c * p[0] + sn * p[1]) / b;
+            let across = (-sn * p[0] + c * p[1]) / b - 0.5;
+            assert!((along - along.round()).abs() < 1e-3, "layer {i}: {p:?}");
+            assert!((across - across.round()).abs() < 1e-3, "layer {i}: {p:?}");
+        }
+    }
+}
+
+#[test]
+fn stagger_lowers_the_cubes_void_fraction() {
+    let mut figures = Vec::new();
+    for stagger in [false, true] {
+        let s = Settings {
+            stagger,
+            ..Settings::default()
+        };
+        let job = dropslice::Job::new(&cube(), "cube", s).unwrap();
+        let (report, _) = dropslice::analysis::analyse_job(&job);
+        assert_eq!(report.layers.len(), job.layer_count());
+        figures.push(report.part);
+    }
+    let (off, on) = (&figures[0], &figures[1]);
+    // 2D: a filled square of discs at pitch B covers about π/4.
+    assert!((off.coverage - PI / 4.0).abs() < 0.01, "{off:?}");
+    assert!(off.overfill_area < 1e-3 * off.region_area);
+    assert!((off.volume - 8000.0).abs() < 1.0, "{}", off.volume);
+    assert!(
+        on.void_fraction < off.void_fraction - 0.05,
+        "{off:?}\n{on:?}"
+    );
+}
