@@ -119,8 +119,7 @@ export class GcodeReader {
       const dx = x - this.x;
       const dy = y - this.y;
       const len = Math.hypot(dx, dy);
-      // As the core counts (plan::line_droplets). The coordinates were rounded to 4 decimals,
-      // so a line within ~1e-4 mm of a multiple of B may gain or lose its last droplet.
+      // As the core counts (plan::line_droplets, from the written 4-decimal coordinates).
       const n = Math.floor(len / this.width + 1e-9) + 1;
       for (let k = 0; k < n; k++) {
         const t = len > 0 ? (k * this.width) / len : 0;

@@ -326,6 +326,7 @@ function settingsProblem(): boolean {
   if (errors.length === 0) return false;
   showBanner(TITLES.setting, `Fix ${errors.map((e) => `${e.name.replace(/_/g, " ")} (${e.message})`).join(", ")} before slicing.`);
   form.focusFirstError();
+  setState("error");
   return true;
 }
 

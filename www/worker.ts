@@ -85,9 +85,9 @@ async function handle(req: Request): Promise<void> {
     }
     case "open": {
       await load();
-      session?.free();
-      session = null;
+      // the old session stays usable if the new model or settings are refused
       const s = new Session(new Uint8Array(req.data.stl), req.data.name, req.data.settings);
+      session?.free();
       session = s;
       post({ id: req.id, kind: "result", data: { layers: s.layer_count(), info: JSON.parse(s.info_json()) } });
       return;

@@ -153,9 +153,9 @@ test("the downloaded .gco has the CLI's commands", async (t) => {
   await pick(page, mine);
   const viewed = await waitDone(page, 120_000);
   assert.equal(viewed.layers, sliced.layers);
-  // G25 lines are re-expanded from 4-decimal coordinates, so a line whose length is within
-  // ~1e-4 mm of a multiple of B can gain or lose its last droplet: allow 1 in 10,000.
-  assert.ok(Math.abs(viewed.droplets - sliced.droplets) <= sliced.droplets * 1e-4, `${viewed.droplets} vs ${sliced.droplets}`);
+  // G25 lines re-expanded from their written coordinates give the core's counts exactly
+  assert.equal(viewed.droplets, sliced.droplets);
+  assert.equal(viewed.counts.fill, sliced.counts.fill);
   assert.equal(viewed.counts.outer, sliced.counts.outer + sliced.counts.inner, "every G26 is a loop droplet");
   assert.ok((await inkPixels(page)) > 1000);
 });
