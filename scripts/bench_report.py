@@ -115,8 +115,8 @@ def targets(stats):
 
 def browser(path):
     rows = [l.rstrip("\n").split("\t") for l in open(path) if l.strip()]
-    if rows and rows[0] == ["TODO"]:
-        return "TODO: browser timing not made (tests/e2e helpers or Chromium missing)."
+    if rows and rows[0][0] == "TODO":
+        return "TODO: no browser timing was made: " + (rows[0][1] if len(rows[0]) > 1 else "see the script's messages")
     by = defaultdict(list)
     info = {}
     for r in rows:
