@@ -1,7 +1,8 @@
 //! Renders a layer's coverage as a PNG: droplets inside the region grey, voids red, overfill
 //! blue, outside white. `cargo run --release --example overlay -- MODEL.stl LAYER OUT.png
 //! [x0 y0 x1 y1] [--zoom N] [--set name=value]...` (layer from 1; window in mm, default the
-//! whole layer; pixels of B/10, each drawn N × N).
+//! whole layer; pixels of B/10, each drawn N × N; `--below` marks the droplet centres of the
+//! layer below with dark dots).
 //! The PNG is written with stored (uncompressed) deflate blocks: no dependency needed.
 use dropslice::analysis::analyse_layer_with_mask;
 use dropslice::{Job, Settings};
@@ -11,9 +12,12 @@ fn main() {
     let mut s = Settings::default();
     let mut pos = Vec::new();
     let mut zoom = 1usize;
+    let mut below = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
-        if a == "--zoom" {
+        if a == "--below" {
+            below = true;
+        } else if a == "--zoom" {
             zoom = it.next().expect("zoom").parse().expect("zoom factor");
         } else if a == "--set" {
             let kv = it.next().expect("name=value");
@@ -41,10 +45,29 @@ fn main() {
         (c0, r0, c1, r1) = (col(w[0]), row(w[1]), col(w[2]), row(w[3]));
     }
     let (w, h) = (c1 - c0, r1 - r0);
+    // Droplet centres of the layer below, as dark dots.
+    let mut dots = std::collections::HashSet::new();
+    if below && i > 0 {
+        let region = job.section(i - 1).region;
+        let plan = dropslice::plan::plan_layer(&region, i - 1, &s);
+        for p in dropslice::analysis::droplet_centres(&plan, b) {
+            let c = ((p[0] - m.origin[0]) / m.cell) as i64;
+            let r = ((p[1] - m.origin[1]) / m.cell) as i64;
+            for dr in -1..=1 {
+                for dc in -1..=1 {
+                    dots.insert((r + dr, c + dc));
+                }
+            }
+        }
+    }
     let mut rgb = Vec::with_capacity(w * h * 3 * zoom * zoom);
     for r in (r0..r1).rev().flat_map(|r| std::iter::repeat_n(r, zoom)) {
         for c in (c0..c1).flat_map(|c| std::iter::repeat_n(c, zoom)) {
             let k = r * m.width + c;
+            if dots.contains(&(r as i64, c as i64)) {
+                rgb.extend([20, 20, 20]);
+                continue;
+            }
             let (v, o, cv) = (
                 m.void[k] as f64 / 255.0,
                 m.overfill[k] as f64 / 255.0,
