@@ -806,6 +806,8 @@ window.dropslice = {
     workers: pool.size,
   }),
   crash: () => pool.crash().catch(showError),
+  /** Draws now (synchronously), for timing. */
+  redraw: () => renderer.draw(),
   setView: (v: View) => {
     renderer.view = { ...v };
     viewTouched = true;
