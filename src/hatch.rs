@@ -25,15 +25,16 @@ pub fn hatch(region: &Shapes, angle_deg: f64, spacing: f64) -> Vec<HatchLine> {
 }
 
 /// Unordered hatch segments of a region, lines at (j + `phase`)·spacing across the hatch
-/// direction. With `lattice = Some((pitch, along))`, each segment's ends move outward to the
-/// next points (k + along)·pitch along the hatch direction (by less than a pitch each), so its
-/// droplets lie on that lattice whichever end it is printed from.
+/// direction. With `lattice = Some((pitch, along, reach))`, each segment's ends move to points
+/// (k + along)·pitch along the hatch direction, so its droplets lie on that lattice whichever
+/// end it is printed from: outward (by less than a pitch, leaving no gap) where that stays
+/// within `reach` of the region (the margin between the fill region and the part), else inward.
 pub fn hatch_at(
     region: &Shapes,
     angle_deg: f64,
     spacing: f64,
     phase: f64,
-    lattice: Option<(f64, f64)>,
+    lattice: Option<(f64, f64, f64)>,
 ) -> Vec<HatchLine> {
     let (s, c) = sin_cos_deg(angle_deg);
     // Into the hatch frame (rotate by −angle): the lines become horizontal.
@@ -80,10 +81,16 @@ pub fn hatch_at(
                 start = x;
             } else if before != 0 && winding == 0 && x - start >= MIN_LENGTH_MM {
                 let (mut x0, mut x1) = (start, x);
-                if let Some((pitch, along)) = lattice {
-                    // Outward: the ends move by less than a pitch, never leaving a gap.
-                    let s0 = ((x0 / pitch - along).floor() + along) * pitch;
-                    let s1 = ((x1 / pitch - along).ceil() + along) * pitch;
+                if let Some((pitch, along, reach)) = lattice {
+                    let (lo, hi) = ((x0 / pitch - along).floor(), (x1 / pitch - along).ceil());
+                    let mut s0 = (lo + along) * pitch;
+                    let mut s1 = (hi + along) * pitch;
+                    if x0 - s0 > reach {
+                        s0 += pitch;
+                    }
+                    if s1 - x1 > reach {
+                        s1 -= pitch;
+                    }
                     if s1 >= s0 {
                         (x0, x1) = (s0, s1);
                     }

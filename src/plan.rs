@@ -129,6 +129,15 @@ pub fn hatch_shifted(s: &Settings, index: usize) -> bool {
     period.is_some_and(|p| (index / p) % 2 == 1)
 }
 
+/// The least distance between the fill region and the part's boundary (outer or hole), mm:
+/// hatch ends may move out this far without a droplet centre leaving the part.
+fn fill_margin(s: &Settings) -> f64 {
+    let last = s.contours as f64 - 1.0;
+    let extra = 1.0 - s.fill_overlap;
+    let f = s.outer_offset.min(s.inner_offset);
+    ((f + last + extra) * s.droplet_width()).max(0.0)
+}
+
 /// Plans one layer from its region.
 pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
     let b = s.droplet_width();
@@ -184,8 +193,10 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
             hatch_angle(s, index),
             b / s.fill_density,
             if hatch_shifted(s, index) { 0.0 } else { 0.5 },
-            s.stagger
-                .then(|| (b, if hatch_shifted(s, index) { 0.5 } else { 0.0 })),
+            s.stagger.then(|| {
+                let along = if hatch_shifted(s, index) { 0.5 } else { 0.0 };
+                (b, along, fill_margin(s))
+            }),
         );
         for l in order_greedy(lines, *at) {
             plan.travel_mm += dist(*at, l.a);

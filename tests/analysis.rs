@@ -241,3 +241,23 @@ fn stagger_lowers_the_cubes_void_fraction() {
         "{off:?}\n{on:?}"
     );
 }
+
+#[test]
+fn staggered_hatch_ends_stay_inside_the_part_without_contours() {
+    use dropslice::analysis::droplet_centres;
+    let s = Settings {
+        stagger: true,
+        contours: 0,
+        ..Settings::default()
+    };
+    let job = dropslice::Job::new(&cube(), "cube", s.clone()).unwrap();
+    for i in [0, 1, 2, 3] {
+        let plan = job.plan_layer(i);
+        for p in droplet_centres(&plan, s.droplet_width()) {
+            assert!(
+                (-1e-6..=20.0 + 1e-6).contains(&p[0]) && (-1e-6..=20.0 + 1e-6).contains(&p[1]),
+                "layer {i}: droplet at {p:?} outside the cube"
+            );
+        }
+    }
+}
