@@ -26,8 +26,10 @@ if [ ! -x /usr/bin/chromium ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y chromium
 fi
 
-if [ ! -d node_modules ] || [ package-lock.json -nt node_modules ]; then
+# npm writes node_modules/.package-lock.json on every install: missing or older than
+# package-lock.json means node_modules is absent, incomplete or stale.
+if [ ! -f node_modules/.package-lock.json ] || [ package-lock.json -nt node_modules/.package-lock.json ] \
+   || [ ! -e node_modules/.bin/esbuild ] || [ ! -e node_modules/.bin/tsc ] || [ ! -d node_modules/playwright-core ]; then
   echo "setup: npm ci" >&2
   npm ci --no-audit --no-fund
-  touch node_modules
 fi
