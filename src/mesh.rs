@@ -4,7 +4,7 @@
 
 use crate::settings::Settings;
 use crate::stl::Triangles;
-use std::collections::HashMap;
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 /// A welded triangle mesh in millimetres.
 #[derive(Clone, Debug, Default)]
@@ -55,7 +55,8 @@ impl Mesh {
     /// Welds corners whose float32 coordinates are bit-identical (−0 = +0) and drops facets
     /// that collapse to a line or a point.
     pub fn weld(tris: &Triangles) -> (Mesh, usize) {
-        let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity(tris.len() / 2 + 16);
+        let mut index: HashMap<[u32; 3], u32> =
+            HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
         let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
         let mut facets = Vec::with_capacity(tris.len());
         let mut degenerate = 0;
@@ -115,7 +116,7 @@ impl Mesh {
     /// dropped and the first kept). Returns how many were dropped.
     pub fn remove_duplicate_facets(&mut self) -> usize {
         let before = self.facets.len();
-        let mut seen = std::collections::HashSet::with_capacity(before);
+        let mut seen = HashSet::with_capacity_and_hasher(before, Default::default());
         self.facets.retain(|f| {
             let mut k = *f;
             k.sort_unstable();
@@ -129,7 +130,8 @@ impl Mesh {
     /// vertices were merged. Used only as a fallback when the exact weld leaves open edges.
     pub fn weld_tolerance(&mut self, tol: f64) -> usize {
         let cell = |p: &[f64; 3]| p.map(|c| (c / tol).floor() as i64);
-        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(self.vertices.len());
+        let mut grid: HashMap<[i64; 3], Vec<u32>> =
+            HashMap::with_capacity_and_hasher(self.vertices.len(), Default::default());
         let mut remap: Vec<u32> = Vec::with_capacity(self.vertices.len());
         let mut kept: Vec<[f64; 3]> = Vec::with_capacity(self.vertices.len());
         let mut merged = 0;

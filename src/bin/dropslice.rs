@@ -221,7 +221,6 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             debug_assert_eq!(header.len(), job.header(None).len());
             file.seek(SeekFrom::Start(0))?;
             file.write_all(header.as_bytes())?;
-            file.sync_all()?;
             Ok(summary)
         };
         let summary = match finish() {
