@@ -9,9 +9,12 @@ import { makeLink, readLink, sha256Hex, type SharedLink } from "./share";
 
 const $ = <T extends HTMLElement = HTMLElement>(id: string) => document.getElementById(id) as T;
 
+/** Tuning through the query string (used by the tests): `?workers=3&cache=2` (MB). */
+const query = new URLSearchParams(location.search);
+
 /** Layer previews kept in the page; beyond this, layers far from the one shown are dropped
  *  and re-planned by a worker when they are shown again. */
-const CACHE_BUDGET_BYTES = 384 * 2 ** 20;
+const CACHE_BUDGET_BYTES = Math.max(1, Number(query.get("cache")) || 384) * 2 ** 20;
 
 interface Model {
   bytes: Uint8Array;
@@ -103,7 +106,8 @@ class Slice {
 // ---------------------------------------------------------------------------------------------
 // state
 
-const pool = new Pool();
+const workersAsked = Math.round(Number(query.get("workers")));
+const pool = workersAsked >= 1 ? new Pool(Math.min(workersAsked, 16)) : new Pool();
 const renderer = new Renderer($<HTMLCanvasElement>("view"));
 let form: SettingsForm;
 let init: InitResult;
@@ -804,6 +808,9 @@ window.dropslice = {
     view: { ...renderer.view },
     name: slice?.name ?? null,
     workers: pool.size,
+    cached: slice?.cache.size ?? 0,
+    /** Index of the layer on the canvas (null while it is being fetched). */
+    shown: renderer.current?.index ?? null,
   }),
   crash: () => pool.crash().catch(showError),
   /** Draws now (synchronously), for timing. */

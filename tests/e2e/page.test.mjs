@@ -274,3 +274,37 @@ test("on a high-DPI screen the canvas has one pixel per device pixel", async () 
   assert.equal(dims.h, Math.round(dims.ch * 2));
   await hi.context.close();
 });
+
+test("three workers give the same slice as one; evicted layers are re-planned on demand", async () => {
+  const multi = await openPage(env.browser, `${env.url}?workers=3&cache=2`);
+  const { page } = multi;
+  await waitDone(page, 60_000);
+  await pick(page, benchy);
+  const s = await waitDone(page, 240_000);
+  assert.equal(s.workers, 3);
+  assert.equal(s.layers, 240);
+  assert.ok(s.cached < 240, `only part of the layers stay cached (${s.cached})`);
+  const single = await openPage(env.browser, env.url);
+  await waitDone(single.page, 60_000);
+  await pick(single.page, benchy);
+  const ref = await waitDone(single.page, 240_000);
+  assert.equal(s.droplets, ref.droplets);
+  assert.deepEqual(s.counts, ref.counts);
+  await single.context.close();
+  // a layer far from the last one shown was evicted and comes back from a worker
+  for (const layer of [3, 230, 5]) {
+    await page.locator("#layer").fill(String(layer));
+    await page.waitForFunction((l) => window.dropslice.status().shown === l, layer, { timeout: 20_000 });
+  }
+  assert.equal(await page.isVisible("#banner"), false);
+  await page.waitForTimeout(100);
+  assert.ok((await inkPixels(page)) > 500);
+  // the download still has every layer
+  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
+  const file = join(tmp, "multi.gco");
+  await download.saveAs(file);
+  const text = readFileSync(file, "utf8");
+  assert.match(text, /; end of code: 240 layers/);
+  assert.equal(parseGcode(text).filter((c) => c.code === "G26").length, ref.counts.outer + ref.counts.inner);
+  await multi.context.close();
+});
