@@ -131,7 +131,7 @@ function setState(state: "loading" | "reading" | "idle" | "slicing" | "done" | "
 // messages
 
 const TITLES: Record<string, string> = {
-  import: "Cannot read this file.",
+  import: "",
   setting: "Bad setting.",
   nothing_to_print: "Nothing to print.",
   crash: "The slicer crashed.",
@@ -143,6 +143,7 @@ function showBanner(title: string, message: string, tone: "error" | "info" | "ok
   const b = $("banner");
   b.className = `banner ${tone === "error" ? "" : tone}`;
   $("banner-title").textContent = title;
+  $("banner-title").hidden = title === "";
   $("banner-message").textContent = message;
   b.hidden = false;
   b.dataset.kind = tone;
