@@ -308,3 +308,36 @@ test("three workers give the same slice as one; evicted layers are re-planned on
   assert.equal(parseGcode(text).filter((c) => c.code === "G26").length, ref.counts.outer + ref.counts.inner);
   await multi.context.close();
 });
+
+test("drag and drop opens a file; wheel zooms, dragging pans, Fit restores", async () => {
+  const { page } = main;
+  const cube = readFileSync(join(benchy, "../cube_20mm_ascii.stl"), "utf8");
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.evaluate((text) => {
+    const dt = new DataTransfer();
+    dt.items.add(new File([text], "dropped-cube.stl", { type: "model/stl" }));
+    const target = document.getElementById("view");
+    for (const type of ["dragenter", "dragover", "drop"]) {
+      target.dispatchEvent(new DragEvent(type, { dataTransfer: dt, bubbles: true, cancelable: true }));
+    }
+  }, cube);
+  const s = await waitDone(page, 60_000);
+  assert.equal(s.name, "dropped-cube.stl");
+  assert.equal(s.layers, 100);
+  assert.equal(await page.isVisible("#drop-overlay"), false);
+
+  const box = await page.locator("#view").boundingBox();
+  await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+  const v0 = (await status(page)).view;
+  await page.mouse.wheel(0, -300);
+  await page.waitForFunction((s0) => window.dropslice.status().view.scale > s0 * 1.5, v0.scale);
+  await page.mouse.down();
+  await page.mouse.move(box.x + box.width / 2 + 100, box.y + box.height / 2 + 40, { steps: 4 });
+  await page.mouse.up();
+  const v1 = (await status(page)).view;
+  assert.ok(v1.cx < v0.cx, "dragging right moves the view left");
+  assert.ok(v1.cy > v0.cy, "dragging down moves the view up");
+  await page.click("#btn-fit");
+  const v2 = (await status(page)).view;
+  assert.ok(Math.abs(v2.scale - v0.scale) < 1e-9 && Math.abs(v2.cx - v0.cx) < 1e-9);
+});
