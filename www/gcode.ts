@@ -161,9 +161,17 @@ export class GcodeReader {
   }
 }
 
-/** Reads a whole .gco Blob as a stream of lines. */
-export async function readGcode(file: Blob, reader: GcodeReader): Promise<void> {
-  const stream = file.stream().pipeThrough(new TextDecoderStream());
+/** Reads a whole .gco Blob as a stream of lines; `progress` gets the share of bytes read. */
+export async function readGcode(file: Blob, reader: GcodeReader, progress?: (fraction: number) => void): Promise<void> {
+  let bytes = 0;
+  const counter = new TransformStream<Uint8Array<ArrayBuffer>, Uint8Array<ArrayBuffer>>({
+    transform(chunk, controller) {
+      bytes += chunk.byteLength;
+      progress?.(file.size > 0 ? bytes / file.size : 1);
+      controller.enqueue(chunk);
+    },
+  });
+  const stream = file.stream().pipeThrough(counter).pipeThrough(new TextDecoderStream());
   const r = stream.getReader();
   let rest = "";
   for (;;) {

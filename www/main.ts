@@ -441,7 +441,7 @@ async function openGcode(file: File): Promise<void> {
       if (gen !== generation) return;
       s.put(l, 0);
       read++;
-      progress(Math.min(0.99, read / Math.max(read + 1, 1)), `Reading G-code… ${read} layers`);
+      progress(l.fraction ?? 0, `Reading ${file.name}… ${read} layers`);
     });
     if (gen !== generation) return;
     s.open(r.layers, {});

@@ -31,6 +31,8 @@ export interface LayerData {
   roles: Uint8Array;
   /** x0,y0,x1,y1 per travel move, mm. */
   travel: Float32Array;
+  /** Share of the input read so far, 0..1 (.gco files only). */
+  fraction?: number;
   /** The layer's share of the core's Summary, JSON (slices only). */
   summary?: string;
   /** The layer's G-code (slices only; absent for preview re-requests). */

@@ -118,8 +118,11 @@ async function handle(req: Request): Promise<void> {
       post({ id: req.id, kind: "result", data: need().footer(req.data.summary) });
       return;
     case "parse_gcode": {
-      const reader = new GcodeReader((layer) => post({ id: req.id, kind: "progress", data: layer }, transferablesOf(layer)));
-      await readGcode(req.data.file, reader);
+      let fraction = 0;
+      const reader = new GcodeReader((layer) =>
+        post({ id: req.id, kind: "progress", data: { ...layer, fraction } }, transferablesOf(layer)),
+      );
+      await readGcode(req.data.file, reader, (f) => (fraction = f));
       post({
         id: req.id,
         kind: "result",
