@@ -173,6 +173,21 @@ export class Pool {
     });
   }
 
+  /** Opens a model in every worker without slicing it (to browse a finished slice again
+   *  after the workers were replaced by a cancel or a crash). */
+  open(stl: Uint8Array, name: string, settings: string): Promise<void> {
+    this.heal();
+    return this.guarded(async () => {
+      const buffer = stl.slice().buffer;
+      await Promise.all(
+        this.handles.map(async (h) => {
+          await h.call<OpenResult>("open", { stl: buffer, name, settings });
+          h.hasModel = true;
+        }),
+      );
+    });
+  }
+
   private pick(): WorkerHandle {
     const ready = this.handles.filter((h) => h.hasModel && !h.broken);
     if (ready.length === 0) throw new SliceError("internal", "no worker holds the model any more; slice again");

@@ -153,7 +153,18 @@ function hideBanner(): void {
   $("banner").hidden = true;
 }
 
+/** After the workers were replaced (cancel, crash), lets them hold the finished slice's model
+ *  again, so its evicted layers and its download keep working. */
+function restoreModel(): void {
+  const s = slice;
+  if (!s || !s.complete || s.source !== "stl" || !s.model || busy) return;
+  pool.open(s.model.bytes, s.model.name, JSON.stringify(s.settings)).catch(() => {
+    // the slice stays visible; what needs a worker reports its own error
+  });
+}
+
 function showError(e: unknown): void {
+  if (e instanceof SliceError && e.kind === "crash") restoreModel();
   if (e instanceof SliceError) {
     showBanner(TITLES[e.kind] ?? "Error.", capitalize(e.message));
   } else if (e instanceof Error) {
@@ -681,6 +692,7 @@ function wire(): void {
       writeStats();
       layerLabel();
     }
+    restoreModel();
     updateButtons();
   });
   $("banner-close").addEventListener("click", hideBanner);

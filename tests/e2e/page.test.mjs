@@ -237,6 +237,9 @@ test("a crash in the wasm becomes a message and the page recovers", async () => 
   const text = await page.locator("#banner").innerText();
   assert.match(text, /crashed/);
   assert.match(text, /crash_for_test/);
+  // the fresh workers got the finished slice's model back: its download still works
+  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
+  assert.equal(download.suggestedFilename(), "sample-block-with-boss.gco");
   await page.evaluate(() => (document.body.dataset.state = "picking"));
   await page.click("#btn-sample");
   await waitDone(page, 60_000);
