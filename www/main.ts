@@ -638,7 +638,11 @@ async function openLink(): Promise<boolean> {
     return false;
   }
   if (!link) return false;
-  form.set({ ...init.defaults, ...link.state.settings });
+  const unknown = form.set({ ...init.defaults, ...link.state.settings });
+  const extra = unknown.length
+    ? ` The link comes from another version: its settings ${unknown.join(", ")} are unknown here and were ignored, so the slice may differ.`
+    : "";
+  if (extra) note(extra.trim(), "warn");
   renderer.showTravel = Boolean(link.state.showTravel);
   $<HTMLInputElement>("opt-travel").checked = renderer.showTravel;
   $("legend-travel").hidden = !renderer.showTravel;
@@ -654,7 +658,7 @@ async function openLink(): Promise<boolean> {
   pendingLink = link;
   $("empty").hidden = false;
   note(
-    `This preview link is for “${link.state.name}” (SHA-256 ${link.state.sha256.slice(0, 12)}…), which was too big to put in the link. Drop that file here to see layer ${link.state.layer + 1} with the link's settings.`,
+    `This preview link is for “${link.state.name}” (SHA-256 ${link.state.sha256.slice(0, 12)}…), which was too big to put in the link. Drop that file here to see layer ${link.state.layer + 1} with the link's settings.${extra}`,
     "warn",
   );
   setState("idle");
