@@ -102,6 +102,7 @@ impl Job {
                 tris.len()
             )));
         }
+        let facets_in_file = tris.len();
         drop(tris);
         mesh.transform(&settings);
         let bounds = mesh.bounds();
@@ -156,7 +157,6 @@ impl Job {
             )));
         }
         let duplicates = mesh.remove_duplicate_facets();
-        let facets_in_file = tris_len(stl_bytes, &mesh, degenerate) + duplicates;
         let mut stats = MeshStats {
             duplicate_facets: duplicates,
             ..mesh.stats(facets_in_file, degenerate)
@@ -249,10 +249,6 @@ impl Job {
             summary,
         )
     }
-}
-
-fn tris_len(_bytes: &[u8], mesh: &Mesh, degenerate: usize) -> usize {
-    mesh.facets.len() + degenerate
 }
 
 /// Plain-language warnings about the mesh.

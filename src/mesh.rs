@@ -111,16 +111,21 @@ impl Mesh {
         }
     }
 
-    /// Drops facets that repeat another facet's three vertices (in either orientation: two
-    /// opposite copies make a zero-thickness sheet that encloses nothing, so the copy is
-    /// dropped and the first kept). Returns how many were dropped.
+    /// Drops facets that repeat another facet with the same orientation (the same three
+    /// vertices in the same cyclic order). Two copies of opposite orientation are kept: they are
+    /// the shared face of two touching bodies, and each closes its own body's surface.
+    /// Returns how many were dropped.
     pub fn remove_duplicate_facets(&mut self) -> usize {
         let before = self.facets.len();
         let mut seen = HashSet::with_capacity_and_hasher(before, Default::default());
         self.facets.retain(|f| {
-            let mut k = *f;
-            k.sort_unstable();
-            seen.insert(k)
+            // The cyclic rotation starting at the smallest vertex id.
+            let k = f
+                .iter()
+                .enumerate()
+                .min_by_key(|(_, v)| **v)
+                .map_or(0, |(k, _)| k);
+            seen.insert([f[k], f[(k + 1) % 3], f[(k + 2) % 3]])
         });
         before - self.facets.len()
     }
