@@ -10,14 +10,18 @@
 //!
 //! The core knows nothing of wasm; this file only converts.
 
+use crate::analysis::{self, CoverageMask, LayerAnalysis};
 use crate::error::Error;
 use crate::gcode;
 use crate::plan::{Counts, LayerPlan};
 use crate::preview::PreviewLayer;
 use crate::settings::{self, Settings};
 use crate::{Job, Summary};
-use js_sys::{Float32Array, Uint8Array};
+use js_sys::{Float32Array, Float64Array, Uint8Array};
 use wasm_bindgen::prelude::*;
+
+/// Cells of the void overlay's mask per droplet width B (cells of B/4: ~0.05 mm by default).
+pub const MASK_CELLS_PER_B: f64 = 4.0;
 
 fn js_error(e: Error) -> JsError {
     JsError::new(&format!("{}: {e}", e.kind()))
@@ -116,6 +120,30 @@ impl Session {
         Ok(LayerResult::new(&plan, &self.settings))
     }
 
+    /// [`Session::slice_layer`] plus the void analysis of the same plan (no second planning):
+    /// `analysis_json` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]). About 2–3
+    /// times the work of planning the layer.
+    pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsError> {
+        if i >= self.job.layer_count() {
+            return Err(js_error(Error::Internal(format!(
+                "layer {i} asked for, but the part has {} layers",
+                self.job.layer_count()
+            ))));
+        }
+        // what Job::plan_layer does, keeping the section for the analysis
+        let section = self.job.section(i);
+        let mut plan = crate::plan::plan_layer(&section.region, i, &self.settings);
+        plan.open_chains = section.open_chains;
+        plan.reoriented_loops = section.reoriented_loops;
+        let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
+        let (a, mask) =
+            analysis::analyse_layer_with_mask(&plan, &section.region, &self.settings, cell);
+        let mut r = LayerResult::new(&plan, &self.settings);
+        r.analysis = Some(a);
+        r.mask = Some(mask);
+        Ok(r)
+    }
+
     /// The header comment block for a finished slice: `summary_json` is the sum of every
     /// layer's `LayerResult::summary_json` with `layers` set; an empty string gives the
     /// same-width placeholder header.
@@ -151,6 +179,8 @@ pub struct LayerResult {
     summary: Summary,
     gcode: String,
     preview: PreviewLayer,
+    analysis: Option<LayerAnalysis>,
+    mask: Option<CoverageMask>,
 }
 
 impl LayerResult {
@@ -167,6 +197,8 @@ impl LayerResult {
             },
             gcode: gcode::layer_text(plan),
             preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
+            analysis: None,
+            mask: None,
         }
     }
 }
@@ -226,5 +258,42 @@ impl LayerResult {
     #[wasm_bindgen(getter)]
     pub fn travel(&self) -> Float32Array {
         Float32Array::from(&self.preview.travel[..])
+    }
+    /// The layer's void analysis (`analysis::LayerAnalysis`: coverage, void_area,
+    /// largest_void {area, centroid, min, max, at_boundary}, overfill_area,
+    /// boundary_deviation, ...) as JSON; empty unless made by `slice_layer_analysed`.
+    #[wasm_bindgen(getter)]
+    pub fn analysis_json(&self) -> String {
+        self.analysis
+            .as_ref()
+            .and_then(|a| serde_json::to_string(a).ok())
+            .unwrap_or_default()
+    }
+    /// The coverage mask's frame: [origin x, origin y, cell (mm), width, height] (cells);
+    /// empty without analysis. Cell (col, row) starts at origin + (col, row)·cell.
+    #[wasm_bindgen(getter)]
+    pub fn mask_frame(&self) -> Float64Array {
+        match &self.mask {
+            Some(m) => Float64Array::from(
+                &[
+                    m.origin[0],
+                    m.origin[1],
+                    m.cell,
+                    m.width as f64,
+                    m.height as f64,
+                ][..],
+            ),
+            None => Float64Array::new_with_length(0),
+        }
+    }
+    /// Void share (region not covered) per mask cell, 0..255, row-major; empty without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn void_mask(&self) -> Uint8Array {
+        Uint8Array::from(self.mask.as_ref().map_or(&[][..], |m| &m.void[..]))
+    }
+    /// Overfill share (covered outside the region) per mask cell, 0..255, row-major.
+    #[wasm_bindgen(getter)]
+    pub fn overfill_mask(&self) -> Uint8Array {
+        Uint8Array::from(self.mask.as_ref().map_or(&[][..], |m| &m.overfill[..]))
     }
 }

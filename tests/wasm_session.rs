@@ -178,3 +178,61 @@ fn errors_name_their_kind() {
     let e = message(Session::new(&bin, "cut.stl", "{}").err().unwrap());
     assert!(e.starts_with("import: "), "{e}");
 }
+
+#[wasm_bindgen_test]
+fn analysed_layers_have_sane_void_figures() {
+    let stl = box_stl(10.0, 6.0, 2.0);
+    let s = Session::new(stl.as_bytes(), "box.stl", "{}").unwrap();
+    // plain slicing carries no analysis
+    let plain = s.slice_layer(3).unwrap();
+    assert_eq!(plain.analysis_json(), "");
+    assert_eq!(plain.void_mask().length(), 0);
+    assert_eq!(plain.mask_frame().length(), 0);
+    for i in [0, 3, 9] {
+        let l = s.slice_layer_analysed(i).unwrap();
+        // the same layer as plain slicing
+        assert_eq!(
+            l.droplets().to_vec(),
+            s.slice_layer(i).unwrap().droplets().to_vec()
+        );
+        let a: serde_json::Value = serde_json::from_str(&l.analysis_json()).unwrap();
+        assert_eq!(a["index"], i);
+        let coverage = a["coverage"].as_f64().unwrap();
+        assert!(
+            (0.7..0.9).contains(&coverage),
+            "layer {i}: coverage {coverage}"
+        );
+        let region = a["region_area"].as_f64().unwrap();
+        assert!((region - 60.0).abs() < 0.01, "region {region}");
+        let void = a["void_area"].as_f64().unwrap();
+        assert!(
+            (void - (1.0 - coverage) * region).abs() < 0.05 * region,
+            "void {void}"
+        );
+        let largest = &a["largest_void"];
+        let area = largest["area"].as_f64().unwrap();
+        assert!(area > 0.0 && area <= void, "largest {area} of {void}");
+        let (min, max) = (&largest["min"], &largest["max"]);
+        assert!(min[0].as_f64().unwrap() >= -0.5 && max[0].as_f64().unwrap() <= 10.5);
+        assert!(a["overfill_area"].as_f64().unwrap() >= 0.0);
+        // the mask: cells of B/4 over the layer, its void share adds up to the void area
+        let f = l.mask_frame().to_vec();
+        assert_eq!(f.len(), 5);
+        let (cell, w, h) = (f[2], f[3] as usize, f[4] as usize);
+        let b = 0.2 * 1.04;
+        assert!((cell - b / 4.0).abs() < b / 10.0, "cell {cell}");
+        assert!(
+            w as f64 * cell >= 10.0 && h as f64 * cell >= 6.0,
+            "{w} x {h}"
+        );
+        let mask = l.void_mask().to_vec();
+        assert_eq!(mask.len(), w * h);
+        assert_eq!(l.overfill_mask().length() as usize, w * h);
+        let masked: f64 = mask.iter().map(|&v| v as f64 / 255.0).sum::<f64>() * cell * cell;
+        assert!(
+            (masked - void).abs() < 0.05 * void,
+            "mask {masked} vs void {void}"
+        );
+    }
+    assert!(s.slice_layer_analysed(10).is_err());
+}
