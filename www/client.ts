@@ -121,6 +121,7 @@ export class Pool {
   /** Stops everything at once and starts fresh workers. */
   cancel(): void {
     const old = this.handles;
+    this.opening = null;
     this.respawn();
     for (const h of old) h.terminate(new Cancelled());
   }
@@ -143,12 +144,13 @@ export class Pool {
   }
 
   /** Slices a model: opens it in every worker and streams all layers through `cb.layer`. */
-  slice(stl: Uint8Array, name: string, settings: string, cb: SliceCallbacks): Promise<OpenResult> {
+  slice(stl: Uint8Array, name: string, settings: string, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
     this.heal();
     return this.guarded(async () => {
       const buffer = stl.slice().buffer;
       // The first worker validates the model and settings; on failure every worker keeps its
       // previous model, so the previous slice can still be browsed.
+      this.opening = null;
       const first = await this.handles[0].call<OpenResult>("open", { stl: buffer, name, settings });
       for (const h of this.handles) h.hasModel = false;
       this.handles[0].hasModel = true;
@@ -166,7 +168,7 @@ export class Pool {
         used.map((h, k) => {
           const from = Math.min(n, k * per);
           const to = Math.min(n, from + per);
-          return from < to ? h.call<null>("slice", { from, to }, cb.layer) : Promise.resolve(null);
+          return from < to ? h.call<null>("slice", { from, to, analyse }, cb.layer) : Promise.resolve(null);
         }),
       );
       return first;
@@ -177,7 +179,7 @@ export class Pool {
    *  after the workers were replaced by a cancel or a crash). */
   open(stl: Uint8Array, name: string, settings: string): Promise<void> {
     this.heal();
-    return this.guarded(async () => {
+    const opening = this.guarded(async () => {
       const buffer = stl.slice().buffer;
       await Promise.all(
         this.handles.map(async (h) => {
@@ -186,9 +188,15 @@ export class Pool {
         }),
       );
     });
+    this.opening = opening.catch(() => {});
+    return opening;
   }
 
-  private pick(): WorkerHandle {
+  /** Set while open() is under way: requests that need the model wait for it. */
+  private opening: Promise<void> | null = null;
+
+  private async pick(): Promise<WorkerHandle> {
+    if (this.opening) await this.opening;
     const ready = this.handles.filter((h) => h.hasModel && !h.broken);
     if (ready.length === 0) throw new SliceError("internal", "no worker holds the model any more; slice again");
     return ready.reduce((a, b) => (b.load < a.load ? b : a));
@@ -196,24 +204,46 @@ export class Pool {
 
   /** Re-plans one layer of the current model (for layers evicted from the page's cache). */
   preview(index: number): Promise<LayerData> {
-    return this.guarded(() => this.pick().call<LayerData>("preview", { index }));
+    return this.guarded(async () => (await this.pick()).call<LayerData>("preview", { index }));
   }
 
   header(summary: string): Promise<string> {
-    return this.guarded(() => this.pick().call<string>("header", { summary }));
+    return this.guarded(async () => (await this.pick()).call<string>("header", { summary }));
   }
 
   repairs(summary: string): Promise<string[]> {
-    return this.guarded(() => this.pick().call<string[]>("repairs", { summary }));
+    return this.guarded(async () => (await this.pick()).call<string[]>("repairs", { summary }));
   }
 
   footer(summary: string): Promise<string> {
-    return this.guarded(() => this.pick().call<string>("footer", { summary }));
+    return this.guarded(async () => (await this.pick()).call<string>("footer", { summary }));
   }
 
   parseGcode(file: Blob, layer: (l: LayerData) => void): Promise<GcodeParseResult> {
     this.heal();
     return this.guarded(() => this.handles[0].call<GcodeParseResult>("parse_gcode", { file }, layer));
+  }
+
+  /** Re-plans one layer with its void analysis and coverage mask. */
+  previewAnalysed(index: number): Promise<LayerData> {
+    return this.guarded(async () => (await this.pick()).call<LayerData>("preview", { index, analyse: true }));
+  }
+
+  /** Re-plans and analyses layers [0, n) of the current model (no G-code), spread over the
+   *  workers holding it: for the void overlay after a slice made without analysis. */
+  analyse(n: number, layer: (l: LayerData) => void): Promise<void> {
+    return this.guarded(async () => {
+      await this.pick(); // waits for a reopening under way; throws if no worker has the model
+      const ready = this.handles.filter((h) => h.hasModel && !h.broken);
+      const per = Math.ceil(n / ready.length);
+      await Promise.all(
+        ready.map((h, k) => {
+          const from = Math.min(n, k * per);
+          const to = Math.min(n, from + per);
+          return from < to ? h.call<null>("slice", { from, to, analyse: true, gcode: false }, layer) : Promise.resolve(null);
+        }),
+      );
+    });
   }
 
   /** For tests: makes the wasm panic in one worker. */
