@@ -2,7 +2,7 @@
 
 import { Cancelled, Pool, SliceError } from "./client";
 import { SettingsForm, type Value } from "./form";
-import { addNumbers, type Counts, type GcodeParseResult, type InitResult, type JobInfo, type LayerData } from "./protocol";
+import { addNumbers, type Counts, type GcodeParseResult, type InitResult, type JobInfo, type LayerAnalysis, type LayerData } from "./protocol";
 import { Renderer, type Bounds, type View } from "./render";
 import { sampleStl } from "./sample";
 import { makeLink, readLink, sha256Hex, type SharedLink } from "./share";
@@ -41,6 +41,13 @@ class Slice {
   repairs: string[] = [];
   /** Sum of the layers' summaries (the core's Summary, for the header and footer). */
   summary: Record<string, unknown> = {};
+  /** Void analysis per layer (when the slice or a later pass made it). */
+  analysis: (LayerAnalysis | undefined)[] = [];
+  analysed = 0;
+  regionArea = 0;
+  coveredArea = 0;
+  /** The worst layer: the one with the largest connected void. */
+  worst: { index: number; area: number } | null = null;
 
   constructor(
     readonly source: "stl" | "gco",
@@ -79,10 +86,21 @@ class Slice {
       }
     }
     if (l.gcode) this.gcode[l.index] = l.gcode;
+    const a = l.analysis;
+    if (a && this.analysis[l.index] === undefined) {
+      this.analysis[l.index] = a;
+      this.analysed++;
+      this.regionArea += a.region_area;
+      this.coveredArea += a.covered_area;
+      const v = a.largest_void;
+      if (v && (!this.worst || v.area > this.worst.area)) this.worst = { index: l.index, area: v.area };
+    }
     const { gcode: _g, summary: _s, ...preview } = l;
-    if (!this.cache.has(l.index)) {
+    const old = this.cache.get(l.index);
+    if (!old || (l.mask && !old.mask)) {
+      if (old) this.cacheBytes -= layerBytes(old);
       this.cache.set(l.index, preview);
-      this.cacheBytes += l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength;
+      this.cacheBytes += layerBytes(l);
     }
     if (this.source === "stl") this.evict(current);
   }
@@ -93,7 +111,7 @@ class Slice {
     for (const i of far) {
       if (this.cacheBytes <= CACHE_BUDGET_BYTES * 0.8 || Math.abs(i - current) <= 1) break;
       const l = this.cache.get(i)!;
-      this.cacheBytes -= l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength;
+      this.cacheBytes -= layerBytes(l);
       this.cache.delete(i);
     }
   }
@@ -101,6 +119,12 @@ class Slice {
   get droplets(): number {
     return this.totals.outer + this.totals.inner + this.totals.fill;
   }
+}
+
+/** Bytes a cached layer holds (droplets, roles, travel and the void mask). */
+function layerBytes(l: LayerData): number {
+  const m = l.mask ? l.mask.void.byteLength + l.mask.overfill.byteLength : 0;
+  return l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength + m;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -246,6 +270,7 @@ function writeStats(): void {
   const set = (id: string, text: string) => ($(id).textContent = text);
   $("empty").hidden = s !== null;
   if (!s) {
+    writeVoids(null);
     for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) set(id, "–");
     $("warnings").hidden = true;
     return;
@@ -272,6 +297,7 @@ function writeStats(): void {
   const c = s.counts[current];
   set("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
   set("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
+  writeVoids(s);
   const warnings = [...((s.info.warnings ?? []) as string[]), ...s.repairs];
   $("warnings").hidden = warnings.length === 0;
   $("warning-list").replaceChildren(
@@ -281,6 +307,28 @@ function writeStats(): void {
       return li;
     }),
   );
+}
+
+const pct = (x: number) => `${(x * 100).toFixed(1)} %`;
+const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
+
+/** The "Voids" block of the statistics: this layer, the part, the worst layer. */
+function writeVoids(s: Slice | null): void {
+  const set = (id: string, text: string) => ($(id).textContent = text);
+  const a = s?.analysis[current];
+  set("stat-coverage", a ? pct(a.coverage) : "–");
+  set("stat-void", a ? mm2(a.void_area) : "–");
+  const v = a?.largest_void;
+  set("stat-largest", v ? `${mm2(v.area)}${v.at_boundary ? " (edge)" : ""}` : a ? "none" : "–");
+  const partial = s && s.analysed < s.layers ? " so far" : "";
+  set("stat-part-coverage", s && s.analysed > 0 && s.regionArea > 0 ? pct(s.coveredArea / s.regionArea) + partial : "–");
+  set("stat-worst", s?.worst ? `${nf.format(s.worst.index + 1)} · ${mm2(s.worst.area)}` : "–");
+  ($("btn-worst") as HTMLButtonElement).disabled = !s?.worst;
+  const hint = $("voids-hint");
+  if (s?.source === "gco") hint.textContent = "Voids are analysed for sliced STL files.";
+  else if (!s || s.analysed === 0) hint.replaceChildren("Turn on ", Object.assign(document.createElement("b"), { textContent: "Voids" }), " to analyse.");
+  else if (s.analysed < s.layers) hint.textContent = `Analysed ${nf.format(s.analysed)} of ${nf.format(s.layers)} layers.`;
+  else hint.textContent = "Worst: largest connected void.";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -311,13 +359,15 @@ function show(i: number): void {
   for (const k of [current, current - 1]) {
     if (k >= 0 && !s.cache.has(k) && s.complete && s.source === "stl") fetchPreview(s, k);
   }
+  // the overlay needs the current layer's mask (evicted, or sliced without analysis)
+  const shown = s.cache.get(current);
+  if (renderer.showVoids && shown && !shown.mask && s.complete && s.source === "stl") fetchPreview(s, current);
 }
 
 function fetchPreview(s: Slice, k: number): void {
   if (previewRequests.has(k)) return;
   previewRequests.add(k);
-  pool
-    .preview(k)
+  (renderer.showVoids ? pool.previewAnalysed(k) : pool.preview(k))
     .then((l) => {
       if (slice !== s) return;
       s.put(l, current);
@@ -398,7 +448,7 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
         if (l.index === current || l.index === current - 1) show(current);
         updateStats();
       },
-    });
+    }, renderer.showVoids);
     if (gen !== generation) return;
     s.complete = true;
     busy = false;
@@ -406,6 +456,8 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
     if (!viewTouched && !s.info.bounds) renderer.fit(s.bbox);
     show(current);
     setState("done");
+    // the overlay was turned on during a slice made without analysis
+    if (renderer.showVoids && s.analysed < s.layers) void analyseVoids(s);
     pool
       .repairs(JSON.stringify({ ...s.summary, layers: s.layers }))
       .then((r) => {
@@ -432,6 +484,40 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
       }
       showError(e);
     }
+  } finally {
+    if (gen === generation) updateButtons();
+  }
+}
+
+/** Re-plans and analyses every layer of a finished slice made without analysis (the overlay
+ *  was off): the figures of the whole part and the masks of the overlay. */
+async function analyseVoids(s: Slice): Promise<void> {
+  if (busy || slice !== s || !s.complete || s.source !== "stl" || s.analysed >= s.layers) return;
+  const gen = ++generation;
+  busy = true;
+  setState("slicing");
+  const label = "Analysing voids…";
+  progress(s.analysed / Math.max(1, s.layers), label);
+  updateButtons();
+  try {
+    await pool.analyse(s.layers, (l) => {
+      if (gen !== generation) return;
+      s.put(l, current);
+      progress(s.analysed / Math.max(1, s.layers), label);
+      if (l.index === current) show(current);
+      updateStats();
+    });
+    if (gen !== generation) return;
+    busy = false;
+    progress(null);
+    show(current);
+    setState("done");
+  } catch (e) {
+    if (gen !== generation) return;
+    busy = false;
+    progress(null);
+    if (e instanceof Cancelled) setState("cancelled");
+    else showError(e);
   } finally {
     if (gen === generation) updateButtons();
   }
@@ -716,6 +802,16 @@ function wire(): void {
     $("legend-travel").hidden = !renderer.showTravel;
     renderer.request();
   });
+  $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
+    renderer.showVoids = (ev.target as HTMLInputElement).checked;
+    $("legend-voids").hidden = !renderer.showVoids;
+    if (slice) show(current);
+    if (renderer.showVoids && slice) void analyseVoids(slice);
+    renderer.request();
+  });
+  $("btn-worst").addEventListener("click", () => {
+    if (slice?.worst) show(slice.worst.index);
+  });
   $<HTMLInputElement>("opt-below").addEventListener("change", (ev) => {
     renderer.showBelow = (ev.target as HTMLInputElement).checked;
     $("legend-below").hidden = !renderer.showBelow;
@@ -826,6 +922,11 @@ window.dropslice = {
     name: slice?.name ?? null,
     workers: pool.size,
     cached: slice?.cache.size ?? 0,
+    voids: renderer.showVoids,
+    analysed: slice?.analysed ?? 0,
+    worst: slice?.worst?.index ?? null,
+    /** Whether the layer on the canvas carries its void mask. */
+    masked: Boolean(renderer.current?.mask),
     /** Index of the layer on the canvas (null while it is being fetched). */
     shown: renderer.current?.index ?? null,
   }),

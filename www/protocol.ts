@@ -37,6 +37,45 @@ export interface LayerData {
   summary?: string;
   /** The layer's G-code (slices only; absent for preview re-requests). */
   gcode?: Blob;
+  /** The void analysis (src/analysis.rs), when the request asked for it. */
+  analysis?: LayerAnalysis;
+  /** Coverage mask of the analysis (cells of B/4). */
+  mask?: CoverageMask;
+}
+
+/** One connected void of a layer (src/analysis.rs `Void`); areas mm², points mm. */
+export interface Void {
+  area: number;
+  centroid: [number, number];
+  min: [number, number];
+  max: [number, number];
+  at_boundary: boolean;
+}
+
+/** What a layer's droplets cover of its region (src/analysis.rs `LayerAnalysis`). */
+export interface LayerAnalysis {
+  index: number;
+  region_area: number;
+  covered_area: number;
+  coverage: number;
+  void_area: number;
+  enclosed_void_area: number;
+  voids: number;
+  largest_void: Void | null;
+  overfill_area: number;
+  boundary_deviation: number;
+  [key: string]: unknown;
+}
+
+/** Per square cell (col, row) from `origin` + (col, row)·cell: the share 0..255 of it that
+ *  is void / overfill; row-major, row 0 at the lowest y. */
+export interface CoverageMask {
+  origin: [number, number];
+  cell: number;
+  width: number;
+  height: number;
+  void: Uint8Array;
+  overfill: Uint8Array;
 }
 
 export interface SettingSpec {
@@ -73,8 +112,8 @@ export interface GcodeParseResult {
 export type Request =
   | { id: number; kind: "init"; data: null }
   | { id: number; kind: "open"; data: { stl: ArrayBuffer; name: string; settings: string } }
-  | { id: number; kind: "slice"; data: { from: number; to: number } }
-  | { id: number; kind: "preview"; data: { index: number } }
+  | { id: number; kind: "slice"; data: { from: number; to: number; analyse?: boolean; gcode?: boolean } }
+  | { id: number; kind: "preview"; data: { index: number; analyse?: boolean } }
   | { id: number; kind: "header"; data: { summary: string } }
   | { id: number; kind: "footer"; data: { summary: string } }
   | { id: number; kind: "repairs"; data: { summary: string } }
@@ -95,7 +134,9 @@ export function splitError(text: string): { kind: string; message: string } {
 }
 
 export function transferablesOf(layer: LayerData): Transferable[] {
-  return [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
+  const out = [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
+  if (layer.mask) out.push(layer.mask.void.buffer, layer.mask.overfill.buffer);
+  return out;
 }
 
 /** Adds every number of `b` into `a` (nested objects too): sums the layers' summaries

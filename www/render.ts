@@ -5,7 +5,7 @@
 // pixels wide, over 60,000 droplets), droplets are written straight into a pixel buffer as
 // small squares: ~330,000 droplets then take ~10 ms instead of ~100 ms of path filling.
 
-import type { LayerData } from "./protocol";
+import type { CoverageMask, LayerData } from "./protocol";
 
 export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
 export const ROLE_NAMES = ["Outer loop", "Inner loops", "Fill"] as const;
@@ -21,6 +21,11 @@ function pixel(hex: string): number {
   return (0xff000000 | ((v & 0xff) << 16) | (v & 0xff00) | ((v >> 16) & 0xff)) >>> 0;
 }
 const TRAVEL_COLOR = "rgba(60, 60, 70, 0.55)";
+/** Void overlay: uncovered part area (RGB, the largest opacity), overfill, the marker. */
+export const VOID_RGB = [214, 51, 132] as const;
+export const OVERFILL_RGB = [12, 166, 120] as const;
+const VOID_ALPHA = 0.9;
+const VOID_MARK = "#a61e4d";
 
 export interface View {
   /** CSS pixels per mm. */
@@ -44,6 +49,8 @@ export class Renderer {
   dropletWidth = 0.208;
   showTravel = false;
   showBelow = true;
+  /** The void overlay of the current layer (when it carries a coverage mask). */
+  showVoids = false;
   /** Called after every draw (for the zoom read-out). */
   onDraw: (() => void) | null = null;
   private frame = 0;
@@ -145,7 +152,9 @@ export class Renderer {
       if (this.current) this.drawDroplets(ctx, this.current, k, vis, false);
     }
     if (this.current && this.showTravel) this.drawTravel(ctx, this.current, k);
+    if (this.current?.mask && this.showVoids) this.drawVoids(ctx, this.current.mask);
     ctx.setTransform(1, 0, 0, 1, 0, 0);
+    if (this.current?.analysis && this.showVoids) this.drawLargestVoid(ctx, this.current, k);
     this.drawScaleBar(ctx);
     this.onDraw?.();
   }
@@ -215,6 +224,85 @@ export class Renderer {
       ctx.fillStyle = ROLE_COLORS[role];
       ctx.fill(paths[role]);
     }
+  }
+
+  private maskImage: { mask: CoverageMask; canvas: OffscreenCanvas } | null = null;
+
+  /** The mask as a bitmap, one pixel per cell (made once per layer). */
+  private maskBitmap(m: CoverageMask): OffscreenCanvas {
+    if (this.maskImage?.mask === m) return this.maskImage.canvas;
+    const w = Math.max(1, m.width);
+    const h = Math.max(1, m.height);
+    const img = new ImageData(w, h);
+    const px = img.data;
+    for (let row = 0; row < m.height; row++) {
+      // bitmap row 0 is drawn at the origin's y: the flipped transform puts it at the bottom
+      for (let col = 0; col < m.width; col++) {
+        const i = row * m.width + col;
+        const v = m.void[i];
+        const o = m.overfill.length ? m.overfill[i] : 0;
+        const [rgb, share] = o > v ? [OVERFILL_RGB, o] : [VOID_RGB, v];
+        if (share === 0) continue;
+        px[4 * i] = rgb[0];
+        px[4 * i + 1] = rgb[1];
+        px[4 * i + 2] = rgb[2];
+        px[4 * i + 3] = Math.round(share * VOID_ALPHA);
+      }
+    }
+    const canvas = new OffscreenCanvas(w, h);
+    canvas.getContext("2d")!.putImageData(img, 0, 0);
+    this.maskImage = { mask: m, canvas };
+    return canvas;
+  }
+
+  /** Uncovered part area (and overfill) over the droplets, in the mm transform. */
+  private drawVoids(ctx: CanvasRenderingContext2D, m: CoverageMask): void {
+    if (m.width === 0 || m.height === 0) return;
+    ctx.save();
+    ctx.imageSmoothingEnabled = true;
+    ctx.drawImage(this.maskBitmap(m), m.origin[0], m.origin[1], m.width * m.cell, m.height * m.cell);
+    ctx.restore();
+  }
+
+  /** A box around the layer's largest void and its area, in device pixels. */
+  private drawLargestVoid(ctx: CanvasRenderingContext2D, layer: LayerData, k: number): void {
+    const v = layer.analysis?.largest_void;
+    if (!v) return;
+    const { cx, cy } = this.view;
+    const W = this.canvas.width;
+    const H = this.canvas.height;
+    const X = (x: number) => (x - cx) * k + W / 2;
+    const Y = (y: number) => -(y - cy) * k + H / 2;
+    const dpr = this.dpr;
+    const pad = this.dropletWidth * k * 0.5 + 4 * dpr;
+    const min = 14 * dpr;
+    let x0 = X(v.min[0]) - pad;
+    let x1 = X(v.max[0]) + pad;
+    let y0 = Y(v.max[1]) - pad;
+    let y1 = Y(v.min[1]) + pad;
+    if (x1 - x0 < 2 * min) [x0, x1] = [X(v.centroid[0]) - min, X(v.centroid[0]) + min];
+    if (y1 - y0 < 2 * min) [y0, y1] = [Y(v.centroid[1]) - min, Y(v.centroid[1]) + min];
+    ctx.strokeStyle = "rgba(255, 255, 255, 0.9)";
+    ctx.lineWidth = 4 * dpr;
+    ctx.strokeRect(x0, y0, x1 - x0, y1 - y0);
+    ctx.strokeStyle = VOID_MARK;
+    ctx.lineWidth = 1.5 * dpr;
+    ctx.setLineDash([5 * dpr, 3 * dpr]);
+    ctx.strokeRect(x0, y0, x1 - x0, y1 - y0);
+    ctx.setLineDash([]);
+    const label = `Largest void ${v.area < 0.1 ? v.area.toFixed(3) : v.area.toFixed(2)} mm²`;
+    ctx.font = `600 ${12 * dpr}px system-ui, sans-serif`;
+    const tw = ctx.measureText(label).width + 12 * dpr;
+    const th = 20 * dpr;
+    const lx = Math.min(Math.max(x0, 4 * dpr), W - tw - 4 * dpr);
+    const ly = y0 - th - 4 * dpr >= 4 * dpr ? y0 - th - 4 * dpr : y1 + 4 * dpr;
+    ctx.fillStyle = "rgba(255, 255, 255, 0.92)";
+    ctx.beginPath();
+    ctx.roundRect(lx, ly, tw, th, 4 * dpr);
+    ctx.fill();
+    ctx.fillStyle = VOID_MARK;
+    ctx.textBaseline = "middle";
+    ctx.fillText(label, lx + 6 * dpr, ly + th / 2);
   }
 
   private drawTravel(ctx: CanvasRenderingContext2D, layer: LayerData, k: number): void {

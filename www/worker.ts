@@ -48,10 +48,10 @@ function yieldToQueue(): Promise<void> {
   });
 }
 
-function layerOf(s: Session, index: number, withGcode: boolean): LayerData {
-  const r = s.slice_layer(index);
+function layerOf(s: Session, index: number, withGcode: boolean, analyse = false): LayerData {
+  const r = analyse ? s.slice_layer_analysed(index) : s.slice_layer(index);
   try {
-    return {
+    const layer: LayerData = {
       index: r.index,
       z: r.z,
       counts: { outer: r.outer, inner: r.inner, fill: r.fill },
@@ -62,6 +62,21 @@ function layerOf(s: Session, index: number, withGcode: boolean): LayerData {
       gcode: withGcode ? new Blob([r.gcode], { type: "text/plain" }) : undefined,
       summary: withGcode ? r.summary_json : undefined,
     };
+    if (analyse) {
+      const f = r.mask_frame;
+      layer.analysis = JSON.parse(r.analysis_json);
+      const overfill = r.overfill_mask;
+      // overfill is rare: an all-zero mask is not worth posting and caching
+      layer.mask = {
+        origin: [f[0], f[1]],
+        cell: f[2],
+        width: f[3],
+        height: f[4],
+        void: r.void_mask,
+        overfill: overfill.some((v) => v !== 0) ? overfill : new Uint8Array(0),
+      };
+    }
+    return layer;
   } finally {
     r.free();
   }
@@ -95,7 +110,7 @@ async function handle(req: Request): Promise<void> {
     case "slice": {
       const s = need();
       for (let i = req.data.from; i < req.data.to; i++) {
-        const layer = layerOf(s, i, true);
+        const layer = layerOf(s, i, req.data.gcode ?? true, req.data.analyse);
         post({ id: req.id, kind: "progress", data: layer }, transferablesOf(layer));
         await yieldToQueue();
         if (session !== s) throw new Error("internal: the model was replaced during slicing");
@@ -104,7 +119,7 @@ async function handle(req: Request): Promise<void> {
       return;
     }
     case "preview": {
-      const layer = layerOf(need(), req.data.index, false);
+      const layer = layerOf(need(), req.data.index, false, req.data.analyse);
       post({ id: req.id, kind: "result", data: layer }, transferablesOf(layer));
       return;
     }

@@ -1,0 +1,101 @@
+// The void overlay in the page: the analysis figures in the statistics, the overlay on the
+// canvas, "Go to worst layer". Needs dist/ (scripts/build.sh).
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { canvasPixels, openPage, start, status, waitSettled } from "./helpers.mjs";
+
+let env;
+let main;
+
+before(async () => {
+  env = await start();
+  main = await openPage(env.browser, env.url);
+});
+
+after(async () => {
+  await env?.close();
+});
+
+/** Canvas pixels in the overlay's magenta (void) colour. */
+function voidPixels(page) {
+  return page.evaluate(() => {
+    const c = document.getElementById("view");
+    const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
+      if (r > 150 && b > 90 && g < 110 && r - g > 80 && b - g > 30) n++;
+    }
+    return n;
+  });
+}
+
+test("the voids overlay: figures, canvas, worst layer", async () => {
+  const { page, errors } = main;
+  let s = await waitSettled(page, 60_000);
+  assert.equal(s.state, "done");
+  assert.equal(s.analysed, 0, "plain slicing does not analyse");
+  assert.equal(await page.locator("#stat-coverage").innerText(), "–");
+  assert.equal(await page.isDisabled("#btn-worst"), true);
+  await page.waitForTimeout(150);
+  const plain = await canvasPixels(page);
+  const plainMagenta = await voidPixels(page);
+
+  // turning the overlay on analyses every layer of the finished slice
+  const t0 = Date.now();
+  await page.check("#opt-voids");
+  await page.waitForFunction(() => {
+    const st = window.dropslice.status();
+    return st.state === "done" && st.analysed === st.layers && st.masked;
+  }, null, { timeout: 120_000, polling: 100 });
+  s = await status(page);
+  console.log(`# sample part: ${s.layers} layers analysed in the page in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  await page.waitForTimeout(150);
+  const overlay = await canvasPixels(page);
+  assert.notEqual(overlay, plain, "the overlay changes the canvas");
+  const magenta = await voidPixels(page);
+  assert.ok(magenta > plainMagenta + 500, `void pixels ${plainMagenta} -> ${magenta}`);
+  assert.equal(await page.isVisible("#legend-voids"), true);
+
+  // figures: this layer, the part, the worst layer
+  const coverage = await page.locator("#stat-coverage").innerText();
+  const m = /^(\d+\.\d) %$/.exec(coverage);
+  assert.ok(m, `coverage "${coverage}"`);
+  assert.ok(Number(m[1]) > 60 && Number(m[1]) < 95, coverage);
+  assert.match(await page.locator("#stat-void").innerText(), /^\d+\.\d+ mm²$/);
+  assert.match(await page.locator("#stat-largest").innerText(), /^\d+\.\d+ mm²/);
+  assert.match(await page.locator("#stat-part-coverage").innerText(), /^\d+\.\d %$/);
+  assert.match(await page.locator("#stat-worst").innerText(), /^[\d,]+ · \d+\.\d+ mm²$/);
+
+  // "Go to worst layer" moves the slider there
+  assert.notEqual(s.worst, null);
+  if (s.worst === s.layer) await page.evaluate(() => window.dropslice.show(0));
+  await page.click("#btn-worst");
+  s = await status(page);
+  assert.equal(s.layer, s.worst);
+  assert.equal(Number(await page.inputValue("#layer")), s.worst);
+  assert.match(await page.locator("#layer-label").innerText(), new RegExp(`^Layer ${s.worst + 1} /`));
+  assert.match(await page.locator("#stat-worst").innerText(), new RegExp(`^${s.worst + 1} · `));
+
+  // off and on again at the same layer: the overlay comes and goes without a new analysis
+  await page.waitForFunction(() => window.dropslice.status().masked, null, { timeout: 30_000 });
+  await page.waitForTimeout(150);
+  const on = await canvasPixels(page);
+  await page.uncheck("#opt-voids");
+  await page.waitForTimeout(150);
+  const off = await canvasPixels(page);
+  assert.notEqual(off, on, "turning the overlay off redraws without it");
+  assert.equal(await page.isVisible("#legend-voids"), false);
+  await page.check("#opt-voids");
+  await page.waitForTimeout(150);
+  assert.equal(await canvasPixels(page), on);
+  assert.equal((await status(page)).state, "done");
+
+  // slicing again with the overlay on analyses during the slice
+  await page.click("#btn-slice");
+  s = await waitSettled(page, 60_000);
+  assert.equal(s.state, "done");
+  assert.equal(s.analysed, s.layers);
+  await page.uncheck("#opt-voids");
+  assert.deepEqual(errors, []);
+});
