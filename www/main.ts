@@ -307,6 +307,27 @@ function writeStats(): void {
       return li;
     }),
   );
+  writeUnitFix(s);
+}
+
+/**
+ * The unit rule's fix, offered, never applied silently: when the part's size suggests the file
+ * is in inches (or micrometres), a button scales x, y and z by the suggested factor and slices
+ * again.
+ */
+function writeUnitFix(s: Slice): void {
+  const factor = s.info.suggested_scale;
+  const btn = $("btn-unit-fix") as HTMLButtonElement;
+  btn.hidden = typeof factor !== "number" || s.model === null;
+  if (typeof factor !== "number" || btn.hidden) return;
+  btn.textContent = factor > 1 ? `Scale ×${factor} (inches → mm)` : `Scale ×${factor} (µm → mm)`;
+  btn.title = "Scale x, y and z by this factor and slice again";
+  btn.onclick = () => {
+    const scaled: Record<string, Value> = {};
+    for (const axis of ["scale_x", "scale_y", "scale_z"]) scaled[axis] = Number(form.get(axis) ?? 1) * factor;
+    form.set(scaled);
+    if (s.model) void startSlice(s.model);
+  };
 }
 
 const pct = (x: number) => `${(x * 100).toFixed(1)} %`;

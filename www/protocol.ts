@@ -16,6 +16,8 @@ export interface JobInfo {
   bounds?: { min: [number, number, number]; max: [number, number, number] };
   layers?: number;
   warnings?: string[];
+  /** Scale for x, y and z when the size suggests inches (25.4) or micrometres (0.001). */
+  suggested_scale?: number | null;
   [key: string]: unknown;
 }
 
