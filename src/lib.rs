@@ -157,9 +157,14 @@ impl Job {
             )));
         }
         let duplicates = mesh.remove_duplicate_facets();
+        // The statistics and the facet index are independent: build them side by side.
+        let (stats, mut buckets) = both(
+            || mesh.stats(facets_in_file, degenerate),
+            || FacetBuckets::new(&mesh, &zs),
+        );
         let mut stats = MeshStats {
             duplicate_facets: duplicates,
-            ..mesh.stats(facets_in_file, degenerate)
+            ..stats
         };
         if stats.open_edges > 0 {
             // Cracks between near-coincident corners: try a tolerance weld, keep it if it helps.
@@ -169,6 +174,7 @@ impl Job {
             let better = welded.stats(facets_in_file, degenerate + dropped);
             if merged > 0 && better.open_edges < stats.open_edges {
                 mesh = welded;
+                buckets = FacetBuckets::new(&mesh, &zs);
                 stats = MeshStats {
                     tolerance_welded: merged,
                     duplicate_facets: duplicates,
@@ -176,7 +182,6 @@ impl Job {
                 };
             }
         }
-        let buckets = FacetBuckets::new(&mesh, &zs);
         let warnings = warnings(&stats, &size);
         let suggested_scale = suggested_scale(&size);
         let info = JobInfo {
@@ -248,6 +253,27 @@ impl Job {
             },
             summary,
         )
+    }
+}
+
+/// Runs two computations, on two threads natively (wasm workers are single-threaded).
+fn both<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        std::thread::scope(|scope| {
+            let other = scope.spawn(b);
+            let first = a();
+            (
+                first,
+                other
+                    .join()
+                    .unwrap_or_else(|p| std::panic::resume_unwind(p)),
+            )
+        })
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        (a(), b())
     }
 }
 
