@@ -1149,6 +1149,124 @@ impl Model {
     }
 }
 
+/// The per-layer half of the job analysis, for the workers that plan the layers (see
+/// [`crate::write_gcode_with`]): [`analyse`](Self::analyse) gives a layer's 2D figures and its
+/// spheroid map; [`JobAnalysis`] takes them in layer order and adds the 3D estimate, so no
+/// layer is planned twice.
+#[derive(Clone, Debug)]
+pub struct LayerStage {
+    settings: Settings,
+    grid: Grid3,
+}
+
+/// One layer analysed by a [`LayerStage`], waiting for its neighbours' spheroid maps.
+pub struct AnalysedLayer {
+    analysis: LayerAnalysis,
+    region: Shapes,
+    map: HeightMap,
+}
+
+/// The 3D grid of a job's analysis (fixed to the part's bounds).
+fn job_grid(job: &crate::Job) -> Grid3 {
+    let s = job.settings();
+    let d = footprint_diameter(s);
+    let bounds = job.info().bounds;
+    Grid3 {
+        origin: [bounds.min[0] - d, bounds.min[1] - d],
+        cell: s.droplet_width() / GRID3_PER_B,
+    }
+}
+
+impl LayerStage {
+    pub fn new(job: &crate::Job) -> LayerStage {
+        LayerStage {
+            settings: job.settings().clone(),
+            grid: job_grid(job),
+        }
+    }
+
+    /// Analyses layer `plan.index` against its `region`, in `raster`'s memory (one raster per
+    /// worker, reused from layer to layer).
+    pub fn analyse(&self, raster: &mut Raster, region: &Shapes, plan: &LayerPlan) -> AnalysedLayer {
+        let s = &self.settings;
+        let centres = droplet_centres(plan, s.droplet_width());
+        raster.rebuild(plan.index, plan.z, &centres, region, s);
+        AnalysedLayer {
+            analysis: raster.analysis(),
+            region: region.clone(),
+            map: HeightMap::new(&centres, &self.grid, footprint_diameter(s)),
+        }
+    }
+}
+
+/// The ordered half of the job analysis: takes every layer's [`AnalysedLayer`] in ascending
+/// order, computes each slab's 3D estimate once its neighbours are in, and gives the
+/// [`Report`] (the same as [`analyse_job`]'s). Keeps two layers' maps at a time.
+pub struct JobAnalysis {
+    stage: LayerStage,
+    file_name: String,
+    part: PartAnalysis,
+    layers: Vec<LayerAnalysis>,
+    below: Option<HeightMap>,
+    current: Option<AnalysedLayer>,
+}
+
+impl JobAnalysis {
+    pub fn new(job: &crate::Job) -> JobAnalysis {
+        JobAnalysis {
+            stage: LayerStage::new(job),
+            file_name: job.info().file_name.clone(),
+            part: PartAnalysis::default(),
+            layers: Vec::with_capacity(job.layer_count()),
+            below: None,
+            current: None,
+        }
+    }
+
+    /// The stage for the workers.
+    pub fn stage(&self) -> LayerStage {
+        self.stage.clone()
+    }
+
+    /// The next layer (layers must come in ascending order, from 0).
+    pub fn push(&mut self, layer: AnalysedLayer) {
+        self.close(Some(&layer.map));
+        self.below = self.current.take().map(|c| c.map);
+        self.current = Some(layer);
+    }
+
+    /// The 3D estimate of the current layer, with `above` (the next layer's map, if any).
+    fn close(&mut self, above: Option<&HeightMap>) {
+        let Some(cur) = &self.current else { return };
+        let s = &self.stage.settings;
+        let (vol, void) = slab_voids(
+            &cur.region,
+            &self.stage.grid,
+            self.below.as_ref(),
+            &cur.map,
+            above,
+            s,
+        );
+        // The slab's exact volume, with the void share sampled on the grid.
+        let exact = cur.analysis.region_area * s.layer_height;
+        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
+        self.part.add(&cur.analysis, exact, void);
+        self.layers.push(cur.analysis.clone());
+    }
+
+    /// The report, after the last layer.
+    pub fn finish(mut self) -> Report {
+        self.close(None);
+        Report {
+            file_name: self.file_name,
+            model: Model::new(&self.stage.settings),
+            settings: self.stage.settings,
+            part: self.part,
+            layers: self.layers,
+        }
+    }
+}
+
 /// Plans and analyses every layer of `job` in parallel (blocks of consecutive layers per
 /// thread, so each layer's spheroids are built once and shared with its neighbours).
 /// `timing` receives (seconds planning, seconds analysing), summed over threads.

@@ -232,11 +232,17 @@ impl Job {
 
     /// Every move of layer `i`.
     pub fn plan_layer(&self, i: usize) -> LayerPlan {
+        self.plan_layer_and_region(i).0
+    }
+
+    /// [`plan_layer`](Self::plan_layer) and the layer's region (its section), which the
+    /// analysis needs.
+    pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, slice::Shapes) {
         let section = self.section(i);
         let mut plan = plan::plan_layer(&section.region, i, &self.settings);
         plan.open_chains = section.open_chains;
         plan.reoriented_loops = section.reoriented_loops;
-        plan
+        (plan, section.region)
     }
 
     /// The header; with `None` the droplet counts are fixed-width placeholders.
@@ -319,15 +325,36 @@ fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
 pub fn write_gcode<W: std::io::Write + ?Sized>(
     job: &Job,
     out: &mut W,
-    mut progress: impl FnMut(usize, usize),
+    progress: impl FnMut(usize, usize),
 ) -> Result<Summary, Error> {
+    write_gcode_with(job, out, progress, || (), |_, _, _, _| (), |_, _| {})
+}
+
+/// [`write_gcode`] with a per-layer stage in the workers: `per_layer(state, i, region, plan)`
+/// runs on the worker that planned layer `i` (each worker has its own `state` from `init`),
+/// with the layer's region and its full plan, before the plan's moves are dropped; its result
+/// is handed to `ordered(i, result)` on the writing thread in ascending layer order, after
+/// the layer's text is written. The code written is the same as [`write_gcode`]'s.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn write_gcode_with<W, S, T>(
+    job: &Job,
+    out: &mut W,
+    mut progress: impl FnMut(usize, usize),
+    init: impl Fn() -> S + Sync,
+    per_layer: impl Fn(&mut S, usize, &slice::Shapes, &LayerPlan) -> T + Sync,
+    mut ordered: impl FnMut(usize, T),
+) -> Result<Summary, Error>
+where
+    W: std::io::Write + ?Sized,
+    T: Send,
+{
     use std::collections::BTreeMap;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     use std::sync::{Condvar, Mutex};
 
-    type Done = Result<(String, LayerPlan), String>;
-    struct Shared {
-        done: BTreeMap<usize, Done>,
+    type Done<T> = Result<(String, LayerPlan, T), String>;
+    struct Shared<T> {
+        done: BTreeMap<usize, Done<T>>,
         written: usize,
     }
     let io = |e: std::io::Error| Error::Io(format!("cannot write the code: {e}"));
@@ -351,6 +378,7 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
     std::thread::scope(|scope| -> Result<(), Error> {
         for _ in 0..threads {
             scope.spawn(|| {
+                let mut state = init();
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     if i >= n {
@@ -365,12 +393,13 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
                     if stop.load(Ordering::Relaxed) {
                         break;
                     }
-                    let result = std::panic::catch_unwind(|| {
-                        let mut p = job.plan_layer(i);
+                    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        let (mut p, region) = job.plan_layer_and_region(i);
                         let text = gcode::layer_text(&p);
+                        let extra = per_layer(&mut state, i, &region, &p);
                         p.moves = Vec::new();
-                        (text, p)
-                    })
+                        (text, p, extra)
+                    }))
                     .map_err(|e| {
                         e.downcast_ref::<&str>()
                             .map(|s| s.to_string())
@@ -396,10 +425,11 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
                         g = changed.wait(g).unwrap_or_else(|p| p.into_inner());
                     }
                 };
-                let (text, plan) =
+                let (text, plan, extra) =
                     done.map_err(|m| Error::Internal(format!("layer {}: {m}", i + 1)))?;
                 out.write_all(text.as_bytes()).map_err(io)?;
                 summary.add(&plan);
+                ordered(i, extra);
                 progress(i + 1, n);
             }
             Ok(())

@@ -261,3 +261,30 @@ fn staggered_hatch_ends_stay_inside_the_part_without_contours() {
         }
     }
 }
+
+/// The analysis done in the slicing workers (the CLI's `--report`) gives `analyse_job`'s
+/// report, and the code is the same as without it.
+#[test]
+fn analysis_in_the_slicing_workers_equals_analyse_job() {
+    use dropslice::analysis::{JobAnalysis, Raster};
+    let job = dropslice::Job::new(&cube(), "cube", Settings::default()).unwrap();
+    let (expected, _) = dropslice::analysis::analyse_job(&job);
+    let mut analysis = JobAnalysis::new(&job);
+    let stage = analysis.stage();
+    let mut with = Vec::new();
+    dropslice::write_gcode_with(
+        &job,
+        &mut with,
+        |_, _| {},
+        Raster::empty,
+        |raster, _, region, plan| stage.analyse(raster, region, plan),
+        |_, layer| analysis.push(layer),
+    )
+    .unwrap();
+    let report = analysis.finish();
+    assert_eq!(report.part, expected.part);
+    assert_eq!(report.layers, expected.layers);
+    let mut without = Vec::new();
+    dropslice::write_gcode(&job, &mut without, |_, _| {}).unwrap();
+    assert_eq!(with, without);
+}

@@ -13,7 +13,8 @@ fn main() {}
 
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
-    use dropslice::{Error, Job, Settings, write_gcode};
+    use dropslice::analysis::{JobAnalysis, Raster};
+    use dropslice::{Error, Job, Settings, write_gcode_with};
     use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
     use std::path::{Path, PathBuf};
     use std::process::ExitCode;
@@ -189,7 +190,10 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         // Progress after the first second: in place on a terminal, a line every 2 s in a log.
         let every_ms = if terminal { 250 } else { 2000 };
         let mut shown = false;
-        let summary = write_gcode(&job, &mut w, |done, total| {
+        // With --report, each layer is analysed by the worker that planned it.
+        let mut analysis = args.report.as_ref().map(|_| JobAnalysis::new(&job));
+        let stage = analysis.as_ref().map(|a| a.stage());
+        let progress = |done: usize, total: usize| {
             let due = last.elapsed().as_millis() >= every_ms || (done == total && shown);
             if quiet || t0.elapsed().as_secs_f64() < 1.0 || !due {
                 return;
@@ -205,7 +209,19 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             } else {
                 eprintln!("dropslice: layer {done}/{total} ({pct} %)");
             }
-        });
+        };
+        let summary = write_gcode_with(
+            &job,
+            &mut w,
+            progress,
+            Raster::empty,
+            |raster, _, region, plan| stage.as_ref().map(|st| st.analyse(raster, region, plan)),
+            |_, layer| {
+                if let (Some(a), Some(l)) = (analysis.as_mut(), layer) {
+                    a.push(l);
+                }
+            },
+        );
         let summary = match summary {
             Ok(s) => s,
             Err(e) => {
@@ -242,8 +258,8 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             eprintln!("dropslice: repaired: {r}");
         }
         let mut voids = String::new();
-        if let Some(path) = &args.report {
-            let (report, _) = dropslice::analysis::analyse_job(&job);
+        if let (Some(path), Some(analysis)) = (&args.report, analysis) {
+            let report = analysis.finish();
             let text = serde_json::to_string_pretty(&report)
                 .map_err(|e| Error::Internal(format!("the report does not serialize: {e}")))?;
             std::fs::write(path, text + "\n").map_err(|e| io("write", path, e))?;
