@@ -433,25 +433,34 @@ impl Raster {
             }
         });
         let (rows, table) = half_width_table(r, gy);
+        // Per phase and row, the columns covered (n, and (n − 1)/2): the rounding carry
+        // depends only on the phase, not on the droplet.
+        let spans: Vec<(i64, f64)> = table
+            .chunks(rows)
+            .flat_map(|widths| {
+                let mut carry = 0.0;
+                widths.iter().map(move |&w| {
+                    let want = 2.0 * w / gx + carry;
+                    // Rounding by truncation: every value here is ≥ 0.
+                    let n = (want + 0.5) as i64;
+                    carry = want - n as f64;
+                    (n, (n - 1) as f64 / 2.0)
+                })
+            })
+            .collect();
         for p in centres {
             let v = (p[1] - r - y0) / gy;
             let k0 = v.floor();
             let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
             let k0 = k0 as usize;
-            let widths = &table[ph * rows..(ph + 1) * rows];
             // Centre in column units (column c's centre at u = c).
             let u = (p[0] - x0) / gx - 0.5;
-            let mut carry = 0.0;
-            for (j, &w) in widths.iter().enumerate() {
+            for (j, &(n, half)) in spans[ph * rows..(ph + 1) * rows].iter().enumerate() {
                 let k = k0 + j;
-                let want = 2.0 * w / gx + carry;
-                // Rounding by truncation: every value here is ≥ 0.
-                let n = (want + 0.5) as i64;
-                carry = want - n as f64;
                 if n < 1 || k >= ny {
                     continue;
                 }
-                let c0 = (u - (n - 1) as f64 / 2.0 + 0.5) as i64;
+                let c0 = (u - half + 0.5) as i64;
                 let c1 = c0 + n - 1;
                 if c0 < 0 || c1 >= nx as i64 {
                     continue;
@@ -1023,12 +1032,14 @@ impl HeightMap {
         }
     }
 
-    fn get(&self, ix: i64, iy: i64) -> f32 {
-        let (x, y) = (ix - self.x0, iy - self.y0);
-        if x < 0 || y < 0 || x as usize >= self.w || y as usize >= self.h {
-            return 0.0;
+    /// Row `iy`: (x index of its first cell, its cells); empty outside the map.
+    fn row(&self, iy: i64) -> (i64, &[f32]) {
+        let y = iy - self.y0;
+        if y < 0 || y as usize >= self.h {
+            return (self.x0, &[]);
         }
-        self.q[y as usize * self.w + x as usize]
+        let y = y as usize;
+        (self.x0, &self.q[y * self.w..(y + 1) * self.w])
     }
 }
 
@@ -1060,27 +1071,35 @@ pub fn slab_voids(
     let (mut cells, mut filled) = (0u64, 0.0f64);
     // A neighbour's droplet reaches into this slab where c·√q > H/2.
     let q_reach = ((half / c) * (half / c)) as f32;
-    let ext = |m: Option<&HeightMap>, ix, iy| -> f64 {
-        m.map_or(0.0, |m| {
-            let q = m.get(ix, iy);
-            if q > q_reach {
-                (c * (q as f64).sqrt() - half).max(0.0)
-            } else {
-                0.0
-            }
-        })
+    let ext = |q: f32| -> f64 {
+        if q > q_reach {
+            (c * (q as f64).sqrt() - half).max(0.0)
+        } else {
+            0.0
+        }
     };
+    let at = |(x0, row): (i64, &[f32]), ix: i64| -> f32 {
+        usize::try_from(ix - x0)
+            .ok()
+            .and_then(|x| row.get(x))
+            .copied()
+            .unwrap_or(0.0)
+    };
+    let none = |_: i64| (0i64, &[][..]);
     region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
         let iy = k0 + k as i64;
         let c0 = ((xa - grid.origin[0]) / grid.cell - 0.5).ceil() as i64;
         let c1 = ((xb - grid.origin[0]) / grid.cell - 0.5).floor() as i64;
+        let rb = below.map_or_else(|| none(iy), |m| m.row(iy));
+        let ra = above.map_or_else(|| none(iy), |m| m.row(iy));
+        let rt = this.row(iy);
         for ix in c0..=c1 {
             cells += 1;
             // Local z from the slab's bottom: [0, lo] from below, the own droplet around h/2,
             // [h − hi, h] from above.
-            let lo = ext(below, ix, iy).min(h);
-            let hi = ext(above, ix, iy).min(h);
-            let q = this.get(ix, iy);
+            let lo = ext(at(rb, ix)).min(h);
+            let hi = ext(at(ra, ix)).min(h);
+            let q = at(rt, ix);
             let a = if q > 0.0 {
                 (c * (q as f64).sqrt()).min(half)
             } else {
