@@ -1097,14 +1097,19 @@ pub fn slab_voids(
             cells += 1;
             // Local z from the slab's bottom: [0, lo] from below, the own droplet around h/2,
             // [h − hi, h] from above.
-            let lo = ext(at(rb, ix)).min(h);
-            let hi = ext(at(ra, ix)).min(h);
             let q = at(rt, ix);
             let a = if q > 0.0 {
                 (c * (q as f64).sqrt()).min(half)
             } else {
                 0.0
             };
+            if a >= half {
+                // The own droplet fills the whole column.
+                filled += h;
+                continue;
+            }
+            let lo = ext(at(rb, ix)).min(h);
+            let hi = ext(at(ra, ix)).min(h);
             let (m0, m1) = (half - a, half + a);
             // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
             let mut len = 0.0;
