@@ -1007,16 +1007,25 @@ impl HeightMap {
         );
         let mut q = vec![0f32; w * h];
         let inv = 1.0 / (r * r);
+        let mut xx = Vec::new();
         for p in centres {
             let (ax, bx) = (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1);
             let (ay, by) = (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1);
+            xx.clear();
+            xx.extend((ax..=bx).map(|ix| {
+                let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
+                x * x
+            }));
             for iy in ay..=by {
                 let y = grid.origin[1] + (iy as f64 + 0.5) * grid.cell - p[1];
-                let row = (iy - min[1]) as usize * w;
-                for ix in ax..=bx {
-                    let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
-                    let v = (1.0 - (x * x + y * y) * inv) as f32;
-                    let slot = &mut q[row + (ix - min[0]) as usize];
+                let yy = y * y;
+                if yy * inv >= 1.0 {
+                    // No cell of this row is inside (q ≤ 0 never raises a cell).
+                    continue;
+                }
+                let row = (iy - min[1]) as usize * w + (ax - min[0]) as usize;
+                for (slot, &x2) in q[row..row + xx.len()].iter_mut().zip(&xx) {
+                    let v = (1.0 - (x2 + yy) * inv) as f32;
                     if v > *slot {
                         *slot = v;
                     }
