@@ -652,15 +652,21 @@ impl Raster {
         }
         // Inward deviation: runs of voids that reach the boundary; outward: overfill runs.
         let index = EdgeIndex::new(&self.edges, self.b);
-        let mut dev_in = (0.0f64, None);
-        let mut dev_out = (0.0f64, None);
-        let probe = |best: &mut (f64, Option<Point>), k: usize, s: u32, e: u32| {
+        let mut dev_in = Deviation::default();
+        let mut dev_out = Deviation::default();
+        let probe = |best: &mut Deviation, k: usize, s: u32, e: u32| {
             let y = g.ry(k);
             for c in [s, (s + e - 1) / 2, e - 1] {
                 let p = [g.cx(c as usize), y];
-                let d = index.distance(p, best.0);
-                if d > best.0 {
-                    *best = (d, Some(p));
+                // The distance to the boundary changes no faster than the point moves: a point
+                // this close to the last one probed cannot beat the maximum.
+                if best.last_d + dist(p, best.last) <= best.max {
+                    continue;
+                }
+                let d = index.distance(p, best.max);
+                (best.last, best.last_d) = (p, d);
+                if d > best.max {
+                    (best.max, best.at) = (d, Some(p));
                 }
             }
         };
@@ -683,10 +689,10 @@ impl Raster {
         } else {
             0.0
         };
-        let (boundary_deviation, deviation_at) = if dev_out.0 > dev_in.0 {
-            dev_out
+        let (boundary_deviation, deviation_at) = if dev_out.max > dev_in.max {
+            (dev_out.max, dev_out.at)
         } else {
-            dev_in
+            (dev_in.max, dev_in.at)
         };
         LayerAnalysis {
             index: self.index,
@@ -700,8 +706,8 @@ impl Raster {
             voids: accs.len(),
             largest_void: largest,
             overfill_area: n_over as f64 * cell,
-            deviation_inward: dev_in.0,
-            deviation_outward: dev_out.0,
+            deviation_inward: dev_in.max,
+            deviation_outward: dev_out.max,
             boundary_deviation,
             deviation_at,
         }
@@ -746,6 +752,26 @@ impl Raster {
             void: counts.iter().map(|c| share(c[0])).collect(),
             overfill: counts.iter().map(|c| share(c[1])).collect(),
             covered: counts.iter().map(|c| share(c[2])).collect(),
+        }
+    }
+}
+
+/// The largest distance to the boundary found so far, where, and the last point probed with
+/// an upper bound of its distance.
+struct Deviation {
+    max: f64,
+    at: Option<Point>,
+    last: Point,
+    last_d: f64,
+}
+
+impl Default for Deviation {
+    fn default() -> Deviation {
+        Deviation {
+            max: 0.0,
+            at: None,
+            last: [0.0; 2],
+            last_d: f64::INFINITY,
         }
     }
 }
