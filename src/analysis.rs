@@ -37,9 +37,10 @@
 //! the region of a covered point outside it. Both are sampled at the ends and the middle of
 //! each run of cells, so they are exact to about a grid step.
 
+use crate::grid::ring_cells;
 use crate::plan::{LayerPlan, MoveKind, line_droplets};
 use crate::settings::{Footprint, Settings};
-use crate::slice::{Point, Shapes, dist, region_area};
+use crate::slice::{Point, Shapes, dist, region_area, segment_distance2};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -816,19 +817,6 @@ struct EdgeIndex<'a> {
     items: Vec<u32>,
 }
 
-/// Squared distance from `p` to the segment a–b.
-fn segment_distance2(p: Point, a: Point, b: Point) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l2 = d[0] * d[0] + d[1] * d[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (x, y) = (p[0] - a[0] - t * d[0], p[1] - a[1] - t * d[1]);
-    x * x + y * y
-}
-
 impl<'a> EdgeIndex<'a> {
     fn new(edges: &'a [(Point, Point)], cell: f64) -> EdgeIndex<'a> {
         let mut min = [f64::INFINITY; 2];
@@ -895,27 +883,11 @@ impl<'a> EdgeIndex<'a> {
         let mut best = f64::INFINITY;
         let max_r = self.nx.max(self.ny) + cx.abs().max(cy.abs());
         for r in 0..=max_r {
-            for y in (cy - r)..=(cy + r) {
-                if y < 0 || y >= self.ny {
-                    continue;
-                }
-                let step = if y == cy - r || y == cy + r {
-                    1
-                } else {
-                    2 * r.max(1)
-                };
-                let mut x = cx - r;
-                while x <= cx + r {
-                    if x >= 0 && x < self.nx {
-                        let c = (y * self.nx + x) as usize;
-                        for &e in
-                            &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize]
-                        {
-                            let (a, b) = self.edges[e as usize];
-                            best = best.min(segment_distance2(p, a, b));
-                        }
-                    }
-                    x += step;
+            for (x, y) in ring_cells(cx, cy, r, self.nx, self.ny) {
+                let c = (y * self.nx + x) as usize;
+                for &e in &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                    let (a, b) = self.edges[e as usize];
+                    best = best.min(segment_distance2(p, a, b));
                 }
             }
             // Edges outside rings 0..=r are at least r·cell away.

@@ -6,6 +6,7 @@
 //! so two layers with the same angle have their lines in the same places; with `stagger`, some
 //! layers use (j + 0)·spacing instead (see [`crate::plan::hatch_shifted`]).
 
+use crate::grid::ring_cells;
 use crate::mesh::sin_cos_deg;
 use crate::slice::{Point, Shapes, dist};
 
@@ -182,31 +183,16 @@ impl EndGrid {
         let max_r = self.nx.max(self.ny);
         for r in 0..=max_r {
             let mut any_cell = false;
-            for y in (cy - r)..=(cy + r) {
-                if y < 0 || y >= self.ny {
-                    continue;
-                }
-                let step = if y == cy - r || y == cy + r {
-                    1
-                } else {
-                    2 * r.max(1)
-                };
-                let mut x = cx - r;
-                while x <= cx + r {
-                    if x >= 0 && x < self.nx {
-                        any_cell = true;
-                        let cell = &mut self.cells[(y * self.nx + x) as usize];
-                        let alive = &self.alive;
-                        cell.retain(|&e| alive[e as usize]);
-                        for &e in cell.iter() {
-                            let d = dist(p, self.ends[e as usize]);
-                            if best.is_none_or(|(bd, be)| d < bd || (d == bd && (e as usize) < be))
-                            {
-                                best = Some((d, e as usize));
-                            }
-                        }
+            for (x, y) in ring_cells(cx, cy, r, self.nx, self.ny) {
+                any_cell = true;
+                let cell = &mut self.cells[(y * self.nx + x) as usize];
+                let alive = &self.alive;
+                cell.retain(|&e| alive[e as usize]);
+                for &e in cell.iter() {
+                    let d = dist(p, self.ends[e as usize]);
+                    if best.is_none_or(|(bd, be)| d < bd || (d == bd && (e as usize) < be)) {
+                        best = Some((d, e as usize));
                     }
-                    x += step;
                 }
             }
             // Every end outside rings 0..=r is at least max(r·cell, how far p lies outside the

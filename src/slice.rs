@@ -477,6 +477,11 @@ pub fn dist(a: Point, b: Point) -> f64 {
 
 /// Distance from `p` to the segment a–b.
 pub fn segment_distance(p: Point, a: Point, b: Point) -> f64 {
+    segment_distance2(p, a, b).sqrt()
+}
+
+/// Squared distance from `p` to the segment a–b.
+pub fn segment_distance2(p: Point, a: Point, b: Point) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
     let l2 = d[0] * d[0] + d[1] * d[1];
     let t = if l2 > 0.0 {
@@ -484,7 +489,8 @@ pub fn segment_distance(p: Point, a: Point, b: Point) -> f64 {
     } else {
         0.0
     };
-    dist(p, [a[0] + t * d[0], a[1] + t * d[1]])
+    let (x, y) = (p[0] - a[0] - t * d[0], p[1] - a[1] - t * d[1]);
+    x * x + y * y
 }
 
 /// Signed area of a closed contour (positive = counter-clockwise).
