@@ -75,21 +75,21 @@ pub struct FacetBuckets {
 
 impl FacetBuckets {
     pub fn new(mesh: &Mesh, zs: &[f64]) -> FacetBuckets {
-        let ranges: Vec<(u32, u32)> = mesh
+        // Per facet: its lowest z and the planes it crosses (lo < z <= hi).
+        let spans: Vec<(f64, u32, u32)> = mesh
             .facets
             .iter()
             .map(|f| {
                 let z = f.map(|i| mesh.vertices[i as usize][2]);
                 let lo = z[0].min(z[1]).min(z[2]);
                 let hi = z[0].max(z[1]).max(z[2]);
-                // Crosses plane z iff lo < z <= hi.
                 let a = zs.partition_point(|&p| p <= lo) as u32;
                 let b = zs.partition_point(|&p| p <= hi) as u32;
-                (a, b.max(a))
+                (lo, a, b.max(a))
             })
             .collect();
         let mut counts = vec![0u32; zs.len() + 1];
-        for &(a, b) in &ranges {
+        for &(_, a, b) in &spans {
             for i in a..b {
                 counts[i as usize + 1] += 1;
             }
@@ -100,16 +100,15 @@ impl FacetBuckets {
         let offsets = counts.clone();
         let mut fill = counts;
         let mut facets = vec![0u32; *offsets.last().unwrap_or(&0) as usize];
-        let lowest = |f: &[u32; 3]| {
-            let z = f.map(|i| mesh.vertices[i as usize][2]);
-            z[0].min(z[1]).min(z[2])
-        };
-        let mut order: Vec<u32> = (0..mesh.facets.len() as u32).collect();
-        order.sort_by(|&p, &q| {
-            lowest(&mesh.facets[p as usize]).total_cmp(&lowest(&mesh.facets[q as usize]))
-        });
-        for f in order {
-            let (a, b) = ranges[f as usize];
+        // Lowest z first, ties in file order.
+        let mut order: Vec<(f64, u32)> = spans
+            .iter()
+            .enumerate()
+            .map(|(f, s)| (s.0, f as u32))
+            .collect();
+        order.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+        for (_, f) in order {
+            let (_, a, b) = spans[f as usize];
             for i in a..b {
                 facets[fill[i as usize] as usize] = f;
                 fill[i as usize] += 1;
