@@ -226,20 +226,23 @@ impl Mesh {
     /// Edge statistics and signed volume.
     pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
         // Directed edges, sorted by their undirected key.
-        let mut edges: Vec<(u64, bool)> = Vec::with_capacity(self.facets.len() * 3);
+        // Directed edges as (undirected key << 1 | direction), sorted: 8 bytes an edge, which
+        // matters at millions of facets. Vertex ids stay below 2^31 (at most 3 per facet, and
+        // files over 20 million facets are refused), so the shift loses nothing.
+        let mut edges: Vec<u64> = Vec::with_capacity(self.facets.len() * 3);
         for f in &self.facets {
             for k in 0..3 {
                 let (a, b) = (f[k], f[(k + 1) % 3]);
-                edges.push((edge_key(a, b), a < b));
+                edges.push(edge_key(a, b) << 1 | u64::from(a < b));
             }
         }
         edges.sort_unstable();
         let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
-        for group in edges.chunk_by(|x, y| x.0 == y.0) {
+        for group in edges.chunk_by(|x, y| x >> 1 == y >> 1) {
             match group.len() {
                 1 => open += 1,
                 2 => {
-                    if group[0].1 == group[1].1 {
+                    if group[0] & 1 == group[1] & 1 {
                         misoriented += 1
                     }
                 }
