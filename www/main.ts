@@ -534,14 +534,19 @@ async function analyseVoids(s: Slice): Promise<void> {
     show(current);
     setState("done");
   } catch (e) {
-    if (gen !== generation) return;
-    busy = false;
-    progress(null);
-    if (e instanceof Cancelled) setState("cancelled");
-    else showError(e);
+    failed(gen, e);
   } finally {
     if (gen === generation) updateButtons();
   }
+}
+
+/** Ends a slice or a G-code read that threw: cancelled, or an error shown in the page. */
+function failed(gen: number, e: unknown): void {
+  if (gen !== generation) return;
+  busy = false;
+  progress(null);
+  if (e instanceof Cancelled) setState("cancelled");
+  else showError(e);
 }
 
 async function openGcode(file: File): Promise<void> {
@@ -578,11 +583,7 @@ async function openGcode(file: File): Promise<void> {
     show(Math.floor((r.layers - 1) * 0.3));
     setState("done");
   } catch (e) {
-    if (gen !== generation) return;
-    busy = false;
-    progress(null);
-    if (e instanceof Cancelled) setState("cancelled");
-    else showError(e);
+    failed(gen, e);
   } finally {
     if (gen === generation) updateButtons();
   }

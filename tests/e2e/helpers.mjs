@@ -65,6 +65,18 @@ export async function waitSettled(page, timeout = 240_000) {
   return status(page);
 }
 
+/** Number of canvas pixels whose colour passes `test` (a JS expression over r, g, b). */
+export function countPixels(page, test) {
+  return page.evaluate((test) => {
+    const pass = new Function("r", "g", "b", `return ${test};`);
+    const c = document.getElementById("view");
+    const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+    let n = 0;
+    for (let i = 0; i < d.length; i += 4) if (pass(d[i], d[i + 1], d[i + 2])) n++;
+    return n;
+  }, test);
+}
+
 /** Pixels of the canvas as a data URL (changes whenever anything drawn changes). */
 export const canvasPixels = (page) => page.evaluate(() => document.getElementById("view").toDataURL("image/png"));
 

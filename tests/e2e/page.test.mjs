@@ -6,7 +6,7 @@ import { execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, canvasPixels, openPage, parseGcode, repo, start, status, torusStl, waitSettled } from "./helpers.mjs";
+import { benchy, canvasPixels, openPage, parseGcode, repo, start, status, torusStl, waitSettled, countPixels } from "./helpers.mjs";
 
 let env;
 let main; // the page most tests share
@@ -25,16 +25,7 @@ after(async () => {
 
 /** Coloured (non-background, non-grid) pixels of the canvas. */
 function inkPixels(page) {
-  return page.evaluate(() => {
-    const c = document.getElementById("view");
-    const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) {
-      const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
-      if (Math.max(r, g, b) - Math.min(r, g, b) > 60) n++; // saturated: a droplet colour
-    }
-    return n;
-  });
+  return countPixels(page, "Math.max(r, g, b) - Math.min(r, g, b) > 60");
 }
 
 /** Opens a file through the file picker (same code path as drag and drop). */

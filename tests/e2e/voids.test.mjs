@@ -2,7 +2,7 @@
 // canvas, "Go to worst layer". Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { canvasPixels, openPage, start, status, waitSettled } from "./helpers.mjs";
+import { canvasPixels, openPage, start, status, waitSettled, countPixels } from "./helpers.mjs";
 
 let env;
 let main;
@@ -18,16 +18,7 @@ after(async () => {
 
 /** Canvas pixels in the overlay's magenta (void) colour. */
 function voidPixels(page) {
-  return page.evaluate(() => {
-    const c = document.getElementById("view");
-    const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) {
-      const [r, g, b] = [d[i], d[i + 1], d[i + 2]];
-      if (r > 150 && b > 90 && g < 110 && r - g > 80 && b - g > 30) n++;
-    }
-    return n;
-  });
+  return countPixels(page, "r > 150 && b > 90 && g < 110 && r - g > 80 && b - g > 30");
 }
 
 test("the voids overlay: figures, canvas, worst layer", async () => {
