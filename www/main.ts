@@ -477,6 +477,13 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
     if (!viewTouched && !s.info.bounds) renderer.fit(s.bbox);
     show(current);
     setState("done");
+    if (s.droplets === 0) {
+      showBanner(
+        "Nothing to print",
+        `No droplet fits in this part: every wall is thinner than the droplet width B = ${s.dropletWidth.toFixed(3)} mm. ` +
+          "Scale the part up (Part → scale) or use smaller droplets (layer height, droplet aspect).",
+      );
+    }
     // the overlay was turned on during a slice made without analysis
     if (renderer.showVoids && s.analysed < s.layers) void analyseVoids(s);
     pool
@@ -592,7 +599,8 @@ async function openGcode(file: File): Promise<void> {
 function updateButtons(): void {
   const s = slice;
   const ready = !busy && s !== null && s.complete;
-  ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl");
+  // Like the CLI, no code for a part without a single droplet.
+  ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && s!.droplets > 0);
   ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && model !== null);
   ($("btn-slice") as HTMLButtonElement).disabled = model === null || form === undefined;
   settingsStatus();

@@ -75,3 +75,33 @@ test("a part in inches: warned, not rescaled, fixed by the button", async () => 
   const status1 = await status(page);
   assert.ok(status1.droplets > 900_000, `${status1.droplets} droplets for the 20 mm cube`);
 });
+
+test("a part too thin for any droplet: a clear message, no download, the page stays usable", async () => {
+  const { page } = main;
+  await page.click("#btn-reset"); // the previous test scaled the part by 25.4
+  // a box 0.1 mm wide: thinner than one droplet (B = 0.208 mm)
+  const v = (x, y, z) => [x * 0.1, y * 20, z * 20];
+  const quads = [
+    [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
+    [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
+    [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
+    [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
+    [v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)],
+    [v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)],
+  ];
+  const tris = quads.flatMap(([p, q, r, s]) => [[p, q, r], [p, r, s]]);
+  const buf = Buffer.alloc(84 + 50 * tris.length);
+  buf.writeUInt32LE(tris.length, 80);
+  tris.forEach((t, i) => t.flat().forEach((c, k) => buf.writeFloatLE(c, 84 + 50 * i + 12 + 4 * k)));
+  const s = await pick(page, "sheet.stl", buf);
+  assert.equal(s.state, "done");
+  assert.equal(s.droplets, 0);
+  assert.equal(await page.isVisible("#banner"), true);
+  assert.match(await page.locator("#banner").innerText(), /Nothing to print[\s\S]*thinner than the droplet width/);
+  assert.equal(await page.isDisabled("#btn-download"), true);
+  // the next slice works
+  await page.click("#btn-sample");
+  const after = await waitSettled(page, 60_000);
+  assert.equal(after.state, "done");
+  assert.ok(after.droplets > 0);
+});
