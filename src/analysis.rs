@@ -1337,14 +1337,13 @@ pub fn analyse_job(job: &crate::Job) -> (Report, [f64; 2]) {
                     let (a, e) = (bi * block, ((bi + 1) * block).min(n));
                     let layer = |i: usize, t_plan: &mut f64, t_analyse: &mut f64| {
                         let t = Instant::now();
-                        let section = job.section(i);
-                        let plan = crate::plan::plan_layer(&section.region, i, s);
+                        let (plan, region) = job.plan_layer_and_region(i);
                         *t_plan += t.elapsed().as_secs_f64();
                         let t = Instant::now();
                         let centres = droplet_centres(&plan, b);
                         let map = HeightMap::new(&centres, &grid, d);
                         *t_analyse += t.elapsed().as_secs_f64();
-                        (section.region, plan, centres, map)
+                        (region, plan, centres, map)
                     };
                     let mut raster = Raster::empty();
                     let mut below = (a > 0).then(|| layer(a - 1, &mut t_plan, &mut t_analyse).3);

@@ -236,6 +236,17 @@ fn segments(mesh: &Mesh, facets: &[u32], z: f64) -> Vec<Segment> {
 /// Chains segments into closed loops (see the module docs for the three passes).
 /// Returns the loops closed by topology and, apart, those joined across gaps (pass 3).
 fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>) {
+    let (mut loops, leftovers) = chain_directed(segs, section);
+    if leftovers.is_empty() {
+        return (loops, Vec::new());
+    }
+    let open = chain_undirected(segs, &leftovers, &mut loops, section);
+    (loops, join_open(open, section))
+}
+
+/// Pass 1: directed chaining through shared edges. Returns the closed loops and the segments
+/// of the chains that did not close.
+fn chain_directed(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<usize>) {
     let mut used = vec![false; segs.len()];
     let mut by_start: Vec<(u64, u32)> = segs
         .iter()
@@ -254,7 +265,6 @@ fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>
 
     let mut loops = Vec::new();
     let mut leftovers: Vec<usize> = Vec::new();
-    // Pass 1: directed chaining through shared edges.
     for s0 in 0..segs.len() {
         if used[s0] {
             continue;
@@ -282,31 +292,37 @@ fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>
             leftovers.extend(chain);
         }
     }
-    if leftovers.is_empty() {
-        return (loops, Vec::new());
-    }
+    (loops, leftovers)
+}
 
-    // Pass 2: chain the leftovers ignoring direction (flipped facets reverse a segment).
+/// Pass 2: chains the leftovers ignoring direction (flipped facets reverse a segment); loops
+/// that close are added to `loops`, oriented by the majority of their facets. Returns the
+/// chains that stay open, each with the lowest segment (facet order) it contains.
+fn chain_undirected(
+    segs: &[Segment],
+    leftovers: &[usize],
+    loops: &mut Vec<Contour>,
+    section: &mut Section,
+) -> Vec<(usize, Vec<Point>)> {
     let mut by_key: Vec<(u64, u32)> = leftovers
         .iter()
         .flat_map(|&i| [(segs[i].start, i as u32), (segs[i].end, i as u32)])
         .collect();
     by_key.sort_unstable();
     let mut free = vec![false; segs.len()];
-    for &i in &leftovers {
+    for &i in leftovers {
         free[i] = true;
     }
-    let neighbour = |key: u64, not: usize, free: &[bool]| -> Option<usize> {
+    let neighbour = |key: u64, free: &[bool]| -> Option<usize> {
         let from = by_key.partition_point(|e| e.0 < key);
         by_key[from..]
             .iter()
             .take_while(|e| e.0 == key)
             .map(|e| e.1 as usize)
-            .find(|&i| i != not && free[i])
+            .find(|&i| free[i])
     };
-    // Open chains with the lowest segment (facet order) they contain.
     let mut open: Vec<(usize, Vec<Point>)> = Vec::new();
-    for &s0 in &leftovers {
+    for &s0 in leftovers {
         if !free[s0] {
             continue;
         }
@@ -315,7 +331,7 @@ fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>
         let mut steps = vec![(s0, true)];
         let mut tail = segs[s0].end;
         let mut closed = false;
-        while let Some(n) = neighbour(tail, usize::MAX, &free) {
+        while let Some(n) = neighbour(tail, &free) {
             free[n] = false;
             let fwd = segs[n].start == tail;
             tail = if fwd { segs[n].end } else { segs[n].start };
@@ -328,7 +344,7 @@ fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>
         if !closed {
             // Grow the chain backwards from its head as well.
             let mut head = segs[s0].start;
-            while let Some(n) = neighbour(head, usize::MAX, &free) {
+            while let Some(n) = neighbour(head, &free) {
                 free[n] = false;
                 let fwd = segs[n].end == head;
                 head = if fwd { segs[n].start } else { segs[n].end };
@@ -363,9 +379,14 @@ fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>
         }
     }
 
-    // Pass 3: join open chains, as CuraEngine and Slic3r stitch open sections: take the
-    // chains in order; while another chain's start or end (then reversed) is nearer to the
-    // current chain's end than its own start, append that chain; then close the loop.
+    open
+}
+
+/// Pass 3: joins open chains, as CuraEngine and Slic3r stitch open sections: take the chains
+/// in order of their lowest segment; while another chain's start or end (then reversed) is
+/// nearer to the current chain's end than its own start, append that chain; then close the
+/// loop.
+fn join_open(mut open: Vec<(usize, Vec<Point>)>, section: &mut Section) -> Vec<Contour> {
     section.open_chains += open.len();
     let mut joined = Vec::new();
     open.sort_by_key(|c| c.0);
@@ -396,7 +417,7 @@ fn chain(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<Contour>
             joined.push(cur);
         }
     }
-    (loops, joined)
+    joined
 }
 
 /// Drops points closer than [`MIN_POINT_DISTANCE_MM`] to the previous kept point, then

@@ -76,6 +76,18 @@ pub fn check_settings(settings_json: &str) -> Result<String, JsError> {
     Ok(serde_json::to_string(&s).unwrap_or_default())
 }
 
+impl Session {
+    fn check_layer(&self, i: usize) -> Result<(), JsError> {
+        if i >= self.job.layer_count() {
+            return Err(js_error(Error::Internal(format!(
+                "layer {i} asked for, but the part has {} layers",
+                self.job.layer_count()
+            ))));
+        }
+        Ok(())
+    }
+}
+
 fn parse_summary(summary_json: &str) -> Result<Summary, JsError> {
     serde_json::from_str(summary_json)
         .map_err(|e| js_error(Error::Internal(format!("bad summary from the page: {e}"))))
@@ -110,12 +122,7 @@ impl Session {
 
     /// Plans layer `i`: its G-code text, droplet counts and preview arrays.
     pub fn slice_layer(&self, i: usize) -> Result<LayerResult, JsError> {
-        if i >= self.job.layer_count() {
-            return Err(js_error(Error::Internal(format!(
-                "layer {i} asked for, but the part has {} layers",
-                self.job.layer_count()
-            ))));
-        }
+        self.check_layer(i)?;
         let plan = self.job.plan_layer(i);
         Ok(LayerResult::new(&plan, &self.settings))
     }
@@ -124,20 +131,10 @@ impl Session {
     /// `analysis_json` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]). About 2–3
     /// times the work of planning the layer.
     pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsError> {
-        if i >= self.job.layer_count() {
-            return Err(js_error(Error::Internal(format!(
-                "layer {i} asked for, but the part has {} layers",
-                self.job.layer_count()
-            ))));
-        }
-        // what Job::plan_layer does, keeping the section for the analysis
-        let section = self.job.section(i);
-        let mut plan = crate::plan::plan_layer(&section.region, i, &self.settings);
-        plan.open_chains = section.open_chains;
-        plan.reoriented_loops = section.reoriented_loops;
+        self.check_layer(i)?;
+        let (plan, region) = self.job.plan_layer_and_region(i);
         let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
-        let (a, mask) =
-            analysis::analyse_layer_with_mask(&plan, &section.region, &self.settings, cell);
+        let (a, mask) = analysis::analyse_layer_with_mask(&plan, &region, &self.settings, cell);
         let mut r = LayerResult::new(&plan, &self.settings);
         r.analysis = Some(a);
         r.mask = Some(mask);
