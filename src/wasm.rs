@@ -236,10 +236,11 @@ impl LayerResult {
     pub fn summary_json(&self) -> String {
         serde_json::to_string(&self.summary).unwrap_or_default()
     }
-    /// The layer's G-code lines.
+    /// The layer's G-code lines as UTF-8 bytes (a copy; the worker collects a run of layers
+    /// into one Blob: a Blob per layer costs far more than the bytes).
     #[wasm_bindgen(getter)]
-    pub fn gcode(&self) -> String {
-        self.gcode.clone()
+    pub fn gcode(&self) -> Uint8Array {
+        Uint8Array::from(self.gcode.as_bytes())
     }
     /// Droplet centres, x,y pairs in mm (a copy; its buffer can be transferred).
     #[wasm_bindgen(getter)]

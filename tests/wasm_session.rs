@@ -102,7 +102,7 @@ fn slices_a_box() {
         for (k, t) in totals.iter_mut().enumerate() {
             *t += roles.iter().filter(|&&r| r as usize == k).count() as u64;
         }
-        text.push_str(&l.gcode());
+        text.push_str(&String::from_utf8(l.gcode().to_vec()).unwrap());
         add_numbers(
             &mut summary,
             &serde_json::from_str(&l.summary_json()).unwrap(),

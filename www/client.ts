@@ -1,10 +1,12 @@
 // The worker pool: min(hardwareConcurrency - 1, 4) workers (at least 1), each with its own
-// wasm instance. A slice opens the model in every worker and hands each one a contiguous range
-// of layers; layers come back as progress replies (buffers transferred) and are stored by index,
-// so the page sees them in layer order however the workers finish. Cancel terminates every
+// wasm instance. A slice opens the model in every worker at once; each worker, as soon as it
+// holds the model, takes units of consecutive layers from a shared counter (two units in
+// flight, so it never waits for the page between units). Layers come back as progress replies
+// (buffers transferred) and are stored by index, so the page sees them in layer order however
+// the workers finish; a unit's result carries its G-code as one Blob. Cancel terminates every
 // worker at once, rejects what was pending and starts fresh workers.
 
-import type { GcodeParseResult, InitResult, LayerData, OpenResult, Reply, Request, RequestKind } from "./protocol";
+import type { GcodeParseResult, InitResult, LayerData, OpenResult, Reply, Request, RequestKind, SliceUnit } from "./protocol";
 
 export class SliceError extends Error {
   constructor(
@@ -93,7 +95,32 @@ export function defaultPoolSize(): number {
 export interface SliceCallbacks {
   opened(result: OpenResult): void;
   layer(layer: LayerData): void;
+  /** A run of layers is complete: its G-code and summary (after all its layers). */
+  unit(unit: SliceUnit): void;
 }
+
+/** A run of consecutive layers [from, to). */
+interface Unit {
+  from: number;
+  to: number;
+}
+
+/** Hands out the units of layers [0, layers) in order, shared by all workers. A unit is small
+ *  enough to share the work evenly and to show progress, and large enough that its round trip
+ *  and its Blob cost little (a Blob costs about 0.5 ms, whatever its size). */
+function unitCounter(layers: number, workers: number): () => Unit | null {
+  const size = Math.max(1, Math.min(16, Math.ceil(layers / (4 * workers))));
+  let next = 0;
+  return () => {
+    if (next >= layers) return null;
+    const from = next;
+    next = Math.min(layers, from + size);
+    return { from, to: next };
+  };
+}
+
+/** Units in flight per worker: the worker starts the next one while the page answers. */
+const UNITS_IN_FLIGHT = 2;
 
 export class Pool {
   private handles: WorkerHandle[] = [];
@@ -148,31 +175,44 @@ export class Pool {
     this.heal();
     return this.guarded(async () => {
       const buffer = stl.slice().buffer;
-      // The first worker validates the model and settings; on failure every worker keeps its
-      // previous model, so the previous slice can still be browsed.
+      // Every worker checks the same model and settings, so they all accept or all refuse it;
+      // on refusal every worker keeps its previous model and the previous slice stays usable.
       this.opening = null;
-      const first = await this.handles[0].call<OpenResult>("open", { stl: buffer, name, settings });
-      for (const h of this.handles) h.hasModel = false;
-      this.handles[0].hasModel = true;
-      cb.opened(first);
-      const n = first.layers;
-      const used = this.handles.slice(0, Math.max(1, Math.min(this.handles.length, n)));
+      let first: OpenResult | null = null;
+      let nextUnit: () => Unit | null = () => null;
+      const handles = this.handles;
       await Promise.all(
-        used.slice(1).map(async (h) => {
-          await h.call<OpenResult>("open", { stl: buffer, name, settings });
+        handles.map(async (h) => {
+          const r = await h.call<OpenResult>("open", { stl: buffer, name, settings });
+          if (!first) {
+            first = r;
+            for (const o of handles) o.hasModel = false;
+            nextUnit = unitCounter(r.layers, handles.length);
+            cb.opened(r);
+          }
           h.hasModel = true;
+          await this.units(h, nextUnit, { analyse }, cb.layer, cb.unit);
         }),
       );
-      const per = Math.ceil(n / used.length);
-      await Promise.all(
-        used.map((h, k) => {
-          const from = Math.min(n, k * per);
-          const to = Math.min(n, from + per);
-          return from < to ? h.call<null>("slice", { from, to, analyse }, cb.layer) : Promise.resolve(null);
-        }),
-      );
-      return first;
+      return first!;
     });
+  }
+
+  /** Runs units from `nextUnit` on one worker, [[UNITS_IN_FLIGHT]] at a time, until it has none. */
+  private async units(
+    h: WorkerHandle,
+    nextUnit: () => Unit | null,
+    options: { analyse: boolean; gcode?: boolean },
+    layer: (l: LayerData) => void,
+    unit?: (u: SliceUnit) => void,
+  ): Promise<void> {
+    const lane = async () => {
+      for (let u = nextUnit(); u; u = nextUnit()) {
+        const done = await h.call<SliceUnit>("slice", { ...u, ...options }, layer);
+        unit?.(done);
+      }
+    };
+    await Promise.all(Array.from({ length: UNITS_IN_FLIGHT }, lane));
   }
 
   /** Opens a model in every worker without slicing it (to browse a finished slice again
@@ -235,14 +275,8 @@ export class Pool {
     return this.guarded(async () => {
       await this.pick(); // waits for a reopening under way; throws if no worker has the model
       const ready = this.handles.filter((h) => h.hasModel && !h.broken);
-      const per = Math.ceil(n / ready.length);
-      await Promise.all(
-        ready.map((h, k) => {
-          const from = Math.min(n, k * per);
-          const to = Math.min(n, from + per);
-          return from < to ? h.call<null>("slice", { from, to, analyse: true, gcode: false }, layer) : Promise.resolve(null);
-        }),
-      );
+      const nextUnit = unitCounter(n, ready.length);
+      await Promise.all(ready.map((h) => this.units(h, nextUnit, { analyse: true, gcode: false }, layer)));
     });
   }
 

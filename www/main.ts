@@ -2,7 +2,7 @@
 
 import { Cancelled, Pool, SliceError } from "./client";
 import { SettingsForm, type Value } from "./form";
-import { addNumbers, type Counts, type GcodeParseResult, type InitResult, type JobInfo, type LayerAnalysis, type LayerData } from "./protocol";
+import { addNumbers, type Counts, type GcodeParseResult, type InitResult, type JobInfo, type LayerAnalysis, type LayerData, type SliceUnit } from "./protocol";
 import { Renderer, type Bounds, type View } from "./render";
 import { sampleStl } from "./sample";
 import { makeLink, readLink, sha256Hex, type SharedLink } from "./share";
@@ -29,7 +29,8 @@ class Slice {
   z: number[] = [];
   counts: (Counts | undefined)[] = [];
   travelMm: number[] = [];
-  gcode: (Blob | undefined)[] = [];
+  /** G-code by runs of layers, keyed by the run's first layer. */
+  gcode = new Map<number, { to: number; blob: Blob }>();
   cache = new Map<number, LayerData>();
   cacheBytes = 0;
   done = 0;
@@ -46,6 +47,10 @@ class Slice {
   analysed = 0;
   regionArea = 0;
   coveredArea = 0;
+  /** When the file was chosen (performance.now()), and the seconds from then until every
+   *  layer's G-code was ready (the figure of the benchmark). */
+  startedAt = performance.now();
+  seconds: number | null = null;
   /** The worst layer: the one with the largest connected void. */
   worst: { index: number; area: number } | null = null;
 
@@ -73,7 +78,6 @@ class Slice {
       this.totals.inner += l.counts.inner;
       this.totals.fill += l.counts.fill;
       this.travelTotal += l.travelMm;
-      if (l.summary) addNumbers(this.summary, JSON.parse(l.summary) as Record<string, unknown>);
       const d = l.droplets;
       const b = this.bbox;
       for (let i = 0; i < d.length; i += 2) {
@@ -85,7 +89,6 @@ class Slice {
         if (y > b.maxY) b.maxY = y;
       }
     }
-    if (l.gcode) this.gcode[l.index] = l.gcode;
     const a = l.analysis;
     if (a && this.analysis[l.index] === undefined) {
       this.analysis[l.index] = a;
@@ -95,14 +98,31 @@ class Slice {
       const v = a.largest_void;
       if (v && (!this.worst || v.area > this.worst.area)) this.worst = { index: l.index, area: v.area };
     }
-    const { gcode: _g, summary: _s, ...preview } = l;
     const old = this.cache.get(l.index);
     if (!old || (l.mask && !old.mask)) {
       if (old) this.cacheBytes -= layerBytes(old);
-      this.cache.set(l.index, preview);
+      this.cache.set(l.index, l);
       this.cacheBytes += layerBytes(l);
     }
     if (this.source === "stl") this.evict(current);
+  }
+
+  /** A run of layers is complete: its G-code and its part of the summary. */
+  addUnit(u: SliceUnit): void {
+    if (u.gcode) this.gcode.set(u.from, { to: u.to, blob: u.gcode });
+    if (u.summary) addNumbers(this.summary, u.summary);
+  }
+
+  /** The G-code of every layer in order, or the first layer without any. */
+  gcodeParts(): Blob[] | number {
+    const parts: Blob[] = [];
+    for (let i = 0; i < this.layers; ) {
+      const u = this.gcode.get(i);
+      if (!u) return i;
+      parts.push(u.blob);
+      i = u.to;
+    }
+    return parts;
   }
 
   private evict(current: number): void {
@@ -223,7 +243,7 @@ function progress(fraction: number | null, label = "Slicing…"): void {
   const pct = Math.floor(fraction * 100);
   $("progress-label").textContent = label;
   $("progress-pct").textContent = `${pct} %`;
-  $("progress-fill").style.width = `${pct}%`;
+  $("progress-fill").style.transform = `scaleX(${pct / 100})`;
   p.dataset.percent = String(pct);
 }
 
@@ -248,13 +268,22 @@ function num(name: string, fallback: number): number {
   return typeof v === "number" ? v : fallback;
 }
 
-let statsFrame = 0;
-function updateStats(): void {
-  if (statsFrame) return;
-  statsFrame = requestAnimationFrame(() => {
-    statsFrame = 0;
-    writeStats();
-  });
+/** While the workers run, the progress and the figures are redrawn at most this often: each
+ *  redraw costs style, layout and paint, and with few cores that time is taken from slicing. */
+const BUSY_REDRAW_MS = 150;
+let busyRedraw: { gen: number; update: () => void } | null = null;
+
+/** Runs `update` within [[BUSY_REDRAW_MS]], once for all calls until then, unless the run `gen`
+ *  has ended by then (the page is then drawn by whatever ended it). */
+function whileBusy(gen: number, update: () => void): void {
+  const pending = busyRedraw !== null;
+  busyRedraw = { gen, update };
+  if (pending) return;
+  setTimeout(() => {
+    const r = busyRedraw;
+    busyRedraw = null;
+    if (r && r.gen === generation && busy) r.update();
+  }, BUSY_REDRAW_MS);
 }
 
 function roleLabels(source: "stl" | "gco"): void {
@@ -264,49 +293,60 @@ function roleLabels(source: "stl" | "gco"): void {
   $("legend-1-wrap").hidden = gco;
 }
 
+/** Sets an element's text; an unchanged text is left alone (no layout for nothing). */
+function setText(id: string, text: string): void {
+  const e = $(id);
+  if (e.textContent !== text) e.textContent = text;
+}
+
 function writeStats(): void {
   const s = slice;
   roleLabels(s?.source ?? "stl");
-  const set = (id: string, text: string) => ($(id).textContent = text);
   $("empty").hidden = s !== null;
   if (!s) {
     writeVoids(null);
-    for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) set(id, "–");
+    for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
     $("warnings").hidden = true;
     return;
   }
-  set("stat-model", s.name);
+  setText("stat-model", s.name);
   const b = s.info.bounds;
-  if (b) set("stat-size", `${fmtMm(b.max[0] - b.min[0])} × ${fmtMm(b.max[1] - b.min[1])} × ${fmtMm(b.max[2] - b.min[2])} mm`);
-  else if (Number.isFinite(s.bbox.minX)) set("stat-size", `${fmtMm(s.bbox.maxX - s.bbox.minX)} × ${fmtMm(s.bbox.maxY - s.bbox.minY)} mm (droplets)`);
-  else set("stat-size", "–");
+  if (b) setText("stat-size", `${fmtMm(b.max[0] - b.min[0])} × ${fmtMm(b.max[1] - b.min[1])} × ${fmtMm(b.max[2] - b.min[2])} mm`);
+  else if (Number.isFinite(s.bbox.minX)) setText("stat-size", `${fmtMm(s.bbox.maxX - s.bbox.minX)} × ${fmtMm(s.bbox.maxY - s.bbox.minY)} mm (droplets)`);
+  else setText("stat-size", "–");
   const facets = s.info.mesh?.facets_in_file;
-  set("stat-facets", facets !== undefined ? nf.format(facets) : s.source === "gco" ? "(G-code file)" : "–");
-  set("stat-layers", s.complete || s.done === s.layers ? nf.format(s.layers) : `${nf.format(s.done)} of ${nf.format(s.layers)}`);
-  set("stat-droplet", `${s.dropletWidth.toFixed(3)} × ${s.layerHeight.toFixed(3)} mm`);
-  set("stat-outer", nf.format(s.totals.outer));
-  set("stat-inner", nf.format(s.totals.inner));
-  set("stat-fill", nf.format(s.totals.fill));
-  set("stat-droplets", nf.format(s.droplets));
+  setText("stat-facets", facets !== undefined ? nf.format(facets) : s.source === "gco" ? "(G-code file)" : "–");
+  setText("stat-layers", s.complete || s.done === s.layers ? nf.format(s.layers) : `${nf.format(s.done)} of ${nf.format(s.layers)}`);
+  setText("stat-droplet", `${s.dropletWidth.toFixed(3)} × ${s.layerHeight.toFixed(3)} mm`);
+  setText("stat-outer", nf.format(s.totals.outer));
+  setText("stat-inner", nf.format(s.totals.inner));
+  setText("stat-fill", nf.format(s.totals.fill));
+  setText("stat-droplets", nf.format(s.droplets));
   const volume = s.droplets * s.dropletWidth * s.dropletWidth * s.layerHeight; // mm³
-  set("stat-volume", `${(volume / 1000).toFixed(2)} cm³`);
-  set("stat-mass", `${((volume / 1000) * num("material_density", 1.04)).toFixed(2)} g`);
+  setText("stat-volume", `${(volume / 1000).toFixed(2)} cm³`);
+  setText("stat-mass", `${((volume / 1000) * num("material_density", 1.04)).toFixed(2)} g`);
   const seconds = s.droplets / num("droplet_rate", 100) + s.travelTotal / num("travel_speed", 50);
-  set("stat-time", (s.complete ? "" : "≥ ") + duration(seconds));
-  set("stat-travel", `${(s.travelTotal / 1000).toFixed(2)} m`);
+  setText("stat-time", (s.complete ? "" : "≥ ") + duration(seconds));
+  setText("stat-travel", `${(s.travelTotal / 1000).toFixed(2)} m`);
   const c = s.counts[current];
-  set("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
-  set("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
+  setText("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
+  setText("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
   writeVoids(s);
   const warnings = [...((s.info.warnings ?? []) as string[]), ...s.repairs];
   $("warnings").hidden = warnings.length === 0;
-  $("warning-list").replaceChildren(
-    ...warnings.map((w) => {
-      const li = document.createElement("li");
-      li.textContent = w;
-      return li;
-    }),
-  );
+  const list = $("warning-list");
+  const text = warnings.join("\n");
+  if (list.dataset.text !== text) {
+    // rebuilt only when it changes: writeStats runs many times during a slice
+    list.dataset.text = text;
+    list.replaceChildren(
+      ...warnings.map((w) => {
+        const li = document.createElement("li");
+        li.textContent = w;
+        return li;
+      }),
+    );
+  }
   writeUnitFix(s);
 }
 
@@ -335,15 +375,14 @@ const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
 
 /** The "Voids" block of the statistics: this layer, the part, the worst layer. */
 function writeVoids(s: Slice | null): void {
-  const set = (id: string, text: string) => ($(id).textContent = text);
   const a = s?.analysis[current];
-  set("stat-coverage", a ? pct(a.coverage) : "–");
-  set("stat-void", a ? mm2(a.void_area) : "–");
+  setText("stat-coverage", a ? pct(a.coverage) : "–");
+  setText("stat-void", a ? mm2(a.void_area) : "–");
   const v = a?.largest_void;
-  set("stat-largest", v ? `${mm2(v.area)}${v.at_boundary ? " (edge)" : ""}` : a ? "none" : "–");
+  setText("stat-largest", v ? `${mm2(v.area)}${v.at_boundary ? " (edge)" : ""}` : a ? "none" : "–");
   const partial = s && s.analysed < s.layers ? " so far" : "";
-  set("stat-part-coverage", s && s.analysed > 0 && s.regionArea > 0 ? pct(s.coveredArea / s.regionArea) + partial : "–");
-  set("stat-worst", s?.worst ? `${nf.format(s.worst.index + 1)} · ${mm2(s.worst.area)}` : "–");
+  setText("stat-part-coverage", s && s.analysed > 0 && s.regionArea > 0 ? pct(s.coveredArea / s.regionArea) + partial : "–");
+  setText("stat-worst", s?.worst ? `${nf.format(s.worst.index + 1)} · ${mm2(s.worst.area)}` : "–");
   ($("btn-worst") as HTMLButtonElement).disabled = !s?.worst;
   const hint = $("voids-hint");
   if (s?.source === "gco") hint.textContent = "Voids are analysed for sliced STL files.";
@@ -434,6 +473,8 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
   const H = Number(values.layer_height);
   const B = H * Number(values.droplet_aspect);
   const s = new Slice("stl", m.name, B, H, values, m);
+  if (fileChosenAt !== null) s.startedAt = fileChosenAt;
+  fileChosenAt = null;
   const sameModel = slice?.model?.sha256 === m.sha256;
   busy = true;
   setState("slicing");
@@ -465,13 +506,24 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
       layer: (l) => {
         if (gen !== generation) return;
         s.put(l, current);
-        progress(s.done / Math.max(1, s.layers));
-        if (l.index === current || l.index === current - 1) show(current);
-        updateStats();
+        // the layer shown and the one below it: drawn once both are there (a draw costs)
+        if ((l.index === current && (current === 0 || s.cache.has(current - 1))) || (l.index === current - 1 && s.cache.has(current))) show(current);
+        // the last layer shows 100 % at once; before it the figures are redrawn now and then
+        if (s.done === s.layers) progress(1);
+        else {
+          whileBusy(gen, () => {
+            progress(s.done / Math.max(1, s.layers));
+            writeStats();
+          });
+        }
+      },
+      unit: (u) => {
+        if (gen === generation) s.addUnit(u);
       },
     }, renderer.showVoids);
     if (gen !== generation) return;
     s.complete = true;
+    s.seconds = (performance.now() - s.startedAt) / 1000;
     busy = false;
     progress(null);
     if (!viewTouched && !s.info.bounds) renderer.fit(s.bbox);
@@ -531,9 +583,11 @@ async function analyseVoids(s: Slice): Promise<void> {
     await pool.analyse(s.layers, (l) => {
       if (gen !== generation) return;
       s.put(l, current);
-      progress(s.analysed / Math.max(1, s.layers), label);
       if (l.index === current) show(current);
-      updateStats();
+      whileBusy(gen, () => {
+        progress(s.analysed / Math.max(1, s.layers), label);
+        writeStats();
+      });
     });
     if (gen !== generation) return;
     busy = false;
@@ -627,7 +681,11 @@ function settingsStatus(): void {
 // ---------------------------------------------------------------------------------------------
 // files
 
+/** When the file being opened was chosen: a slice's time runs from there. */
+let fileChosenAt: number | null = null;
+
 async function openFile(file: File): Promise<void> {
+  const chosen = performance.now();
   setState("reading");
   if (/\.(gco|gcode)$/i.test(file.name)) {
     pendingLink = null;
@@ -643,6 +701,7 @@ async function openFile(file: File): Promise<void> {
     return;
   }
   const m: Model = { bytes, name: file.name, sha256: await sha256Hex(bytes) };
+  fileChosenAt = chosen;
   const link = pendingLink;
   if (link) {
     pendingLink = null;
@@ -687,14 +746,9 @@ async function download(): Promise<void> {
   const summary = JSON.stringify({ ...s.summary, layers: s.layers });
   try {
     const [header, footer] = await Promise.all([pool.header(summary), pool.footer(summary)]);
-    const parts: BlobPart[] = [header];
-    for (let i = 0; i < s.layers; i++) {
-      const g = s.gcode[i];
-      if (!g) throw new SliceError("internal", `layer ${i + 1} has no G-code`);
-      parts.push(g);
-    }
-    parts.push(footer);
-    const blob = new Blob(parts, { type: "text/plain" });
+    const layers = s.gcodeParts();
+    if (typeof layers === "number") throw new SliceError("internal", `layer ${layers + 1} has no G-code`);
+    const blob = new Blob([header, ...layers, footer], { type: "text/plain" });
     const a = document.createElement("a");
     a.href = URL.createObjectURL(blob);
     a.download = `${baseName(s.name)}.gco`;
@@ -951,6 +1005,8 @@ window.dropslice = {
     view: { ...renderer.view },
     name: slice?.name ?? null,
     workers: pool.size,
+    /** Seconds from the file chosen to every layer's G-code ready (the last finished slice). */
+    seconds: slice?.seconds ?? null,
     cached: slice?.cache.size ?? 0,
     voids: renderer.showVoids,
     analysed: slice?.analysed ?? 0,

@@ -35,10 +35,6 @@ export interface LayerData {
   travel: Float32Array;
   /** Share of the input read so far, 0..1 (.gco files only). */
   fraction?: number;
-  /** The layer's share of the core's Summary, JSON (slices only). */
-  summary?: string;
-  /** The layer's G-code (slices only; absent for preview re-requests). */
-  gcode?: Blob;
   /** The void analysis (src/analysis.rs), when the request asked for it. */
   analysis?: LayerAnalysis;
   /** Coverage mask of the analysis (cells of B/4). */
@@ -78,6 +74,16 @@ export interface CoverageMask {
   height: number;
   void: Uint8Array;
   overfill: Uint8Array;
+}
+
+/** The result of a "slice" request: what belongs to its run of layers as a whole. */
+export interface SliceUnit {
+  from: number;
+  to: number;
+  /** The G-code of layers [from, to), in order (absent when the request asked for none). */
+  gcode?: Blob;
+  /** The core's Summary of these layers, summed (the page adds the units up for the header). */
+  summary?: Record<string, unknown>;
 }
 
 export interface SettingSpec {

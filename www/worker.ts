@@ -11,7 +11,7 @@ import init, {
   type InitOutput,
 } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
-import { splitError, transferablesOf, type LayerData, type Reply, type Request } from "./protocol";
+import { addNumbers, splitError, transferablesOf, type LayerData, type Reply, type Request, type SliceUnit } from "./protocol";
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 
@@ -48,9 +48,19 @@ function yieldToQueue(): Promise<void> {
   });
 }
 
-function layerOf(s: Session, index: number, withGcode: boolean, analyse = false): LayerData {
+/** What a layer adds to its unit: G-code bytes and the core's summary. */
+interface UnitParts {
+  gcode: Uint8Array[];
+  summary: Record<string, unknown>;
+}
+
+function layerOf(s: Session, index: number, unit: UnitParts | null, analyse = false): LayerData {
   const r = analyse ? s.slice_layer_analysed(index) : s.slice_layer(index);
   try {
+    if (unit) {
+      unit.gcode.push(r.gcode);
+      addNumbers(unit.summary, JSON.parse(r.summary_json) as Record<string, unknown>);
+    }
     const layer: LayerData = {
       index: r.index,
       z: r.z,
@@ -59,8 +69,6 @@ function layerOf(s: Session, index: number, withGcode: boolean, analyse = false)
       droplets: r.droplets,
       roles: r.roles,
       travel: r.travel,
-      gcode: withGcode ? new Blob([r.gcode], { type: "text/plain" }) : undefined,
-      summary: withGcode ? r.summary_json : undefined,
     };
     if (analyse) {
       const f = r.mask_frame;
@@ -80,6 +88,27 @@ function layerOf(s: Session, index: number, withGcode: boolean, analyse = false)
   } finally {
     r.free();
   }
+}
+
+/** The unit being sliced: the next one starts when it ends. */
+let slicing: Promise<void> = Promise.resolve();
+
+async function sliceUnit(id: number, req: Extract<Request, { kind: "slice" }>["data"]): Promise<void> {
+  const s = need();
+  const { from, to } = req;
+  const parts: UnitParts | null = (req.gcode ?? true) ? { gcode: [], summary: {} } : null;
+  for (let i = from; i < to; i++) {
+    const layer = layerOf(s, i, parts, req.analyse);
+    post({ id, kind: "progress", data: layer }, transferablesOf(layer));
+    await yieldToQueue();
+    if (session !== s) throw new Error("internal: the model was replaced during slicing");
+  }
+  const unit: SliceUnit = { from, to };
+  if (parts) {
+    unit.gcode = new Blob(parts.gcode as BlobPart[], { type: "text/plain" });
+    unit.summary = parts.summary;
+  }
+  post({ id, kind: "result", data: unit });
 }
 
 function need(): Session {
@@ -108,18 +137,15 @@ async function handle(req: Request): Promise<void> {
       return;
     }
     case "slice": {
-      const s = need();
-      for (let i = req.data.from; i < req.data.to; i++) {
-        const layer = layerOf(s, i, req.data.gcode ?? true, req.data.analyse);
-        post({ id: req.id, kind: "progress", data: layer }, transferablesOf(layer));
-        await yieldToQueue();
-        if (session !== s) throw new Error("internal: the model was replaced during slicing");
-      }
-      post({ id: req.id, kind: "result", data: null });
+      // Units run one after the other (the page keeps two in flight); previews still get in
+      // between two layers.
+      const run = slicing.then(() => sliceUnit(req.id, req.data));
+      slicing = run.catch(() => {});
+      await run;
       return;
     }
     case "preview": {
-      const layer = layerOf(need(), req.data.index, false, req.data.analyse);
+      const layer = layerOf(need(), req.data.index, null, req.data.analyse);
       post({ id: req.id, kind: "result", data: layer }, transferablesOf(layer));
       return;
     }
