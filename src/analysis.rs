@@ -37,10 +37,10 @@
 //! the region of a covered point outside it. Both are sampled at the ends and the middle of
 //! each run of cells, so they are exact to about a grid step.
 
-use crate::grid::ring_cells;
+use crate::grid::EdgeIndex;
 use crate::plan::{LayerPlan, MoveKind, line_droplets};
 use crate::settings::{Footprint, Settings};
-use crate::slice::{Point, Shapes, dist, region_area, segment_distance2};
+use crate::slice::{Point, Shapes, dist, region_area};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -803,100 +803,6 @@ impl UnionFind {
             let (lo, hi) = (ra.min(rb), ra.max(rb));
             self.parent[hi] = lo as u32;
         }
-    }
-}
-
-/// Region edges in a uniform grid, for the distance from a point to the boundary.
-struct EdgeIndex<'a> {
-    edges: &'a [(Point, Point)],
-    min: Point,
-    cell: f64,
-    nx: i64,
-    ny: i64,
-    offsets: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl<'a> EdgeIndex<'a> {
-    fn new(edges: &'a [(Point, Point)], cell: f64) -> EdgeIndex<'a> {
-        let mut min = [f64::INFINITY; 2];
-        let mut max = [f64::NEG_INFINITY; 2];
-        for (a, b) in edges {
-            for k in 0..2 {
-                min[k] = min[k].min(a[k]).min(b[k]);
-                max[k] = max[k].max(a[k]).max(b[k]);
-            }
-        }
-        if edges.is_empty() {
-            min = [0.0; 2];
-            max = [0.0; 2];
-        }
-        let nx = ((max[0] - min[0]) / cell).floor() as i64 + 1;
-        let ny = ((max[1] - min[1]) / cell).floor() as i64 + 1;
-        let cell_of = |p: Point| {
-            (
-                (((p[0] - min[0]) / cell).floor() as i64).clamp(0, nx - 1),
-                (((p[1] - min[1]) / cell).floor() as i64).clamp(0, ny - 1),
-            )
-        };
-        let mut counts = vec![0u32; (nx * ny) as usize + 1];
-        let each = |f: &mut dyn FnMut(usize, usize)| {
-            for (i, (a, b)) in edges.iter().enumerate() {
-                let (ax, ay) = cell_of(*a);
-                let (bx, by) = cell_of(*b);
-                for y in ay.min(by)..=ay.max(by) {
-                    for x in ax.min(bx)..=ax.max(bx) {
-                        f((y * nx + x) as usize, i);
-                    }
-                }
-            }
-        };
-        each(&mut |c, _| counts[c + 1] += 1);
-        for i in 1..counts.len() {
-            counts[i] += counts[i - 1];
-        }
-        let mut fill = counts.clone();
-        let mut items = vec![0u32; *counts.last().unwrap_or(&0) as usize];
-        each(&mut |c, i| {
-            items[fill[c] as usize] = i as u32;
-            fill[c] += 1;
-        });
-        EdgeIndex {
-            edges,
-            min,
-            cell,
-            nx,
-            ny,
-            offsets: counts,
-            items,
-        }
-    }
-
-    /// Distance from `p` to the nearest edge; may stop early (returning a value ≤ `enough`)
-    /// once the distance is known to be at most `enough`.
-    fn distance(&self, p: Point, enough: f64) -> f64 {
-        if self.edges.is_empty() {
-            return 0.0;
-        }
-        let cx = ((p[0] - self.min[0]) / self.cell).floor() as i64;
-        let cy = ((p[1] - self.min[1]) / self.cell).floor() as i64;
-        let mut best = f64::INFINITY;
-        let max_r = self.nx.max(self.ny) + cx.abs().max(cy.abs());
-        for r in 0..=max_r {
-            for (x, y) in ring_cells(cx, cy, r, self.nx, self.ny) {
-                let c = (y * self.nx + x) as usize;
-                for &e in &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
-                    let (a, b) = self.edges[e as usize];
-                    best = best.min(segment_distance2(p, a, b));
-                }
-            }
-            // Edges outside rings 0..=r are at least r·cell away.
-            let bound = r as f64 * self.cell;
-            if best <= bound * bound || best <= enough * enough {
-                break;
-            }
-        }
-        best.sqrt()
     }
 }
 
