@@ -37,8 +37,8 @@ pub enum Corners {
 /// mitre that another part of the curve reached: small features, thin walls), the layer is
 /// offset again with every convex corner through its vertex. A wrong mitre only adds area near
 /// its corner, bounded by curves that come closer to the boundary than allowed, so one of its
-/// vertices fails the test. On the shared models that happens to 3 of esca's 372 offsets, 1 of 426 on spikey_top, 1 of 2,316 on the
-/// bunny and none on 3DBenchy.
+/// vertices fails the test. On the shared models that happens to 3 of esca's 372 offsets, 1
+/// of 426 on spikey_top, 1 of 2,316 on the bunny and none on 3DBenchy.
 pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
     if region.is_empty() || (d_outer == 0.0 && d_hole == 0.0) {
         return region.clone();
