@@ -3,7 +3,8 @@
 //! the region thinner than twice the offset vanish instead of crossing themselves.
 //!
 //! Every edge is moved by the distance, joined by arcs at the corners where the moved edges
-//! part and by their crossing where they meet; the self-overlaps are resolved by the winding
+//! part (reflex corners of the region: the convex corners of the offset curve, in SPEC.md's
+//! words) and by their crossing where they meet; the self-overlaps are resolved by the winding
 //! number (the thesis's step), i_overlay's positive fill rule. Arcs are approximated by chords
 //! no farther than [`CHORD_TOLERANCE_MM`] from the true arc. `tests/offset.rs` compares the
 //! result with i_overlay's own outline offset on every layer of the shared models.

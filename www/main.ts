@@ -506,8 +506,9 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
       layer: (l) => {
         if (gen !== generation) return;
         s.put(l, current);
-        // the layer shown and the one below it: drawn once both are there (a draw costs)
-        if ((l.index === current && (current === 0 || s.cache.has(current - 1))) || (l.index === current - 1 && s.cache.has(current))) show(current);
+        // the layer shown and the one below it: drawn once both have arrived (a draw costs)
+        const arrived = (k: number) => k < 0 || s.counts[k] !== undefined;
+        if ((l.index === current || l.index === current - 1) && arrived(current) && arrived(current - 1)) show(current);
         // the last layer shows 100 % at once; before it the figures are redrawn now and then
         if (s.done === s.layers) progress(1);
         else {
