@@ -255,6 +255,16 @@ try {
     for (let i = 0; i <= runs; i++) {
       const { page, context } = await openPage(env.browser, env.url);
       await waitSettled(page); // the sample part of the first visit
+      // responsiveness: the longest gap between ticks of a 16 ms timer on the page's thread
+      // while it slices (a long task there would freeze the page)
+      await page.evaluate(() => {
+        const g = (window.__gap = { max: 0, last: performance.now() });
+        g.timer = setInterval(() => {
+          const now = performance.now();
+          g.max = Math.max(g.max, now - g.last);
+          g.last = now;
+        }, 16);
+      });
       const t0 = Date.now();
       await page.setInputFiles("#file-input", f);
       await page.waitForFunction(() => document.body.dataset.state === "slicing", null, { timeout: 120_000 }).catch(() => {});
@@ -262,11 +272,12 @@ try {
       // the page's own clock (file chosen -> every layer's G-code ready); the outer one also
       // counts playwright handing the file over and polling the state
       const outer = (Date.now() - t0) / 1000;
+      const gap = await page.evaluate(() => (clearInterval(window.__gap.timer), window.__gap.max));
       const dt = s.seconds ?? outer;
       if (s.state !== "done") throw new Error(\`\${f}: page state \${s.state}\`);
       if (i > 0) times.push(dt);
-      console.error(\`[browser] \${f} run \${i}\${i ? "" : " (warm-up)"}: \${dt.toFixed(2)} s (outer \${outer.toFixed(2)} s), \${s.layers} layers, \${s.workers} worker(s)\`);
-      if (i > 0) console.log([f.split("/").pop().replace(/\.stl$/, ""), i, dt, s.layers, s.workers].join("\t"));
+      console.error(\`[browser] \${f} run \${i}\${i ? "" : " (warm-up)"}: \${dt.toFixed(2)} s (outer \${outer.toFixed(2)} s), longest timer gap \${gap.toFixed(0)} ms, \${s.layers} layers, \${s.workers} worker(s)\`);
+      if (i > 0) console.log([f.split("/").pop().replace(/\.stl$/, ""), i, dt, s.layers, s.workers, gap.toFixed(0)].join("\t"));
       await context.close();
     }
   }

@@ -118,13 +118,20 @@ def browser(path):
     if rows and rows[0][0] == "TODO":
         return "TODO: no browser timing was made: " + (rows[0][1] if len(rows[0]) > 1 else "see the script's messages")
     by = defaultdict(list)
+    gaps = defaultdict(list)
     info = {}
     for r in rows:
         by[r[0]].append(float(r[2]))
         info[r[0]] = (r[3], r[4])
-    out = ["| model | layers | workers | wall s in the page (median) | runs |", "|---|---:|---:|---:|---|"]
+        if len(r) > 5:
+            gaps[r[0]].append(float(r[5]))
+    out = [
+        "| model | layers | workers | s in the page (median) | runs | longest gap of a 16 ms timer, ms |",
+        "|---|---:|---:|---:|---|---:|",
+    ]
     for m, ts in by.items():
-        out.append(f"| {m} | {info[m][0]} | {info[m][1]} | {statistics.median(ts):.2f} | {'/'.join(f'{t:.2f}' for t in ts)} |")
+        gap = f"{max(gaps[m]):.0f}" if gaps[m] else "–"
+        out.append(f"| {m} | {info[m][0]} | {info[m][1]} | {statistics.median(ts):.2f} | {'/'.join(f'{t:.2f}' for t in ts)} | {gap} |")
     return "\n".join(out)
 
 
@@ -140,7 +147,7 @@ def main():
     print("\n## Targets\n")
     print(targets(stats))
     if a.browser:
-        print("\n## Browser (headless Chromium, file picked -> state done)\n")
+        print("\n## Browser (headless Chromium; the page's clock from the file chosen to every layer's G-code ready)\n")
         print(browser(a.browser))
 
 

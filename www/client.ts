@@ -119,6 +119,13 @@ function unitCounter(layers: number, workers: number): () => Unit | null {
   };
 }
 
+/** Opens a model in one worker, handing it a copy of the bytes of its own (transferred, not
+ *  cloned: one copy of the file per worker, made once). */
+function openIn(h: WorkerHandle, stl: Uint8Array, name: string, settings: string): Promise<OpenResult> {
+  const copy = stl.slice().buffer;
+  return h.call<OpenResult>("open", { stl: copy, name, settings }, undefined, [copy]);
+}
+
 /** Units in flight per worker: the worker starts the next one while the page answers. */
 const UNITS_IN_FLIGHT = 2;
 
@@ -174,7 +181,6 @@ export class Pool {
   slice(stl: Uint8Array, name: string, settings: string, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
     this.heal();
     return this.guarded(async () => {
-      const buffer = stl.slice().buffer;
       // Every worker checks the same model and settings, so they all accept or all refuse it;
       // on refusal every worker keeps its previous model and the previous slice stays usable.
       this.opening = null;
@@ -183,7 +189,7 @@ export class Pool {
       const handles = this.handles;
       await Promise.all(
         handles.map(async (h) => {
-          const r = await h.call<OpenResult>("open", { stl: buffer, name, settings });
+          const r = await openIn(h, stl, name, settings);
           if (!first) {
             first = r;
             for (const o of handles) o.hasModel = false;
@@ -220,10 +226,9 @@ export class Pool {
   open(stl: Uint8Array, name: string, settings: string): Promise<void> {
     this.heal();
     const opening = this.guarded(async () => {
-      const buffer = stl.slice().buffer;
       await Promise.all(
         this.handles.map(async (h) => {
-          await h.call<OpenResult>("open", { stl: buffer, name, settings });
+          await openIn(h, stl, name, settings);
           h.hasModel = true;
         }),
       );
