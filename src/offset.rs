@@ -10,7 +10,7 @@
 //! result with i_overlay's own outline offset on every layer of the shared models.
 
 use crate::grid::EdgeIndex;
-use crate::slice::{Contour, Point, Shapes, dist, segment_distance, signed_area};
+use crate::slice::{Contour, Point, Shapes, dist, segment_distance2, signed_area};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::float::simplify::SimplifyShape;
 
@@ -44,15 +44,16 @@ pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
     if region.is_empty() || (d_outer == 0.0 && d_hole == 0.0) {
         return region.clone();
     }
-    // Boundary edges and the distance each must keep (less the chord tolerance and rounding).
+    // Boundary edges and the distance each must keep (less the chord tolerance and rounding),
+    // squared.
     let mut edges = Vec::new();
     let mut limit = Vec::new();
     for shape in region {
         for (i, c) in shape.iter().enumerate() {
-            let d = if i == 0 { d_outer } else { d_hole } - 2.0 * CHORD_TOLERANCE_MM;
+            let d = (if i == 0 { d_outer } else { d_hole } - 2.0 * CHORD_TOLERANCE_MM).max(0.0);
             for k in 0..c.len() {
                 edges.push((c[k], c[(k + 1) % c.len()]));
-                limit.push(d);
+                limit.push(d * d);
             }
         }
     }
@@ -70,7 +71,7 @@ pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
     let keeps = |p: Point| {
         !index.any_near(p, reach, |e| {
             let (a, b) = edges[e];
-            segment_distance(p, a, b) < limit[e]
+            segment_distance2(p, a, b) < limit[e]
         })
     };
     let fast = inset_with(region, d_outer, d_hole, Corners::Miter);
