@@ -34,6 +34,8 @@ pub struct EdgeIndex<'a> {
 }
 
 impl<'a> EdgeIndex<'a> {
+    /// Cells of `cell` (> 0), made larger where that would give more cells than about one per
+    /// edge: the grid's memory stays proportional to the edges however large the part.
     pub fn new(edges: &'a [(Point, Point)], cell: f64) -> EdgeIndex<'a> {
         let mut min = [f64::INFINITY; 2];
         let mut max = [f64::NEG_INFINITY; 2];
@@ -47,6 +49,8 @@ impl<'a> EdgeIndex<'a> {
             min = [0.0; 2];
             max = [0.0; 2];
         }
+        let spread = ((max[0] - min[0]) * (max[1] - min[1]) / edges.len().max(1) as f64).sqrt();
+        let cell = cell.max(spread);
         let nx = ((max[0] - min[0]) / cell).floor() as i64 + 1;
         let ny = ((max[1] - min[1]) / cell).floor() as i64 + 1;
         let cell_of = |p: Point| {

@@ -57,17 +57,8 @@ pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
             }
         }
     }
-    // Cells of at least the offset, and about as many cells as edges.
     let reach = d_outer.max(d_hole);
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in region.iter().flatten().flatten() {
-        for k in 0..2 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let spread = ((hi[0] - lo[0]) * (hi[1] - lo[1]) / edges.len().max(1) as f64).sqrt();
-    let index = EdgeIndex::new(&edges, reach.max(spread).max(1e-3));
+    let index = EdgeIndex::new(&edges, reach.max(1e-3));
     let keeps = |p: Point| {
         !index.any_near(p, reach, |e| {
             let (a, b) = edges[e];
