@@ -41,6 +41,12 @@ pub enum Corners {
 /// vertices fails the test. On the shared models that happens to 3 of esca's 372 offsets, 1
 /// of 426 on spikey_top, 1 of 2,316 on the bunny and none on 3DBenchy.
 pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
+    inset_within(region, d_outer, d_hole, CHORD_TOLERANCE_MM)
+}
+
+/// [`inset`] with arcs approximated by chords no farther than `tolerance` from them (mm, > 0):
+/// a chain of n insets, each within [`CHORD_TOLERANCE_MM`] / n, stays within it.
+pub fn inset_within(region: &Shapes, d_outer: f64, d_hole: f64, tolerance: f64) -> Shapes {
     if region.is_empty() || (d_outer == 0.0 && d_hole == 0.0) {
         return region.clone();
     }
@@ -65,21 +71,27 @@ pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
             segment_distance2(p, a, b) < limit[e]
         })
     };
-    let fast = inset_with(region, d_outer, d_hole, Corners::Miter);
+    let fast = inset_with(region, d_outer, d_hole, tolerance, Corners::Miter);
     if fast.iter().flatten().flatten().all(|&p| keeps(p)) {
         fast
     } else {
-        inset_with(region, d_outer, d_hole, Corners::ThroughVertex)
+        inset_with(region, d_outer, d_hole, tolerance, Corners::ThroughVertex)
     }
 }
 
 /// [`inset`] with one way of joining convex corners.
-pub fn inset_with(region: &Shapes, d_outer: f64, d_hole: f64, corners: Corners) -> Shapes {
+pub fn inset_with(
+    region: &Shapes,
+    d_outer: f64,
+    d_hole: f64,
+    tolerance: f64,
+    corners: Corners,
+) -> Shapes {
     let mut raw: Vec<Contour> = Vec::new();
     for shape in region {
         for (i, c) in shape.iter().enumerate() {
             let d = if i == 0 { d_outer } else { d_hole };
-            let r = raw_offset(c, d, corners);
+            let r = raw_offset(c, d, tolerance, corners);
             if r.len() >= 3 {
                 raw.push(r);
             }
@@ -103,8 +115,8 @@ pub fn inset_with(region: &Shapes, d_outer: f64, d_hole: f64, corners: Corners) 
 /// The raw offset curve of one closed loop moved by `d` (≥ 0) to the left of its edges (the
 /// material's side: outer loops run counter-clockwise, holes clockwise). Every edge is moved
 /// by d; at a reflex corner the moved edges are joined by an arc of radius d around the
-/// corner (chords within [`CHORD_TOLERANCE_MM`]); at a convex corner as `corners` says.
-pub fn raw_offset(c: &[Point], d: f64, corners: Corners) -> Contour {
+/// corner (chords within `tolerance` of it); at a convex corner as `corners` says.
+pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Contour {
     let mut pts: Vec<Point> = Vec::with_capacity(c.len());
     for &p in c {
         if pts.last().is_none_or(|&q| q != p) {
@@ -127,7 +139,10 @@ pub fn raw_offset(c: &[Point], d: f64, corners: Corners) -> Contour {
         })
         .collect();
     // Chord step of the arcs: d·(1 − cos(step/2)) = tolerance.
-    let step = 2.0 * (1.0 - (CHORD_TOLERANCE_MM / d).min(1.0)).acos();
+    let step = 2.0 * (1.0 - (tolerance / d).min(1.0)).acos();
+    // Largest turn of a reflex corner whose two moved edges may simply be extended to their
+    // crossing, at d / cos(turn/2) from the corner: within the tolerance of the arc.
+    let tangent_max = 2.0 * (d / (d + tolerance)).acos();
     let mut out: Contour = Vec::with_capacity(2 * n);
     for i in 0..n {
         // The corner at pts[i], between edge i − 1 (in) and edge i (out).
@@ -152,6 +167,12 @@ pub fn raw_offset(c: &[Point], d: f64, corners: Corners) -> Contour {
             } else {
                 out.extend([a, p, b]);
             }
+        } else if -turn <= tangent_max {
+            // Reflex corner turning so little that the crossing of the moved edges' lines lies
+            // within the tolerance outside the arc: that one point, not the arc's two ends
+            // (which would double the vertices of a curve at every offset of a chain).
+            let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
+            out.push([p[0] + k * (n0[0] + n1[0]), p[1] + k * (n0[1] + n1[1])]);
         } else {
             // Reflex corner: the arc around p from a to b, turning clockwise by |turn|.
             out.push(a);
