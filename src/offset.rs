@@ -115,7 +115,9 @@ pub fn inset_with(
 /// The raw offset curve of one closed loop moved by `d` (≥ 0) to the left of its edges (the
 /// material's side: outer loops run counter-clockwise, holes clockwise). Every edge is moved
 /// by d; at a reflex corner the moved edges are joined by an arc of radius d around the
-/// corner (chords within `tolerance` of it); at a convex corner as `corners` says.
+/// corner (chords within `tolerance` of it), or, when the corner turns so little that their
+/// crossing lies within `tolerance` of that arc, at their crossing; at a convex corner as
+/// `corners` says.
 pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Contour {
     let mut pts: Vec<Point> = Vec::with_capacity(c.len());
     for &p in c {
