@@ -40,7 +40,7 @@
 use crate::grid::EdgeIndex;
 use crate::plan::{LayerPlan, MoveKind, line_droplets};
 use crate::settings::{Footprint, Settings};
-use crate::slice::{Point, Shapes, dist, region_area};
+use crate::slice::{Point, Shapes, dist, region_area, scanline_spans};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -255,44 +255,15 @@ fn region_spans(
     ny: usize,
     mut span: impl FnMut(usize, f64, f64),
 ) {
-    let mut hits: Vec<(u32, f64, i32)> = Vec::new();
-    for contour in region.iter().flatten() {
-        let n = contour.len();
-        for i in 0..n {
-            let (p, q) = (contour[i], contour[(i + 1) % n]);
-            if p[1] == q[1] {
-                continue;
-            }
-            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
-            let k0 = ((lo[1] - y0) / gy - 0.5).ceil().max(0.0) as usize;
-            let mut k = k0;
-            while k < ny {
-                let y = y0 + (k as f64 + 0.5) * gy;
-                if y >= hi[1] {
-                    break;
-                }
-                if y >= lo[1] {
-                    let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
-                    hits.push((k as u32, x, w));
-                }
-                k += 1;
-            }
-        }
-    }
-    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    for row in hits.chunk_by(|a, b| a.0 == b.0) {
-        let mut winding = 0;
-        let mut start = 0.0;
-        for &(k, x, w) in row {
-            let before = winding;
-            winding += w;
-            if before == 0 && winding != 0 {
-                start = x;
-            } else if before != 0 && winding == 0 {
-                span(k as usize, start, x);
-            }
-        }
-    }
+    scanline_spans(
+        region,
+        |p| p,
+        y0,
+        gy,
+        0.5,
+        0..ny as i64,
+        |k, xa, xb| span(k as usize, xa, xb),
+    );
 }
 
 /// Band-averaged half-widths of a disc of radius `r` on rows of height `gy`: entry

@@ -8,7 +8,7 @@
 
 use crate::grid::ring_cells;
 use crate::mesh::sin_cos_deg;
-use crate::slice::{Point, Shapes, dist};
+use crate::slice::{Point, Shapes, dist, scanline_spans};
 
 /// One hatch segment: a `G25` line from `a` to `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,68 +41,40 @@ pub fn hatch_at(
     // Into the hatch frame (rotate by −angle): the lines become horizontal.
     let to = |p: Point| [c * p[0] + s * p[1], -s * p[0] + c * p[1]];
     let back = |p: Point| [c * p[0] - s * p[1], s * p[0] + c * p[1]];
-    // (line j, x, winding)
-    let mut hits: Vec<(i64, f64, i32)> = Vec::new();
-    for contour in region.iter().flatten() {
-        let n = contour.len();
-        for i in 0..n {
-            let p = to(contour[i]);
-            let q = to(contour[(i + 1) % n]);
-            if p[1] == q[1] {
-                continue;
-            }
-            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
-            // Lines with lo.y <= y < hi.y, y = (j + phase)·spacing.
-            let mut j = (lo[1] / spacing - phase).ceil() as i64;
-            loop {
-                let y = (j as f64 + phase) * spacing;
-                if y < lo[1] {
-                    j += 1;
-                    continue;
-                }
-                if y >= hi[1] {
-                    break;
-                }
-                let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
-                hits.push((j, x, w));
-                j += 1;
-            }
-        }
-    }
-    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let mut lines = Vec::new();
-    for row in hits.chunk_by(|a, b| a.0 == b.0) {
-        let y = (row[0].0 as f64 + phase) * spacing;
-        let mut winding = 0;
-        let mut start = 0.0;
-        for &(_, x, w) in row {
-            let before = winding;
-            winding += w;
-            if before == 0 && winding != 0 {
-                start = x;
-            } else if before != 0 && winding == 0 && x - start >= MIN_LENGTH_MM {
-                let (mut x0, mut x1) = (start, x);
-                if let Some((pitch, along, reach)) = lattice {
-                    let (lo, hi) = ((x0 / pitch - along).floor(), (x1 / pitch - along).ceil());
-                    let mut s0 = (lo + along) * pitch;
-                    let mut s1 = (hi + along) * pitch;
-                    if x0 - s0 > reach {
-                        s0 += pitch;
-                    }
-                    if s1 - x1 > reach {
-                        s1 -= pitch;
-                    }
-                    if s1 >= s0 {
-                        (x0, x1) = (s0, s1);
-                    }
-                }
-                lines.push(HatchLine {
-                    a: back([x0, y]),
-                    b: back([x1, y]),
-                });
+    scanline_spans(
+        region,
+        to,
+        0.0,
+        spacing,
+        phase,
+        i64::MIN..i64::MAX,
+        |j, x0, x1| {
+            if x1 - x0 < MIN_LENGTH_MM {
+                return;
             }
-        }
-    }
+            let y = (j as f64 + phase) * spacing;
+            let (mut x0, mut x1) = (x0, x1);
+            if let Some((pitch, along, reach)) = lattice {
+                let (lo, hi) = ((x0 / pitch - along).floor(), (x1 / pitch - along).ceil());
+                let mut s0 = (lo + along) * pitch;
+                let mut s1 = (hi + along) * pitch;
+                if x0 - s0 > reach {
+                    s0 += pitch;
+                }
+                if s1 - x1 > reach {
+                    s1 -= pitch;
+                }
+                if s1 >= s0 {
+                    (x0, x1) = (s0, s1);
+                }
+            }
+            lines.push(HatchLine {
+                a: back([x0, y]),
+                b: back([x1, y]),
+            });
+        },
+    );
     lines
 }
 

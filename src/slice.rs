@@ -534,6 +534,59 @@ pub fn region_area(shapes: &Shapes) -> f64 {
         .sum()
 }
 
+/// Crosses a region with the lines y = y0 + (k + phase)·step, k in `rows`: calls
+/// `span(k, xa, xb)` for every span of a line inside the region (non-zero rule), in order of
+/// k, then x. `to` maps the region's points first (the hatch turns its lines horizontal).
+pub fn scanline_spans(
+    region: &Shapes,
+    to: impl Fn(Point) -> Point,
+    y0: f64,
+    step: f64,
+    phase: f64,
+    rows: std::ops::Range<i64>,
+    mut span: impl FnMut(i64, f64, f64),
+) {
+    // (line k, x, winding)
+    let mut hits: Vec<(i64, f64, i32)> = Vec::new();
+    for contour in region.iter().flatten() {
+        let n = contour.len();
+        for i in 0..n {
+            let (p, q) = (to(contour[i]), to(contour[(i + 1) % n]));
+            if p[1] == q[1] {
+                continue;
+            }
+            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
+            // Lines with lo.y <= y < hi.y.
+            let mut k = (((lo[1] - y0) / step - phase).ceil() as i64).max(rows.start);
+            while k < rows.end {
+                let y = y0 + (k as f64 + phase) * step;
+                if y >= hi[1] {
+                    break;
+                }
+                if y >= lo[1] {
+                    let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
+                    hits.push((k, x, w));
+                }
+                k += 1;
+            }
+        }
+    }
+    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for row in hits.chunk_by(|a, b| a.0 == b.0) {
+        let mut winding = 0;
+        let mut start = 0.0;
+        for &(k, x, w) in row {
+            let before = winding;
+            winding += w;
+            if before == 0 && winding != 0 {
+                start = x;
+            } else if before != 0 && winding == 0 {
+                span(k, start, x);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
