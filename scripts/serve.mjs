@@ -1,8 +1,8 @@
 // A tiny static file server for dist/ (correct MIME types, application/wasm included).
 // Usage: node scripts/serve.mjs [port]   (default 8080, or $PORT); 0 picks a free port.
 import { createServer } from "node:http";
-import { readFile, stat } from "node:fs/promises";
-import { extname, join, normalize, resolve } from "node:path";
+import { readFile, realpath, stat } from "node:fs/promises";
+import { extname, join, resolve, sep } from "node:path";
 import { fileURLToPath } from "node:url";
 
 const TYPES = {
@@ -18,15 +18,52 @@ const TYPES = {
   ".stl": "model/stl",
 };
 
+/** A request the server refuses, with its status. */
+class Refused extends Error {
+  constructor(status) {
+    super(status === 400 ? "bad request" : "not found");
+    this.status = status;
+  }
+}
+
+/**
+ * The file a URL path names inside `root` (a real path, links resolved), or a Refused:
+ * 400 for malformed percent-encoding or a NUL byte, 404 for anything that is missing or whose
+ * real path is not `root` itself or inside `root` + separator (`..`, encoded or not, a sibling
+ * folder whose name starts like root's, a symbolic link pointing out).
+ */
+async function locate(root, url) {
+  let path;
+  try {
+    path = decodeURIComponent(new URL(url ?? "/", "http://x").pathname);
+  } catch {
+    throw new Refused(400);
+  }
+  if (path.includes("\0")) throw new Refused(400);
+  const inside = (p) => p === root || p.startsWith(root + sep);
+  const real = async (p) => {
+    try {
+      return await realpath(p);
+    } catch {
+      throw new Refused(404);
+    }
+  };
+  let file = await real(join(root, path));
+  if (!inside(file)) throw new Refused(404);
+  if ((await stat(file)).isDirectory()) {
+    file = await real(join(file, "index.html"));
+    if (!inside(file) || (await stat(file)).isDirectory()) throw new Refused(404);
+  }
+  return file;
+}
+
 /** Serves `root` on 127.0.0.1:`port`; resolves to { server, url }. */
 export function serve(root, port = 0) {
-  const base = resolve(root);
+  let base = null; // root's real path, resolved at the first request
   const server = createServer(async (req, res) => {
     try {
-      const path = decodeURIComponent(new URL(req.url ?? "/", "http://x").pathname);
-      let file = normalize(join(base, path));
-      if (!file.startsWith(base)) throw Object.assign(new Error("outside"), { code: "ENOENT" });
-      if ((await stat(file)).isDirectory()) file = join(file, "index.html");
+      base ??= await realpath(resolve(root));
+      const file = await locate(base, req.url);
       const body = await readFile(file);
       res.writeHead(200, {
         "content-type": TYPES[extname(file)] ?? "application/octet-stream",
@@ -34,8 +71,9 @@ export function serve(root, port = 0) {
       });
       res.end(body);
     } catch (e) {
-      res.writeHead(e?.code === "ENOENT" || e?.code === "ENOTDIR" ? 404 : 500, { "content-type": "text/plain" });
-      res.end("not found");
+      const status = e instanceof Refused ? e.status : e?.code === "ENOENT" || e?.code === "ENOTDIR" ? 404 : 500;
+      res.writeHead(status, { "content-type": "text/plain" });
+      res.end(status === 400 ? "bad request" : status === 404 ? "not found" : "server error");
     }
   });
   return new Promise((ok, fail) => {
