@@ -125,21 +125,17 @@ impl Job {
             });
         }
         let b = settings.droplet_width();
-        let volume = mesh.signed_volume().abs();
+        // Every closed shell as its author meant it (inside-out shells turned outward, cavities
+        // kept), so the volume below counts what will be printed: shells of opposite
+        // orientation can no longer cancel.
+        let shells = mesh.orient_shells();
+        let volume = mesh.signed_volume().abs().max(shells.closed_volume);
         if size[0] <= 0.0 || size[1] <= 0.0 || volume <= 1e-9 * size[0] * size[1] * size[2] {
             return Err(Error::NothingToPrint(
                 "the mesh encloses no volume (a surface without thickness): export the part as a solid".into(),
             ));
         }
-        let droplets = volume / (b * b * settings.layer_height);
-        if droplets > MAX_DROPLETS {
-            return Err(Error::Setting {
-                name: "layer_height".into(),
-                message: format!(
-                    "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of {b:.4} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height) or check the scale"
-                ),
-            });
-        }
+        check_droplets(volume, &settings)?;
         if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
             return Err(Error::Setting {
                 name: "scale_x".into(),
@@ -182,6 +178,17 @@ impl Job {
                     ..better
                 };
             }
+        }
+        stats.flipped_shells = shells.flipped;
+        stats.cavity_shells = shells.cavities;
+        stats.unchecked_shells = shells.unchecked;
+        if shells.flipped > 0 {
+            stats.signed_volume = mesh.signed_volume();
+        }
+        if shells.open > 0 {
+            // Open shells enclose no definite volume: estimate what will be printed from the
+            // sliced area of sampled layers (the slicer closes open sections the same way).
+            check_droplets(sampled_volume(&mesh, &buckets, &zs, h), &settings)?;
         }
         let warnings = warnings(&stats, &size);
         let suggested_scale = suggested_scale(&size);
@@ -263,6 +270,38 @@ impl Job {
     }
 }
 
+/// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
+fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
+    let b = settings.droplet_width();
+    let droplets = volume / (b * b * settings.layer_height);
+    if droplets > MAX_DROPLETS || !droplets.is_finite() {
+        return Err(Error::Setting {
+            name: "layer_height".into(),
+            message: format!(
+                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of {b:.4} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height) or check the scale"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Layers sampled by [`sampled_volume`].
+const VOLUME_SAMPLES: usize = 24;
+
+/// The volume the slicer will print, estimated from the sliced area of up to
+/// [`VOLUME_SAMPLES`] evenly spaced layers (their mean area × the part's height).
+fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f64 {
+    let n = zs.len();
+    let samples = n.min(VOLUME_SAMPLES);
+    let total: f64 = (0..samples)
+        .map(|k| {
+            let i = (2 * k + 1) * n / (2 * samples);
+            slice::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
+        })
+        .sum();
+    total / samples as f64 * n as f64 * h
+}
+
 /// Runs two computations, on two threads natively (wasm workers are single-threaded).
 fn both<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
     #[cfg(not(target_arch = "wasm32"))]
@@ -300,7 +339,27 @@ fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
         .filter(|(n, _, _)| *n > 0)
         .map(|(n, before, after)| format!("{before}{n}{after}"))
         .collect();
-    if m.signed_volume < 0.0 {
+    if m.flipped_shells > 0 {
+        w.push(format!(
+            "{} closed shell{} inside out (facets facing inward) and outside every other shell: turned outward and printed as solid",
+            m.flipped_shells,
+            if m.flipped_shells == 1 { " was" } else { "s were" }
+        ));
+    }
+    if m.cavity_shells > 0 {
+        w.push(format!(
+            "{} inside-out closed shell{} inside another shell: kept as cavities (hollow inside the part)",
+            m.cavity_shells,
+            if m.cavity_shells == 1 { " lies" } else { "s lie" }
+        ));
+    }
+    if m.unchecked_shells > 0 {
+        w.push(format!(
+            "{} inside-out shells were not checked (too many to check quickly) and are sliced as they are",
+            m.unchecked_shells
+        ));
+    }
+    if m.signed_volume < 0.0 && m.flipped_shells == 0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
     }
     let largest = size[0].max(size[1]).max(size[2]);
