@@ -35,6 +35,29 @@ export interface View {
   cy: number;
 }
 
+/** The renderer's zoom limits (CSS pixels per mm) and the farthest the view's centre may be
+ *  from the plate's origin (mm): a view outside them is brought inside, whatever set it (a
+ *  link, a .gco file's bounds, the wheel or a drag), so no drawing loop can run away. */
+export const MIN_SCALE = 0.05;
+export const MAX_SCALE = 5000;
+export const MAX_CENTRE_MM = 1e5;
+/** At most this many grid lines per direction are drawn, whatever the view. */
+const MAX_GRID_LINES = 2000;
+
+const clamp = (x: number, lo: number, hi: number) => Math.min(hi, Math.max(lo, x));
+
+/** `v` brought within the limits; a number that is not finite is replaced by `fallback`'s. */
+export function clampView(v: View, fallback: View = { scale: 10, cx: 0, cy: 0 }): View {
+  const scale = Number.isFinite(v.scale) && v.scale > 0 ? v.scale : fallback.scale;
+  const cx = Number.isFinite(v.cx) ? v.cx : fallback.cx;
+  const cy = Number.isFinite(v.cy) ? v.cy : fallback.cy;
+  return {
+    scale: clamp(scale, MIN_SCALE, MAX_SCALE),
+    cx: clamp(cx, -MAX_CENTRE_MM, MAX_CENTRE_MM),
+    cy: clamp(cy, -MAX_CENTRE_MM, MAX_CENTRE_MM),
+  };
+}
+
 export interface Bounds {
   minX: number;
   minY: number;
@@ -43,7 +66,14 @@ export interface Bounds {
 }
 
 export class Renderer {
-  view: View = { scale: 10, cx: 0, cy: 0 };
+  private _view: View = { scale: 10, cx: 0, cy: 0 };
+  /** The view, always within the limits (see [[clampView]]): set it as a whole. */
+  get view(): View {
+    return this._view;
+  }
+  set view(v: View) {
+    this._view = clampView(v, this._view);
+  }
   current: LayerData | null = null;
   below: LayerData | null = null;
   dropletWidth = 0.208;
@@ -97,24 +127,23 @@ export class Renderer {
     const margin = 28;
     const sx = (this.cssW - 2 * margin) / (b.maxX - b.minX);
     const sy = (this.cssH - 2 * margin) / (b.maxY - b.minY);
-    this.view = { scale: Math.max(0.05, Math.min(sx, sy)), cx: (b.minX + b.maxX) / 2, cy: (b.minY + b.maxY) / 2 };
+    // the setter keeps the zoom and the centre within the limits (a .gco's bounds may be huge)
+    this.view = { scale: Math.min(sx, sy), cx: b.minX / 2 + b.maxX / 2, cy: b.minY / 2 + b.maxY / 2 };
     this.request();
   }
 
   /** Zooms by `factor` keeping the mm under the CSS pixel (px, py) in place. */
   zoomAt(px: number, py: number, factor: number): void {
-    const v = this.view;
     const [mx, my] = this.toMm(px, py);
-    const scale = Math.min(5000, Math.max(0.05, v.scale * factor));
-    v.cx = mx - (px - this.cssW / 2) / scale;
-    v.cy = my + (py - this.cssH / 2) / scale;
-    v.scale = scale;
+    const scale = clamp(this.view.scale * factor, MIN_SCALE, MAX_SCALE);
+    if (!Number.isFinite(scale)) return;
+    this.view = { scale, cx: mx - (px - this.cssW / 2) / scale, cy: my + (py - this.cssH / 2) / scale };
     this.request();
   }
 
   panBy(dxPx: number, dyPx: number): void {
-    this.view.cx -= dxPx / this.view.scale;
-    this.view.cy += dyPx / this.view.scale;
+    const v = this.view;
+    this.view = { scale: v.scale, cx: v.cx - dxPx / v.scale, cy: v.cy + dyPx / v.scale };
     this.request();
   }
 
@@ -327,25 +356,43 @@ export class Renderer {
     return 10 * p;
   }
 
+  /**
+   * The grid, computed in canvas space: the lines on screen are counted first (an integer,
+   * at most [[MAX_GRID_LINES]]) and placed at `first + i * spacing` device pixels, so no loop
+   * depends on a step in mm that might not advance a far-away coordinate.
+   */
   private drawGrid(ctx: CanvasRenderingContext2D, k: number): void {
     const W = this.canvas.width;
     const H = this.canvas.height;
     const { cx, cy } = this.view;
     const step = this.gridStep();
-    const x0 = cx - W / 2 / k;
-    const x1 = cx + W / 2 / k;
-    const y0 = cy - H / 2 / k;
-    const y1 = cy + H / 2 / k;
+    const spacing = step * k; // device px between lines
+    if (!Number.isFinite(spacing) || spacing < 2) return;
     const minor = new Path2D();
     const axes = new Path2D();
-    for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
-      const px = Math.round((x - cx) * k + W / 2) + 0.5;
-      if (Math.abs(x) < step / 2) { axes.moveTo(px, 0); axes.lineTo(px, H); } else { minor.moveTo(px, 0); minor.lineTo(px, H); }
-    }
-    for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
-      const py = Math.round(-(y - cy) * k + H / 2) + 0.5;
-      if (Math.abs(y) < step / 2) { axes.moveTo(0, py); axes.lineTo(W, py); } else { minor.moveTo(0, py); minor.lineTo(W, py); }
-    }
+    // x: line i (an integer) is at x = i * step; on screen at (i * step - cx) * k + W / 2
+    const lines = (size: number, centre: number, flip: boolean, add: (path: Path2D, at: number) => void) => {
+      // the canvas edge in mm and the first line's offset from it, in device px
+      const edge = flip ? centre + size / 2 / k : centre - size / 2 / k;
+      const first = flip ? Math.floor(edge / step) : Math.ceil(edge / step);
+      let offset = Math.abs(first * step - edge) * k;
+      if (!(offset >= 0 && offset < spacing)) offset = 0; // far from the origin, precision is gone
+      const count = Math.min(MAX_GRID_LINES, Math.floor((size - offset) / spacing) + 1);
+      const axis = flip ? (centre * k + size / 2) : (-centre * k + size / 2); // where 0 mm falls
+      for (let i = 0; i < count; i++) {
+        const at = offset + i * spacing;
+        const px = Math.round(at) + 0.5;
+        add(Math.abs(at - axis) < spacing / 2 ? axes : minor, px);
+      }
+    };
+    lines(W, cx, false, (path, px) => {
+      path.moveTo(px, 0);
+      path.lineTo(px, H);
+    });
+    lines(H, cy, true, (path, py) => {
+      path.moveTo(0, py);
+      path.lineTo(W, py);
+    });
     ctx.lineWidth = 1;
     ctx.strokeStyle = "#e9ecf1";
     ctx.stroke(minor);
