@@ -129,10 +129,16 @@ function openIn(h: WorkerHandle, stl: Uint8Array, name: string, settings: string
 /** Units in flight per worker: the worker starts the next one while the page answers. */
 const UNITS_IN_FLIGHT = 2;
 
+/** Never more workers than this, whatever is asked: each holds its own copy of the model. */
+export const MAX_WORKERS = 8;
+
 export class Pool {
   private handles: WorkerHandle[] = [];
+  readonly size: number;
 
-  constructor(readonly size = defaultPoolSize()) {
+  /** `size` workers, brought within 1 … [[MAX_WORKERS]] (the default when not a number). */
+  constructor(size = defaultPoolSize()) {
+    this.size = Number.isFinite(size) ? Math.max(1, Math.min(MAX_WORKERS, Math.round(size))) : defaultPoolSize();
     this.respawn();
   }
 

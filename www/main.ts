@@ -1,11 +1,11 @@
 // Page wiring only: events -> worker pool -> layer store -> renderer and statistics.
 
-import { Cancelled, Pool, SliceError } from "./client";
+import { Cancelled, MAX_WORKERS, Pool, SliceError } from "./client";
 import { SettingsForm, type Value } from "./form";
 import { addNumbers, type Counts, type GcodeParseResult, type InitResult, type JobInfo, type LayerAnalysis, type LayerData, type SliceUnit } from "./protocol";
 import { Renderer, type Bounds, type View } from "./render";
 import { sampleStl } from "./sample";
-import { makeLink, readLink, sha256Hex, type SharedLink } from "./share";
+import { LinkError, makeLink, readLink, sha256Hex, type SharedLink } from "./share";
 
 const $ = <T extends HTMLElement = HTMLElement>(id: string) => document.getElementById(id) as T;
 
@@ -150,8 +150,19 @@ function layerBytes(l: LayerData): number {
 // ---------------------------------------------------------------------------------------------
 // state
 
-const workersAsked = Math.round(Number(query.get("workers")));
-const pool = workersAsked >= 1 ? new Pool(Math.min(workersAsked, 16)) : new Pool();
+/** Most workers `?workers=N` may ask for: each holds its own copy of the model, so not more
+ *  than the cores (but 4 even on fewer cores, which the tests use) and never more than 8. */
+const WORKERS_MAX = Math.min(MAX_WORKERS, Math.max(4, navigator.hardwareConcurrency || 1));
+
+/** `?workers=N`: clamped to 1 … [[WORKERS_MAX]]; absent, empty or not a number: the default. */
+function workersAsked(): number | null {
+  const raw = query.get("workers");
+  const n = raw === null || raw.trim() === "" ? NaN : Math.round(Number(raw));
+  return Number.isFinite(n) ? Math.max(1, Math.min(WORKERS_MAX, n)) : null;
+}
+
+const asked = workersAsked();
+const pool = asked === null ? new Pool() : new Pool(asked);
 const renderer = new Renderer($<HTMLCanvasElement>("view"));
 let form: SettingsForm;
 let init: InitResult;
@@ -181,6 +192,7 @@ const TITLES: Record<string, string> = {
   crash: "The slicer crashed.",
   internal: "Internal error.",
   link: "Cannot open this preview link.",
+  linkPart: "Parts of this preview link were ignored.",
 };
 
 function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error"): void {
@@ -408,7 +420,7 @@ function layerLabel(): void {
 function show(i: number): void {
   const s = slice;
   if (!s || s.layers === 0) return;
-  current = Math.max(0, Math.min(s.layers - 1, Math.round(i)));
+  current = clampLayer(Number.isFinite(i) ? i : current, s.layers);
   slider.value = String(current);
   layerLabel();
   renderer.current = s.cache.get(current) ?? null;
@@ -422,6 +434,12 @@ function show(i: number): void {
   // the overlay needs the current layer's mask (evicted, or sliced without analysis)
   const shown = s.cache.get(current);
   if (renderer.showVoids && shown && !shown.mask && s.complete && s.source === "stl") fetchPreview(s, current);
+}
+
+/** A layer index within [0, layers): rounded, clamped; 0 when it is not a number. */
+function clampLayer(i: number, layers: number): number {
+  if (!Number.isFinite(i)) return 0;
+  return Math.max(0, Math.min(layers - 1, Math.round(i)));
 }
 
 function fetchPreview(s: Slice, k: number): void {
@@ -445,6 +463,9 @@ function fetchPreview(s: Slice, k: number): void {
 interface Target {
   layer?: number;
   view?: View;
+  /** Shown once the slice has started (a slice hides the banner): about the link that asked
+   *  for it. */
+  notice?: { title: string; message: string; tone?: "error" | "info" };
 }
 
 function settingsProblem(): boolean {
@@ -467,6 +488,7 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
   if (settingsProblem()) return;
   cancelRunning();
   hideBanner();
+  if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone);
   const gen = ++generation;
   const values = form.values();
   const json = form.json();
@@ -492,8 +514,10 @@ async function startSlice(m: Model, target: Target = {}): Promise<void> {
         progress(0);
         $("model-name").textContent = m.name;
         $("empty").hidden = true;
-        current = target.layer ?? (sameModel ? Math.min(current, r.layers - 1) : Math.floor((r.layers - 1) * 0.3));
+        const wanted = target.layer ?? (sameModel ? current : Math.floor((r.layers - 1) * 0.3));
+        current = clampLayer(wanted, r.layers);
         if (target.view) {
+          // the renderer keeps any view within its limits
           renderer.view = { ...target.view };
           viewTouched = true;
         } else if (!sameModel || !viewTouched) {
@@ -726,12 +750,12 @@ function sample(): Model {
   return { bytes: s.bytes, name: s.name, sha256: "" };
 }
 
-async function openSample(): Promise<void> {
+async function openSample(notice?: Target["notice"]): Promise<void> {
   const m = sample();
   m.sha256 = await sha256Hex(m.bytes);
   pendingLink = null;
   note("", "none");
-  await startSlice(m);
+  await startSlice(m, { notice });
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -800,16 +824,46 @@ function changedFrom(values: Record<string, Value>): Record<string, Value> {
   return out;
 }
 
+/** What a link's settings must be for each kind of setting (the form checks the ranges). */
+const KIND_TYPE: Record<string, { type: string; words: string }> = {
+  number: { type: "number", words: "a number" },
+  integer: { type: "number", words: "a whole number" },
+  bool: { type: "boolean", words: "yes or no (true/false)" },
+  enum: { type: "string", words: "one of the choices" },
+};
+
+/** The link's settings whose type fits their kind; the others named in `ignored`. Unknown
+ *  names are kept (the form ignores them and the page says so). */
+function linkSettings(settings: Record<string, Value>, ignored: string[]): Record<string, Value> {
+  const out: Record<string, Value> = {};
+  for (const [name, v] of Object.entries(settings)) {
+    const spec = init.schema.find((x) => x.name === name);
+    const want = spec ? KIND_TYPE[spec.kind] : undefined;
+    if (want && typeof v !== want.type) {
+      const shown = typeof v === "string" ? JSON.stringify(v.length > 24 ? `${v.slice(0, 24)}…` : v) : String(v);
+      ignored.push(`its setting ${name} (${shown} is not ${want.words}: the default is used)`);
+      continue;
+    }
+    out[name] = v;
+  }
+  return out;
+}
+
+/** Opens the preview link in the URL, if there is one (returns whether there was one that the
+ *  page now shows or waits for a file of). A link too large or damaged is refused with a
+ *  message and the sample part is shown; fields it gets wrong are ignored and named. */
 async function openLink(): Promise<boolean> {
   let link: SharedLink | null;
   try {
     link = await readLink(location.hash);
   } catch (e) {
-    showBanner(TITLES.link, `The link is damaged or incomplete (${e instanceof Error ? e.message : String(e)}). Showing the sample part instead.`);
-    return false;
+    const why = e instanceof LinkError ? e.message : `it could not be read (${e instanceof Error ? e.message : String(e)})`;
+    await openSample({ title: TITLES.link, message: `This preview link is too large or damaged: ${why}. Showing the sample part instead.` });
+    return true;
   }
   if (!link) return false;
-  const unknown = form.set({ ...init.defaults, ...link.state.settings });
+  const ignored = [...link.ignored];
+  const unknown = form.set({ ...init.defaults, ...linkSettings(link.state.settings, ignored) });
   const extra = unknown.length
     ? ` The link comes from another version: its settings ${unknown.join(", ")} are unknown here and were ignored, so the slice may differ.`
     : "";
@@ -817,19 +871,32 @@ async function openLink(): Promise<boolean> {
   renderer.showTravel = Boolean(link.state.showTravel);
   $<HTMLInputElement>("opt-travel").checked = renderer.showTravel;
   $("legend-travel").hidden = !renderer.showTravel;
+  const notice: Target["notice"] = ignored.length
+    ? { title: TITLES.linkPart, message: `This preview link is partly damaged: ${ignored.join("; ")}.`, tone: "info" }
+    : undefined;
+  const { layer, view, name, sha256 } = link.state;
   if (link.model) {
-    const m: Model = { bytes: link.model, name: link.state.name, sha256: await sha256Hex(link.model) };
-    if (m.sha256 !== link.state.sha256) {
-      showBanner(TITLES.link, "The model inside the link is damaged (its SHA-256 does not match).");
+    const m: Model = { bytes: link.model, name, sha256: await sha256Hex(link.model) };
+    if (m.sha256 === sha256) {
+      await startSlice(m, { layer, view, notice });
       return true;
     }
-    await startSlice(m, { layer: link.state.layer, view: link.state.view });
-    return true;
+    link.model = null;
+    link.modelError = "its model does not match the SHA-256 it carries";
   }
   pendingLink = link;
   $("empty").hidden = false;
+  const at = layer !== undefined ? ` to see layer ${nf.format(layer + 1)}` : "";
+  if (link.modelError) {
+    const also = ignored.length ? ` Also ignored: ${ignored.join("; ")}.` : "";
+    showBanner(TITLES.link, `This preview link is too large or damaged: ${link.modelError}. Its settings are applied; drop “${name}” here to see the slice.${also}`);
+  } else if (notice) {
+    showBanner(notice.title, notice.message, notice.tone);
+  }
   note(
-    `This preview link is for “${link.state.name}” (SHA-256 ${link.state.sha256.slice(0, 12)}…), which was too big to put in the link. Drop that file here to see layer ${link.state.layer + 1} with the link's settings.${extra}`,
+    link.modelError
+      ? `The model “${name}” (SHA-256 ${sha256.slice(0, 12)}…) could not be taken from the link. Drop that file here${at} with the link's settings.${extra}`
+      : `This preview link is for “${name}” (SHA-256 ${sha256.slice(0, 12)}…), which was too big to put in the link. Drop that file here${at} with the link's settings.${extra}`,
     "warn",
   );
   setState("idle");
@@ -871,6 +938,8 @@ function wire(): void {
     updateButtons();
   });
   $("banner-close").addEventListener("click", hideBanner);
+  // the form is never submitted (Enter slices, below); no inline handler: the page's CSP
+  $("settings").addEventListener("submit", (ev) => ev.preventDefault());
   $("settings").addEventListener("keydown", (ev) => {
     if ((ev as KeyboardEvent).key === "Enter" && model) {
       ev.preventDefault();

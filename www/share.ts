@@ -2,16 +2,47 @@
 // server). The model is embedded (deflate-raw, base64url) when it compresses to at most
 // 256 KB; otherwise the link carries its SHA-256 and file name, and the receiver drops in
 // the same file, which the page checks against the hash.
+//
+// A link comes from anyone, so reading one is bounded: the encoded texts are measured before
+// they are decoded, both parts are inflated as a stream that is cancelled as soon as it grows
+// past its cap, and every field of the state is checked (type, finite, range) before the page
+// uses it. Fields that are wrong are dropped and named (`ignored`); a link that is too large or
+// damaged is refused with a [[LinkError]].
 
-import type { View } from "./render";
+import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./render";
 
 export const EMBED_LIMIT = 256 * 1024;
+
+/** The link's state (settings, layer, view, names) inflates to at most 64 KB: a state made
+ *  here is well under 2 KB. */
+export const STATE_MAX_BYTES = 64 * 1024;
+/** An embedded model inflates to at most 64 MB. Links made here embed at most
+ *  [[EMBED_LIMIT]] (256 KB) of deflated STL, which real STL files never inflate beyond a few
+ *  MB; anything bigger is a deflate bomb (deflate can expand about 1000 times). */
+export const MODEL_MAX_BYTES = 64 * 1024 * 1024;
+const nf = new Intl.NumberFormat("en-US");
+
+/** Base64 text of `n` bytes. */
+const base64Chars = (n: number) => Math.ceil((n * 4) / 3);
+/** Encoded lengths checked before decoding: the state's deflated bytes (incompressible data
+ *  grows by a few bytes per block) and the model's, with room for 4 × [[EMBED_LIMIT]]. */
+export const STATE_TEXT_MAX = base64Chars(STATE_MAX_BYTES + 1024);
+export const MODEL_TEXT_MAX = base64Chars(4 * EMBED_LIMIT);
+/** Bounds of the state's strings and settings. */
+const NAME_MAX = 255;
+const SETTING_TEXT_MAX = 100;
+const SETTINGS_MAX = 500;
+/** Compressed bytes handed to the inflater at a time: it is checked between pieces, so a bomb
+ *  overshoots the cap by at most about 1000 × this (4 MB). */
+const FEED_BYTES = 4096;
 
 export interface ShareState {
   /** Settings that differ from the defaults. */
   settings: Record<string, number | boolean | string>;
-  layer: number;
-  view: View;
+  /** Absent when the link's layer was unusable. */
+  layer?: number;
+  /** Absent when the link's view was unusable (the part is then fitted). */
+  view?: View;
   name: string;
   sha256: string;
   showTravel?: boolean;
@@ -21,7 +52,14 @@ export interface SharedLink {
   state: ShareState;
   /** The model, when it was embedded. */
   model: Uint8Array | null;
+  /** Why an embedded model was refused (too large or damaged): the state is still usable. */
+  modelError?: string;
+  /** Parts of the state that were dropped or limited, in words ("its view (…)"). */
+  ignored: string[];
 }
+
+/** A link too large or damaged to be read; the message says which part and why. */
+export class LinkError extends Error {}
 
 async function pipe(bytes: Uint8Array, stream: CompressionStream | DecompressionStream): Promise<Uint8Array> {
   const out = new Blob([bytes as BlobPart]).stream().pipeThrough(stream);
@@ -29,7 +67,53 @@ async function pipe(bytes: Uint8Array, stream: CompressionStream | Decompression
 }
 
 export const deflate = (b: Uint8Array) => pipe(b, new CompressionStream("deflate-raw"));
-export const inflate = (b: Uint8Array) => pipe(b, new DecompressionStream("deflate-raw"));
+
+function size(bytes: number): string {
+  return bytes >= 2 ** 20 ? `${bytes / 2 ** 20} MB` : `${bytes / 1024} KB`;
+}
+
+/**
+ * Inflates `bytes` (deflate-raw), at most `cap` bytes: the input is fed in small pieces and
+ * the output read as it comes; past the cap both sides are cancelled and a [[LinkError]]
+ * naming `what` is thrown, as for data that is not valid deflate.
+ */
+export async function inflate(bytes: Uint8Array, cap: number, what = "the data"): Promise<Uint8Array> {
+  const ds = new DecompressionStream("deflate-raw");
+  const writer = ds.writable.getWriter();
+  const reader = ds.readable.getReader();
+  const feeding = (async () => {
+    for (let i = 0; i < bytes.length; i += FEED_BYTES) {
+      await writer.write(bytes.slice(i, i + FEED_BYTES));
+    }
+    await writer.close();
+  })();
+  // a failure of the writing side shows up on the reading side too
+  feeding.catch(() => {});
+  const chunks: Uint8Array[] = [];
+  let total = 0;
+  try {
+    for (;;) {
+      const { value, done } = await reader.read();
+      if (done) break;
+      total += value.byteLength;
+      if (total > cap) throw new LinkError(`${what} unpacks to more than ${size(cap)}, the most this page accepts`);
+      chunks.push(value);
+    }
+    await feeding;
+  } catch (e) {
+    reader.cancel().catch(() => {});
+    writer.abort().catch(() => {});
+    if (e instanceof LinkError) throw e;
+    throw new LinkError(`${what} is not valid compressed data (the link may have been cut short)`);
+  }
+  const out = new Uint8Array(total);
+  let at = 0;
+  for (const c of chunks) {
+    out.set(c, at);
+    at += c.byteLength;
+  }
+  return out;
+}
 
 export function toBase64Url(bytes: Uint8Array): string {
   let bin = "";
@@ -40,9 +124,21 @@ export function toBase64Url(bytes: Uint8Array): string {
   return btoa(bin).replace(/\+/g, "-").replace(/\//g, "_").replace(/=+$/, "");
 }
 
-export function fromBase64Url(text: string): Uint8Array {
-  const b64 = text.replace(/-/g, "+").replace(/_/g, "/");
-  const bin = atob(b64 + "===".slice((b64.length + 3) % 4));
+/** Decodes base64url of at most `max` characters; a [[LinkError]] naming `what` otherwise. */
+export function fromBase64Url(text: string, max = Infinity, what = "the data"): Uint8Array {
+  if (text.length > max) {
+    throw new LinkError(`${what} is ${nf.format(text.length)} characters long; at most ${nf.format(max)} are accepted`);
+  }
+  if (!/^[A-Za-z0-9_-]*={0,2}$/.test(text) || text.length % 4 === 1) {
+    throw new LinkError(`${what} holds characters that do not belong in a link (it may have been cut or changed)`);
+  }
+  const b64 = text.replace(/=+$/, "").replace(/-/g, "+").replace(/_/g, "/");
+  let bin: string;
+  try {
+    bin = atob(b64 + "===".slice((b64.length + 3) % 4));
+  } catch {
+    throw new LinkError(`${what} is not valid base64 (it may have been cut or changed)`);
+  }
   const out = new Uint8Array(bin.length);
   for (let i = 0; i < bin.length; i++) out[i] = bin.charCodeAt(i);
   return out;
@@ -62,16 +158,108 @@ export async function makeLink(base: string, state: ShareState, model: Uint8Arra
   return { url, embedded };
 }
 
-/** Reads a link's fragment; null when it holds no preview. Throws on a damaged link. */
+/** A value of the link as words for a message: short, whatever it is. */
+function shown(v: unknown): string {
+  let s: string;
+  if (typeof v === "number") s = v !== 0 && (Math.abs(v) >= 1e7 || Math.abs(v) < 1e-4) ? v.toExponential() : String(v);
+  else if (typeof v === "string") s = JSON.stringify(v.length > 24 ? `${v.slice(0, 24)}…` : v);
+  else if (v === null) s = "null";
+  else if (Array.isArray(v)) s = "a list";
+  else if (typeof v === "object") s = "an object";
+  else s = String(v);
+  return s;
+}
+
+const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "object" && v !== null && !Array.isArray(v);
+
+/**
+ * The state of a link as the page may use it: structure and hash checked (a [[LinkError]]
+ * otherwise), unusable fields dropped and limited ones brought in range, each named in
+ * `ignored`. Settings are checked for their basic type here (finite number, boolean or short
+ * text); the page checks each against its own kind and range.
+ */
+export function checkState(raw: unknown): { state: ShareState; ignored: string[] } {
+  if (!isObject(raw)) throw new LinkError("its state is not a preview's state");
+  const ignored: string[] = [];
+  if (typeof raw.sha256 !== "string" || !/^[0-9a-f]{64}$/.test(raw.sha256)) {
+    throw new LinkError("its model's SHA-256 is missing or not 64 hexadecimal digits");
+  }
+  if (typeof raw.name !== "string") throw new LinkError("its model's name is missing");
+  const name = raw.name.length > NAME_MAX ? `${raw.name.slice(0, NAME_MAX)}…` : raw.name;
+
+  const settings: Record<string, number | boolean | string> = {};
+  if (raw.settings !== undefined) {
+    if (!isObject(raw.settings)) throw new LinkError("its settings are not a list of settings");
+    const entries = Object.entries(raw.settings);
+    if (entries.length > SETTINGS_MAX) throw new LinkError(`it has ${nf.format(entries.length)} settings; at most ${SETTINGS_MAX} are accepted`);
+    for (const [k, v] of entries) {
+      const key = k.length > 40 ? `${k.slice(0, 40)}…` : k;
+      if (!/^[a-z][a-z0-9_]{0,63}$/.test(k)) ignored.push(`a setting named ${JSON.stringify(key)}`);
+      else if (typeof v === "number" && !Number.isFinite(v)) ignored.push(`its setting ${k} (${shown(v)} is not a finite number: the default is used)`);
+      else if (typeof v === "string" && v.length > SETTING_TEXT_MAX) ignored.push(`its setting ${k} (a text of ${nf.format(v.length)} characters: the default is used)`);
+      else if (typeof v === "number" || typeof v === "boolean" || typeof v === "string") settings[k] = v;
+      else ignored.push(`its setting ${k} (${shown(v)} is not a number, a yes/no or a choice: the default is used)`);
+    }
+  }
+
+  let layer: number | undefined;
+  if (typeof raw.layer === "number" && Number.isFinite(raw.layer)) {
+    // the page clamps it to the slice's layers once it knows how many there are
+    layer = Math.max(0, Math.min(1e9, Math.round(raw.layer)));
+  } else if (raw.layer !== undefined) {
+    ignored.push(`its layer (${shown(raw.layer)} is not a layer number: a default layer is shown)`);
+  }
+
+  let view: View | undefined;
+  if (raw.view !== undefined) {
+    const v = raw.view;
+    const finite = (x: unknown): x is number => typeof x === "number" && Number.isFinite(x);
+    if (!isObject(v) || !finite(v.scale) || !finite(v.cx) || !finite(v.cy)) {
+      ignored.push("its view (not three finite numbers: the part is fitted instead)");
+    } else if (!(v.scale > 0)) {
+      ignored.push(`its view (zoom ${shown(v.scale)} px/mm is not positive: the part is fitted instead)`);
+    } else if (Math.abs(v.cx) > MAX_CENTRE_MM || Math.abs(v.cy) > MAX_CENTRE_MM) {
+      ignored.push(`its view (centre ${shown(v.cx)}, ${shown(v.cy)} mm is beyond ±${nf.format(MAX_CENTRE_MM)} mm: the part is fitted instead)`);
+    } else {
+      const scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, v.scale));
+      if (scale !== v.scale) ignored.push(`its zoom (${shown(v.scale)} px/mm, limited to ${scale} px/mm)`);
+      view = { scale, cx: v.cx, cy: v.cy };
+    }
+  }
+
+  let showTravel: boolean | undefined;
+  if (typeof raw.showTravel === "boolean") showTravel = raw.showTravel;
+  else if (raw.showTravel !== undefined) ignored.push(`its travel option (${shown(raw.showTravel)})`);
+
+  return { state: { settings, layer, view, name, sha256: raw.sha256, showTravel }, ignored };
+}
+
+/** Reads a link's fragment; null when it holds no preview. Throws a [[LinkError]] on a link
+ *  too large or damaged to read; a too large or damaged embedded model is reported in
+ *  `modelError` (the state is still usable: the receiver can drop the file in). */
 export async function readLink(hash: string): Promise<SharedLink | null> {
   const params = new URLSearchParams(hash.replace(/^#/, ""));
   const p = params.get("p");
   if (!p) return null;
-  const state = JSON.parse(new TextDecoder().decode(await inflate(fromBase64Url(p)))) as ShareState;
-  if (typeof state !== "object" || state === null || typeof state.sha256 !== "string") {
-    throw new Error("the preview link is damaged");
+  const packed = fromBase64Url(p, STATE_TEXT_MAX, "its state");
+  const text = new TextDecoder().decode(await inflate(packed, STATE_MAX_BYTES, "its state"));
+  let raw: unknown;
+  try {
+    raw = JSON.parse(text);
+  } catch {
+    throw new LinkError("its state is not readable (the link may have been cut or changed)");
   }
+  const { state, ignored } = checkState(raw);
   const m = params.get("m");
-  const model = m ? await inflate(fromBase64Url(m)) : null;
-  return { state, model };
+  let model: Uint8Array | null = null;
+  let modelError: string | undefined;
+  if (m) {
+    try {
+      model = await inflate(fromBase64Url(m, MODEL_TEXT_MAX, "its model"), MODEL_MAX_BYTES, "its model");
+    } catch (e) {
+      if (!(e instanceof LinkError)) throw e;
+      modelError = e.message;
+    }
+  }
+  return { state, model, modelError, ignored };
 }
