@@ -13,8 +13,10 @@ export const chromiumPath = process.env.CHROMIUM ?? "/usr/bin/chromium";
 
 /** Starts the server and the browser; returns { url, browser, close }. */
 export async function start() {
-  if (!existsSync(join(repo, "dist/index.html"))) throw new Error("dist/ is missing: run scripts/build.sh first");
-  const { server, url } = await serve(join(repo, "dist"), 0);
+  // DROPSLICE_DIST serves another build of the page (e.g. one made aside while dist/ is rebuilt)
+  const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
+  if (!existsSync(join(dist, "index.html"))) throw new Error(`${dist} is missing: run scripts/build.sh first`);
+  const { server, url } = await serve(dist, 0);
   // playwright gives every launch a fresh, empty user-data-dir of its own
   const browser = await chromium.launch({
     executablePath: chromiumPath,
@@ -65,16 +67,18 @@ export async function waitSettled(page, timeout = 240_000) {
   return status(page);
 }
 
-/** Number of canvas pixels whose colour passes `test` (a JS expression over r, g, b). */
+/** Number of canvas pixels whose colour passes `test` (a JS expression over r, g, b). The
+ *  expression goes in the evaluated source (run by the DevTools protocol): a `new Function`
+ *  inside the page would be refused by its Content-Security-Policy (no 'unsafe-eval'). */
 export function countPixels(page, test) {
-  return page.evaluate((test) => {
-    const pass = new Function("r", "g", "b", `return ${test};`);
+  return page.evaluate(`(() => {
+    const pass = (r, g, b) => (${test});
     const c = document.getElementById("view");
     const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
     let n = 0;
     for (let i = 0; i < d.length; i += 4) if (pass(d[i], d[i + 1], d[i + 2])) n++;
     return n;
-  }, test);
+  })()`);
 }
 
 /** Pixels of the canvas as a data URL (changes whenever anything drawn changes). */
