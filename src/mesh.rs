@@ -249,40 +249,8 @@ impl Mesh {
         if self.facets.is_empty() {
             return out;
         }
-        let shell_of_vertex = self.vertex_components();
-        // Dense shell ids.
-        let mut id = vec![u32::MAX; self.vertices.len()];
-        let mut shells = 0usize;
-        let facet_shell: Vec<u32> = self
-            .facets
-            .iter()
-            .map(|f| {
-                let root = shell_of_vertex[f[0] as usize] as usize;
-                if id[root] == u32::MAX {
-                    id[root] = shells as u32;
-                    shells += 1;
-                }
-                id[root]
-            })
-            .collect();
-        // A shell is closed when each of its edges has exactly two facets of opposite direction.
-        let mut closed = vec![true; shells];
-        let mut edges: Vec<u64> = Vec::with_capacity(self.facets.len() * 3);
-        for f in &self.facets {
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                edges.push(edge_key(a, b) << 1 | u64::from(a < b));
-            }
-        }
-        edges.sort_unstable();
-        for group in edges.chunk_by(|x, y| x >> 1 == y >> 1) {
-            let good = group.len() == 2 && group[0] & 1 != group[1] & 1;
-            if !good {
-                let v = (group[0] >> 1) as u32; // the edge's higher vertex id
-                closed[id[shell_of_vertex[v as usize] as usize] as usize] = false;
-            }
-        }
-        drop(edges);
+        let (facet_shell, closed) = self.edge_shells();
+        let shells = closed.len();
         // Volumes (about a point near the mesh, for precision) and bounding boxes per shell.
         let b = self.bounds();
         let o = [0, 1, 2].map(|k| 0.5 * (b.min[k] + b.max[k]));
@@ -371,6 +339,85 @@ impl Mesh {
             .map(|s| volume[s].abs())
             .sum();
         out
+    }
+
+    /// The shells: pieces of the surface connected through edges shared by exactly two facets
+    /// (two bodies touching at a vertex or along a non-manifold edge stay apart). Returns the
+    /// shell of every facet and, per shell, whether it is closed: each of its edges shared by
+    /// exactly two facets running along it in opposite directions.
+    fn edge_shells(&self) -> (Vec<u32>, Vec<bool>) {
+        let nf = self.facets.len();
+        // Facets around each vertex (compressed rows).
+        let mut start = vec![0u32; self.vertices.len() + 1];
+        for f in &self.facets {
+            for &v in f {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for k in 0..self.vertices.len() {
+            start[k + 1] += start[k];
+        }
+        let mut next = start.clone();
+        let mut around = vec![0u32; 3 * nf];
+        for (fi, f) in self.facets.iter().enumerate() {
+            for &v in f {
+                around[next[v as usize] as usize] = fi as u32;
+                next[v as usize] += 1;
+            }
+        }
+        drop(next);
+        let mut parent: Vec<u32> = (0..nf as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        let mut bad: Vec<u32> = Vec::new();
+        for (fi, f) in self.facets.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                // The other facets with the edge a–b, and whether they run b→a.
+                let (mut others, mut opposite, mut other) = (0, true, 0u32);
+                for &g in &around[start[a as usize] as usize..start[a as usize + 1] as usize] {
+                    if g as usize == fi {
+                        continue;
+                    }
+                    let h = self.facets[g as usize];
+                    if let Some(j) = h.iter().position(|&v| v == b) {
+                        others += 1;
+                        other = g;
+                        opposite &= h[(j + 1) % 3] == a;
+                    }
+                }
+                if others == 1 && opposite {
+                    let (x, y) = (find(&mut parent, fi as u32), find(&mut parent, other));
+                    if x != y {
+                        parent[y as usize] = x;
+                    }
+                } else {
+                    bad.push(fi as u32);
+                }
+            }
+        }
+        drop(around);
+        let mut id = vec![u32::MAX; nf];
+        let mut shells = 0u32;
+        let mut facet_shell = vec![0u32; nf];
+        for fi in 0..nf {
+            let r = find(&mut parent, fi as u32) as usize;
+            if id[r] == u32::MAX {
+                id[r] = shells;
+                shells += 1;
+            }
+            facet_shell[fi] = id[r];
+        }
+        let mut closed = vec![true; shells as usize];
+        for f in bad {
+            closed[facet_shell[f as usize] as usize] = false;
+        }
+        (facet_shell, closed)
     }
 
     /// The winding number of the closed surface made of `facets` around `p`: ±1 inside, 0

@@ -99,6 +99,30 @@ fn an_inverted_box_overlapping_a_box_gives_their_union() {
 }
 
 #[test]
+fn boxes_touching_at_a_corner_are_separate_shells() {
+    // One vertex is shared after welding: a shell is what edges connect, so the inverted box
+    // is still recognised, and a box overlapping both (positive) keeps both printed.
+    let mut t = cuboid([0.0; 3], [10.0; 3]);
+    t.extend(inverted(cuboid([10.0; 3], [20.0; 3])));
+    t.extend(cuboid([15.0, 15.0, 15.0], [25.0, 25.0, 20.0]));
+    let j = job(&t).unwrap();
+    assert_eq!(j.info().mesh.flipped_shells, 1);
+    assert_areas(
+        &j,
+        |z| {
+            if z < 10.0 {
+                100.0
+            } else if z < 15.0 {
+                100.0
+            } else {
+                175.0
+            }
+        },
+        "boxes touching at a corner",
+    );
+}
+
+#[test]
 fn an_inverted_box_inside_a_box_is_a_cavity() {
     let mut t = cuboid([0.0; 3], [20.0; 3]);
     t.extend(inverted(cuboid([5.0; 3], [15.0; 3])));
