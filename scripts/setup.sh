@@ -15,7 +15,7 @@ if ! rustup target list --installed 2>/dev/null | grep -qx wasm32-unknown-unknow
 fi
 
 if [ "$(wasm-bindgen --version 2>/dev/null || true)" != "wasm-bindgen $WASM_BINDGEN_VERSION" ]; then
-  # without --locked: one dependency locked by the CLI's lockfile is missing from crates.io
+  # without --locked: one dependency locked by the CLI's lockfile is missing from the registry
   echo "setup: cargo install wasm-bindgen-cli $WASM_BINDGEN_VERSION (takes ~4 minutes)" >&2
   cargo install wasm-bindgen-cli --version "$WASM_BINDGEN_VERSION" --force
 fi
