@@ -15,6 +15,7 @@ fn main() {}
 mod cli {
     use dropslice::analysis::{JobAnalysis, Raster};
     use dropslice::{Error, Job, Settings, write_gcode_with};
+    use staged::Staged;
     use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
     use std::path::{Path, PathBuf};
     use std::process::ExitCode;
@@ -38,7 +39,12 @@ G25 droplet line, G26 droplet).
   -h, --help             this text
   -V, --version          the version
 
-Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 other errors.";
+The code (and the report) are written to a temporary file beside the target and put in
+place only when the run succeeds: a failed or interrupted run leaves no partial file and
+does not touch an existing one.
+
+Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 other errors,
+130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP.";
 
     struct Args {
         model: PathBuf,
@@ -66,7 +72,16 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 return ExitCode::from(2);
             }
         };
-        match run(&args) {
+        // Before any file is created: SIGINT, SIGTERM and SIGHUP remove the temporary files.
+        staged::remove_on_signals();
+        let (output, out, report) = match prepare(&args) {
+            Ok(p) => p,
+            Err(msg) => {
+                eprintln!("dropslice: {msg}");
+                return ExitCode::from(2);
+            }
+        };
+        match run(&args, &output, out, report) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("dropslice: {e}");
@@ -155,7 +170,129 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         out
     }
 
-    fn run(args: &Args) -> Result<(), Error> {
+    /// The G-code's path: `-o`, else the model's name with `.gco` in the current directory.
+    fn output_path(args: &Args) -> PathBuf {
+        args.output.clone().unwrap_or_else(|| {
+            let stem = args
+                .model
+                .file_stem()
+                .map(|s| s.to_os_string())
+                .unwrap_or_else(|| "out".into());
+            PathBuf::from(stem).with_extension("gco")
+        })
+    }
+
+    /// Checks, before any slicing, that `path` (given with `option`) can be written: not a
+    /// directory or a device, in a folder that exists. Whether the folder is writable is
+    /// checked by creating the temporary file there ([`Staged::create`]).
+    fn check_destination(path: &Path, option: &str, example: &Path) -> Result<(), String> {
+        let shown = path.display();
+        let text = path.as_os_str().to_string_lossy();
+        if text.is_empty() {
+            return Err(format!("{option} needs a file name"));
+        }
+        let is_dir = || {
+            let dir = Path::new(text.trim_end_matches('/'));
+            format!(
+                "{option} {shown}: is a directory, not a file name (give a file in it, e.g. {})",
+                dir.join(example).display()
+            )
+        };
+        if text.ends_with('/') || path.file_name().is_none() {
+            return Err(is_dir());
+        }
+        match std::fs::metadata(path) {
+            Ok(m) if m.is_dir() => return Err(is_dir()),
+            Ok(m) if !m.is_file() => {
+                return Err(format!(
+                    "{option} {shown}: exists and is not a regular file; give the name of a file"
+                ));
+            }
+            _ => {}
+        }
+        let dir = parent_dir(path);
+        match std::fs::metadata(&dir) {
+            Ok(m) if m.is_dir() => Ok(()),
+            Ok(_) => Err(format!(
+                "{option} {shown}: {} is not a folder",
+                dir.display()
+            )),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!(
+                "{option} {shown}: the folder {} does not exist; create it first",
+                dir.display()
+            )),
+            Err(e) => Err(format!(
+                "{option} {shown}: cannot use the folder {}: {e}",
+                dir.display()
+            )),
+        }
+    }
+
+    /// The folder a file is written in ("." for a bare name).
+    fn parent_dir(path: &Path) -> PathBuf {
+        match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        }
+    }
+
+    /// The same file, as far as can be told before it exists: the folder resolved, same name.
+    fn same_file(a: &Path, b: &Path) -> bool {
+        let resolve = |p: &Path| {
+            std::fs::canonicalize(p).ok().or_else(|| {
+                let dir = std::fs::canonicalize(parent_dir(p)).ok()?;
+                Some(dir.join(p.file_name()?))
+            })
+        };
+        matches!((resolve(a), resolve(b)), (Some(x), Some(y)) if x == y)
+    }
+
+    /// Where each file goes, checked and with its temporary file created, before any slicing.
+    fn prepare(args: &Args) -> Result<(PathBuf, Staged, Option<Staged>), String> {
+        let output = output_path(args);
+        let stem = args.model.file_stem().unwrap_or("model".as_ref());
+        let example = Path::new(stem);
+        check_destination(&output, "-o", &example.with_extension("gco"))?;
+        if same_file(&output, &args.model) {
+            return Err(format!(
+                "-o {}: that is the model file; give another name for the code",
+                output.display()
+            ));
+        }
+        if let Some(report) = &args.report {
+            check_destination(report, "--report", &example.with_extension("json"))?;
+            if same_file(report, &output) || same_file(report, &args.model) {
+                return Err(format!(
+                    "--report {}: that is the {} file; give another name for the report",
+                    report.display(),
+                    if same_file(report, &output) {
+                        "output"
+                    } else {
+                        "model"
+                    }
+                ));
+            }
+        }
+        let staged = |path: &Path| {
+            Staged::create(path).map_err(|e| {
+                format!(
+                    "cannot write in the folder {} (for {}): {e}",
+                    parent_dir(path).display(),
+                    path.display()
+                )
+            })
+        };
+        let out = staged(&output)?;
+        let report = args.report.as_deref().map(staged).transpose()?;
+        Ok((output, out, report))
+    }
+
+    fn run(
+        args: &Args,
+        output: &Path,
+        mut out: Staged,
+        report: Option<Staged>,
+    ) -> Result<(), Error> {
         let t0 = Instant::now();
         let bytes = std::fs::read(&args.model)
             .map_err(|e| Error::Import(format!("cannot open {}: {e}", args.model.display())))?;
@@ -169,21 +306,12 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         for w in &job.info().warnings {
             eprintln!("dropslice: warning: {w}");
         }
-        let output = args.output.clone().unwrap_or_else(|| {
-            let stem = args
-                .model
-                .file_stem()
-                .map(|s| s.to_os_string())
-                .unwrap_or_else(|| "out".into());
-            PathBuf::from(stem).with_extension("gco")
-        });
-        // Written next to the target first, so a failed run never destroys an existing file.
-        let partial = partial_path(&output);
+        // Written to a temporary file beside the target (`out`), put in place only at the end:
+        // a failed or interrupted run never destroys an existing file nor leaves a partial one.
         let io = |what: &str, p: &Path, e: std::io::Error| {
             Error::Io(format!("cannot {what} {}: {e}", p.display()))
         };
-        let file = std::fs::File::create(&partial).map_err(|e| io("create", &partial, e))?;
-        let mut w = BufWriter::with_capacity(1 << 20, file);
+        let mut w = BufWriter::with_capacity(1 << 20, out.file());
         let quiet = args.quiet;
         let mut last = Instant::now();
         let terminal = std::io::stderr().is_terminal();
@@ -191,7 +319,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         let every_ms = if terminal { 250 } else { 2000 };
         let mut shown = false;
         // With --report, each layer is analysed by the worker that planned it.
-        let mut analysis = args.report.as_ref().map(|_| JobAnalysis::new(&job));
+        let mut analysis = report.as_ref().map(|_| JobAnalysis::new(&job));
         let stage = analysis.as_ref().map(|a| a.stage());
         let progress = |done: usize, total: usize| {
             let due = last.elapsed().as_millis() >= every_ms || (done == total && shown);
@@ -221,54 +349,49 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                     a.push(l);
                 }
             },
-        );
-        let summary = match summary {
-            Ok(s) => s,
-            Err(e) => {
-                drop(w);
-                let _ = std::fs::remove_file(&partial);
-                return Err(e);
-            }
-        };
-        let finish = || -> std::io::Result<dropslice::Summary> {
-            let mut file = w.into_inner().map_err(|e| e.into_error())?;
+        )?;
+        let finish = || -> std::io::Result<()> {
+            let file = w.into_inner().map_err(|e| e.into_error())?;
             // Fill in the header's droplet counts (same length as the placeholders).
             let header = job.header(Some(&summary));
             debug_assert_eq!(header.len(), job.header(None).len());
             file.seek(SeekFrom::Start(0))?;
-            file.write_all(header.as_bytes())?;
-            Ok(summary)
+            file.write_all(header.as_bytes())
         };
-        let summary = match finish() {
-            Ok(s) => s,
-            Err(e) => {
-                let _ = std::fs::remove_file(&partial);
-                return Err(io("write", &partial, e));
-            }
-        };
+        finish().map_err(|e| io("write", output, e))?;
         if summary.counts.total() == 0 {
-            let _ = std::fs::remove_file(&partial);
             return Err(Error::NothingToPrint(format!(
                 "no droplet fits in the part: every wall is thinner than the droplet width B = {:.3} mm; scale the part up or use smaller droplets (layer_height, droplet_aspect)",
                 job.settings().droplet_width()
             )));
         }
-        std::fs::rename(&partial, &output).map_err(|e| io("write", &output, e))?;
-        for r in summary.repairs() {
-            eprintln!("dropslice: repaired: {r}");
-        }
         let mut voids = String::new();
-        if let (Some(path), Some(analysis)) = (&args.report, analysis) {
+        let mut report_done = None;
+        if let (Some(mut staged), Some(analysis)) = (report, analysis) {
+            let path = staged.target().to_path_buf();
             let report = analysis.finish();
             let text = serde_json::to_string_pretty(&report)
                 .map_err(|e| Error::Internal(format!("the report does not serialize: {e}")))?;
-            std::fs::write(path, text + "\n").map_err(|e| io("write", path, e))?;
+            let file = staged.file();
+            file.write_all(text.as_bytes())
+                .and_then(|()| file.write_all(b"\n"))
+                .map_err(|e| io("write", &path, e))?;
             voids = format!(
                 ", void fraction {:.1} % (coverage {:.1} %; report {})",
                 100.0 * report.part.void_fraction,
                 100.0 * report.part.coverage,
                 path.display()
             );
+            report_done = Some(staged);
+        }
+        // Everything is written: only now are the files put in place.
+        out.commit().map_err(|e| io("write", output, e))?;
+        if let Some(staged) = report_done {
+            let path = staged.target().to_path_buf();
+            staged.commit().map_err(|e| io("write", &path, e))?;
+        }
+        for r in summary.repairs() {
+            eprintln!("dropslice: repaired: {r}");
         }
         if !args.quiet {
             let c = summary.counts;
@@ -287,12 +410,226 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         Ok(())
     }
 
-    fn partial_path(output: &Path) -> PathBuf {
-        let mut name = output
-            .file_name()
-            .map(|n| n.to_os_string())
-            .unwrap_or_else(|| "out.gco".into());
-        name.push(".partial");
-        output.with_file_name(name)
+    /// Files written beside their destination and put in place only when complete.
+    ///
+    /// On Linux the file is first unnamed (`O_TMPFILE` in the destination's folder): if the
+    /// process dies in any way, even by SIGKILL or the OOM killer, nothing is left. At the end
+    /// it is linked under a fresh temporary name (`linkat` of `/proc/self/fd/N`) and renamed
+    /// over the destination. Where that is not available (another system, a file system
+    /// without `O_TMPFILE`, no `/proc`), or with `DROPSLICE_NAMED_TEMP=1` (for the tests), it
+    /// is a named file `.NAME.XXXXXX.partial` created exclusively (never through an existing
+    /// link), removed on every error and, by the signal handler, on SIGINT, SIGTERM and SIGHUP.
+    mod staged {
+        use std::fs::File;
+        use std::io;
+        use std::path::{Path, PathBuf};
+        use std::sync::{Mutex, MutexGuard};
+        use tempfile::TempPath;
+
+        /// Named temporary files that exist now: the signal handler removes them. Held while a
+        /// file is created, put in place or removed, so the handler never races with that.
+        static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+        fn pending() -> MutexGuard<'static, Vec<PathBuf>> {
+            PENDING.lock().unwrap_or_else(|e| e.into_inner())
+        }
+
+        /// Starts a thread that, on SIGINT, SIGTERM or SIGHUP, removes the pending temporary
+        /// files and exits with 128 + the signal's number (130, 143, 129).
+        pub fn remove_on_signals() {
+            use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+            let mut signals = match signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+                Ok(s) => s,
+                Err(e) => {
+                    eprintln!(
+                        "dropslice: warning: cannot handle signals ({e}); an interrupted run may leave a .partial file"
+                    );
+                    return;
+                }
+            };
+            std::thread::spawn(move || {
+                if let Some(signal) = signals.forever().next() {
+                    // Kept locked until the exit: a file being put in place is finished first,
+                    // and none is created after this.
+                    let files = pending();
+                    for f in files.iter() {
+                        let _ = std::fs::remove_file(f);
+                    }
+                    let name = match signal {
+                        SIGINT => "SIGINT",
+                        SIGTERM => "SIGTERM",
+                        _ => "SIGHUP",
+                    };
+                    // After an in-place progress line, start a new line.
+                    let nl = if std::io::IsTerminal::is_terminal(&std::io::stderr()) {
+                        "\n"
+                    } else {
+                        ""
+                    };
+                    eprintln!("{nl}dropslice: interrupted ({name}); unfinished files removed");
+                    std::process::exit(128 + signal);
+                }
+            });
+        }
+
+        /// `.NAME.` for the temporary names of `target`.
+        fn prefix(target: &Path) -> std::ffi::OsString {
+            let mut prefix = std::ffi::OsString::from(".");
+            prefix.push(target.file_name().unwrap_or_default());
+            prefix.push(".");
+            prefix
+        }
+
+        /// Temporary names `.NAME.XXXXXX.partial`, files readable as a plain new file is.
+        fn builder(prefix: &std::ffi::OsStr) -> tempfile::Builder<'_, 'static> {
+            let mut b = tempfile::Builder::new();
+            b.prefix(prefix).suffix(".partial");
+            #[cfg(unix)]
+            b.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+            b
+        }
+
+        pub struct Staged {
+            file: File,
+            dir: PathBuf,
+            target: PathBuf,
+            /// The file's temporary name; `None` while it is unnamed (`O_TMPFILE`).
+            named: Option<TempPath>,
+        }
+
+        impl Staged {
+            /// A new empty temporary file in `target`'s folder (which must exist).
+            pub fn create(target: &Path) -> io::Result<Staged> {
+                let dir = super::parent_dir(target);
+                let target = target.to_path_buf();
+                #[cfg(target_os = "linux")]
+                if let Some(file) = unnamed_in(&dir) {
+                    return Ok(Staged {
+                        file,
+                        dir,
+                        target,
+                        named: None,
+                    });
+                }
+                let mut list = pending();
+                let prefix = prefix(&target);
+                let (file, path) = builder(&prefix)
+                    .tempfile_in(&dir)
+                    .map_err(without_path)?
+                    .into_parts();
+                list.push(path.to_path_buf());
+                Ok(Staged {
+                    file,
+                    dir,
+                    target,
+                    named: Some(path),
+                })
+            }
+
+            pub fn file(&mut self) -> &mut File {
+                &mut self.file
+            }
+
+            pub fn target(&self) -> &Path {
+                &self.target
+            }
+
+            /// Puts the file in place (replacing any file there); on error nothing is left.
+            pub fn commit(mut self) -> io::Result<()> {
+                // Locked throughout: a signal now waits until the file is in place (or gone).
+                let mut list = pending();
+                let path = match self.named.take() {
+                    Some(path) => {
+                        forget(&mut list, &path);
+                        path
+                    }
+                    None => self.link().map_err(without_path)?,
+                };
+                // On error the temporary name is dropped, which removes it.
+                path.persist(&self.target)
+                    .map_err(|e| without_path(e.error))
+            }
+
+            /// Gives the unnamed file a fresh temporary name in its folder.
+            #[cfg(target_os = "linux")]
+            fn link(&self) -> io::Result<TempPath> {
+                use std::os::fd::AsRawFd;
+                let fd = format!("/proc/self/fd/{}", self.file.as_raw_fd());
+                let prefix = prefix(&self.target);
+                let named = builder(&prefix).make_in(&self.dir, |p| link_to(&fd, p))?;
+                Ok(named.into_temp_path())
+            }
+
+            #[cfg(not(target_os = "linux"))]
+            fn link(&self) -> io::Result<TempPath> {
+                unreachable!("unnamed temporary files are only made on Linux")
+            }
+        }
+
+        impl Drop for Staged {
+            fn drop(&mut self) {
+                if let Some(path) = self.named.take() {
+                    let mut list = pending();
+                    forget(&mut list, &path);
+                    drop(path); // removes the file
+                }
+            }
+        }
+
+        /// tempfile's error without its ` at path ".X.XXXXXX.partial"` (the caller names the
+        /// target, not the temporary name).
+        fn without_path(e: io::Error) -> io::Error {
+            let text = e.to_string();
+            match text.rfind(" at path \"") {
+                Some(i) => io::Error::new(e.kind(), &text[..i]),
+                None => e,
+            }
+        }
+
+        fn forget(list: &mut Vec<PathBuf>, path: &Path) {
+            list.retain(|p| p != path);
+        }
+
+        /// An unnamed file in `dir`, if this system and file system have them.
+        #[cfg(target_os = "linux")]
+        fn unnamed_in(dir: &Path) -> Option<File> {
+            use std::os::unix::fs::OpenOptionsExt;
+            if std::env::var_os("DROPSLICE_NAMED_TEMP").is_some_and(|v| v == "1")
+                || !Path::new("/proc/self/fd").is_dir()
+            {
+                return None;
+            }
+            std::fs::OpenOptions::new()
+                .write(true)
+                .mode(0o666)
+                .custom_flags(libc::O_TMPFILE)
+                .open(dir)
+                .ok()
+        }
+
+        /// `linkat(AT_FDCWD, from, AT_FDCWD, to, AT_SYMLINK_FOLLOW)`: `from` is a
+        /// `/proc/self/fd/N` link; `to` must not exist (an existing link there is not followed).
+        #[cfg(target_os = "linux")]
+        fn link_to(from: &str, to: &Path) -> io::Result<()> {
+            use std::ffi::CString;
+            use std::os::unix::ffi::OsStrExt;
+            let from = CString::new(from)?;
+            let to = CString::new(to.as_os_str().as_bytes())?;
+            // SAFETY: both are valid NUL-terminated strings that outlive the call.
+            let r = unsafe {
+                libc::linkat(
+                    libc::AT_FDCWD,
+                    from.as_ptr(),
+                    libc::AT_FDCWD,
+                    to.as_ptr(),
+                    libc::AT_SYMLINK_FOLLOW,
+                )
+            };
+            if r == 0 {
+                Ok(())
+            } else {
+                Err(io::Error::last_os_error())
+            }
+        }
     }
 }
