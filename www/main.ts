@@ -14,7 +14,7 @@ const query = new URLSearchParams(location.search);
 
 /** Layer previews kept in the page; beyond this, layers far from the one shown are dropped
  *  and re-planned by a worker when they are shown again. */
-const CACHE_BUDGET_BYTES = Math.max(1, Number(query.get("cache")) || 384) * 2 ** 20;
+const CACHE_BUDGET_BYTES = Math.min(4096, Math.max(1, Number(query.get("cache")) || 384)) * 2 ** 20;
 
 interface Model {
   bytes: Uint8Array;

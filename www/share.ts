@@ -77,7 +77,7 @@ function size(bytes: number): string {
  * the output read as it comes; past the cap both sides are cancelled and a [[LinkError]]
  * naming `what` is thrown, as for data that is not valid deflate.
  */
-export async function inflate(bytes: Uint8Array, cap: number, what = "the data"): Promise<Uint8Array> {
+export async function inflate(bytes: Uint8Array, cap = Infinity, what = "the data"): Promise<Uint8Array> {
   const ds = new DecompressionStream("deflate-raw");
   const writer = ds.writable.getWriter();
   const reader = ds.readable.getReader();
@@ -181,9 +181,11 @@ const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "obj
 export function checkState(raw: unknown): { state: ShareState; ignored: string[] } {
   if (!isObject(raw)) throw new LinkError("its state is not a preview's state");
   const ignored: string[] = [];
-  if (typeof raw.sha256 !== "string" || !/^[0-9a-f]{64}$/.test(raw.sha256)) {
-    throw new LinkError("its model's SHA-256 is missing or not 64 hexadecimal digits");
+  // a SHA-256 is 64 hexadecimal digits; fewer are accepted (they can only fail to match)
+  if (typeof raw.sha256 !== "string" || !/^[0-9a-fA-F]{1,64}$/.test(raw.sha256)) {
+    throw new LinkError("its model's SHA-256 is missing or not hexadecimal digits (at most 64)");
   }
+  const sha256 = raw.sha256.toLowerCase();
   if (typeof raw.name !== "string") throw new LinkError("its model's name is missing");
   const name = raw.name.length > NAME_MAX ? `${raw.name.slice(0, NAME_MAX)}…` : raw.name;
 
@@ -231,7 +233,11 @@ export function checkState(raw: unknown): { state: ShareState; ignored: string[]
   if (typeof raw.showTravel === "boolean") showTravel = raw.showTravel;
   else if (raw.showTravel !== undefined) ignored.push(`its travel option (${shown(raw.showTravel)})`);
 
-  return { state: { settings, layer, view, name, sha256: raw.sha256, showTravel }, ignored };
+  const state: ShareState = { settings, name, sha256 };
+  if (layer !== undefined) state.layer = layer;
+  if (view !== undefined) state.view = view;
+  if (showTravel !== undefined) state.showTravel = showTravel;
+  return { state, ignored };
 }
 
 /** Reads a link's fragment; null when it holds no preview. Throws a [[LinkError]] on a link
