@@ -57,6 +57,12 @@ async function locate(root, url) {
   return file;
 }
 
+/** The policy of www/index.html, plus what only a header can say (frame-ancestors). */
+const CSP =
+  "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; worker-src 'self'; connect-src 'self'; " +
+  "img-src 'self' data: blob:; style-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; " +
+  "frame-ancestors 'none'";
+
 /** Serves `root` on 127.0.0.1:`port`; resolves to { server, url }. */
 export function serve(root, port = 0) {
   let base = null; // root's real path, resolved at the first request
@@ -68,6 +74,10 @@ export function serve(root, port = 0) {
       res.writeHead(200, {
         "content-type": TYPES[extname(file)] ?? "application/octet-stream",
         "cache-control": "no-cache",
+        // The page's policy (as in index.html's meta tag) also as a header, which covers the
+        // workers' scripts and framing too; nosniff keeps types as served.
+        "content-security-policy": CSP,
+        "x-content-type-options": "nosniff",
       });
       res.end(body);
     } catch (e) {

@@ -41,7 +41,7 @@ function get(path) {
       let body = "";
       res.setEncoding("utf8");
       res.on("data", (c) => (body += c));
-      res.on("end", () => ok({ status: res.statusCode, body, type: res.headers["content-type"] }));
+      res.on("end", () => ok({ status: res.statusCode, body, type: res.headers["content-type"], csp: res.headers["content-security-policy"] }));
     });
     req.on("error", fail);
     req.end();
@@ -54,7 +54,10 @@ test("files inside the root are served", async () => {
     assert.equal(r.status, 200, path);
     if (body !== null) assert.equal(r.body, body, path);
   }
-  assert.match((await get("/app.js")).type, /javascript/);
+  const js = await get("/app.js");
+  assert.match(js.type, /javascript/);
+  assert.match(js.csp, /script-src 'self' 'wasm-unsafe-eval'/);
+  assert.match(js.csp, /frame-ancestors 'none'/);
 });
 
 test("traversal, links out, NUL and bad encoding are refused", async () => {
