@@ -37,14 +37,26 @@ fn main() {
     let b = s.droplet_width();
     let (a, m) = analyse_layer_with_mask(&plan, &region, &s, b / 10.0);
     eprintln!("{}", serde_json::to_string(&a).unwrap());
-    let (mut c0, mut r0, mut c1, mut r1) = (0, 0, m.width, m.height);
+    // The window, in mask cells (the mask holds tiles only where the part is).
+    let (width, height) = m.size();
+    let (mut c0, mut r0, mut c1, mut r1) = (0, 0, width, height);
     if pos.len() >= 7 {
         let w: Vec<f64> = pos[3..7].iter().map(|v| v.parse().unwrap()).collect();
-        let col = |x: f64| (((x - m.origin[0]) / m.cell).max(0.0) as usize).min(m.width);
-        let row = |y: f64| (((y - m.origin[1]) / m.cell).max(0.0) as usize).min(m.height);
+        let col = |x: f64| (((x - m.origin[0]) / m.cell).max(0.0) as usize).min(width);
+        let row = |y: f64| (((y - m.origin[1]) / m.cell).max(0.0) as usize).min(height);
         (c0, r0, c1, r1) = (col(w[0]), row(w[1]), col(w[2]), row(w[3]));
     }
     let (w, h) = (c1 - c0, r1 - r0);
+    // The window's shares [void, overfill, covered], row-major from its lowest row.
+    let mut shares = vec![[0u8; 3]; w * h];
+    for t in &m.tiles {
+        for r in t.row.max(r0)..(t.row + t.height).min(r1) {
+            for c in t.col.max(c0)..(t.col + t.width).min(c1) {
+                let i = (r - t.row) * t.width + c - t.col;
+                shares[(r - r0) * w + c - c0] = [t.void[i], t.overfill[i], t.covered[i]];
+            }
+        }
+    }
     // Droplet centres of the layer below, as dark dots.
     let mut dots = std::collections::HashSet::new();
     if below && i > 0 {
@@ -63,16 +75,11 @@ fn main() {
     let mut rgb = Vec::with_capacity(w * h * 3 * zoom * zoom);
     for r in (r0..r1).rev().flat_map(|r| std::iter::repeat_n(r, zoom)) {
         for c in (c0..c1).flat_map(|c| std::iter::repeat_n(c, zoom)) {
-            let k = r * m.width + c;
             if dots.contains(&(r as i64, c as i64)) {
                 rgb.extend([20, 20, 20]);
                 continue;
             }
-            let (v, o, cv) = (
-                m.void[k] as f64 / 255.0,
-                m.overfill[k] as f64 / 255.0,
-                m.covered[k] as f64 / 255.0,
-            );
+            let [v, o, cv] = shares[(r - r0) * w + c - c0].map(|x| x as f64 / 255.0);
             let white = (1.0 - v - o - cv).max(0.0);
             // white, red (void), blue (overfill), grey (covered)
             let px = [

@@ -36,8 +36,15 @@
 //! between droplets, or of a wall too thin for any droplet); outward, the largest distance from
 //! the region of a covered point outside it. Both are sampled at the ends and the middle of
 //! each run of cells, so they are exact to about a grid step.
+//!
+//! # Memory
+//! The grids span the layer's bounding box, but only tiles near its region and droplets are
+//! stored ([`Tiles`]): the 2D bitmaps in tiles of 64 rows × 256 columns (1.3 mm square with the
+//! default B), the spheroid maps in tiles of 32 × 32 cells (2.2 mm), the coverage mask in tiles
+//! over those. Parts a metre apart take the memory each takes alone, and the figures are those
+//! of a dense grid: the same grid, its rows and runs visited in the same order.
 
-use crate::grid::EdgeIndex;
+use crate::grid::{EdgeIndex, Row, Segment, Spot, Tiles};
 use crate::plan::{LayerPlan, MoveKind, line_droplets};
 use crate::settings::{Footprint, Settings};
 use crate::slice::{Point, Shapes, dist, region_area, scanline_spans};
@@ -119,17 +126,58 @@ pub struct LayerAnalysis {
 
 /// A coarse picture of a layer for an overlay: per square cell the share (0 … 255) of it that
 /// is void (region, uncovered), overfill (covered, outside the region) and covered region.
-/// Cell (col, row) spans x = origin.x + col·cell …, y = origin.y + row·cell …; index
-/// row·width + col.
+/// Only tiles of cells near the layer's region and droplets are kept (parts far apart cost no
+/// memory for the space between them); every cell outside the tiles is empty (shares 0).
+/// Cell (col, row) of the mask spans x = origin.x + col·cell …, y = origin.y + row·cell ….
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct CoverageMask {
     pub origin: Point,
     pub cell: f64,
+    /// Disjoint, by rows then columns.
+    pub tiles: Vec<MaskTile>,
+}
+
+/// A rectangle of a [`CoverageMask`]: cells (col + i, row + j) for i < width, j < height, the
+/// shares of cell (col + i, row + j) at index j·width + i.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct MaskTile {
+    pub col: usize,
+    pub row: usize,
     pub width: usize,
     pub height: usize,
     pub void: Vec<u8>,
     pub overfill: Vec<u8>,
     pub covered: Vec<u8>,
+}
+
+impl CoverageMask {
+    /// Where tile `t`'s cell (0, 0) starts, in mm.
+    pub fn tile_origin(&self, t: &MaskTile) -> Point {
+        [
+            self.origin[0] + t.col as f64 * self.cell,
+            self.origin[1] + t.row as f64 * self.cell,
+        ]
+    }
+
+    /// The shares [void, overfill, covered] of cell (col, row); zero outside the tiles.
+    pub fn shares(&self, col: usize, row: usize) -> [u8; 3] {
+        self.tiles
+            .iter()
+            .find(|t| {
+                (t.col..t.col + t.width).contains(&col) && (t.row..t.row + t.height).contains(&row)
+            })
+            .map_or([0; 3], |t| {
+                let i = (row - t.row) * t.width + col - t.col;
+                [t.void[i], t.overfill[i], t.covered[i]]
+            })
+    }
+
+    /// Cells (width, height) from the origin to the far corner of the last tiles.
+    pub fn size(&self) -> (usize, usize) {
+        self.tiles.iter().fold((0, 0), |(w, h), t| {
+            (w.max(t.col + t.width), h.max(t.row + t.height))
+        })
+    }
 }
 
 /// Every droplet centre of a layer (each droplet of a `G25` line too), in print order.
@@ -170,7 +218,16 @@ pub fn analyse_layer_with_mask(
     (r.analysis(), r.mask(mask_cell))
 }
 
-/// The rasterised layer: region and droplet bitmaps on one grid.
+/// Rows of the 2D grid per band of the sparse raster, and words (of 64 columns) per tile: tiles
+/// of 64 × 256 cells, 1.33 mm square with the default B.
+const BAND_ROWS: usize = 64;
+const TILE_WORDS: usize = 4;
+/// Mask rows per band of a [`CoverageMask`]'s tiles.
+const MASK_BAND_ROWS: usize = 64;
+
+/// The rasterised layer: region and droplet bitmaps on one grid over the layer, stored only in
+/// the tiles its region and droplets touch ([`Tiles`], counted in words of 64 columns), so parts
+/// far apart cost no memory for the space between them.
 pub struct Raster {
     index: usize,
     z: f64,
@@ -178,11 +235,17 @@ pub struct Raster {
     region_area: f64,
     b: f64,
     grid: Grid,
+    /// Which words of the grid are stored, and where.
+    tiles: Tiles,
     region_bits: Vec<u64>,
     drop_bits: Vec<u64>,
-    /// Per row, the words [lo, hi) holding any bit.
+    /// Per stored row ([`Row::slot`]), the words [lo, hi) of its slice holding any bit.
     extent: Vec<(u32, u32)>,
     edges: Vec<(Point, Point)>,
+    /// The region's spans (row, first column, last column) and each droplet's first row,
+    /// phase and centre column, between marking and setting.
+    spans: Vec<(u32, u32, u32)>,
+    places: Vec<(usize, usize, f64)>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -193,7 +256,6 @@ struct Grid {
     gy: f64,
     nx: usize,
     ny: usize,
-    nw: usize,
 }
 
 impl Grid {
@@ -324,12 +386,14 @@ impl Raster {
                 gy: 1.0,
                 nx: 0,
                 ny: 0,
-                nw: 0,
             },
+            tiles: Tiles::default(),
             region_bits: Vec::new(),
             drop_bits: Vec::new(),
             extent: Vec::new(),
             edges: Vec::new(),
+            spans: Vec::new(),
+            places: Vec::new(),
         }
     }
 
@@ -383,27 +447,21 @@ impl Raster {
             gy,
             nx,
             ny,
-            nw,
         };
-        self.region_bits.clear();
-        self.region_bits.resize(nw * ny, 0);
-        self.drop_bits.clear();
-        self.drop_bits.resize(nw * ny, 0);
-        self.extent.clear();
-        self.extent.resize(ny, (u32::MAX, 0));
-        let (region_bits, drop_bits, extent) =
-            (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
-        let mut mark = |k: usize, c0: usize, c1: usize| {
-            let e = &mut extent[k];
-            e.0 = e.0.min((c0 >> 6) as u32);
-            e.1 = e.1.max((c1 >> 6) as u32 + 1);
-        };
+        // First the tiles the region and the droplets touch, then their bits.
+        let tiles = &mut self.tiles;
+        tiles.reset(ny, nw, BAND_ROWS, TILE_WORDS);
+        let spans = &mut self.spans;
+        spans.clear();
         region_spans(region, y0, gy, ny, |k, xa, xb| {
             if let Some((c0, c1)) = grid.cols(xa, xb) {
-                set_range(&mut region_bits[k * nw..(k + 1) * nw], c0, c1);
-                mark(k, c0, c1);
+                spans.push((k as u32, c0 as u32, c1 as u32));
             }
         });
+        for &(k, c0, c1) in spans.iter() {
+            let k = k as usize;
+            tiles.mark(k, k, c0 as usize >> 6, c1 as usize >> 6);
+        }
         let (rows, table) = half_width_table(r, gy);
         // Per phase and row, the columns covered (n, and (n − 1)/2): the rounding carry
         // depends only on the phase, not on the droplet.
@@ -420,14 +478,87 @@ impl Raster {
                 })
             })
             .collect();
-        for p in centres {
+        // Per phase, the widest row: a droplet's columns in every row lie within its columns.
+        let widest: Vec<(i64, f64)> = spans
+            .chunks(rows)
+            .map(|c| c.iter().copied().max_by_key(|s| s.0).unwrap_or((0, 0.0)))
+            .collect();
+        // A droplet's first row, phase, and centre in column units (column c's centre at u = c).
+        let place = |p: &Point| {
             let v = (p[1] - r - y0) / gy;
             let k0 = v.floor();
             let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
-            let k0 = k0 as usize;
-            // Centre in column units (column c's centre at u = c).
-            let u = (p[0] - x0) / gx - 0.5;
-            for (j, &(n, half)) in spans[ph * rows..(ph + 1) * rows].iter().enumerate() {
+            (k0 as usize, ph, (p[0] - x0) / gx - 0.5)
+        };
+        let places = &mut self.places;
+        places.clear();
+        places.extend(centres.iter().map(place));
+        for &(k0, ph, u) in places.iter() {
+            let (n, half) = widest[ph];
+            if n >= 1 {
+                let c0 = (u - half + 0.5) as i64;
+                // A column to spare on each side.
+                let w0 = (c0 - 1).max(0) as usize >> 6;
+                let w1 = (c0 + n).max(0) as usize >> 6;
+                tiles.mark(k0, k0 + rows - 1, w0, w1);
+            }
+        }
+        let len = tiles.build();
+        self.region_bits.clear();
+        self.region_bits.resize(len, 0);
+        self.drop_bits.clear();
+        self.drop_bits.resize(len, 0);
+        self.extent.clear();
+        self.extent.resize(tiles.row_slots(), (u32::MAX, 0));
+        let (region_bits, drop_bits, extent) =
+            (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
+        // Columns c0..=c1 of a row's slice are set.
+        let mut mark = |slot: usize, c0: usize, c1: usize| {
+            let e = &mut extent[slot];
+            e.0 = e.0.min((c0 >> 6) as u32);
+            e.1 = e.1.max((c1 >> 6) as u32 + 1);
+        };
+        // Where the last span or droplet row was stored (mostly where the next one is).
+        let mut spot: Option<Spot> = None;
+        for &(k, c0, c1) in self.spans.iter() {
+            let (k, c0, c1) = (k as usize, c0 as usize, c1 as usize);
+            let Some(sp) = tiles.spot_cached(&mut spot, k, c0 >> 6, c1 >> 6) else {
+                debug_assert!(false, "region span outside the tiles");
+                continue;
+            };
+            let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
+            let at = 64 * sp.index(k);
+            set_range(region_bits, at + c0, at + c1);
+            mark(sp.slot(k), c0, c1);
+        }
+        for &(k0, ph, u) in self.places.iter() {
+            let rows_of = &spans[ph * rows..(ph + 1) * rows];
+            // Mostly the whole droplet lies in the grid and in one band and segment: its rows
+            // are then one step apart in the storage.
+            let (n, half) = widest[ph];
+            let (w0, k1) = ((u - half + 0.5) as i64, k0 + rows - 1);
+            let whole = n >= 1 && w0 >= 0 && w0 + n <= nx as i64 && k1 < ny;
+            let (w0, w1) = (w0.max(0) as usize, (w0 + n - 1).max(0) as usize);
+            if let Some(sp) = whole
+                .then(|| tiles.spot_cached(&mut spot, k0, w0 >> 6, w1 >> 6))
+                .flatten()
+                .filter(|sp| k1 < sp.end_row)
+            {
+                let shift = 64 * sp.shift;
+                let mut at = 64 * sp.index(k0);
+                for (slot, &(n, half)) in (sp.slot(k0)..).zip(rows_of) {
+                    if n >= 1 {
+                        // Within the widest row's columns: ≥ w0 ≥ 0.
+                        let c0 = (u - half + 0.5) as usize - shift;
+                        let c1 = c0 + n as usize - 1;
+                        set_range(drop_bits, at + c0, at + c1);
+                        mark(slot, c0, c1);
+                    }
+                    at += 64 * sp.row_len;
+                }
+                continue;
+            }
+            for (j, &(n, half)) in rows_of.iter().enumerate() {
                 let k = k0 + j;
                 if n < 1 || k >= ny {
                     continue;
@@ -438,8 +569,14 @@ impl Raster {
                     continue;
                 }
                 let (c0, c1) = (c0 as usize, c1 as usize);
-                set_range(&mut drop_bits[k * nw..(k + 1) * nw], c0, c1);
-                mark(k, c0, c1);
+                let Some(sp) = tiles.spot_cached(&mut spot, k, c0 >> 6, c1 >> 6) else {
+                    debug_assert!(false, "droplet outside the tiles");
+                    continue;
+                };
+                let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
+                let at = 64 * sp.index(k);
+                set_range(drop_bits, at + c0, at + c1);
+                mark(sp.slot(k), c0, c1);
             }
         }
         self.index = index;
@@ -450,71 +587,109 @@ impl Raster {
         self.grid = grid;
     }
 
-    fn row<'b>(bits: &'b [u64], g: &Grid, k: usize) -> &'b [u64] {
-        &bits[k * g.nw..(k + 1) * g.nw]
+    /// Words of memory its bitmaps take (for tests of the memory it needs).
+    pub fn stored_words(&self) -> usize {
+        self.region_bits.len() + self.drop_bits.len()
     }
 
-    /// Runs [start, end) of set bits of `mask(word)` in row `k`, appended to `out`.
-    fn runs(&self, k: usize, mask: impl Fn(u64, u64) -> u64, out: &mut Vec<(u32, u32)>) {
-        let g = &self.grid;
-        let (r, d) = (
-            Raster::row(&self.region_bits, g, k),
-            Raster::row(&self.drop_bits, g, k),
-        );
-        let mut carry = 0u64;
-        let mut start = 0u32;
-        let (lo, hi) = self.extent[k];
-        for w in lo as usize..hi as usize {
-            let v = mask(r[w], d[w]);
-            let prev = (v << 1) | carry;
-            let mut starts = v & !prev;
-            let mut ends = !v & prev;
-            let base = (w * 64) as u32;
-            while starts != 0 || ends != 0 {
-                let s = if starts != 0 {
-                    starts.trailing_zeros()
-                } else {
-                    64
-                };
-                let e = if ends != 0 { ends.trailing_zeros() } else { 64 };
-                if s < e {
-                    start = base + s;
-                    starts &= starts - 1;
-                } else {
-                    out.push((start, base + e));
-                    ends &= ends - 1;
+    /// Runs [start, end) of set bits of `mask(region word, droplet word)` in `row`, in grid
+    /// columns, appended to `out`.
+    fn runs(&self, row: &Row, mask: impl Fn(u64, u64) -> u64, out: &mut Vec<(u32, u32)>) {
+        let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+        let (lo, hi) = self.extent[row.slot];
+        for seg in row.segs {
+            let (a, e) = (seg.at.max(lo as usize), seg.end().min(hi as usize));
+            if a >= e {
+                continue;
+            }
+            // Grid column of the slice's column 0 in this segment.
+            let shift = (64 * seg.shift()) as u32;
+            let mut carry = 0u64;
+            let mut start = 0u32;
+            for w in a..e {
+                let v = mask(r[w], d[w]);
+                let prev = (v << 1) | carry;
+                let mut starts = v & !prev;
+                let mut ends = !v & prev;
+                let base = (w * 64) as u32 + shift;
+                while starts != 0 || ends != 0 {
+                    let s = if starts != 0 {
+                        starts.trailing_zeros()
+                    } else {
+                        64
+                    };
+                    let e = if ends != 0 { ends.trailing_zeros() } else { 64 };
+                    if s < e {
+                        start = base + s;
+                        starts &= starts - 1;
+                    } else {
+                        out.push((start, base + e));
+                        ends &= ends - 1;
+                    }
+                }
+                carry = v >> 63;
+            }
+            // The segment's next word is not stored (zero) or beyond the row's bits.
+            if carry != 0 {
+                out.push((start, (e * 64) as u32 + shift));
+            }
+        }
+    }
+
+    /// The region words of row `k` laid out as `row`'s slice (its own slice when both are in
+    /// the same band, else copied into `buf`); `None` when row `k` holds nothing.
+    fn region_row_as<'a>(
+        &'a self,
+        row: &Row,
+        k: usize,
+        buf: &'a mut Vec<u64>,
+    ) -> Option<&'a [u64]> {
+        let other = self.tiles.row(k)?;
+        if other.band == row.band {
+            return Some(&self.region_bits[other.range()]);
+        }
+        buf.clear();
+        buf.resize(row.len, 0);
+        for s in row.segs {
+            for o in other.segs {
+                let (c0, c1) = (s.c0.max(o.c0), s.c1.min(o.c1));
+                if c0 < c1 {
+                    let from = other.offset + c0 - o.shift();
+                    buf[c0 - s.shift()..c1 - s.shift()]
+                        .copy_from_slice(&self.region_bits[from..from + c1 - c0]);
                 }
             }
-            carry = v >> 63;
         }
-        if carry != 0 {
-            out.push((start, hi * 64));
-        }
+        Some(buf)
     }
 
     /// The figures of the layer.
     pub fn analysis(&self) -> LayerAnalysis {
         let g = self.grid;
+        let tiles = &self.tiles;
         let cell = g.gx * g.gy;
         let (mut n_region, mut n_covered, mut n_over) = (0u64, 0u64, 0u64);
         let mut over_rows = Vec::new();
-        for k in 0..g.ny {
-            let (lo, hi) = self.extent[k];
-            if lo >= hi {
-                continue;
-            }
-            let range = k * g.nw + lo as usize..k * g.nw + hi as usize;
-            let before = n_over;
-            for (r, d) in self.region_bits[range.clone()]
-                .iter()
-                .zip(&self.drop_bits[range])
-            {
-                n_region += r.count_ones() as u64;
-                n_covered += (r & d).count_ones() as u64;
-                n_over += (d & !r).count_ones() as u64;
-            }
-            if n_over > before {
-                over_rows.push(k);
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                let row = tiles.row_in(bi, k);
+                let (lo, hi) = self.extent[row.slot];
+                if lo >= hi {
+                    continue;
+                }
+                let range = row.offset + lo as usize..row.offset + hi as usize;
+                let before = n_over;
+                for (r, d) in self.region_bits[range.clone()]
+                    .iter()
+                    .zip(&self.drop_bits[range])
+                {
+                    n_region += r.count_ones() as u64;
+                    n_covered += (r & d).count_ones() as u64;
+                    n_over += (d & !r).count_ones() as u64;
+                }
+                if n_over > before {
+                    over_rows.push(k);
+                }
             }
         }
         // Voids: runs of region & !droplets, joined across rows.
@@ -522,46 +697,70 @@ impl Raster {
         let mut touches: Vec<bool> = Vec::new();
         let mut uf = UnionFind::new(0);
         let mut buf = Vec::new();
+        // The runs of the row before, and the row after the last one looked at.
         let mut prev = 0..0;
+        let mut next_k = 0;
         // Region cells with a neighbour (left, right, above, below) outside the region.
-        let mut edge = vec![0u64; g.nw];
-        for k in 0..g.ny {
-            buf.clear();
-            self.runs(k, |r, d| r & !d, &mut buf);
-            if buf.is_empty() {
-                prev = runs.len()..runs.len();
-                continue;
-            }
-            let (lo, hi) = self.extent[k];
-            let row = Raster::row(&self.region_bits, &g, k);
-            let up = (k + 1 < g.ny).then(|| Raster::row(&self.region_bits, &g, k + 1));
-            let down = (k > 0).then(|| Raster::row(&self.region_bits, &g, k - 1));
-            for w in lo as usize..hi as usize {
-                let r = row[w];
-                let left = (r << 1) | if w > 0 { row[w - 1] >> 63 } else { 0 };
-                let right = (r >> 1) | if w + 1 < g.nw { row[w + 1] << 63 } else { 0 };
-                let u = up.map_or(0, |x| x[w]);
-                let d = down.map_or(0, |x| x[w]);
-                edge[w] = r & !(left & right & u & d);
-            }
-            let first = runs.len();
-            for &(s, e) in &buf {
-                let boundary = count_range(&edge, s as usize, e as usize - 1) > 0;
-                runs.push((k as u32, s, e));
-                touches.push(boundary);
-                uf.parent.push(uf.parent.len() as u32);
-            }
-            let cur = first..runs.len();
-            let (mut i, mut j) = (prev.start, cur.start);
-            while i < prev.end && j < cur.end {
-                let (_, s1, e1) = runs[i];
-                let (_, s2, e2) = runs[j];
-                if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                    uf.union(i, j);
+        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
+        let mut edge = vec![0u64; widest];
+        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                if k != next_k {
+                    prev = runs.len()..runs.len();
                 }
-                if e1 < e2 { i += 1 } else { j += 1 }
+                next_k = k + 1;
+                let row = tiles.row_in(bi, k);
+                buf.clear();
+                self.runs(&row, |r, d| r & !d, &mut buf);
+                if buf.is_empty() {
+                    prev = runs.len()..runs.len();
+                    continue;
+                }
+                let (lo, hi) = self.extent[row.slot];
+                let bits = &self.region_bits[row.range()];
+                let up = (k + 1 < g.ny)
+                    .then(|| self.region_row_as(&row, k + 1, &mut up_buf))
+                    .flatten();
+                let down = (k > 0)
+                    .then(|| self.region_row_as(&row, k - 1, &mut down_buf))
+                    .flatten();
+                for seg in row.segs {
+                    let end = seg.end();
+                    for w in seg.at.max(lo as usize)..end.min(hi as usize) {
+                        let r = bits[w];
+                        let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
+                        let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
+                        let u = up.map_or(0, |x| x[w]);
+                        let d = down.map_or(0, |x| x[w]);
+                        edge[w] = r & !(left & right & u & d);
+                    }
+                }
+                let first = runs.len();
+                let mut seg = 0;
+                for &(s, e) in &buf {
+                    while row.segs[seg].c1 * 64 <= s as usize {
+                        seg += 1;
+                    }
+                    let shift = 64 * row.segs[seg].shift();
+                    let boundary =
+                        count_range(&edge, s as usize - shift, e as usize - 1 - shift) > 0;
+                    runs.push((k as u32, s, e));
+                    touches.push(boundary);
+                    uf.parent.push(uf.parent.len() as u32);
+                }
+                let cur = first..runs.len();
+                let (mut i, mut j) = (prev.start, cur.start);
+                while i < prev.end && j < cur.end {
+                    let (_, s1, e1) = runs[i];
+                    let (_, s2, e2) = runs[j];
+                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                        uf.union(i, j);
+                    }
+                    if e1 < e2 { i += 1 } else { j += 1 }
+                }
+                prev = cur;
             }
-            prev = cur;
         }
         // Components, numbered in order of their first run (a root precedes its members).
         #[derive(Clone, Copy)]
@@ -647,13 +846,13 @@ impl Raster {
                 probe(&mut dev_in, k as usize, s, e);
             }
         }
-        {
-            for &k in &over_rows {
-                buf.clear();
-                self.runs(k, |r, d| d & !r, &mut buf);
-                for &(s, e) in &buf {
-                    probe(&mut dev_out, k, s, e);
-                }
+        for &k in &over_rows {
+            buf.clear();
+            if let Some(row) = tiles.row(k) {
+                self.runs(&row, |r, d| d & !r, &mut buf);
+            }
+            for &(s, e) in &buf {
+                probe(&mut dev_out, k, s, e);
             }
         }
         let coverage = if n_region > 0 {
@@ -685,45 +884,111 @@ impl Raster {
         }
     }
 
-    /// A [`CoverageMask`] with square cells of about `cell` mm.
+    /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
     pub fn mask(&self, cell: f64) -> CoverageMask {
         let g = self.grid;
+        let tiles = &self.tiles;
         let rows = ((cell / g.gy).round() as usize).max(1);
         let cols = rows * COLS_PER_ROW as usize;
-        let width = g.nx.div_ceil(cols);
         let height = g.ny.div_ceil(rows);
-        let mut counts = vec![[0u32; 3]; width * height];
-        let mut void = vec![0u64; g.nw];
-        let mut over = vec![0u64; g.nw];
-        let mut cov = vec![0u64; g.nw];
-        for k in 0..g.ny {
-            let (r, d) = (
-                Raster::row(&self.region_bits, &g, k),
-                Raster::row(&self.drop_bits, &g, k),
-            );
-            for w in 0..g.nw {
-                void[w] = r[w] & !d[w];
-                over[w] = d[w] & !r[w];
-                cov[w] = d[w] & r[w];
+        // In each band of MASK_BAND_ROWS mask rows, the mask columns over the raster's segments
+        // in those rows, merged: (mask band, first column, last column).
+        let mut spans = Vec::new();
+        for band in tiles.bands() {
+            let mb0 = band.first_row / rows / MASK_BAND_ROWS;
+            let mb1 = (band.end_row - 1) / rows / MASK_BAND_ROWS;
+            for seg in tiles.segments(band) {
+                let (c0, c1) = (64 * seg.c0 / cols, ((64 * seg.c1).min(g.nx) - 1) / cols);
+                spans.extend((mb0..=mb1).map(|mb| (mb, c0, c1)));
             }
-            for cx in 0..width {
-                let (c0, c1) = (cx * cols, ((cx + 1) * cols).min(g.nx) - 1);
-                let slot = &mut counts[(k / rows) * width + cx];
-                slot[0] += count_range(&void, c0, c1);
-                slot[1] += count_range(&over, c0, c1);
-                slot[2] += count_range(&cov, c0, c1);
+        }
+        spans.sort_unstable();
+        // The tiles, and per mask band the range of its tiles.
+        let mut out: Vec<MaskTile> = Vec::new();
+        let mut groups: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
+        let mut i = 0;
+        while i < spans.len() {
+            let mb = spans[i].0;
+            let first = out.len();
+            while i < spans.len() && spans[i].0 == mb {
+                let (_, c0, mut c1) = spans[i];
+                i += 1;
+                while i < spans.len() && spans[i].0 == mb && spans[i].1 <= c1 + 1 {
+                    c1 = c1.max(spans[i].2);
+                    i += 1;
+                }
+                let row = mb * MASK_BAND_ROWS;
+                out.push(MaskTile {
+                    col: c0,
+                    row,
+                    width: c1 - c0 + 1,
+                    height: MASK_BAND_ROWS.min(height - row),
+                    ..MaskTile::default()
+                });
+            }
+            groups.push((mb, first..out.len()));
+        }
+        let mut counts: Vec<Vec<[u32; 3]>> = out
+            .iter()
+            .map(|t| vec![[0; 3]; t.width * t.height])
+            .collect();
+        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
+        let mut void = vec![0u64; widest];
+        let mut over = vec![0u64; widest];
+        let mut cov = vec![0u64; widest];
+        let mut group = 0;
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                let row = tiles.row_in(bi, k);
+                let (lo, hi) = self.extent[row.slot];
+                if lo >= hi {
+                    continue;
+                }
+                let (lo, hi) = (lo as usize, hi as usize);
+                let my = k / rows;
+                while groups[group].0 < my / MASK_BAND_ROWS {
+                    group += 1;
+                }
+                let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+                for w in lo..hi {
+                    void[w] = r[w] & !d[w];
+                    over[w] = d[w] & !r[w];
+                    cov[w] = d[w] & r[w];
+                }
+                let mut t = groups[group].1.start;
+                for seg in row.segs {
+                    let (a, e) = (seg.at.max(lo), seg.end().min(hi));
+                    if a >= e {
+                        continue;
+                    }
+                    // Grid columns [gc0, gc1] of the segment's bits; column c at c − shift.
+                    let shift = 64 * seg.shift();
+                    let (gc0, gc1) = (64 * a + shift, (64 * e + shift).min(g.nx) - 1);
+                    for cx in gc0 / cols..=gc1 / cols {
+                        let (c0, c1) = ((cx * cols).max(gc0), ((cx + 1) * cols - 1).min(gc1));
+                        while out[t].col + out[t].width <= cx {
+                            t += 1;
+                        }
+                        let tile = &out[t];
+                        let slot = &mut counts[t][(my - tile.row) * tile.width + cx - tile.col];
+                        slot[0] += count_range(&void, c0 - shift, c1 - shift);
+                        slot[1] += count_range(&over, c0 - shift, c1 - shift);
+                        slot[2] += count_range(&cov, c0 - shift, c1 - shift);
+                    }
+                }
             }
         }
         let full = (rows * cols) as f64;
         let share = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
+        for (tile, counts) in out.iter_mut().zip(&counts) {
+            tile.void = counts.iter().map(|c| share(c[0])).collect();
+            tile.overfill = counts.iter().map(|c| share(c[1])).collect();
+            tile.covered = counts.iter().map(|c| share(c[2])).collect();
+        }
         CoverageMask {
             origin: [g.x0, g.y0],
             cell: rows as f64 * g.gy,
-            width,
-            height,
-            void: counts.iter().map(|c| share(c[0])).collect(),
-            overfill: counts.iter().map(|c| share(c[1])).collect(),
-            covered: counts.iter().map(|c| share(c[2])).collect(),
+            tiles: out,
         }
     }
 }
@@ -837,14 +1102,20 @@ impl PartAnalysis {
     }
 }
 
+/// Rows per band and cells per tile of a [`HeightMap`]: tiles of 32 × 32 cells (2.2 mm square
+/// with the default B).
+const MAP_BAND_ROWS: usize = 32;
+const MAP_TILE_COLS: usize = 32;
+
 /// The droplet spheroids of one layer on the 3D grid: per cell, the largest
 /// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
-/// droplets fill the cell's column within c·√q of the layer's mid-height.
+/// droplets fill the cell's column within c·√q of the layer's mid-height. Stored only in the
+/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere.
 pub struct HeightMap {
+    /// Grid indices of the map's cell (0, 0).
     x0: i64,
     y0: i64,
-    w: usize,
-    h: usize,
+    tiles: Tiles,
     q: Vec<f32>,
 }
 
@@ -853,6 +1124,37 @@ pub struct HeightMap {
 pub struct Grid3 {
     pub origin: Point,
     pub cell: f64,
+}
+
+/// One row of a [`HeightMap`]: its segments' cells in `data`.
+#[derive(Clone, Copy)]
+struct MapRow<'a> {
+    x0: i64,
+    segs: &'a [Segment],
+    data: &'a [f32],
+}
+
+impl<'a> MapRow<'a> {
+    const EMPTY: MapRow<'static> = MapRow {
+        x0: 0,
+        segs: &[],
+        data: &[],
+    };
+
+    /// The stretch of the row from grid index `ix` on: (grid index of `cells[0]`, cells, grid
+    /// index of its last cell); no cells where nothing is stored.
+    fn piece(&self, ix: i64) -> (i64, &'a [f32], i64) {
+        for s in self.segs {
+            let (a, b) = (self.x0 + s.c0 as i64, self.x0 + s.c1 as i64);
+            if ix < a {
+                return (ix, &[], a - 1);
+            }
+            if ix < b {
+                return (a, &self.data[s.at..s.end()], b - 1);
+            }
+        }
+        (ix, &[], i64::MAX)
+    }
 }
 
 impl HeightMap {
@@ -867,12 +1169,12 @@ impl HeightMap {
                 max[k] = max[k].max(idx(p[k] + r, k) + 1);
             }
         }
+        let mut tiles = Tiles::default();
         if centres.is_empty() {
             return HeightMap {
                 x0: 0,
                 y0: 0,
-                w: 0,
-                h: 0,
+                tiles,
                 q: Vec::new(),
             };
         }
@@ -880,12 +1182,28 @@ impl HeightMap {
             (max[0] - min[0] + 1) as usize,
             (max[1] - min[1] + 1) as usize,
         );
-        let mut q = vec![0f32; w * h];
+        // A droplet's cells [ax, bx] × [ay, by].
+        let cells = |p: &Point| {
+            (
+                (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1),
+                (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1),
+            )
+        };
+        let cells: Vec<_> = centres.iter().map(cells).collect();
+        tiles.reset(h, w, MAP_BAND_ROWS, MAP_TILE_COLS);
+        for &((ax, bx), (ay, by)) in &cells {
+            let (x, y) = (
+                |v: i64| (v - min[0]) as usize,
+                |v: i64| (v - min[1]) as usize,
+            );
+            tiles.mark(y(ay), y(by), x(ax), x(bx));
+        }
+        let mut q = vec![0f32; tiles.build()];
         let inv = 1.0 / (r * r);
         let mut xx = Vec::new();
-        for p in centres {
-            let (ax, bx) = (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1);
-            let (ay, by) = (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1);
+        // Where the last droplet row's cells were stored (mostly the next one's too).
+        let mut spot: Option<Spot> = None;
+        for (p, &((ax, bx), (ay, by))) in centres.iter().zip(&cells) {
             xx.clear();
             xx.extend((ax..=bx).map(|ix| {
                 let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
@@ -898,8 +1216,13 @@ impl HeightMap {
                     // No cell of this row is inside (q ≤ 0 never raises a cell).
                     continue;
                 }
-                let row = (iy - min[1]) as usize * w + (ax - min[0]) as usize;
-                for (slot, &x2) in q[row..row + xx.len()].iter_mut().zip(&xx) {
+                let (k, c) = ((iy - min[1]) as usize, (ax - min[0]) as usize);
+                let Some(sp) = tiles.spot_cached(&mut spot, k, c, c + xx.len() - 1) else {
+                    debug_assert!(false, "droplet outside the map's tiles");
+                    continue;
+                };
+                let at = sp.index(k) + c - sp.shift;
+                for (slot, &x2) in q[at..at + xx.len()].iter_mut().zip(&xx) {
                     let v = (1.0 - (x2 + yy) * inv) as f32;
                     if v > *slot {
                         *slot = v;
@@ -910,20 +1233,26 @@ impl HeightMap {
         HeightMap {
             x0: min[0],
             y0: min[1],
-            w,
-            h,
+            tiles,
             q,
         }
     }
 
-    /// Row `iy`: (x index of its first cell, its cells); empty outside the map.
-    fn row(&self, iy: i64) -> (i64, &[f32]) {
-        let y = iy - self.y0;
-        if y < 0 || y as usize >= self.h {
-            return (self.x0, &[]);
-        }
-        let y = y as usize;
-        (self.x0, &self.q[y * self.w..(y + 1) * self.w])
+    /// Row `iy` (a grid index); empty outside the map.
+    fn row(&self, iy: i64) -> MapRow<'_> {
+        usize::try_from(iy - self.y0)
+            .ok()
+            .and_then(|y| self.tiles.row(y))
+            .map_or(MapRow::EMPTY, |row| MapRow {
+                x0: self.x0,
+                segs: row.segs,
+                data: &self.q[row.range()],
+            })
+    }
+
+    /// Cells stored (for tests of the memory it takes).
+    pub fn stored_cells(&self) -> usize {
+        self.q.len()
     }
 }
 
@@ -969,46 +1298,55 @@ pub fn slab_voids(
             .copied()
             .unwrap_or(0.0)
     };
-    let none = |_: i64| (0i64, &[][..]);
     region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
         let iy = k0 + k as i64;
         let c0 = ((xa - grid.origin[0]) / grid.cell - 0.5).ceil() as i64;
         let c1 = ((xb - grid.origin[0]) / grid.cell - 0.5).floor() as i64;
-        let rb = below.map_or_else(|| none(iy), |m| m.row(iy));
-        let ra = above.map_or_else(|| none(iy), |m| m.row(iy));
-        let rt = this.row(iy);
-        for ix in c0..=c1 {
-            cells += 1;
-            // Local z from the slab's bottom: [0, lo] from below, the own droplet around h/2,
-            // [h − hi, h] from above.
-            let q = at(rt, ix);
-            let a = if q > 0.0 {
-                (c * (q as f64).sqrt()).min(half)
-            } else {
-                0.0
-            };
-            if a >= half {
-                // The own droplet fills the whole column.
-                filled += h;
-                continue;
-            }
-            let lo = ext(at(rb, ix)).min(h);
-            let hi = ext(at(ra, ix)).min(h);
-            let (m0, m1) = (half - a, half + a);
-            // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
-            let mut len = 0.0;
-            let mut end = 0.0f64;
-            for (s0, s1) in [(0.0, lo), (m0, m1), (h - hi, h)] {
-                if s1 <= s0 {
+        let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
+        let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
+        let this = this.row(iy);
+        // Stretches of the span over which each map is one slice (or nothing).
+        let mut from = c0;
+        while from <= c1 {
+            let (xt, rt, et) = this.piece(from);
+            let (xb, rb, eb) = below.piece(from);
+            let (xa, ra, ea) = above.piece(from);
+            let to = c1.min(et).min(eb).min(ea);
+            let (rt, rb, ra) = ((xt, rt), (xb, rb), (xa, ra));
+            for ix in from..=to {
+                cells += 1;
+                // Local z from the slab's bottom: [0, lo] from below, the own droplet around
+                // h/2, [h − hi, h] from above.
+                let q = at(rt, ix);
+                let a = if q > 0.0 {
+                    (c * (q as f64).sqrt()).min(half)
+                } else {
+                    0.0
+                };
+                if a >= half {
+                    // The own droplet fills the whole column.
+                    filled += h;
                     continue;
                 }
-                let s0 = s0.max(end);
-                if s1 > s0 {
-                    len += s1 - s0;
-                    end = s1;
+                let lo = ext(at(rb, ix)).min(h);
+                let hi = ext(at(ra, ix)).min(h);
+                let (m0, m1) = (half - a, half + a);
+                // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
+                let mut len = 0.0;
+                let mut end = 0.0f64;
+                for (s0, s1) in [(0.0, lo), (m0, m1), (h - hi, h)] {
+                    if s1 <= s0 {
+                        continue;
+                    }
+                    let s0 = s0.max(end);
+                    if s1 > s0 {
+                        len += s1 - s0;
+                        end = s1;
+                    }
                 }
+                filled += len;
             }
-            filled += len;
+            from = to + 1;
         }
     });
     let area = grid.cell * grid.cell;
@@ -1109,7 +1447,7 @@ impl LayerStage {
 
 /// The ordered half of the job analysis: takes every layer's [`AnalysedLayer`] in ascending
 /// order, computes each slab's 3D estimate once its neighbours are in, and gives the
-/// [`Report`] (the same as [`analyse_job`]'s). Keeps two layers' maps at a time.
+/// [`Report`]. Keeps two layers' maps at a time.
 pub struct JobAnalysis {
     stage: LayerStage,
     file_name: String,
@@ -1173,115 +1511,4 @@ impl JobAnalysis {
             layers: self.layers,
         }
     }
-}
-
-/// Plans and analyses every layer of `job` in parallel (blocks of consecutive layers per
-/// thread, so each layer's spheroids are built once and shared with its neighbours).
-/// `timing` receives (seconds planning, seconds analysing), summed over threads.
-#[cfg(not(target_arch = "wasm32"))]
-pub fn analyse_job(job: &crate::Job) -> (Report, [f64; 2]) {
-    use std::sync::Mutex;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::time::Instant;
-    let s = job.settings();
-    let n = job.layer_count();
-    let b = s.droplet_width();
-    let d = footprint_diameter(s);
-    let bounds = job.info().bounds;
-    let grid = Grid3 {
-        origin: [bounds.min[0] - d, bounds.min[1] - d],
-        cell: b / GRID3_PER_B,
-    };
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |t| t.get())
-        .min(n.max(1));
-    let block = n.div_ceil(4 * threads).max(4);
-    let blocks = n.div_ceil(block);
-    let next = AtomicUsize::new(0);
-    type Out = (LayerAnalysis, f64, f64);
-    let results: Mutex<Vec<Option<Out>>> = Mutex::new(vec![None; n]);
-    let times = Mutex::new([0.0f64; 2]);
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| {
-                let mut t_plan = 0.0;
-                let mut t_analyse = 0.0;
-                loop {
-                    let bi = next.fetch_add(1, Ordering::Relaxed);
-                    if bi >= blocks {
-                        break;
-                    }
-                    let (a, e) = (bi * block, ((bi + 1) * block).min(n));
-                    let layer = |i: usize, t_plan: &mut f64, t_analyse: &mut f64| {
-                        let t = Instant::now();
-                        let (plan, region) = job.plan_layer_and_region(i);
-                        *t_plan += t.elapsed().as_secs_f64();
-                        let t = Instant::now();
-                        let centres = droplet_centres(&plan, b);
-                        let map = HeightMap::new(&centres, &grid, d);
-                        *t_analyse += t.elapsed().as_secs_f64();
-                        (region, plan, centres, map)
-                    };
-                    let mut raster = Raster::empty();
-                    let mut below = (a > 0).then(|| layer(a - 1, &mut t_plan, &mut t_analyse).3);
-                    let mut cur = layer(a, &mut t_plan, &mut t_analyse);
-                    let mut out = Vec::with_capacity(e - a);
-                    for i in a..e {
-                        let above = (i + 1 < n).then(|| layer(i + 1, &mut t_plan, &mut t_analyse));
-                        let t = Instant::now();
-                        let (region, plan, centres, map) = &cur;
-                        raster.rebuild(i, plan.z, centres, region, s);
-                        let la = raster.analysis();
-                        let (vol, void) = slab_voids(
-                            region,
-                            &grid,
-                            below.as_ref(),
-                            map,
-                            above.as_ref().map(|x| &x.3),
-                            s,
-                        );
-                        t_analyse += t.elapsed().as_secs_f64();
-                        // The slab's exact volume, with the void share sampled on the grid.
-                        let exact = la.region_area * s.layer_height;
-                        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
-                        out.push((la, exact, void));
-                        let Some(next) = above else { break };
-                        below = Some(std::mem::replace(&mut cur, next).3);
-                        if i + 1 == e {
-                            break;
-                        }
-                    }
-                    let mut r = results.lock().unwrap_or_else(|p| p.into_inner());
-                    for (k, o) in out.into_iter().enumerate() {
-                        r[a + k] = Some(o);
-                    }
-                }
-                let mut t = times.lock().unwrap_or_else(|p| p.into_inner());
-                t[0] += t_plan;
-                t[1] += t_analyse;
-            });
-        }
-    });
-    let mut part = PartAnalysis::default();
-    let mut layers = Vec::with_capacity(n);
-    for (la, vol, void) in results
-        .into_inner()
-        .unwrap_or_else(|p| p.into_inner())
-        .into_iter()
-        .flatten()
-    {
-        part.add(&la, vol, void);
-        layers.push(la);
-    }
-    let report = Report {
-        file_name: job.info().file_name.clone(),
-        settings: s.clone(),
-        model: Model::new(s),
-        part,
-        layers,
-    };
-    (
-        report,
-        times.into_inner().unwrap_or_else(|p| p.into_inner()),
-    )
 }

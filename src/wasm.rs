@@ -10,7 +10,7 @@
 //!
 //! The core knows nothing of wasm; this file only converts.
 
-use crate::analysis::{self, CoverageMask, LayerAnalysis};
+use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::error::Error;
 use crate::gcode;
 use crate::plan::{Counts, LayerPlan};
@@ -267,31 +267,45 @@ impl LayerResult {
             .and_then(|a| serde_json::to_string(a).ok())
             .unwrap_or_default()
     }
-    /// The coverage mask's frame: [origin x, origin y, cell (mm), width, height] (cells);
-    /// empty without analysis. Cell (col, row) starts at origin + (col, row)·cell.
+    /// The coverage mask's cell, mm; 0 without analysis.
     #[wasm_bindgen(getter)]
-    pub fn mask_frame(&self) -> Float64Array {
-        match &self.mask {
-            Some(m) => Float64Array::from(
-                &[
-                    m.origin[0],
-                    m.origin[1],
-                    m.cell,
-                    m.width as f64,
-                    m.height as f64,
-                ][..],
-            ),
-            None => Float64Array::new_with_length(0),
-        }
+    pub fn mask_cell(&self) -> f64 {
+        self.mask.as_ref().map_or(0.0, |m| m.cell)
     }
-    /// Void share (region not covered) per mask cell, 0..255, row-major; empty without analysis.
+    /// The coverage mask's tiles (only where the layer's region and droplets are): per tile
+    /// origin x, origin y (mm), width, height (cells); cell (col, row) of a tile starts at its
+    /// origin + (col, row)·cell. Empty without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn mask_tiles(&self) -> Float64Array {
+        let frames: Vec<f64> = self.mask.as_ref().map_or_else(Vec::new, |m| {
+            m.tiles
+                .iter()
+                .flat_map(|t| {
+                    let o = m.tile_origin(t);
+                    [o[0], o[1], t.width as f64, t.height as f64]
+                })
+                .collect()
+        });
+        Float64Array::from(&frames[..])
+    }
+    /// Void share (region not covered) per mask cell, 0..255: the tiles one after the other,
+    /// each row-major from its lowest row; empty without analysis.
     #[wasm_bindgen(getter)]
     pub fn void_mask(&self) -> Uint8Array {
-        Uint8Array::from(self.mask.as_ref().map_or(&[][..], |m| &m.void[..]))
+        self.shares(|t| &t.void)
     }
-    /// Overfill share (covered outside the region) per mask cell, 0..255, row-major.
+    /// Overfill share (covered outside the region) per mask cell, laid out as `void_mask`.
     #[wasm_bindgen(getter)]
     pub fn overfill_mask(&self) -> Uint8Array {
-        Uint8Array::from(self.mask.as_ref().map_or(&[][..], |m| &m.overfill[..]))
+        self.shares(|t| &t.overfill)
+    }
+}
+
+impl LayerResult {
+    /// One share of every tile of the mask, one tile after the other.
+    fn shares(&self, of: impl Fn(&MaskTile) -> &Vec<u8>) -> Uint8Array {
+        let tiles = self.mask.as_ref().map_or(&[][..], |m| &m.tiles[..]);
+        let bytes: Vec<u8> = tiles.iter().flat_map(|t| of(t).iter().copied()).collect();
+        Uint8Array::from(&bytes[..])
     }
 }

@@ -31,6 +31,23 @@ fn box_stl(w: f64, d: f64, h: f64) -> String {
     s
 }
 
+/// Two boxes as one ASCII STL, the second moved by (dx, dy).
+fn two_boxes_stl(w: f64, d: f64, h: f64, dx: f64, dy: f64) -> String {
+    let one = box_stl(w, d, h);
+    let moved: String = one
+        .lines()
+        .filter(|l| l.starts_with("vertex") || l.contains("facet") || l.contains("loop"))
+        .map(|l| match l.strip_prefix("vertex ") {
+            Some(xyz) => {
+                let v: Vec<f64> = xyz.split(' ').map(|c| c.parse().unwrap()).collect();
+                format!("vertex {} {} {}\n", v[0] + dx, v[1] + dy, v[2])
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    one.replace("endsolid box\n", &moved) + "endsolid box\n"
+}
+
 /// Adds every number of `b` into `a`, as the page sums the layers' summaries.
 fn add_numbers(a: &mut serde_json::Value, b: &serde_json::Value) {
     use serde_json::Value;
@@ -187,7 +204,8 @@ fn analysed_layers_have_sane_void_figures() {
     let plain = s.slice_layer(3).unwrap();
     assert_eq!(plain.analysis_json(), "");
     assert_eq!(plain.void_mask().length(), 0);
-    assert_eq!(plain.mask_frame().length(), 0);
+    assert_eq!(plain.mask_tiles().length(), 0);
+    assert_eq!(plain.mask_cell(), 0.0);
     for i in [0, 3, 9] {
         let l = s.slice_layer_analysed(i).unwrap();
         // the same layer as plain slicing
@@ -215,19 +233,34 @@ fn analysed_layers_have_sane_void_figures() {
         let (min, max) = (&largest["min"], &largest["max"]);
         assert!(min[0].as_f64().unwrap() >= -0.5 && max[0].as_f64().unwrap() <= 10.5);
         assert!(a["overfill_area"].as_f64().unwrap() >= 0.0);
-        // the mask: cells of B/4 over the layer, its void share adds up to the void area
-        let f = l.mask_frame().to_vec();
-        assert_eq!(f.len(), 5);
-        let (cell, w, h) = (f[2], f[3] as usize, f[4] as usize);
+        // the mask: tiles of cells of B/4 over the layer, its void share adds up to the void
+        // area
+        let cell = l.mask_cell();
         let b = 0.2 * 1.04;
         assert!((cell - b / 4.0).abs() < b / 10.0, "cell {cell}");
+        let tiles = l.mask_tiles().to_vec();
         assert!(
-            w as f64 * cell >= 10.0 && h as f64 * cell >= 6.0,
-            "{w} x {h}"
+            !tiles.is_empty() && tiles.len().is_multiple_of(4),
+            "{tiles:?}"
         );
+        let mut cells = 0;
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for t in tiles.chunks(4) {
+            let (w, h) = (t[2] as usize, t[3] as usize);
+            cells += w * h;
+            lo = [lo[0].min(t[0]), lo[1].min(t[1])];
+            hi = [
+                hi[0].max(t[0] + w as f64 * cell),
+                hi[1].max(t[1] + h as f64 * cell),
+            ];
+        }
+        // the tiles cover the box (10 x 6 mm) and not much more
+        assert!(lo[0] <= 0.0 && lo[1] <= 0.0, "{lo:?}");
+        assert!(hi[0] >= 10.0 && hi[1] >= 6.0, "{hi:?}");
+        assert!(hi[0] < 15.0 && hi[1] < 11.0, "{hi:?}");
         let mask = l.void_mask().to_vec();
-        assert_eq!(mask.len(), w * h);
-        assert_eq!(l.overfill_mask().length() as usize, w * h);
+        assert_eq!(mask.len(), cells);
+        assert_eq!(l.overfill_mask().length() as usize, cells);
         let masked: f64 = mask.iter().map(|&v| v as f64 / 255.0).sum::<f64>() * cell * cell;
         assert!(
             (masked - void).abs() < 0.05 * void,
@@ -235,4 +268,31 @@ fn analysed_layers_have_sane_void_figures() {
         );
     }
     assert!(s.slice_layer_analysed(10).is_err());
+}
+
+#[wasm_bindgen_test]
+fn the_mask_of_parts_far_apart_has_tiles_near_them_only() {
+    // Two 3 x 3 mm boxes 1 m apart: a dense mask over their bounding box (cells of B/4) would
+    // hold 2.6e8 cells of 2 bytes and not fit in the 4 GB a wasm instance can address.
+    let stl = two_boxes_stl(3.0, 3.0, 1.0, 1000.0, 1000.0);
+    let s = Session::new(stl.as_bytes(), "two.stl", "{}").unwrap();
+    let l = s.slice_layer_analysed(2).unwrap();
+    let a: serde_json::Value = serde_json::from_str(&l.analysis_json()).unwrap();
+    let region = a["region_area"].as_f64().unwrap();
+    assert!((region - 18.0).abs() < 0.01, "region {region}");
+    let coverage = a["coverage"].as_f64().unwrap();
+    assert!((0.7..0.9).contains(&coverage), "coverage {coverage}");
+    let cell = l.mask_cell();
+    let tiles = l.mask_tiles().to_vec();
+    let cells: f64 = tiles.chunks(4).map(|t| t[2] * t[3]).sum();
+    assert!(
+        cells * cell * cell < 200.0,
+        "tiles over {} mm²",
+        cells * cell * cell
+    );
+    for t in tiles.chunks(4) {
+        let near = |c: f64| (t[0] - c).abs() < 10.0 && (t[1] - c).abs() < 10.0;
+        assert!(near(0.0) || near(1000.0), "tile at {t:?}");
+    }
+    assert_eq!(l.void_mask().length() as f64, cells);
 }
