@@ -141,9 +141,10 @@ class Slice {
   }
 }
 
-/** Bytes a cached layer holds (droplets, roles, travel and the void mask). */
+/** Bytes a cached layer holds (droplets, roles, travel and the void mask's tiles). */
 function layerBytes(l: LayerData): number {
-  const m = l.mask ? l.mask.void.byteLength + l.mask.overfill.byteLength : 0;
+  let m = 0;
+  for (const t of l.mask?.tiles ?? []) m += t.void.byteLength + t.overfill.byteLength;
   return l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength + m;
 }
 

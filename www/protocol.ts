@@ -65,15 +65,52 @@ export interface LayerAnalysis {
   [key: string]: unknown;
 }
 
-/** Per square cell (col, row) from `origin` + (col, row)·cell: the share 0..255 of it that
- *  is void / overfill; row-major, row 0 at the lowest y. */
+/** The analysis' coverage mask: square cells of `cell` mm, in tiles only where the layer's
+ *  region and droplets are (parts far apart cost nothing for the space between them). */
 export interface CoverageMask {
-  origin: [number, number];
   cell: number;
+  tiles: MaskTile[];
+}
+
+/** Per square cell (col, row) from `origin` + (col, row)·cell: the share 0..255 of it that
+ *  is void / overfill; row-major, row 0 at the lowest y. `overfill` is empty when the tile
+ *  has none (it is rare). */
+export interface MaskTile {
+  origin: [number, number];
   width: number;
   height: number;
   void: Uint8Array;
   overfill: Uint8Array;
+}
+
+/** The mask from the core's flat arrays (src/wasm.rs: `mask_cell`, `mask_tiles` = origin x,
+ *  origin y, width, height per tile, `void_mask` and `overfill_mask` = the tiles' shares one
+ *  after the other); each tile gets its own buffers. */
+export function coverageMaskOf(r: {
+  mask_cell: number;
+  mask_tiles: Float64Array;
+  void_mask: Uint8Array;
+  overfill_mask: Uint8Array;
+}): CoverageMask {
+  const frames = r.mask_tiles;
+  const voids = r.void_mask;
+  const overfill = r.overfill_mask;
+  const tiles: MaskTile[] = [];
+  let at = 0;
+  for (let i = 0; i + 3 < frames.length; i += 4) {
+    const [x, y, width, height] = [frames[i], frames[i + 1], frames[i + 2], frames[i + 3]];
+    const end = at + width * height;
+    const over = overfill.subarray(at, end);
+    tiles.push({
+      origin: [x, y],
+      width,
+      height,
+      void: voids.slice(at, end),
+      overfill: over.some((v) => v !== 0) ? over.slice() : new Uint8Array(0),
+    });
+    at = end;
+  }
+  return { cell: r.mask_cell, tiles };
 }
 
 /** The result of a "slice" request: what belongs to its run of layers as a whole. */
@@ -143,7 +180,7 @@ export function splitError(text: string): { kind: string; message: string } {
 
 export function transferablesOf(layer: LayerData): Transferable[] {
   const out = [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
-  if (layer.mask) out.push(layer.mask.void.buffer, layer.mask.overfill.buffer);
+  for (const t of layer.mask?.tiles ?? []) out.push(t.void.buffer, t.overfill.buffer);
   return out;
 }
 

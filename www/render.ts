@@ -255,41 +255,48 @@ export class Renderer {
     }
   }
 
-  private maskImage: { mask: CoverageMask; canvas: OffscreenCanvas } | null = null;
+  private maskImage: { mask: CoverageMask; canvases: (OffscreenCanvas | null)[] } | null = null;
 
-  /** The mask as a bitmap, one pixel per cell (made once per layer). */
-  private maskBitmap(m: CoverageMask): OffscreenCanvas {
-    if (this.maskImage?.mask === m) return this.maskImage.canvas;
-    const w = Math.max(1, m.width);
-    const h = Math.max(1, m.height);
-    const img = new ImageData(w, h);
-    const px = img.data;
-    for (let row = 0; row < m.height; row++) {
-      // bitmap row 0 is drawn at the origin's y: the flipped transform puts it at the bottom
-      for (let col = 0; col < m.width; col++) {
-        const i = row * m.width + col;
-        const v = m.void[i];
-        const o = m.overfill.length ? m.overfill[i] : 0;
-        const [rgb, share] = o > v ? [OVERFILL_RGB, o] : [VOID_RGB, v];
-        if (share === 0) continue;
-        px[4 * i] = rgb[0];
-        px[4 * i + 1] = rgb[1];
-        px[4 * i + 2] = rgb[2];
-        px[4 * i + 3] = Math.round(share * VOID_ALPHA);
+  /** The mask's tiles as bitmaps, one pixel per cell, null for a tile with nothing to draw
+   *  (made once per layer). */
+  private maskBitmaps(m: CoverageMask): (OffscreenCanvas | null)[] {
+    if (this.maskImage?.mask === m) return this.maskImage.canvases;
+    const canvases = m.tiles.map((t) => {
+      if (t.width === 0 || t.height === 0) return null;
+      if (t.overfill.length === 0 && !t.void.some((v) => v !== 0)) return null;
+      const img = new ImageData(t.width, t.height);
+      const px = img.data;
+      for (let row = 0; row < t.height; row++) {
+        // bitmap row 0 is drawn at the origin's y: the flipped transform puts it at the bottom
+        for (let col = 0; col < t.width; col++) {
+          const i = row * t.width + col;
+          const v = t.void[i];
+          const o = t.overfill.length ? t.overfill[i] : 0;
+          const [rgb, share] = o > v ? [OVERFILL_RGB, o] : [VOID_RGB, v];
+          if (share === 0) continue;
+          px[4 * i] = rgb[0];
+          px[4 * i + 1] = rgb[1];
+          px[4 * i + 2] = rgb[2];
+          px[4 * i + 3] = Math.round(share * VOID_ALPHA);
+        }
       }
-    }
-    const canvas = new OffscreenCanvas(w, h);
-    canvas.getContext("2d")!.putImageData(img, 0, 0);
-    this.maskImage = { mask: m, canvas };
-    return canvas;
+      const canvas = new OffscreenCanvas(t.width, t.height);
+      canvas.getContext("2d")!.putImageData(img, 0, 0);
+      return canvas;
+    });
+    this.maskImage = { mask: m, canvases };
+    return canvases;
   }
 
   /** Uncovered part area (and overfill) over the droplets, in the mm transform. */
   private drawVoids(ctx: CanvasRenderingContext2D, m: CoverageMask): void {
-    if (m.width === 0 || m.height === 0) return;
+    const canvases = this.maskBitmaps(m);
     ctx.save();
     ctx.imageSmoothingEnabled = true;
-    ctx.drawImage(this.maskBitmap(m), m.origin[0], m.origin[1], m.width * m.cell, m.height * m.cell);
+    m.tiles.forEach((t, i) => {
+      const c = canvases[i];
+      if (c) ctx.drawImage(c, t.origin[0], t.origin[1], t.width * m.cell, t.height * m.cell);
+    });
     ctx.restore();
   }
 

@@ -11,7 +11,7 @@ import init, {
   type InitOutput,
 } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
-import { addNumbers, splitError, transferablesOf, type LayerData, type Reply, type Request, type SliceUnit } from "./protocol";
+import { addNumbers, coverageMaskOf, splitError, transferablesOf, type LayerData, type Reply, type Request, type SliceUnit } from "./protocol";
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 
@@ -71,18 +71,8 @@ function layerOf(s: Session, index: number, unit: UnitParts | null, analyse = fa
       travel: r.travel,
     };
     if (analyse) {
-      const f = r.mask_frame;
       layer.analysis = JSON.parse(r.analysis_json);
-      const overfill = r.overfill_mask;
-      // overfill is rare: an all-zero mask is not worth posting and caching
-      layer.mask = {
-        origin: [f[0], f[1]],
-        cell: f[2],
-        width: f[3],
-        height: f[4],
-        void: r.void_mask,
-        overfill: overfill.some((v) => v !== 0) ? overfill : new Uint8Array(0),
-      };
+      layer.mask = coverageMaskOf(r);
     }
     return layer;
   } finally {
