@@ -404,15 +404,16 @@ impl Mesh {
         drop(around);
         let mut id = vec![u32::MAX; nf];
         let mut shells = 0u32;
-        let mut facet_shell = vec![0u32; nf];
-        for fi in 0..nf {
-            let r = find(&mut parent, fi as u32) as usize;
-            if id[r] == u32::MAX {
-                id[r] = shells;
-                shells += 1;
-            }
-            facet_shell[fi] = id[r];
-        }
+        let facet_shell: Vec<u32> = (0..nf as u32)
+            .map(|fi| {
+                let r = find(&mut parent, fi) as usize;
+                if id[r] == u32::MAX {
+                    id[r] = shells;
+                    shells += 1;
+                }
+                id[r]
+            })
+            .collect();
         let mut closed = vec![true; shells as usize];
         for f in bad {
             closed[facet_shell[f as usize] as usize] = false;
