@@ -21,6 +21,7 @@ pub mod error;
 pub mod gcode;
 pub mod grid;
 pub mod hatch;
+pub mod import;
 pub mod mesh;
 pub mod offset;
 pub mod plan;

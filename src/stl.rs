@@ -10,12 +10,19 @@ use crate::error::Error;
 /// they are often wrong or zero; orientation comes from the vertex order).
 pub type Triangles = Vec<[[f32; 3]; 3]>;
 
-/// Which of the two STL encodings a file used.
+/// Most triangles a file may hold (1 GB of binary STL); the import of every format keeps to it.
+pub const MAX_TRIANGLES: usize = 20_000_000;
+
+/// The format a model file was read as: one of the two STL encodings, or OBJ / 3MF
+/// ([`crate::import`]). Serialised as `"binary"`, `"ascii"`, `"obj"`, `"3mf"`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Format {
     Binary,
     Ascii,
+    Obj,
+    #[serde(rename = "3mf")]
+    ThreeMf,
 }
 
 /// Parses an STL file. Every coordinate is checked to be finite.
@@ -38,7 +45,7 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         let expected = 84 + 50 * n;
         // Real files rarely hold more than 20 million triangles (1 GB); a count beyond that
         // is text or another format read as a binary header.
-        let msg = if n > 20_000_000 {
+        let msg = if n > MAX_TRIANGLES as u64 {
             format!(
                 "this is not an STL file: it does not start with 'solid' (ASCII STL), and as a binary STL it would declare {n} triangles ({expected} bytes) in a file of {} bytes; choose an STL file",
                 bytes.len()
