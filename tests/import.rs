@@ -12,6 +12,7 @@ use dropslice::import::{self, IDENTITY, Part};
 use dropslice::stl::Format;
 
 type Tri = [[f32; 3]; 3];
+type P3 = [f64; 3];
 
 fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
@@ -54,7 +55,7 @@ fn import_err(r: Result<Vec<Part>, Error>) -> String {
 #[test]
 fn obj_models() {
     // (file, triangles after a fan split of every face, min, max, signed volume), from Python.
-    let cases: [(&str, usize, [f64; 3], [f64; 3], f64); 4] = [
+    let cases: [(&str, usize, P3, P3, f64); 4] = [
         (
             "extruder_idler_quads.obj",
             7344,
@@ -221,7 +222,7 @@ fn cube_gears_3mf() {
     // Per build item: object id, name, triangles, min and max after the item's transform
     // (Python: zipfile + ElementTree + numpy, rounded to 1e-4).
     #[rustfmt::skip]
-    let want: [(u32, &str, usize, [f64; 3], [f64; 3]); 17] = [
+    let want: [(u32, &str, usize, P3, P3); 17] = [
         (1, "gear 1", 3484, [22.7075, 2.6185, 2.2479], [63.8605, 43.7288, 35.8492]),
         (2, "gear 2", 1192, [129.3844, 12.304, 2.2479], [137.1844, 38.004, 6.5977]),
         (3, "gear 3", 1192, [139.3844, 12.304, 2.2479], [147.1844, 38.004, 6.5977]),
@@ -334,6 +335,7 @@ fn conformance() {
             .unwrap_or_else(|_| panic!("{f}: panicked"));
         match (want, got) {
             (None, Ok(parts)) => {
+                eprintln!("{f}: read, {} part(s)", parts.len());
                 let all: Vec<Tri> = parts.iter().flat_map(|p| p.triangles.clone()).collect();
                 if f.starts_with("MUSTPASS") {
                     assert_eq!(parts.len(), 1, "{f}");
@@ -344,6 +346,7 @@ fn conformance() {
                 }
             }
             (Some(text), Err(Error::Import(m))) => {
+                eprintln!("{f}: refused: {m}");
                 assert!(m.contains(text), "{f}: {m}");
             }
             (w, g) => panic!("{f}: expected {w:?}, got {:?}", g.map(|p| p.len())),
@@ -551,7 +554,27 @@ fn units_items_and_components() {
     let parts = read(&b).unwrap();
     assert_eq!(
         parts[0].source_object.as_deref(),
-        Some("/3d/objects/other.model#7")
+        Some("/3D/Objects/other.model#7")
+    );
+    // 32 levels of components are read; an empty mesh beside a cube is skipped.
+    let mut res = cube(1) + r#"<object id="50"><mesh><vertices/><triangles/></mesh></object>"#;
+    for i in 2..=32 {
+        res += &format!(
+            r#"<object id="{i}"><components><component objectid="{}" transform="1 0 0 0 1 0 0 0 1 1 0 0"/></components></object>"#,
+            i - 1
+        );
+    }
+    let b = package(
+        "millimeter",
+        &res,
+        r#"<item objectid="50"/><item objectid="32"/>"#,
+        vec![],
+    );
+    let parts = read(&b).unwrap();
+    assert_eq!(parts.len(), 1);
+    assert_eq!(
+        bounds(&parts[0].triangles),
+        ([31.0, 0.0, 0.0], [32.0, 1.0, 1.0])
     );
     // Supports are not printed; 1000 items of a small object are 1000 parts.
     let items: String = (0..1000)
@@ -617,6 +640,64 @@ fn refused_3mf() {
                 )
             },
             "more than 20000000 triangles",
+        ),
+        (
+            "1000 × 1000 × 1000 components of an empty mesh",
+            {
+                let fan = |id: u32, child: u32| {
+                    let c: String = (0..1000)
+                        .map(|_| format!(r#"<component objectid="{child}"/>"#))
+                        .collect();
+                    format!(r#"<object id="{id}"><components>{c}</components></object>"#)
+                };
+                let empty = r#"<object id="1"><mesh><vertices/><triangles/></mesh></object>"#;
+                package(
+                    "millimeter",
+                    &(cube(9) + empty + &fan(2, 1) + &fan(3, 2) + &fan(4, 3)),
+                    r#"<item objectid="9"/><item objectid="4"/>"#,
+                    vec![],
+                )
+            },
+            "more than 20000000 objects",
+        ),
+        (
+            "a 30-level chain reached again 5 levels deeper",
+            {
+                let mut res = chain(30);
+                for i in 31..=35 {
+                    res += &format!(
+                        r#"<object id="{i}"><components><component objectid="{}"/></components></object>"#,
+                        i - 1
+                    );
+                }
+                package(
+                    "millimeter",
+                    &res,
+                    r#"<item objectid="30"/><item objectid="35"/>"#,
+                    vec![],
+                )
+            },
+            "more than 32 deep",
+        ),
+        (
+            "only empty meshes",
+            package(
+                "millimeter",
+                r#"<object id="1"><mesh><vertices/><triangles/></mesh></object>"#,
+                ok_build,
+                vec![],
+            ),
+            "no mesh to print",
+        ),
+        (
+            "only supports",
+            package(
+                "millimeter",
+                &cube(1).replace(r#"type="model""#, r#"type="support""#),
+                ok_build,
+                vec![],
+            ),
+            "support, surface or 'other'",
         ),
         (
             "missing object",
@@ -795,6 +876,7 @@ fn refused_3mf() {
     ];
     for (what, bytes, want) in cases {
         let m = import_err(read(&bytes));
+        eprintln!("{what}: {m}");
         assert!(m.contains(want), "{what}: {m}");
     }
     assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());

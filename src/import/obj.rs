@@ -59,7 +59,6 @@ pub fn parse(bytes: &[u8]) -> Result<Triangles, Error> {
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = bytes;
     let (models, _) =

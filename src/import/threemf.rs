@@ -167,9 +167,15 @@ pub fn parse(bytes: &[u8], file_stem: &str) -> Result<Vec<Part>, Error> {
     }
     // Part names are case-insensitive (OPC); the ZIP holds them without the leading '/'.
     let mut names: HashMap<String, usize> = HashMap::new();
+    // The names as the package spells them, for messages.
+    let mut shown: HashMap<String, String> = HashMap::new();
     for i in 0..zip.len() {
         if let Some(Ok(n)) = zip.name_for_index(i) {
-            names.entry(part_key(&n)).or_insert(i);
+            let key = part_key(&n);
+            if !names.contains_key(&key) {
+                names.insert(key.clone(), i);
+                shown.insert(key, n.trim_start_matches('/').to_string());
+            }
         }
     }
     let mut totals = Totals::default();
@@ -196,7 +202,7 @@ pub fn parse(bytes: &[u8], file_stem: &str) -> Result<Vec<Part>, Error> {
                 }
             )));
         };
-        let model = parse_model(&mut zip, index, &path, path == root, &mut totals)?;
+        let model = parse_model(&mut zip, index, &shown[&path], path == root, &mut totals)?;
         for o in model.objects.values() {
             if let Content::Components(cs) = &o.content {
                 queue.extend(cs.iter().filter_map(|c| c.path.clone()));
@@ -205,7 +211,7 @@ pub fn parse(bytes: &[u8], file_stem: &str) -> Result<Vec<Part>, Error> {
         queue.extend(model.items.iter().filter_map(|i| i.path.clone()));
         models.insert(path, model);
     }
-    build(&models, &root, file_stem)
+    build(&models, &root, file_stem, &shown)
 }
 
 /// The key a part name is looked up by: no leading '/', ASCII lower case.
@@ -283,6 +289,8 @@ impl<R: Read> Read for Limited<R> {
 }
 
 type Zip<'a> = zip::ZipArchive<Cursor<&'a [u8]>>;
+/// A ZIP entry being inflated, bounded.
+type EntryReader<'z, 'a> = BufReader<Limited<zip::read::ZipFile<'z, Cursor<&'a [u8]>>>>;
 
 /// Opens entry `index` for streaming, mapping ZIP errors (encryption, methods) to messages.
 fn open_entry<'z, 'a>(
@@ -290,7 +298,7 @@ fn open_entry<'z, 'a>(
     index: usize,
     path: &str,
     totals: &Totals,
-) -> Result<BufReader<Limited<zip::read::ZipFile<'z, Cursor<&'a [u8]>>>>, Error> {
+) -> Result<EntryReader<'z, 'a>, Error> {
     let f = zip.by_index(index).map_err(|e| {
         let s = e.to_string();
         if s.to_ascii_lowercase().contains("password") || s.contains("ncrypt") {
@@ -869,19 +877,17 @@ fn parse_model(
                     });
                 }
             }
-            ("build", "item") => {
-                if is_root {
-                    if model.items.len() >= MAX_ITEMS {
-                        return Err(err(format!(
-                            "the 3MF build has more than {MAX_ITEMS} items; at most that many are accepted"
-                        )));
-                    }
-                    model.items.push(Item {
-                        id: index(attr(&attrs, "objectid"), "a build <item> objectid", p)?,
-                        transform: transform(attr(&attrs, "transform"), scale, p)?,
-                        path: attr_ns(&attrs, PRODUCTION_NS, "path").map(|s| part_key(&s)),
-                    });
+            ("build", "item") if is_root => {
+                if model.items.len() >= MAX_ITEMS {
+                    return Err(err(format!(
+                        "the 3MF build has more than {MAX_ITEMS} items; at most that many are accepted"
+                    )));
                 }
+                model.items.push(Item {
+                    id: index(attr(&attrs, "objectid"), "a build <item> objectid", p)?,
+                    transform: transform(attr(&attrs, "transform"), scale, p)?,
+                    path: attr_ns(&attrs, PRODUCTION_NS, "path").map(|s| part_key(&s)),
+                });
             }
             _ => {}
         }
@@ -896,50 +902,75 @@ fn parse_model(
     Ok(model)
 }
 
-/// Resolves the build: one part per printable build item.
-fn build(models: &HashMap<String, Model>, root: &str, stem: &str) -> Result<Vec<Part>, Error> {
+/// Most object instances the build may visit (components included), so that components of
+/// empty meshes cannot make the resolution run for hours.
+pub const MAX_INSTANCES: u64 = MAX_TRIANGLES as u64;
+
+/// What an object instantiates: triangles, object instances (itself included) and the
+/// height of its component tree (a mesh: 1).
+#[derive(Clone, Copy)]
+struct Size {
+    triangles: u64,
+    instances: u64,
+    height: usize,
+}
+
+/// Resolves the build: one part per printable build item with triangles.
+fn build(
+    models: &HashMap<String, Model>,
+    root: &str,
+    stem: &str,
+    shown: &HashMap<String, String>,
+) -> Result<Vec<Part>, Error> {
     let items = &models[root].items;
     if items.is_empty() {
         return Err(err(
             "the 3MF file's build is empty (no <item>): there is nothing to print; place the objects on the plate in your modelling program and export again",
         ));
     }
-    // Triangles each object instantiates, with cycle and depth checks, memoised.
-    let mut counts: HashMap<(String, u32), u64> = HashMap::new();
-    let mut total: u64 = 0;
+    // Sizes first (with cycle, depth and size checks, memoised), so that nothing is
+    // instantiated before the whole build is known to be within bounds.
+    let mut memo: HashMap<(String, u32), Size> = HashMap::new();
+    let (mut triangles, mut instances) = (0u64, 0u64);
     let mut wanted = Vec::new();
+    let mut skipped = 0;
     for item in items {
         let path = item.path.clone().unwrap_or_else(|| root.to_string());
         let obj = lookup(models, &path, item.id, "a build item")?;
         if !obj.printable {
+            skipped += 1;
             continue;
         }
         let mut stack = Vec::new();
-        let n = count(models, &path, item.id, 1, &mut stack, &mut counts)?;
-        total = total.saturating_add(n);
-        if total > MAX_TRIANGLES as u64 {
+        let size = measure(models, &path, item.id, 1, &mut stack, &mut memo)?;
+        triangles = triangles.saturating_add(size.triangles);
+        instances = instances.saturating_add(size.instances);
+        if triangles > MAX_TRIANGLES as u64 {
             return Err(err(format!(
                 "the 3MF build places more than {MAX_TRIANGLES} triangles (counting every instance of every component); at most that many are accepted — simplify the model or print fewer copies"
             )));
         }
-        wanted.push((item, path, obj, n));
+        if instances > MAX_INSTANCES {
+            return Err(err(format!(
+                "the 3MF build places more than {MAX_INSTANCES} objects (counting every instance of every component); at most that many are accepted"
+            )));
+        }
+        if size.triangles > 0 {
+            wanted.push((item, path, obj, size.triangles));
+        }
     }
     if wanted.is_empty() {
-        return Err(err(
-            "the 3MF build has only support, surface or 'other' objects, which dropslice does not print; nothing to print",
-        ));
+        return Err(err(if skipped > 0 {
+            "the 3MF build has no mesh to print: its items are support, surface or 'other' objects (which dropslice does not print) or have no triangles"
+        } else {
+            "the 3MF build has no mesh to print: its objects have no triangles"
+        }));
     }
     let mut parts = Vec::with_capacity(wanted.len());
     let mut seen_names: HashMap<String, usize> = HashMap::new();
     for (item, path, obj, n) in wanted {
         let mut tris = Triangles::with_capacity(n as usize);
         emit(models, &path, item.id, &item.transform, &mut tris)?;
-        if tris.is_empty() {
-            return Err(err(format!(
-                "the 3MF build item for object {} has no triangles; the file has no mesh to print",
-                item.id
-            )));
-        }
         let base = obj
             .name
             .clone()
@@ -959,7 +990,7 @@ fn build(models: &HashMap<String, Model>, root: &str, stem: &str) -> Result<Vec<
             source_object: Some(if path == root {
                 item.id.to_string()
             } else {
-                format!("/{path}#{}", item.id)
+                format!("/{}#{}", shown.get(&path).unwrap_or(&path), item.id)
             }),
         });
     }
@@ -982,18 +1013,27 @@ fn lookup<'m>(
         })
 }
 
-/// Triangles object `id` of model `path` instantiates (saturating).
-fn count(
+/// What object `id` of model `path` instantiates (saturating), referred to at nesting level
+/// `depth` (a build item's object is level 1).
+fn measure(
     models: &HashMap<String, Model>,
     path: &str,
     id: u32,
     depth: usize,
     stack: &mut Vec<(String, u32)>,
-    memo: &mut HashMap<(String, u32), u64>,
-) -> Result<u64, Error> {
+    memo: &mut HashMap<(String, u32), Size>,
+) -> Result<Size, Error> {
+    let too_deep = || {
+        err(format!(
+            "the 3MF file nests components more than {MAX_COMPONENT_DEPTH} deep; at most that many levels are read"
+        ))
+    };
     let key = (path.to_string(), id);
-    if let Some(&n) = memo.get(&key) {
-        return Ok(n);
+    if let Some(&s) = memo.get(&key) {
+        if depth - 1 + s.height > MAX_COMPONENT_DEPTH {
+            return Err(too_deep());
+        }
+        return Ok(s);
     }
     if stack.contains(&key) {
         return Err(err(format!(
@@ -1001,12 +1041,10 @@ fn count(
         )));
     }
     if depth > MAX_COMPONENT_DEPTH {
-        return Err(err(format!(
-            "the 3MF file nests components more than {MAX_COMPONENT_DEPTH} deep; at most that many levels are read"
-        )));
+        return Err(too_deep());
     }
     let obj = lookup(models, path, id, "a component")?;
-    let n = match &obj.content {
+    let size = match &obj.content {
         Content::Mesh {
             triangles, beams, ..
         } => {
@@ -1015,17 +1053,28 @@ fn count(
                     "object {id} of the 3MF file is a beam lattice without triangles; dropslice prints meshes only — export the lattice as a mesh"
                 )));
             }
-            triangles.len() as u64
+            Size {
+                triangles: triangles.len() as u64,
+                instances: 1,
+                height: 1,
+            }
         }
         Content::Components(cs) => {
             stack.push(key.clone());
-            let mut n: u64 = 0;
+            let mut s = Size {
+                triangles: 0,
+                instances: 1,
+                height: 1,
+            };
             for c in cs {
                 let cp = c.path.as_deref().unwrap_or(path);
-                n = n.saturating_add(count(models, cp, c.id, depth + 1, stack, memo)?);
+                let cs = measure(models, cp, c.id, depth + 1, stack, memo)?;
+                s.triangles = s.triangles.saturating_add(cs.triangles);
+                s.instances = s.instances.saturating_add(cs.instances);
+                s.height = s.height.max(cs.height + 1);
             }
             stack.pop();
-            n
+            s
         }
         Content::None(what) => {
             return Err(err(match what {
@@ -1038,8 +1087,8 @@ fn count(
             }));
         }
     };
-    memo.insert(key, n);
-    Ok(n)
+    memo.insert(key, size);
+    Ok(size)
 }
 
 /// Appends the triangles of object `id` placed by `at` (counted beforehand: bounded).
