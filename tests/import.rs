@@ -958,3 +958,25 @@ fn damaged_3mf_never_panics() {
         let _ = std::panic::catch_unwind(|| read(&b)).expect("no panic");
     }
 }
+
+/// 20 MB of repeated ZIP signatures (end-of-directory records, ZIP64 records, directory
+/// headers): refused at once, not searched quadratically.
+#[test]
+fn fake_zip_directories_are_refused_quickly() {
+    let patterns: [&[u8]; 4] = [
+        b"PK\x05\x06",
+        b"PK\x05\x06\0\0\0\0\x01\0\x01\0\x2e\0\0\0\0\0\0\0\0\0",
+        b"PK\x06\x06",
+        b"PK\x01\x02",
+    ];
+    for pat in patterns {
+        let mut b = b"PK\x03\x04".to_vec();
+        while b.len() < 20 << 20 {
+            b.extend(pat);
+        }
+        let t0 = Instant::now();
+        let m = import_err(read(&b));
+        assert!(m.contains("not a readable ZIP archive"), "{m}");
+        assert!(t0.elapsed() < Duration::from_secs(2), "{:?}", t0.elapsed());
+    }
+}

@@ -270,12 +270,9 @@ impl<R: Read> Read for Limited<R> {
             return Err(std::io::Error::other("limit"));
         }
         self.left -= n as u64;
-        for &c in &buf[..n] {
-            if c == b'<' {
-                self.since_lt = 0;
-            } else {
-                self.since_lt += 1;
-            }
+        match buf[..n].iter().rposition(|&c| c == b'<') {
+            Some(i) => self.since_lt = n - 1 - i,
+            None => self.since_lt += n,
         }
         if self.since_lt > MAX_XML_TOKEN {
             self.exceeded = Some(format!(
