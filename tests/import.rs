@@ -168,6 +168,13 @@ fn obj_errors_name_the_line() {
     }
     let m = import_err(import::read_parts(b"v 0 0 0\nv 1 0 0\nl 1 2\n", "e.obj"));
     assert!(m.contains("no faces"), "{m}");
+    // 21 million triangles in one polygon: refused before tobj allocates them.
+    let mut big = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf".to_vec();
+    for _ in 0..21_000_002 {
+        big.extend(b" 1");
+    }
+    let m = import_err(import::read_parts(&big, "e.obj"));
+    assert!(m.contains("21000000 triangles"), "{m}");
     let m = import_err(import::read_parts(b"", "e.obj"));
     assert!(m.contains("empty"), "{m}");
     let m = import_err(import::read_parts(b"v 0 0 0\n\xff\xfe\nf 1 1 1\n", "e.obj"));
@@ -854,6 +861,13 @@ fn refused_3mf() {
             "not a 3MF zip",
             zip(&[stored("readme.txt", "hello")]),
             "not a 3MF package",
+        ),
+        (
+            "too many ZIP entries",
+            zip(&(0..10_001)
+                .map(|i| stored(&format!("f{i}"), ""))
+                .collect::<Vec<_>>()),
+            "10001 entries",
         ),
         (
             "deep XML",

@@ -54,6 +54,21 @@ pub fn parse(bytes: &[u8]) -> Result<Triangles, Error> {
             "the OBJ file is empty (0 bytes); choose a model file".into(),
         ));
     }
+    // Count the triangles before tobj allocates them.
+    let mut n: u64 = 0;
+    for line in bytes.split(|&c| c == b'\n') {
+        let mut toks = trim(line)
+            .split(|c| c.is_ascii_whitespace())
+            .filter(|t| !t.is_empty());
+        if toks.next() == Some(b"f") {
+            n += (toks.count() as u64).saturating_sub(2);
+        }
+    }
+    if n > MAX_TRIANGLES as u64 {
+        return Err(Error::Import(format!(
+            "the OBJ file has {n} triangles (after splitting polygons); at most {MAX_TRIANGLES} are accepted — simplify the model"
+        )));
+    }
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: false,
@@ -65,11 +80,6 @@ pub fn parse(bytes: &[u8]) -> Result<Triangles, Error> {
         tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
             .map_err(|e| Error::Import(describe(bytes, e)))?;
     let n: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
-    if n > MAX_TRIANGLES {
-        return Err(Error::Import(format!(
-            "the OBJ file has {n} triangles (after splitting polygons); at most {MAX_TRIANGLES} are accepted — simplify the model"
-        )));
-    }
     let mut tris = Triangles::with_capacity(n);
     for m in &models {
         let p = &m.mesh.positions;
