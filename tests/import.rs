@@ -145,6 +145,13 @@ fn obj_features() {
     assert_eq!(t[1], [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]);
     assert_eq!(t[2], [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [2.0, 1.0, 1.0]]);
     assert_eq!(t[4], [[0.0, 0.0, 1.0], [1.0, 2.0, 1.0], [0.0, 1.0, 1.0]]);
+    // CRLF, v/vt/vn corners, a w coordinate.
+    let crlf = "v 0 0 0 1\r\nv 1 0 0\r\nv 0 1 0\r\nvt 0 0\r\nvn 0 0 1\r\nf 1/1/1 2/1/1 3/1/1\r\n";
+    let t = &import::read_parts(crlf.as_bytes(), "c.obj").unwrap()[0].triangles;
+    assert_eq!(
+        t,
+        &vec![[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]
+    );
     // Recognised by content without the extension.
     assert_eq!(import::detect(text.as_bytes(), "model.dat"), Format::Obj);
     let (_, f) = import::read_merged(text.as_bytes(), "noext").unwrap();

@@ -722,8 +722,13 @@ fn parse_model(
             ("model", "resources") | ("model", "build") => {}
             ("resources", _) => {
                 // Any resource (objects, materials, …): ids are unique within a model part.
-                if let Some(id) = attr(&attrs, "id") {
-                    let id = index(Some(id), &format!("a <{local}> id"), p)?;
+                // (Another extension's resource with an id that is not a number is ignored.)
+                let id = match attr(&attrs, "id") {
+                    Some(v) if core => Some(index(Some(v), &format!("a <{local}> id"), p)?),
+                    Some(v) => v.trim().parse::<u32>().ok(),
+                    None => None,
+                };
+                if let Some(id) = id {
                     if !resource_ids.insert(id) {
                         return Err(err(format!(
                             "the 3MF part '/{p}' has two resources with id {id}; ids must be unique — the file is damaged"
