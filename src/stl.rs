@@ -11,7 +11,7 @@ use crate::error::Error;
 pub type Triangles = Vec<[[f32; 3]; 3]>;
 
 /// Which of the two STL encodings a file used.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Format {
     Binary,
