@@ -1,0 +1,300 @@
+// The runs of the workers, each a plain async function of the page (its store and its pool):
+// a slice, the analysis pass over a finished slice, reading a .gco file, cancel, and the
+// G-code's assembly for download. Opening files and links: open.ts.
+
+import { Cancelled, SliceError } from "./client";
+import type { Value } from "./form";
+import type { GcodeParseResult } from "./protocol";
+import type { View } from "./render";
+import { restoreModel, showError } from "./errors";
+import type { Page } from "./page";
+import type { Model, Slice } from "./store";
+import { hideBanner, showBanner, TITLES } from "./views/banner";
+import { updateButtons } from "./views/controls";
+import { saveGcode } from "./views/download";
+import { clampLayer, layerLabel, setLayers, show } from "./views/layer";
+import { showModel, writeStats } from "./views/stats";
+import { progress, setState } from "./views/status";
+
+export interface Target {
+  layer?: number;
+  view?: View;
+  /** Shown once the slice has started (a slice hides the banner): about the link that asked
+   *  for it. */
+  notice?: { title: string; message: string; tone?: "error" | "info" };
+}
+
+/** While the workers run, the progress and the figures are redrawn at most this often: each
+ *  redraw costs style, layout and paint, and with few cores that time is taken from slicing. */
+const BUSY_REDRAW_MS = 150;
+
+/** Runs `update` within [[BUSY_REDRAW_MS]], once for all calls until then, unless the run `gen`
+ *  has ended by then (the page is then drawn by whatever ended it). */
+function whileBusy(page: Page, gen: number, update: () => void): void {
+  const store = page.store;
+  const pending = store.busyRedraw !== null;
+  store.busyRedraw = { gen, update };
+  if (pending) return;
+  setTimeout(() => {
+    const r = store.busyRedraw;
+    store.busyRedraw = null;
+    if (r && r.gen === store.generation && store.busy) r.update();
+  }, BUSY_REDRAW_MS);
+}
+
+function settingsProblem(page: Page): boolean {
+  const form = page.form!;
+  const errors = form.errors();
+  if (errors.length === 0) return false;
+  showBanner(TITLES.setting, `Fix ${errors.map((e) => `${e.name.replace(/_/g, " ")} (${e.message})`).join(", ")} before slicing.`);
+  form.focusFirstError();
+  setState("error");
+  return true;
+}
+
+function cancelRunning(page: Page): void {
+  if (page.store.busy) {
+    page.pool.cancel();
+    page.store.busy = false;
+  }
+}
+
+export async function startSlice(page: Page, m: Model, target: Target = {}): Promise<void> {
+  const { store, pool, renderer } = page;
+  const form = page.form!;
+  if (settingsProblem(page)) return;
+  cancelRunning(page);
+  hideBanner();
+  if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone);
+  const gen = ++store.generation;
+  const values = form.values();
+  const json = form.json();
+  const H = Number(values.layer_height);
+  const B = H * Number(values.droplet_aspect);
+  const s = store.newSlice("stl", m.name, B, H, values, m);
+  if (store.fileChosenAt !== null) s.startedAt = store.fileChosenAt;
+  store.fileChosenAt = null;
+  const sameModel = store.slice?.model?.sha256 === m.sha256;
+  store.busy = true;
+  setState("slicing");
+  progress(0, `Reading ${m.name}…`);
+  updateButtons(page);
+  try {
+    await pool.slice(m.bytes, m.name, json, {
+      opened: (r) => {
+        if (gen !== store.generation) return;
+        s.open(r.layers, r.info);
+        store.model = m;
+        store.slice = s;
+        store.slicedSettings = json;
+        setLayers(r.layers);
+        progress(0);
+        showModel(m.name);
+        const wanted = target.layer ?? (sameModel ? store.current : Math.floor((r.layers - 1) * 0.3));
+        store.current = clampLayer(wanted, r.layers);
+        if (target.view) {
+          // the renderer keeps any view within its limits
+          renderer.view = { ...target.view };
+          store.viewTouched = true;
+        } else if (!sameModel || !store.viewTouched) {
+          store.viewTouched = false;
+          const b = r.info.bounds;
+          renderer.fit(b ? { minX: b.min[0], minY: b.min[1], maxX: b.max[0], maxY: b.max[1] } : null);
+        }
+        show(page, store.current);
+      },
+      layer: (l) => {
+        if (gen !== store.generation) return;
+        s.put(l, store.current);
+        const current = store.current;
+        // the layer shown and the one below it: drawn once both have arrived (a draw costs)
+        const arrived = (k: number) => k < 0 || s.counts[k] !== undefined;
+        if ((l.index === current || l.index === current - 1) && arrived(current) && arrived(current - 1)) show(page, current);
+        // the last layer shows 100 % at once; before it the figures are redrawn now and then
+        if (s.done === s.layers) progress(1);
+        else {
+          whileBusy(page, gen, () => {
+            progress(s.done / Math.max(1, s.layers));
+            writeStats(page);
+          });
+        }
+      },
+      unit: (u) => {
+        if (gen === store.generation) s.addUnit(u);
+      },
+    }, renderer.showVoids);
+    if (gen !== store.generation) return;
+    s.complete = true;
+    s.seconds = (performance.now() - s.startedAt) / 1000;
+    store.busy = false;
+    progress(null);
+    if (!store.viewTouched && !s.info.bounds) renderer.fit(s.bbox);
+    show(page, store.current);
+    setState("done");
+    if (s.figures.nothingToPrint) {
+      showBanner(
+        "Nothing to print",
+        `No droplet fits in this part: every wall is thinner than the droplet width B = ${s.dropletWidth.toFixed(3)} mm. ` +
+          "Scale the part up (Part → scale) or use smaller droplets (layer height, droplet aspect).",
+      );
+    }
+    // the overlay was turned on during a slice made without analysis
+    if (renderer.showVoids && s.analysed < s.layers) void analyseVoids(page, s);
+    pool
+      .repairs(s.figures.summaryJson(s.layers))
+      .then((r) => {
+        s.repairs = r;
+        if (store.slice === s) writeStats(page);
+      })
+      .catch(() => {
+        // only informative; a failure here must not disturb the finished slice
+      });
+  } catch (e) {
+    if (gen !== store.generation) return;
+    store.busy = false;
+    progress(null);
+    if (e instanceof Cancelled) {
+      setState("cancelled");
+      showBanner("Slicing cancelled.", "Change the settings or open another file, then slice again.", "info");
+    } else {
+      if (store.slice === s) {
+        // the slice broke half-way: nothing of it can be downloaded
+        store.slice = null;
+        renderer.current = renderer.below = null;
+        renderer.request();
+        writeStats(page);
+      }
+      showError(page, e);
+    }
+  } finally {
+    if (gen === store.generation) updateButtons(page);
+  }
+}
+
+/** Re-plans and analyses every layer of a finished slice made without analysis (the overlay
+ *  was off): the figures of the whole part and the masks of the overlay. */
+export async function analyseVoids(page: Page, s: Slice): Promise<void> {
+  const { store, pool } = page;
+  if (store.busy || store.slice !== s || !s.complete || s.source !== "stl" || s.analysed >= s.layers) return;
+  const gen = ++store.generation;
+  store.busy = true;
+  setState("slicing");
+  const label = "Analysing voids…";
+  progress(s.analysed / Math.max(1, s.layers), label);
+  updateButtons(page);
+  try {
+    await pool.analyse(s.layers, (l) => {
+      if (gen !== store.generation) return;
+      s.put(l, store.current);
+      if (l.index === store.current) show(page, store.current);
+      whileBusy(page, gen, () => {
+        progress(s.analysed / Math.max(1, s.layers), label);
+        writeStats(page);
+      });
+    });
+    if (gen !== store.generation) return;
+    store.busy = false;
+    progress(null);
+    show(page, store.current);
+    setState("done");
+  } catch (e) {
+    failed(page, gen, e);
+  } finally {
+    if (gen === store.generation) updateButtons(page);
+  }
+}
+
+/** Ends a slice or a G-code read that threw: cancelled, or an error shown in the page. */
+function failed(page: Page, gen: number, e: unknown): void {
+  if (gen !== page.store.generation) return;
+  page.store.busy = false;
+  progress(null);
+  if (e instanceof Cancelled) setState("cancelled");
+  else showError(page, e);
+}
+
+export async function openGcode(page: Page, file: File): Promise<void> {
+  const { store, pool, renderer } = page;
+  cancelRunning(page);
+  hideBanner();
+  const gen = ++store.generation;
+  const s = store.newSlice("gco", file.name, NaN, NaN, page.form!.values(), null);
+  store.busy = true;
+  setState("slicing");
+  progress(0, "Reading G-code…");
+  updateButtons(page);
+  let read = 0;
+  try {
+    const r: GcodeParseResult = await pool.parseGcode(file, (l) => {
+      if (gen !== store.generation) return;
+      s.put(l, 0);
+      read++;
+      progress(l.fraction ?? 0, `Reading ${file.name}… ${read} layers`);
+    });
+    if (gen !== store.generation) return;
+    s.open(r.layers, {});
+    s.dropletWidth = r.dropletWidth;
+    s.layerHeight = r.layerHeight;
+    s.complete = true;
+    store.slice = s;
+    store.model = null;
+    setLayers(r.layers);
+    showModel(file.name);
+    store.busy = false;
+    progress(null);
+    store.viewTouched = false;
+    renderer.fit(s.bbox);
+    show(page, Math.floor((r.layers - 1) * 0.3));
+    setState("done");
+  } catch (e) {
+    failed(page, gen, e);
+  } finally {
+    if (gen === store.generation) updateButtons(page);
+  }
+}
+
+/** Cancel: the workers stop at once; a slice not yet complete is dropped. */
+export function cancel(page: Page): void {
+  const { store, pool, renderer } = page;
+  if (!store.busy) return;
+  store.generation++;
+  pool.cancel();
+  store.busy = false;
+  progress(null);
+  setState("cancelled");
+  showBanner("Slicing cancelled.", "Change the settings or open another file, then slice again.", "info");
+  if (store.slice && !store.slice.complete) {
+    store.slice = null;
+    renderer.current = renderer.below = null;
+    renderer.request();
+    writeStats(page);
+    layerLabel(page);
+  }
+  restoreModel(page);
+  updateButtons(page);
+}
+
+/** The unit fix: x, y and z scaled by `factor` in the form, and `s`'s model sliced again. */
+export function fixUnits(page: Page, s: Slice, factor: number): void {
+  const form = page.form!;
+  const scaled: Record<string, Value> = {};
+  for (const axis of ["scale_x", "scale_y", "scale_z"]) scaled[axis] = Number(form.get(axis) ?? 1) * factor;
+  form.set(scaled);
+  if (s.model) void startSlice(page, s.model);
+}
+
+/** The G-code of the finished slice: the core's header and footer around the layers' pieces. */
+export async function download(page: Page): Promise<void> {
+  const { store, pool } = page;
+  const s = store.slice;
+  if (!s || !s.complete || s.source !== "stl") return;
+  const summary = s.figures.summaryJson(s.layers);
+  try {
+    const [header, footer] = await Promise.all([pool.header(summary), pool.footer(summary)]);
+    const layers = s.gcodeParts();
+    if (typeof layers === "number") throw new SliceError("internal", `layer ${layers + 1} has no G-code`);
+    saveGcode(new Blob([header, ...layers, footer], { type: "text/plain" }), s.name);
+  } catch (e) {
+    showError(page, e);
+  }
+}

@@ -1,0 +1,20 @@
+// What the flows and views share: the store, the worker pool, the canvas renderer and the
+// settings form (set once the core's schema has arrived). main.ts makes the one instance.
+
+import type { Pool } from "./client";
+import type { SettingsForm } from "./form";
+import type { InitResult } from "./protocol";
+import type { Renderer } from "./render";
+import type { Slice, Store } from "./store";
+
+export interface Page {
+  readonly store: Store;
+  readonly pool: Pool;
+  readonly renderer: Renderer;
+  /** The settings form, once init has answered. */
+  form?: SettingsForm;
+  /** The core's version, settings schema and defaults, once init has answered. */
+  init?: InitResult;
+  /** The unit fix's button was pressed: scale the part by `factor` and slice `s`'s model again. */
+  onUnitFix(s: Slice, factor: number): void;
+}

@@ -1,0 +1,168 @@
+// The page's state: the model, the slice (its layers in a bounded cache, their analyses and
+// figures), the layer shown, and the generation counter that retires the callbacks of a run
+// that was replaced. No DOM here.
+
+import type { Value } from "./form";
+import { Figures } from "./figures";
+import type { Counts, JobInfo, LayerAnalysis, LayerData, SliceUnit } from "./protocol";
+import type { Bounds } from "./render";
+import type { SharedLink } from "./share";
+
+/** Layer previews kept in the page (`?cache=MB`, 384 MB unless asked): beyond this, layers far
+ *  from the one shown are dropped and re-planned by a worker when they are shown again. */
+export function cacheBudgetBytes(query: URLSearchParams): number {
+  return Math.min(4096, Math.max(1, Number(query.get("cache")) || 384)) * 2 ** 20;
+}
+
+export interface Model {
+  bytes: Uint8Array;
+  name: string;
+  sha256: string;
+}
+
+/** Everything known about one slice (or one opened .gco file). */
+export class Slice {
+  layers = 0;
+  info: JobInfo = {};
+  z: number[] = [];
+  counts: (Counts | undefined)[] = [];
+  travelMm: number[] = [];
+  /** G-code by runs of layers, keyed by the run's first layer. */
+  gcode = new Map<number, { to: number; blob: Blob }>();
+  cache = new Map<number, LayerData>();
+  cacheBytes = 0;
+  done = 0;
+  complete = false;
+  bbox: Bounds = { minX: Infinity, minY: Infinity, maxX: -Infinity, maxY: -Infinity };
+  /** Droplets, travel, summary, coverage, worst layer: figures.ts. */
+  figures = new Figures();
+  /** What slicing repaired (from the core, once the slice is complete). */
+  repairs: string[] = [];
+  /** Void analysis per layer (when the slice or a later pass made it). */
+  analysis: (LayerAnalysis | undefined)[] = [];
+  analysed = 0;
+  /** When the file was chosen (performance.now()), and the seconds from then until every
+   *  layer's G-code was ready (the figure of the benchmark). */
+  startedAt = performance.now();
+  seconds: number | null = null;
+
+  constructor(
+    readonly source: "stl" | "gco",
+    readonly name: string,
+    public dropletWidth: number,
+    public layerHeight: number,
+    readonly settings: Record<string, Value>,
+    readonly model: Model | null,
+    /** Bytes of layers the cache keeps ([[cacheBudgetBytes]]). */
+    readonly cacheBudget: number,
+  ) {}
+
+  open(layers: number, info: JobInfo): void {
+    this.layers = layers;
+    this.info = info;
+  }
+
+  put(l: LayerData, current: number): void {
+    if (this.counts[l.index] === undefined) {
+      this.done++;
+      this.counts[l.index] = l.counts;
+      this.z[l.index] = l.z;
+      this.travelMm[l.index] = l.travelMm;
+      this.figures.addLayer(l);
+      const d = l.droplets;
+      const b = this.bbox;
+      for (let i = 0; i < d.length; i += 2) {
+        const x = d[i];
+        const y = d[i + 1];
+        if (x < b.minX) b.minX = x;
+        if (x > b.maxX) b.maxX = x;
+        if (y < b.minY) b.minY = y;
+        if (y > b.maxY) b.maxY = y;
+      }
+    }
+    const a = l.analysis;
+    if (a && this.analysis[l.index] === undefined) {
+      this.analysis[l.index] = a;
+      this.analysed++;
+      this.figures.addAnalysis(l.index, a);
+    }
+    const old = this.cache.get(l.index);
+    if (!old || (l.mask && !old.mask)) {
+      if (old) this.cacheBytes -= layerBytes(old);
+      this.cache.set(l.index, l);
+      this.cacheBytes += layerBytes(l);
+    }
+    if (this.source === "stl") this.evict(current);
+  }
+
+  /** A run of layers is complete: its G-code and its part of the summary. */
+  addUnit(u: SliceUnit): void {
+    if (u.gcode) this.gcode.set(u.from, { to: u.to, blob: u.gcode });
+    this.figures.addUnit(u);
+  }
+
+  /** The G-code of every layer in order, or the first layer without any. */
+  gcodeParts(): Blob[] | number {
+    const parts: Blob[] = [];
+    for (let i = 0; i < this.layers; ) {
+      const u = this.gcode.get(i);
+      if (!u) return i;
+      parts.push(u.blob);
+      i = u.to;
+    }
+    return parts;
+  }
+
+  private evict(current: number): void {
+    if (this.cacheBytes <= this.cacheBudget) return;
+    const far = [...this.cache.keys()].sort((a, b) => Math.abs(b - current) - Math.abs(a - current));
+    for (const i of far) {
+      if (this.cacheBytes <= this.cacheBudget * 0.8 || Math.abs(i - current) <= 1) break;
+      const l = this.cache.get(i)!;
+      this.cacheBytes -= layerBytes(l);
+      this.cache.delete(i);
+    }
+  }
+
+  get droplets(): number {
+    return this.figures.droplets;
+  }
+}
+
+/** Bytes a cached layer holds (droplets, roles, travel and the void mask's tiles). */
+function layerBytes(l: LayerData): number {
+  let m = 0;
+  for (const t of l.mask?.tiles ?? []) m += t.void.byteLength + t.overfill.byteLength;
+  return l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength + m;
+}
+
+/** The page's state (one per page). */
+export class Store {
+  model: Model | null = null;
+  slice: Slice | null = null;
+  /** The layer shown. */
+  current = 0;
+  /** Bumped by every run (slice, analysis, G-code read) and by cancel: a callback of an older
+   *  run finds it changed and does nothing. */
+  generation = 0;
+  busy = false;
+  /** The user zoomed or panned (or a link set the view): a new slice of the same model keeps it. */
+  viewTouched = false;
+  /** A preview link waiting for its model file (too big to be in the link). */
+  pendingLink: SharedLink | null = null;
+  /** The settings (JSON) of the slice shown, to tell when the form differs. */
+  slicedSettings = "";
+  /** When the file being opened was chosen: a slice's time runs from there. */
+  fileChosenAt: number | null = null;
+  /** Layers being fetched from a worker (evicted, or wanted with their mask). */
+  readonly previewRequests = new Set<number>();
+  /** The redraw waiting while the workers run (flows.ts whileBusy). */
+  busyRedraw: { gen: number; update: () => void } | null = null;
+
+  constructor(readonly cacheBudget: number) {}
+
+  /** A new, empty slice with this store's cache budget. */
+  newSlice(source: "stl" | "gco", name: string, dropletWidth: number, layerHeight: number, settings: Record<string, Value>, model: Model | null): Slice {
+    return new Slice(source, name, dropletWidth, layerHeight, settings, model, this.cacheBudget);
+  }
+}

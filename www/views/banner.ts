@@ -1,0 +1,50 @@
+// Messages: the banner (errors, notices) and the note about a preview link.
+
+import { SliceError } from "../client";
+import { $ } from "./dom";
+
+export const TITLES: Record<string, string> = {
+  import: "",
+  setting: "Bad setting.",
+  nothing_to_print: "Nothing to print.",
+  crash: "The slicer crashed.",
+  internal: "Internal error.",
+  link: "Cannot open this preview link.",
+  linkPart: "Parts of this preview link were ignored.",
+};
+
+export function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error"): void {
+  const b = $("banner");
+  b.className = `banner ${tone === "error" ? "" : tone}`;
+  $("banner-title").textContent = title;
+  $("banner-title").hidden = title === "";
+  $("banner-message").textContent = message;
+  b.hidden = false;
+  b.dataset.kind = tone;
+}
+
+export function hideBanner(): void {
+  $("banner").hidden = true;
+}
+
+/** The banner of an error: the core's kind of error as its title. */
+export function errorBanner(e: unknown): void {
+  if (e instanceof SliceError) {
+    showBanner(TITLES[e.kind] ?? "Error.", capitalize(e.message));
+  } else if (e instanceof Error) {
+    showBanner("Something went wrong.", e.message);
+  } else {
+    showBanner("Something went wrong.", String(e));
+  }
+}
+
+function capitalize(s: string): string {
+  return s.charAt(0).toUpperCase() + s.slice(1);
+}
+
+export function note(text: string, tone: "warn" | "ok" | "none"): void {
+  const n = $("link-note");
+  n.hidden = tone === "none";
+  n.textContent = text;
+  n.className = tone === "ok" ? "banner ok" : "note";
+}

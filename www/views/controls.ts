@@ -1,0 +1,34 @@
+// The buttons Download, Copy preview link and Slice, and the settings' status line.
+
+import type { Page } from "../page";
+import { $ } from "./dom";
+
+export function updateButtons(page: Page): void {
+  const { store, form } = page;
+  const s = store.slice;
+  const ready = !store.busy && s !== null && s.complete;
+  // Like the CLI, no code for a part without a single droplet.
+  ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && !s!.figures.nothingToPrint);
+  ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && store.model !== null);
+  ($("btn-slice") as HTMLButtonElement).disabled = store.model === null || form === undefined;
+  settingsStatus(page);
+}
+
+function settingsStatus(page: Page): void {
+  const { store, form } = page;
+  if (!form) return;
+  const st = $("settings-status");
+  const errors = form.errors();
+  const btn = $("btn-slice");
+  if (errors.length) {
+    st.textContent = `${errors.length} setting${errors.length > 1 ? "s are" : " is"} invalid.`;
+    st.className = "hint bad";
+    ($("btn-slice") as HTMLButtonElement).disabled = true;
+    btn.classList.remove("attention");
+    return;
+  }
+  const stale = store.model !== null && store.slice?.source === "stl" && form.json() !== store.slicedSettings;
+  st.className = "hint";
+  st.textContent = stale ? "Settings changed: press Slice (or Enter) to update." : "";
+  btn.classList.toggle("attention", stale);
+}

@@ -1,0 +1,47 @@
+// The share dialog: makes the preview link of the slice shown, copies it, and shows it.
+
+import type { Value } from "../form";
+import type { Page } from "../page";
+import { makeLink } from "../share";
+import { $ } from "./dom";
+
+export async function share(page: Page): Promise<void> {
+  const { store, renderer } = page;
+  const s = store.slice;
+  const model = store.model;
+  if (!s || !model || s.source !== "stl") return;
+  const { url, embedded } = await makeLink(location.href, {
+    settings: changedFrom(page, s.settings),
+    layer: store.current,
+    view: { ...renderer.view },
+    name: model.name,
+    sha256: model.sha256,
+    showTravel: renderer.showTravel,
+  }, model.bytes);
+  let copied = false;
+  try {
+    // some browsers never settle the promise when they do not grant the permission
+    copied = await Promise.race([
+      navigator.clipboard.writeText(url).then(() => true),
+      new Promise<boolean>((ok) => setTimeout(() => ok(false), 1500)),
+    ]);
+  } catch {
+    // clipboard refused (permissions, insecure context): the dialog shows the link to copy
+  }
+  $("share-text").textContent =
+    (copied ? "Copied to the clipboard. " : "Copy this link. ") +
+    (embedded
+      ? `The model is inside the link (${Math.round(url.length / 1024)} KB), so it opens the same slice anywhere.`
+      : `“${model.name}” is too big to embed, so the link carries its SHA-256: whoever opens it drops in the same file and the page checks that it matches.`);
+  const input = $<HTMLInputElement>("share-url");
+  input.value = url;
+  $<HTMLDialogElement>("share-dialog").showModal();
+  input.select();
+}
+
+/** The settings that differ from the core's defaults (the link carries only those). */
+function changedFrom(page: Page, values: Record<string, Value>): Record<string, Value> {
+  const out: Record<string, Value> = {};
+  for (const [k, v] of Object.entries(values)) if (page.init!.defaults[k] !== v) out[k] = v;
+  return out;
+}

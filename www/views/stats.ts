@@ -1,0 +1,104 @@
+// The statistics panel: the model, droplets by role, the estimates, this layer, the mesh
+// warnings and the unit fix. The figures come from the slice's Figures (figures.ts).
+
+import type { Page } from "../page";
+import type { Slice } from "../store";
+import { $, nf, setText } from "./dom";
+import { writeVoids } from "./voids";
+
+const fmtMm = (x: number) => `${x.toFixed(1)}`;
+
+function duration(seconds: number): string {
+  if (!Number.isFinite(seconds)) return "–";
+  const h = Math.floor(seconds / 3600);
+  const m = Math.floor((seconds % 3600) / 60);
+  const s = Math.round(seconds % 60);
+  if (h > 0) return `${h} h ${m} min`;
+  if (m > 0) return `${m} min ${s} s`;
+  return `${s} s`;
+}
+
+function roleLabels(source: "stl" | "gco"): void {
+  const gco = source === "gco";
+  $("legend-0").textContent = $("stat-label-0").textContent = gco ? "Loop droplets (G26)" : "Outer loop";
+  $("legend-2").textContent = $("stat-label-2").textContent = gco ? "Fill lines (G25)" : "Fill";
+  $("legend-1-wrap").hidden = gco;
+}
+
+export function writeStats(page: Page): void {
+  const { store, form } = page;
+  const s = store.slice;
+  const current = store.current;
+  roleLabels(s?.source ?? "stl");
+  $("empty").hidden = s !== null;
+  if (!s) {
+    writeVoids(null, current);
+    for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
+    $("warnings").hidden = true;
+    return;
+  }
+  const num = (name: string, fallback: number): number => {
+    const v = s.settings[name] ?? form?.get(name);
+    return typeof v === "number" ? v : fallback;
+  };
+  const f = s.figures;
+  setText("stat-model", s.name);
+  const b = s.info.bounds;
+  if (b) setText("stat-size", `${fmtMm(b.max[0] - b.min[0])} × ${fmtMm(b.max[1] - b.min[1])} × ${fmtMm(b.max[2] - b.min[2])} mm`);
+  else if (Number.isFinite(s.bbox.minX)) setText("stat-size", `${fmtMm(s.bbox.maxX - s.bbox.minX)} × ${fmtMm(s.bbox.maxY - s.bbox.minY)} mm (droplets)`);
+  else setText("stat-size", "–");
+  const facets = s.info.mesh?.facets_in_file;
+  setText("stat-facets", facets !== undefined ? nf.format(facets) : s.source === "gco" ? "(G-code file)" : "–");
+  setText("stat-layers", s.complete || s.done === s.layers ? nf.format(s.layers) : `${nf.format(s.done)} of ${nf.format(s.layers)}`);
+  setText("stat-droplet", `${s.dropletWidth.toFixed(3)} × ${s.layerHeight.toFixed(3)} mm`);
+  setText("stat-outer", nf.format(f.totals.outer));
+  setText("stat-inner", nf.format(f.totals.inner));
+  setText("stat-fill", nf.format(f.totals.fill));
+  setText("stat-droplets", nf.format(f.droplets));
+  const { volume, mass, seconds } = f.estimates(s.dropletWidth, s.layerHeight, num);
+  setText("stat-volume", `${(volume / 1000).toFixed(2)} cm³`);
+  setText("stat-mass", `${mass.toFixed(2)} g`);
+  setText("stat-time", (s.complete ? "" : "≥ ") + duration(seconds));
+  setText("stat-travel", `${(f.travelTotal / 1000).toFixed(2)} m`);
+  const c = s.counts[current];
+  setText("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
+  setText("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
+  writeVoids(s, current);
+  const warnings = [...((s.info.warnings ?? []) as string[]), ...s.repairs];
+  $("warnings").hidden = warnings.length === 0;
+  const list = $("warning-list");
+  const text = warnings.join("\n");
+  if (list.dataset.text !== text) {
+    // rebuilt only when it changes: writeStats runs many times during a slice
+    list.dataset.text = text;
+    list.replaceChildren(
+      ...warnings.map((w) => {
+        const li = document.createElement("li");
+        li.textContent = w;
+        return li;
+      }),
+    );
+  }
+  writeUnitFix(page, s);
+}
+
+/**
+ * The unit rule's fix, offered, never applied silently: when the part's size suggests the file
+ * is in inches (or micrometres), a button scales x, y and z by the suggested factor and slices
+ * again.
+ */
+function writeUnitFix(page: Page, s: Slice): void {
+  const factor = s.info.suggested_scale;
+  const btn = $("btn-unit-fix") as HTMLButtonElement;
+  btn.hidden = typeof factor !== "number" || s.model === null;
+  if (typeof factor !== "number" || btn.hidden) return;
+  btn.textContent = factor > 1 ? `Scale ×${factor} (inches → mm)` : `Scale ×${factor} (µm → mm)`;
+  btn.title = "Scale x, y and z by this factor and slice again";
+  btn.onclick = () => page.onUnitFix(s, factor);
+}
+
+/** The model's name in the header; the "open a file" hint hidden (or shown again). */
+export function showModel(name: string | null): void {
+  if (name !== null) $("model-name").textContent = name;
+  $("empty").hidden = name !== null;
+}

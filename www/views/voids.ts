@@ -1,0 +1,26 @@
+// The "Voids" block of the statistics: this layer, the part, the worst layer (and its button).
+
+import type { Slice } from "../store";
+import { $, nf, setText } from "./dom";
+
+const pct = (x: number) => `${(x * 100).toFixed(1)} %`;
+const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
+
+export function writeVoids(s: Slice | null, current: number): void {
+  const a = s?.analysis[current];
+  setText("stat-coverage", a ? pct(a.coverage) : "–");
+  setText("stat-void", a ? mm2(a.void_area) : "–");
+  const v = a?.largest_void;
+  setText("stat-largest", v ? `${mm2(v.area)}${v.at_boundary ? " (edge)" : ""}` : a ? "none" : "–");
+  const partial = s && s.analysed < s.layers ? " so far" : "";
+  const coverage = s?.figures.partCoverage(s.analysed) ?? null;
+  setText("stat-part-coverage", coverage !== null ? pct(coverage) + partial : "–");
+  const worst = s?.figures.worst;
+  setText("stat-worst", worst ? `${nf.format(worst.index + 1)} · ${mm2(worst.area)}` : "–");
+  ($("btn-worst") as HTMLButtonElement).disabled = !worst;
+  const hint = $("voids-hint");
+  if (s?.source === "gco") hint.textContent = "Voids are analysed for sliced STL files.";
+  else if (!s || s.analysed === 0) hint.replaceChildren("Turn on ", Object.assign(document.createElement("b"), { textContent: "Voids" }), " to analyse.");
+  else if (s.analysed < s.layers) hint.textContent = `Analysed ${nf.format(s.analysed)} of ${nf.format(s.layers)} layers.`;
+  else hint.textContent = "Worst: largest connected void.";
+}
