@@ -208,7 +208,7 @@ impl Session {
     ) -> Result<Session, JsValue> {
         let settings = settings_of(settings)?;
         let info: JobInfo = from_js(info, "job info")?;
-        if vertices.len() % 3 != 0 || facets.len() % 3 != 0 {
+        if !vertices.len().is_multiple_of(3) || !facets.len().is_multiple_of(3) {
             return Err(js_error(Error::Internal(
                 "prepared mesh: arrays are not triples".into(),
             )));

@@ -105,10 +105,12 @@ fn figures_follow_the_estimate_settings() {
         f.print_seconds,
         f.droplets as f64 / 100.0 + s.travel_mm / 50.0
     ));
-    let mut other = Settings::default();
-    other.droplet_rate = 200.0;
-    other.travel_speed = 100.0;
-    other.material_density = 2.08;
+    let other = Settings {
+        droplet_rate: 200.0,
+        travel_speed: 100.0,
+        material_density: 2.08,
+        ..Settings::default()
+    };
     let g = s.figures(&other);
     assert!(close(g.print_seconds, f.print_seconds / 2.0));
     assert!(close(g.mass_g, 2.0 * f.mass_g));
