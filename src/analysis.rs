@@ -79,7 +79,7 @@ pub fn spheroid_half_height(s: &Settings) -> f64 {
 }
 
 /// One connected void of a layer.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Void {
     /// mm².
     pub area: f64,
@@ -1043,7 +1043,7 @@ impl UnionFind {
 }
 
 /// Part-level figures. Areas in mm² summed over layers; volumes in mm³.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct PartAnalysis {
     pub layers: usize,
     pub droplets: u64,

@@ -6,7 +6,7 @@ use std::fmt;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Error {
-    /// The file could not be read as an STL mesh.
+    /// The file could not be read as a model (STL, OBJ or 3MF).
     Import(String),
     /// A setting is unknown or out of range.
     Setting { name: String, message: String },
@@ -31,10 +31,36 @@ impl Error {
     }
 }
 
+/// An [`Error`] as the page receives it: `{kind, message, setting?}` (`setting` names the
+/// setting of an [`Error::Setting`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ErrorReport {
+    /// [`Error::kind`].
+    pub kind: &'static str,
+    /// The whole sentence shown to the user (the error's `Display`).
+    pub message: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub setting: Option<String>,
+}
+
+impl Error {
+    /// The error as the page receives it.
+    pub fn report(&self) -> ErrorReport {
+        ErrorReport {
+            kind: self.kind(),
+            message: self.to_string(),
+            setting: match self {
+                Error::Setting { name, .. } if !name.is_empty() => Some(name.clone()),
+                _ => None,
+            },
+        }
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Error::Import(m) => write!(f, "cannot read the STL file: {m}"),
+            Error::Import(m) => write!(f, "cannot read the model file: {m}"),
             Error::Setting { name, message } if name.is_empty() => {
                 write!(f, "bad settings: {message}")
             }

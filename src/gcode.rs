@@ -4,51 +4,10 @@
 //! written before any layer, with fixed-width placeholders for the droplet counts that
 //! [`header`] fills in once the slice is done (same length, so a file can be patched in place).
 
-use crate::plan::{Counts, LayerPlan, MoveKind};
+use crate::plan::{LayerPlan, MoveKind};
 use crate::settings::Settings;
-use serde::{Deserialize, Serialize};
+pub use crate::summary::Summary;
 use std::fmt::Write;
-
-/// Totals of a finished slice.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Summary {
-    pub layers: usize,
-    pub counts: Counts,
-    /// Length of all moves without material, in mm.
-    pub travel_mm: f64,
-    /// Layers whose section had open chains that were joined across gaps.
-    pub layers_with_open_chains: usize,
-    /// Loops chained against the direction of some of their facets (flipped facets).
-    pub reoriented_loops: usize,
-}
-
-impl Summary {
-    /// Adds one finished layer.
-    pub fn add(&mut self, plan: &LayerPlan) {
-        self.counts.add(&plan.counts);
-        self.travel_mm += plan.travel_mm;
-        self.layers_with_open_chains += usize::from(plan.open_chains > 0);
-        self.reoriented_loops += plan.reoriented_loops;
-    }
-
-    /// Plain-language notes on what slicing repaired.
-    pub fn repairs(&self) -> Vec<String> {
-        let mut r = Vec::new();
-        if self.layers_with_open_chains > 0 {
-            r.push(format!(
-                "{} layers had open sections (holes in the mesh), closed by joining their ends",
-                self.layers_with_open_chains
-            ));
-        }
-        if self.reoriented_loops > 0 {
-            r.push(format!(
-                "{} loops crossed flipped facets and were oriented by the majority",
-                self.reoriented_loops
-            ));
-        }
-        r
-    }
-}
 
 /// What the header says about the input.
 #[derive(Clone, Debug)]

@@ -29,12 +29,13 @@ pub mod preview;
 pub mod settings;
 pub mod slice;
 pub mod stl;
+pub mod summary;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 
 pub use error::Error;
-pub use gcode::Summary;
 pub use settings::Settings;
+pub use summary::{Figures, Summary};
 
 use mesh::{Bounds, Mesh, MeshStats};
 use plan::LayerPlan;
@@ -50,7 +51,7 @@ pub const MAX_DROPLETS: f64 = 2e9;
 pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
 
 /// What the import found, for the CLI summary, the header and the page.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct JobInfo {
     pub file_name: String,
     pub format: stl::Format,
@@ -93,123 +94,99 @@ pub struct Job {
 }
 
 impl Job {
-    /// Reads the STL bytes, validates the settings and places the part.
-    pub fn new(stl_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
+    /// Reads the model (STL, OBJ or a 3MF build, see [`import`]), validates the settings and
+    /// places the part: import → checks → mesh repair → facet index. A 3MF build's items keep
+    /// their relative positions and are sliced together.
+    pub fn new(model_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
         settings.validate()?;
-        let (tris, format) = stl::parse(stl_bytes)?;
-        let (mut mesh, degenerate) = Mesh::weld(&tris);
-        if mesh.facets.is_empty() {
-            return Err(Error::Import(format!(
-                "all {} triangles are degenerate (their corners coincide): the mesh has no surface",
-                tris.len()
-            )));
-        }
-        let facets_in_file = tris.len();
-        drop(tris);
-        mesh.transform(&settings);
+        let Imported {
+            mut mesh,
+            format,
+            facets_in_file,
+            degenerate,
+        } = import(model_bytes, file_name, &settings)?;
         let bounds = mesh.bounds();
         let size = bounds.size();
-        let h = settings.layer_height;
-        if size[2] <= 0.0 {
-            return Err(Error::NothingToPrint(
-                "the part is flat (0 mm tall after rotation): check rotate_x/rotate_y".into(),
-            ));
-        }
-        let layers_needed = size[2] / h;
-        if layers_needed > MAX_LAYERS as f64 {
-            return Err(Error::Setting {
-                name: "layer_height".into(),
-                message: format!(
-                    "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
-                    size[2], layers_needed
-                ),
-            });
-        }
-        let b = settings.droplet_width();
+        check_height(&size, &settings)?;
         // Every closed shell as its author meant it (inside-out shells turned outward, cavities
         // kept), so the volume below counts what will be printed: shells of opposite
         // orientation can no longer cancel.
         let shells = mesh.orient_shells();
-        let volume = mesh.signed_volume().abs().max(shells.closed_volume);
-        if size[0] <= 0.0 || size[1] <= 0.0 || volume <= 1e-9 * size[0] * size[1] * size[2] {
-            return Err(Error::NothingToPrint(
-                "the mesh encloses no volume (a surface without thickness): export the part as a solid".into(),
-            ));
-        }
-        check_droplets(volume, &settings)?;
-        if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
-            return Err(Error::Setting {
-                name: "scale_x".into(),
-                message: format!(
-                    "the part is {:.0} mm wide, more than {MAX_WIDTH_IN_DROPLETS} droplets of {b:.4} mm; check the scale (is the file in micrometres?)",
-                    size[0].max(size[1])
-                ),
-            });
-        }
-        let zs = slice::layer_heights(size[2], h, settings.slice_plane);
-        if zs.is_empty() {
-            return Err(Error::NothingToPrint(format!(
-                "the part is {:.4} mm tall, less than half a layer ({} mm): scale it up or lower layer_height",
-                size[2],
-                h / 2.0
-            )));
-        }
-        let duplicates = mesh.remove_duplicate_facets();
-        // The statistics and the facet index are independent: build them side by side.
-        let (stats, mut buckets) = both(
-            || mesh.stats(facets_in_file, degenerate),
-            || FacetBuckets::new(&mesh, &zs),
-        );
-        let mut stats = MeshStats {
-            duplicate_facets: duplicates,
-            ..stats
-        };
-        if stats.open_edges > 0 {
-            // Cracks between near-coincident corners: try a tolerance weld, keep it if it helps.
-            let mut welded = mesh.clone();
-            let merged = welded.weld_tolerance(WELD_TOLERANCE_MM);
-            let dropped = mesh.facets.len() - welded.facets.len();
-            let better = welded.stats(facets_in_file, degenerate + dropped);
-            if merged > 0 && better.open_edges < stats.open_edges {
-                mesh = welded;
-                buckets = FacetBuckets::new(&mesh, &zs);
-                stats = MeshStats {
-                    tolerance_welded: merged,
-                    duplicate_facets: duplicates,
-                    ..better
-                };
-            }
-        }
-        stats.flipped_shells = shells.flipped;
-        stats.cavity_shells = shells.cavities;
-        stats.unchecked_shells = shells.unchecked;
-        if shells.flipped > 0 {
-            stats.signed_volume = mesh.signed_volume();
-        }
+        check_volume(&mesh, &shells, &size, &settings)?;
+        let zs = plane_heights(&size, &settings)?;
+        let (mesh, buckets, stats) = repair(mesh, &zs, &shells, facets_in_file, degenerate);
         if shells.open > 0 {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
+            let h = settings.layer_height;
             check_droplets(sampled_volume(&mesh, &buckets, &zs, h), &settings)?;
         }
-        let warnings = warnings(&stats, &size);
-        let suggested_scale = suggested_scale(&size);
         let info = JobInfo {
             file_name: file_name.to_string(),
             format,
+            warnings: warnings(&stats, &size),
+            suggested_scale: suggested_scale(&size),
             mesh: stats,
             bounds,
             layers: zs.len(),
-            droplet_width: b,
-            warnings,
-            suggested_scale,
+            droplet_width: settings.droplet_width(),
         };
-        Ok(Job {
+        Ok(Job::assemble(settings, mesh, buckets, zs, info))
+    }
+
+    /// A job from a mesh another [`Job`] prepared (its [`Job::mesh`] and [`Job::info`], with
+    /// the same settings): no import, checks or repair, only the facet index. Slices exactly
+    /// as that job does.
+    pub fn from_prepared(mesh: Mesh, info: JobInfo, settings: Settings) -> Result<Job, Error> {
+        settings.validate()?;
+        let zs = slice::layer_heights(
+            info.bounds.size()[2],
+            settings.layer_height,
+            settings.slice_plane,
+        );
+        let bad = |what: String| Error::Internal(format!("prepared mesh: {what}"));
+        if zs.len() != info.layers {
+            return Err(bad(format!(
+                "{} layers, but the settings give {} (prepared with other settings?)",
+                info.layers,
+                zs.len()
+            )));
+        }
+        if info.mesh.facets != mesh.facets.len() {
+            return Err(bad(format!(
+                "{} facets, but the info says {}",
+                mesh.facets.len(),
+                info.mesh.facets
+            )));
+        }
+        let n = mesh.vertices.len();
+        if mesh.facets.iter().flatten().any(|&v| v as usize >= n) {
+            return Err(bad("a facet refers to a vertex that does not exist".into()));
+        }
+        let buckets = FacetBuckets::new(&mesh, &zs);
+        Ok(Job::assemble(settings, mesh, buckets, zs, info))
+    }
+
+    /// The common tail of [`Job::new`] and [`Job::from_prepared`].
+    fn assemble(
+        settings: Settings,
+        mesh: Mesh,
+        buckets: FacetBuckets,
+        zs: Vec<f64>,
+        info: JobInfo,
+    ) -> Job {
+        Job {
             settings,
             mesh,
             buckets,
             zs,
             info,
-        })
+        }
+    }
+
+    /// The placed, repaired mesh that is sliced (for [`Job::from_prepared`]).
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
     }
 
     pub fn settings(&self) -> &Settings {
@@ -269,6 +246,141 @@ impl Job {
             summary,
         )
     }
+}
+
+/// What [`import`] read.
+struct Imported {
+    mesh: Mesh,
+    format: stl::Format,
+    facets_in_file: usize,
+    degenerate: usize,
+}
+
+/// Import: STL bytes → triangles → welded mesh → rotated, scaled, placed.
+fn import(bytes: &[u8], file_name: &str, settings: &Settings) -> Result<Imported, Error> {
+    let (tris, format) = import::read_merged(bytes, file_name)?;
+    let (mut mesh, degenerate) = Mesh::weld(&tris);
+    if mesh.facets.is_empty() {
+        return Err(Error::Import(format!(
+            "all {} triangles are degenerate (their corners coincide): the mesh has no surface",
+            tris.len()
+        )));
+    }
+    let facets_in_file = tris.len();
+    drop(tris);
+    mesh.transform(settings);
+    Ok(Imported {
+        mesh,
+        format,
+        facets_in_file,
+        degenerate,
+    })
+}
+
+/// Checks: the part has a height, and not too many layers of it.
+fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), Error> {
+    let h = settings.layer_height;
+    if size[2] <= 0.0 {
+        return Err(Error::NothingToPrint(
+            "the part is flat (0 mm tall after rotation): check rotate_x/rotate_y".into(),
+        ));
+    }
+    let layers_needed = size[2] / h;
+    if layers_needed > MAX_LAYERS as f64 {
+        return Err(Error::Setting {
+            name: "layer_height".into(),
+            message: format!(
+                "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
+                size[2], layers_needed
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Checks: the mesh encloses a volume, and not one of too many droplets.
+fn check_volume(
+    mesh: &Mesh,
+    shells: &mesh::ShellOrientation,
+    size: &[f64; 3],
+    settings: &Settings,
+) -> Result<(), Error> {
+    let volume = mesh.signed_volume().abs().max(shells.closed_volume);
+    if size[0] <= 0.0 || size[1] <= 0.0 || volume <= 1e-9 * size[0] * size[1] * size[2] {
+        return Err(Error::NothingToPrint(
+            "the mesh encloses no volume (a surface without thickness): export the part as a solid"
+                .into(),
+        ));
+    }
+    check_droplets(volume, settings)
+}
+
+/// Checks the width in droplets; the plane heights of the layers (at least one).
+fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {
+    let b = settings.droplet_width();
+    let h = settings.layer_height;
+    if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
+        return Err(Error::Setting {
+            name: "scale_x".into(),
+            message: format!(
+                "the part is {:.0} mm wide, more than {MAX_WIDTH_IN_DROPLETS} droplets of {b:.4} mm; check the scale (is the file in micrometres?)",
+                size[0].max(size[1])
+            ),
+        });
+    }
+    let zs = slice::layer_heights(size[2], h, settings.slice_plane);
+    if zs.is_empty() {
+        return Err(Error::NothingToPrint(format!(
+            "the part is {:.4} mm tall, less than half a layer ({} mm): scale it up or lower layer_height",
+            size[2],
+            h / 2.0
+        )));
+    }
+    Ok(zs)
+}
+
+/// Mesh repair and index: duplicate facets removed, statistics, the facet index per layer,
+/// and a tolerance weld kept if it closes cracks.
+fn repair(
+    mut mesh: Mesh,
+    zs: &[f64],
+    shells: &mesh::ShellOrientation,
+    facets_in_file: usize,
+    degenerate: usize,
+) -> (Mesh, FacetBuckets, MeshStats) {
+    let duplicates = mesh.remove_duplicate_facets();
+    // The statistics and the facet index are independent: build them side by side.
+    let (stats, mut buckets) = both(
+        || mesh.stats(facets_in_file, degenerate),
+        || FacetBuckets::new(&mesh, zs),
+    );
+    let mut stats = MeshStats {
+        duplicate_facets: duplicates,
+        ..stats
+    };
+    if stats.open_edges > 0 {
+        // Cracks between near-coincident corners: try a tolerance weld, keep it if it helps.
+        let mut welded = mesh.clone();
+        let merged = welded.weld_tolerance(WELD_TOLERANCE_MM);
+        let dropped = mesh.facets.len() - welded.facets.len();
+        let better = welded.stats(facets_in_file, degenerate + dropped);
+        if merged > 0 && better.open_edges < stats.open_edges {
+            mesh = welded;
+            buckets = FacetBuckets::new(&mesh, zs);
+            stats = MeshStats {
+                tolerance_welded: merged,
+                duplicate_facets: duplicates,
+                ..better
+            };
+        }
+    }
+    stats.flipped_shells = shells.flipped;
+    stats.cavity_shells = shells.cavities;
+    stats.unchecked_shells = shells.unchecked;
+    if shells.flipped > 0 {
+        stats.signed_volume = mesh.signed_volume();
+    }
+    (mesh, buckets, stats)
 }
 
 /// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
@@ -432,10 +544,7 @@ where
         written: 0,
     });
     let changed = Condvar::new();
-    let mut summary = Summary {
-        layers: n,
-        ..Summary::default()
-    };
+    let mut summary = Summary::default();
     std::thread::scope(|scope| -> Result<(), Error> {
         for _ in 0..threads {
             scope.spawn(|| {

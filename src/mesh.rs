@@ -15,7 +15,7 @@ pub struct Mesh {
 }
 
 /// Axis-aligned bounding box.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Bounds {
     pub min: [f64; 3],
     pub max: [f64; 3],
@@ -28,7 +28,7 @@ impl Bounds {
 }
 
 /// What the import found in the mesh.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MeshStats {
     pub facets_in_file: usize,
     pub facets: usize,

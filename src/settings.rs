@@ -433,6 +433,12 @@ impl Settings {
             name: String::new(),
             message: format!("the settings are not valid JSON: {e}"),
         })?;
+        Settings::from_value(value)
+    }
+
+    /// Settings from an object `{"name": value, ...}` (parsed JSON, or a JS object from the
+    /// page); missing names take their defaults. The result is validated.
+    pub fn from_value(value: serde_json::Value) -> Result<Settings, Error> {
         let serde_json::Value::Object(map) = value else {
             return Err(Error::Setting {
                 name: String::new(),

@@ -15,7 +15,7 @@ pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// The format a model file was read as: one of the two STL encodings, or OBJ / 3MF
 /// ([`crate::import`]). Serialised as `"binary"`, `"ascii"`, `"obj"`, `"3mf"`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Format {
     Binary,
@@ -29,7 +29,7 @@ pub enum Format {
 pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
     if bytes.is_empty() {
         return Err(Error::Import(
-            "the file is empty (0 bytes); choose an STL file".into(),
+            "the file is empty (0 bytes); choose an STL, OBJ or 3MF file".into(),
         ));
     }
     let (tris, format) = if let Some(n) = binary_count(bytes) {
@@ -38,7 +38,7 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         (parse_ascii(bytes)?, Format::Ascii)
     } else if let Some(kind) = other_format(bytes) {
         return Err(Error::Import(format!(
-            "this is not an STL file but {kind}; choose an STL file (export one from your modelling program)"
+            "this is not an STL file but {kind}; choose an STL, OBJ or 3MF file (export one from your modelling program)"
         )));
     } else if bytes.len() >= 84 {
         let n = u32::from_le_bytes(bytes[80..84].try_into().expect("4 bytes")) as u64;
@@ -47,7 +47,7 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         // is text or another format read as a binary header.
         let msg = if n > MAX_TRIANGLES as u64 {
             format!(
-                "this is not an STL file: it does not start with 'solid' (ASCII STL), and as a binary STL it would declare {n} triangles ({expected} bytes) in a file of {} bytes; choose an STL file",
+                "this is not an STL file: it does not start with 'solid' (ASCII STL), and as a binary STL it would declare {n} triangles ({expected} bytes) in a file of {} bytes; choose an STL, OBJ or 3MF file",
                 bytes.len()
             )
         } else if (bytes.len() as u64) < expected {
@@ -64,7 +64,7 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         return Err(Error::Import(msg));
     } else {
         return Err(Error::Import(format!(
-            "the file is too short ({} bytes) to be a binary STL and is not ASCII STL; choose an STL file",
+            "the file is too short ({} bytes) to be a binary STL and is not ASCII STL; choose an STL, OBJ or 3MF file",
             bytes.len()
         )));
     };

@@ -2,29 +2,78 @@
 //!
 //! One [`Session`] per worker owns one prepared [`Job`]; the worker asks it for layers by index
 //! and gets flat typed arrays (droplet centres, roles, travel moves) and the layer's G-code text,
-//! never a JS object per point. Errors cross the boundary as `JsError`s whose message is
-//! `"<kind>: <message>"`, `kind` being [`Error::kind`] ("import", "setting", ...), so the page
-//! can tell the user's mistakes from bugs. A panic is reported to `globalThis.dropslicePanic`
-//! (if the worker defined it) and to the console, and the worker turns the trap that follows
-//! into an error message.
+//! never a JS object per point. Everything else crosses as typed values through
+//! serde-wasm-bindgen (plain JS objects, never JSON text): settings go in as an object; info,
+//! summaries, figures, layer analyses, the schema and the defaults come out as objects. An
+//! error is thrown as a plain object `{kind, message, setting?}` ([`ErrorReport`]: `kind` from
+//! [`Error::kind`], `setting` the setting's name), so the page can tell the user's mistakes
+//! from bugs; a value that cannot be converted is an internal error, never a silent default.
+//! A panic is reported to `globalThis.dropslicePanic` (if the worker defined it) and to the
+//! console, and the worker turns the trap that follows into an error message.
+//!
+//! The model comes in as a `File` read in the worker ([`Session::from_file`], `FileReaderSync`),
+//! so the page's thread never copies its bytes; one worker prepares the job and hands the
+//! prepared mesh ([`Session::vertices`], [`Session::facets`], [`Session::info`]) to the others
+//! ([`Session::from_prepared`]), which skip the import.
 //!
 //! The core knows nothing of wasm; this file only converts.
 
 use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
-use crate::error::Error;
+use crate::error::{Error, ErrorReport};
 use crate::gcode;
+use crate::mesh::Mesh;
 use crate::plan::{Counts, LayerPlan};
 use crate::preview::PreviewLayer;
 use crate::settings::{self, Settings};
-use crate::{Job, Summary};
-use js_sys::{Float32Array, Float64Array, Uint8Array};
+use crate::summary::{Figures, Summary};
+use crate::{Job, JobInfo};
+use js_sys::{Float32Array, Float64Array, Uint8Array, Uint32Array};
+use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
 /// Cells of the void overlay's mask per droplet width B (cells of B/4: ~0.05 mm by default).
 pub const MASK_CELLS_PER_B: f64 = 4.0;
 
-fn js_error(e: Error) -> JsError {
-    JsError::new(&format!("{}: {e}", e.kind()))
+/// The error as thrown to JS: a plain object `{kind, message, setting?}`.
+pub fn js_error(e: Error) -> JsValue {
+    let report = e.report();
+    report
+        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .unwrap_or_else(|_| {
+            // Cannot happen for this plain struct; still an error, never a silent value.
+            let o = js_sys::Object::new();
+            let _ = js_sys::Reflect::set(&o, &"kind".into(), &report.kind.into());
+            let _ = js_sys::Reflect::set(&o, &"message".into(), &report.message.into());
+            o.into()
+        })
+}
+
+/// A value for JS (plain objects and arrays, `null` for `None`); a failure is an internal error.
+fn to_js<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<JsValue, JsValue> {
+    value
+        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| {
+            js_error(Error::Internal(format!(
+                "cannot pass {what} to the page: {e}"
+            )))
+        })
+}
+
+/// A value from JS; a failure is an internal error (the page sent what the core did not make).
+fn from_js<T: serde::de::DeserializeOwned>(value: JsValue, what: &str) -> Result<T, JsValue> {
+    serde_wasm_bindgen::from_value(value)
+        .map_err(|e| js_error(Error::Internal(format!("bad {what} from the page: {e}"))))
+}
+
+/// Settings from a JS object `{name: value, ...}` (missing names: defaults), validated.
+fn settings_of(value: JsValue) -> Result<Settings, JsValue> {
+    let value: serde_json::Value = serde_wasm_bindgen::from_value(value).map_err(|e| {
+        js_error(Error::Setting {
+            name: String::new(),
+            message: format!("the settings are not a plain object of values: {e}"),
+        })
+    })?;
+    Settings::from_value(value).map_err(js_error)
 }
 
 fn report_panic(info: &std::panic::PanicHookInfo<'_>) {
@@ -49,17 +98,17 @@ pub fn version() -> String {
     crate::VERSION.to_string()
 }
 
-/// The settings table as JSON: `[{name, kind, unit, min, max, min_exclusive, choices, group,
+/// The settings table: `[{name, kind, unit, min, max, min_exclusive, choices, group,
 /// description, default}]`.
 #[wasm_bindgen]
-pub fn settings_schema() -> String {
-    settings::schema_json()
+pub fn settings_schema() -> Result<JsValue, JsValue> {
+    to_js(&settings::schema(), "the settings schema")
 }
 
-/// The default settings as a JSON object.
+/// The default settings: `{name: value, ...}`.
 #[wasm_bindgen]
-pub fn default_settings_json() -> String {
-    serde_json::to_string(&Settings::default()).unwrap_or_default()
+pub fn default_settings() -> Result<JsValue, JsValue> {
+    to_js(&Settings::default(), "the default settings")
 }
 
 /// Panics on purpose: lets the page's tests check that a crash becomes an error message.
@@ -69,15 +118,23 @@ pub fn crash_for_test() {
     panic!("crash_for_test was called");
 }
 
-/// Checks settings JSON; returns the validated settings as JSON (all names) or an error.
+/// Checks settings; returns the validated settings (all names) or throws `{kind: "setting",
+/// message, setting}`.
 #[wasm_bindgen]
-pub fn check_settings(settings_json: &str) -> Result<String, JsError> {
-    let s = Settings::from_json(settings_json).map_err(js_error)?;
-    Ok(serde_json::to_string(&s).unwrap_or_default())
+pub fn check_settings(settings: JsValue) -> Result<JsValue, JsValue> {
+    let s = settings_of(settings)?;
+    to_js(&s, "the settings")
+}
+
+/// Merges the summaries of the units of a slice (any order) into one.
+#[wasm_bindgen]
+pub fn merge_summaries(parts: JsValue) -> Result<JsValue, JsValue> {
+    let parts: Vec<Summary> = from_js(parts, "summaries")?;
+    to_js(&Summary::merged(&parts), "a summary")
 }
 
 impl Session {
-    fn check_layer(&self, i: usize) -> Result<(), JsError> {
+    fn check_layer(&self, i: usize) -> Result<(), JsValue> {
         if i >= self.job.layer_count() {
             return Err(js_error(Error::Internal(format!(
                 "layer {i} asked for, but the part has {} layers",
@@ -86,11 +143,20 @@ impl Session {
         }
         Ok(())
     }
+
+    fn with(job: Job) -> Session {
+        let settings = job.settings().clone();
+        Session { job, settings }
+    }
 }
 
-fn parse_summary(summary_json: &str) -> Result<Summary, JsError> {
-    serde_json::from_str(summary_json)
-        .map_err(|e| js_error(Error::Internal(format!("bad summary from the page: {e}"))))
+/// The figures of a slice as the page shows them: the merged summary (to keep instead of its
+/// parts), its figures, and "nothing to print" once every layer is in.
+#[derive(Serialize)]
+struct SliceFigures {
+    summary: Summary,
+    figures: Figures,
+    nothing_to_print: Option<ErrorReport>,
 }
 
 /// One prepared slicing job: the parsed, transformed mesh and its settings.
@@ -102,12 +168,72 @@ pub struct Session {
 
 #[wasm_bindgen]
 impl Session {
-    /// Parses the STL and prepares the job. Errors: `"import: ..."`, `"setting: ..."`, ...
+    /// Parses the STL bytes and prepares the job (tests and Node; the page uses
+    /// [`Session::from_file`]). Throws `{kind, message, setting?}`.
     #[wasm_bindgen(constructor)]
-    pub fn new(stl: &[u8], file_name: &str, settings_json: &str) -> Result<Session, JsError> {
-        let settings = Settings::from_json(settings_json).map_err(js_error)?;
-        let job = Job::new(stl, file_name, settings.clone()).map_err(js_error)?;
-        Ok(Session { job, settings })
+    pub fn new(stl: &[u8], file_name: &str, settings: JsValue) -> Result<Session, JsValue> {
+        let settings = settings_of(settings)?;
+        let job = Job::new(stl, file_name, settings).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// Reads the model from a `File` (in a worker: `FileReaderSync`, so the page's thread
+    /// never copies it) and prepares the job.
+    pub fn from_file(file: web_sys::File, settings: JsValue) -> Result<Session, JsValue> {
+        let settings = settings_of(settings)?;
+        let name = file.name();
+        let unreadable = |e: JsValue| {
+            js_error(Error::Import(format!(
+                "the browser could not read {name}: {}",
+                e.as_string()
+                    .or_else(|| e.dyn_ref::<js_sys::Error>().map(|e| e.message().into()))
+                    .unwrap_or_else(|| format!("{e:?}"))
+            )))
+        };
+        let reader = web_sys::FileReaderSync::new().map_err(unreadable)?;
+        let buffer = reader.read_as_array_buffer(&file).map_err(unreadable)?;
+        let bytes = Uint8Array::new(&buffer).to_vec();
+        drop(buffer);
+        let job = Job::new(&bytes, &name, settings).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// A session from the prepared mesh of another worker's session (its `vertices`, `facets`
+    /// and `info`, made with the same settings): no import, only the facet index.
+    pub fn from_prepared(
+        vertices: &[f64],
+        facets: &[u32],
+        info: JsValue,
+        settings: JsValue,
+    ) -> Result<Session, JsValue> {
+        let settings = settings_of(settings)?;
+        let info: JobInfo = from_js(info, "job info")?;
+        if !vertices.len().is_multiple_of(3) || !facets.len().is_multiple_of(3) {
+            return Err(js_error(Error::Internal(
+                "prepared mesh: arrays are not triples".into(),
+            )));
+        }
+        let mesh = Mesh {
+            vertices: vertices
+                .chunks_exact(3)
+                .map(|v| [v[0], v[1], v[2]])
+                .collect(),
+            facets: facets.chunks_exact(3).map(|f| [f[0], f[1], f[2]]).collect(),
+        };
+        let job = Job::from_prepared(mesh, info, settings).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// The prepared mesh's vertices, x,y,z per vertex, mm (a copy; transfer its buffer).
+    pub fn vertices(&self) -> Float64Array {
+        let v: &[[f64; 3]] = &self.job.mesh().vertices;
+        Float64Array::from(v.as_flattened())
+    }
+
+    /// The prepared mesh's facets, three vertex indices each (a copy; transfer its buffer).
+    pub fn facets(&self) -> Uint32Array {
+        let f: &[[u32; 3]] = &self.job.mesh().facets;
+        Uint32Array::from(f.as_flattened())
     }
 
     /// Number of layers.
@@ -115,22 +241,22 @@ impl Session {
         self.job.layer_count()
     }
 
-    /// Facets, bounds, layers and mesh warnings as JSON.
-    pub fn info_json(&self) -> String {
-        serde_json::to_string(self.job.info()).unwrap_or_default()
+    /// Facets, bounds, layers, droplet width and mesh warnings (`JobInfo`).
+    pub fn info(&self) -> Result<JsValue, JsValue> {
+        to_js(self.job.info(), "the job info")
     }
 
     /// Plans layer `i`: its G-code text, droplet counts and preview arrays.
-    pub fn slice_layer(&self, i: usize) -> Result<LayerResult, JsError> {
+    pub fn slice_layer(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
         let plan = self.job.plan_layer(i);
         Ok(LayerResult::new(&plan, &self.settings))
     }
 
     /// [`Session::slice_layer`] plus the void analysis of the same plan (no second planning):
-    /// `analysis_json` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]). About 2–3
+    /// `analysis` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]). About 2–3
     /// times the work of planning the layer.
-    pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsError> {
+    pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
         let (plan, region) = self.job.plan_layer_and_region(i);
         let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
@@ -141,28 +267,74 @@ impl Session {
         Ok(r)
     }
 
-    /// The header comment block for a finished slice: `summary_json` is the sum of every
-    /// layer's `LayerResult::summary_json` with `layers` set; an empty string gives the
-    /// same-width placeholder header.
-    pub fn header(&self, summary_json: &str) -> Result<String, JsError> {
-        if summary_json.trim().is_empty() {
+    /// The header comment block for a finished slice (`summary`: every unit's summary
+    /// merged); `null` gives the same-width placeholder header.
+    pub fn header(&self, summary: JsValue) -> Result<String, JsValue> {
+        if summary.is_null() || summary.is_undefined() {
             return Ok(self.job.header(None));
         }
-        let summary = parse_summary(summary_json)?;
+        let summary: Summary = from_js(summary, "summary")?;
         Ok(self.job.header(Some(&summary)))
     }
 
-    /// What slicing repaired (open sections joined, flipped facets), as a JSON array of
-    /// sentences, for the summed summary of a finished slice.
-    pub fn repairs(&self, summary_json: &str) -> Result<String, JsError> {
-        let summary = parse_summary(summary_json)?;
-        Ok(serde_json::to_string(&summary.repairs()).unwrap_or_default())
+    /// The closing comment block.
+    pub fn footer(&self, summary: JsValue) -> Result<String, JsValue> {
+        let summary: Summary = from_js(summary, "summary")?;
+        Ok(gcode::footer(&summary))
     }
 
-    /// The closing comment block.
-    pub fn footer(&self, summary_json: &str) -> Result<String, JsError> {
-        let summary = parse_summary(summary_json)?;
-        Ok(gcode::footer(&summary))
+    /// Merges `parts` (summaries of units, in any order) and computes the figures with this
+    /// session's settings: `{summary, figures, nothing_to_print}` (`nothing_to_print` is the
+    /// error `{kind, message}` when every layer is in and not one droplet fits, else `null`).
+    pub fn figures(&self, parts: JsValue) -> Result<JsValue, JsValue> {
+        let parts: Vec<Summary> = from_js(parts, "summaries")?;
+        let summary = Summary::merged(&parts);
+        let complete = summary.layers == self.job.layer_count();
+        let out = SliceFigures {
+            figures: summary.figures(&self.settings),
+            nothing_to_print: if complete {
+                summary.printable(&self.settings).err().map(|e| e.report())
+            } else {
+                None
+            },
+            summary,
+        };
+        to_js(&out, "the figures")
+    }
+}
+
+/// A unit's summary, built layer by layer in the worker.
+#[wasm_bindgen]
+#[derive(Default)]
+pub struct Tally {
+    summary: Summary,
+}
+
+#[wasm_bindgen]
+impl Tally {
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> Tally {
+        Tally::default()
+    }
+
+    /// Adds a sliced layer (its counts, travel and repairs, and its analysis if it has one).
+    pub fn add_layer(&mut self, layer: &LayerResult) {
+        self.summary.merge(&layer.summary);
+        if let Some(a) = &layer.analysis {
+            self.summary.add_analysis(a);
+        }
+    }
+
+    /// Adds only a layer's analysis (a layer analysed after the slice that counted it).
+    pub fn add_analysis(&mut self, layer: &LayerResult) {
+        if let Some(a) = &layer.analysis {
+            self.summary.add_analysis(a);
+        }
+    }
+
+    /// The summary so far (`Summary`).
+    pub fn summary(&self) -> Result<JsValue, JsValue> {
+        to_js(&self.summary, "a summary")
     }
 }
 
@@ -187,11 +359,7 @@ impl LayerResult {
             z: plan.z,
             counts: plan.counts,
             travel_mm: plan.travel_mm,
-            summary: {
-                let mut s = Summary::default();
-                s.add(plan);
-                s
-            },
+            summary: Summary::of_layer(plan),
             gcode: gcode::layer_text(plan),
             preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
             analysis: None,
@@ -230,12 +398,6 @@ impl LayerResult {
     pub fn travel_mm(&self) -> f64 {
         self.travel_mm
     }
-    /// This layer's share of the slice's [`Summary`] as JSON (`layers` is 0): the page adds
-    /// the numbers of all layers up, sets `layers`, and hands the sum to `Session::header`.
-    #[wasm_bindgen(getter)]
-    pub fn summary_json(&self) -> String {
-        serde_json::to_string(&self.summary).unwrap_or_default()
-    }
     /// The layer's G-code lines as UTF-8 bytes (a copy; the worker collects a run of layers
     /// into one Blob: a Blob per layer costs far more than the bytes).
     #[wasm_bindgen(getter)]
@@ -259,13 +421,12 @@ impl LayerResult {
     }
     /// The layer's void analysis (`analysis::LayerAnalysis`: coverage, void_area,
     /// largest_void {area, centroid, min, max, at_boundary}, overfill_area,
-    /// boundary_deviation, ...) as JSON; empty unless made by `slice_layer_analysed`.
-    #[wasm_bindgen(getter)]
-    pub fn analysis_json(&self) -> String {
-        self.analysis
-            .as_ref()
-            .and_then(|a| serde_json::to_string(a).ok())
-            .unwrap_or_default()
+    /// boundary_deviation, ...); `null` unless made by `slice_layer_analysed`.
+    pub fn analysis(&self) -> Result<JsValue, JsValue> {
+        match &self.analysis {
+            Some(a) => to_js(a, "a layer analysis"),
+            None => Ok(JsValue::NULL),
+        }
     }
     /// The coverage mask's cell, mm; 0 without analysis.
     #[wasm_bindgen(getter)]

@@ -2,7 +2,11 @@
 //! `cargo test --target wasm32-unknown-unknown --test wasm_session` is given it as the runner.
 #![cfg(target_arch = "wasm32")]
 
-use dropslice::wasm::{Session, default_settings_json, settings_schema, version};
+use dropslice::wasm::{
+    Session, Tally, default_settings, merge_summaries, settings_schema, version,
+};
+use serde::Serialize;
+use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::wasm_bindgen_test;
 
 /// A closed axis-aligned box as an ASCII STL.
@@ -48,34 +52,33 @@ fn two_boxes_stl(w: f64, d: f64, h: f64, dx: f64, dy: f64) -> String {
     one.replace("endsolid box\n", &moved) + "endsolid box\n"
 }
 
-/// Adds every number of `b` into `a`, as the page sums the layers' summaries.
-fn add_numbers(a: &mut serde_json::Value, b: &serde_json::Value) {
-    use serde_json::Value;
-    match (a, b) {
-        (Value::Object(a), Value::Object(b)) => {
-            for (k, v) in b {
-                add_numbers(a.entry(k.clone()).or_insert(Value::Null), v);
-            }
-        }
-        (a @ Value::Null, b) => *a = b.clone(),
-        (a @ Value::Number(_), Value::Number(b)) => {
-            *a = match (a.as_u64(), b.as_u64()) {
-                (Some(x), Some(y)) => serde_json::json!(x + y),
-                _ => serde_json::json!(a.as_f64().unwrap() + b.as_f64().unwrap()),
-            };
-        }
-        _ => {}
-    }
+/// A JS value as the page makes it (plain objects).
+fn js(v: serde_json::Value) -> JsValue {
+    v.serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .unwrap()
 }
 
-fn message(e: wasm_bindgen::JsError) -> String {
-    let v: wasm_bindgen::JsValue = e.into();
-    js_sys::Error::from(v).message().into()
+/// A value from the facade, as JSON for the assertions.
+fn json(v: JsValue) -> serde_json::Value {
+    serde_wasm_bindgen::from_value(v).unwrap()
+}
+
+fn defaults() -> JsValue {
+    js(serde_json::json!({}))
+}
+
+/// The thrown error as `{kind, message, setting?}`.
+fn thrown(e: JsValue) -> serde_json::Value {
+    assert!(
+        !e.is_instance_of::<js_sys::Error>(),
+        "a plain object, not an Error"
+    );
+    json(e)
 }
 
 #[wasm_bindgen_test]
 fn schema_defaults_and_version() {
-    let schema: serde_json::Value = serde_json::from_str(&settings_schema()).unwrap();
+    let schema = json(settings_schema().unwrap());
     let names: Vec<&str> = schema
         .as_array()
         .unwrap()
@@ -83,7 +86,7 @@ fn schema_defaults_and_version() {
         .map(|s| s["name"].as_str().unwrap())
         .collect();
     assert!(names.contains(&"layer_height") && names.contains(&"droplet_aspect"));
-    let defaults: serde_json::Value = serde_json::from_str(&default_settings_json()).unwrap();
+    let defaults = json(default_settings().unwrap());
     assert_eq!(defaults["layer_height"], 0.2);
     assert_eq!(defaults["contours"], 2);
     assert_eq!(version(), dropslice::VERSION);
@@ -92,13 +95,13 @@ fn schema_defaults_and_version() {
 #[wasm_bindgen_test]
 fn slices_a_box() {
     let stl = box_stl(10.0, 6.0, 2.0);
-    let s = Session::new(stl.as_bytes(), "box.stl", "{}").unwrap();
+    let s = Session::new(stl.as_bytes(), "box.stl", defaults()).unwrap();
     assert_eq!(s.layer_count(), 10);
-    let info: serde_json::Value = serde_json::from_str(&s.info_json()).unwrap();
+    let info = json(s.info().unwrap());
     assert_eq!(info["layers"], 10);
     let mut totals = [0u64; 3];
     let mut text = String::new();
-    let mut summary = serde_json::Value::Null;
+    let mut tally = Tally::new();
     for i in 0..s.layer_count() {
         let l = s.slice_layer(i).unwrap();
         assert_eq!(l.index(), i);
@@ -120,26 +123,32 @@ fn slices_a_box() {
             *t += roles.iter().filter(|&&r| r as usize == k).count() as u64;
         }
         text.push_str(&String::from_utf8(l.gcode().to_vec()).unwrap());
-        add_numbers(
-            &mut summary,
-            &serde_json::from_str(&l.summary_json()).unwrap(),
-        );
+        tally.add_layer(&l);
     }
     assert!(text.contains("G26 ") && text.contains("G25 ") && text.contains("G01 "));
+    let summary = json(tally.summary().unwrap());
+    assert_eq!(summary["layers"], 10);
     assert_eq!(summary["counts"]["outer"], totals[0]);
     assert_eq!(summary["counts"]["inner"], totals[1]);
     assert_eq!(summary["counts"]["fill"], totals[2]);
-    summary["layers"] = 10.into();
-    let summary = summary.to_string();
-    let header = s.header(&summary).unwrap();
+    let header = s.header(js(summary.clone())).unwrap();
     assert!(header.contains("; layer_height = 0.2"), "{header}");
     assert!(header.contains("box.stl"));
-    let placeholder = s.header("").unwrap();
+    let placeholder = s.header(JsValue::NULL).unwrap();
     assert_eq!(placeholder.len(), header.len());
-    let footer = s.footer(&summary).unwrap();
+    let footer = s.footer(js(summary.clone())).unwrap();
     assert!(footer.contains("10 layers"), "{footer}");
-    let repairs: Vec<String> = serde_json::from_str(&s.repairs(&summary).unwrap()).unwrap();
-    assert!(repairs.is_empty(), "{repairs:?}");
+    let f = json(s.figures(js(serde_json::json!([summary]))).unwrap());
+    let figures = &f["figures"];
+    assert!(figures["repairs"].as_array().unwrap().is_empty(), "{f}");
+    let droplets = totals.iter().sum::<u64>();
+    assert_eq!(figures["droplets"], droplets);
+    let b = 0.2 * 1.04;
+    let volume = figures["volume_mm3"].as_f64().unwrap();
+    assert!((volume - droplets as f64 * b * b * 0.2).abs() < 1e-6 * volume);
+    assert!(figures["print_seconds"].as_f64().unwrap() > droplets as f64 / 100.0);
+    assert!(f["nothing_to_print"].is_null(), "{f}");
+    assert!(figures["coverage"].is_null() && figures["worst_layer"].is_null());
     assert!(s.slice_layer(10).is_err());
 }
 
@@ -149,7 +158,7 @@ fn settings_change_the_slice() {
     let s = Session::new(
         stl.as_bytes(),
         "box.stl",
-        r#"{"layer_height":0.25,"contours":3}"#,
+        js(serde_json::json!({"layer_height": 0.25, "contours": 3})),
     )
     .unwrap();
     assert_eq!(s.layer_count(), 8);
@@ -158,51 +167,159 @@ fn settings_change_the_slice() {
 }
 
 #[wasm_bindgen_test]
-fn errors_name_their_kind() {
+fn errors_are_typed_objects() {
     let garbage = b"this is not an STL file at all, just some words";
-    let e = message(Session::new(garbage, "x.stl", "{}").err().unwrap());
-    assert!(e.starts_with("import: "), "{e}");
-
-    let stl = box_stl(10.0, 6.0, 2.0);
-    let e = message(
-        Session::new(stl.as_bytes(), "box.stl", r#"{"layer_height":-1}"#)
-            .err()
-            .unwrap(),
-    );
+    let e = thrown(Session::new(garbage, "x.stl", defaults()).err().unwrap());
+    assert_eq!(e["kind"], "import", "{e}");
     assert!(
-        e.starts_with("setting: ") && e.contains("layer_height"),
+        e["message"]
+            .as_str()
+            .unwrap()
+            .starts_with("cannot read the model file"),
         "{e}"
     );
-    let e = message(
-        Session::new(stl.as_bytes(), "box.stl", r#"{"no_such_setting":1}"#)
-            .err()
-            .unwrap(),
-    );
-    assert!(e.starts_with("setting: "), "{e}");
-    let e = message(
-        Session::new(stl.as_bytes(), "box.stl", "not json")
-            .err()
-            .unwrap(),
-    );
-    assert!(e.starts_with("setting: "), "{e}");
+    assert!(e.get("setting").is_none(), "{e}");
 
-    let e = message(Session::new(&[], "empty.stl", "{}").err().unwrap());
-    assert!(e.starts_with("import: "), "{e}");
+    let stl = box_stl(10.0, 6.0, 2.0);
+    let bad = |settings: serde_json::Value| {
+        thrown(
+            Session::new(stl.as_bytes(), "box.stl", js(settings))
+                .err()
+                .unwrap(),
+        )
+    };
+    let e = bad(serde_json::json!({"layer_height": -1}));
+    assert_eq!(e["kind"], "setting", "{e}");
+    assert_eq!(e["setting"], "layer_height", "{e}");
+    assert!(
+        e["message"].as_str().unwrap().contains("layer_height"),
+        "{e}"
+    );
+    let e = bad(serde_json::json!({"contours": "many"}));
+    assert_eq!(
+        (&e["kind"], &e["setting"]),
+        (&"setting".into(), &"contours".into()),
+        "{e}"
+    );
+    let e = bad(serde_json::json!({"no_such_setting": 1}));
+    assert_eq!(e["kind"], "setting", "{e}");
+    let e = bad(serde_json::json!("not an object"));
+    assert_eq!(e["kind"], "setting", "{e}");
+    assert!(e.get("setting").is_none(), "{e}");
+    // a part thinner than half a layer
+    let e = thrown(
+        Session::new(box_stl(10.0, 6.0, 0.05).as_bytes(), "thin.stl", defaults())
+            .err()
+            .unwrap(),
+    );
+    assert_eq!(e["kind"], "nothing_to_print", "{e}");
+
+    let e = thrown(Session::new(&[], "empty.stl", defaults()).err().unwrap());
+    assert_eq!(e["kind"], "import", "{e}");
     // a truncated binary STL
     let mut bin = vec![0u8; 84];
     bin[80] = 5;
     bin.extend_from_slice(&[0u8; 60]);
-    let e = message(Session::new(&bin, "cut.stl", "{}").err().unwrap());
-    assert!(e.starts_with("import: "), "{e}");
+    let e = thrown(Session::new(&bin, "cut.stl", defaults()).err().unwrap());
+    assert_eq!(e["kind"], "import", "{e}");
+    // a layer out of range and a summary the core did not make are internal errors
+    let s = Session::new(stl.as_bytes(), "box.stl", defaults()).unwrap();
+    let e = thrown(s.slice_layer(99).err().unwrap());
+    assert_eq!(e["kind"], "internal", "{e}");
+    let e = thrown(
+        s.footer(js(serde_json::json!({"counts": 5})))
+            .err()
+            .unwrap(),
+    );
+    assert_eq!(e["kind"], "internal", "{e}");
+}
+
+#[wasm_bindgen_test]
+fn nothing_to_print_comes_with_the_figures() {
+    // 0.1 mm walls: thinner than a droplet, so no droplet fits
+    let stl = box_stl(0.1, 20.0, 2.0);
+    let s = Session::new(stl.as_bytes(), "wall.stl", defaults()).unwrap();
+    let mut tally = Tally::new();
+    for i in 0..s.layer_count() {
+        tally.add_layer(&s.slice_layer(i).unwrap());
+    }
+    let f = json(
+        s.figures(js(serde_json::json!([json(tally.summary().unwrap())])))
+            .unwrap(),
+    );
+    assert_eq!(f["figures"]["droplets"], 0, "{f}");
+    assert_eq!(f["nothing_to_print"]["kind"], "nothing_to_print", "{f}");
+    assert!(
+        f["nothing_to_print"]["message"]
+            .as_str()
+            .unwrap()
+            .contains("thinner than the droplet width"),
+        "{f}"
+    );
+}
+
+#[wasm_bindgen_test]
+fn a_session_from_the_prepared_mesh_slices_the_same() {
+    let stl = two_boxes_stl(10.0, 6.0, 2.0, 3.0, 2.0);
+    let settings = serde_json::json!({"layer_height": 0.25, "rotate_z": 30});
+    let first = Session::new(stl.as_bytes(), "two.stl", js(settings.clone())).unwrap();
+    let info = first.info().unwrap();
+    let other = Session::from_prepared(
+        &first.vertices().to_vec(),
+        &first.facets().to_vec(),
+        info,
+        js(settings.clone()),
+    )
+    .unwrap();
+    assert_eq!(other.layer_count(), first.layer_count());
+    assert_eq!(json(other.info().unwrap()), json(first.info().unwrap()));
+    assert_eq!(
+        other.header(JsValue::NULL).unwrap(),
+        first.header(JsValue::NULL).unwrap()
+    );
+    let (mut a, mut b) = (Tally::new(), Tally::new());
+    for i in 0..first.layer_count() {
+        let (x, y) = (
+            first.slice_layer_analysed(i).unwrap(),
+            other.slice_layer_analysed(i).unwrap(),
+        );
+        assert_eq!(x.gcode().to_vec(), y.gcode().to_vec(), "layer {i}");
+        assert_eq!(x.droplets().to_vec(), y.droplets().to_vec(), "layer {i}");
+        assert_eq!(x.roles().to_vec(), y.roles().to_vec(), "layer {i}");
+        assert_eq!(
+            json(x.analysis().unwrap()),
+            json(y.analysis().unwrap()),
+            "layer {i}"
+        );
+        a.add_layer(&x);
+        b.add_layer(&y);
+    }
+    assert_eq!(json(a.summary().unwrap()), json(b.summary().unwrap()));
+    // merged in another order, the summary is the same
+    let sa = json(a.summary().unwrap());
+    let merged = json(merge_summaries(js(serde_json::json!([sa]))).unwrap());
+    assert_eq!(merged["counts"], sa["counts"]);
+    // other settings than the prepared mesh was made with are refused
+    let e = thrown(
+        Session::from_prepared(
+            &first.vertices().to_vec(),
+            &first.facets().to_vec(),
+            first.info().unwrap(),
+            js(serde_json::json!({"layer_height": 0.1})),
+        )
+        .err()
+        .unwrap(),
+    );
+    assert_eq!(e["kind"], "internal", "{e}");
 }
 
 #[wasm_bindgen_test]
 fn analysed_layers_have_sane_void_figures() {
     let stl = box_stl(10.0, 6.0, 2.0);
-    let s = Session::new(stl.as_bytes(), "box.stl", "{}").unwrap();
+    let s = Session::new(stl.as_bytes(), "box.stl", defaults()).unwrap();
     // plain slicing carries no analysis
     let plain = s.slice_layer(3).unwrap();
-    assert_eq!(plain.analysis_json(), "");
+    assert!(plain.analysis().unwrap().is_null());
     assert_eq!(plain.void_mask().length(), 0);
     assert_eq!(plain.mask_tiles().length(), 0);
     assert_eq!(plain.mask_cell(), 0.0);
@@ -213,7 +330,7 @@ fn analysed_layers_have_sane_void_figures() {
             l.droplets().to_vec(),
             s.slice_layer(i).unwrap().droplets().to_vec()
         );
-        let a: serde_json::Value = serde_json::from_str(&l.analysis_json()).unwrap();
+        let a = json(l.analysis().unwrap());
         assert_eq!(a["index"], i);
         let coverage = a["coverage"].as_f64().unwrap();
         assert!(
@@ -275,9 +392,9 @@ fn the_mask_of_parts_far_apart_has_tiles_near_them_only() {
     // Two 3 x 3 mm boxes 1 m apart: a dense mask over their bounding box (cells of B/4) would
     // hold 2.6e8 cells of 2 bytes and not fit in the 4 GB a wasm instance can address.
     let stl = two_boxes_stl(3.0, 3.0, 1.0, 1000.0, 1000.0);
-    let s = Session::new(stl.as_bytes(), "two.stl", "{}").unwrap();
+    let s = Session::new(stl.as_bytes(), "two.stl", defaults()).unwrap();
     let l = s.slice_layer_analysed(2).unwrap();
-    let a: serde_json::Value = serde_json::from_str(&l.analysis_json()).unwrap();
+    let a = json(l.analysis().unwrap());
     let region = a["region_area"].as_f64().unwrap();
     assert!((region - 18.0).abs() < 0.01, "region {region}");
     let coverage = a["coverage"].as_f64().unwrap();

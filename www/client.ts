@@ -1,17 +1,34 @@
-// The worker pool: min(hardwareConcurrency - 1, 4) workers (at least 1), each with its own
-// wasm instance. A slice opens the model in every worker at once; each worker, as soon as it
-// holds the model, takes units of consecutive layers from a shared counter (two units in
+// The worker pool: one worker per core (hardwareConcurrency, 1 … 8), each with its own wasm
+// instance. A slice hands the model's File to one worker, which reads and prepares the job
+// (parse, weld, checks, repair) and returns the prepared mesh as transferable arrays; the
+// other workers build their session from that (no import work repeated). Each worker, as soon
+// as it holds the model, takes units of consecutive layers from a shared counter (two units in
 // flight, so it never waits for the page between units). Layers come back as progress replies
 // (buffers transferred) and are stored by index, so the page sees them in layer order however
 // the workers finish; a unit's result carries its G-code as one Blob. Cancel terminates every
 // worker at once, rejects what was pending and starts fresh workers.
 
-import type { GcodeParseResult, InitResult, LayerData, OpenResult, Reply, Request, RequestKind, SliceUnit } from "./protocol";
+import type {
+  GcodeParseResult,
+  InitResult,
+  LayerData,
+  OpenResult,
+  Reply,
+  RequestData,
+  RequestKind,
+  ResultOf,
+  Settings,
+  SliceFigures,
+  SliceUnit,
+  Summary,
+} from "./protocol";
 
+/** An error from a worker: the core's `{kind, message, setting?}` or the page's "crash". */
 export class SliceError extends Error {
   constructor(
     readonly kind: string,
     message: string,
+    readonly setting?: string,
   ) {
     super(message);
   }
@@ -52,11 +69,15 @@ class WorkerHandle {
     return this.pending.size;
   }
 
-  call<T>(kind: RequestKind, data: unknown, progress?: (layer: LayerData) => void, transfer: Transferable[] = []): Promise<T> {
+  /** Sends request `kind` with its data (checked against protocol.ts `Calls`) and resolves
+   *  with its typed result. */
+  call<K extends RequestKind>(kind: K, data: RequestData<K>, progress?: (layer: LayerData) => void, transfer: Transferable[] = []): Promise<ResultOf<K>> {
     const id = this.nextId++;
-    return new Promise<T>((resolve, reject) => {
+    // one member of protocol.ts `Request`, checked by the signature (no cast)
+    const message: { id: number; kind: K; data: RequestData<K> } = { id, kind, data };
+    return new Promise<ResultOf<K>>((resolve, reject) => {
       this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, progress });
-      this.worker.postMessage({ id, kind, data } as Request, transfer);
+      this.worker.postMessage(message, transfer);
     });
   }
 
@@ -71,7 +92,7 @@ class WorkerHandle {
     if (reply.kind === "result") p.resolve(reply.data);
     else {
       if (reply.data.kind === "crash") this.broken = true;
-      p.reject(new SliceError(reply.data.kind, reply.data.message));
+      p.reject(new SliceError(reply.data.kind, reply.data.message, reply.data.setting));
     }
   }
 
@@ -87,9 +108,11 @@ class WorkerHandle {
   }
 }
 
+/** One worker per core, 1 … [[MAX_WORKERS]]: preparing the job is done once, not per worker,
+ *  so every worker slices from the start. */
 export function defaultPoolSize(): number {
-  const n = (navigator.hardwareConcurrency || 2) - 1;
-  return Math.max(1, Math.min(n, 4));
+  const n = navigator.hardwareConcurrency || 1;
+  return Math.max(1, Math.min(n, MAX_WORKERS));
 }
 
 export interface SliceCallbacks {
@@ -119,17 +142,44 @@ function unitCounter(layers: number, workers: number): () => Unit | null {
   };
 }
 
-/** Opens a model in one worker, handing it a copy of the bytes of its own (transferred, not
- *  cloned: one copy of the file per worker, made once). */
-function openIn(h: WorkerHandle, stl: Uint8Array, name: string, settings: string): Promise<OpenResult> {
-  const copy = stl.slice().buffer;
-  return h.call<OpenResult>("open", { stl: copy, name, settings }, undefined, [copy]);
+/** Opens a model: the first worker reads the File and prepares the job (and hashes the file
+ *  when asked); the others take the prepared mesh. `ready(h, r)` runs for each worker as soon
+ *  as it holds the model (for the first one before the others are asked). If the first worker
+ *  refuses the model, no worker is touched and every one keeps its previous model. */
+async function openAll(
+  handles: WorkerHandle[],
+  file: File,
+  settings: Settings,
+  ready: (h: WorkerHandle, r: OpenResult) => Promise<void>,
+): Promise<OpenResult> {
+  const [first, ...others] = handles;
+  const r = await first.call("open", { file, settings, hash: true, prepare: others.length > 0 });
+  for (const h of handles) h.hasModel = false;
+  first.hasModel = true;
+  const prepared = r.prepared;
+  delete r.prepared;
+  const work = [ready(first, r)];
+  if (prepared) {
+    others.forEach((h, k) => {
+      // each worker gets its own copy; the last one takes the buffers themselves
+      const last = k === others.length - 1;
+      const transfer = last ? [prepared.vertices.buffer, prepared.facets.buffer] : [];
+      work.push(
+        h.call("adopt", { prepared, settings }, undefined, transfer).then(async (o) => {
+          h.hasModel = true;
+          await ready(h, o);
+        }),
+      );
+    });
+  }
+  await Promise.all(work);
+  return r;
 }
 
 /** Units in flight per worker: the worker starts the next one while the page answers. */
 const UNITS_IN_FLIGHT = 2;
 
-/** Never more workers than this, whatever is asked: each holds its own copy of the model. */
+/** Never more workers than this, whatever is asked: each holds its own copy of the mesh. */
 export const MAX_WORKERS = 8;
 
 export class Pool {
@@ -180,33 +230,23 @@ export class Pool {
 
   init(): Promise<InitResult> {
     this.heal();
-    return this.guarded(() => this.handles[0].call<InitResult>("init", null));
+    return this.guarded(() => this.handles[0].call("init", null));
   }
 
-  /** Slices a model: opens it in every worker and streams all layers through `cb.layer`. */
-  slice(stl: Uint8Array, name: string, settings: string, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
+  /** Slices a model: opens it (see [[openAll]]) and streams all layers through `cb.layer`. */
+  slice(file: File, settings: Settings, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
     this.heal();
     return this.guarded(async () => {
-      // Every worker checks the same model and settings, so they all accept or all refuse it;
-      // on refusal every worker keeps its previous model and the previous slice stays usable.
       this.opening = null;
-      let first: OpenResult | null = null;
       let nextUnit: () => Unit | null = () => null;
       const handles = this.handles;
-      await Promise.all(
-        handles.map(async (h) => {
-          const r = await openIn(h, stl, name, settings);
-          if (!first) {
-            first = r;
-            for (const o of handles) o.hasModel = false;
-            nextUnit = unitCounter(r.layers, handles.length);
-            cb.opened(r);
-          }
-          h.hasModel = true;
-          await this.units(h, nextUnit, { analyse }, cb.layer, cb.unit);
-        }),
-      );
-      return first!;
+      return openAll(handles, file, settings, async (h, r) => {
+        if (h === handles[0]) {
+          nextUnit = unitCounter(r.layers, handles.length);
+          cb.opened(r);
+        }
+        await this.units(h, nextUnit, { analyse }, cb.layer, cb.unit);
+      });
     });
   }
 
@@ -220,7 +260,7 @@ export class Pool {
   ): Promise<void> {
     const lane = async () => {
       for (let u = nextUnit(); u; u = nextUnit()) {
-        const done = await h.call<SliceUnit>("slice", { ...u, ...options }, layer);
+        const done: SliceUnit = await h.call("slice", { ...u, ...options }, layer);
         unit?.(done);
       }
     };
@@ -229,15 +269,10 @@ export class Pool {
 
   /** Opens a model in every worker without slicing it (to browse a finished slice again
    *  after the workers were replaced by a cancel or a crash). */
-  open(stl: Uint8Array, name: string, settings: string): Promise<void> {
+  open(file: File, settings: Settings): Promise<void> {
     this.heal();
     const opening = this.guarded(async () => {
-      await Promise.all(
-        this.handles.map(async (h) => {
-          await openIn(h, stl, name, settings);
-          h.hasModel = true;
-        }),
-      );
+      await openAll(this.handles, file, settings, async () => {});
     });
     this.opening = opening.catch(() => {});
     return opening;
@@ -254,45 +289,48 @@ export class Pool {
   }
 
   /** Re-plans one layer of the current model (for layers evicted from the page's cache). */
-  preview(index: number): Promise<LayerData> {
-    return this.guarded(async () => (await this.pick()).call<LayerData>("preview", { index }));
+  preview(index: number, analyse = false): Promise<LayerData> {
+    return this.guarded(async () => (await this.pick()).call("preview", { index, analyse }));
   }
 
-  header(summary: string): Promise<string> {
-    return this.guarded(async () => (await this.pick()).call<string>("header", { summary }));
+  /** The G-code header: with the merged summary of a finished slice, or placeholders. */
+  header(summary: Summary | null): Promise<string> {
+    return this.guarded(async () => (await this.pick()).call("header", { summary }));
   }
 
-  repairs(summary: string): Promise<string[]> {
-    return this.guarded(async () => (await this.pick()).call<string[]>("repairs", { summary }));
+  footer(summary: Summary): Promise<string> {
+    return this.guarded(async () => (await this.pick()).call("footer", { summary }));
   }
 
-  footer(summary: string): Promise<string> {
-    return this.guarded(async () => (await this.pick()).call<string>("footer", { summary }));
+  /** The core's figures of the summaries `parts` (merged by the core, in any order). */
+  figures(parts: Summary[]): Promise<SliceFigures> {
+    return this.guarded(async () => (await this.pick()).call("figures", { parts }));
+  }
+
+  /** SHA-256 of a file, hex, computed in a worker (the page never reads the file). */
+  hash(file: Blob): Promise<string> {
+    this.heal();
+    return this.guarded(() => this.handles[0].call("hash", { file }));
   }
 
   parseGcode(file: Blob, layer: (l: LayerData) => void): Promise<GcodeParseResult> {
     this.heal();
-    return this.guarded(() => this.handles[0].call<GcodeParseResult>("parse_gcode", { file }, layer));
-  }
-
-  /** Re-plans one layer with its void analysis and coverage mask. */
-  previewAnalysed(index: number): Promise<LayerData> {
-    return this.guarded(async () => (await this.pick()).call<LayerData>("preview", { index, analyse: true }));
+    return this.guarded(() => this.handles[0].call("parse_gcode", { file }, layer));
   }
 
   /** Re-plans and analyses layers [0, n) of the current model (no G-code), spread over the
    *  workers holding it: for the void overlay after a slice made without analysis. */
-  analyse(n: number, layer: (l: LayerData) => void): Promise<void> {
+  analyse(n: number, layer: (l: LayerData) => void, unit: (u: SliceUnit) => void): Promise<void> {
     return this.guarded(async () => {
       await this.pick(); // waits for a reopening under way; throws if no worker has the model
       const ready = this.handles.filter((h) => h.hasModel && !h.broken);
       const nextUnit = unitCounter(n, ready.length);
-      await Promise.all(ready.map((h) => this.units(h, nextUnit, { analyse: true, gcode: false }, layer)));
+      await Promise.all(ready.map((h) => this.units(h, nextUnit, { analyse: true, gcode: false }, layer, unit)));
     });
   }
 
   /** For tests: makes the wasm panic in one worker. */
   crash(): Promise<void> {
-    return this.guarded(() => this.handles[this.handles.length - 1].call<void>("crash", null));
+    return this.guarded(() => this.handles[this.handles.length - 1].call("crash", null));
   }
 }

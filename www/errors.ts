@@ -11,7 +11,7 @@ export function restoreModel(page: Page): void {
   const { store, pool } = page;
   const s = store.slice;
   if (!s || !s.complete || s.source !== "stl" || !s.model || store.busy) return;
-  pool.open(s.model.bytes, s.model.name, JSON.stringify(s.settings)).catch(() => {
+  pool.open(s.model.file, s.settings).catch(() => {
     // the slice stays visible; what needs a worker reports its own error
   });
 }

@@ -1,68 +1,113 @@
-// The figures of a slice that the page still computes itself, all in this one module:
-// droplets by role and travel (sums of the layers), the summary of the runs of layers (for the
-// G-code's header and footer), the part's coverage and worst layer (from the layers' analyses),
-// nothing-to-print, and the estimates (volume, mass, print time). DESIGN.md wants the core to
-// compute them; switching to the core's figures is a change of this module (and of what
-// store.ts hands it), not of the views.
+// The figures of a slice, as the core computed them (src/summary.rs): droplets by role,
+// travel, material volume and mass, print time, part coverage, void area, the worst layer,
+// what slicing repaired, and nothing-to-print. The page keeps the core's per-unit summaries
+// (it never adds them up) and asks a worker to merge them into figures; the views only show
+// what comes back. A .gco file opened for viewing has no core figures: its droplets are
+// counted as its layers are read.
 
-import { addNumbers, type Counts, type LayerAnalysis, type LayerData, type SliceUnit } from "./protocol";
+import type { Pool } from "./client";
+import type { Counts, ErrorValue, Figures as CoreFigures, LayerData, SliceFigures, SliceUnit, Summary } from "./protocol";
 
 export class Figures {
-  totals: Counts = { outer: 0, inner: 0, fill: 0 };
-  travelTotal = 0;
-  /** Sum of the layers' summaries (the core's Summary, for the header and footer). */
-  summary: Record<string, unknown> = {};
-  regionArea = 0;
-  coveredArea = 0;
-  /** The worst layer: the one with the largest connected void. */
-  worst: { index: number; area: number } | null = null;
+  /** The core's summaries of the slice's units, and of a later analysis pass. */
+  private parts: Summary[] = [];
+  private analysisParts: Summary[] = [];
+  /** The last figures from the core (null before the first answer). */
+  core: CoreFigures | null = null;
+  /** The merged summary, for the G-code's header and footer. */
+  summary: Summary | null = null;
+  /** Set by the core when every layer is in and not one droplet fits. */
+  nothingToPrint: ErrorValue | null = null;
+  /** A .gco file's droplets and travel, as read. */
+  private read: Counts = { outer: 0, inner: 0, fill: 0 };
+  private readTravel = 0;
+  private running: Promise<void> | null = null;
+  private again = false;
 
-  /** A layer's droplets and travel (once per layer). */
-  addLayer(l: LayerData): void {
-    this.totals.outer += l.counts.outer;
-    this.totals.inner += l.counts.inner;
-    this.totals.fill += l.counts.fill;
-    this.travelTotal += l.travelMm;
+  /** A layer of a .gco file (once per layer). */
+  addReadLayer(l: LayerData): void {
+    this.read.outer += l.counts.outer;
+    this.read.inner += l.counts.inner;
+    this.read.fill += l.counts.fill;
+    this.readTravel += l.travelMm;
   }
 
-  /** A layer's void analysis (once per layer). */
-  addAnalysis(index: number, a: LayerAnalysis): void {
-    this.regionArea += a.region_area;
-    this.coveredArea += a.covered_area;
-    const v = a.largest_void;
-    if (v && (!this.worst || v.area > this.worst.area)) this.worst = { index, area: v.area };
-  }
-
-  /** A run of layers is complete: its part of the summary. */
+  /** A run of layers is complete: its summary (of a slice, or only analyses). */
   addUnit(u: SliceUnit): void {
-    if (u.summary) addNumbers(this.summary, u.summary);
+    if (u.gcode) this.parts.push(u.summary);
+    else this.analysisParts.push(u.summary);
   }
 
-  /** The summary as the core's header, footer and repairs take it. */
-  summaryJson(layers: number): string {
-    return JSON.stringify({ ...this.summary, layers });
+  /** A new analysis pass starts: the analyses of an unfinished earlier one are dropped. */
+  restartAnalysis(): void {
+    this.analysisParts = [];
+  }
+
+  /** Asks a worker for the figures of every summary so far, one request at a time; resolves
+   *  once the figures include every summary added before the call. `changed` runs after
+   *  each answer. */
+  refresh(pool: Pool, changed: () => void): Promise<void> {
+    if (this.running) {
+      this.again = true;
+      return this.running;
+    }
+    const run = async () => {
+      try {
+        do {
+          this.again = false;
+          this.apply(await pool.figures([...this.parts, ...this.analysisParts]));
+          changed();
+        } while (this.again);
+      } finally {
+        this.running = null;
+      }
+    };
+    this.running = run();
+    return this.running;
+  }
+
+  private apply(f: SliceFigures): void {
+    this.core = f.figures;
+    this.summary = f.summary;
+    this.nothingToPrint = f.nothing_to_print;
+  }
+
+  get totals(): Counts {
+    return this.core?.counts ?? this.read;
+  }
+
+  get travelTotal(): number {
+    return this.core?.travel_mm ?? this.readTravel;
   }
 
   get droplets(): number {
-    return this.totals.outer + this.totals.inner + this.totals.fill;
+    const t = this.totals;
+    return t.outer + t.inner + t.fill;
   }
 
-  /** Like the CLI: no droplet at all, no code. */
-  get nothingToPrint(): boolean {
-    return this.droplets === 0;
+  /** Layers analysed (the core's count). */
+  get analysed(): number {
+    return this.core?.analysed_layers ?? 0;
   }
 
   /** Covered share of the part's region over the layers analysed so far (null before any). */
-  partCoverage(analysed: number): number | null {
-    return analysed > 0 && this.regionArea > 0 ? this.coveredArea / this.regionArea : null;
+  get partCoverage(): number | null {
+    return this.core?.coverage ?? null;
   }
 
-  /** Material volume (mm³), mass (g) and print time (s) from the droplet size and the settings'
-   *  material_density, droplet_rate and travel_speed (`setting(name, default)`). */
-  estimates(dropletWidth: number, layerHeight: number, setting: (name: string, fallback: number) => number): { volume: number; mass: number; seconds: number } {
-    const volume = this.droplets * dropletWidth * dropletWidth * layerHeight; // mm³
-    const mass = (volume / 1000) * setting("material_density", 1.04);
-    const seconds = this.droplets / setting("droplet_rate", 100) + this.travelTotal / setting("travel_speed", 50);
-    return { volume, mass, seconds };
+  /** The worst layer: the one with the largest connected void. */
+  get worst(): { index: number; area: number } | null {
+    return this.core?.worst_layer ?? null;
+  }
+
+  /** What slicing repaired. */
+  get repairs(): string[] {
+    return this.core?.repairs ?? [];
+  }
+
+  /** Material volume (mm³), mass (g) and print time (s); null for a .gco file. */
+  get estimates(): { volume: number; mass: number; seconds: number } | null {
+    const c = this.core;
+    return c ? { volume: c.volume_mm3, mass: c.mass_g, seconds: c.print_seconds } : null;
   }
 }

@@ -9,7 +9,7 @@ import type { View } from "./render";
 import { restoreModel, showError } from "./errors";
 import type { Page } from "./page";
 import type { Model, Slice } from "./store";
-import { hideBanner, showBanner, TITLES } from "./views/banner";
+import { errorBanner, hideBanner, showBanner, TITLES } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { saveGcode } from "./views/download";
 import { clampLayer, layerLabel, setLayers, show } from "./views/layer";
@@ -69,21 +69,26 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
   const gen = ++store.generation;
   const values = form.values();
   const json = form.json();
-  const H = Number(values.layer_height);
-  const B = H * Number(values.droplet_aspect);
-  const s = store.newSlice("stl", m.name, B, H, values, m);
+  // B is the core's (JobInfo.droplet_width, once the model is open)
+  const s = store.newSlice("stl", m.name, NaN, Number(values.layer_height), values, m);
   if (store.fileChosenAt !== null) s.startedAt = store.fileChosenAt;
   store.fileChosenAt = null;
-  const sameModel = store.slice?.model?.sha256 === m.sha256;
+  const before = store.slice?.model ?? null;
   store.busy = true;
   setState("slicing");
   progress(0, `Reading ${m.name}…`);
   updateButtons(page);
   try {
-    await pool.slice(m.bytes, m.name, json, {
+    const figuresChanged = () => {
+      if (store.slice === s && gen === store.generation) whileBusy(page, gen, () => writeStats(page));
+    };
+    await pool.slice(m.file, values, {
       opened: (r) => {
         if (gen !== store.generation) return;
+        if (r.sha256) m.sha256 = r.sha256;
+        const sameModel = before !== null && (before === m || (before.sha256 !== "" && before.sha256 === m.sha256));
         s.open(r.layers, r.info);
+        if (typeof r.info.droplet_width === "number") s.dropletWidth = r.info.droplet_width;
         store.model = m;
         store.slice = s;
         store.slicedSettings = json;
@@ -120,9 +125,16 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
         }
       },
       unit: (u) => {
-        if (gen === store.generation) s.addUnit(u);
+        if (gen !== store.generation) return;
+        s.addUnit(u);
+        s.figures.refresh(pool, figuresChanged).catch(() => {
+          // the final refresh below reports what went wrong
+        });
       },
     }, renderer.showVoids);
+    if (gen !== store.generation) return;
+    // the core's figures of every unit, before the slice counts as done
+    await s.figures.refresh(pool, figuresChanged);
     if (gen !== store.generation) return;
     s.complete = true;
     s.seconds = (performance.now() - s.startedAt) / 1000;
@@ -131,24 +143,10 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
     if (!store.viewTouched && !s.info.bounds) renderer.fit(s.bbox);
     show(page, store.current);
     setState("done");
-    if (s.figures.nothingToPrint) {
-      showBanner(
-        "Nothing to print",
-        `No droplet fits in this part: every wall is thinner than the droplet width B = ${s.dropletWidth.toFixed(3)} mm. ` +
-          "Scale the part up (Part → scale) or use smaller droplets (layer height, droplet aspect).",
-      );
-    }
+    const nothing = s.figures.nothingToPrint;
+    if (nothing) errorBanner(new SliceError(nothing.kind, nothing.message));
     // the overlay was turned on during a slice made without analysis
     if (renderer.showVoids && s.analysed < s.layers) void analyseVoids(page, s);
-    pool
-      .repairs(s.figures.summaryJson(s.layers))
-      .then((r) => {
-        s.repairs = r;
-        if (store.slice === s) writeStats(page);
-      })
-      .catch(() => {
-        // only informative; a failure here must not disturb the finished slice
-      });
   } catch (e) {
     if (gen !== store.generation) return;
     store.busy = false;
@@ -180,18 +178,35 @@ export async function analyseVoids(page: Page, s: Slice): Promise<void> {
   store.busy = true;
   setState("slicing");
   const label = "Analysing voids…";
-  progress(s.analysed / Math.max(1, s.layers), label);
+  progress(0, label);
   updateButtons(page);
+  // every layer is analysed again: what an earlier, cancelled pass analysed is dropped
+  s.figures.restartAnalysis();
+  let arrived = 0;
+  const figuresChanged = () => {
+    if (store.slice === s && gen === store.generation) whileBusy(page, gen, () => writeStats(page));
+  };
   try {
-    await pool.analyse(s.layers, (l) => {
-      if (gen !== store.generation) return;
-      s.put(l, store.current);
-      if (l.index === store.current) show(page, store.current);
-      whileBusy(page, gen, () => {
-        progress(s.analysed / Math.max(1, s.layers), label);
-        writeStats(page);
-      });
-    });
+    await pool.analyse(
+      s.layers,
+      (l) => {
+        if (gen !== store.generation) return;
+        s.put(l, store.current);
+        arrived++;
+        if (l.index === store.current) show(page, store.current);
+        whileBusy(page, gen, () => {
+          progress(arrived / Math.max(1, s.layers), label);
+          writeStats(page);
+        });
+      },
+      (u) => {
+        if (gen !== store.generation) return;
+        s.addUnit(u);
+        s.figures.refresh(pool, figuresChanged).catch(() => {});
+      },
+    );
+    if (gen !== store.generation) return;
+    await s.figures.refresh(pool, figuresChanged);
     if (gen !== store.generation) return;
     store.busy = false;
     progress(null);
@@ -288,8 +303,9 @@ export async function download(page: Page): Promise<void> {
   const { store, pool } = page;
   const s = store.slice;
   if (!s || !s.complete || s.source !== "stl") return;
-  const summary = s.figures.summaryJson(s.layers);
+  const summary = s.figures.summary;
   try {
+    if (!summary) throw new SliceError("internal", "the slice has no summary from the core");
     const [header, footer] = await Promise.all([pool.header(summary), pool.footer(summary)]);
     const layers = s.gcodeParts();
     if (typeof layers === "number") throw new SliceError("internal", `layer ${layers + 1} has no G-code`);

@@ -5,7 +5,7 @@ import type { Value } from "./form";
 import { openGcode, startSlice, type Target } from "./flows";
 import type { Page } from "./page";
 import { sampleStl } from "./sample";
-import { LinkError, readLink, sha256Hex, type SharedLink } from "./share";
+import { LinkError, readLink, type SharedLink } from "./share";
 import type { Model } from "./store";
 import { note, showBanner, TITLES } from "./views/banner";
 import { updateButtons } from "./views/controls";
@@ -24,18 +24,20 @@ export async function openFile(page: Page, file: File): Promise<void> {
     await openGcode(page, file);
     return;
   }
-  let bytes: Uint8Array;
-  try {
-    bytes = new Uint8Array(await file.arrayBuffer());
-  } catch (e) {
-    showBanner(TITLES.import, `The browser could not read “${file.name}”: ${String(e)}`);
-    return;
-  }
-  const m: Model = { bytes, name: file.name, sha256: await sha256Hex(bytes) };
+  // The File goes to a worker, which reads it and computes its SHA-256: the page never reads it.
+  const m: Model = { file, name: file.name, sha256: "" };
   store.fileChosenAt = chosen;
   const link = store.pendingLink;
   if (link) {
     store.pendingLink = null;
+    let sha256: string;
+    try {
+      sha256 = await page.pool.hash(file);
+    } catch (e) {
+      showBanner(TITLES.import, `The browser could not read “${file.name}”: ${e instanceof Error ? e.message : String(e)}`);
+      return;
+    }
+    m.sha256 = sha256;
     if (link.state.sha256 === m.sha256) {
       note(`“${m.name}” matches the model of the preview link.`, "ok");
       await startSlice(page, m, { layer: link.state.layer, view: link.state.view });
@@ -51,14 +53,15 @@ export async function openFile(page: Page, file: File): Promise<void> {
   await startSlice(page, m);
 }
 
-function sample(): Model {
-  const s = sampleStl();
-  return { bytes: s.bytes, name: s.name, sha256: "" };
+/** A model from bytes the page already holds (the sample, a link's model), as a File for
+ *  the workers. */
+function modelOf(bytes: Uint8Array, name: string): Model {
+  return { file: new File([bytes as BlobPart], name, { type: "model/stl" }), name, sha256: "" };
 }
 
 export async function openSample(page: Page, notice?: Target["notice"]): Promise<void> {
-  const m = sample();
-  m.sha256 = await sha256Hex(m.bytes);
+  const s = sampleStl();
+  const m = modelOf(s.bytes, s.name);
   page.store.pendingLink = null;
   note("", "none");
   await startSlice(page, m, { notice });
@@ -114,7 +117,8 @@ export async function openLink(page: Page): Promise<boolean> {
     : undefined;
   const { layer, view, name, sha256 } = link.state;
   if (link.model) {
-    const m: Model = { bytes: link.model, name, sha256: await sha256Hex(link.model) };
+    const m = modelOf(link.model, name);
+    m.sha256 = await page.pool.hash(m.file);
     if (m.sha256 === sha256) {
       await startSlice(page, m, { layer, view, notice });
       return true;

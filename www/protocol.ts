@@ -113,14 +113,62 @@ export function coverageMaskOf(r: {
   return { cell: r.mask_cell, tiles };
 }
 
+/** An error as the core throws it (src/error.rs `ErrorReport`) and as a worker replies it;
+ *  `crash` and `link` are the page's own kinds. */
+export interface ErrorValue {
+  kind: string;
+  message: string;
+  /** The setting at fault, for kind "setting". */
+  setting?: string;
+}
+
+/** Settings as the form gives them: `{name: value}`; the core validates them. */
+export type Settings = Record<string, number | boolean | string>;
+
+/** The core's summary of some layers (src/summary.rs `Summary`). The page never adds these
+ *  up: it keeps them and asks a worker for the merged figures. */
+export interface Summary {
+  layers: number;
+  counts: Counts;
+  travel_mm: number;
+  layers_with_open_chains: number;
+  reoriented_loops: number;
+  analysis: Record<string, unknown>;
+}
+
+/** Every figure of a slice, as the core computed it (src/summary.rs `Figures`). */
+export interface Figures {
+  layers: number;
+  counts: Counts;
+  droplets: number;
+  volume_mm3: number;
+  mass_g: number;
+  print_seconds: number;
+  travel_mm: number;
+  analysed_layers: number;
+  coverage: number | null;
+  void_area: number | null;
+  worst_layer: { index: number; area: number } | null;
+  repairs: string[];
+}
+
+/** The result of a "figures" request (src/wasm.rs `Session::figures`). */
+export interface SliceFigures {
+  /** The parts merged: keep this instead of them. */
+  summary: Summary;
+  figures: Figures;
+  /** Once every layer is in and not one droplet fits. */
+  nothing_to_print: ErrorValue | null;
+}
+
 /** The result of a "slice" request: what belongs to its run of layers as a whole. */
 export interface SliceUnit {
   from: number;
   to: number;
   /** The G-code of layers [from, to), in order (absent when the request asked for none). */
   gcode?: Blob;
-  /** The core's Summary of these layers, summed (the page adds the units up for the header). */
-  summary?: Record<string, unknown>;
+  /** The core's summary of these layers (with `gcode: false` only their analysis). */
+  summary: Summary;
 }
 
 export interface SettingSpec {
@@ -139,12 +187,24 @@ export interface SettingSpec {
 export interface InitResult {
   version: string;
   schema: SettingSpec[];
-  defaults: Record<string, number | boolean | string>;
+  defaults: Settings;
+}
+
+/** A job one worker prepared (parsed, welded, checked, repaired, placed) for the others:
+ *  vertices x,y,z (mm) and facets (three vertex indices each), transferable. */
+export interface PreparedMesh {
+  vertices: Float64Array;
+  facets: Uint32Array;
+  info: JobInfo;
 }
 
 export interface OpenResult {
   layers: number;
   info: JobInfo;
+  /** SHA-256 of the file, hex (when asked for). */
+  sha256?: string;
+  /** The prepared mesh (when asked for). */
+  prepared?: PreparedMesh;
 }
 
 export interface GcodeParseResult {
@@ -154,45 +214,42 @@ export interface GcodeParseResult {
   header: Record<string, string>;
 }
 
-export type Request =
-  | { id: number; kind: "init"; data: null }
-  | { id: number; kind: "open"; data: { stl: ArrayBuffer; name: string; settings: string } }
-  | { id: number; kind: "slice"; data: { from: number; to: number; analyse?: boolean; gcode?: boolean } }
-  | { id: number; kind: "preview"; data: { index: number; analyse?: boolean } }
-  | { id: number; kind: "header"; data: { summary: string } }
-  | { id: number; kind: "footer"; data: { summary: string } }
-  | { id: number; kind: "repairs"; data: { summary: string } }
-  | { id: number; kind: "parse_gcode"; data: { file: Blob } }
-  | { id: number; kind: "crash"; data: null };
+/** Every request a worker answers: what it is sent and what it replies. */
+export interface Calls {
+  init: { data: null; result: InitResult };
+  /** Reads and prepares the model (in the worker: the page never reads it). */
+  open: { data: { file: File; settings: Settings; hash?: boolean; prepare?: boolean }; result: OpenResult };
+  /** Takes the job another worker prepared. */
+  adopt: { data: { prepared: PreparedMesh; settings: Settings }; result: OpenResult };
+  slice: { data: { from: number; to: number; analyse?: boolean; gcode?: boolean }; result: SliceUnit };
+  preview: { data: { index: number; analyse?: boolean }; result: LayerData };
+  header: { data: { summary: Summary | null }; result: string };
+  footer: { data: { summary: Summary }; result: string };
+  figures: { data: { parts: Summary[] }; result: SliceFigures };
+  /** SHA-256 of a file, hex (computed in the worker). */
+  hash: { data: { file: Blob }; result: string };
+  parse_gcode: { data: { file: Blob }; result: GcodeParseResult };
+  crash: { data: null; result: void };
+}
 
-export type RequestKind = Request["kind"];
+export type RequestKind = keyof Calls;
+export type RequestData<K extends RequestKind> = Calls[K]["data"];
+export type ResultOf<K extends RequestKind> = Calls[K]["result"];
+
+export type Request = { [K in RequestKind]: { id: number; kind: K; data: RequestData<K> } }[RequestKind];
 
 export type Reply =
   | { id: number; kind: "progress"; data: LayerData }
-  | { id: number; kind: "result"; data: unknown }
-  | { id: number; kind: "error"; data: { kind: string; message: string } };
+  | { id: number; kind: "result"; data: ResultOf<RequestKind> }
+  | { id: number; kind: "error"; data: ErrorValue };
 
-/** Splits "kind: message" as produced by src/wasm.rs. */
-export function splitError(text: string): { kind: string; message: string } {
-  const m = /^(import|setting|nothing_to_print|io|internal): ([\s\S]*)$/.exec(text);
-  return m ? { kind: m[1], message: m[2] } : { kind: "internal", message: text };
+/** Whether a thrown value is an error object of the core (`{kind, message, setting?}`). */
+export function isErrorValue(e: unknown): e is ErrorValue {
+  return typeof e === "object" && e !== null && typeof (e as ErrorValue).kind === "string" && typeof (e as ErrorValue).message === "string";
 }
 
 export function transferablesOf(layer: LayerData): Transferable[] {
   const out = [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
   for (const t of layer.mask?.tiles ?? []) out.push(t.void.buffer, t.overfill.buffer);
   return out;
-}
-
-/** Adds every number of `b` into `a` (nested objects too): sums the layers' summaries
- *  without the page having to know the core's Summary fields. */
-export function addNumbers(a: Record<string, unknown>, b: Record<string, unknown>): Record<string, unknown> {
-  for (const [k, v] of Object.entries(b)) {
-    if (typeof v === "number") a[k] = (typeof a[k] === "number" ? (a[k] as number) : 0) + v;
-    else if (v && typeof v === "object" && !Array.isArray(v)) {
-      const inner = a[k] && typeof a[k] === "object" ? (a[k] as Record<string, unknown>) : {};
-      a[k] = addNumbers(inner, v as Record<string, unknown>);
-    } else if (!(k in a)) a[k] = v;
-  }
-  return a;
 }

@@ -149,10 +149,11 @@ export async function sha256Hex(bytes: Uint8Array): Promise<string> {
   return [...new Uint8Array(digest)].map((b) => b.toString(16).padStart(2, "0")).join("");
 }
 
-/** Builds the link; `embedded` tells whether the model travels inside it. */
-export async function makeLink(base: string, state: ShareState, model: Uint8Array): Promise<{ url: string; embedded: boolean }> {
+/** Builds the link; `embedded` tells whether the model travels inside it. The model is a
+ *  Blob (the File the user gave): it is compressed as a stream, never read whole here. */
+export async function makeLink(base: string, state: ShareState, model: Blob): Promise<{ url: string; embedded: boolean }> {
   const p = toBase64Url(await deflate(new TextEncoder().encode(JSON.stringify(state))));
-  const packed = await deflate(model);
+  const packed = new Uint8Array(await new Response(model.stream().pipeThrough(new CompressionStream("deflate-raw"))).arrayBuffer());
   const embedded = packed.length <= EMBED_LIMIT;
   const url = `${base.split("#")[0]}#p=${p}${embedded ? `&m=${toBase64Url(packed)}` : ""}`;
   return { url, embedded };

@@ -14,9 +14,11 @@ export function cacheBudgetBytes(query: URLSearchParams): number {
   return Math.min(4096, Math.max(1, Number(query.get("cache")) || 384)) * 2 ** 20;
 }
 
+/** A model to slice: its File is read in a worker, never on the page's thread. */
 export interface Model {
-  bytes: Uint8Array;
+  file: File;
   name: string;
+  /** SHA-256 (hex) as a worker computed it; "" until the model was opened. */
   sha256: string;
 }
 
@@ -34,13 +36,10 @@ export class Slice {
   done = 0;
   complete = false;
   bbox: Bounds = { minX: Infinity, minY: Infinity, maxX: -Infinity, maxY: -Infinity };
-  /** Droplets, travel, summary, coverage, worst layer: figures.ts. */
+  /** Droplets, travel, estimates, coverage, worst layer, repairs: the core's (figures.ts). */
   figures = new Figures();
-  /** What slicing repaired (from the core, once the slice is complete). */
-  repairs: string[] = [];
   /** Void analysis per layer (when the slice or a later pass made it). */
   analysis: (LayerAnalysis | undefined)[] = [];
-  analysed = 0;
   /** When the file was chosen (performance.now()), and the seconds from then until every
    *  layer's G-code was ready (the figure of the benchmark). */
   startedAt = performance.now();
@@ -68,7 +67,7 @@ export class Slice {
       this.counts[l.index] = l.counts;
       this.z[l.index] = l.z;
       this.travelMm[l.index] = l.travelMm;
-      this.figures.addLayer(l);
+      if (this.source === "gco") this.figures.addReadLayer(l);
       const d = l.droplets;
       const b = this.bbox;
       for (let i = 0; i < d.length; i += 2) {
@@ -81,11 +80,7 @@ export class Slice {
       }
     }
     const a = l.analysis;
-    if (a && this.analysis[l.index] === undefined) {
-      this.analysis[l.index] = a;
-      this.analysed++;
-      this.figures.addAnalysis(l.index, a);
-    }
+    if (a && this.analysis[l.index] === undefined) this.analysis[l.index] = a;
     const old = this.cache.get(l.index);
     if (!old || (l.mask && !old.mask)) {
       if (old) this.cacheBytes -= layerBytes(old);
@@ -126,6 +121,16 @@ export class Slice {
 
   get droplets(): number {
     return this.figures.droplets;
+  }
+
+  /** Layers with a void analysis (the core's count). */
+  get analysed(): number {
+    return this.figures.analysed;
+  }
+
+  /** What slicing repaired (the core's, once the slice is complete). */
+  get repairs(): string[] {
+    return this.complete ? this.figures.repairs : [];
   }
 }
 

@@ -1,17 +1,30 @@
 // One worker = one wasm instance = at most one Session (one prepared slicing job).
 // Answers the requests of protocol.ts; streams layers as "progress" replies with their
-// buffers transferred.
+// buffers transferred. The model arrives as a File and is read here (by the core, with
+// FileReaderSync), never on the page's thread; the worker that prepares a job hands the
+// prepared mesh to the others ("adopt"). Everything from the core is a typed value; its
+// errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, {
-  Session,
-  crash_for_test,
-  default_settings_json,
-  settings_schema,
-  version,
-  type InitOutput,
-} from "./pkg/dropslice.js";
+import init, { Session, Tally, crash_for_test, default_settings, settings_schema, version, type InitOutput } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
-import { addNumbers, coverageMaskOf, splitError, transferablesOf, type LayerData, type Reply, type Request, type SliceUnit } from "./protocol";
+import {
+  coverageMaskOf,
+  isErrorValue,
+  transferablesOf,
+  type ErrorValue,
+  type InitResult,
+  type LayerAnalysis,
+  type OpenResult,
+  type Reply,
+  type Request,
+  type RequestData,
+  type RequestKind,
+  type ResultOf,
+  type SliceUnit,
+  type JobInfo,
+  type Summary,
+  type LayerData,
+} from "./protocol";
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 
@@ -39,6 +52,24 @@ function post(reply: Reply, transfer: Transferable[] = []): void {
   scope.postMessage(reply, transfer);
 }
 
+/** The result of request `id` of kind `K` (typed by protocol.ts `Calls`). */
+function answer<K extends RequestKind>(_kind: K, id: number, data: ResultOf<K>, transfer: Transferable[] = []): void {
+  post({ id, kind: "result", data }, transfer);
+}
+
+/** SHA-256 of a file, hex, computed here (for preview links). */
+async function sha256Of(file: Blob): Promise<string> {
+  const digest = await crypto.subtle.digest("SHA-256", await file.arrayBuffer());
+  return [...new Uint8Array(digest)].map((b) => b.toString(16).padStart(2, "0")).join("");
+}
+
+/** Makes `s` this worker's session (the old one stays usable until then) and describes it. */
+function adopt(s: Session): OpenResult {
+  session?.free();
+  session = s;
+  return { layers: s.layer_count(), info: s.info() as JobInfo };
+}
+
 /** Lets other requests (previews) in between two layers of a long slice. */
 function yieldToQueue(): Promise<void> {
   return new Promise((resolve) => {
@@ -48,18 +79,14 @@ function yieldToQueue(): Promise<void> {
   });
 }
 
-/** What a layer adds to its unit: G-code bytes and the core's summary. */
-interface UnitParts {
-  gcode: Uint8Array[];
-  summary: Record<string, unknown>;
-}
-
-function layerOf(s: Session, index: number, unit: UnitParts | null, analyse = false): LayerData {
+function layerOf(s: Session, index: number, unit: { gcode: Uint8Array[]; tally: Tally } | null, analyse = false, counted = true): LayerData {
   const r = analyse ? s.slice_layer_analysed(index) : s.slice_layer(index);
   try {
     if (unit) {
-      unit.gcode.push(r.gcode);
-      addNumbers(unit.summary, JSON.parse(r.summary_json) as Record<string, unknown>);
+      if (counted) {
+        unit.gcode.push(r.gcode);
+        unit.tally.add_layer(r);
+      } else unit.tally.add_analysis(r);
     }
     const layer: LayerData = {
       index: r.index,
@@ -71,7 +98,7 @@ function layerOf(s: Session, index: number, unit: UnitParts | null, analyse = fa
       travel: r.travel,
     };
     if (analyse) {
-      layer.analysis = JSON.parse(r.analysis_json);
+      layer.analysis = r.analysis() as LayerAnalysis;
       layer.mask = coverageMaskOf(r);
     }
     return layer;
@@ -83,26 +110,35 @@ function layerOf(s: Session, index: number, unit: UnitParts | null, analyse = fa
 /** The unit being sliced: the next one starts when it ends. */
 let slicing: Promise<void> = Promise.resolve();
 
-async function sliceUnit(id: number, req: Extract<Request, { kind: "slice" }>["data"]): Promise<void> {
+/** Slices layers [from, to): each a progress reply, then the unit's G-code and summary. With
+ *  `gcode: false` (an analysis after the slice) the summary holds only the layers' analysis. */
+async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
   const s = need();
   const { from, to } = req;
-  const parts: UnitParts | null = (req.gcode ?? true) ? { gcode: [], summary: {} } : null;
-  for (let i = from; i < to; i++) {
-    const layer = layerOf(s, i, parts, req.analyse);
-    post({ id, kind: "progress", data: layer }, transferablesOf(layer));
-    await yieldToQueue();
-    if (session !== s) throw new Error("internal: the model was replaced during slicing");
+  const counted = req.gcode ?? true;
+  const parts = { gcode: [] as Uint8Array[], tally: new Tally() };
+  try {
+    for (let i = from; i < to; i++) {
+      const layer = layerOf(s, i, parts, req.analyse, counted);
+      post({ id, kind: "progress", data: layer }, transferablesOf(layer));
+      await yieldToQueue();
+      if (session !== s) throw internal("the model was replaced during slicing");
+    }
+    const unit: SliceUnit = { from, to, summary: parts.tally.summary() as Summary };
+    if (counted) unit.gcode = new Blob(parts.gcode as BlobPart[], { type: "text/plain" });
+    answer("slice", id, unit);
+  } finally {
+    parts.tally.free();
   }
-  const unit: SliceUnit = { from, to };
-  if (parts) {
-    unit.gcode = new Blob(parts.gcode as BlobPart[], { type: "text/plain" });
-    unit.summary = parts.summary;
-  }
-  post({ id, kind: "result", data: unit });
+}
+
+/** A bug of the page or the worker, as an error value. */
+function internal(message: string): ErrorValue {
+  return { kind: "internal", message: `internal error (a bug in dropslice, please report it): ${message}` };
 }
 
 function need(): Session {
-  if (!session) throw new Error("internal: no model is open in this worker");
+  if (!session) throw internal("no model is open in this worker");
   return session;
 }
 
@@ -110,20 +146,30 @@ async function handle(req: Request): Promise<void> {
   switch (req.kind) {
     case "init": {
       await load();
-      post({
-        id: req.id,
-        kind: "result",
-        data: { version: version(), schema: JSON.parse(settings_schema()), defaults: JSON.parse(default_settings_json()) },
-      });
+      const result: InitResult = { version: version(), schema: settings_schema(), defaults: default_settings() };
+      answer(req.kind, req.id, result);
       return;
     }
     case "open": {
       await load();
+      const { file, settings } = req.data;
+      const hash = req.data.hash ? sha256Of(file) : undefined;
       // the old session stays usable if the new model or settings are refused
-      const s = new Session(new Uint8Array(req.data.stl), req.data.name, req.data.settings);
-      session?.free();
-      session = s;
-      post({ id: req.id, kind: "result", data: { layers: s.layer_count(), info: JSON.parse(s.info_json()) } });
+      const result = adopt(Session.from_file(file, settings));
+      const transfer: Transferable[] = [];
+      if (req.data.prepare) {
+        const s = need();
+        result.prepared = { vertices: s.vertices(), facets: s.facets(), info: result.info };
+        transfer.push(result.prepared.vertices.buffer, result.prepared.facets.buffer);
+      }
+      if (hash) result.sha256 = await hash;
+      answer(req.kind, req.id, result, transfer);
+      return;
+    }
+    case "adopt": {
+      await load();
+      const { prepared, settings } = req.data;
+      answer(req.kind, req.id, adopt(Session.from_prepared(prepared.vertices, prepared.facets, prepared.info, settings)));
       return;
     }
     case "slice": {
@@ -140,13 +186,16 @@ async function handle(req: Request): Promise<void> {
       return;
     }
     case "header":
-      post({ id: req.id, kind: "result", data: need().header(req.data.summary) });
-      return;
-    case "repairs":
-      post({ id: req.id, kind: "result", data: JSON.parse(need().repairs(req.data.summary)) });
+      answer(req.kind, req.id, need().header(req.data.summary));
       return;
     case "footer":
-      post({ id: req.id, kind: "result", data: need().footer(req.data.summary) });
+      answer(req.kind, req.id, need().footer(req.data.summary));
+      return;
+    case "figures":
+      answer(req.kind, req.id, need().figures(req.data.parts));
+      return;
+    case "hash":
+      answer(req.kind, req.id, await sha256Of(req.data.file));
       return;
     case "parse_gcode": {
       let fraction = 0;
@@ -154,15 +203,11 @@ async function handle(req: Request): Promise<void> {
         post({ id: req.id, kind: "progress", data: { ...layer, fraction } }, transferablesOf(layer)),
       );
       await readGcode(req.data.file, reader, (f) => (fraction = f));
-      post({
-        id: req.id,
-        kind: "result",
-        data: {
-          layers: reader.layers,
-          dropletWidth: reader.dropletWidth,
-          layerHeight: Number(reader.header.layer_height),
-          header: reader.header,
-        },
+      answer(req.kind, req.id, {
+        layers: reader.layers,
+        dropletWidth: reader.dropletWidth,
+        layerHeight: Number(reader.header.layer_height),
+        header: reader.header,
       });
       return;
     }
@@ -173,7 +218,7 @@ async function handle(req: Request): Promise<void> {
   }
 }
 
-function describe(e: unknown): { kind: string; message: string } {
+function describe(e: unknown): ErrorValue {
   if (e instanceof GcodeError) return { kind: "import", message: `cannot read the G-code file: ${e.message}` };
   if (e instanceof WebAssembly.RuntimeError || e instanceof RangeError) {
     broken = true;
@@ -187,8 +232,8 @@ function describe(e: unknown): { kind: string; message: string } {
     }
     return { kind: "crash", message: `the slicer stopped unexpectedly (${String(e)}). Please report it.` };
   }
-  if (e instanceof Error) return splitError(e.message);
-  return splitError(String(e));
+  if (isErrorValue(e)) return { kind: e.kind, message: e.message, ...(e.setting ? { setting: e.setting } : {}) };
+  return internal(e instanceof Error ? e.message : String(e));
 }
 
 scope.onmessage = (ev: MessageEvent<Request>) => {

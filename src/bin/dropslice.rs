@@ -22,10 +22,10 @@ mod cli {
     use std::time::Instant;
 
     const USAGE: &str = "\
-usage: dropslice MODEL.stl [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
+usage: dropslice MODEL [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
 
-Slices an STL file (binary or ASCII) into droplet machine code (.gco: G01 travel,
-G25 droplet line, G26 droplet).
+Slices a model (STL, binary or ASCII; OBJ; or a 3MF build, all its items in their
+places) into droplet machine code (.gco: G01 travel, G25 droplet line, G26 droplet).
 
   -o, --output FILE      where to write the code (default: MODEL.gco in the current directory)
   --set name=value       change one setting (repeatable; see --list-settings)
@@ -359,12 +359,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             file.write_all(header.as_bytes())
         };
         finish().map_err(|e| io("write", output, e))?;
-        if summary.counts.total() == 0 {
-            return Err(Error::NothingToPrint(format!(
-                "no droplet fits in the part: every wall is thinner than the droplet width B = {:.3} mm; scale the part up or use smaller droplets (layer_height, droplet_aspect)",
-                job.settings().droplet_width()
-            )));
-        }
+        summary.printable(job.settings())?;
         let mut voids = String::new();
         let mut report_done = None;
         if let (Some(mut staged), Some(analysis)) = (report, analysis) {
@@ -394,20 +389,40 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             eprintln!("dropslice: repaired: {r}");
         }
         if !args.quiet {
-            let c = summary.counts;
+            let f = summary.figures(job.settings());
+            let c = f.counts;
             eprintln!(
-                "dropslice: {} → {}: {} layers, {} droplets ({} outer, {} inner, {} fill){voids}, {:.2} s",
+                "dropslice: {} → {}: {} layers, {} droplets ({} outer, {} inner, {} fill){voids}, {:.2} cm³, {:.2} g, print time {}, {:.2} s",
                 name,
                 output.display(),
-                summary.layers,
-                c.total(),
+                f.layers,
+                f.droplets,
                 c.outer,
                 c.inner,
                 c.fill,
+                f.volume_mm3 / 1000.0,
+                f.mass_g,
+                duration(f.print_seconds),
                 t0.elapsed().as_secs_f64()
             );
         }
         Ok(())
+    }
+
+    /// A print time as the page shows it: "1 h 5 min", "3 min 2 s", "40 s".
+    fn duration(seconds: f64) -> String {
+        if !seconds.is_finite() {
+            return "–".into();
+        }
+        let s = seconds.round() as u64;
+        let (h, m, s) = (s / 3600, s / 60 % 60, s % 60);
+        if h > 0 {
+            format!("{h} h {m} min")
+        } else if m > 0 {
+            format!("{m} min {s} s")
+        } else {
+            format!("{s} s")
+        }
     }
 
     /// Files written beside their destination and put in place only when complete.

@@ -232,8 +232,8 @@ test("the renderer keeps any view in range on its own and draws it at once", asy
   await context.close();
 });
 
-test("?workers=N is clamped to 1 … min(cores, 8) (at least 4 allowed); NaN gives the default", async () => {
-  for (const [q, want] of [["16", (n, cores) => n === Math.min(8, Math.max(4, cores))], ["1000000", (n) => n <= 8], ["NaN", (n, cores) => n === Math.max(1, Math.min(cores - 1, 4))], ["-3", (n) => n === 1], ["0", (n) => n === 1], ["2.4", (n) => n === 2], ["abc", (n, cores) => n === Math.max(1, Math.min(cores - 1, 4))]]) {
+test("?workers=N is clamped to 1 … min(cores, 8) (at least 4 allowed); NaN gives the default (one per core, at most 8)", async () => {
+  for (const [q, want] of [["16", (n, cores) => n === Math.min(8, Math.max(4, cores))], ["1000000", (n) => n <= 8], ["NaN", (n, cores) => n === Math.max(1, Math.min(cores, 8))], ["-3", (n) => n === 1], ["0", (n) => n === 1], ["2.4", (n) => n === 2], ["abc", (n, cores) => n === Math.max(1, Math.min(cores, 8))]]) {
     const { page, context, errors } = await open(`?workers=${q}`);
     const s = await settle(page);
     assert.equal(s.state, "done");

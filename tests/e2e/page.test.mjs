@@ -214,7 +214,7 @@ test("a garbage file shows an error and the next slice works", async () => {
   const s = await waitSettled(page, 30_000);
   assert.equal(s.state, "error");
   assert.equal(await page.isVisible("#banner"), true);
-  assert.match(await page.locator("#banner").innerText(), /Cannot read the STL file/i);
+  assert.match(await page.locator("#banner").innerText(), /Cannot read the model file/i);
   await page.evaluate(() => (document.body.dataset.state = "picking"));
   await page.click("#btn-sample");
   const ok = await waitDone(page, 60_000);

@@ -78,7 +78,7 @@ test("preview links: base64url and deflate round trips, hash of bytes", async ()
 test("preview links: embedded when small, hash only when big", async () => {
   const state = { settings: { contours: 3 }, layer: 7, view: { scale: 12, cx: 1, cy: 2 }, name: "p.stl", sha256: "ab" };
   const small = new Uint8Array(1000).fill(7);
-  const a = await share.makeLink("http://x/#old", state, small);
+  const a = await share.makeLink("http://x/#old", state, new Blob([small]));
   assert.ok(a.embedded && a.url.startsWith("http://x/#p="));
   const back = await share.readLink(a.url.slice(a.url.indexOf("#")));
   assert.deepEqual(back.state, state);
@@ -86,7 +86,7 @@ test("preview links: embedded when small, hash only when big", async () => {
   // random bytes do not compress: 300 KB stays above the 256 KB limit
   const big = new Uint8Array(300_000);
   for (let i = 0; i < big.length; i += 65536) crypto.getRandomValues(big.subarray(i, i + 65536));
-  const b = await share.makeLink("http://x/", state, big);
+  const b = await share.makeLink("http://x/", state, new Blob([big]));
   assert.equal(b.embedded, false);
   assert.doesNotMatch(b.url, /&m=/);
   assert.equal((await share.readLink(b.url.slice(b.url.indexOf("#")))).model, null);

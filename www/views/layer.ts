@@ -58,7 +58,7 @@ function fetchPreview(page: Page, s: Slice, k: number): void {
   const { store, pool, renderer } = page;
   if (store.previewRequests.has(k)) return;
   store.previewRequests.add(k);
-  (renderer.showVoids ? pool.previewAnalysed(k) : pool.preview(k))
+  pool.preview(k, renderer.showVoids)
     .then((l) => {
       if (store.slice !== s) return;
       s.put(l, store.current);

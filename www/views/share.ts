@@ -17,7 +17,7 @@ export async function share(page: Page): Promise<void> {
     name: model.name,
     sha256: model.sha256,
     showTravel: renderer.showTravel,
-  }, model.bytes);
+  }, model.file);
   let copied = false;
   try {
     // some browsers never settle the promise when they do not grant the permission

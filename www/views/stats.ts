@@ -1,5 +1,5 @@
 // The statistics panel: the model, droplets by role, the estimates, this layer, the mesh
-// warnings and the unit fix. The figures come from the slice's Figures (figures.ts).
+// warnings and the unit fix. The figures are the core's (figures.ts); nothing is computed here.
 
 import type { Page } from "../page";
 import type { Slice } from "../store";
@@ -26,7 +26,7 @@ function roleLabels(source: "stl" | "gco"): void {
 }
 
 export function writeStats(page: Page): void {
-  const { store, form } = page;
+  const { store } = page;
   const s = store.slice;
   const current = store.current;
   roleLabels(s?.source ?? "stl");
@@ -37,10 +37,6 @@ export function writeStats(page: Page): void {
     $("warnings").hidden = true;
     return;
   }
-  const num = (name: string, fallback: number): number => {
-    const v = s.settings[name] ?? form?.get(name);
-    return typeof v === "number" ? v : fallback;
-  };
   const f = s.figures;
   setText("stat-model", s.name);
   const b = s.info.bounds;
@@ -55,10 +51,10 @@ export function writeStats(page: Page): void {
   setText("stat-inner", nf.format(f.totals.inner));
   setText("stat-fill", nf.format(f.totals.fill));
   setText("stat-droplets", nf.format(f.droplets));
-  const { volume, mass, seconds } = f.estimates(s.dropletWidth, s.layerHeight, num);
-  setText("stat-volume", `${(volume / 1000).toFixed(2)} cm³`);
-  setText("stat-mass", `${mass.toFixed(2)} g`);
-  setText("stat-time", (s.complete ? "" : "≥ ") + duration(seconds));
+  const e = f.estimates;
+  setText("stat-volume", e ? `${(e.volume / 1000).toFixed(2)} cm³` : "–");
+  setText("stat-mass", e ? `${e.mass.toFixed(2)} g` : "–");
+  setText("stat-time", e ? (s.complete ? "" : "≥ ") + duration(e.seconds) : "–");
   setText("stat-travel", `${(f.travelTotal / 1000).toFixed(2)} m`);
   const c = s.counts[current];
   setText("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");

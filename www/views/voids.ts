@@ -13,7 +13,7 @@ export function writeVoids(s: Slice | null, current: number): void {
   const v = a?.largest_void;
   setText("stat-largest", v ? `${mm2(v.area)}${v.at_boundary ? " (edge)" : ""}` : a ? "none" : "–");
   const partial = s && s.analysed < s.layers ? " so far" : "";
-  const coverage = s?.figures.partCoverage(s.analysed) ?? null;
+  const coverage = s?.figures.partCoverage ?? null;
   setText("stat-part-coverage", coverage !== null ? pct(coverage) + partial : "–");
   const worst = s?.figures.worst;
   setText("stat-worst", worst ? `${nf.format(worst.index + 1)} · ${mm2(worst.area)}` : "–");

@@ -1,0 +1,227 @@
+//! Every figure about a slice, computed once, here: the CLI prints them and the page shows
+//! them (it computes none of its own).
+//!
+//! A [`Summary`] is built per unit of work (a layer, a run of layers, a worker's share) and
+//! merged with [`Summary::merge`]; units may arrive in any order and from several workers, and
+//! merging them gives the same figures as one summary over all layers. [`Summary::figures`]
+//! turns it into what is shown: droplets by role, material volume and mass, print time, part
+//! coverage, void area, the worst layer and what slicing repaired. [`Summary::printable`] is
+//! the one "nothing to print" check of the CLI and the page.
+
+use crate::analysis::{LayerAnalysis, PartAnalysis};
+use crate::error::Error;
+use crate::plan::{Counts, LayerPlan};
+use crate::settings::Settings;
+use serde::{Deserialize, Serialize};
+
+/// Totals of some layers of a slice (all of them once every unit is merged).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Layers planned (added with [`Summary::add`]).
+    pub layers: usize,
+    pub counts: Counts,
+    /// Length of all moves without material, in mm.
+    pub travel_mm: f64,
+    /// Layers whose section had open chains that were joined across gaps.
+    pub layers_with_open_chains: usize,
+    /// Loops chained against the direction of some of their facets (flipped facets).
+    pub reoriented_loops: usize,
+    /// The void analysis of the layers analysed (added with [`Summary::add_analysis`];
+    /// `analysis.layers` of them), in 2D (no slab volumes).
+    #[serde(default)]
+    pub analysis: PartAnalysis,
+}
+
+/// The layer with the largest connected void.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct WorstLayer {
+    /// Layer number from 0.
+    pub index: usize,
+    /// Area of its largest void, mm².
+    pub area: f64,
+}
+
+/// What the CLI prints and the page shows about a slice.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Figures {
+    pub layers: usize,
+    pub counts: Counts,
+    pub droplets: u64,
+    /// Droplets × B²H, mm³.
+    pub volume_mm3: f64,
+    /// volume × material_density, g.
+    pub mass_g: f64,
+    /// droplets / droplet_rate + travel / travel_speed, s.
+    pub print_seconds: f64,
+    pub travel_mm: f64,
+    /// Layers with a void analysis.
+    pub analysed_layers: usize,
+    /// Area-weighted coverage of the analysed layers (0 … 1); `None` without analysis.
+    pub coverage: Option<f64>,
+    /// Uncovered area summed over the analysed layers, mm².
+    pub void_area: Option<f64>,
+    pub worst_layer: Option<WorstLayer>,
+    /// What slicing repaired, in plain language.
+    pub repairs: Vec<String>,
+}
+
+impl Summary {
+    /// Adds one planned layer.
+    pub fn add(&mut self, plan: &LayerPlan) {
+        self.layers += 1;
+        self.counts.add(&plan.counts);
+        self.travel_mm += plan.travel_mm;
+        self.layers_with_open_chains += usize::from(plan.open_chains > 0);
+        self.reoriented_loops += plan.reoriented_loops;
+    }
+
+    /// A summary of one planned layer.
+    pub fn of_layer(plan: &LayerPlan) -> Summary {
+        let mut s = Summary::default();
+        s.add(plan);
+        s
+    }
+
+    /// Adds one layer's void analysis (a layer may be analysed without being counted again,
+    /// e.g. when the analysis is made after the slice).
+    pub fn add_analysis(&mut self, layer: &LayerAnalysis) {
+        self.analysis.add(layer, 0.0, 0.0);
+    }
+
+    /// Adds the layers of another summary (disjoint from this one's).
+    pub fn merge(&mut self, other: &Summary) {
+        self.layers += other.layers;
+        self.counts.add(&other.counts);
+        self.travel_mm += other.travel_mm;
+        self.layers_with_open_chains += other.layers_with_open_chains;
+        self.reoriented_loops += other.reoriented_loops;
+        self.analysis.merge(&other.analysis);
+    }
+
+    /// The merge of `parts`.
+    pub fn merged<'a>(parts: impl IntoIterator<Item = &'a Summary>) -> Summary {
+        let mut s = Summary::default();
+        for p in parts {
+            s.merge(p);
+        }
+        s
+    }
+
+    /// Plain-language notes on what slicing repaired.
+    pub fn repairs(&self) -> Vec<String> {
+        let mut r = Vec::new();
+        if self.layers_with_open_chains > 0 {
+            r.push(format!(
+                "{} layers had open sections (holes in the mesh), closed by joining their ends",
+                self.layers_with_open_chains
+            ));
+        }
+        if self.reoriented_loops > 0 {
+            r.push(format!(
+                "{} loops crossed flipped facets and were oriented by the majority",
+                self.reoriented_loops
+            ));
+        }
+        r
+    }
+
+    /// The figures shown to the user, with the estimates of `settings`.
+    pub fn figures(&self, settings: &Settings) -> Figures {
+        let droplets = self.counts.total();
+        let b = settings.droplet_width();
+        let volume = droplets as f64 * b * b * settings.layer_height;
+        let a = &self.analysis;
+        let analysed = a.layers > 0;
+        Figures {
+            layers: self.layers,
+            counts: self.counts,
+            droplets,
+            volume_mm3: volume,
+            mass_g: volume / 1000.0 * settings.material_density,
+            print_seconds: droplets as f64 / settings.droplet_rate
+                + self.travel_mm / settings.travel_speed,
+            travel_mm: self.travel_mm,
+            analysed_layers: a.layers,
+            coverage: analysed.then_some(a.coverage),
+            void_area: analysed.then_some(a.void_area),
+            worst_layer: match (a.largest_void, a.largest_void_layer) {
+                (Some(v), Some(index)) => Some(WorstLayer {
+                    index,
+                    area: v.area,
+                }),
+                _ => None,
+            },
+            repairs: self.repairs(),
+        }
+    }
+
+    /// "Nothing to print": a finished slice without a single droplet (every wall thinner than
+    /// a droplet). The CLI writes no file and the page offers no download.
+    pub fn printable(&self, settings: &Settings) -> Result<(), Error> {
+        if self.counts.total() > 0 {
+            return Ok(());
+        }
+        Err(Error::NothingToPrint(format!(
+            "no droplet fits in the part: every wall is thinner than the droplet width B = {:.3} mm; scale the part up or use smaller droplets (layer_height, droplet_aspect)",
+            settings.droplet_width()
+        )))
+    }
+}
+
+impl PartAnalysis {
+    /// Adds the layers of another part analysis (disjoint layers), as if each of its layers
+    /// had been [`add`](PartAnalysis::add)ed here. Of equal largest voids (or deviations) the
+    /// lower layer wins, so the order of the merges does not matter.
+    pub fn merge(&mut self, o: &PartAnalysis) {
+        if o.layers == 0 {
+            return;
+        }
+        let covered = self.coverage * self.region_area + o.coverage * o.region_area;
+        self.layers += o.layers;
+        self.droplets += o.droplets;
+        self.region_area += o.region_area;
+        self.coverage = if self.region_area > 0.0 {
+            covered / self.region_area
+        } else {
+            0.0
+        };
+        self.void_area += o.void_area;
+        self.enclosed_void_area += o.enclosed_void_area;
+        self.overfill_area += o.overfill_area;
+        let better = |a: f64, ai: Option<usize>, b: f64, bi: Option<usize>| {
+            a > b || (a == b && ai.unwrap_or(usize::MAX) < bi.unwrap_or(usize::MAX))
+        };
+        if let Some(v) = o.largest_void
+            && self.largest_void.is_none_or(|mine| {
+                better(
+                    v.area,
+                    o.largest_void_layer,
+                    mine.area,
+                    self.largest_void_layer,
+                )
+            })
+        {
+            self.largest_void = Some(v);
+            self.largest_void_layer = o.largest_void_layer;
+        }
+        if o.max_deviation_layer.is_some()
+            && (self.max_deviation_layer.is_none()
+                || better(
+                    o.max_boundary_deviation,
+                    o.max_deviation_layer,
+                    self.max_boundary_deviation,
+                    self.max_deviation_layer,
+                ))
+        {
+            self.max_boundary_deviation = o.max_boundary_deviation;
+            self.max_deviation_layer = o.max_deviation_layer;
+        }
+        self.volume += o.volume;
+        self.void_volume += o.void_volume;
+        self.void_fraction = if self.volume > 0.0 {
+            self.void_volume / self.volume
+        } else {
+            0.0
+        };
+    }
+}
