@@ -44,10 +44,12 @@
 //! over those. Parts a metre apart take the memory each takes alone, and the figures are those
 //! of a dense grid: the same grid, its rows and runs visited in the same order.
 
+use crate::geom::{
+    DVec2, Point, Shapes, all_contours, dist, line_droplets, region_area, scanline_spans,
+};
 use crate::grid::{EdgeIndex, Row, Segment, Spot, Tiles};
-use crate::plan::{LayerPlan, MoveKind, line_droplets};
+use crate::plan::{LayerPlan, MoveKind};
 use crate::settings::{Footprint, Settings};
-use crate::slice::{Point, Shapes, dist, region_area, scanline_spans};
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -153,10 +155,10 @@ pub struct MaskTile {
 impl CoverageMask {
     /// Where tile `t`'s cell (0, 0) starts, in mm.
     pub fn tile_origin(&self, t: &MaskTile) -> Point {
-        [
+        DVec2::new(
             self.origin[0] + t.col as f64 * self.cell,
             self.origin[1] + t.row as f64 * self.cell,
-        ]
+        )
     }
 
     /// The shares [void, overfill, covered] of cell (col, row); zero outside the tiles.
@@ -183,18 +185,12 @@ impl CoverageMask {
 /// Every droplet centre of a layer (each droplet of a `G25` line too), in print order.
 pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
     let mut out = Vec::with_capacity(plan.counts.total() as usize);
-    let mut at: Point = [0.0, 0.0];
+    let mut at = Point::ZERO;
     for m in &plan.moves {
         match m.kind {
             MoveKind::Travel => {}
             MoveKind::Droplet => out.push(m.to),
-            MoveKind::Line => {
-                let l = dist(at, m.to);
-                for j in 0..line_droplets(l, b) {
-                    let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
-                    out.push([at[0] + t * (m.to[0] - at[0]), at[1] + t * (m.to[1] - at[1])]);
-                }
-            }
+            MoveKind::Line => out.extend(line_droplets(at, m.to, b)),
         }
         at = m.to;
     }
@@ -412,7 +408,7 @@ impl Raster {
         let gx = gy / COLS_PER_ROW;
         let mut min = [f64::INFINITY; 2];
         let mut max = [f64::NEG_INFINITY; 2];
-        for p in region.iter().flatten().flatten() {
+        for p in all_contours(region).flatten() {
             for k in 0..2 {
                 min[k] = min[k].min(p[k]);
                 max[k] = max[k].max(p[k]);
@@ -425,7 +421,7 @@ impl Raster {
             }
         }
         self.edges.clear();
-        for c in region.iter().flatten() {
+        for c in all_contours(region) {
             for i in 0..c.len() {
                 self.edges.push((c[i], c[(i + 1) % c.len()]));
             }
@@ -811,12 +807,12 @@ impl Raster {
                 let n = a.cells as f64;
                 largest = Some(Void {
                     area,
-                    centroid: [
+                    centroid: DVec2::new(
                         g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
                         g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
-                    ],
-                    min: [g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy],
-                    max: [g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy],
+                    ),
+                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
+                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
                     at_boundary: a.boundary,
                 });
             }
@@ -828,7 +824,7 @@ impl Raster {
         let probe = |best: &mut Deviation, k: usize, s: u32, e: u32| {
             let y = g.ry(k);
             for c in [s, (s + e - 1) / 2, e - 1] {
-                let p = [g.cx(c as usize), y];
+                let p = DVec2::new(g.cx(c as usize), y);
                 // The distance to the boundary changes no faster than the point moves: a point
                 // this close to the last one probed cannot beat the maximum.
                 if best.last_d + dist(p, best.last) <= best.max {
@@ -986,7 +982,7 @@ impl Raster {
             tile.covered = counts.iter().map(|c| share(c[2])).collect();
         }
         CoverageMask {
-            origin: [g.x0, g.y0],
+            origin: DVec2::new(g.x0, g.y0),
             cell: rows as f64 * g.gy,
             tiles: out,
         }
@@ -1007,7 +1003,7 @@ impl Default for Deviation {
         Deviation {
             max: 0.0,
             at: None,
-            last: [0.0; 2],
+            last: DVec2::ZERO,
             last_d: f64::INFINITY,
         }
     }
@@ -1271,7 +1267,7 @@ pub fn slab_voids(
     let half = h / 2.0;
     let mut ymin = f64::INFINITY;
     let mut ymax = f64::NEG_INFINITY;
-    for p in region.iter().flatten().flatten() {
+    for p in all_contours(region).flatten() {
         ymin = ymin.min(p[1]);
         ymax = ymax.max(p[1]);
     }
@@ -1418,7 +1414,7 @@ fn job_grid(job: &crate::Job) -> Grid3 {
     let d = footprint_diameter(s);
     let bounds = job.info().bounds;
     Grid3 {
-        origin: [bounds.min[0] - d, bounds.min[1] - d],
+        origin: DVec2::new(bounds.min[0] - d, bounds.min[1] - d),
         cell: s.droplet_width() / GRID3_PER_B,
     }
 }

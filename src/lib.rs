@@ -19,6 +19,7 @@ pub mod contours;
 pub mod droplets;
 pub mod error;
 pub mod gcode;
+pub mod geom;
 pub mod grid;
 pub mod hatch;
 pub mod mesh;
@@ -234,7 +235,7 @@ impl Job {
     }
 
     /// The closed loops of layer `i` before their union (for diagnostics).
-    pub fn section_loops(&self, i: usize) -> Vec<slice::Contour> {
+    pub fn section_loops(&self, i: usize) -> Vec<geom::Contour> {
         slice::section_loops(&self.mesh, self.buckets.layer(i), self.zs[i]).0
     }
 
@@ -245,7 +246,7 @@ impl Job {
 
     /// [`plan_layer`](Self::plan_layer) and the layer's region (its section), which the
     /// analysis needs.
-    pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, slice::Shapes) {
+    pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
         let section = self.section(i);
         let mut plan = plan::plan_layer(&section.region, i, &self.settings);
         plan.open_chains = section.open_chains;
@@ -296,7 +297,7 @@ fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f6
     let total: f64 = (0..samples)
         .map(|k| {
             let i = (2 * k + 1) * n / (2 * samples);
-            slice::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
+            geom::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
         })
         .sum();
     total / samples as f64 * n as f64 * h
@@ -401,7 +402,7 @@ pub fn write_gcode_with<W, S, T>(
     out: &mut W,
     mut progress: impl FnMut(usize, usize),
     init: impl Fn() -> S + Sync,
-    per_layer: impl Fn(&mut S, usize, &slice::Shapes, &LayerPlan) -> T + Sync,
+    per_layer: impl Fn(&mut S, usize, &geom::Shapes, &LayerPlan) -> T + Sync,
     mut ordered: impl FnMut(usize, T),
 ) -> Result<Summary, Error>
 where
