@@ -388,26 +388,74 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
     out: &mut W,
     progress: impl FnMut(usize, usize),
 ) -> Result<Summary, Error> {
-    write_gcode_with(job, out, progress, || (), |_, _, _, _| (), |_, _| {})
+    write_gcode_with(job, out, progress, &mut ())
 }
 
-/// [`write_gcode`] with a per-layer stage in the workers: `per_layer(state, i, region, plan)`
-/// runs on the worker that planned layer `i` (each worker has its own `state` from `init`),
-/// with the layer's region and its full plan, before the plan's moves are dropped; its result
-/// is handed to `ordered(i, result)` on the writing thread in ascending layer order, after
-/// the layer's text is written. The code written is the same as [`write_gcode`]'s.
+/// A stage that [`write_gcode_with`] runs on every layer: [`per_layer`](Self::per_layer) on
+/// the worker that planned the layer, with the layer's region and its full plan (before the
+/// plan's moves are dropped), then [`ordered`](Self::ordered) with its result on the writing
+/// thread, in ascending layer order, after the layer's text is written.
+pub trait LayerSink {
+    /// A worker's own state (one per worker, reused from layer to layer).
+    type State: Send;
+    /// What a layer hands from its worker to the writing thread.
+    type Out: Send;
+    /// A new worker's state (made on the writing thread before the workers start).
+    fn init(&self) -> Self::State;
+    /// On the worker that planned layer `i`.
+    fn per_layer(
+        state: &mut Self::State,
+        i: usize,
+        region: &geom::Shapes,
+        plan: &LayerPlan,
+    ) -> Self::Out;
+    /// On the writing thread, layer by layer in ascending order.
+    fn ordered(&mut self, i: usize, out: Self::Out);
+}
+
+/// No stage.
+impl LayerSink for () {
+    type State = ();
+    type Out = ();
+    fn init(&self) {}
+    fn per_layer(_: &mut (), _: usize, _: &geom::Shapes, _: &LayerPlan) {}
+    fn ordered(&mut self, _: usize, _: ()) {}
+}
+
+/// A stage or none (`--report` or not).
+impl<S: LayerSink> LayerSink for Option<S> {
+    type State = Option<S::State>;
+    type Out = Option<S::Out>;
+    fn init(&self) -> Self::State {
+        self.as_ref().map(S::init)
+    }
+    fn per_layer(
+        state: &mut Self::State,
+        i: usize,
+        region: &geom::Shapes,
+        plan: &LayerPlan,
+    ) -> Self::Out {
+        state.as_mut().map(|st| S::per_layer(st, i, region, plan))
+    }
+    fn ordered(&mut self, i: usize, out: Self::Out) {
+        if let (Some(s), Some(o)) = (self.as_mut(), out) {
+            s.ordered(i, o);
+        }
+    }
+}
+
+/// [`write_gcode`] with a [`LayerSink`] run on every layer. The code written is the same as
+/// [`write_gcode`]'s.
 #[cfg(not(target_arch = "wasm32"))]
-pub fn write_gcode_with<W, S, T>(
+pub fn write_gcode_with<W, K>(
     job: &Job,
     out: &mut W,
     mut progress: impl FnMut(usize, usize),
-    init: impl Fn() -> S + Sync,
-    per_layer: impl Fn(&mut S, usize, &geom::Shapes, &LayerPlan) -> T + Sync,
-    mut ordered: impl FnMut(usize, T),
+    sink: &mut K,
 ) -> Result<Summary, Error>
 where
     W: std::io::Write + ?Sized,
-    T: Send,
+    K: LayerSink,
 {
     use std::collections::BTreeMap;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -436,10 +484,11 @@ where
         layers: n,
         ..Summary::default()
     };
+    let states: Vec<K::State> = (0..threads).map(|_| sink.init()).collect();
     std::thread::scope(|scope| -> Result<(), Error> {
-        for _ in 0..threads {
-            scope.spawn(|| {
-                let mut state = init();
+        for mut state in states {
+            let (next, stop, shared, changed) = (&next, &stop, &shared, &changed);
+            scope.spawn(move || {
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     if i >= n {
@@ -457,7 +506,7 @@ where
                     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                         let (mut p, region) = job.plan_layer_and_region(i);
                         let text = gcode::layer_text(&p);
-                        let extra = per_layer(&mut state, i, &region, &p);
+                        let extra = K::per_layer(&mut state, i, &region, &p);
                         p.moves = Vec::new();
                         (text, p, extra)
                     }))
@@ -490,7 +539,7 @@ where
                     done.map_err(|m| Error::Internal(format!("layer {}: {m}", i + 1)))?;
                 out.write_all(text.as_bytes()).map_err(io)?;
                 summary.add(&plan);
-                ordered(i, extra);
+                sink.ordered(i, extra);
                 progress(i + 1, n);
             }
             Ok(())

@@ -271,19 +271,10 @@ fn staggered_hatch_ends_stay_inside_the_part_without_contours() {
 /// The job's report as `--report` makes it (each layer analysed in the slicing worker that
 /// planned it), and the code written meanwhile.
 fn report_of(job: &dropslice::Job) -> (dropslice::analysis::Report, Vec<u8>) {
-    use dropslice::analysis::{JobAnalysis, Raster};
+    use dropslice::analysis::JobAnalysis;
     let mut analysis = JobAnalysis::new(job);
-    let stage = analysis.stage();
     let mut code = Vec::new();
-    dropslice::write_gcode_with(
-        job,
-        &mut code,
-        |_, _| {},
-        Raster::empty,
-        |raster, _, region, plan| stage.analyse(raster, region, plan),
-        |_, layer| analysis.push(layer),
-    )
-    .unwrap();
+    dropslice::write_gcode_with(job, &mut code, |_, _| {}, &mut analysis).unwrap();
     (analysis.finish(), code)
 }
 
