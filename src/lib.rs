@@ -19,6 +19,7 @@ pub mod contours;
 pub mod droplets;
 pub mod error;
 pub mod gcode;
+pub mod gcode_read;
 pub mod geom;
 pub mod grid;
 pub mod hatch;
