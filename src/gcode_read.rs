@@ -94,7 +94,7 @@ fn grouped(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i) % 3 == 0 {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
             out.push(',');
         }
         out.push(c);
@@ -215,7 +215,7 @@ impl GcodeReader {
                 )));
             }
         };
-        if !(self.width > 0.0) {
+        if self.width.is_nan() || self.width <= 0.0 {
             return Err(GcodeError(
                 "the header does not give the droplet size (lines '; layer_height = …' and '; droplet_aspect = …' are needed before the first command)".into(),
             ));
@@ -270,7 +270,7 @@ impl GcodeReader {
         let n: u64 = match code.as_str() {
             "G25" => {
                 let n = (len / self.width + 1e-9).floor() + 1.0;
-                if !(self.droplets as f64 + n <= MAX_DROPLETS as f64) {
+                if n.is_nan() || self.droplets as f64 + n > MAX_DROPLETS as f64 {
                     return Err(if n > MAX_DROPLETS as f64 / 10.0 || !n.is_finite() {
                         GcodeError(format!(
                             "line {no}: a G25 of {} mm would expand to {} droplets (one every {} mm); this viewer expands at most {} droplets per file",
@@ -367,7 +367,7 @@ impl GcodeReader {
         if let Some((max, unit)) = header_max(name) {
             // The droplet size decides how many droplets a G25 line holds: only the core's range.
             let v: f64 = value.parse().unwrap_or(f64::NAN);
-            if !(v > 0.0 && v <= max) {
+            if v.is_nan() || v <= 0.0 || v > max {
                 let unit = if unit.is_empty() {
                     String::new()
                 } else {

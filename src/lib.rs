@@ -32,6 +32,8 @@ pub mod slice;
 pub mod stl;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
+#[cfg(target_arch = "wasm32")]
+mod wasm_gcode;
 
 pub use error::Error;
 pub use gcode::Summary;
