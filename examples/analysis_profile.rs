@@ -12,7 +12,7 @@ fn main() {
     let mut nvoids = 0;
     let bounds = job.info().bounds;
     let grid = Grid3 {
-        origin: [bounds.min[0] - b, bounds.min[1] - b],
+        origin: [bounds.min[0] - b, bounds.min[1] - b].into(),
         cell: b / GRID3_PER_B,
     };
     for i in 0..job.layer_count() {

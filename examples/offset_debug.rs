@@ -1,6 +1,6 @@
 //! Finds offset loop vertices closer to the section boundary than the loop's offset:
 //! `cargo run --release --example offset_debug -- MODEL.stl LAYER`.
-use dropslice::slice::segment_distance as seg_dist;
+use dropslice::geom::segment_distance as seg_dist;
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
@@ -20,9 +20,7 @@ fn main() {
         for l in &c.loops {
             let want = (0.5 + l.k as f64) * b;
             for (j, p) in l.points.iter().enumerate() {
-                let d = region
-                    .iter()
-                    .flatten()
+                let d = dropslice::geom::all_contours(&region)
                     .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
                     .map(|(x, y)| seg_dist(*p, x, y))
                     .fold(f64::INFINITY, f64::min);

@@ -1,6 +1,6 @@
 //! Coverage and void figures with stagger off and on, and the analysis time against slicing:
 //! `cargo run --release --example quality -- MODEL.stl...` (the figures of docs/quality.md).
-use dropslice::analysis::{JobAnalysis, Raster};
+use dropslice::analysis::JobAnalysis;
 use dropslice::{Job, Settings, write_gcode, write_gcode_with};
 use std::time::Instant;
 
@@ -29,16 +29,8 @@ fn main() {
             // As `--report` does it: each layer analysed by the worker that planned it.
             let t = Instant::now();
             let mut analysis = JobAnalysis::new(&job);
-            let stage = analysis.stage();
-            write_gcode_with(
-                &job,
-                &mut std::io::sink(),
-                |_, _| {},
-                Raster::empty,
-                |raster, _, region, plan| stage.analyse(raster, region, plan),
-                |_, layer| analysis.push(layer),
-            )
-            .expect("slice and analyse");
+            write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis)
+                .expect("slice and analyse");
             let r = analysis.finish();
             let with_analysis = t.elapsed().as_secs_f64();
             let p = &r.part;

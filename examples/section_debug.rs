@@ -9,9 +9,9 @@ fn main() {
         println!(
             "layer {i} z={} area={:.3} shapes={} holes={} closed={} reoriented={} open={} gap={:.3}",
             s.z,
-            dropslice::slice::region_area(&s.region),
+            dropslice::geom::region_area(&s.region),
             s.region.len(),
-            s.region.iter().map(|x| x.len() - 1).sum::<usize>(),
+            s.region.iter().map(|x| x.holes.len()).sum::<usize>(),
             s.closed_loops,
             s.reoriented_loops,
             s.open_chains,
@@ -19,7 +19,7 @@ fn main() {
         );
         if std::env::var_os("LOOPS").is_some() {
             for c in job.section_loops(i) {
-                let a = dropslice::slice::signed_area(&c);
+                let a = dropslice::geom::signed_area(&c);
                 println!("  loop n={} signed_area={a:.3} first={:?}", c.len(), c[0]);
             }
         }

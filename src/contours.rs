@@ -6,9 +6,9 @@
 //! by d_fill = d_(contours−1) + (1 − `fill_overlap`)·B (never less than 0: no fill droplet
 //! centre lies outside the part).
 
+use crate::geom::{Contour, Shapes};
 use crate::offset::{CHORD_TOLERANCE_MM, inset_within};
 use crate::settings::Settings;
-use crate::slice::{Contour, Shapes};
 
 /// One closed contour loop, in print direction (material on the left: outer loops
 /// counter-clockwise, loops around holes clockwise).
@@ -68,10 +68,10 @@ pub fn contours(region: &Shapes, s: &Settings) -> LayerContours {
             _ => inset_within(region, d.0, d.1, tolerance),
         };
         for shape in &shapes {
-            for (i, points) in shape.iter().enumerate() {
+            for (hole, points) in shape.contours_with_hole() {
                 loops.push(Loop {
                     k,
-                    hole: i > 0,
+                    hole,
                     points: points.clone(),
                 });
             }

@@ -4,7 +4,7 @@
 //! after the loop's canonical start, its lowest point (then leftmost), so each layer's seam
 //! moves on by `start_jitter`. With `close`, the first droplet is repeated at the end.
 
-use crate::slice::{Point, dist};
+use crate::geom::{DVec2, Point, dist};
 
 /// Droplet centres along a closed loop.
 pub fn loop_droplets(points: &[Point], b: f64, shift: f64, close: bool) -> Vec<Point> {
@@ -56,7 +56,7 @@ fn unrolled(points: &[Point], shift: f64) -> Vec<Point> {
         let l = dist(p, q);
         if rest < l {
             let t = rest / l;
-            start = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+            start = DVec2::new(p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]));
             break;
         }
         rest -= l;
@@ -74,8 +74,7 @@ fn unrolled(points: &[Point], shift: f64) -> Vec<Point> {
 
 /// Where the segment p→q leaves the circle of radius `r` around `c`, if it does; p is inside.
 fn circle_exit(p: Point, q: Point, c: Point, r: f64) -> Option<Point> {
-    let d = [q[0] - p[0], q[1] - p[1]];
-    let f = [p[0] - c[0], p[1] - c[1]];
+    let (d, f) = (q - p, p - c);
     let a = d[0] * d[0] + d[1] * d[1];
     if a == 0.0 {
         return None;
@@ -96,7 +95,7 @@ fn circle_exit(p: Point, q: Point, c: Point, r: f64) -> Option<Point> {
     let t = if bq >= 0.0 && bq + sq == 0.0 { 0.0 } else { t };
     (0.0..=1.0)
         .contains(&t)
-        .then(|| [p[0] + t * d[0], p[1] + t * d[1]])
+        .then(|| DVec2::new(p[0] + t * d[0], p[1] + t * d[1]))
 }
 
 #[cfg(test)]
@@ -105,7 +104,9 @@ mod tests {
 
     #[test]
     fn square_loop_spacing() {
-        let sq = vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]];
+        let sq: Vec<Point> = [[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [0.0, 10.0]]
+            .map(Point::from)
+            .into();
         let b = 0.208;
         for shift in [0.0, 0.07, 3.3, 41.0] {
             let d = loop_droplets(&sq, b, shift, true);
@@ -121,7 +122,9 @@ mod tests {
 
     #[test]
     fn tiny_loop_gets_one_droplet() {
-        let tri = vec![[0.0, 0.0], [0.05, 0.0], [0.0, 0.05]];
+        let tri: Vec<Point> = [[0.0, 0.0], [0.05, 0.0], [0.0, 0.05]]
+            .map(Point::from)
+            .into();
         assert_eq!(loop_droplets(&tri, 0.2, 0.0, true).len(), 1);
     }
 }

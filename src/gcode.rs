@@ -4,6 +4,7 @@
 //! written before any layer, with fixed-width placeholders for the droplet counts that
 //! [`header`] fills in once the slice is done (same length, so a file can be patched in place).
 
+use crate::geom::{OUTPUT_DECIMALS, OUTPUT_SCALE, OUTPUT_SCALE_INT};
 use crate::plan::{LayerPlan, MoveKind};
 use crate::settings::Settings;
 pub use crate::summary::Summary;
@@ -23,19 +24,21 @@ pub struct HeaderInput<'a> {
 /// Width of the droplet count fields in the header.
 const COUNT_WIDTH: usize = 12;
 
-/// `x` with 4 decimals, never `-0.0000`.
+/// `x` with [`OUTPUT_DECIMALS`] (4) decimals, never `-0.0000`.
 pub fn coord(x: f64) -> String {
     let mut s = String::with_capacity(12);
     push_coord(&mut s, x);
     s
 }
 
-/// Appends `x` rounded to 4 decimals (half away from zero), never `-0.0000`. Much faster
-/// than `format!("{x:.4}")`, which matters for files with millions of droplets.
+/// Appends `x` rounded to [`OUTPUT_DECIMALS`] (4) decimals (half away from zero), never
+/// `-0.0000`. Much faster than `format!("{x:.4}")`, which matters for files with millions of
+/// droplets.
 pub fn push_coord(out: &mut String, x: f64) {
-    let v = (x * 10_000.0).round();
+    const _: () = assert!(OUTPUT_DECIMALS == 4, "push_coord writes 4 digits");
+    let v = (x * OUTPUT_SCALE).round();
     if !v.is_finite() || v.abs() >= 1e15 {
-        let _ = write!(out, "{x:.4}");
+        let _ = write!(out, "{x:.OUTPUT_DECIMALS$}");
         return;
     }
     let v = v as i64;
@@ -43,7 +46,7 @@ pub fn push_coord(out: &mut String, x: f64) {
         out.push('-');
     }
     let v = v.unsigned_abs();
-    let (int, frac) = (v / 10_000, v % 10_000);
+    let (int, frac) = (v / OUTPUT_SCALE_INT, v % OUTPUT_SCALE_INT);
     let _ = write!(out, "{int}.");
     let digits = [frac / 1000, frac / 100 % 10, frac / 10 % 10, frac % 10];
     for d in digits {

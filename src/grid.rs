@@ -1,6 +1,6 @@
 //! Uniform-grid helpers shared by the spatial indexes (hatch ordering, boundary distances).
 
-use crate::slice::{Point, segment_distance2};
+use crate::geom::{Point, segment_distance2};
 
 /// The cells (x, y) at Chebyshev distance exactly `r` from (cx, cy) that lie inside an
 /// `nx` × `ny` grid: the ring searched in step `r` of a nearest-neighbour search.
@@ -83,7 +83,7 @@ impl<'a> EdgeIndex<'a> {
         });
         EdgeIndex {
             edges,
-            min,
+            min: min.into(),
             cell,
             nx,
             ny,

@@ -7,8 +7,8 @@
 //! layers use (j + 0)·spacing instead (see [`crate::plan::hatch_shifted`]).
 
 use crate::grid::ring_cells;
-use crate::mesh::sin_cos_deg;
-use crate::slice::{Point, Shapes, dist, scanline_spans};
+
+use crate::geom::{DVec2, Point, Shapes, dist, scanline_spans, sin_cos_deg};
 
 /// One hatch segment: a `G25` line from `a` to `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,8 +39,8 @@ pub fn hatch_at(
 ) -> Vec<HatchLine> {
     let (s, c) = sin_cos_deg(angle_deg);
     // Into the hatch frame (rotate by −angle): the lines become horizontal.
-    let to = |p: Point| [c * p[0] + s * p[1], -s * p[0] + c * p[1]];
-    let back = |p: Point| [c * p[0] - s * p[1], s * p[0] + c * p[1]];
+    let to = |p: Point| DVec2::new(c * p[0] + s * p[1], -s * p[0] + c * p[1]);
+    let back = |p: Point| DVec2::new(c * p[0] - s * p[1], s * p[0] + c * p[1]);
     let mut lines = Vec::new();
     scanline_spans(
         region,
@@ -70,8 +70,8 @@ pub fn hatch_at(
                 }
             }
             lines.push(HatchLine {
-                a: back([x0, y]),
-                b: back([x1, y]),
+                a: back(DVec2::new(x0, y)),
+                b: back(DVec2::new(x1, y)),
             });
         },
     );
@@ -113,8 +113,8 @@ struct EndGrid {
 impl EndGrid {
     fn new(lines: &[HatchLine]) -> EndGrid {
         let ends: Vec<Point> = lines.iter().flat_map(|l| [l.a, l.b]).collect();
-        let mut min = [f64::INFINITY; 2];
-        let mut max = [f64::NEG_INFINITY; 2];
+        let mut min = DVec2::INFINITY;
+        let mut max = DVec2::NEG_INFINITY;
         for p in &ends {
             for k in 0..2 {
                 min[k] = min[k].min(p[k]);
@@ -195,7 +195,10 @@ mod tests {
     use super::*;
 
     fn square(a: f64) -> Shapes {
-        vec![vec![vec![[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]]]]
+        let outer = [[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]]
+            .map(Point::from)
+            .into();
+        vec![crate::geom::Shape::new(outer, vec![])]
     }
 
     #[test]
@@ -214,7 +217,7 @@ mod tests {
         // Area / spacing.
         assert!((total - 200.0).abs() < 1.0, "{total}");
         // From the corner where the 45° lines begin, greedy sweeps to the opposite corner.
-        let ordered = order_greedy(lines.clone(), [0.0, 10.0]);
+        let ordered = order_greedy(lines.clone(), DVec2::new(0.0, 10.0));
         assert_eq!(ordered.len(), lines.len());
         // Each next segment starts at the nearest remaining end: consecutive lines are neighbours.
         for w in ordered.windows(2) {

@@ -19,6 +19,8 @@ pub mod contours;
 pub mod droplets;
 pub mod error;
 pub mod gcode;
+pub mod gcode_read;
+pub mod geom;
 pub mod grid;
 pub mod hatch;
 pub mod import;
@@ -32,6 +34,8 @@ pub mod stl;
 pub mod summary;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
+#[cfg(target_arch = "wasm32")]
+mod wasm_gcode;
 
 pub use error::Error;
 pub use settings::Settings;
@@ -212,7 +216,7 @@ impl Job {
     }
 
     /// The closed loops of layer `i` before their union (for diagnostics).
-    pub fn section_loops(&self, i: usize) -> Vec<slice::Contour> {
+    pub fn section_loops(&self, i: usize) -> Vec<geom::Contour> {
         slice::section_loops(&self.mesh, self.buckets.layer(i), self.zs[i]).0
     }
 
@@ -223,7 +227,7 @@ impl Job {
 
     /// [`plan_layer`](Self::plan_layer) and the layer's region (its section), which the
     /// analysis needs.
-    pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, slice::Shapes) {
+    pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
         let section = self.section(i);
         let mut plan = plan::plan_layer(&section.region, i, &self.settings);
         plan.open_chains = section.open_chains;
@@ -409,7 +413,7 @@ fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f6
     let total: f64 = (0..samples)
         .map(|k| {
             let i = (2 * k + 1) * n / (2 * samples);
-            slice::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
+            geom::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
         })
         .sum();
     total / samples as f64 * n as f64 * h
@@ -500,26 +504,74 @@ pub fn write_gcode<W: std::io::Write + ?Sized>(
     out: &mut W,
     progress: impl FnMut(usize, usize),
 ) -> Result<Summary, Error> {
-    write_gcode_with(job, out, progress, || (), |_, _, _, _| (), |_, _| {})
+    write_gcode_with(job, out, progress, &mut ())
 }
 
-/// [`write_gcode`] with a per-layer stage in the workers: `per_layer(state, i, region, plan)`
-/// runs on the worker that planned layer `i` (each worker has its own `state` from `init`),
-/// with the layer's region and its full plan, before the plan's moves are dropped; its result
-/// is handed to `ordered(i, result)` on the writing thread in ascending layer order, after
-/// the layer's text is written. The code written is the same as [`write_gcode`]'s.
+/// A stage that [`write_gcode_with`] runs on every layer: [`per_layer`](Self::per_layer) on
+/// the worker that planned the layer, with the layer's region and its full plan (before the
+/// plan's moves are dropped), then [`ordered`](Self::ordered) with its result on the writing
+/// thread, in ascending layer order, after the layer's text is written.
+pub trait LayerSink {
+    /// A worker's own state (one per worker, reused from layer to layer).
+    type State: Send;
+    /// What a layer hands from its worker to the writing thread.
+    type Out: Send;
+    /// A new worker's state (made on the writing thread before the workers start).
+    fn init(&self) -> Self::State;
+    /// On the worker that planned layer `i`.
+    fn per_layer(
+        state: &mut Self::State,
+        i: usize,
+        region: &geom::Shapes,
+        plan: &LayerPlan,
+    ) -> Self::Out;
+    /// On the writing thread, layer by layer in ascending order.
+    fn ordered(&mut self, i: usize, out: Self::Out);
+}
+
+/// No stage.
+impl LayerSink for () {
+    type State = ();
+    type Out = ();
+    fn init(&self) {}
+    fn per_layer(_: &mut (), _: usize, _: &geom::Shapes, _: &LayerPlan) {}
+    fn ordered(&mut self, _: usize, _: ()) {}
+}
+
+/// A stage or none (`--report` or not).
+impl<S: LayerSink> LayerSink for Option<S> {
+    type State = Option<S::State>;
+    type Out = Option<S::Out>;
+    fn init(&self) -> Self::State {
+        self.as_ref().map(S::init)
+    }
+    fn per_layer(
+        state: &mut Self::State,
+        i: usize,
+        region: &geom::Shapes,
+        plan: &LayerPlan,
+    ) -> Self::Out {
+        state.as_mut().map(|st| S::per_layer(st, i, region, plan))
+    }
+    fn ordered(&mut self, i: usize, out: Self::Out) {
+        if let (Some(s), Some(o)) = (self.as_mut(), out) {
+            s.ordered(i, o);
+        }
+    }
+}
+
+/// [`write_gcode`] with a [`LayerSink`] run on every layer. The code written is the same as
+/// [`write_gcode`]'s.
 #[cfg(not(target_arch = "wasm32"))]
-pub fn write_gcode_with<W, S, T>(
+pub fn write_gcode_with<W, K>(
     job: &Job,
     out: &mut W,
     mut progress: impl FnMut(usize, usize),
-    init: impl Fn() -> S + Sync,
-    per_layer: impl Fn(&mut S, usize, &slice::Shapes, &LayerPlan) -> T + Sync,
-    mut ordered: impl FnMut(usize, T),
+    sink: &mut K,
 ) -> Result<Summary, Error>
 where
     W: std::io::Write + ?Sized,
-    T: Send,
+    K: LayerSink,
 {
     use std::collections::BTreeMap;
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -545,10 +597,11 @@ where
     });
     let changed = Condvar::new();
     let mut summary = Summary::default();
+    let states: Vec<K::State> = (0..threads).map(|_| sink.init()).collect();
     std::thread::scope(|scope| -> Result<(), Error> {
-        for _ in 0..threads {
-            scope.spawn(|| {
-                let mut state = init();
+        for mut state in states {
+            let (next, stop, shared, changed) = (&next, &stop, &shared, &changed);
+            scope.spawn(move || {
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     if i >= n {
@@ -566,7 +619,7 @@ where
                     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                         let (mut p, region) = job.plan_layer_and_region(i);
                         let text = gcode::layer_text(&p);
-                        let extra = per_layer(&mut state, i, &region, &p);
+                        let extra = K::per_layer(&mut state, i, &region, &p);
                         p.moves = Vec::new();
                         (text, p, extra)
                     }))
@@ -599,7 +652,7 @@ where
                     done.map_err(|m| Error::Internal(format!("layer {}: {m}", i + 1)))?;
                 out.write_all(text.as_bytes()).map_err(io)?;
                 summary.add(&plan);
-                ordered(i, extra);
+                sink.ordered(i, extra);
                 progress(i + 1, n);
             }
             Ok(())

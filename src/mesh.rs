@@ -2,6 +2,7 @@
 //! transforms (SPEC.md: rotate, scale, bounding box minimum to the origin, placement) and its
 //! diagnostics (open and non-manifold edges).
 
+use crate::geom::{DMat3, DVec3, sin_cos_deg};
 use crate::settings::Settings;
 use crate::stl::Triangles;
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
@@ -125,21 +126,17 @@ impl Mesh {
     /// bounding box minimum to the origin, then rotate by `place_angle` about the z axis
     /// through the origin and move by (`place_x`, `place_y`).
     pub fn transform(&mut self, s: &Settings) {
-        let r = mat_mul(
-            rot(2, s.rotate_z),
-            mat_mul(rot(1, s.rotate_y), rot(0, s.rotate_x)),
-        );
-        let scale = [s.scale_x, s.scale_y, s.scale_z];
+        let r = rot(2, s.rotate_z) * (rot(1, s.rotate_y) * rot(0, s.rotate_x));
+        let scale = DVec3::new(s.scale_x, s.scale_y, s.scale_z);
         for v in &mut self.vertices {
-            let p = apply(&r, *v);
-            *v = [0, 1, 2].map(|k| p[k] * scale[k]);
+            *v = (r * DVec3::from(*v) * scale).to_array();
         }
         let b = self.bounds();
         let place = rot(2, s.place_angle);
+        let min = DVec3::from(b.min);
         for v in &mut self.vertices {
-            let p = [v[0] - b.min[0], v[1] - b.min[1], v[2] - b.min[2]];
-            let q = apply(&place, p);
-            *v = [q[0] + s.place_x, q[1] + s.place_y, q[2]];
+            let q = place * (DVec3::from(*v) - min);
+            *v = [q.x + s.place_x, q.y + s.place_y, q.z];
         }
     }
 
@@ -517,8 +514,6 @@ pub fn edge_key(a: u32, b: u32) -> u64 {
     ((lo as u64) << 32) | hi as u64
 }
 
-type Mat = [[f64; 3]; 3];
-
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -536,45 +531,17 @@ fn norm(a: [f64; 3]) -> f64 {
 }
 
 /// Rotation about axis `axis` (0 x, 1 y, 2 z) by `deg` degrees; exact for multiples of 90°.
-fn rot(axis: usize, deg: f64) -> Mat {
+fn rot(axis: usize, deg: f64) -> DMat3 {
     let (s, c) = sin_cos_deg(deg);
     let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    // Rows, then transposed into glam's columns.
     let mut m = [[0.0; 3]; 3];
     m[axis][axis] = 1.0;
     m[i][i] = c;
     m[j][j] = c;
     m[i][j] = -s;
     m[j][i] = s;
-    m
-}
-
-/// sin and cos of an angle in degrees, exact at multiples of 90°.
-pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
-    let q = deg / 90.0;
-    if q == q.round() {
-        match (q.round() as i64).rem_euclid(4) {
-            0 => (0.0, 1.0),
-            1 => (1.0, 0.0),
-            2 => (0.0, -1.0),
-            _ => (-1.0, 0.0),
-        }
-    } else {
-        deg.to_radians().sin_cos()
-    }
-}
-
-fn mat_mul(a: Mat, b: Mat) -> Mat {
-    let mut m = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    m
-}
-
-fn apply(m: &Mat, v: [f64; 3]) -> [f64; 3] {
-    [0, 1, 2].map(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+    DMat3::from_cols_array_2d(&m).transpose()
 }
 
 #[cfg(test)]

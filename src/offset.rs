@@ -9,8 +9,11 @@
 //! no farther than [`CHORD_TOLERANCE_MM`] from the true arc. `tests/offset.rs` compares the
 //! result with i_overlay's own outline offset on every layer of the shared models.
 
+use crate::geom::{
+    Contour, DVec2, Point, Shape, Shapes, all_contours, dist, segment_distance2, signed_area,
+    to_overlay,
+};
 use crate::grid::EdgeIndex;
-use crate::slice::{Contour, Point, Shapes, dist, segment_distance2, signed_area};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::float::simplify::SimplifyShape;
 
@@ -55,8 +58,8 @@ pub fn inset_within(region: &Shapes, d_outer: f64, d_hole: f64, tolerance: f64) 
     let mut edges = Vec::new();
     let mut limit = Vec::new();
     for shape in region {
-        for (i, c) in shape.iter().enumerate() {
-            let d = (if i == 0 { d_outer } else { d_hole } - 2.0 * CHORD_TOLERANCE_MM).max(0.0);
+        for (hole, c) in shape.contours_with_hole() {
+            let d = (if hole { d_hole } else { d_outer } - 2.0 * CHORD_TOLERANCE_MM).max(0.0);
             for k in 0..c.len() {
                 edges.push((c[k], c[(k + 1) % c.len()]));
                 limit.push(d * d);
@@ -72,7 +75,7 @@ pub fn inset_within(region: &Shapes, d_outer: f64, d_hole: f64, tolerance: f64) 
         })
     };
     let fast = inset_with(region, d_outer, d_hole, tolerance, Corners::Miter);
-    if fast.iter().flatten().flatten().all(|&p| keeps(p)) {
+    if all_contours(&fast).flatten().all(|&p| keeps(p)) {
         fast
     } else {
         inset_with(region, d_outer, d_hole, tolerance, Corners::ThroughVertex)
@@ -89,25 +92,28 @@ pub fn inset_with(
 ) -> Shapes {
     let mut raw: Vec<Contour> = Vec::new();
     for shape in region {
-        for (i, c) in shape.iter().enumerate() {
-            let d = if i == 0 { d_outer } else { d_hole };
+        for (hole, c) in shape.contours_with_hole() {
+            let d = if hole { d_hole } else { d_outer };
             let r = raw_offset(c, d, tolerance, corners);
             if r.len() >= 3 {
                 raw.push(r);
             }
         }
     }
-    raw.simplify_shape(FillRule::Positive)
+    to_overlay(&raw)
+        .simplify_shape(FillRule::Positive)
         .into_iter()
         .filter_map(|shape| {
-            let mut contours = shape.into_iter().map(remove_spikes);
+            let mut contours = shape
+                .into_iter()
+                .map(crate::geom::contour_from_overlay)
+                .map(remove_spikes);
             // The outer boundary decides whether the shape survives; holes that collapse go.
             let outer = contours
                 .next()
                 .filter(|c| signed_area(c).abs() >= MIN_AREA_MM2)?;
-            let mut shape = vec![outer];
-            shape.extend(contours.filter(|c| signed_area(c).abs() >= MIN_AREA_MM2));
-            Some(shape)
+            let holes = contours.filter(|c| signed_area(c).abs() >= MIN_AREA_MM2);
+            Some(Shape::new(outer, holes.collect()))
         })
         .collect()
 }
@@ -137,7 +143,7 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
         .map(|i| {
             let (p, q) = (pts[i], pts[(i + 1) % n]);
             let len = dist(p, q);
-            ([(q[0] - p[0]) / len, (q[1] - p[1]) / len], len)
+            (DVec2::new((q[0] - p[0]) / len, (q[1] - p[1]) / len), len)
         })
         .collect();
     // Chord step of the arcs: d·(1 − cos(step/2)) = tolerance.
@@ -151,17 +157,17 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
         let (t0, l0) = edges[(i + n - 1) % n];
         let (t1, l1) = edges[i];
         let p = pts[i];
-        let n0 = [-t0[1], t0[0]];
-        let n1 = [-t1[1], t1[0]];
-        let a = [p[0] + d * n0[0], p[1] + d * n0[1]];
-        let b = [p[0] + d * n1[0], p[1] + d * n1[1]];
+        let n0 = DVec2::new(-t0[1], t0[0]);
+        let n1 = DVec2::new(-t1[1], t1[0]);
+        let a = DVec2::new(p[0] + d * n0[0], p[1] + d * n0[1]);
+        let b = DVec2::new(p[0] + d * n1[0], p[1] + d * n1[1]);
         let turn = (t0[0] * t1[1] - t0[1] * t1[0]).atan2(t0[0] * t1[0] + t0[1] * t1[1]);
         if turn >= 0.0 {
             // Convex corner (or straight on): the moved edges cross d·tan(turn/2) back along
             // each of them, at the mitre point.
             let back = d * (0.5 * turn).tan();
             let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
-            let m = [p[0] + k * (n0[0] + n1[0]), p[1] + k * (n0[1] + n1[1])];
+            let m = DVec2::new(p[0] + k * (n0[0] + n1[0]), p[1] + k * (n0[1] + n1[1]));
             if corners == Corners::Miter && back <= l0 && back <= l1 && turn < MAX_MITER_TURN {
                 out.push(m);
             } else if turn == 0.0 {
@@ -174,7 +180,10 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
             // within the tolerance outside the arc: that one point, not the arc's two ends
             // (which would double the vertices of a curve at every offset of a chain).
             let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
-            out.push([p[0] + k * (n0[0] + n1[0]), p[1] + k * (n0[1] + n1[1])]);
+            out.push(DVec2::new(
+                p[0] + k * (n0[0] + n1[0]),
+                p[1] + k * (n0[1] + n1[1]),
+            ));
         } else {
             // Reflex corner: the arc around p from a to b, turning clockwise by |turn|.
             out.push(a);
@@ -182,7 +191,7 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
             let start = n0[1].atan2(n0[0]);
             for k in 1..parts {
                 let ang = start + turn * k as f64 / parts as f64;
-                out.push([p[0] + d * ang.cos(), p[1] + d * ang.sin()]);
+                out.push(DVec2::new(p[0] + d * ang.cos(), p[1] + d * ang.sin()));
             }
             out.push(b);
         }

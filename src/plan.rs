@@ -3,9 +3,9 @@
 
 use crate::contours::{Loop, contours};
 use crate::droplets::loop_droplets;
+use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
 use crate::hatch::{hatch_at, order_greedy};
 use crate::settings::{ContourOrder, PrintOrder, Settings};
-use crate::slice::{Point, Shapes, dist};
 use serde::{Deserialize, Serialize};
 
 /// What a move does (the machine command it becomes).
@@ -75,11 +75,6 @@ pub struct LayerPlan {
     pub reoriented_loops: usize,
 }
 
-/// Number of droplets a `G25` line of this length sets: one at its start, then one every B.
-pub fn line_droplets(length: f64, b: f64) -> u64 {
-    (length / b + 1e-9).floor() as u64 + 1
-}
-
 /// Hatch angle of a layer (from 0): α_s + index·α_v.
 pub fn hatch_angle(s: &Settings, index: usize) -> f64 {
     (s.hatch_angle + index as f64 * s.hatch_angle_step).rem_euclid(360.0)
@@ -147,7 +142,7 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
         z: (index + 1) as f64 * s.layer_height,
         ..LayerPlan::default()
     };
-    let mut at: Point = [0.0, 0.0];
+    let mut at = Point::ZERO;
     let add_contours = |plan: &mut LayerPlan, at: &mut Point| {
         let mut loops: Vec<&Loop> = layer.loops.iter().collect();
         loops.sort_by_key(|l| match s.contour_order {
@@ -223,9 +218,9 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
             add_contours(&mut plan, &mut at);
         }
     }
-    // Positions as written (4 decimals), so counts, previews and the code agree exactly.
+    // Positions as written, so counts, previews and the code agree exactly.
     for m in &mut plan.moves {
-        m.to = m.to.map(|v| (v * 10_000.0).round() / 10_000.0);
+        m.to = round_output(m.to);
     }
     plan.counts = count(&plan.moves, b);
     plan
@@ -234,12 +229,12 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
 /// Droplet counts of a move list.
 pub fn count(moves: &[Move], b: f64) -> Counts {
     let mut c = Counts::default();
-    let mut at = [0.0, 0.0];
+    let mut at = DVec2::ZERO;
     for m in moves {
         let n = match m.kind {
             MoveKind::Travel => 0,
             MoveKind::Droplet => 1,
-            MoveKind::Line => line_droplets(dist(at, m.to), b),
+            MoveKind::Line => line_droplet_count(dist(at, m.to), b),
         };
         match m.role {
             Role::Outer => c.outer += n,

@@ -1,7 +1,7 @@
 //! Preview: a [`LayerPlan`] → flat arrays for the page's canvas (no object per point).
 
-use crate::plan::{LayerPlan, MoveKind, line_droplets};
-use crate::slice::dist;
+use crate::geom::{DVec2, dist, line_droplets};
+use crate::plan::{LayerPlan, MoveKind};
 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PreviewLayer {
@@ -21,7 +21,7 @@ impl PreviewLayer {
             roles: Vec::with_capacity(n),
             travel: Vec::new(),
         };
-        let mut at = [0.0f64, 0.0];
+        let mut at = DVec2::ZERO;
         for m in &plan.moves {
             match m.kind {
                 MoveKind::Travel | MoveKind::Droplet => {
@@ -35,14 +35,8 @@ impl PreviewLayer {
                     }
                 }
                 MoveKind::Line => {
-                    let l = dist(at, m.to);
-                    let k = line_droplets(l, b);
-                    for j in 0..k {
-                        let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
-                        p.droplets.extend(
-                            [at[0] + t * (m.to[0] - at[0]), at[1] + t * (m.to[1] - at[1])]
-                                .map(|v| v as f32),
-                        );
+                    for d in line_droplets(at, m.to, b) {
+                        p.droplets.extend([d.x as f32, d.y as f32]);
                         p.roles.push(m.role as u8);
                     }
                 }

@@ -17,18 +17,13 @@
 //! - Overlapping shells are merged with the non-zero fill rule (their union), as PrusaSlicer
 //!   and CuraEngine do.
 
+use crate::geom::{
+    Contour, DVec2, Point, Shapes, dist, shapes_from_overlay, signed_area, to_overlay,
+};
 use crate::mesh::{Mesh, edge_key};
 use crate::settings::SlicePlane;
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::float::simplify::SimplifyShape;
-
-pub type Point = [f64; 2];
-/// A closed polygon (the last point connects to the first).
-pub type Contour = Vec<Point>;
-/// A shape: its outer boundary (counter-clockwise) followed by its holes (clockwise).
-pub type Shape = Vec<Contour>;
-/// A region of one layer: disjoint shapes.
-pub type Shapes = Vec<Shape>;
 
 /// Points closer than this to their predecessor on a loop are dropped (SPEC.md 5.3.2).
 pub const MIN_POINT_DISTANCE_MM: f64 = 0.001;
@@ -179,9 +174,11 @@ pub fn section_loops(mesh: &Mesh, facets: &[u32], z: f64) -> (Vec<Contour>, Sect
 /// (counter-clockwise: material; clockwise: a hole in what surrounds it).
 fn resolve_joined(c: &Contour) -> Vec<Contour> {
     let clockwise = signed_area(c) < 0.0;
-    c.simplify_shape(FillRule::EvenOdd)
+    to_overlay([c])
+        .simplify_shape(FillRule::EvenOdd)
         .into_iter()
         .flatten()
+        .map(crate::geom::contour_from_overlay)
         .map(|mut ring| {
             if clockwise {
                 ring.reverse();
@@ -196,7 +193,7 @@ pub fn union(contours: &[Contour]) -> Shapes {
     if contours.is_empty() {
         return Shapes::new();
     }
-    contours.simplify_shape(FillRule::NonZero)
+    shapes_from_overlay(to_overlay(contours).simplify_shape(FillRule::NonZero))
 }
 
 fn segments(mesh: &Mesh, facets: &[u32], z: f64) -> Vec<Segment> {
@@ -221,7 +218,7 @@ fn segments(mesh: &Mesh, facets: &[u32], z: f64) -> Vec<Segment> {
             // From the lower (below) vertex to the upper one: identical in both facets.
             let (lo, hi) = if above[i] { (p[j], p[i]) } else { (p[i], p[j]) };
             let t = (z - lo[2]) / (hi[2] - lo[2]);
-            [lo[0] + t * (hi[0] - lo[0]), lo[1] + t * (hi[1] - lo[1])]
+            DVec2::new(lo[0] + t * (hi[0] - lo[0]), lo[1] + t * (hi[1] - lo[1]))
         };
         out.push(Segment {
             a: point(down),
@@ -465,7 +462,7 @@ pub fn simplify_closed(c: &[Point], tol: f64) -> Contour {
             continue;
         }
         let (p, q) = (at(a), at(b));
-        let d = [q[0] - p[0], q[1] - p[1]];
+        let d = q - p;
         let len = d[0].hypot(d[1]);
         let (mut worst, mut wd) = (0, -1.0);
         for i in a + 1..b {
@@ -486,105 +483,6 @@ pub fn simplify_closed(c: &[Point], tol: f64) -> Contour {
         }
     }
     (0..n).filter(|&i| keep[i]).map(|i| c[i]).collect()
-}
-
-pub fn dist(a: Point, b: Point) -> f64 {
-    // Not `hypot`: coordinates are millimetres, far from overflow, and hypot is several
-    // times slower.
-    let (dx, dy) = (a[0] - b[0], a[1] - b[1]);
-    (dx * dx + dy * dy).sqrt()
-}
-
-/// Distance from `p` to the segment a–b.
-pub fn segment_distance(p: Point, a: Point, b: Point) -> f64 {
-    segment_distance2(p, a, b).sqrt()
-}
-
-/// Squared distance from `p` to the segment a–b.
-pub fn segment_distance2(p: Point, a: Point, b: Point) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let l2 = d[0] * d[0] + d[1] * d[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let (x, y) = (p[0] - a[0] - t * d[0], p[1] - a[1] - t * d[1]);
-    x * x + y * y
-}
-
-/// Signed area of a closed contour (positive = counter-clockwise).
-pub fn signed_area(c: &[Point]) -> f64 {
-    let n = c.len();
-    (0..n)
-        .map(|i| {
-            let (p, q) = (c[i], c[(i + 1) % n]);
-            p[0] * q[1] - q[0] * p[1]
-        })
-        .sum::<f64>()
-        / 2.0
-}
-
-/// Area of a region (outer boundaries minus holes).
-pub fn region_area(shapes: &Shapes) -> f64 {
-    shapes
-        .iter()
-        .flat_map(|s| s.iter())
-        .map(|c| signed_area(c))
-        .sum()
-}
-
-/// Crosses a region with the lines y = y0 + (k + phase)·step, k in `rows`: calls
-/// `span(k, xa, xb)` for every span of a line inside the region (non-zero rule), in order of
-/// k, then x. `to` maps the region's points first (the hatch turns its lines horizontal).
-pub fn scanline_spans(
-    region: &Shapes,
-    to: impl Fn(Point) -> Point,
-    y0: f64,
-    step: f64,
-    phase: f64,
-    rows: std::ops::Range<i64>,
-    mut span: impl FnMut(i64, f64, f64),
-) {
-    // (line k, x, winding)
-    let mut hits: Vec<(i64, f64, i32)> = Vec::new();
-    for contour in region.iter().flatten() {
-        let n = contour.len();
-        for i in 0..n {
-            let (p, q) = (to(contour[i]), to(contour[(i + 1) % n]));
-            if p[1] == q[1] {
-                continue;
-            }
-            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
-            // Lines with lo.y <= y < hi.y.
-            let mut k = (((lo[1] - y0) / step - phase).ceil() as i64).max(rows.start);
-            while k < rows.end {
-                let y = y0 + (k as f64 + phase) * step;
-                if y >= hi[1] {
-                    break;
-                }
-                if y >= lo[1] {
-                    let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
-                    hits.push((k, x, w));
-                }
-                k += 1;
-            }
-        }
-    }
-    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    for row in hits.chunk_by(|a, b| a.0 == b.0) {
-        let mut winding = 0;
-        let mut start = 0.0;
-        for &(k, x, w) in row {
-            let before = winding;
-            winding += w;
-            if before == 0 && winding != 0 {
-                start = x;
-            } else if before != 0 && winding == 0 {
-                span(k, start, x);
-            }
-        }
-    }
 }
 
 #[cfg(test)]

@@ -3,8 +3,11 @@
 
 use dropslice::Settings;
 use dropslice::analysis::{analyse_layer, analyse_layer_with_mask};
+use dropslice::geom::{Shape, Shapes};
 use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
-use dropslice::slice::{Point, Shapes};
+
+/// Points as plain arrays in these tests.
+type Point = [f64; 2];
 use std::f64::consts::PI;
 
 fn plan_of(points: &[Point]) -> LayerPlan {
@@ -14,7 +17,7 @@ fn plan_of(points: &[Point]) -> LayerPlan {
             .map(|&to| Move {
                 kind: MoveKind::Droplet,
                 role: Role::Fill,
-                to,
+                to: to.into(),
             })
             .collect(),
         ..LayerPlan::default()
@@ -22,7 +25,8 @@ fn plan_of(points: &[Point]) -> LayerPlan {
 }
 
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Shapes {
-    vec![vec![vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1]]]]
+    let outer = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]].map(Into::into);
+    vec![Shape::new(outer.into(), vec![])]
 }
 
 #[test]
@@ -267,19 +271,10 @@ fn staggered_hatch_ends_stay_inside_the_part_without_contours() {
 /// The job's report as `--report` makes it (each layer analysed in the slicing worker that
 /// planned it), and the code written meanwhile.
 fn report_of(job: &dropslice::Job) -> (dropslice::analysis::Report, Vec<u8>) {
-    use dropslice::analysis::{JobAnalysis, Raster};
+    use dropslice::analysis::JobAnalysis;
     let mut analysis = JobAnalysis::new(job);
-    let stage = analysis.stage();
     let mut code = Vec::new();
-    dropslice::write_gcode_with(
-        job,
-        &mut code,
-        |_, _| {},
-        Raster::empty,
-        |raster, _, region, plan| stage.analyse(raster, region, plan),
-        |_, layer| analysis.push(layer),
-    )
-    .unwrap();
+    dropslice::write_gcode_with(job, &mut code, |_, _| {}, &mut analysis).unwrap();
     (analysis.finish(), code)
 }
 

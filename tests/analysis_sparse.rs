@@ -8,8 +8,8 @@ use dropslice::analysis::{
     Grid3, HeightMap, Raster, analyse_layer, analyse_layer_with_mask, footprint_diameter,
     slab_voids,
 };
+use dropslice::geom::{Point, Shapes};
 use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
-use dropslice::slice::{Point, Shapes};
 
 fn plan_of(points: &[Point]) -> LayerPlan {
     LayerPlan {
@@ -28,17 +28,16 @@ fn plan_of(points: &[Point]) -> LayerPlan {
 /// A `side` mm square at (x, y) filled with droplets on a square lattice of pitch B (their
 /// gaps are voids).
 fn square(x: f64, y: f64, side: f64, b: f64) -> (Shapes, Vec<Point>) {
-    let region = vec![vec![vec![
-        [x, y],
-        [x + side, y],
-        [x + side, y + side],
-        [x, y + side],
-    ]]];
+    let outer = [[x, y], [x + side, y], [x + side, y + side], [x, y + side]];
+    let region = vec![dropslice::geom::Shape::new(
+        outer.map(Into::into).into(),
+        vec![],
+    )];
     let n = (side / b) as usize;
     let mut pts = Vec::new();
     for i in 0..n {
         for j in 0..n {
-            pts.push([x + (i as f64 + 0.5) * b, y + (j as f64 + 0.5) * b]);
+            pts.push([x + (i as f64 + 0.5) * b, y + (j as f64 + 0.5) * b].into());
         }
     }
     (region, pts)
@@ -112,7 +111,7 @@ fn parts_far_apart_take_memory_for_the_parts_only() {
 
     // The 3D estimate's spheroid map: a 1 m square at B/3 would take 800 MB.
     let grid = Grid3 {
-        origin: [-1.0, -1.0],
+        origin: [-1.0, -1.0].into(),
         cell: b / 3.0,
     };
     let d = footprint_diameter(&s);

@@ -39,7 +39,7 @@ impl Rng {
 fn areas(tris: &[Tri]) -> Vec<f64> {
     let job = Job::new(&binary(tris), "damaged", Settings::default()).unwrap();
     (0..job.layer_count())
-        .map(|i| dropslice::slice::region_area(&job.section(i).region))
+        .map(|i| dropslice::geom::region_area(&job.section(i).region))
         .collect()
 }
 

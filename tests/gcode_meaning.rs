@@ -101,7 +101,7 @@ fn check_model(model: &str, stride: usize) {
     // Geometry against the layer's section.
     for l in g.layers.iter().step_by(stride) {
         let i = layer_index(l.z, H);
-        let region = job.section(i).region;
+        let region = common::nested(&job.section(i).region);
         let idx = IndexedRegion::new(&region);
         let inside = |p: Point, what: &str| {
             assert!(
@@ -143,7 +143,7 @@ fn check_rings(model: &str, stride: usize) {
     let mut bad = Vec::new();
     for l in g.layers.iter().step_by(stride) {
         let i = layer_index(l.z, H);
-        let idx = IndexedRegion::new(&job.section(i).region);
+        let idx = IndexedRegion::new(&common::nested(&job.section(i).region));
         for c in l.cmds.iter().filter(|c| c.code == "G26") {
             let d = idx.boundary_distance(c.p());
             let k = (d / B - s.outer_offset).round();
@@ -300,7 +300,7 @@ fn loop_rings(model: &str, sets: &[&str]) -> Vec<(usize, Vec<u32>)> {
     let mut out = Vec::new();
     for l in &g.layers {
         let i = layer_index(l.z, H);
-        let idx = IndexedRegion::new(&job.section(i).region);
+        let idx = IndexedRegion::new(&common::nested(&job.section(i).region));
         let mut rings = Vec::new();
         for run in g26_runs(l) {
             for lp in split_loops(&run, B, SPACING_TOL_MM) {

@@ -4,9 +4,9 @@
 
 mod common;
 
-use common::{B, IndexedRegion, model_bytes};
+use common::{B, IndexedRegion, model_bytes, nested};
+use dropslice::geom::{Shape, Shapes, all_contours, region_area, shapes_from_overlay, signed_area};
 use dropslice::offset::{CHORD_TOLERANCE_MM, inset};
-use dropslice::slice::{Shapes, region_area, signed_area};
 use dropslice::{Job, Settings};
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
@@ -21,20 +21,24 @@ fn reference(region: &Shapes, d: f64) -> Shapes {
         .outer_offset(-d)
         .inner_offset(-d)
         .line_join(LineJoin::Round(angle));
-    region
+    let region: Vec<Vec<Vec<[f64; 2]>>> = nested(region);
+    let out = region
         .outline(&style)
         .into_iter()
         .map(|s| {
             s.into_iter()
-                .filter(|c| signed_area(c).abs() >= 1e-6)
+                .filter(|c| {
+                    signed_area(&c.iter().map(|&p| p.into()).collect::<Vec<_>>()).abs() >= 1e-6
+                })
                 .collect::<Vec<_>>()
         })
         .filter(|s| !s.is_empty())
-        .collect()
+        .collect();
+    shapes_from_overlay(out)
 }
 
 fn loops(s: &Shapes) -> usize {
-    s.iter().map(|shape| shape.len()).sum()
+    s.iter().map(|shape| 1 + shape.holes.len()).sum()
 }
 
 fn layers_of(name: &str) -> Vec<Shapes> {
@@ -44,8 +48,10 @@ fn layers_of(name: &str) -> Vec<Shapes> {
         .collect()
 }
 
-fn square(x0: f64, y0: f64, a: f64, ccw: bool) -> Vec<[f64; 2]> {
-    let mut c = vec![[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]];
+fn square(x0: f64, y0: f64, a: f64, ccw: bool) -> dropslice::geom::Contour {
+    let mut c: dropslice::geom::Contour = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
+        .map(Into::into)
+        .into();
     if !ccw {
         c.reverse();
     }
@@ -56,13 +62,13 @@ fn square(x0: f64, y0: f64, a: f64, ccw: bool) -> Vec<[f64; 2]> {
 fn square_with_a_hole_has_the_exact_area() {
     // 10 mm square with a 2 mm hole, both moved 0.5 mm into the material: the outer square
     // shrinks to 9 × 9; the hole grows by 0.5 mm with quarter circles at its corners.
-    let region: Shapes = vec![vec![
+    let region: Shapes = vec![Shape::new(
         square(0.0, 0.0, 10.0, true),
-        square(4.0, 4.0, 2.0, false),
-    ]];
+        vec![square(4.0, 4.0, 2.0, false)],
+    )];
     let out = inset(&region, 0.5, 0.5);
     assert_eq!(out.len(), 1);
-    assert_eq!(out[0].len(), 2);
+    assert_eq!(out[0].holes.len(), 1);
     let hole = 2.0 * 2.0 + 4.0 * 2.0 * 0.5 + PI * 0.25;
     let want = 81.0 - hole;
     // chords cut the hole's arcs by at most the chord tolerance
@@ -73,7 +79,8 @@ fn square_with_a_hole_has_the_exact_area() {
     );
     // outer corners are sharp (mitred), exactly at 0.5, 0.5
     assert!(
-        out[0][0]
+        out[0]
+            .outer
             .iter()
             .any(|p| (p[0] - 0.5).abs() < 1e-9 && (p[1] - 0.5).abs() < 1e-9)
     );
@@ -83,16 +90,17 @@ fn square_with_a_hole_has_the_exact_area() {
 fn parts_thinner_than_twice_the_offset_vanish() {
     // A small kite (from a spike of spikey_top_solid_header.stl at z = 27.9): its mitred raw
     // offset leaves islands, which the distance check sends to the exact construction.
-    let kite = vec![
+    let kite = [
         [27.48330807447128, 28.61514463768925],
         [27.48330807447128, 28.049842533931393],
         [27.81558429956131, 27.592503396138806],
         [28.797960219380187, 28.47699898229565],
     ];
-    let region: Shapes = vec![vec![kite.clone()]];
+    let region: Shapes = vec![Shape::new(kite.map(Into::into).into(), vec![])];
     assert!(inset(&region, 2.0 * B, 2.0 * B).is_empty());
     // a 0.3 mm wall: gone at 0.16 mm, kept at 0.14 mm
-    let wall: Shapes = vec![vec![vec![[0.0, 0.0], [5.0, 0.0], [5.0, 0.3], [0.0, 0.3]]]];
+    let wall_outer = [[0.0, 0.0], [5.0, 0.0], [5.0, 0.3], [0.0, 0.3]];
+    let wall: Shapes = vec![Shape::new(wall_outer.map(Into::into).into(), vec![])];
     assert!(inset(&wall, 0.16, 0.16).is_empty());
     let thin = inset(&wall, 0.14, 0.14);
     assert!(
@@ -156,13 +164,13 @@ fn every_vertex_keeps_its_distance_from_the_boundary() {
         "slide_n_snap_test_a_medium.stl",
     ] {
         for (i, region) in layers_of(name).iter().enumerate() {
-            let index = IndexedRegion::new(region);
+            let index = IndexedRegion::new(&nested(region));
             for f in [0.5, 1.5, 2.0] {
                 let d = f * B;
-                for p in inset(region, d, d).iter().flatten().flatten() {
-                    let dist = index.boundary_distance(*p);
+                for p in dropslice::geom::all_contours(&inset(region, d, d)).flatten() {
+                    let dist = index.boundary_distance(p.to_array());
                     assert!(
-                        index.contains(*p, 0.0) && dist >= d - 2.0 * CHORD_TOLERANCE_MM,
+                        index.contains(p.to_array(), 0.0) && dist >= d - 2.0 * CHORD_TOLERANCE_MM,
                         "{name} layer {i} d = {f} B: vertex {p:?} at {dist} from the boundary"
                     );
                 }
@@ -199,9 +207,7 @@ fn loops_far_inside_match_direct_offsets() {
                 // and not the other: every loop of 0.001 mm² or more in one has a match of
                 // 0.0005 mm² or more in the other.
                 let mine_a: Vec<f64> = mine.iter().map(|l| signed_area(&l.points).abs()).collect();
-                let direct_a: Vec<f64> = direct
-                    .iter()
-                    .flatten()
+                let direct_a: Vec<f64> = all_contours(&direct)
                     .map(|c| signed_area(c).abs())
                     .collect();
                 let at_least = |v: &[f64], a: f64| v.iter().filter(|&&x| x >= a).count();

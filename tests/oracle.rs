@@ -50,7 +50,7 @@ fn compare(model: &str, fixture: &str, counts: bool) -> (Vec<Mismatch>, usize) {
         let nz = &l["nonzero"];
         let want = nz["area"].as_f64().unwrap();
         let section = job.section(i);
-        let got = dropslice::slice::region_area(&section.region);
+        let got = dropslice::geom::region_area(&section.region);
         let tol = (want * 0.005).max(0.05);
         if (got - want).abs() > tol {
             bad.push(Mismatch {
@@ -63,7 +63,7 @@ fn compare(model: &str, fixture: &str, counts: bool) -> (Vec<Mismatch>, usize) {
             let holes = section
                 .region
                 .iter()
-                .map(|s| s.len() as u64 - 1)
+                .map(|s| s.holes.len() as u64)
                 .sum::<u64>();
             let (wo, wh) = (nz["outer"].as_u64().unwrap(), nz["holes"].as_u64().unwrap());
             // A loop touching itself at one point (a pinch) is one polygon in the even-odd count

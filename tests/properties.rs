@@ -5,7 +5,7 @@
 
 mod common;
 
-use dropslice::slice::region_area;
+use dropslice::geom::region_area;
 use dropslice::{Job, Settings};
 use proptest::prelude::*;
 use std::collections::HashMap;

@@ -55,7 +55,7 @@ fn areas(job: &Job) -> Vec<(f64, f64)> {
         .map(|i| {
             (
                 job.plane_z(i),
-                dropslice::slice::region_area(&job.section(i).region),
+                dropslice::geom::region_area(&job.section(i).region),
             )
         })
         .collect()
@@ -219,7 +219,7 @@ fn a_shared_model_with_one_shell_inside_out_matches_the_oracle() {
             continue;
         }
         let want = l["nonzero"]["area"].as_f64().unwrap();
-        let got = dropslice::slice::region_area(&j.section(i).region);
+        let got = dropslice::geom::region_area(&j.section(i).region);
         if (got - want).abs() > (want * 0.005).max(0.05) {
             bad.push(format!("layer {i}: {got:.3} vs oracle {want:.3}"));
         }

@@ -13,7 +13,7 @@ fn main() {}
 
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
-    use dropslice::analysis::{JobAnalysis, Raster};
+    use dropslice::analysis::JobAnalysis;
     use dropslice::{Error, Job, Settings, write_gcode_with};
     use staged::Staged;
     use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
@@ -320,7 +320,6 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         let mut shown = false;
         // With --report, each layer is analysed by the worker that planned it.
         let mut analysis = report.as_ref().map(|_| JobAnalysis::new(&job));
-        let stage = analysis.as_ref().map(|a| a.stage());
         let progress = |done: usize, total: usize| {
             let due = last.elapsed().as_millis() >= every_ms || (done == total && shown);
             if quiet || t0.elapsed().as_secs_f64() < 1.0 || !due {
@@ -338,18 +337,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 eprintln!("dropslice: layer {done}/{total} ({pct} %)");
             }
         };
-        let summary = write_gcode_with(
-            &job,
-            &mut w,
-            progress,
-            Raster::empty,
-            |raster, _, region, plan| stage.as_ref().map(|st| st.analyse(raster, region, plan)),
-            |_, layer| {
-                if let (Some(a), Some(l)) = (analysis.as_mut(), layer) {
-                    a.push(l);
-                }
-            },
-        )?;
+        let summary = write_gcode_with(&job, &mut w, progress, &mut analysis)?;
         let finish = || -> std::io::Result<()> {
             let file = w.into_inner().map_err(|e| e.into_error())?;
             // Fill in the header's droplet counts (same length as the placeholders).

@@ -370,7 +370,7 @@ pub fn split_loops(run: &[Point], b: f64, b_tol: f64) -> Vec<Vec<Point>> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Geometry on a section (dropslice::slice::Shapes: shapes of contours)
+// Geometry on a section (dropslice::geom::Shapes: shapes of contours)
 
 pub type Shapes = Vec<Vec<Vec<Point>>>;
 
@@ -400,7 +400,19 @@ pub fn contour_winding(c: &[Point], p: Point) -> i32 {
 }
 
 fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
-    dropslice::slice::segment_distance(p, a, b)
+    dropslice::geom::segment_distance(p.into(), a.into(), b.into())
+}
+
+/// A section's region as plain arrays (outer boundary first, then the holes).
+pub fn nested(region: &dropslice::geom::Shapes) -> Shapes {
+    region
+        .iter()
+        .map(|s| {
+            s.contours()
+                .map(|c| c.iter().map(|p| p.to_array()).collect())
+                .collect()
+        })
+        .collect()
 }
 
 /// Distance from `p` to the region's boundary (its nearest contour edge).

@@ -2,7 +2,7 @@
 // sample part), bundled from www/*.ts with esbuild and run in Node.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { mkdtempSync, rmSync } from "node:fs";
+import { mkdtempSync, readFileSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { pathToFileURL } from "node:url";
@@ -23,6 +23,8 @@ before(async () => {
     logLevel: "error",
   });
   [gcode, share, form, sample] = await Promise.all(names.map((n) => import(pathToFileURL(join(out, `${n}.js`)).href)));
+  // the G-code reader is the core's (built into www/pkg by the page build)
+  await gcode.loadCore(readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")));
 });
 
 after(() => rmSync(out, { recursive: true, force: true }));

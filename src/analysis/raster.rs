@@ -1,55 +1,12 @@
-//! Analysis: see the print before printing. A layer's droplets are rasterised against the
-//! layer's true region, giving coverage, voids, overfill and how far the printed outline strays
-//! from the boundary; over adjacent layers, a 3D estimate gives the part's void fraction.
-//!
-//! # The droplet model
-//! - **Footprint** (setting `footprint`): in the layer's plane a droplet covers a disc centred
-//!   on its position, of diameter D = B (`disc`, the droplet as measured, thesis 4.2) or
-//!   D = 2B/√π ≈ 1.13 B (`spread`: the disc whose area is a B × B cell, i.e. a droplet that
-//!   flattens with the volume a dense part needs). Discs of diameter B on a lattice of pitch B
-//!   only touch, so `disc` leaves at least 1 − π/4 ≈ 21 % of a filled area uncovered: its
-//!   figures are a pessimistic bound and best used to compare settings; real droplets flow
-//!   into part of those gaps.
-//! - **Volume** (3D estimate): a droplet is an oblate spheroid of horizontal diameter D, centred
-//!   at its layer's mid-height, whose volume is the cell a droplet must fill, B·B·H. Its height
-//!   is therefore 6B²H/(πD²) (1.91 H for `disc`): it reaches about 0.45 H into the layers above
-//!   and below, into their gaps, which is what staggering (setting `stagger`) exploits. A
-//!   point of the part (layer i's region × its slab) is filled when a spheroid of layer i − 1,
-//!   i or i + 1 contains it. Flow, surface tension and the shape of the surface a droplet lands
-//!   on are not modelled; spheroids below the first layer are cut by the bed.
-//!
-//! # The grid
-//! Rows every B/10 ([`ROWS_PER_B`]), columns every B/40 ([`COLS_PER_ROW`] per row). A droplet
-//! covers, in each row, as many columns around its centre as the average width of its disc
-//! over the row's band, rounded with the remainder carried from row to row (so one disc covers
-//! its exact area within half a cell, wherever it lies on the grid); the region covers the
-//! columns whose centres lie inside it at the row's centre (non-zero rule). Voids are the
-//! region's cells no droplet covers; two void cells in neighbouring rows are connected when
-//! their runs overlap by at least [`MIN_PASSAGE_COLS`] columns (B/20), so the voids on both
-//! sides of two touching droplets stay apart. The 3D estimate samples the part at cell centres
-//! every B/3 ([`GRID3_PER_B`]).
-//!
-//! # Boundary deviation
-//! The printed outline is the droplets' envelope with its enclosed voids filled. Its deviation
-//! from the region's boundary is measured one-sidedly: inward, the largest distance from the
-//! boundary of an uncovered point connected to the boundary (the depth of the scallops
-//! between droplets, or of a wall too thin for any droplet); outward, the largest distance from
-//! the region of a covered point outside it. Both are sampled at the ends and the middle of
-//! each run of cells, so they are exact to about a grid step.
-//!
-//! # Memory
-//! The grids span the layer's bounding box, but only tiles near its region and droplets are
-//! stored ([`Tiles`]): the 2D bitmaps in tiles of 64 rows × 256 columns (1.3 mm square with the
-//! default B), the spheroid maps in tiles of 32 × 32 cells (2.2 mm), the coverage mask in tiles
-//! over those. Parts a metre apart take the memory each takes alone, and the figures are those
-//! of a dense grid: the same grid, its rows and runs visited in the same order.
+//! The 2D analysis of one layer: its droplets rasterised against its region (coverage, voids,
+//! overfill, boundary deviation) and the coverage mask for the page's overlay.
 
-use crate::grid::{EdgeIndex, Row, Segment, Spot, Tiles};
-use crate::plan::{LayerPlan, MoveKind, line_droplets};
-use crate::settings::{Footprint, Settings};
-use crate::slice::{Point, Shapes, dist, region_area, scanline_spans};
+use super::droplet::{droplet_centres, footprint_diameter};
+use crate::geom::{DVec2, Point, Shapes, all_contours, dist, region_area, scanline_spans};
+use crate::grid::{EdgeIndex, Row, Spot, Tiles};
+use crate::plan::LayerPlan;
+use crate::settings::Settings;
 use serde::Serialize;
-use std::f64::consts::PI;
 
 /// Grid rows per droplet width B.
 pub const ROWS_PER_B: f64 = 10.0;
@@ -57,26 +14,8 @@ pub const ROWS_PER_B: f64 = 10.0;
 pub const COLS_PER_ROW: f64 = 4.0;
 /// Void runs in neighbouring rows connect when they overlap by at least this many columns.
 pub const MIN_PASSAGE_COLS: u32 = 2;
-/// The 3D estimate samples the part every B / this.
-pub const GRID3_PER_B: f64 = 3.0;
 /// Steps of the table of band-averaged half-widths (a droplet's offset within its first row).
 const PHASES: usize = 256;
-
-/// Footprint diameter D of a droplet, in mm.
-pub fn footprint_diameter(s: &Settings) -> f64 {
-    let b = s.droplet_width();
-    match s.footprint {
-        Footprint::Disc => b,
-        Footprint::Spread => 2.0 * b / PI.sqrt(),
-    }
-}
-
-/// Vertical semi-axis of the droplet spheroid (volume B·B·H), in mm.
-pub fn spheroid_half_height(s: &Settings) -> f64 {
-    let b = s.droplet_width();
-    let d = footprint_diameter(s);
-    3.0 * b * b * s.layer_height / (PI * d * d)
-}
 
 /// One connected void of a layer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
@@ -153,10 +92,10 @@ pub struct MaskTile {
 impl CoverageMask {
     /// Where tile `t`'s cell (0, 0) starts, in mm.
     pub fn tile_origin(&self, t: &MaskTile) -> Point {
-        [
+        DVec2::new(
             self.origin[0] + t.col as f64 * self.cell,
             self.origin[1] + t.row as f64 * self.cell,
-        ]
+        )
     }
 
     /// The shares [void, overfill, covered] of cell (col, row); zero outside the tiles.
@@ -178,27 +117,6 @@ impl CoverageMask {
             (w.max(t.col + t.width), h.max(t.row + t.height))
         })
     }
-}
-
-/// Every droplet centre of a layer (each droplet of a `G25` line too), in print order.
-pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
-    let mut out = Vec::with_capacity(plan.counts.total() as usize);
-    let mut at: Point = [0.0, 0.0];
-    for m in &plan.moves {
-        match m.kind {
-            MoveKind::Travel => {}
-            MoveKind::Droplet => out.push(m.to),
-            MoveKind::Line => {
-                let l = dist(at, m.to);
-                for j in 0..line_droplets(l, b) {
-                    let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
-                    out.push([at[0] + t * (m.to[0] - at[0]), at[1] + t * (m.to[1] - at[1])]);
-                }
-            }
-        }
-        at = m.to;
-    }
-    out
 }
 
 /// Analyses one layer: its plan against its region (the section, before any offset).
@@ -310,7 +228,7 @@ fn count_range(row: &[u64], c0: usize, c1: usize) -> u32 {
 
 /// Calls `span(row, xa, xb)` for every inside span (non-zero rule) of `region` on rows at
 /// y0 + (k + ½)·gy, k < ny.
-fn region_spans(
+pub(super) fn region_spans(
     region: &Shapes,
     y0: f64,
     gy: f64,
@@ -412,7 +330,7 @@ impl Raster {
         let gx = gy / COLS_PER_ROW;
         let mut min = [f64::INFINITY; 2];
         let mut max = [f64::NEG_INFINITY; 2];
-        for p in region.iter().flatten().flatten() {
+        for p in all_contours(region).flatten() {
             for k in 0..2 {
                 min[k] = min[k].min(p[k]);
                 max[k] = max[k].max(p[k]);
@@ -425,7 +343,7 @@ impl Raster {
             }
         }
         self.edges.clear();
-        for c in region.iter().flatten() {
+        for c in all_contours(region) {
             for i in 0..c.len() {
                 self.edges.push((c[i], c[(i + 1) % c.len()]));
             }
@@ -811,12 +729,12 @@ impl Raster {
                 let n = a.cells as f64;
                 largest = Some(Void {
                     area,
-                    centroid: [
+                    centroid: DVec2::new(
                         g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
                         g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
-                    ],
-                    min: [g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy],
-                    max: [g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy],
+                    ),
+                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
+                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
                     at_boundary: a.boundary,
                 });
             }
@@ -828,7 +746,7 @@ impl Raster {
         let probe = |best: &mut Deviation, k: usize, s: u32, e: u32| {
             let y = g.ry(k);
             for c in [s, (s + e - 1) / 2, e - 1] {
-                let p = [g.cx(c as usize), y];
+                let p = DVec2::new(g.cx(c as usize), y);
                 // The distance to the boundary changes no faster than the point moves: a point
                 // this close to the last one probed cannot beat the maximum.
                 if best.last_d + dist(p, best.last) <= best.max {
@@ -986,7 +904,7 @@ impl Raster {
             tile.covered = counts.iter().map(|c| share(c[2])).collect();
         }
         CoverageMask {
-            origin: [g.x0, g.y0],
+            origin: DVec2::new(g.x0, g.y0),
             cell: rows as f64 * g.gy,
             tiles: out,
         }
@@ -1007,7 +925,7 @@ impl Default for Deviation {
         Deviation {
             max: 0.0,
             at: None,
-            last: [0.0; 2],
+            last: DVec2::ZERO,
             last_d: f64::INFINITY,
         }
     }
@@ -1038,477 +956,6 @@ impl UnionFind {
         if ra != rb {
             let (lo, hi) = (ra.min(rb), ra.max(rb));
             self.parent[hi] = lo as u32;
-        }
-    }
-}
-
-/// Part-level figures. Areas in mm² summed over layers; volumes in mm³.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
-pub struct PartAnalysis {
-    pub layers: usize,
-    pub droplets: u64,
-    pub region_area: f64,
-    /// Area-weighted coverage over all layers.
-    pub coverage: f64,
-    pub void_area: f64,
-    pub enclosed_void_area: f64,
-    pub overfill_area: f64,
-    /// The largest connected void of any layer, and its layer (from 0).
-    pub largest_void: Option<Void>,
-    pub largest_void_layer: Option<usize>,
-    pub max_boundary_deviation: f64,
-    pub max_deviation_layer: Option<usize>,
-    /// The part's volume: each layer's region (exact area) times H.
-    pub volume: f64,
-    /// Volume of the part no droplet spheroid fills (3D estimate: each slab's void share, sampled
-    /// on the 3D grid, times its exact volume).
-    pub void_volume: f64,
-    /// void_volume / volume.
-    pub void_fraction: f64,
-}
-
-impl PartAnalysis {
-    /// Adds one layer's figures (its 3D slab: `slab_volume`, `slab_void`).
-    pub fn add(&mut self, l: &LayerAnalysis, slab_volume: f64, slab_void: f64) {
-        self.layers += 1;
-        self.droplets += l.droplets;
-        let covered = self.coverage * self.region_area + l.coverage * l.region_area;
-        self.region_area += l.region_area;
-        self.coverage = if self.region_area > 0.0 {
-            covered / self.region_area
-        } else {
-            0.0
-        };
-        self.void_area += l.void_area;
-        self.enclosed_void_area += l.enclosed_void_area;
-        self.overfill_area += l.overfill_area;
-        if let Some(v) = l.largest_void
-            && self.largest_void.is_none_or(|b| v.area > b.area)
-        {
-            self.largest_void = Some(v);
-            self.largest_void_layer = Some(l.index);
-        }
-        if l.boundary_deviation > self.max_boundary_deviation {
-            self.max_boundary_deviation = l.boundary_deviation;
-            self.max_deviation_layer = Some(l.index);
-        }
-        self.volume += slab_volume;
-        self.void_volume += slab_void;
-        self.void_fraction = if self.volume > 0.0 {
-            self.void_volume / self.volume
-        } else {
-            0.0
-        };
-    }
-}
-
-/// Rows per band and cells per tile of a [`HeightMap`]: tiles of 32 × 32 cells (2.2 mm square
-/// with the default B).
-const MAP_BAND_ROWS: usize = 32;
-const MAP_TILE_COLS: usize = 32;
-
-/// The droplet spheroids of one layer on the 3D grid: per cell, the largest
-/// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
-/// droplets fill the cell's column within c·√q of the layer's mid-height. Stored only in the
-/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere.
-pub struct HeightMap {
-    /// Grid indices of the map's cell (0, 0).
-    x0: i64,
-    y0: i64,
-    tiles: Tiles,
-    q: Vec<f32>,
-}
-
-/// The 3D grid: square cells of `cell` mm from a fixed origin (the same for every layer).
-#[derive(Clone, Copy, Debug)]
-pub struct Grid3 {
-    pub origin: Point,
-    pub cell: f64,
-}
-
-/// One row of a [`HeightMap`]: its segments' cells in `data`.
-#[derive(Clone, Copy)]
-struct MapRow<'a> {
-    x0: i64,
-    segs: &'a [Segment],
-    data: &'a [f32],
-}
-
-impl<'a> MapRow<'a> {
-    const EMPTY: MapRow<'static> = MapRow {
-        x0: 0,
-        segs: &[],
-        data: &[],
-    };
-
-    /// The stretch of the row from grid index `ix` on: (grid index of `cells[0]`, cells, grid
-    /// index of its last cell); no cells where nothing is stored.
-    fn piece(&self, ix: i64) -> (i64, &'a [f32], i64) {
-        for s in self.segs {
-            let (a, b) = (self.x0 + s.c0 as i64, self.x0 + s.c1 as i64);
-            if ix < a {
-                return (ix, &[], a - 1);
-            }
-            if ix < b {
-                return (a, &self.data[s.at..s.end()], b - 1);
-            }
-        }
-        (ix, &[], i64::MAX)
-    }
-}
-
-impl HeightMap {
-    pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
-        let r = d / 2.0;
-        let mut min = [i64::MAX; 2];
-        let mut max = [i64::MIN; 2];
-        let idx = |v: f64, k: usize| ((v - grid.origin[k]) / grid.cell - 0.5).floor() as i64;
-        for p in centres {
-            for k in 0..2 {
-                min[k] = min[k].min(idx(p[k] - r, k));
-                max[k] = max[k].max(idx(p[k] + r, k) + 1);
-            }
-        }
-        let mut tiles = Tiles::default();
-        if centres.is_empty() {
-            return HeightMap {
-                x0: 0,
-                y0: 0,
-                tiles,
-                q: Vec::new(),
-            };
-        }
-        let (w, h) = (
-            (max[0] - min[0] + 1) as usize,
-            (max[1] - min[1] + 1) as usize,
-        );
-        // A droplet's cells [ax, bx] × [ay, by].
-        let cells = |p: &Point| {
-            (
-                (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1),
-                (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1),
-            )
-        };
-        let cells: Vec<_> = centres.iter().map(cells).collect();
-        tiles.reset(h, w, MAP_BAND_ROWS, MAP_TILE_COLS);
-        for &((ax, bx), (ay, by)) in &cells {
-            let (x, y) = (
-                |v: i64| (v - min[0]) as usize,
-                |v: i64| (v - min[1]) as usize,
-            );
-            tiles.mark(y(ay), y(by), x(ax), x(bx));
-        }
-        let mut q = vec![0f32; tiles.build()];
-        let inv = 1.0 / (r * r);
-        let mut xx = Vec::new();
-        // Where the last droplet row's cells were stored (mostly the next one's too).
-        let mut spot: Option<Spot> = None;
-        for (p, &((ax, bx), (ay, by))) in centres.iter().zip(&cells) {
-            xx.clear();
-            xx.extend((ax..=bx).map(|ix| {
-                let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
-                x * x
-            }));
-            for iy in ay..=by {
-                let y = grid.origin[1] + (iy as f64 + 0.5) * grid.cell - p[1];
-                let yy = y * y;
-                if yy * inv >= 1.0 {
-                    // No cell of this row is inside (q ≤ 0 never raises a cell).
-                    continue;
-                }
-                let (k, c) = ((iy - min[1]) as usize, (ax - min[0]) as usize);
-                let Some(sp) = tiles.spot_cached(&mut spot, k, c, c + xx.len() - 1) else {
-                    debug_assert!(false, "droplet outside the map's tiles");
-                    continue;
-                };
-                let at = sp.index(k) + c - sp.shift;
-                for (slot, &x2) in q[at..at + xx.len()].iter_mut().zip(&xx) {
-                    let v = (1.0 - (x2 + yy) * inv) as f32;
-                    if v > *slot {
-                        *slot = v;
-                    }
-                }
-            }
-        }
-        HeightMap {
-            x0: min[0],
-            y0: min[1],
-            tiles,
-            q,
-        }
-    }
-
-    /// Row `iy` (a grid index); empty outside the map.
-    fn row(&self, iy: i64) -> MapRow<'_> {
-        usize::try_from(iy - self.y0)
-            .ok()
-            .and_then(|y| self.tiles.row(y))
-            .map_or(MapRow::EMPTY, |row| MapRow {
-                x0: self.x0,
-                segs: row.segs,
-                data: &self.q[row.range()],
-            })
-    }
-
-    /// Cells stored (for tests of the memory it takes).
-    pub fn stored_cells(&self) -> usize {
-        self.q.len()
-    }
-}
-
-/// The 3D estimate for layer i's slab: (volume, void volume) in mm³ of its region × H, filled
-/// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`).
-pub fn slab_voids(
-    region: &Shapes,
-    grid: &Grid3,
-    below: Option<&HeightMap>,
-    this: &HeightMap,
-    above: Option<&HeightMap>,
-    s: &Settings,
-) -> (f64, f64) {
-    let h = s.layer_height;
-    let c = spheroid_half_height(s);
-    let half = h / 2.0;
-    let mut ymin = f64::INFINITY;
-    let mut ymax = f64::NEG_INFINITY;
-    for p in region.iter().flatten().flatten() {
-        ymin = ymin.min(p[1]);
-        ymax = ymax.max(p[1]);
-    }
-    if !ymin.is_finite() {
-        return (0.0, 0.0);
-    }
-    let k0 = ((ymin - grid.origin[1]) / grid.cell - 0.5).floor() as i64;
-    let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
-    let y0 = grid.origin[1] + k0 as f64 * grid.cell;
-    let (mut cells, mut filled) = (0u64, 0.0f64);
-    // A neighbour's droplet reaches into this slab where c·√q > H/2.
-    let q_reach = ((half / c) * (half / c)) as f32;
-    let ext = |q: f32| -> f64 {
-        if q > q_reach {
-            (c * (q as f64).sqrt() - half).max(0.0)
-        } else {
-            0.0
-        }
-    };
-    let at = |(x0, row): (i64, &[f32]), ix: i64| -> f32 {
-        usize::try_from(ix - x0)
-            .ok()
-            .and_then(|x| row.get(x))
-            .copied()
-            .unwrap_or(0.0)
-    };
-    region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
-        let iy = k0 + k as i64;
-        let c0 = ((xa - grid.origin[0]) / grid.cell - 0.5).ceil() as i64;
-        let c1 = ((xb - grid.origin[0]) / grid.cell - 0.5).floor() as i64;
-        let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let this = this.row(iy);
-        // Stretches of the span over which each map is one slice (or nothing).
-        let mut from = c0;
-        while from <= c1 {
-            let (xt, rt, et) = this.piece(from);
-            let (xb, rb, eb) = below.piece(from);
-            let (xa, ra, ea) = above.piece(from);
-            let to = c1.min(et).min(eb).min(ea);
-            let (rt, rb, ra) = ((xt, rt), (xb, rb), (xa, ra));
-            for ix in from..=to {
-                cells += 1;
-                // Local z from the slab's bottom: [0, lo] from below, the own droplet around
-                // h/2, [h − hi, h] from above.
-                let q = at(rt, ix);
-                let a = if q > 0.0 {
-                    (c * (q as f64).sqrt()).min(half)
-                } else {
-                    0.0
-                };
-                if a >= half {
-                    // The own droplet fills the whole column.
-                    filled += h;
-                    continue;
-                }
-                let lo = ext(at(rb, ix)).min(h);
-                let hi = ext(at(ra, ix)).min(h);
-                let (m0, m1) = (half - a, half + a);
-                // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
-                let mut len = 0.0;
-                let mut end = 0.0f64;
-                for (s0, s1) in [(0.0, lo), (m0, m1), (h - hi, h)] {
-                    if s1 <= s0 {
-                        continue;
-                    }
-                    let s0 = s0.max(end);
-                    if s1 > s0 {
-                        len += s1 - s0;
-                        end = s1;
-                    }
-                }
-                filled += len;
-            }
-            from = to + 1;
-        }
-    });
-    let area = grid.cell * grid.cell;
-    let volume = cells as f64 * area * h;
-    (volume, (volume - filled * area).max(0.0))
-}
-
-/// The whole report of a job: settings, model, part figures and every layer's figures.
-#[derive(Clone, Debug, Serialize)]
-pub struct Report {
-    pub file_name: String,
-    pub settings: Settings,
-    pub model: Model,
-    pub part: PartAnalysis,
-    pub layers: Vec<LayerAnalysis>,
-}
-
-/// The analysis model as used, for the report.
-#[derive(Clone, Debug, Serialize)]
-pub struct Model {
-    pub footprint: crate::settings::Footprint,
-    /// Droplet width B, footprint diameter D, spheroid height, mm.
-    pub droplet_width: f64,
-    pub footprint_diameter: f64,
-    pub spheroid_height: f64,
-    /// Grid rows and columns, mm; 3D cells, mm.
-    pub grid_row: f64,
-    pub grid_column: f64,
-    pub grid_3d: f64,
-    pub description: &'static str,
-}
-
-impl Model {
-    pub fn new(s: &Settings) -> Model {
-        let b = s.droplet_width();
-        Model {
-            footprint: s.footprint,
-            droplet_width: b,
-            footprint_diameter: footprint_diameter(s),
-            spheroid_height: 2.0 * spheroid_half_height(s),
-            grid_row: b / ROWS_PER_B,
-            grid_column: b / ROWS_PER_B / COLS_PER_ROW,
-            grid_3d: b / GRID3_PER_B,
-            description: "2D: each droplet covers a disc of diameter D centred on it; 3D: an oblate spheroid of diameter D and volume B*B*H centred at its layer's mid-height (see docs/quality.md)",
-        }
-    }
-}
-
-/// The per-layer half of the job analysis, for the workers that plan the layers (see
-/// [`crate::write_gcode_with`]): [`analyse`](Self::analyse) gives a layer's 2D figures and its
-/// spheroid map; [`JobAnalysis`] takes them in layer order and adds the 3D estimate, so no
-/// layer is planned twice.
-#[derive(Clone, Debug)]
-pub struct LayerStage {
-    settings: Settings,
-    grid: Grid3,
-}
-
-/// One layer analysed by a [`LayerStage`], waiting for its neighbours' spheroid maps.
-pub struct AnalysedLayer {
-    analysis: LayerAnalysis,
-    region: Shapes,
-    map: HeightMap,
-}
-
-/// The 3D grid of a job's analysis (fixed to the part's bounds).
-fn job_grid(job: &crate::Job) -> Grid3 {
-    let s = job.settings();
-    let d = footprint_diameter(s);
-    let bounds = job.info().bounds;
-    Grid3 {
-        origin: [bounds.min[0] - d, bounds.min[1] - d],
-        cell: s.droplet_width() / GRID3_PER_B,
-    }
-}
-
-impl LayerStage {
-    pub fn new(job: &crate::Job) -> LayerStage {
-        LayerStage {
-            settings: job.settings().clone(),
-            grid: job_grid(job),
-        }
-    }
-
-    /// Analyses layer `plan.index` against its `region`, in `raster`'s memory (one raster per
-    /// worker, reused from layer to layer).
-    pub fn analyse(&self, raster: &mut Raster, region: &Shapes, plan: &LayerPlan) -> AnalysedLayer {
-        let s = &self.settings;
-        let centres = droplet_centres(plan, s.droplet_width());
-        raster.rebuild(plan.index, plan.z, &centres, region, s);
-        AnalysedLayer {
-            analysis: raster.analysis(),
-            region: region.clone(),
-            map: HeightMap::new(&centres, &self.grid, footprint_diameter(s)),
-        }
-    }
-}
-
-/// The ordered half of the job analysis: takes every layer's [`AnalysedLayer`] in ascending
-/// order, computes each slab's 3D estimate once its neighbours are in, and gives the
-/// [`Report`]. Keeps two layers' maps at a time.
-pub struct JobAnalysis {
-    stage: LayerStage,
-    file_name: String,
-    part: PartAnalysis,
-    layers: Vec<LayerAnalysis>,
-    below: Option<HeightMap>,
-    current: Option<AnalysedLayer>,
-}
-
-impl JobAnalysis {
-    pub fn new(job: &crate::Job) -> JobAnalysis {
-        JobAnalysis {
-            stage: LayerStage::new(job),
-            file_name: job.info().file_name.clone(),
-            part: PartAnalysis::default(),
-            layers: Vec::with_capacity(job.layer_count()),
-            below: None,
-            current: None,
-        }
-    }
-
-    /// The stage for the workers.
-    pub fn stage(&self) -> LayerStage {
-        self.stage.clone()
-    }
-
-    /// The next layer (layers must come in ascending order, from 0).
-    pub fn push(&mut self, layer: AnalysedLayer) {
-        self.close(Some(&layer.map));
-        self.below = self.current.take().map(|c| c.map);
-        self.current = Some(layer);
-    }
-
-    /// The 3D estimate of the current layer, with `above` (the next layer's map, if any).
-    fn close(&mut self, above: Option<&HeightMap>) {
-        let Some(cur) = &self.current else { return };
-        let s = &self.stage.settings;
-        let (vol, void) = slab_voids(
-            &cur.region,
-            &self.stage.grid,
-            self.below.as_ref(),
-            &cur.map,
-            above,
-            s,
-        );
-        // The slab's exact volume, with the void share sampled on the grid.
-        let exact = cur.analysis.region_area * s.layer_height;
-        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
-        self.part.add(&cur.analysis, exact, void);
-        self.layers.push(cur.analysis.clone());
-    }
-
-    /// The report, after the last layer.
-    pub fn finish(mut self) -> Report {
-        self.close(None);
-        Report {
-            file_name: self.file_name,
-            model: Model::new(&self.stage.settings),
-            settings: self.stage.settings,
-            part: self.part,
-            layers: self.layers,
         }
     }
 }

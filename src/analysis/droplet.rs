@@ -1,0 +1,38 @@
+//! The droplet model: a droplet's footprint in its layer's plane and its spheroid in 3D, and
+//! where a layer's droplets are.
+
+use crate::geom::{Point, line_droplets};
+use crate::plan::{LayerPlan, MoveKind};
+use crate::settings::{Footprint, Settings};
+use std::f64::consts::PI;
+
+/// Footprint diameter D of a droplet, in mm.
+pub fn footprint_diameter(s: &Settings) -> f64 {
+    let b = s.droplet_width();
+    match s.footprint {
+        Footprint::Disc => b,
+        Footprint::Spread => 2.0 * b / PI.sqrt(),
+    }
+}
+
+/// Vertical semi-axis of the droplet spheroid (volume B·B·H), in mm.
+pub fn spheroid_half_height(s: &Settings) -> f64 {
+    let b = s.droplet_width();
+    let d = footprint_diameter(s);
+    3.0 * b * b * s.layer_height / (PI * d * d)
+}
+
+/// Every droplet centre of a layer (each droplet of a `G25` line too), in print order.
+pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
+    let mut out = Vec::with_capacity(plan.counts.total() as usize);
+    let mut at = Point::ZERO;
+    for m in &plan.moves {
+        match m.kind {
+            MoveKind::Travel => {}
+            MoveKind::Droplet => out.push(m.to),
+            MoveKind::Line => out.extend(line_droplets(at, m.to, b)),
+        }
+        at = m.to;
+    }
+    out
+}

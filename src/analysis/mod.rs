@@ -1,0 +1,58 @@
+//! Analysis: see the print before printing. A layer's droplets are rasterised against the
+//! layer's true region, giving coverage, voids, overfill and how far the printed outline strays
+//! from the boundary; over adjacent layers, a 3D estimate gives the part's void fraction.
+//!
+//! # The droplet model
+//! - **Footprint** (setting `footprint`): in the layer's plane a droplet covers a disc centred
+//!   on its position, of diameter D = B (`disc`, the droplet as measured, thesis 4.2) or
+//!   D = 2B/√π ≈ 1.13 B (`spread`: the disc whose area is a B × B cell, i.e. a droplet that
+//!   flattens with the volume a dense part needs). Discs of diameter B on a lattice of pitch B
+//!   only touch, so `disc` leaves at least 1 − π/4 ≈ 21 % of a filled area uncovered: its
+//!   figures are a pessimistic bound and best used to compare settings; real droplets flow
+//!   into part of those gaps.
+//! - **Volume** (3D estimate): a droplet is an oblate spheroid of horizontal diameter D, centred
+//!   at its layer's mid-height, whose volume is the cell a droplet must fill, B·B·H. Its height
+//!   is therefore 6B²H/(πD²) (1.91 H for `disc`): it reaches about 0.45 H into the layers above
+//!   and below, into their gaps, which is what staggering (setting `stagger`) exploits. A
+//!   point of the part (layer i's region × its slab) is filled when a spheroid of layer i − 1,
+//!   i or i + 1 contains it. Flow, surface tension and the shape of the surface a droplet lands
+//!   on are not modelled; spheroids below the first layer are cut by the bed.
+//!
+//! # The grid
+//! Rows every B/10 ([`ROWS_PER_B`]), columns every B/40 ([`COLS_PER_ROW`] per row). A droplet
+//! covers, in each row, as many columns around its centre as the average width of its disc
+//! over the row's band, rounded with the remainder carried from row to row (so one disc covers
+//! its exact area within half a cell, wherever it lies on the grid); the region covers the
+//! columns whose centres lie inside it at the row's centre (non-zero rule). Voids are the
+//! region's cells no droplet covers; two void cells in neighbouring rows are connected when
+//! their runs overlap by at least [`MIN_PASSAGE_COLS`] columns (B/20), so the voids on both
+//! sides of two touching droplets stay apart. The 3D estimate samples the part at cell centres
+//! every B/3 ([`GRID3_PER_B`]).
+//!
+//! # Boundary deviation
+//! The printed outline is the droplets' envelope with its enclosed voids filled. Its deviation
+//! from the region's boundary is measured one-sidedly: inward, the largest distance from the
+//! boundary of an uncovered point connected to the boundary (the depth of the scallops
+//! between droplets, or of a wall too thin for any droplet); outward, the largest distance from
+//! the region of a covered point outside it. Both are sampled at the ends and the middle of
+//! each run of cells, so they are exact to about a grid step.
+//!
+//! # Memory
+//! The grids span the layer's bounding box, but only tiles near its region and droplets are
+//! stored ([`Tiles`]): the 2D bitmaps in tiles of 64 rows × 256 columns (1.3 mm square with the
+//! default B), the spheroid maps in tiles of 32 × 32 cells (2.2 mm), the coverage mask in tiles
+//! over those. Parts a metre apart take the memory each takes alone, and the figures are those
+//! of a dense grid: the same grid, its rows and runs visited in the same order.
+
+mod droplet;
+mod estimate3d;
+mod raster;
+mod report;
+
+pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
+pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
+pub use raster::{
+    COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
+    Void, analyse_layer, analyse_layer_with_mask,
+};
+pub use report::{AnalysedLayer, JobAnalysis, LayerStage, Model, PartAnalysis, Report};

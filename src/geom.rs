@@ -1,0 +1,262 @@
+//! Geometry kernel: the plane types every stage shares, with the few figures they all use.
+//!
+//! - Points are [`glam::DVec2`] in millimetres (`p[0]`, `p[1]` or `p.x`, `p.y`).
+//! - A [`Shape`] is an outer boundary, counter-clockwise, and its holes, clockwise: the
+//!   material lies left of every loop. A [`Shapes`] is a layer's region: disjoint shapes.
+//! - Angles are in degrees; [`sin_cos_deg`] is exact at multiples of 90°.
+//! - Positions are written with [`OUTPUT_DECIMALS`] decimals; plans are rounded to them
+//!   ([`round_output`]) so counts, previews and the code agree exactly.
+//! - A `G25` line sets one droplet at its start and then one every B ([`line_droplets`]):
+//!   the one rule the plan, the preview, the analysis and the `.gco` reader use.
+//! - The boolean operations (i_overlay) take `[f64; 2]`: [`to_overlay`] and
+//!   [`shapes_from_overlay`] convert at that boundary.
+
+pub use glam::{DMat3, DVec2, DVec3};
+
+/// A point of a layer, in mm.
+pub type Point = DVec2;
+/// A closed polygon (the last point connects to the first).
+pub type Contour = Vec<Point>;
+
+/// One connected piece of a layer's material.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Shape {
+    /// The outer boundary, counter-clockwise.
+    pub outer: Contour,
+    /// The holes, clockwise.
+    pub holes: Vec<Contour>,
+}
+
+/// A region of one layer: disjoint shapes.
+pub type Shapes = Vec<Shape>;
+
+impl Shape {
+    pub fn new(outer: Contour, holes: Vec<Contour>) -> Shape {
+        Shape { outer, holes }
+    }
+
+    /// The outer boundary, then the holes.
+    pub fn contours(&self) -> impl Iterator<Item = &Contour> {
+        std::iter::once(&self.outer).chain(&self.holes)
+    }
+
+    /// The outer boundary (`false`) then the holes (`true`).
+    pub fn contours_with_hole(&self) -> impl Iterator<Item = (bool, &Contour)> {
+        std::iter::once((false, &self.outer)).chain(self.holes.iter().map(|h| (true, h)))
+    }
+
+    /// Its area (outer minus holes).
+    pub fn area(&self) -> f64 {
+        self.contours().map(|c| signed_area(c)).sum()
+    }
+}
+
+/// Every loop of a region, outer boundaries and holes.
+pub fn all_contours(region: &Shapes) -> impl Iterator<Item = &Contour> {
+    region.iter().flat_map(Shape::contours)
+}
+
+/// Positions are written with this many decimals.
+pub const OUTPUT_DECIMALS: usize = 4;
+/// 10^[`OUTPUT_DECIMALS`]: a position in output units is `(v * OUTPUT_SCALE).round()`.
+pub const OUTPUT_SCALE: f64 = 10_000.0;
+/// [`OUTPUT_SCALE`] as an integer.
+pub const OUTPUT_SCALE_INT: u64 = 10_000;
+
+/// `p` rounded to the output precision, as written in the code.
+pub fn round_output(p: Point) -> Point {
+    DVec2::new(
+        (p.x * OUTPUT_SCALE).round() / OUTPUT_SCALE,
+        (p.y * OUTPUT_SCALE).round() / OUTPUT_SCALE,
+    )
+}
+
+pub fn dist(a: Point, b: Point) -> f64 {
+    // Not `hypot`: coordinates are millimetres, far from overflow, and hypot is several
+    // times slower.
+    let (dx, dy) = (a[0] - b[0], a[1] - b[1]);
+    (dx * dx + dy * dy).sqrt()
+}
+
+/// Distance from `p` to the segment a–b.
+pub fn segment_distance(p: Point, a: Point, b: Point) -> f64 {
+    segment_distance2(p, a, b).sqrt()
+}
+
+/// Squared distance from `p` to the segment a–b.
+pub fn segment_distance2(p: Point, a: Point, b: Point) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let (x, y) = (p[0] - a[0] - t * d[0], p[1] - a[1] - t * d[1]);
+    x * x + y * y
+}
+
+/// Signed area of a closed contour (positive = counter-clockwise).
+pub fn signed_area(c: &[Point]) -> f64 {
+    let n = c.len();
+    (0..n)
+        .map(|i| {
+            let (p, q) = (c[i], c[(i + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+/// Area of a region (outer boundaries minus holes).
+pub fn region_area(shapes: &Shapes) -> f64 {
+    all_contours(shapes).map(|c| signed_area(c)).sum()
+}
+
+/// sin and cos of an angle in degrees, exact at multiples of 90°.
+pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
+    let q = deg / 90.0;
+    if q == q.round() {
+        match (q.round() as i64).rem_euclid(4) {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        }
+    } else {
+        deg.to_radians().sin_cos()
+    }
+}
+
+/// Number of droplets a `G25` line of this length sets: one at its start, then one every B.
+pub fn line_droplet_count(length: f64, b: f64) -> u64 {
+    (length / b + 1e-9).floor() as u64 + 1
+}
+
+/// The droplets of a `G25` line from `from` to `to`: one at `from`, then one every `b`
+/// ([`line_droplet_count`] of them).
+pub fn line_droplets(from: Point, to: Point, b: f64) -> impl Iterator<Item = Point> {
+    let l = dist(from, to);
+    (0..line_droplet_count(l, b)).map(move |j| {
+        let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
+        DVec2::new(
+            from[0] + t * (to[0] - from[0]),
+            from[1] + t * (to[1] - from[1]),
+        )
+    })
+}
+
+/// Loops in the boolean engine's point type.
+pub fn to_overlay<'a>(contours: impl IntoIterator<Item = &'a Contour>) -> Vec<Vec<[f64; 2]>> {
+    contours
+        .into_iter()
+        .map(|c| c.iter().map(|p| p.to_array()).collect())
+        .collect()
+}
+
+/// A loop from the boolean engine's point type.
+pub fn contour_from_overlay(c: Vec<[f64; 2]>) -> Contour {
+    c.into_iter().map(DVec2::from).collect()
+}
+
+/// Shapes from the boolean engine (each its outer boundary followed by its holes).
+pub fn shapes_from_overlay(shapes: Vec<Vec<Vec<[f64; 2]>>>) -> Shapes {
+    shapes
+        .into_iter()
+        .filter_map(|s| {
+            let mut loops = s.into_iter().map(contour_from_overlay);
+            let outer = loops.next()?;
+            Some(Shape::new(outer, loops.collect()))
+        })
+        .collect()
+}
+
+/// Crosses a region with the lines y = y0 + (k + phase)·step, k in `rows`: calls
+/// `span(k, xa, xb)` for every span of a line inside the region (non-zero rule), in order of
+/// k, then x. `to` maps the region's points first (the hatch turns its lines horizontal).
+pub fn scanline_spans(
+    region: &Shapes,
+    to: impl Fn(Point) -> Point,
+    y0: f64,
+    step: f64,
+    phase: f64,
+    rows: std::ops::Range<i64>,
+    mut span: impl FnMut(i64, f64, f64),
+) {
+    // (line k, x, winding)
+    let mut hits: Vec<(i64, f64, i32)> = Vec::new();
+    for contour in all_contours(region) {
+        let n = contour.len();
+        for i in 0..n {
+            let (p, q) = (to(contour[i]), to(contour[(i + 1) % n]));
+            if p[1] == q[1] {
+                continue;
+            }
+            let (lo, hi, w) = if p[1] < q[1] { (p, q, 1) } else { (q, p, -1) };
+            // Lines with lo.y <= y < hi.y.
+            let mut k = (((lo[1] - y0) / step - phase).ceil() as i64).max(rows.start);
+            while k < rows.end {
+                let y = y0 + (k as f64 + phase) * step;
+                if y >= hi[1] {
+                    break;
+                }
+                if y >= lo[1] {
+                    let x = lo[0] + (y - lo[1]) * (hi[0] - lo[0]) / (hi[1] - lo[1]);
+                    hits.push((k, x, w));
+                }
+                k += 1;
+            }
+        }
+    }
+    hits.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    for row in hits.chunk_by(|a, b| a.0 == b.0) {
+        let mut winding = 0;
+        let mut start = 0.0;
+        for &(k, x, w) in row {
+            let before = winding;
+            winding += w;
+            if before == 0 && winding != 0 {
+                start = x;
+            } else if before != 0 && winding == 0 {
+                span(k, start, x);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn right_angles_are_exact() {
+        assert_eq!(sin_cos_deg(90.0), (1.0, 0.0));
+        assert_eq!(sin_cos_deg(-90.0), (-1.0, 0.0));
+        assert_eq!(sin_cos_deg(540.0), (0.0, -1.0));
+    }
+
+    #[test]
+    fn a_line_sets_a_droplet_every_b() {
+        let d: Vec<Point> =
+            line_droplets(DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0), 0.25).collect();
+        assert_eq!(d.len(), 5);
+        assert_eq!(d[4], DVec2::new(1.0, 0.0));
+        assert_eq!(line_droplets(DVec2::ZERO, DVec2::ZERO, 0.2).count(), 1);
+    }
+
+    #[test]
+    fn area_of_a_square_with_a_hole() {
+        let sq = |a: f64| {
+            vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(a, 0.0),
+                DVec2::new(a, a),
+                DVec2::new(0.0, a),
+            ]
+        };
+        let mut hole = sq(1.0);
+        hole.reverse();
+        let s = vec![Shape::new(sq(4.0), vec![hole])];
+        assert_eq!(region_area(&s), 15.0);
+    }
+}

@@ -1,0 +1,112 @@
+//! The `.gco` reader ([`crate::gcode_read`]) for the page: a streaming [`GcodeStream`] fed
+//! with decoded text, giving finished layers as flat typed arrays.
+
+use crate::gcode_read::{GcodeReader, ReadLayer};
+use js_sys::{Float32Array, Uint8Array};
+use wasm_bindgen::prelude::*;
+
+/// A `.gco` file being read: `feed` pieces of text, `take_layer` the finished layers, then
+/// `finish`. Errors are the reader's messages ("line 5: …").
+#[wasm_bindgen]
+pub struct GcodeStream {
+    reader: GcodeReader,
+}
+
+/// One layer read from a file.
+#[wasm_bindgen]
+pub struct GcodeLayer {
+    layer: ReadLayer,
+}
+
+#[wasm_bindgen]
+impl GcodeStream {
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> GcodeStream {
+        GcodeStream {
+            reader: GcodeReader::new(),
+        }
+    }
+
+    /// Reads a piece of the file (lines may be split across pieces).
+    pub fn feed(&mut self, text: &str) -> Result<(), JsError> {
+        self.reader.feed(text).map_err(|e| JsError::new(&e.0))
+    }
+
+    /// After the last piece.
+    pub fn finish(&mut self) -> Result<(), JsError> {
+        self.reader.finish().map_err(|e| JsError::new(&e.0))
+    }
+
+    /// The next finished layer, if any.
+    pub fn take_layer(&mut self) -> Option<GcodeLayer> {
+        self.reader.take_layer().map(|layer| GcodeLayer { layer })
+    }
+
+    #[wasm_bindgen(getter)]
+    pub fn droplet_width(&self) -> f64 {
+        self.reader.droplet_width()
+    }
+
+    #[wasm_bindgen(getter)]
+    pub fn layers(&self) -> usize {
+        self.reader.layers()
+    }
+
+    #[wasm_bindgen(getter)]
+    pub fn line_number(&self) -> usize {
+        self.reader.line_number()
+    }
+
+    /// The header's `name = value` lines as a JSON object.
+    pub fn header_json(&self) -> String {
+        let map: serde_json::Map<String, serde_json::Value> = self
+            .reader
+            .header
+            .iter()
+            .map(|(n, v)| (n.clone(), serde_json::Value::String(v.clone())))
+            .collect();
+        serde_json::Value::Object(map).to_string()
+    }
+}
+
+impl Default for GcodeStream {
+    fn default() -> GcodeStream {
+        GcodeStream::new()
+    }
+}
+
+#[wasm_bindgen]
+impl GcodeLayer {
+    #[wasm_bindgen(getter)]
+    pub fn index(&self) -> usize {
+        self.layer.index
+    }
+
+    #[wasm_bindgen(getter)]
+    pub fn z(&self) -> f64 {
+        self.layer.z
+    }
+
+    /// Droplets by role: outer, inner, fill.
+    pub fn counts(&self) -> Vec<f64> {
+        let c = &self.layer.counts;
+        vec![c.outer as f64, c.inner as f64, c.fill as f64]
+    }
+
+    #[wasm_bindgen(getter)]
+    pub fn travel_mm(&self) -> f64 {
+        self.layer.travel_mm
+    }
+
+    pub fn droplets(&self) -> Float32Array {
+        Float32Array::from(&self.layer.preview.droplets[..])
+    }
+
+    pub fn roles(&self) -> Uint8Array {
+        Uint8Array::from(&self.layer.preview.roles[..])
+    }
+
+    pub fn travel(&self) -> Float32Array {
+        Float32Array::from(&self.layer.preview.travel[..])
+    }
+}
