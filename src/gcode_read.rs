@@ -11,7 +11,7 @@
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
 //! filling its memory, and every refusal names the line and the reason.
 
-use crate::geom::{DVec2, dist, line_droplets};
+use crate::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
 use crate::plan::Counts;
 use crate::preview::PreviewLayer;
 use std::collections::VecDeque;
@@ -269,7 +269,7 @@ impl GcodeReader {
         };
         let n: u64 = match code.as_str() {
             "G25" => {
-                let n = (len / self.width + 1e-9).floor() + 1.0;
+                let n = line_droplet_count_f64(len, self.width);
                 if n.is_nan() || self.droplets as f64 + n > MAX_DROPLETS as f64 {
                     return Err(if n > MAX_DROPLETS as f64 / 10.0 || !n.is_finite() {
                         GcodeError(format!(

@@ -130,7 +130,13 @@ pub fn sin_cos_deg(deg: f64) -> (f64, f64) {
 
 /// Number of droplets a `G25` line of this length sets: one at its start, then one every B.
 pub fn line_droplet_count(length: f64, b: f64) -> u64 {
-    (length / b + 1e-9).floor() as u64 + 1
+    line_droplet_count_f64(length, b) as u64
+}
+
+/// [`line_droplet_count`] as a float, unbounded: for checking a line from an untrusted file
+/// before it is expanded.
+pub fn line_droplet_count_f64(length: f64, b: f64) -> f64 {
+    (length / b + 1e-9).floor() + 1.0
 }
 
 /// The droplets of a `G25` line from `from` to `to`: one at `from`, then one every `b`
