@@ -49,7 +49,7 @@ pub fn js_error(e: Error) -> JsValue {
 }
 
 /// A value for JS (plain objects and arrays, `null` for `None`); a failure is an internal error.
-fn to_js<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<JsValue, JsValue> {
+pub(crate) fn to_js<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<JsValue, JsValue> {
     value
         .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
         .map_err(|e| {

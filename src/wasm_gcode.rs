@@ -57,15 +57,16 @@ impl GcodeStream {
         self.reader.line_number()
     }
 
-    /// The header's `name = value` lines as a JSON object.
-    pub fn header_json(&self) -> String {
-        let map: serde_json::Map<String, serde_json::Value> = self
+    /// The header's `name = value` lines as a plain object `{name: value}` (a typed value,
+    /// as everything else that crosses the boundary; a later line of the same name wins).
+    pub fn header(&self) -> Result<JsValue, JsValue> {
+        let map: std::collections::BTreeMap<&str, &str> = self
             .reader
             .header
             .iter()
-            .map(|(n, v)| (n.clone(), serde_json::Value::String(v.clone())))
+            .map(|(n, v)| (n.as_str(), v.as_str()))
             .collect();
-        serde_json::Value::Object(map).to_string()
+        crate::wasm::to_js(&map, "the .gco header")
     }
 }
 

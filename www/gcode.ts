@@ -38,7 +38,7 @@ export class GcodeReader {
 
   /** The header's `name = value` lines (before the first command). */
   get header(): Record<string, string> {
-    return JSON.parse(this.stream.header_json()) as Record<string, string>;
+    return this.stream.header() as Record<string, string>;
   }
   get dropletWidth(): number {
     return this.stream.droplet_width;
