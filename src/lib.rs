@@ -112,13 +112,22 @@ impl Job {
         let bounds = mesh.bounds();
         let size = bounds.size();
         check_height(&size, &settings)?;
-        // Every closed shell as its author meant it (inside-out shells turned outward, cavities
-        // kept), so the volume below counts what will be printed: shells of opposite
-        // orientation can no longer cancel.
+        // Repeated facets first (they would make a shell's edges look non-manifold), then every
+        // closed shell as its author meant it (inside-out shells turned outward, cavities kept),
+        // so the volume below counts what will be printed: shells of opposite orientation can
+        // no longer cancel.
+        let duplicates = mesh.remove_duplicate_facets();
         let shells = mesh.orient_shells();
         check_volume(&mesh, &shells, &size, &settings)?;
         let zs = plane_heights(&size, &settings)?;
-        let (mesh, buckets, stats) = repair(mesh, &zs, &shells, facets_in_file, degenerate);
+        let (mesh, buckets, stats) = repair(
+            mesh,
+            &zs,
+            shells.clone(),
+            duplicates,
+            facets_in_file,
+            degenerate,
+        );
         if shells.open > 0 {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
@@ -348,11 +357,11 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
 fn repair(
     mut mesh: Mesh,
     zs: &[f64],
-    shells: &mesh::ShellOrientation,
+    mut shells: mesh::ShellOrientation,
+    duplicates: usize,
     facets_in_file: usize,
     degenerate: usize,
 ) -> (Mesh, FacetBuckets, MeshStats) {
-    let duplicates = mesh.remove_duplicate_facets();
     // The statistics and the facet index are independent: build them side by side.
     let (stats, mut buckets) = both(
         || mesh.stats(facets_in_file, degenerate),
@@ -370,6 +379,12 @@ fn repair(
         let better = welded.stats(facets_in_file, degenerate + dropped);
         if merged > 0 && better.open_edges < stats.open_edges {
             mesh = welded;
+            // Shells the weld closed can now be oriented too (the facet index does not depend
+            // on the facets' orientation).
+            let again = mesh.orient_shells();
+            shells.flipped += again.flipped;
+            shells.cavities += again.cavities;
+            shells.unchecked = shells.unchecked.max(again.unchecked);
             buckets = FacetBuckets::new(&mesh, zs);
             stats = MeshStats {
                 tolerance_welded: merged,

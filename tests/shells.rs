@@ -99,6 +99,34 @@ fn an_inverted_box_overlapping_a_box_gives_their_union() {
 }
 
 #[test]
+fn an_inverted_shell_with_repeated_facets_or_cracks_is_still_turned() {
+    // Repeated facets (removed before orientation) and corners a micrometre apart (closed by
+    // the tolerance weld, then oriented): the overlap must still be printed.
+    let base = cuboid([0.0; 3], [10.0; 3]);
+    let other = inverted(cuboid([5.0, 0.0, 0.0], [15.0, 10.0, 10.0]));
+    let mut repeated = base.clone();
+    repeated.extend(other.iter().copied());
+    repeated.extend(other.iter().take(4).copied());
+    let j = job(&repeated).unwrap();
+    assert_eq!(j.info().mesh.flipped_shells, 1);
+    assert_eq!(j.info().mesh.duplicate_facets, 4);
+    assert_areas(&j, |_| 150.0, "inverted box with repeated facets");
+
+    let mut cracked = base;
+    for (k, f) in other.into_iter().enumerate() {
+        // Each facet's copy of a corner moved by up to 0.5 µm on its own: no exact weld.
+        let f = f.map(|v| v.map(|c| c + 5e-7 * ((k % 3) as f32 - 1.0)));
+        cracked.push(f);
+    }
+    let j = job(&cracked).unwrap();
+    assert!(j.info().mesh.tolerance_welded > 0, "{:?}", j.info().mesh);
+    assert_eq!(j.info().mesh.flipped_shells, 1);
+    for (z, a) in areas(&j) {
+        assert!((a - 150.0).abs() < 1e-3, "cracked: z = {z}: area {a}");
+    }
+}
+
+#[test]
 fn boxes_touching_at_a_corner_are_separate_shells() {
     // One vertex is shared after welding: a shell is what edges connect, so the inverted box
     // is still recognised, and a box overlapping both (positive) keeps both printed.
