@@ -1,0 +1,40 @@
+//! Time of `Job::new` (import, shells, checks, repair, facet index) on a model, median of 7.
+//! Usage: cargo run --release --example prepare_time -- MODEL.stl
+use dropslice::{Job, Settings};
+use std::time::Instant;
+
+fn main() {
+    let path = std::env::args()
+        .nth(1)
+        .expect("usage: prepare_time MODEL.stl");
+    let bytes = std::fs::read(&path).expect("read the model");
+    let mut times: Vec<f64> = (0..7)
+        .map(|_| {
+            let t = Instant::now();
+            let job = Job::new(&bytes, &path, Settings::default()).expect("job");
+            std::hint::black_box(job.layer_count());
+            t.elapsed().as_secs_f64() * 1000.0
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    let mut mesh = dropslice::mesh::Mesh::weld(&dropslice::stl::parse(&bytes).unwrap().0).0;
+    let t = Instant::now();
+    let shells = mesh.orient_shells();
+    let orient = t.elapsed().as_secs_f64() * 1000.0;
+    let t = Instant::now();
+    let stats = mesh.stats(0, 0);
+    let st = t.elapsed().as_secs_f64() * 1000.0;
+    let b = mesh.bounds();
+    let zs: Vec<f64> = (0..((b.max[2] - b.min[2]) / 0.2) as usize)
+        .map(|i| b.min[2] + (i as f64 + 0.5) * 0.2)
+        .collect();
+    let t = Instant::now();
+    let buckets = dropslice::slice::FacetBuckets::new(&mesh, &zs);
+    let bt = t.elapsed().as_secs_f64() * 1000.0;
+    std::hint::black_box((stats, buckets.layer(0).len()));
+    println!("stats {st:.1} ms, facet index {bt:.1} ms");
+    println!(
+        "Job::new: median {:.1} ms; orient_shells alone {orient:.1} ms ({} closed, {} open shells)",
+        times[3], shells.closed, shells.open
+    );
+}
