@@ -391,14 +391,15 @@ fn repair(
                 duplicate_facets: duplicates,
                 ..better
             };
+            if again.flipped > 0 {
+                // `better` was measured before these shells were turned.
+                stats.signed_volume = mesh.signed_volume();
+            }
         }
     }
     stats.flipped_shells = shells.flipped;
     stats.cavity_shells = shells.cavities;
     stats.unchecked_shells = shells.unchecked;
-    if shells.flipped > 0 {
-        stats.signed_volume = mesh.signed_volume();
-    }
     (mesh, buckets, stats)
 }
 

@@ -1,28 +1,16 @@
 //! The coverage analysis against exact cases (disc area, square lattice, scallops along an
 //! edge, overfill across an edge) and the staggering of loops and hatch lines.
 
+mod common;
+
 use dropslice::Settings;
 use dropslice::analysis::{analyse_layer, analyse_layer_with_mask};
 use dropslice::geom::{Shape, Shapes};
-use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
+use dropslice::plan::{LayerPlan, Move, Role};
 
 /// Points as plain arrays in these tests.
 type Point = [f64; 2];
 use std::f64::consts::PI;
-
-fn plan_of(points: &[Point]) -> LayerPlan {
-    LayerPlan {
-        moves: points
-            .iter()
-            .map(|&to| Move {
-                kind: MoveKind::Droplet,
-                role: Role::Fill,
-                to: to.into(),
-            })
-            .collect(),
-        ..LayerPlan::default()
-    }
-}
 
 fn rect(x0: f64, y0: f64, x1: f64, y1: f64) -> Shapes {
     let outer = [[x0, y0], [x1, y0], [x1, y1], [x0, y1]].map(Into::into);
@@ -38,7 +26,7 @@ fn one_disc_covers_its_area_within_one_percent() {
     // Many positions relative to the grid.
     for i in 0..97 {
         let p = [0.0137 * i as f64 % 0.3, 0.0291 * i as f64 % 0.3];
-        let a = analyse_layer(&plan_of(&[p]), &region, &s);
+        let a = analyse_layer(&common::droplet_plan(&[p]), &region, &s);
         let got = a.covered_area;
         assert!(
             (got - want).abs() < 0.01 * want,
@@ -63,7 +51,7 @@ fn square_lattice_at_pitch_b_leaves_one_minus_pi_over_four() {
         }
         let side = n as f64 * b;
         let region = rect(ox, oy, ox + side, oy + side);
-        let a = analyse_layer(&plan_of(&pts), &region, &s);
+        let a = analyse_layer(&common::droplet_plan(&pts), &region, &s);
         let share = a.void_area / a.region_area;
         let want = 1.0 - PI / 4.0;
         assert!(
@@ -93,7 +81,7 @@ fn a_row_along_an_edge_gives_the_scallop_depth() {
         let n = 60;
         let pts: Vec<Point> = (0..n).map(|k| [r + k as f64 * pitch, r]).collect();
         let len = 2.0 * r + (n - 1) as f64 * pitch;
-        let a = analyse_layer(&plan_of(&pts), &rect(0.0, 0.0, len, b), &s);
+        let a = analyse_layer(&common::droplet_plan(&pts), &rect(0.0, 0.0, len, b), &s);
         let want = r - (r * r - pitch * pitch / 4.0).sqrt();
         assert!(
             (a.deviation_inward - want).abs() < b / 10.0,
@@ -106,7 +94,7 @@ fn a_row_along_an_edge_gives_the_scallop_depth() {
     }
     // Droplets centred on the edge reach r outside it.
     let pts: Vec<Point> = (0..50).map(|k| [1.0 + k as f64 * 0.8 * b, 0.0]).collect();
-    let a = analyse_layer(&plan_of(&pts), &rect(0.0, 0.0, 12.0, b), &s);
+    let a = analyse_layer(&common::droplet_plan(&pts), &rect(0.0, 0.0, 12.0, b), &s);
     assert!(
         (a.deviation_outward - r).abs() < b / 10.0,
         "outward {} vs {r}",
@@ -131,7 +119,7 @@ fn an_enclosed_void_is_found_with_its_position() {
         }
     }
     let side = 29.0 * p;
-    let a = analyse_layer(&plan_of(&pts), &rect(0.0, 0.0, side, side), &s);
+    let a = analyse_layer(&common::droplet_plan(&pts), &rect(0.0, 0.0, side, side), &s);
     let v = a.largest_void.unwrap();
     assert!(!v.at_boundary, "{v:?}");
     let centre = 13.0 * p;
@@ -141,7 +129,12 @@ fn an_enclosed_void_is_found_with_its_position() {
     let want = (4.0 * p - b).powi(2);
     assert!((v.area - want).abs() < 0.35 * want, "{} vs {want}", v.area);
     assert!((a.enclosed_void_area - v.area).abs() < 1e-9);
-    let (_, mask) = analyse_layer_with_mask(&plan_of(&pts), &rect(0.0, 0.0, side, side), &s, b);
+    let (_, mask) = analyse_layer_with_mask(
+        &common::droplet_plan(&pts),
+        &rect(0.0, 0.0, side, side),
+        &s,
+        b,
+    );
     for t in &mask.tiles {
         assert_eq!(t.void.len(), t.width * t.height);
     }

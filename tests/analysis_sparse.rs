@@ -3,27 +3,14 @@
 //! 3 m apart it could not allocate at all; the page's coverage mask was a dense grid over the
 //! same box. Now rasters, spheroid maps and masks are stored in tiles near the parts only.
 
+mod common;
+
 use dropslice::Settings;
 use dropslice::analysis::{
     Grid3, HeightMap, Raster, analyse_layer, analyse_layer_with_mask, footprint_diameter,
     slab_voids,
 };
 use dropslice::geom::{Point, Shapes};
-use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
-
-fn plan_of(points: &[Point]) -> LayerPlan {
-    LayerPlan {
-        moves: points
-            .iter()
-            .map(|&to| Move {
-                kind: MoveKind::Droplet,
-                role: Role::Fill,
-                to,
-            })
-            .collect(),
-        ..LayerPlan::default()
-    }
-}
 
 /// A `side` mm square at (x, y) filled with droplets on a square lattice of pitch B (their
 /// gaps are voids).
@@ -55,8 +42,8 @@ fn parts_far_apart_take_memory_for_the_parts_only() {
     let pts: Vec<Point> = pa.iter().chain(&pb).copied().collect();
 
     // The figures: twice those of one square.
-    let one = analyse_layer(&plan_of(&pa), &ra, &s);
-    let (two, mask) = analyse_layer_with_mask(&plan_of(&pts), &region, &s, b / 4.0);
+    let one = analyse_layer(&common::droplet_plan(&pa), &ra, &s);
+    let (two, mask) = analyse_layer_with_mask(&common::droplet_plan(&pts), &region, &s, b / 4.0);
     assert!((two.region_area - 8.0).abs() < 1e-9, "{}", two.region_area);
     let close = |a: f64, b: f64| (a - b).abs() <= 0.01 * b.abs().max(1e-3);
     assert!(

@@ -12,26 +12,10 @@
 
 mod common;
 
+use common::Rng;
 use dropslice::settings::{Kind, schema};
 use dropslice::{Error, Job, Settings};
 use std::time::{Duration, Instant};
-
-/// xorshift64*: small, deterministic.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 const MODELS: [&str; 6] = [
     "cube_20mm_ascii.stl",
@@ -64,39 +48,39 @@ fn mutate(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, String) {
         let n = u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as usize;
         b.len() == 84 + 50 * n
     };
-    let what = match rng.below(8) {
+    let what = match rng.pick(8) {
         0 => {
-            let n = 1 + rng.below(32);
+            let n = 1 + rng.pick(32);
             for _ in 0..n {
-                let i = rng.below(b.len());
-                b[i] ^= 1 << rng.below(8);
+                let i = rng.pick(b.len());
+                b[i] ^= 1 << rng.pick(8);
             }
             format!("{n} bit flips")
         }
         1 => {
-            let at = rng.below(b.len());
+            let at = rng.pick(b.len());
             b.truncate(at);
             format!("truncated at {at}")
         }
         2 => {
-            let (from, len) = (rng.below(b.len()), 1 + rng.below(4096));
+            let (from, len) = (rng.pick(b.len()), 1 + rng.pick(4096));
             let chunk: Vec<u8> = b[from..(from + len).min(b.len())].to_vec();
-            let at = rng.below(b.len());
+            let at = rng.pick(b.len());
             b.splice(at..at, chunk);
             format!("{len} bytes from {from} spliced in at {at}")
         }
         3 if binary => {
-            let n: u32 = [0, 1, u32::MAX, 0x7fff_ffff, rng.next() as u32][rng.below(5)];
+            let n: u32 = [0, 1, u32::MAX, 0x7fff_ffff, rng.next_u64() as u32][rng.pick(5)];
             b[80..84].copy_from_slice(&n.to_le_bytes());
             format!("triangle count set to {n}")
         }
         4 | 5 if binary => {
-            let k = 1 + rng.below(16);
+            let k = 1 + rng.pick(16);
             let tris = (b.len() - 84) / 50;
             for _ in 0..k {
-                let t = rng.below(tris);
-                let c = rng.below(12); // normal or a vertex coordinate
-                let v = SPECIAL_F32[rng.below(SPECIAL_F32.len())];
+                let t = rng.pick(tris);
+                let c = rng.pick(12); // normal or a vertex coordinate
+                let v = SPECIAL_F32[rng.pick(SPECIAL_F32.len())];
                 let at = 84 + 50 * t + 4 * c;
                 b[at..at + 4].copy_from_slice(&v.to_le_bytes());
             }
@@ -106,11 +90,11 @@ fn mutate(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, String) {
             // ASCII: replace numbers after "vertex" with special texts.
             let text = String::from_utf8_lossy(&b).into_owned();
             let mut words: Vec<String> = text.split(' ').map(str::to_string).collect();
-            let k = 1 + rng.below(8);
+            let k = 1 + rng.pick(8);
             for _ in 0..k {
-                let i = rng.below(words.len());
+                let i = rng.pick(words.len());
                 if words[i].parse::<f64>().is_ok() {
-                    words[i] = SPECIAL_TEXT[rng.below(SPECIAL_TEXT.len())].into();
+                    words[i] = SPECIAL_TEXT[rng.pick(SPECIAL_TEXT.len())].into();
                 }
             }
             b = words.join(" ").into_bytes();
@@ -118,8 +102,8 @@ fn mutate(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, String) {
         }
         6 => {
             // Facets repeated (or, in ASCII, lines repeated) to grow the file.
-            let reps = 1 + rng.below(20);
-            let (from, len) = (rng.below(b.len()), 1 + rng.below(2000));
+            let reps = 1 + rng.pick(20);
+            let (from, len) = (rng.pick(b.len()), 1 + rng.pick(2000));
             let chunk: Vec<u8> = b[from..(from + len).min(b.len())].to_vec();
             for _ in 0..reps {
                 b.extend_from_slice(&chunk);
@@ -127,8 +111,8 @@ fn mutate(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, String) {
             format!("{len} bytes from {from} appended {reps} times")
         }
         _ => {
-            let n = rng.below(512);
-            b = (0..n).map(|_| rng.next() as u8).collect();
+            let n = rng.pick(512);
+            b = (0..n).map(|_| rng.next_u64() as u8).collect();
             format!("{n} random bytes")
         }
     };
@@ -139,21 +123,21 @@ fn mutate(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, String) {
 /// choice setting one of its choices; layer height and droplets kept so a case stays fast.
 fn random_settings(rng: &mut Rng) -> Settings {
     let mut s = Settings::default();
-    if rng.below(3) == 0 {
+    if rng.pick(3) == 0 {
         return s;
     }
     for spec in schema() {
-        if rng.below(4) != 0 {
+        if rng.pick(4) != 0 {
             continue;
         }
         let value = match spec.kind {
-            Kind::Bool => ["true", "false"][rng.below(2)].to_string(),
-            Kind::Enum => spec.choices[rng.below(spec.choices.len())].into(),
+            Kind::Bool => ["true", "false"][rng.pick(2)].to_string(),
+            Kind::Enum => spec.choices[rng.pick(spec.choices.len())].into(),
             _ => {
                 let (Some(lo), Some(hi)) = (spec.min, spec.max) else {
                     continue;
                 };
-                let x = match rng.below(4) {
+                let x = match rng.pick(4) {
                     0 => lo,
                     1 => hi,
                     _ => lo + (hi - lo) * rng.unit(),
@@ -247,7 +231,7 @@ fn mutated_models_never_panic() {
         .iter()
         .map(|m| (*m, common::model_bytes(m)))
         .collect();
-    let mut rng = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let mut rng = Rng::new(seed);
     let start = Instant::now();
     let mut cases = 0;
     let mut failures = Vec::new();
@@ -255,10 +239,10 @@ fn mutated_models_never_panic() {
     let hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(|_| {}));
     while start.elapsed() < Duration::from_secs_f64(seconds) && failures.len() < 5 {
-        let (name, original) = &models[rng.below(models.len())];
+        let (name, original) = &models[rng.pick(models.len())];
         let (bytes, what) = mutate(&mut rng, original);
         // Sometimes a second mutation on top of the first.
-        let (bytes, what) = if rng.below(4) == 0 {
+        let (bytes, what) = if rng.pick(4) == 0 {
             let (b, w) = mutate(&mut rng, &bytes);
             (b, format!("{what}, then {w}"))
         } else {

@@ -535,4 +535,32 @@ impl Rng {
     pub fn bytes(&mut self, n: usize) -> Vec<u8> {
         (0..n).map(|_| self.next_u64() as u8).collect()
     }
+
+    /// An index below `n` (0 when `n` is 0).
+    pub fn pick(&mut self, n: usize) -> usize {
+        (self.next_u64() % n.max(1) as u64) as usize
+    }
+
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A layer plan of single droplets (`G26`, fill) at the given points, for analysis tests.
+pub fn droplet_plan<P: Copy + Into<dropslice::geom::Point>>(
+    points: &[P],
+) -> dropslice::plan::LayerPlan {
+    use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
+    LayerPlan {
+        moves: points
+            .iter()
+            .map(|&to| Move {
+                kind: MoveKind::Droplet,
+                role: Role::Fill,
+                to: to.into(),
+            })
+            .collect(),
+        ..LayerPlan::default()
+    }
 }
