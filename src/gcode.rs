@@ -19,6 +19,8 @@ pub struct HeaderInput<'a> {
     /// Bounding box of the placed part (min, max).
     pub bounds: ([f64; 3], [f64; 3]),
     pub warnings: &'a [String],
+    /// Whether discharge unit 1 prints anything (its settings are listed only then).
+    pub unit1_used: bool,
 }
 
 /// Width of the droplet count fields in the header.
@@ -105,7 +107,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
         let _ = writeln!(h, "; warning: {}", w.replace(['\n', '\r'], " "));
     }
     let _ = writeln!(h, "; settings:");
-    for (name, value, unit) in s.entries() {
+    for (name, value, unit) in s.entries_with(input.unit1_used) {
         if unit.is_empty() {
             let _ = writeln!(h, "; {name} = {value}");
         } else {

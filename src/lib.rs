@@ -255,6 +255,7 @@ impl Job {
                 layers: self.zs.len(),
                 bounds: (b.min, b.max),
                 warnings: &self.info.warnings,
+                unit1_used: self.settings.support == settings::Support::Unit1,
             },
             summary,
         )

@@ -47,6 +47,33 @@ pub enum Footprint {
     Spread,
 }
 
+/// How droplets are spaced along a contour loop (SPEC.md "Loop seams").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LoopSpacing {
+    /// Centres B apart, the first droplet repeated at the end (the thesis).
+    Exact,
+    /// n = ⌈L/B⌉ droplets spaced L/n along the loop, none repeated.
+    Even,
+}
+
+/// Whether support is printed under overhangs (SPEC.md "Two discharge units").
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Support {
+    Off,
+    /// Support printed by discharge unit 1.
+    Unit1,
+}
+
+/// Which discharge unit prints first within a layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum UnitOrder {
+    Unit0First,
+    Unit1First,
+}
+
 /// Every parameter of a slice. `Default` gives the values of SPEC.md.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -67,6 +94,8 @@ pub struct Settings {
     pub contour_order: ContourOrder,
     pub print_order: PrintOrder,
     pub close_loops: bool,
+    /// Droplet spacing along loops (`exact`: the thesis; `even`: no repeated seam droplet).
+    pub loop_spacing: LoopSpacing,
     pub rotate_x: f64,
     pub rotate_y: f64,
     pub rotate_z: f64,
@@ -85,6 +114,29 @@ pub struct Settings {
     pub material_density: f64,
     /// Droplet footprint model of the coverage analysis.
     pub footprint: Footprint,
+    /// Build plate size in x and y (mm): parts are arranged on it.
+    pub plate_x: f64,
+    pub plate_y: f64,
+    /// Gap between the bounding boxes of arranged parts (mm).
+    pub part_spacing: f64,
+    /// A droplet is supported when the layer below has material within this many B.
+    pub overhang_limit: f64,
+    /// Support under overhangs, printed by discharge unit 1.
+    pub support: Support,
+    /// Support is kept this many B (of unit 0) away from the part within a layer.
+    pub support_gap_xy: f64,
+    /// Support ends this many layers below the overhang it carries.
+    pub support_gap_z: u32,
+    /// Hatch spacing of the support = B₁ / support_density.
+    pub support_density: f64,
+    /// Droplet width of unit 1 divided by the layer height (B₁ = aspect × H).
+    pub unit1_droplet_aspect: f64,
+    /// Droplets unit 1 sets per second (time estimate).
+    pub unit1_droplet_rate: f64,
+    /// Density of unit 1's material (mass estimate).
+    pub unit1_material_density: f64,
+    /// Which unit prints first within a layer.
+    pub unit_order: UnitOrder,
 }
 
 impl Default for Settings {
@@ -104,6 +156,7 @@ impl Default for Settings {
             contour_order: ContourOrder::InsideOut,
             print_order: PrintOrder::ContoursFirst,
             close_loops: true,
+            loop_spacing: LoopSpacing::Exact,
             rotate_x: 0.0,
             rotate_y: 0.0,
             rotate_z: 0.0,
@@ -118,6 +171,18 @@ impl Default for Settings {
             travel_speed: 50.0,
             material_density: 1.04,
             footprint: Footprint::Disc,
+            plate_x: 154.0,
+            plate_y: 134.0,
+            part_spacing: 5.0,
+            overhang_limit: 0.5,
+            support: Support::Off,
+            support_gap_xy: 0.5,
+            support_gap_z: 0,
+            support_density: 1.0,
+            unit1_droplet_aspect: 1.04,
+            unit1_droplet_rate: 100.0,
+            unit1_material_density: 1.04,
+            unit_order: UnitOrder::Unit0First,
         }
     }
 }
@@ -277,6 +342,13 @@ pub fn schema() -> Vec<SettingSpec> {
             "Contours",
             "Repeat a loop's first droplet at its end to close it",
         ),
+        choice(
+            "loop_spacing",
+            Kind::Enum,
+            &["exact", "even"],
+            "Contours",
+            "exact: droplets B apart, the first repeated at the end (the thesis); even: n = ceil(L/B) droplets spaced evenly, no double droplet at the seam",
+        ),
         num(
             "fill_density",
             "",
@@ -411,6 +483,103 @@ pub fn schema() -> Vec<SettingSpec> {
             &["disc", "spread"],
             "Analysis",
             "Droplet footprint in the coverage report: disc = diameter B; spread = diameter 2B/sqrt(pi), the area of a B x B cell",
+        ),
+        positive(num(
+            "plate_x",
+            "mm",
+            0.0,
+            100000.0,
+            "Plate",
+            "Build plate size in x: parts without a placement are arranged on it",
+        )),
+        positive(num(
+            "plate_y",
+            "mm",
+            0.0,
+            100000.0,
+            "Plate",
+            "Build plate size in y",
+        )),
+        num(
+            "part_spacing",
+            "mm",
+            0.0,
+            1000.0,
+            "Plate",
+            "Gap between the bounding boxes of arranged parts",
+        ),
+        num(
+            "overhang_limit",
+            "x B",
+            0.0,
+            10.0,
+            "Support",
+            "A droplet is supported when the layer below has material within this many droplet widths of its centre",
+        ),
+        choice(
+            "support",
+            Kind::Enum,
+            &["off", "unit1"],
+            "Support",
+            "off: no support; unit1: support under every overhang, printed by discharge unit 1",
+        ),
+        num(
+            "support_gap_xy",
+            "x B",
+            0.0,
+            10.0,
+            "Support",
+            "Support is kept this many droplet widths away from the part within a layer",
+        ),
+        SettingSpec {
+            kind: Kind::Integer,
+            ..num(
+                "support_gap_z",
+                "layers",
+                0.0,
+                100.0,
+                "Support",
+                "Support ends this many layers below the overhang (0: a soluble support touches the part)",
+            )
+        },
+        positive(num(
+            "support_density",
+            "",
+            0.0,
+            1.0,
+            "Support",
+            "Hatch spacing of the support = B1 / support_density",
+        )),
+        positive(num(
+            "unit1_droplet_aspect",
+            "",
+            0.0,
+            10.0,
+            "Unit 1",
+            "Droplet width B1 of discharge unit 1 divided by the layer height",
+        )),
+        positive(num(
+            "unit1_droplet_rate",
+            "Hz",
+            0.0,
+            100000.0,
+            "Unit 1",
+            "Droplets unit 1 sets per second (time estimate)",
+        )),
+        positive(num(
+            "unit1_material_density",
+            "g/cm³",
+            0.0,
+            30.0,
+            "Unit 1",
+            "Density of unit 1's material (mass estimate)",
+        )),
+        choice(
+            "unit_order",
+            Kind::Enum,
+            &["unit0_first", "unit1_first"],
+            "Unit 1",
+            "Which discharge unit prints first within a layer",
         ),
     ];
     let defaults = serde_json::to_value(Settings::default()).expect("settings serialize");
@@ -566,11 +735,23 @@ impl Settings {
         self.layer_height * self.droplet_aspect
     }
 
+    /// Droplet width B₁ of discharge unit 1 in mm.
+    pub fn unit1_droplet_width(&self) -> f64 {
+        self.layer_height * self.unit1_droplet_aspect
+    }
+
     /// The settings as `(name, value)` pairs in schema order, values as they appear in the header.
     pub fn entries(&self) -> Vec<(&'static str, String, &'static str)> {
+        self.entries_with(true)
+    }
+
+    /// [`entries`](Self::entries) for the header: the settings of discharge unit 1 (those only
+    /// unit 1 uses, [`is_unit1_setting`]) only when unit 1 is used.
+    pub fn entries_with(&self, unit1_used: bool) -> Vec<(&'static str, String, &'static str)> {
         let map = serde_json::to_value(self).expect("settings serialize");
         schema()
             .into_iter()
+            .filter(|spec| unit1_used || !is_unit1_setting(spec.name))
             .map(|spec| {
                 let v = &map[spec.name];
                 let text = match v {
@@ -581,6 +762,13 @@ impl Settings {
             })
             .collect()
     }
+}
+
+/// Settings that only discharge unit 1 uses (listed in the header when unit 1 is used).
+pub fn is_unit1_setting(name: &str) -> bool {
+    name.starts_with("unit1_")
+        || name == "unit_order"
+        || matches!(name, "support_gap_xy" | "support_gap_z" | "support_density")
 }
 
 /// Names of all settings, in schema order.
