@@ -191,10 +191,20 @@ fn check_loop(model: &str, z: f64, lp: &[Point]) {
     );
 }
 
-/// Every setting is in the header as `; name = value`, and the header reproduces the settings.
+/// Every setting is in the header as `; name = value` (unit 1's only when unit 1 is used), and
+/// the header reproduces the settings.
 fn check_header(model: &str, g: &Gcode, used: &Settings) {
     let mut rebuilt = Settings::default();
+    let unit1_used = used.support != dropslice::settings::Support::Off;
     for name in dropslice::settings::names() {
+        if !unit1_used && dropslice::settings::is_unit1_setting(name) {
+            // SPEC.md: unit 1's settings are listed only when unit 1 is used.
+            assert!(
+                g.get(name).is_none(),
+                "{model}: unit-1 setting '{name}' listed though unit 1 is unused"
+            );
+            continue;
+        }
         let v = g
             .get(name)
             .unwrap_or_else(|| panic!("{model}: setting '{name}' is missing from the header"));
