@@ -99,7 +99,7 @@ export const COLORS = {
   /** The current layer's slab (the outer-loop colour of the layer view). */
   slab: 0xe8590c,
   /** The cut through the parts at the current layer's top. */
-  cap: 0xf08c3c,
+  cap: 0xf4b37e,
 } as const;
 
 /** Plates up to this size (mm) are drawn (the settings allow up to 100 m). */
@@ -282,6 +282,8 @@ export class View3D {
     axes.add(label("x", "#e03131", len + len * 0.25, 0, 0, len * 0.35), label("y", "#2f9e44", 0, len + len * 0.25, 0, len * 0.35));
     axes.position.z = 0.01;
     this.plate.add(axes);
+    // a hair below z = 0: the cut's cap shows the inside of a part's bottom, at z = 0 itself
+    this.plate.position.z = -0.05;
     this.request();
   }
 
