@@ -415,13 +415,22 @@ export class View3D {
     }
     const center = b.getCenter(new Vector3());
     center.z *= 0.5;
-    const radius = Math.max(1, b.getSize(new Vector3()).length() / 2);
-    const aspect = this.width > 0 && this.height > 0 ? this.width / this.height : 1.5;
-    const vfov = (this.camera.fov * Math.PI) / 180;
-    const hfov = 2 * Math.atan(Math.tan(vfov / 2) * aspect);
-    const dist = (radius / Math.sin(Math.min(vfov, hfov) / 2)) * 0.92;
     // from the front, a little to the left, above: an iso-like view
     const dir = new Vector3(-0.55, -1, 0.85).normalize();
+    const right = new Vector3().crossVectors(this.camera.up, dir).normalize();
+    const up = new Vector3().crossVectors(dir, right);
+    const aspect = this.width > 0 && this.height > 0 ? this.width / this.height : 1.5;
+    const tanV = Math.tan((this.camera.fov * Math.PI) / 360);
+    const tanH = tanV * aspect;
+    // the distance at which every corner of the box is in the picture (with a margin)
+    let dist = 1;
+    const v = new Vector3();
+    for (let i = 0; i < 8; i++) {
+      v.set(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z).sub(center);
+      const depth = v.dot(dir);
+      dist = Math.max(dist, (Math.abs(v.dot(right)) * 1.06) / tanH + depth, (Math.abs(v.dot(up)) * 1.06) / tanV + depth);
+    }
+    const radius = Math.max(1, b.getSize(v).length() / 2);
     this.camera.position.copy(center).addScaledVector(dir, dist);
     this.camera.near = Math.max(0.01, dist / 200);
     this.camera.far = dist * 20;
