@@ -35,8 +35,10 @@ export class View3DPanel {
   private parts: View3DPart[] = [];
   private plate = { x: 154, y: 134 };
   private slice: View3DSlice | null = null;
-  /** The model the camera was last fitted to (a new model is framed once). */
-  private framed: Float32Array | null = null;
+  /** The model shown, and the one the camera was last fitted to: a new model is framed once
+   *  (slicing the same model again keeps the camera). */
+  private model: unknown = null;
+  private framed: unknown = null;
   active = false;
 
   constructor(private readonly container: HTMLElement) {}
@@ -50,6 +52,7 @@ export class View3DPanel {
   sync(s: Slice | null, current: number): void {
     const part = s?.source === "stl" ? s.part3d : null;
     this.parts = part ? [part] : [];
+    this.model = part ? (s?.model ?? part) : null;
     const px = Number(s?.settings.plate_x);
     const py = Number(s?.settings.plate_y);
     if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
@@ -63,9 +66,8 @@ export class View3DPanel {
     v.setPlate(this.plate.x, this.plate.y);
     v.setParts(this.parts);
     v.setSlice(this.slice);
-    const shown = this.parts[0]?.positions ?? null;
-    if (shown !== null && shown !== this.framed) {
-      this.framed = shown;
+    if (this.model !== null && this.model !== this.framed) {
+      this.framed = this.model;
       v.fit();
     }
     $("view3d-empty").hidden = this.parts.length > 0;
