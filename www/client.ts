@@ -13,6 +13,7 @@ import type {
   InitResult,
   LayerData,
   OpenResult,
+  PreparedMesh,
   Reply,
   RequestData,
   RequestKind,
@@ -120,6 +121,10 @@ export interface SliceCallbacks {
   layer(layer: LayerData): void;
   /** A run of layers is complete: its G-code and summary (after all its layers). */
   unit(unit: SliceUnit): void;
+  /** The prepared (placed, repaired) mesh, for the 3D view: called once, after the first
+   *  worker opened the model and before `opened`; the arrays are the page's until it returns
+   *  (then they are handed on to the other workers). */
+  mesh?(prepared: PreparedMesh): void;
 }
 
 /** A run of consecutive layers [from, to). */
@@ -145,21 +150,24 @@ function unitCounter(layers: number, workers: number): () => Unit | null {
 /** Opens a model: the first worker reads the File and prepares the job (and hashes the file
  *  when asked); the others take the prepared mesh. `ready(h, r)` runs for each worker as soon
  *  as it holds the model (for the first one before the others are asked). If the first worker
- *  refuses the model, no worker is touched and every one keeps its previous model. */
+ *  refuses the model, no worker is touched and every one keeps its previous model. With
+ *  `mesh`, the prepared mesh is shown to it first (synchronously, before it is handed on). */
 async function openAll(
   handles: WorkerHandle[],
   file: File,
   settings: Settings,
   ready: (h: WorkerHandle, r: OpenResult) => Promise<void>,
+  mesh?: (prepared: PreparedMesh) => void,
 ): Promise<OpenResult> {
   const [first, ...others] = handles;
-  const r = await first.call("open", { file, settings, hash: true, prepare: others.length > 0 });
+  const r = await first.call("open", { file, settings, hash: true, prepare: others.length > 0 || mesh !== undefined });
   for (const h of handles) h.hasModel = false;
   first.hasModel = true;
   const prepared = r.prepared;
   delete r.prepared;
+  if (prepared && mesh) mesh(prepared);
   const work = [ready(first, r)];
-  if (prepared) {
+  if (prepared && others.length > 0) {
     others.forEach((h, k) => {
       // each worker gets its own copy; the last one takes the buffers themselves
       const last = k === others.length - 1;
@@ -246,7 +254,7 @@ export class Pool {
           cb.opened(r);
         }
         await this.units(h, nextUnit, { analyse }, cb.layer, cb.unit);
-      });
+      }, cb.mesh);
     });
   }
 

@@ -14,6 +14,7 @@ import { updateButtons } from "./views/controls";
 import { saveGcode } from "./views/download";
 import { clampLayer, layerLabel, setLayers, show } from "./views/layer";
 import { showModel, writeStats } from "./views/stats";
+import { View3DPanel } from "./views/view3d";
 import { progress, setState } from "./views/status";
 
 export interface Target {
@@ -131,6 +132,10 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
           // the final refresh below reports what went wrong
         });
       },
+      // before `opened`, which shows the slice (and so the part in 3D)
+      mesh: (prepared) => {
+        if (gen === store.generation) s.part3d = View3DPanel.part(s, prepared);
+      },
     }, renderer.showVoids);
     if (gen !== store.generation) return;
     // the core's figures of every unit, before the slice counts as done
@@ -160,6 +165,7 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
         store.slice = null;
         renderer.current = renderer.below = null;
         renderer.request();
+        page.view3d.sync(null, 0);
         writeStats(page);
       }
       showError(page, e);
@@ -282,6 +288,7 @@ export function cancel(page: Page): void {
     store.slice = null;
     renderer.current = renderer.below = null;
     renderer.request();
+    page.view3d.sync(null, 0);
     writeStats(page);
     layerLabel(page);
   }

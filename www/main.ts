@@ -16,6 +16,7 @@ import { $ } from "./views/dom";
 import { show, wireLayerView } from "./views/layer";
 import { share } from "./views/share";
 import { setState } from "./views/status";
+import { View3DPanel, wireView3D } from "./views/view3d";
 
 /** Tuning through the query string (used by the tests): `?workers=3&cache=2` (MB). */
 const query = new URLSearchParams(location.search);
@@ -36,6 +37,7 @@ const page: Page = {
   store: new Store(cacheBudgetBytes(query)),
   pool: asked === null ? new Pool() : new Pool(asked),
   renderer: new Renderer($<HTMLCanvasElement>("view")),
+  view3d: new View3DPanel($("view3d")),
   onUnitFix: (s, factor) => fixUnits(page, s, factor),
 };
 const { store, pool, renderer } = page;
@@ -65,6 +67,7 @@ function wire(): void {
   });
 
   wireLayerView(page);
+  wireView3D(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;
@@ -146,6 +149,9 @@ window.dropslice = {
     renderer.request();
   },
   show: (i: number) => show(page, i),
+  /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
+   *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
+  view3d: () => page.view3d.testState(),
 };
 
 async function main(): Promise<void> {

@@ -7,6 +7,7 @@ import { Figures } from "./figures";
 import type { Counts, JobInfo, LayerAnalysis, LayerData, SliceUnit } from "./protocol";
 import type { Bounds } from "./render";
 import type { SharedLink } from "./share";
+import type { View3DPart } from "./view3d";
 
 /** Layer previews kept in the page (`?cache=MB`, 384 MB unless asked): beyond this, layers far
  *  from the one shown are dropped and re-planned by a worker when they are shown again. */
@@ -44,6 +45,8 @@ export class Slice {
    *  layer's G-code was ready (the figure of the benchmark). */
   startedAt = performance.now();
   seconds: number | null = null;
+  /** The model's prepared mesh for the 3D view (a model's slice, once a worker prepared it). */
+  part3d: View3DPart | null = null;
 
   constructor(
     readonly source: "stl" | "gco",

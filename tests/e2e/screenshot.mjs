@@ -4,6 +4,8 @@
 //   DETAIL=70,17,22 SCREENSHOT=docs/screenshot-detail.png node tests/e2e/screenshot.mjs 60
 // With VOIDS=1 the void overlay is on (the layer "worst" is the layer with the largest void):
 //   VOIDS=1 SCREENSHOT=docs/screenshot-voids.png node tests/e2e/screenshot.mjs worst
+// With VIEW3D=1 the stage shows the 3D tab (the part cut at the layer):
+//   VIEW3D=1 SCREENSHOT=docs/images/view3d.png node tests/e2e/screenshot.mjs 100
 import { join } from "node:path";
 import { benchy, openPage, repo, start, waitSettled } from "./helpers.mjs";
 
@@ -25,6 +27,7 @@ try {
     await page.evaluate((v) => window.dropslice.setView(v), { scale, cx, cy });
     await page.check("#opt-travel");
   }
+  if (process.env.VIEW3D) await page.click("#mode-3d");
   await page.waitForTimeout(300);
   const out = process.env.SCREENSHOT ?? join(repo, "docs/screenshot-benchy.png");
   await page.screenshot({ path: out });

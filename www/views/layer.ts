@@ -39,6 +39,7 @@ export function show(page: Page, i: number): void {
   renderer.below = current > 0 ? (s.cache.get(current - 1) ?? null) : null;
   renderer.dropletWidth = s.dropletWidth;
   renderer.request();
+  page.view3d.sync(s, current);
   writeStats(page);
   for (const k of [current, current - 1]) {
     if (k >= 0 && !s.cache.has(k) && s.complete && s.source === "stl") fetchPreview(page, s, k);
@@ -70,8 +71,10 @@ function fetchPreview(page: Page, s: Slice, k: number): void {
     .finally(() => store.previewRequests.delete(k));
 }
 
-/** The part's bounds (the droplets' for a .gco file) fill the canvas. */
+/** The part's bounds (the droplets' for a .gco file) fill the canvas (or the 3D view frames
+ *  the plate and the part, when it is shown). */
 export function fit(page: Page): void {
+  if (page.view3d.active) return page.view3d.fit();
   const s = page.store.slice;
   if (!s) return;
   const b = s.info.bounds;

@@ -1,0 +1,173 @@
+// The 3D tab (www/view3d.ts, www/views/view3d.ts) in headless Chromium: WebGL2 renders in
+// software here. The canvas' pixels are read back (the view keeps its drawing buffer) and
+// classified by colour: the part's steel blue, the selected part's accent blue, the cut's orange.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { benchy, openPage, start, waitSettled } from "./helpers.mjs";
+
+let env;
+let main;
+
+before(async () => {
+  env = await start();
+  main = await openPage(env.browser, env.url);
+  // CSP violations (three.js must need no eval) are counted from the first page load on
+  await main.page.evaluate(() => {
+    window.__csp = [];
+    document.addEventListener("securitypolicyviolation", (e) => window.__csp.push(`${e.violatedDirective} ${e.blockedURI}`));
+  });
+});
+
+after(async () => {
+  await env?.close();
+});
+
+/** Draws the 3D view now and classifies its pixels (device pixels of the WebGL canvas):
+ *  counts and centroids of part (steel blue), selected (accent blue) and cut (orange) pixels,
+ *  and whether a given pixel is background. */
+function pixels3d(page) {
+  return page.evaluate(() => {
+    const state = window.dropslice.view3d();
+    const c = document.querySelector("#view3d canvas");
+    const t = document.createElement("canvas");
+    t.width = c.width;
+    t.height = c.height;
+    const g = t.getContext("2d");
+    g.drawImage(c, 0, 0);
+    const d = g.getImageData(0, 0, t.width, t.height).data;
+    const cls = { part: [0, 0, 0], selected: [0, 0, 0], cut: [0, 0, 0], background: [0, 0, 0] };
+    let top = t.height; // the highest row with part or cut pixels
+    for (let i = 0, p = 0; i < d.length; i += 4, p++) {
+      const r = d[i], gr = d[i + 1], b = d[i + 2];
+      const x = p % t.width, y = (p / t.width) | 0;
+      let k = null;
+      if (b - r > 120 && r < 90) k = "selected";
+      else if (b - r > 40 && b > gr) k = "part";
+      else if (r - b > 80 && r > 180) k = "cut";
+      else if (Math.abs(r - 0xee) < 4 && Math.abs(gr - 0xf1) < 4 && Math.abs(b - 0xf5) < 4) k = "background";
+      if (k === null) continue;
+      cls[k][0]++;
+      cls[k][1] += x;
+      cls[k][2] += y;
+      if (k !== "background" && y < top) top = y;
+    }
+    const out = { state, width: t.width, height: t.height, top };
+    for (const [k, [n, sx, sy]] of Object.entries(cls)) out[k] = { n, x: n ? sx / n : NaN, y: n ? sy / n : NaN };
+    // the part pixel nearest the part's centroid, with part pixels all around it (to click)
+    const isPart = (x, y) => {
+      const i = 4 * (y * t.width + x);
+      return d[i + 2] - d[i] > 40 && d[i + 2] > d[i + 1];
+    };
+    let best = null;
+    for (let y = 3; y < t.height - 3; y++) {
+      for (let x = 3; x < t.width - 3; x++) {
+        if (!(isPart(x, y) && isPart(x - 3, y) && isPart(x + 3, y) && isPart(x, y - 3) && isPart(x, y + 3))) continue;
+        const dist = Math.hypot(x - out.part.x, y - out.part.y);
+        if (!best || dist < best.dist) best = { x, y, dist };
+      }
+    }
+    out.partPixel = best;
+    return out;
+  });
+}
+
+async function waitDone(page, timeout) {
+  const s = await waitSettled(page, timeout);
+  assert.equal(s.state, "done", `page state ${s.state}`);
+  return s;
+}
+
+/** Client coordinates of a device pixel of the 3D canvas. */
+async function clientPoint(page, px, py) {
+  const r = await page.locator("#view3d canvas").boundingBox();
+  const dims = await page.evaluate(() => {
+    const c = document.querySelector("#view3d canvas");
+    return { w: c.width, h: c.height };
+  });
+  return { x: r.x + (px * r.width) / dims.w, y: r.y + (py * r.height) / dims.h };
+}
+
+test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbited by a drag", async () => {
+  const { page, errors } = main;
+  await waitDone(page, 60_000);
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.setInputFiles("#file-input", benchy);
+  const s = await waitDone(page, 240_000);
+  assert.equal(s.layers, 240);
+
+  assert.equal(await page.evaluate(() => window.dropslice.view3d()), null, "no WebGL context before the tab is opened");
+  await page.click("#mode-3d");
+  assert.equal(await page.isVisible("#view3d canvas"), true);
+  assert.equal(await page.isVisible("#legend3d"), true);
+  assert.equal(await page.isVisible("#legend"), false);
+
+  // the top layer: the whole boat
+  await page.locator("#layer").fill("239");
+  const whole = await pixels3d(page);
+  assert.deepEqual(whole.state.parts, ["part"]);
+  assert.equal(whole.state.slice.current, 239);
+  assert.ok(Math.abs(whole.state.slice.top - 48) < 1e-9, `top ${whole.state.slice.top}`);
+  assert.ok(whole.width > 400 && whole.height > 400, `canvas ${whole.width}×${whole.height}`);
+  assert.ok(whole.part.n > 20_000, `part pixels: ${whole.part.n}`);
+  // the part is framed: its pixels' centroid is well inside the canvas
+  assert.ok(whole.part.x > whole.width * 0.2 && whole.part.x < whole.width * 0.8, `centroid x ${whole.part.x}`);
+  assert.ok(whole.part.y > whole.height * 0.2 && whole.part.y < whole.height * 0.85, `centroid y ${whole.part.y}`);
+  assert.ok(whole.background.n > 10_000, "the background shows around the plate");
+
+  // a click on the part selects it (tinted in the accent colour); a click on empty space clears
+  assert.ok(whole.partPixel, "a part pixel to click");
+  const onPart = await clientPoint(page, whole.partPixel.x + 0.5, whole.partPixel.y + 0.5);
+  await page.mouse.click(onPart.x, onPart.y);
+  assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, "part", "a click on the part selects it");
+  const tinted = await pixels3d(page);
+  assert.ok(tinted.selected.n > whole.part.n * 0.5, `selected pixels ${tinted.selected.n}`);
+  assert.ok(tinted.part.n < whole.part.n * 0.2, `unselected part pixels ${tinted.part.n}`);
+  const empty = await clientPoint(page, 20, tinted.height - 20);
+  await page.mouse.click(empty.x, empty.y);
+  assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, null, "a click on empty space clears");
+  assert.ok((await pixels3d(page)).part.n > whole.part.n * 0.9, "the part's own colour again");
+
+  // a drag from empty space orbits: the part moves on the screen; Fit brings the view back
+  const from = await clientPoint(page, whole.width * 0.85, whole.height * 0.15);
+  await page.mouse.move(from.x, from.y);
+  await page.mouse.down();
+  await page.mouse.move(from.x - 150, from.y + 40, { steps: 6 });
+  await page.mouse.up();
+  const orbited = await pixels3d(page);
+  assert.equal(orbited.state.selected, null, "an orbit is not a click");
+  assert.ok(Math.hypot(orbited.part.x - whole.part.x, orbited.part.y - whole.part.y) > 20, "the view turned");
+  await page.click("#btn-fit");
+  const fitted = await pixels3d(page);
+  assert.ok(Math.hypot(fitted.part.x - whole.part.x, fitted.part.y - whole.part.y) < 2, "Fit restores the framing");
+
+  // a low layer: the boat cut at 4 mm (of 48): far fewer part pixels, none high up, a cap
+  await page.locator("#layer").fill("19");
+  const low = await pixels3d(page);
+  assert.equal(low.state.slice.current, 19);
+  assert.ok(low.part.n < whole.part.n * 0.7, `part pixels ${low.part.n} vs ${whole.part.n} whole`);
+  assert.ok(low.cut.n > 2000, `cut pixels: ${low.cut.n}`);
+  // the chimney and the cabin roof are gone: the drawing starts lower on the screen
+  assert.ok(low.top > whole.top + 40, `top row ${low.top} vs ${whole.top}`);
+
+  // back to the layer canvas
+  await page.click("#mode-layer");
+  assert.equal(await page.isVisible("#view3d"), false);
+  assert.equal(await page.isVisible("#view"), true);
+
+  assert.deepEqual(await page.evaluate(() => window.__csp), [], "no CSP violation");
+  assert.deepEqual(errors, []);
+});
+
+test("a .gco file has no mesh: the 3D tab says so", async () => {
+  const { page } = main;
+  await page.click("#mode-3d");
+  const gco = "; dropslice test\n; layer_height = 0.2 (mm)\n; droplet_aspect = 1.04\nG01 X0 Y0 Z0.2\nG25 X10 Y0\nG26 X10 Y1\n";
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.setInputFiles("#file-input", { name: "tiny.gco", mimeType: "text/plain", buffer: Buffer.from(gco) });
+  await waitDone(page, 60_000);
+  const st = await page.evaluate(() => window.dropslice.view3d());
+  assert.deepEqual(st.parts, []);
+  assert.equal(st.slice, null);
+  assert.equal(await page.isVisible("#view3d-empty"), true);
+  await page.click("#mode-layer");
+});

@@ -1,0 +1,641 @@
+// The 3D view of the build plate and its parts (three.js, WebGL2). A self-contained class the
+// page drives; it knows nothing of the store, the workers or the DOM around its container.
+//
+// API (kept stable for the build-job parts panel):
+//   new View3D(container)        a canvas filling `container`, resized with it (ResizeObserver)
+//   setPlate(x, y)               the plate [0,x]×[0,y] at z = 0 (mm), a 10 mm grid, its outline
+//   setParts(parts)              the parts; geometry cached by id (same id + same positions
+//                                array => no re-upload), matrices applied
+//   setMatrix(id, matrix)        a cheap move (16 numbers, column-major, model -> plate, mm)
+//   select(id | null)            the selected part is tinted (no callback)
+//   onSelect(cb)                 a click (press and release within a few pixels) on a part, or
+//                                on empty space (null); the view selects it before calling cb
+//   onDrag(cb)                   with a listener, a left drag that starts on a part moves it on
+//                                the plate plane: cb(id, dx, dy, done) with dx, dy the plate
+//                                millimetres from the drag's start (cumulative); the view moves
+//                                the part itself meanwhile (its matrix at the start, translated),
+//                                and the owner's setMatrix (at any time) overrides that. Without
+//                                a listener parts are not draggable and a drag orbits.
+//   setSlice(s | null)           the layer stack up to layer s.current: parts clipped at that
+//                                layer's top (s.top, default (current + 1) · layerHeight), the
+//                                cut drawn as a solid cap (back faces in the cut colour), the
+//                                current layer's slab highlighted; null = whole parts
+//   fit()                        an iso-like camera framing the plate and the parts
+//   dispose()                    frees the GPU resources, the listeners and the canvas
+// Extensions (documented here, used by the page and its tests):
+//   renderNow()                  draws at once (the view otherwise draws on demand, in the next
+//                                animation frame after a change, and never when idle)
+//   state()                      {parts, selected, slice, frames, width, height} for the tests
+//
+// Input is checked (finite numbers, lengths, bounds): bad input throws an Error naming what is
+// wrong. Per frame nothing is allocated and nothing is O(triangles) but the GPU's draw: a part
+// is one non-indexed BufferGeometry (flat normals) uploaded once, drawn by up to three meshes
+// sharing it (body, current-layer slab, cut cap) with clipping planes.
+
+import {
+  AmbientLight,
+  BackSide,
+  BufferAttribute,
+  BufferGeometry,
+  CanvasTexture,
+  Color,
+  DirectionalLight,
+  Float32BufferAttribute,
+  FrontSide,
+  Group,
+  HemisphereLight,
+  type Intersection,
+  LineBasicMaterial,
+  LineSegments,
+  Matrix4,
+  Mesh,
+  MeshBasicMaterial,
+  MeshStandardMaterial,
+  Object3D,
+  PerspectiveCamera,
+  Plane,
+  PlaneGeometry,
+  Raycaster,
+  Scene,
+  Sprite,
+  SpriteMaterial,
+  SRGBColorSpace,
+  Vector2,
+  Vector3,
+  WebGLRenderer,
+  Box3,
+} from "three";
+import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+
+export interface View3DPart {
+  id: string;
+  name: string;
+  /** 9 floats per triangle, the part's model coordinates in mm. */
+  positions: Float32Array;
+  /** 16 numbers, column-major, model -> plate coordinates (mm), z up. */
+  matrix: number[];
+  /** The discharge unit printing the part (1 is drawn in a second colour). */
+  unit?: 0 | 1;
+}
+
+export interface View3DSlice {
+  layerHeight: number;
+  layers: number;
+  current: number;
+  /** The current layer's top (mm); (current + 1) · layerHeight when absent. */
+  top?: number;
+}
+
+/** Colours of the view (sRGB). */
+export const COLORS = {
+  background: 0xeef1f5,
+  plate: 0xfbfcfd,
+  grid: 0xdde2e9,
+  gridMajor: 0xc5cdd7,
+  outline: 0x7d8a99,
+  part: 0x7f9cc4,
+  unit1: 0x3bb99a,
+  selected: 0x1c7ed6,
+  /** The current layer's slab (the outer-loop colour of the layer view). */
+  slab: 0xe8590c,
+  /** The cut through the parts at the current layer's top. */
+  cap: 0xf4b37e,
+} as const;
+
+/** Plates up to this size (mm) are drawn (the settings allow up to 100 m). */
+const PLATE_MAX = 100_000;
+/** Beyond this many grid lines per axis, the grid is drawn every 10^k·10 mm. */
+const GRID_LINES_MAX = 400;
+/** A press and release this close together (px) is a click, not a drag. */
+const CLICK_PX = 4;
+/** A clipping plane's constant far beyond any part: nothing clipped. */
+const NO_CLIP = 1e9;
+
+interface Entry {
+  id: string;
+  part: View3DPart;
+  positions: Float32Array;
+  geometry: BufferGeometry;
+  group: Group;
+  body: Mesh;
+  slab: Mesh;
+  cap: Mesh;
+  unit: 0 | 1;
+}
+
+interface Press {
+  pointerId: number;
+  x: number;
+  y: number;
+  /** The part under the press (only looked up at press time when parts are draggable). */
+  id: string | null;
+  dragging: boolean;
+  /** The plate point grabbed, and the height of the drag plane. */
+  origin: Vector3;
+  start: Matrix4;
+  dx: number;
+  dy: number;
+}
+
+function checkMatrix(m: unknown, what: string): number[] {
+  if (!Array.isArray(m) || m.length !== 16 || !m.every((v) => typeof v === "number" && Number.isFinite(v))) {
+    throw new Error(`${what}: the matrix must be 16 finite numbers (column-major)`);
+  }
+  return m;
+}
+
+export class View3D {
+  readonly canvas: HTMLCanvasElement;
+  private readonly renderer: WebGLRenderer;
+  private readonly scene = new Scene();
+  private readonly camera = new PerspectiveCamera(35, 1, 0.1, 10_000);
+  private readonly controls: OrbitControls;
+  private readonly observer: ResizeObserver;
+  private readonly plate = new Group();
+  private readonly partsGroup = new Group();
+  private readonly entries = new Map<string, Entry>();
+  private plateSize = { x: 0, y: 0 };
+  private selected: string | null = null;
+  private slice: Required<View3DSlice> | null = null;
+  private selectCb: ((id: string | null) => void) | null = null;
+  private dragCb: ((id: string, dx: number, dy: number, done: boolean) => void) | null = null;
+  private frame = 0;
+  private frames = 0;
+  private width = 0;
+  private height = 0;
+  private press: Press | null = null;
+  private disposed = false;
+
+  // clipping: the body keeps z <= top - h, the slab top - h <= z <= top, the cap z <= top
+  private readonly clipBody = new Plane(new Vector3(0, 0, -1), NO_CLIP);
+  private readonly clipTop = new Plane(new Vector3(0, 0, -1), NO_CLIP);
+  private readonly clipSlabBottom = new Plane(new Vector3(0, 0, 1), NO_CLIP);
+  private readonly materials = {
+    part: this.bodyMaterial(COLORS.part),
+    unit1: this.bodyMaterial(COLORS.unit1),
+    selected: this.bodyMaterial(COLORS.selected),
+    slab: new MeshStandardMaterial({
+      color: COLORS.slab,
+      roughness: 0.55,
+      metalness: 0,
+      side: FrontSide,
+      clippingPlanes: [this.clipTop, this.clipSlabBottom],
+    }),
+    cap: new MeshBasicMaterial({ color: COLORS.cap, side: BackSide, clippingPlanes: [this.clipTop] }),
+  };
+
+  // scratch objects: nothing is allocated per frame or per pointer move
+  private readonly raycaster = new Raycaster();
+  private readonly ndc = new Vector2();
+  private readonly hits: Intersection[] = [];
+  private readonly targets: Object3D[] = [];
+  private readonly dragPlane = new Plane();
+  private readonly point = new Vector3();
+  private readonly moved = new Matrix4();
+  private readonly box = new Box3();
+  private readonly partBox = new Box3();
+
+  constructor(private readonly container: HTMLElement) {
+    this.renderer = new WebGLRenderer({ antialias: true, preserveDrawingBuffer: true, alpha: false });
+    this.renderer.outputColorSpace = SRGBColorSpace;
+    this.renderer.localClippingEnabled = true;
+    this.renderer.setClearColor(COLORS.background, 1);
+    this.canvas = this.renderer.domElement;
+    this.canvas.className = "view3d-canvas";
+    this.canvas.tabIndex = 0;
+    this.canvas.setAttribute("aria-label", "3D view of the plate and the parts");
+    container.appendChild(this.canvas);
+
+    this.scene.background = new Color(COLORS.background);
+    this.camera.up.set(0, 0, 1);
+    this.scene.add(new HemisphereLight(0xffffff, 0x9aa4b0, 1.9));
+    this.scene.add(new AmbientLight(0xffffff, 0.25));
+    // a light that follows the camera (from above its left shoulder): every side is lit
+    const key = new DirectionalLight(0xffffff, 1.6);
+    key.position.set(-0.5, 1, 0.6);
+    key.target.position.set(0, 0, -1);
+    this.camera.add(key, key.target);
+    this.scene.add(this.camera, this.plate, this.partsGroup);
+
+    this.controls = new OrbitControls(this.camera, this.canvas);
+    this.controls.zoomToCursor = true;
+    this.controls.addEventListener("change", this.request);
+
+    // before the controls' own pointerdown (a capture listener on the container runs first)
+    container.addEventListener("pointerdown", this.onPointerDown, { capture: true });
+    this.canvas.addEventListener("pointermove", this.onPointerMove);
+    this.canvas.addEventListener("pointerup", this.onPointerUp);
+    this.canvas.addEventListener("pointercancel", this.onPointerCancel);
+    this.canvas.addEventListener("contextmenu", this.preventDefault);
+
+    this.observer = new ResizeObserver(() => this.resize());
+    this.observer.observe(container);
+    this.resize();
+    this.setPlate(154, 134);
+    this.fit();
+  }
+
+  private bodyMaterial(color: number): MeshStandardMaterial {
+    return new MeshStandardMaterial({
+      color,
+      roughness: 0.62,
+      metalness: 0,
+      side: FrontSide,
+      clippingPlanes: [this.clipBody],
+    });
+  }
+
+  // ---- plate ----
+
+  setPlate(x: number, y: number): void {
+    if (!(Number.isFinite(x) && Number.isFinite(y) && x > 0 && y > 0 && x <= PLATE_MAX && y <= PLATE_MAX)) {
+      throw new Error(`plate ${x} × ${y} mm: each side must be a number above 0 and at most ${PLATE_MAX} mm`);
+    }
+    if (x === this.plateSize.x && y === this.plateSize.y) return;
+    this.plateSize = { x, y };
+    for (const c of [...this.plate.children]) {
+      this.plate.remove(c);
+      disposeObject(c);
+    }
+    // the plate's top face, seen from above only (from below, the parts' bottoms show)
+    const top = new Mesh(
+      new PlaneGeometry(x, y),
+      new MeshBasicMaterial({ color: COLORS.plate, side: FrontSide, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }),
+    );
+    top.position.set(x / 2, y / 2, 0);
+    top.renderOrder = -2;
+    this.plate.add(top);
+
+    let step = 10;
+    while (Math.max(x, y) / step > GRID_LINES_MAX) step *= 10;
+    const minor: number[] = [];
+    const major: number[] = [];
+    for (let gx = step; gx < x - 1e-9; gx += step) (Math.round(gx / step) % 5 === 0 ? major : minor).push(gx, 0, 0, gx, y, 0);
+    for (let gy = step; gy < y - 1e-9; gy += step) (Math.round(gy / step) % 5 === 0 ? major : minor).push(0, gy, 0, x, gy, 0);
+    this.plate.add(lines(minor, COLORS.grid), lines(major, COLORS.gridMajor));
+    this.plate.add(lines([0, 0, 0, x, 0, 0, x, 0, 0, x, y, 0, x, y, 0, 0, y, 0, 0, y, 0, 0, 0, 0], COLORS.outline));
+
+    // axis hint at the origin: x red, y green, with labels
+    const len = Math.min(20, Math.max(5, Math.min(x, y) * 0.15));
+    const axes = new Group();
+    axes.add(lines([0, 0, 0, len, 0, 0], 0xe03131), lines([0, 0, 0, 0, len, 0], 0x2f9e44));
+    axes.add(label("x", "#e03131", len + len * 0.25, 0, 0, len * 0.35), label("y", "#2f9e44", 0, len + len * 0.25, 0, len * 0.35));
+    axes.position.z = 0.01;
+    this.plate.add(axes);
+    // a hair below z = 0: the cut's cap shows the inside of a part's bottom, at z = 0 itself
+    this.plate.position.z = -0.05;
+    this.request();
+  }
+
+  // ---- parts ----
+
+  setParts(parts: View3DPart[]): void {
+    const seen = new Set<string>();
+    for (const p of parts) {
+      if (typeof p.id !== "string" || seen.has(p.id)) throw new Error(`part ids must be distinct strings (${JSON.stringify(p.id)} is not)`);
+      seen.add(p.id);
+      if (!(p.positions instanceof Float32Array) || p.positions.length % 9 !== 0) {
+        throw new Error(`part ${p.name || p.id}: positions must be a Float32Array of 9 numbers per triangle`);
+      }
+      checkMatrix(p.matrix, `part ${p.name || p.id}`);
+      if (p.unit !== undefined && p.unit !== 0 && p.unit !== 1) throw new Error(`part ${p.name || p.id}: unit must be 0 or 1`);
+    }
+    for (const [id, e] of this.entries) {
+      if (!seen.has(id)) this.drop(e);
+    }
+    for (const p of parts) {
+      let e = this.entries.get(p.id);
+      if (e && e.positions !== p.positions) {
+        this.drop(e);
+        e = undefined;
+      }
+      if (!e) e = this.add(p);
+      e.part = p;
+      e.unit = p.unit ?? 0;
+      e.group.matrix.fromArray(p.matrix);
+      e.group.matrixWorldNeedsUpdate = true;
+    }
+    if (this.selected !== null && !this.entries.has(this.selected)) this.selected = null;
+    this.applyMaterials();
+    this.request();
+  }
+
+  private add(p: View3DPart): Entry {
+    const geometry = new BufferGeometry();
+    geometry.setAttribute("position", new BufferAttribute(p.positions, 3));
+    // non-indexed: each triangle's own normal (flat shading), computed once
+    geometry.computeVertexNormals();
+    geometry.computeBoundingBox();
+    geometry.computeBoundingSphere();
+    const group = new Group();
+    group.matrixAutoUpdate = false;
+    const body = new Mesh(geometry, this.materials.part);
+    const slab = new Mesh(geometry, this.materials.slab);
+    const cap = new Mesh(geometry, this.materials.cap);
+    for (const m of [body, slab, cap]) m.userData.partId = p.id;
+    group.add(body, slab, cap);
+    this.partsGroup.add(group);
+    const e: Entry = { id: p.id, part: p, positions: p.positions, geometry, group, body, slab, cap, unit: p.unit ?? 0 };
+    this.entries.set(p.id, e);
+    return e;
+  }
+
+  private drop(e: Entry): void {
+    this.partsGroup.remove(e.group);
+    e.geometry.dispose();
+    this.entries.delete(e.id);
+    if (this.press?.id === e.id) this.endPress(false);
+  }
+
+  setMatrix(id: string, matrix: number[]): void {
+    const e = this.entries.get(id);
+    if (!e) throw new Error(`no part ${JSON.stringify(id)} in the 3D view`);
+    checkMatrix(matrix, `part ${e.part.name || id}`);
+    e.part.matrix = matrix;
+    e.group.matrix.fromArray(matrix);
+    e.group.matrixWorldNeedsUpdate = true;
+    if (this.press?.id === id) this.press.start.fromArray(matrix);
+    this.request();
+  }
+
+  select(id: string | null): void {
+    const next = id !== null && this.entries.has(id) ? id : null;
+    if (next === this.selected) return;
+    this.selected = next;
+    this.applyMaterials();
+    this.request();
+  }
+
+  onSelect(cb: (id: string | null) => void): void {
+    this.selectCb = cb;
+  }
+
+  onDrag(cb: (id: string, dx: number, dy: number, done: boolean) => void): void {
+    this.dragCb = cb;
+  }
+
+  private applyMaterials(): void {
+    for (const e of this.entries.values()) {
+      e.body.material = e.id === this.selected ? this.materials.selected : e.unit === 1 ? this.materials.unit1 : this.materials.part;
+      e.slab.visible = e.cap.visible = this.slice !== null;
+    }
+  }
+
+  // ---- slice ----
+
+  setSlice(s: View3DSlice | null): void {
+    if (s === null) {
+      this.slice = null;
+      this.clipBody.constant = this.clipTop.constant = this.clipSlabBottom.constant = NO_CLIP;
+    } else {
+      const { layerHeight: h, layers, current } = s;
+      if (!(Number.isFinite(h) && h > 0)) throw new Error(`layer height ${h}: must be a number above 0`);
+      if (!(Number.isInteger(layers) && layers > 0)) throw new Error(`layers ${layers}: must be a whole number above 0`);
+      if (!(Number.isInteger(current) && current >= 0 && current < layers)) throw new Error(`layer ${current}: must be a whole number in [0, ${layers})`);
+      const top = s.top ?? (current + 1) * h;
+      if (!Number.isFinite(top)) throw new Error(`layer top ${top}: must be a number`);
+      this.slice = { layerHeight: h, layers, current, top };
+      // a plane keeps the points p with n·p + constant >= 0
+      this.clipBody.constant = top - h; // -z + (top - h) >= 0
+      this.clipTop.constant = top; // -z + top >= 0
+      this.clipSlabBottom.constant = -(top - h); // z - (top - h) >= 0
+    }
+    this.applyMaterials();
+    this.request();
+  }
+
+  // ---- camera ----
+
+  fit(): void {
+    const b = this.box.makeEmpty();
+    b.expandByPoint(this.point.set(0, 0, 0)).expandByPoint(this.point.set(this.plateSize.x, this.plateSize.y, 0));
+    this.partsGroup.updateMatrixWorld(true);
+    for (const e of this.entries.values()) {
+      if (e.geometry.boundingBox && !e.geometry.boundingBox.isEmpty()) b.union(this.partBox.copy(e.geometry.boundingBox).applyMatrix4(e.group.matrixWorld));
+    }
+    const center = b.getCenter(new Vector3());
+    center.z *= 0.5;
+    // from the front, a little to the left, above: an iso-like view
+    const dir = new Vector3(-0.55, -1, 0.85).normalize();
+    const right = new Vector3().crossVectors(this.camera.up, dir).normalize();
+    const up = new Vector3().crossVectors(dir, right);
+    const aspect = this.width > 0 && this.height > 0 ? this.width / this.height : 1.5;
+    const tanV = Math.tan((this.camera.fov * Math.PI) / 360);
+    const tanH = tanV * aspect;
+    // the distance at which every corner of the box is in the picture (with a margin)
+    let dist = 1;
+    const v = new Vector3();
+    for (let i = 0; i < 8; i++) {
+      v.set(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z).sub(center);
+      const depth = v.dot(dir);
+      dist = Math.max(dist, (Math.abs(v.dot(right)) * 1.06) / tanH + depth, (Math.abs(v.dot(up)) * 1.06) / tanV + depth);
+    }
+    const radius = Math.max(1, b.getSize(v).length() / 2);
+    this.camera.position.copy(center).addScaledVector(dir, dist);
+    this.camera.near = Math.max(0.01, dist / 200);
+    this.camera.far = dist * 20;
+    this.camera.updateProjectionMatrix();
+    this.controls.target.copy(center);
+    this.controls.maxDistance = dist * 8;
+    this.controls.minDistance = Math.max(0.5, radius * 0.02);
+    this.controls.update();
+    this.request();
+  }
+
+  // ---- drawing ----
+
+  private readonly request = (): void => {
+    if (this.frame || this.disposed) return;
+    this.frame = requestAnimationFrame(() => {
+      this.frame = 0;
+      this.renderNow();
+    });
+  };
+
+  renderNow(): void {
+    if (this.disposed || this.width === 0 || this.height === 0) return;
+    this.renderer.render(this.scene, this.camera);
+    this.frames++;
+  }
+
+  private resize(): void {
+    const w = this.container.clientWidth;
+    const h = this.container.clientHeight;
+    if (w === this.width && h === this.height) return;
+    this.width = w;
+    this.height = h;
+    if (w === 0 || h === 0) return;
+    this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+    this.request();
+  }
+
+  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; frames: number; width: number; height: number } {
+    return {
+      parts: [...this.entries.keys()],
+      selected: this.selected,
+      slice: this.slice ? { ...this.slice } : null,
+      frames: this.frames,
+      width: this.canvas.width,
+      height: this.canvas.height,
+    };
+  }
+
+  // ---- picking and dragging ----
+
+  private ray(ev: PointerEvent): void {
+    const r = this.canvas.getBoundingClientRect();
+    this.ndc.set(((ev.clientX - r.left) / r.width) * 2 - 1, -((ev.clientY - r.top) / r.height) * 2 + 1);
+    this.raycaster.setFromCamera(this.ndc, this.camera);
+  }
+
+  /** The visible part under the pointer and where it was hit (in `this.point`); O(triangles). */
+  private pick(ev: PointerEvent): string | null {
+    this.ray(ev);
+    this.scene.updateMatrixWorld();
+    this.targets.length = 0;
+    for (const e of this.entries.values()) {
+      this.targets.push(e.body);
+      if (this.slice) this.targets.push(e.slab, e.cap);
+    }
+    this.hits.length = 0;
+    this.raycaster.intersectObjects(this.targets, false, this.hits);
+    const top = this.slice ? this.slice.top + 1e-6 : Infinity;
+    for (const h of this.hits) {
+      // parts above the cut are clipped away: not there to be hit
+      if (h.point.z <= top) {
+        this.point.copy(h.point);
+        return h.object.userData.partId as string;
+      }
+    }
+    return null;
+  }
+
+  private readonly onPointerDown = (ev: PointerEvent): void => {
+    if (ev.target !== this.canvas) return;
+    this.canvas.focus({ preventScroll: true });
+    if (this.press) this.endPress(false);
+    if (ev.button !== 0 || ev.shiftKey || ev.ctrlKey || ev.metaKey) return;
+    // parts are only looked up now when they can be dragged; a click looks them up on release
+    const id = this.dragCb ? this.pick(ev) : null;
+    const e = id !== null ? this.entries.get(id) : undefined;
+    this.press = {
+      pointerId: ev.pointerId,
+      x: ev.clientX,
+      y: ev.clientY,
+      id,
+      dragging: false,
+      origin: this.point.clone(),
+      start: e ? e.group.matrix.clone() : new Matrix4(),
+      dx: 0,
+      dy: 0,
+    };
+    if (e) {
+      // a part grabbed: no orbit (the controls' listener runs after this one)
+      this.controls.enabled = false;
+      this.canvas.setPointerCapture(ev.pointerId);
+      this.dragPlane.setFromNormalAndCoplanarPoint(this.point.set(0, 0, 1), this.press.origin);
+    }
+  };
+
+  private readonly onPointerMove = (ev: PointerEvent): void => {
+    const p = this.press;
+    if (!p || ev.pointerId !== p.pointerId || p.id === null || !this.dragCb) return;
+    if (!p.dragging && Math.hypot(ev.clientX - p.x, ev.clientY - p.y) < CLICK_PX) return;
+    p.dragging = true;
+    this.ray(ev);
+    if (!this.raycaster.ray.intersectPlane(this.dragPlane, this.point)) return;
+    p.dx = this.point.x - p.origin.x;
+    p.dy = this.point.y - p.origin.y;
+    const e = this.entries.get(p.id);
+    if (!e) return;
+    this.moved.makeTranslation(p.dx, p.dy, 0);
+    e.group.matrix.multiplyMatrices(this.moved, p.start);
+    e.group.matrixWorldNeedsUpdate = true;
+    this.request();
+    this.dragCb(p.id, p.dx, p.dy, false);
+  };
+
+  private readonly onPointerUp = (ev: PointerEvent): void => {
+    const p = this.press;
+    if (!p || ev.pointerId !== p.pointerId) return;
+    const click = !p.dragging && Math.hypot(ev.clientX - p.x, ev.clientY - p.y) < CLICK_PX;
+    this.endPress(true);
+    if (click) {
+      const id = this.dragCb ? p.id : this.pick(ev);
+      this.select(id);
+      this.selectCb?.(this.selected);
+    }
+  };
+
+  private readonly onPointerCancel = (): void => this.endPress(true);
+
+  /** Ends a press; a drag under way is reported as done (`report`). */
+  private endPress(report: boolean): void {
+    const p = this.press;
+    this.press = null;
+    this.controls.enabled = true;
+    if (p && p.dragging && p.id !== null && report) this.dragCb?.(p.id, p.dx, p.dy, true);
+  }
+
+  private readonly preventDefault = (ev: Event): void => ev.preventDefault();
+
+  dispose(): void {
+    if (this.disposed) return;
+    this.disposed = true;
+    if (this.frame) cancelAnimationFrame(this.frame);
+    this.observer.disconnect();
+    this.controls.removeEventListener("change", this.request);
+    this.controls.dispose();
+    this.container.removeEventListener("pointerdown", this.onPointerDown, { capture: true });
+    this.canvas.removeEventListener("pointermove", this.onPointerMove);
+    this.canvas.removeEventListener("pointerup", this.onPointerUp);
+    this.canvas.removeEventListener("pointercancel", this.onPointerCancel);
+    this.canvas.removeEventListener("contextmenu", this.preventDefault);
+    for (const e of [...this.entries.values()]) this.drop(e);
+    disposeObject(this.plate);
+    for (const m of Object.values(this.materials)) m.dispose();
+    this.renderer.dispose();
+    this.canvas.remove();
+  }
+}
+
+function lines(xyz: number[], color: number): LineSegments {
+  const g = new BufferGeometry();
+  g.setAttribute("position", new Float32BufferAttribute(xyz, 3));
+  return new LineSegments(g, new LineBasicMaterial({ color }));
+}
+
+/** A text label facing the camera, `size` mm tall, centred at (x, y, z). */
+function label(text: string, color: string, x: number, y: number, z: number, size: number): Sprite {
+  const c = document.createElement("canvas");
+  c.width = c.height = 64;
+  const g = c.getContext("2d")!;
+  g.fillStyle = color;
+  g.font = "600 48px system-ui, sans-serif";
+  g.textAlign = "center";
+  g.textBaseline = "middle";
+  g.fillText(text, 32, 34);
+  const tex = new CanvasTexture(c);
+  tex.colorSpace = SRGBColorSpace;
+  const s = new Sprite(new SpriteMaterial({ map: tex, transparent: true, depthWrite: false }));
+  s.position.set(x, y, z);
+  s.scale.set(size, size, 1);
+  return s;
+}
+
+/** Frees the geometries, materials and textures of `o` and everything below it. */
+function disposeObject(o: Object3D): void {
+  o.traverse((c) => {
+    const m = c as Partial<Mesh>;
+    m.geometry?.dispose();
+    const mats = m.material === undefined ? [] : Array.isArray(m.material) ? m.material : [m.material];
+    for (const mat of mats) {
+      (mat as SpriteMaterial).map?.dispose();
+      mat.dispose();
+    }
+  });
+}
+
