@@ -13,6 +13,7 @@ import { cacheBudgetBytes, Store } from "./store";
 import { hideBanner } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
+import { wireCut } from "./views/cut";
 import { show, wireLayerView } from "./views/layer";
 import { share } from "./views/share";
 import { setState } from "./views/status";
@@ -41,6 +42,8 @@ const page: Page = {
 const { store, pool, renderer } = page;
 const error = (e: unknown) => showError(page, e);
 
+let cutHooks: ReturnType<typeof wireCut> | null = null;
+
 function wire(): void {
   $("btn-sample").addEventListener("click", () => void openSample(page));
   $<HTMLInputElement>("file-input").addEventListener("change", (ev) => {
@@ -65,6 +68,7 @@ function wire(): void {
   });
 
   wireLayerView(page);
+  cutHooks = wireCut(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;
@@ -146,6 +150,8 @@ window.dropslice = {
     renderer.request();
   },
   show: (i: number) => show(page, i),
+  /** The vertical cut (views/cut.ts): set(line), status(), setView(v), redraw(). */
+  cut: () => cutHooks,
 };
 
 async function main(): Promise<void> {
