@@ -66,8 +66,12 @@ export class CutRenderer {
     this.cssH = Math.max(1, r.height);
     this.canvas.width = Math.round(this.cssW * this.dpr);
     this.canvas.height = Math.round(this.cssH * this.dpr);
+    if (!this.touched) this.fit();
     this.draw();
   }
+
+  /** The user zoomed or panned: a resize keeps the view (else it fits the cut again). */
+  touched = false;
 
   request(): void {
     if (this.frame) return;
@@ -79,6 +83,7 @@ export class CutRenderer {
 
   /** Sets the view, brought within the layer view's limits. */
   setView(v: CutView): void {
+    this.touched = true;
     const c = clampView({ scale: v.scale, cx: v.ct, cy: v.cz }, { scale: this.view.scale, cx: this.view.ct, cy: this.view.cz });
     this.view = { scale: c.scale, ct: c.cx, cz: c.cy };
   }
@@ -95,10 +100,12 @@ export class CutRenderer {
     const w = this.cssW - MARGIN_LEFT - 24;
     const h = this.cssH - MARGIN_BOTTOM - 24;
     this.setView({ scale: Math.min(w / this.length, h / top), ct: this.length / 2, cz: top / 2 });
+    this.touched = false;
     this.request();
   }
 
   zoomAt(px: number, py: number, factor: number): void {
+    this.touched = true;
     const [t, z] = this.toMm(px, py);
     const scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, this.view.scale * factor));
     const [ox, oy] = this.centre();
@@ -107,6 +114,7 @@ export class CutRenderer {
   }
 
   panBy(dx: number, dy: number): void {
+    this.touched = true;
     const v = this.view;
     this.setView({ scale: v.scale, ct: v.ct - dx / v.scale, cz: v.cz + dy / v.scale });
     this.request();
@@ -174,9 +182,8 @@ export class CutRenderer {
         const band = h / 6;
         for (let j = 0; j + 2 < v.length; j += 3) {
           if (v[j + 2] < t0 || v[j + 1] > t1) continue;
-          // at least a device pixel wide, so a thin void stays visible zoomed out
-          const w = Math.max(v[j + 2] - v[j + 1], 1 / k);
-          voids.rect(v[j + 1], bottom + v[j] * band, w, band);
+          // true width: zoomed out, thin voids only tint the section (as much as they are)
+          voids.rect(v[j + 1], bottom + v[j] * band, v[j + 2] - v[j + 1], band);
         }
       }
     }

@@ -240,7 +240,10 @@ export function setLine(page: Page, line: Line | null, refit = true): void {
   if (!line || !cut) return;
   reset(page);
   update(page);
-  if (refit) requestAnimationFrame(() => cut?.fit());
+  if (refit) {
+    cut.touched = false;
+    cut.fit();
+  }
 }
 
 /** The line a little longer than the part, through `v` on the other axis. */
