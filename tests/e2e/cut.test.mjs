@@ -66,6 +66,7 @@ test("the cut draws the droplets of many layers, moves with its line and shows t
   assert.ok(c.line, "a line is set");
   assert.ok(c.layers > s.layers * 0.9, `droplets in ${c.layers} of ${s.layers} layers`);
   const first = await cutPixels(page);
+  const firstCut = c;
   // one layer is 0.2 mm: droplets at many distinct heights
   assert.ok(first.rows > 60, `droplet colours on ${first.rows} rows`);
 
@@ -122,4 +123,18 @@ test("the cut draws the droplets of many layers, moves with its line and shows t
   await page.evaluate(() => window.dropslice.show(5));
   assert.deepEqual((await cutStatus(page)).line, c.line);
   assert.deepEqual(errors, []);
+
+  // with a cache of 1 MB the page holds few layers: the workers plan the others for the cut
+  // and send their droplets near the line; the cut is the same as from the page's cache
+  const small = await openPage(env.browser, `${env.url}?cache=1`);
+  const s3 = await waitSettled(small.page, 60_000);
+  assert.equal(s3.state, "done");
+  assert.ok(s3.cached < s3.layers / 2, `${s3.cached} layers cached`);
+  await small.page.evaluate((l) => window.dropslice.cut().set(l), firstCut.line);
+  const again = await waitCut(small.page, s3.layers);
+  assert.equal(again.droplets, firstCut.droplets);
+  assert.equal(again.layers, firstCut.layers);
+  assert.equal(again.voids, firstCut.voids);
+  assert.deepEqual(small.errors, []);
+  await small.context.close();
 });

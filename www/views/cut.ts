@@ -72,8 +72,9 @@ function length(l: Line): number {
   return Math.hypot(l.b[0] - l.a[0], l.b[1] - l.a[1]);
 }
 
-/** t, d, role (+ x, y) of a layer's droplets within `reach` of the line. */
-function bin(layer: LayerData, l: Line, reach: number): { near: Float64Array; xy: Float64Array } {
+/** t, d, role of a layer's droplets whose footprint (radius `radius`) the plane crosses, and
+ *  x, y of those within `reach` of the line (sent to the core). */
+function bin(layer: LayerData, l: Line, reach: number, radius: number): { near: Float64Array; xy: Float64Array } {
   const len = length(l);
   const ux = (l.b[0] - l.a[0]) / len;
   const uy = (l.b[1] - l.a[1]) / len;
@@ -87,8 +88,8 @@ function bin(layer: LayerData, l: Line, reach: number): { near: Float64Array; xy
     if (dist > reach || dist < -reach) continue;
     const t = ux * x + uy * y;
     if (t < -reach || t > len + reach) continue;
-    near.push(t, Math.abs(dist), layer.roles[i]);
     xy.push(d[2 * i], d[2 * i + 1]);
+    if (Math.abs(dist) < radius && t > -radius && t < len + radius) near.push(t, Math.abs(dist), layer.roles[i]);
   }
   return { near: Float64Array.from(near), xy: Float64Array.from(xy) };
 }
@@ -103,7 +104,7 @@ function binCached(page: Page): boolean {
   let added = false;
   for (const [i, layer] of s.cache) {
     if (state.binned.has(i)) continue;
-    const { near, xy } = bin(layer, state.line, s.dropletWidth);
+    const { near, xy } = bin(layer, state.line, s.dropletWidth, radiusOf(s));
     const old = cut.layers.get(i);
     cut.layers.set(i, { near, spans: old?.spans ?? null, voids: old?.voids ?? null });
     sentXY.set(i, xy);
@@ -153,11 +154,13 @@ function pump(page: Page): void {
     }
     const l = state.line;
     const gen = state.gen;
+    // `sent` is transferred to the worker: the reply is read with a copy
+    const flags = sent.slice();
     state.inFlight++;
     page.pool
       .cut({ line: [l.a[0], l.a[1], l.b[0], l.b[1]], from, to, sent, centres })
       .then((r) => {
-        if (gen === state.gen) take(r, from, to, sent, lo);
+        if (gen === state.gen) take(r, from, to, flags, lo);
       })
       .catch((e) => {
         if (e instanceof Cancelled || gen !== state.gen) return;
