@@ -35,6 +35,8 @@ pub mod summary;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 #[cfg(target_arch = "wasm32")]
+mod wasm_cut;
+#[cfg(target_arch = "wasm32")]
 mod wasm_gcode;
 
 pub use error::Error;

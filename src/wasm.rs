@@ -162,8 +162,8 @@ struct SliceFigures {
 /// One prepared slicing job: the parsed, transformed mesh and its settings.
 #[wasm_bindgen]
 pub struct Session {
-    job: Job,
-    settings: Settings,
+    pub(crate) job: Job,
+    pub(crate) settings: Settings,
 }
 
 #[wasm_bindgen]

@@ -337,6 +337,11 @@ export class Pool {
     });
   }
 
+  /** The vertical cut of a run of layers of the current model (views/cut.ts). */
+  cut(data: RequestData<"cut">): Promise<ResultOf<"cut">> {
+    return this.guarded(async () => (await this.pick()).call("cut", data, undefined, [data.sent.buffer, data.centres.buffer]));
+  }
+
   /** For tests: makes the wasm panic in one worker. */
   crash(): Promise<void> {
     return this.guarded(() => this.handles[this.handles.length - 1].call("crash", null));

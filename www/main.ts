@@ -13,6 +13,7 @@ import { cacheBudgetBytes, Store } from "./store";
 import { hideBanner } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
+import { wireCut } from "./views/cut";
 import { show, wireLayerView } from "./views/layer";
 import { share } from "./views/share";
 import { setState } from "./views/status";
@@ -43,6 +44,8 @@ const page: Page = {
 const { store, pool, renderer } = page;
 const error = (e: unknown) => showError(page, e);
 
+let cutHooks: ReturnType<typeof wireCut> | null = null;
+
 function wire(): void {
   $("btn-sample").addEventListener("click", () => void openSample(page));
   $<HTMLInputElement>("file-input").addEventListener("change", (ev) => {
@@ -68,6 +71,7 @@ function wire(): void {
 
   wireLayerView(page);
   wireView3D(page);
+  cutHooks = wireCut(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;
@@ -152,6 +156,8 @@ window.dropslice = {
   /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
    *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
   view3d: () => page.view3d.testState(),
+  /** The vertical cut (views/cut.ts): set(line), status(), setView(v), redraw(). */
+  cut: () => cutHooks,
 };
 
 async function main(): Promise<void> {

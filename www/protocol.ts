@@ -230,6 +230,29 @@ export interface Calls {
   hash: { data: { file: Blob }; result: string };
   parse_gcode: { data: { file: Blob }; result: GcodeParseResult };
   crash: { data: null; result: void };
+  /** The vertical cut of layers [from, to) (views/cut.ts, src/wasm_cut.rs `Session.cut`). */
+  cut: { data: CutRequest; result: CutReply };
+}
+
+/** A vertical cut along `line` = [ax, ay, bx, by] for layers [from, to): `sent` per layer of
+ *  [from − 1, to + 1) within the part, the droplet centres sent in `centres` (x, y pairs, every
+ *  droplet within B of the line), or [[NOT_SENT]] for a layer the worker plans itself. */
+export interface CutRequest {
+  line: [number, number, number, number];
+  from: number;
+  to: number;
+  sent: Uint32Array;
+  centres: Float64Array;
+}
+export const NOT_SENT = 0xffffffff;
+
+/** src/wasm_cut.rs `CutResult`: droplets (layer, t, d, role; only layers not sent), spans
+ *  (layer, t0, t1), voids (layer, band, t0, t1) of `bands` heights per slab. */
+export interface CutReply {
+  droplets: Float64Array;
+  spans: Float64Array;
+  voids: Float64Array;
+  bands: number;
 }
 
 export type RequestKind = keyof Calls;

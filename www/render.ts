@@ -152,6 +152,12 @@ export class Renderer {
     return [v.cx + (px - this.cssW / 2) / v.scale, v.cy - (py - this.cssH / 2) / v.scale];
   }
 
+  /** CSS pixels of the point (x, y) in mm (the inverse of [[toMm]]). */
+  toPx(x: number, y: number): [number, number] {
+    const v = this.view;
+    return [(x - v.cx) * v.scale + this.cssW / 2, -(y - v.cy) * v.scale + this.cssH / 2];
+  }
+
   draw(): void {
     const ctx = this.canvas.getContext("2d", { alpha: false });
     if (!ctx) return;

@@ -211,6 +211,17 @@ async function handle(req: Request): Promise<void> {
       });
       return;
     }
+    case "cut": {
+      const { line, from, to, sent, centres } = req.data;
+      const r = need().cut(Float64Array.from(line), from, to, sent, centres);
+      try {
+        const reply = { droplets: r.droplets, spans: r.spans, voids: r.voids, bands: r.bands };
+        answer(req.kind, req.id, reply, [reply.droplets.buffer, reply.spans.buffer, reply.voids.buffer]);
+      } finally {
+        r.free();
+      }
+      return;
+    }
     case "crash":
       await load();
       crash_for_test();

@@ -18,6 +18,10 @@
 //!   i or i + 1 contains it. Flow, surface tension and the shape of the surface a droplet lands
 //!   on are not modelled; spheroids below the first layer are cut by the bed.
 //!
+//! # The vertical cut
+//! [`cut`] gives the same 3D estimate on a vertical plane through a line: per slab, the
+//! intervals along the line, at a few heights, that no spheroid fills (exact along the line).
+//!
 //! # The grid
 //! Rows every B/10 ([`ROWS_PER_B`]), columns every B/40 ([`COLS_PER_ROW`] per row). A droplet
 //! covers, in each row, as many columns around its centre as the average width of its disc
@@ -44,11 +48,13 @@
 //! over those. Parts a metre apart take the memory each takes alone, and the figures are those
 //! of a dense grid: the same grid, its rows and runs visited in the same order.
 
+mod cut;
 mod droplet;
 mod estimate3d;
 mod raster;
 mod report;
 
+pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_voids};
 pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
 pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
 pub use raster::{
