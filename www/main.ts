@@ -14,6 +14,7 @@ import { hideBanner } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
 import { show, wireLayerView } from "./views/layer";
+import { wirePlot } from "./views/plot";
 import { share } from "./views/share";
 import { setState } from "./views/status";
 
@@ -65,6 +66,7 @@ function wire(): void {
   });
 
   wireLayerView(page);
+  wirePlot(page, (i) => show(page, i));
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;
