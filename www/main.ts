@@ -15,6 +15,7 @@ import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
 import { show, wireLayerView } from "./views/layer";
 import { wirePlot } from "./views/plot";
+import { registerOffline } from "./offline";
 import { share } from "./views/share";
 import { setState } from "./views/status";
 
@@ -165,4 +166,5 @@ async function main(): Promise<void> {
   if (!(await openLink(page))) await openSample(page);
 }
 
+registerOffline();
 void main();
