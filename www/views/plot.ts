@@ -152,7 +152,8 @@ export function drawPlot(): void {
     tallest[c] = m;
     if (m > maxDroplets) maxDroplets = m;
   }
-  const dStep = step(Math.max(1, maxDroplets), Math.max(1, Math.floor(h / (22 * dpr))));
+  // whole droplets and whole layers per tick
+  const dStep = Math.max(1, step(maxDroplets, Math.max(1, Math.floor(h / (22 * dpr)))));
   const dTop = Math.max(dStep, Math.ceil(maxDroplets / dStep) * dStep);
   const sum = sumsOf(s);
   const total = sum.start[n];
@@ -217,7 +218,7 @@ export function drawPlot(): void {
   // the layer axis (bottom): layer numbers, the z of each tick beneath
   g.fillStyle = AXIS;
   g.fillRect(x0, y1, cols, Math.max(1, Math.round(dpr)));
-  const lStep = step(n, Math.max(1, Math.floor(cols / (64 * dpr))));
+  const lStep = Math.max(1, step(n, Math.max(1, Math.floor(cols / (64 * dpr)))));
   g.textAlign = "center";
   const xOf = (i: number) => x0 + ((i + 0.5) / n) * cols;
   for (let l = lStep; l <= n; l += lStep) {
@@ -245,7 +246,6 @@ export function drawPlot(): void {
   g.closePath();
   g.fillStyle = MARK;
   g.fill();
-  canvas.dataset.drawn = String(Number(canvas.dataset.drawn ?? 0) + 1);
 }
 
 /** Asks for a redraw: on the next frame, or while the workers run at most every
