@@ -160,7 +160,8 @@ export function drawPlot(): void {
 
   g.font = FONT.replace("11px", `${11 * dpr}px`);
   g.textBaseline = "middle";
-  // horizontal grid and the droplets' axis (left)
+  // horizontal grid and the droplets' axis (left), in thousands when they reach 10,000
+  const thousands = dTop >= 10000;
   g.fillStyle = AXIS;
   g.textAlign = "right";
   for (let v = 0; v <= dTop + 1e-9; v += dStep) {
@@ -168,7 +169,7 @@ export function drawPlot(): void {
     g.fillStyle = GRID;
     g.fillRect(x0, y - 0.5, cols, Math.max(1, Math.round(dpr / 2)));
     g.fillStyle = AXIS;
-    g.fillText(v >= 10000 ? `${+(v / 1000).toFixed(1)}k` : nf.format(v), x0 - 5 * dpr, y);
+    g.fillText(thousands && v > 0 ? `${+(v / 1000).toFixed(1)}k` : nf.format(v), x0 - 5 * dpr, y);
   }
   g.save();
   g.translate(11 * dpr, (y0 + y1) / 2);
