@@ -13,6 +13,7 @@ const TYPES = {
   ".wasm": "application/wasm",
   ".map": "application/json",
   ".json": "application/json",
+  ".webmanifest": "application/manifest+json",
   ".svg": "image/svg+xml",
   ".png": "image/png",
   ".stl": "model/stl",
@@ -59,7 +60,7 @@ async function locate(root, url) {
 
 /** The policy of www/index.html, plus what only a header can say (frame-ancestors). */
 const CSP =
-  "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; worker-src 'self'; connect-src 'self'; " +
+  "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; worker-src 'self'; connect-src 'self'; manifest-src 'self'; " +
   "img-src 'self' data: blob:; style-src 'self'; object-src 'none'; base-uri 'none'; form-action 'none'; " +
   "frame-ancestors 'none'";
 
@@ -73,6 +74,8 @@ export function serve(root, port = 0) {
       const body = await readFile(file);
       res.writeHead(200, {
         "content-type": TYPES[extname(file)] ?? "application/octet-stream",
+        // no-cache: the browser asks again every time (cheap 200s on 127.0.0.1), which is
+        // also what lets it find a new service worker (sw.js) as soon as a new build is served
         "cache-control": "no-cache",
         // The page's policy (as in index.html's meta tag) also as a header, which covers the
         // workers' scripts and framing too; nosniff keeps types as served.

@@ -41,6 +41,19 @@ pub struct WorstLayer {
     pub area: f64,
 }
 
+/// The estimated print time of `droplets` droplets and `travel_mm` of travel, s: droplets /
+/// droplet_rate + travel / travel_speed. The one estimate of the job's figures
+/// ([`Figures::print_seconds`]) and of each layer ([`layer_seconds`]), so the layers' times
+/// add up to the job's.
+pub fn print_seconds(droplets: u64, travel_mm: f64, settings: &Settings) -> f64 {
+    droplets as f64 / settings.droplet_rate + travel_mm / settings.travel_speed
+}
+
+/// The estimated print time of one planned layer, s (the page's per-layer plot).
+pub fn layer_seconds(plan: &LayerPlan, settings: &Settings) -> f64 {
+    print_seconds(plan.counts.total(), plan.travel_mm, settings)
+}
+
 /// What the CLI prints and the page shows about a slice.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Figures {
@@ -51,7 +64,7 @@ pub struct Figures {
     pub volume_mm3: f64,
     /// volume × material_density, g.
     pub mass_g: f64,
-    /// droplets / droplet_rate + travel / travel_speed, s.
+    /// droplets / droplet_rate + travel / travel_speed, s ([`print_seconds`]).
     pub print_seconds: f64,
     pub travel_mm: f64,
     /// Layers with a void analysis.
@@ -138,8 +151,7 @@ impl Summary {
             droplets,
             volume_mm3: volume,
             mass_g: volume / 1000.0 * settings.material_density,
-            print_seconds: droplets as f64 / settings.droplet_rate
-                + self.travel_mm / settings.travel_speed,
+            print_seconds: print_seconds(droplets, self.travel_mm, settings),
             travel_mm: self.travel_mm,
             analysed_layers: a.layers,
             coverage: analysed.then_some(a.coverage),

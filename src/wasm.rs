@@ -25,7 +25,7 @@ use crate::mesh::Mesh;
 use crate::plan::{Counts, LayerPlan};
 use crate::preview::PreviewLayer;
 use crate::settings::{self, Settings};
-use crate::summary::{Figures, Summary};
+use crate::summary::{self, Figures, Summary};
 use crate::{Job, JobInfo};
 use js_sys::{Float32Array, Float64Array, Uint8Array, Uint32Array};
 use serde::Serialize;
@@ -345,6 +345,7 @@ pub struct LayerResult {
     z: f64,
     counts: Counts,
     travel_mm: f64,
+    seconds: f64,
     summary: Summary,
     gcode: String,
     preview: PreviewLayer,
@@ -359,6 +360,7 @@ impl LayerResult {
             z: plan.z,
             counts: plan.counts,
             travel_mm: plan.travel_mm,
+            seconds: summary::layer_seconds(plan, settings),
             summary: Summary::of_layer(plan),
             gcode: gcode::layer_text(plan),
             preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
@@ -397,6 +399,12 @@ impl LayerResult {
     #[wasm_bindgen(getter)]
     pub fn travel_mm(&self) -> f64 {
         self.travel_mm
+    }
+    /// The layer's estimated print time, s (`summary::layer_seconds`: the layers' times add up
+    /// to the job's `print_seconds`).
+    #[wasm_bindgen(getter)]
+    pub fn seconds(&self) -> f64 {
+        self.seconds
     }
     /// The layer's G-code lines as UTF-8 bytes (a copy; the worker collects a run of layers
     /// into one Blob: a Blob per layer costs far more than the bytes).

@@ -4,6 +4,7 @@
 mod common;
 
 use dropslice::analysis::analyse_layer;
+use dropslice::summary::layer_seconds;
 use dropslice::{Figures, Job, Settings, Summary};
 use std::process::Command;
 
@@ -117,6 +118,43 @@ fn figures_follow_the_estimate_settings() {
     assert!(s.printable(job.settings()).is_ok());
     // coverage of a cube: most of each layer
     assert!((0.7..1.0).contains(&f.coverage.unwrap()), "{f:?}");
+}
+
+/// The page's per-layer plot shows each layer's time (`layer_seconds`, on `LayerResult`); its
+/// running total must reach the job's print time. Settings other than the defaults, so a
+/// layer estimate that ignored them would not add up.
+#[test]
+fn layer_times_add_up_to_the_print_time() {
+    let settings = Settings {
+        droplet_rate: 137.0,
+        travel_speed: 23.0,
+        ..Settings::default()
+    };
+    let job = Job::new(
+        &common::model_bytes("3DBenchy.stl"),
+        "3DBenchy.stl",
+        settings.clone(),
+    )
+    .unwrap();
+    let mut whole = Summary::default();
+    let mut sum = 0.0;
+    let mut with_travel = 0;
+    for i in 0..job.layer_count() {
+        let plan = job.plan_layer(i);
+        let t = layer_seconds(&plan, job.settings());
+        // droplets at droplet_rate per second, travel at travel_speed mm/s
+        let droplets = (plan.counts.outer + plan.counts.inner + plan.counts.fill) as f64;
+        assert!(
+            close(t, droplets / 137.0 + plan.travel_mm / 23.0),
+            "layer {i}: {t}"
+        );
+        with_travel += usize::from(plan.travel_mm > 0.0);
+        sum += t;
+        whole.add(&plan);
+    }
+    let f = whole.figures(job.settings());
+    assert!(f.droplets > 100_000 && with_travel > 100, "{f:?}");
+    assert!(close(sum, f.print_seconds), "{sum} vs {}", f.print_seconds);
 }
 
 #[test]

@@ -102,9 +102,18 @@ fn slices_a_box() {
     let mut totals = [0u64; 3];
     let mut text = String::new();
     let mut tally = Tally::new();
+    let mut seconds = 0.0;
     for i in 0..s.layer_count() {
         let l = s.slice_layer(i).unwrap();
         assert_eq!(l.index(), i);
+        // the layer's time: droplets at droplet_rate (100/s), travel at travel_speed (50 mm/s)
+        let t = (l.outer() + l.inner() + l.fill()) / 100.0 + l.travel_mm() / 50.0;
+        assert!(
+            (l.seconds() - t).abs() <= 1e-9 * t,
+            "layer {i}: {}",
+            l.seconds()
+        );
+        seconds += l.seconds();
         assert!((l.z() - 0.2 * (i + 1) as f64).abs() < 1e-9);
         let n = (l.outer() + l.inner() + l.fill()) as u32;
         assert!(n > 100, "layer {i}: only {n} droplets");
@@ -146,7 +155,10 @@ fn slices_a_box() {
     let b = 0.2 * 1.04;
     let volume = figures["volume_mm3"].as_f64().unwrap();
     assert!((volume - droplets as f64 * b * b * 0.2).abs() < 1e-6 * volume);
-    assert!(figures["print_seconds"].as_f64().unwrap() > droplets as f64 / 100.0);
+    let print_seconds = figures["print_seconds"].as_f64().unwrap();
+    assert!(print_seconds > droplets as f64 / 100.0);
+    // the page's per-layer plot: the layers' times add up to the job's
+    assert!((seconds - print_seconds).abs() <= 1e-9 * print_seconds);
     assert!(f["nothing_to_print"].is_null(), "{f}");
     assert!(figures["coverage"].is_null() && figures["worst_layer"].is_null());
     assert!(s.slice_layer(10).is_err());

@@ -15,6 +15,8 @@ import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
 import { wireCut } from "./views/cut";
 import { show, wireLayerView } from "./views/layer";
+import { wirePlot } from "./views/plot";
+import { registerOffline } from "./offline";
 import { share } from "./views/share";
 import { setState } from "./views/status";
 import { View3DPanel, wireView3D } from "./views/view3d";
@@ -72,6 +74,7 @@ function wire(): void {
   wireLayerView(page);
   wireView3D(page);
   cutHooks = wireCut(page);
+  wirePlot(page, (i) => show(page, i));
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;
@@ -175,4 +178,5 @@ async function main(): Promise<void> {
   if (!(await openLink(page))) await openSample(page);
 }
 
+registerOffline();
 void main();

@@ -27,6 +27,9 @@ export interface LayerData {
   z: number;
   counts: Counts;
   travelMm: number;
+  /** The core's estimated print time of the layer, s (src/summary.rs `layer_seconds`; the
+   *  layers' times add up to the job's `print_seconds`). Absent for a .gco file's layers. */
+  seconds?: number;
   /** x,y pairs in mm, every droplet (each one of a G25 line too). */
   droplets: Float32Array;
   /** 0 outermost loop, 1 inner loops, 2 fill; one per droplet. */

@@ -30,6 +30,8 @@ export class Slice {
   z: number[] = [];
   counts: (Counts | undefined)[] = [];
   travelMm: number[] = [];
+  /** The core's print time per layer, s (slices only; the per-layer plot). */
+  layerSeconds: number[] = [];
   /** G-code by runs of layers, keyed by the run's first layer. */
   gcode = new Map<number, { to: number; blob: Blob }>();
   cache = new Map<number, LayerData>();
@@ -70,6 +72,7 @@ export class Slice {
       this.counts[l.index] = l.counts;
       this.z[l.index] = l.z;
       this.travelMm[l.index] = l.travelMm;
+      if (l.seconds !== undefined) this.layerSeconds[l.index] = l.seconds;
       if (this.source === "gco") this.figures.addReadLayer(l);
       const d = l.droplets;
       const b = this.bbox;

@@ -93,6 +93,7 @@ function layerOf(s: Session, index: number, unit: { gcode: Uint8Array[]; tally: 
       z: r.z,
       counts: { outer: r.outer, inner: r.inner, fill: r.fill },
       travelMm: r.travel_mm,
+      seconds: r.seconds,
       droplets: r.droplets,
       roles: r.roles,
       travel: r.travel,

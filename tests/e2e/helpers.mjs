@@ -17,8 +17,21 @@ export async function start() {
   const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
   if (!existsSync(join(dist, "index.html"))) throw new Error(`${dist} is missing: run scripts/build.sh first`);
   const { server, url } = await serve(dist, 0);
+  const browser = await launchBrowser();
+  return {
+    url,
+    browser,
+    async close() {
+      await browser.close().catch(() => {});
+      await new Promise((ok) => server.close(ok));
+    },
+  };
+}
+
+/** Debian's Chromium, headless. */
+export function launchBrowser() {
   // playwright gives every launch a fresh, empty user-data-dir of its own
-  const browser = await chromium.launch({
+  return chromium.launch({
     executablePath: chromiumPath,
     headless: true,
     args: [
@@ -32,14 +45,6 @@ export async function start() {
       "--disable-sync",
     ],
   });
-  return {
-    url,
-    browser,
-    async close() {
-      await browser.close().catch(() => {});
-      await new Promise((ok) => server.close(ok));
-    },
-  };
 }
 
 /** A new page that fails the test on page errors it did not expect. */

@@ -9,3 +9,15 @@ export function setText(id: string, text: string): void {
 }
 
 export const nf = new Intl.NumberFormat("en-US");
+
+/** A duration for people: "2 h 10 min", "3 min 5 s", "40 s". */
+export function duration(seconds: number): string {
+  if (!Number.isFinite(seconds)) return "–";
+  const whole = Math.round(seconds);
+  const h = Math.floor(whole / 3600);
+  const m = Math.floor((whole % 3600) / 60);
+  const s = whole % 60;
+  if (h > 0) return `${h} h ${m} min`;
+  if (m > 0) return `${m} min ${s} s`;
+  return `${s} s`;
+}

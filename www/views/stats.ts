@@ -3,20 +3,11 @@
 
 import type { Page } from "../page";
 import type { Slice } from "../store";
-import { $, nf, setText } from "./dom";
+import { $, duration, nf, setText } from "./dom";
+import { requestPlot } from "./plot";
 import { writeVoids } from "./voids";
 
 const fmtMm = (x: number) => `${x.toFixed(1)}`;
-
-function duration(seconds: number): string {
-  if (!Number.isFinite(seconds)) return "–";
-  const h = Math.floor(seconds / 3600);
-  const m = Math.floor((seconds % 3600) / 60);
-  const s = Math.round(seconds % 60);
-  if (h > 0) return `${h} h ${m} min`;
-  if (m > 0) return `${m} min ${s} s`;
-  return `${s} s`;
-}
 
 function roleLabels(source: "stl" | "gco"): void {
   const gco = source === "gco";
@@ -35,6 +26,7 @@ export function writeStats(page: Page): void {
     writeVoids(null, current);
     for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
     $("warnings").hidden = true;
+    requestPlot();
     return;
   }
   const f = s.figures;
@@ -76,6 +68,8 @@ export function writeStats(page: Page): void {
     );
   }
   writeUnitFix(page, s);
+  // the per-layer plot shows the same figures (and the current layer)
+  requestPlot();
 }
 
 /**
