@@ -488,6 +488,93 @@ impl Model {
     }
 }
 
+/// What a file holds, for the page: `{name, format, triangles, bounds, items, warnings,
+/// suggested_scale}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModelInfo {
+    pub name: String,
+    pub format: Format,
+    pub triangles: usize,
+    /// In the file's coordinates (mm, after its units and 3MF transforms).
+    pub bounds: Bounds,
+    /// The 3MF build items (one item for STL and OBJ).
+    pub items: Vec<ItemInfo>,
+    pub warnings: Vec<String>,
+    /// See [`crate::suggested_scale`].
+    pub suggested_scale: Option<f64>,
+}
+
+/// One build item of a [`ModelInfo`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ItemInfo {
+    pub name: String,
+    pub triangles: usize,
+    pub bounds: Bounds,
+}
+
+/// The bounding box of triangles.
+pub fn bounds_of(tris: &[[[f32; 3]; 3]]) -> Bounds {
+    let mut b = Bounds {
+        min: [f64::INFINITY; 3],
+        max: [f64::NEG_INFINITY; 3],
+    };
+    for p in corners(tris) {
+        grow(&mut b, p, p);
+    }
+    b
+}
+
+/// `b` grown to hold the box `lo`..`hi`.
+fn grow(b: &mut Bounds, lo: [f64; 3], hi: [f64; 3]) {
+    for (k, (l, h)) in lo.iter().zip(hi).enumerate() {
+        b.min[k] = b.min[k].min(*l);
+        b.max[k] = b.max[k].max(h);
+    }
+}
+
+impl Model {
+    /// What the file holds.
+    pub fn info(&self) -> ModelInfo {
+        let items: Vec<ItemInfo> = self
+            .parts
+            .iter()
+            .map(|p| ItemInfo {
+                name: clean_name(&p.name),
+                triangles: p.triangles.len(),
+                bounds: bounds_of(&p.triangles),
+            })
+            .collect();
+        let mut bounds = Bounds {
+            min: [f64::INFINITY; 3],
+            max: [f64::NEG_INFINITY; 3],
+        };
+        for i in &items {
+            grow(&mut bounds, i.bounds.min, i.bounds.max);
+        }
+        let size = bounds.size();
+        let suggested_scale = crate::suggested_scale(&size);
+        let largest = size[0].max(size[1]).max(size[2]);
+        let warnings = match suggested_scale {
+            Some(f) if f > 1.0 => vec![format!(
+                "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f}"
+            )],
+            Some(f) => vec![format!(
+                "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f}"
+            )],
+            None => Vec::new(),
+        };
+        ModelInfo {
+            name: clean_name(&self.name),
+            format: self.format,
+            triangles: items.iter().map(|i| i.triangles).sum(),
+            bounds,
+            items,
+            warnings,
+            suggested_scale,
+        }
+    }
+}
+
 /// Names as the header and messages show them: one line, at most [`MAX_NAME_CHARS`].
 pub fn clean_name(name: &str) -> String {
     let one_line: String = name
@@ -799,10 +886,7 @@ pub fn place_instances(
         max: [f64::NEG_INFINITY; 3],
     };
     for inst in &instances {
-        for k in 0..3 {
-            bounds.min[k] = bounds.min[k].min(inst.min[k]);
-            bounds.max[k] = bounds.max[k].max(inst.max[k]);
-        }
+        grow(&mut bounds, inst.min, inst.max);
     }
     Ok(Layout {
         instances,
@@ -961,6 +1045,8 @@ pub fn lay_flat(tris: &[[[f32; 3]; 3]]) -> (f64, f64) {
         .map(|p| DVec3::from(p) - centre)
         .collect();
     let tol = 1e-4 * extent;
+    // The supporting planes among the largest: (area, outward normal).
+    let mut supporting: Vec<(f64, DVec3)> = Vec::new();
     for (area, nsum, dsum) in groups {
         let n = nsum.normalize_or_zero();
         if n == DVec3::ZERO {
@@ -982,16 +1068,26 @@ pub fn lay_flat(tris: &[[[f32; 3]; 3]]) -> (f64, f64) {
         } else {
             continue;
         };
-        return angles_down(outward);
+        supporting.push((area, outward));
     }
-    (0.0, 0.0)
+    // The largest; of faces as large (a box's bottom and top), the one facing down most, so a
+    // part already lying flat is not turned over.
+    let Some(largest) = supporting.iter().map(|s| s.0).reduce(f64::max) else {
+        return (0.0, 0.0);
+    };
+    supporting
+        .iter()
+        .filter(|s| s.0 >= largest * (1.0 - 1e-6))
+        .min_by(|a, b| a.1.z.total_cmp(&b.1.z))
+        .map_or((0.0, 0.0), |s| angles_down(s.1))
 }
 
 /// Angles (rotate x first, then y) that turn the unit vector `n` to −z.
 pub fn angles_down(n: DVec3) -> (f64, f64) {
+    // About x: n to (n.x, 0, −m); then about y: (n.x, 0, −m) to (0, 0, −1).
     let m = (n.y * n.y + n.z * n.z).sqrt();
-    let a = n.y.atan2(n.z);
-    let b = n.x.atan2(-m);
+    let a = if m < 1e-12 { 0.0 } else { (-n.y).atan2(-n.z) };
+    let b = n.x.atan2(m);
     let clean = |r: f64| {
         let d = r.to_degrees();
         // Exact right angles stay exact (the trig of the transform is exact there).
