@@ -861,6 +861,12 @@ fn cli_slices_several_models_and_job_files() {
         from_file.contains("; part 2 = idler.obj"),
         "{from_file:.2000}"
     );
+    // Recognised by its content too (a name that is not a model's).
+    std::fs::copy(dir.join("models/job.json"), dir.join("models/the-job")).unwrap();
+    let r = run(&["models/the-job", "-o", "job2.gco"], &dir);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    let t = std::fs::read_to_string(dir.join("job2.gco")).unwrap();
+    assert_eq!(moves(&t), moves(&from_file));
     // --set overrides the job file's settings; a part key is refused there.
     let r = run(
         &[

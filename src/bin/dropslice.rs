@@ -32,7 +32,8 @@ places) into droplet machine code (.gco: G01 travel, G25 droplet line, G26 dropl
 
 Several models make a build job: one part each, arranged on the plate (plate_x, plate_y,
 part_spacing); rotate_* and scale_* then apply to every part, place_* is refused (give the
-parts' places in a job file). A job file (JSON, named *.json or starting with '{') lists
+parts' places in a job file). A job file (JSON: named *.json, or not named .stl/.obj/.3mf
+and starting with '{') lists
 the settings and the parts:
   {\"settings\": {\"layer_height\": 0.2},
    \"parts\": [{\"file\": \"a.stl\", \"rotate_z\": 90, \"place_x\": 30, \"place_y\": 5},
@@ -509,13 +510,16 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         }
     }
 
-    /// A job file: named `*.json`, or its first non-blank byte is `{`.
+    /// A job file: named `*.json`, or not named as a model (`.stl`, `.obj`, `.3mf`) and its
+    /// first non-blank byte is `{` (a model file holding JSON gets the model reader's message).
     fn is_job_file(path: &Path) -> Result<bool, Error> {
-        if path
+        let ext = path
             .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-        {
-            return Ok(true);
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("json") => return Ok(true),
+            Some("stl" | "obj" | "3mf") => return Ok(false),
+            _ => {}
         }
         use std::io::Read;
         let mut start = [0u8; 64];
