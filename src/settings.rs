@@ -625,7 +625,12 @@ impl Settings {
     /// Sets one value given as text (`--set name=value`). Not validated; call [`validate`](Self::validate).
     pub fn set(&mut self, name: &str, value: &str) -> Result<(), Error> {
         let t = value.trim();
+        // An enum's choices are text even when they read as a bool (`support = off`).
+        let is_enum = schema()
+            .iter()
+            .any(|s| s.name == name && s.kind == Kind::Enum);
         let v = match t {
+            _ if is_enum => serde_json::Value::String(t.to_string()),
             "true" | "yes" | "on" => serde_json::Value::Bool(true),
             "false" | "no" | "off" => serde_json::Value::Bool(false),
             _ => match t.parse::<f64>() {
@@ -815,6 +820,10 @@ mod tests {
         assert!(s.set("contours", "2.5").is_err());
         assert!(s.set("nonsense", "1").is_err());
         assert!(s.set("contour_order", "sideways").is_err());
+        // An enum choice that reads like a bool stays text.
+        s.set("support", "unit1").unwrap();
+        s.set("support", "off").unwrap();
+        assert_eq!(s.support, Support::Off);
         s.set("layer_height", "-1").unwrap();
         let e = s.validate().unwrap_err().to_string();
         assert!(
