@@ -10,6 +10,9 @@ pub enum Error {
     Import(String),
     /// A setting is unknown or out of range.
     Setting { name: String, message: String },
+    /// A build job (its file, its parts or their arrangement on the plate) is not valid; the
+    /// message names the part (`parts[2].scale_x: …`).
+    Job(String),
     /// The mesh was read but there is nothing a droplet printer could print.
     NothingToPrint(String),
     /// Reading or writing a file failed.
@@ -19,11 +22,12 @@ pub enum Error {
 }
 
 impl Error {
-    /// A short machine-readable tag: "import", "setting", "nothing_to_print", "io", "internal".
+    /// A short machine-readable tag: "import", "setting", "job", "nothing_to_print", "io", "internal".
     pub fn kind(&self) -> &'static str {
         match self {
             Error::Import(_) => "import",
             Error::Setting { .. } => "setting",
+            Error::Job(_) => "job",
             Error::NothingToPrint(_) => "nothing_to_print",
             Error::Io(_) => "io",
             Error::Internal(_) => "internal",
@@ -65,6 +69,7 @@ impl fmt::Display for Error {
                 write!(f, "bad settings: {message}")
             }
             Error::Setting { name, message } => write!(f, "bad setting {name}: {message}"),
+            Error::Job(m) => write!(f, "bad job: {m}"),
             Error::NothingToPrint(m) => write!(f, "nothing to print: {m}"),
             Error::Io(m) => write!(f, "{m}"),
             Error::Internal(m) => write!(

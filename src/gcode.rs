@@ -19,6 +19,8 @@ pub struct HeaderInput<'a> {
     /// Bounding box of the placed part (min, max).
     pub bounds: ([f64; 3], [f64; 3]),
     pub warnings: &'a [String],
+    /// Every copy of every part (one line each).
+    pub instances: &'a [crate::job::Instance],
     /// Whether discharge unit 1 prints anything (its settings are listed only then).
     pub unit1_used: bool,
 }
@@ -103,6 +105,9 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
         "; droplets total       = {}",
         field(c.map(|c| c.total()))
     );
+    for p in input.instances {
+        let _ = writeln!(h, "; {}", part_line(p));
+    }
     for w in input.warnings {
         let _ = writeln!(h, "; warning: {}", w.replace(['\n', '\r'], " "));
     }
@@ -116,6 +121,36 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
     }
     let _ = writeln!(h, "; end of header");
     h
+}
+
+/// An instance as the header lists it: `part 1 = gear.3mf (object 3), rotate 0/0/90 deg,
+/// scale 1/1/1, at X30.0000 Y5.0000, angle 0 deg, copy 1 of 2, unit 0`.
+pub fn part_line(p: &crate::job::Instance) -> String {
+    let clean = |s: &str| crate::job::clean_name(s);
+    let what = match (&p.object, p.item) {
+        (Some(o), _) => format!(" (object {})", clean(o)),
+        (None, Some(i)) => format!(" (item {i})"),
+        (None, None) => String::new(),
+    };
+    let name = if crate::import::stem(&p.file) == p.name {
+        String::new()
+    } else {
+        format!(" \"{}\"", clean(&p.name))
+    };
+    let [rx, ry, rz] = p.rotate;
+    let [sx, sy, sz] = p.scale;
+    format!(
+        "part {} = {}{what}{name}, rotate {rx}/{ry}/{rz} deg, scale {sx}/{sy}/{sz}, at X{} Y{}{}, angle {} deg, copy {} of {}, unit {}",
+        p.part + 1,
+        clean(&p.file),
+        coord(p.at[0]),
+        coord(p.at[1]),
+        if p.placed { "" } else { " (arranged)" },
+        p.place_angle,
+        p.copy + 1,
+        p.copies,
+        p.unit
+    )
 }
 
 /// One layer's commands.

@@ -24,6 +24,7 @@ pub mod geom;
 pub mod grid;
 pub mod hatch;
 pub mod import;
+pub mod job;
 pub mod mesh;
 pub mod offset;
 pub mod plan;
@@ -72,6 +73,9 @@ pub struct JobInfo {
     /// A scale factor for all three axes when the part's size suggests the file is not in
     /// millimetres (25.4: inches; 0.001: micrometres); never applied silently.
     pub suggested_scale: Option<f64>,
+    /// Every copy of every part: its file, transform, placement, matrix and bounds.
+    #[serde(default)]
+    pub instances: Vec<job::Instance>,
 }
 
 /// Vertices closer than this are merged when exact welding leaves the surface open.
@@ -106,11 +110,126 @@ impl Job {
     pub fn new(model_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
         settings.validate()?;
         let Imported {
-            mut mesh,
+            mesh,
             format,
             facets_in_file,
             degenerate,
+            instance,
         } = import(model_bytes, file_name, &settings)?;
+        let input = Input {
+            file_name: file_name.to_string(),
+            format,
+            facets_in_file,
+            degenerate,
+            instances: vec![instance],
+            warnings: Vec::new(),
+        };
+        Job::build(mesh, input, settings)
+    }
+
+    /// A build job (SPEC.md "Build jobs"): reads each file of `files` (name, bytes) once and
+    /// builds the job of `spec` from them (see [`Job::from_models`]).
+    pub fn from_parts(files: &[(&str, &[u8])], spec: &job::JobSpec) -> Result<Job, Error> {
+        let models = files
+            .iter()
+            .map(|(name, bytes)| job::Model::read(bytes, name))
+            .collect::<Result<Vec<_>, _>>()?;
+        Job::from_models(&models, spec)
+    }
+
+    /// A build job from imported files: every part welded once, each instance placed (the
+    /// arrangement of [`job::place_instances`]) with [`Mesh::place`] — the very transform of
+    /// [`Job::new`] — the instances merged into one mesh and prepared as [`Job::new`] does
+    /// (checks, shells, repair, facet index). The job's settings are `spec.settings`.
+    pub fn from_models(models: &[job::Model], spec: &job::JobSpec) -> Result<Job, Error> {
+        spec.validate()?;
+        let settings = spec.settings.clone();
+        let by_part = job::models_of(models, spec)?;
+        if let Some((i, p)) = spec.parts.iter().enumerate().find(|(_, p)| p.unit != 0) {
+            return Err(Error::Job(format!(
+                "parts[{i}] ({}): parts of discharge unit {} are not printed yet; set its unit to 0",
+                job::clean_name(&by_part[i].part_name(p.item)),
+                p.unit
+            )));
+        }
+        let mut welded = Vec::with_capacity(spec.parts.len());
+        let mut frames = Vec::with_capacity(spec.parts.len());
+        let (mut facets_in_file, mut degenerate, mut facets) = (0usize, 0usize, 0usize);
+        for (i, (p, m)) in spec.parts.iter().zip(&by_part).enumerate() {
+            let tris = m.triangles(p.item).map_err(|e| job::at_part(i, e))?;
+            let (mesh, dropped) = Mesh::weld(&tris);
+            let copies = p.copies as usize;
+            facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
+            if facets > import::MAX_TRIANGLES {
+                return Err(Error::Job(format!(
+                    "the job has more than {} triangles in all (parts × copies); print fewer copies or simplify the models",
+                    import::MAX_TRIANGLES
+                )));
+            }
+            let frame = job::Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0]));
+            let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
+                return Err(Error::Import(format!(
+                    "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
+                    job::clean_name(&m.part_name(p.item)),
+                    tris.len()
+                )));
+            };
+            facets_in_file += tris.len() * copies;
+            degenerate += dropped * copies;
+            welded.push(mesh);
+            frames.push(frame);
+        }
+        let layout = job::place_instances(&by_part, spec, &frames)?;
+        let vertices: usize = layout
+            .instances
+            .iter()
+            .map(|x| welded[x.part].vertices.len())
+            .sum();
+        let mut mesh = Mesh {
+            vertices: Vec::with_capacity(vertices),
+            facets: Vec::with_capacity(facets),
+        };
+        for inst in &layout.instances {
+            let mut m = welded[inst.part].clone();
+            m.place(&spec.parts[inst.part].placement(inst.shift));
+            let base = mesh.vertices.len() as u32;
+            mesh.vertices.extend_from_slice(&m.vertices);
+            mesh.facets
+                .extend(m.facets.iter().map(|f| f.map(|v| v + base)));
+        }
+        drop(welded);
+        let mut names: Vec<String> = Vec::new();
+        for p in &spec.parts {
+            let n = job::clean_name(&p.file);
+            if !names.contains(&n) {
+                names.push(n);
+            }
+        }
+        let mut file_name = names.join(", ");
+        if file_name.chars().count() > 4 * job::MAX_NAME_CHARS {
+            file_name = format!(
+                "{}… ({} files)",
+                file_name
+                    .chars()
+                    .take(4 * job::MAX_NAME_CHARS)
+                    .collect::<String>(),
+                names.len()
+            );
+        }
+        let input = Input {
+            file_name,
+            format: by_part[0].format,
+            facets_in_file,
+            degenerate,
+            instances: layout.instances,
+            warnings: layout.warnings,
+        };
+        Job::build(mesh, input, settings)
+    }
+
+    /// The common tail of [`Job::new`] and [`Job::from_models`]: checks → shells → mesh repair
+    /// → facet index.
+    fn build(mut mesh: Mesh, input: Input, settings: Settings) -> Result<Job, Error> {
         let bounds = mesh.bounds();
         let size = bounds.size();
         check_height(&size, &settings)?;
@@ -127,8 +246,8 @@ impl Job {
             &zs,
             shells.clone(),
             duplicates,
-            facets_in_file,
-            degenerate,
+            input.facets_in_file,
+            input.degenerate,
         );
         if shells.open > 0 {
             // Open shells enclose no definite volume: estimate what will be printed from the
@@ -136,15 +255,18 @@ impl Job {
             let h = settings.layer_height;
             check_droplets(sampled_volume(&mesh, &buckets, &zs, h), &settings)?;
         }
+        let mut all_warnings = input.warnings;
+        all_warnings.extend(warnings(&stats, &size));
         let info = JobInfo {
-            file_name: file_name.to_string(),
-            format,
-            warnings: warnings(&stats, &size),
+            file_name: input.file_name,
+            format: input.format,
+            warnings: all_warnings,
             suggested_scale: suggested_scale(&size),
             mesh: stats,
             bounds,
             layers: zs.len(),
             droplet_width: settings.droplet_width(),
+            instances: input.instances,
         };
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
@@ -257,6 +379,7 @@ impl Job {
                 layers: self.zs.len(),
                 bounds: (b.min, b.max),
                 warnings: &self.info.warnings,
+                instances: &self.info.instances,
                 unit1_used: self.settings.support == settings::Support::Unit1,
             },
             summary,
@@ -270,6 +393,17 @@ struct Imported {
     format: stl::Format,
     facets_in_file: usize,
     degenerate: usize,
+    instance: job::Instance,
+}
+
+/// What [`Job::build`] needs besides the mesh.
+struct Input {
+    file_name: String,
+    format: stl::Format,
+    facets_in_file: usize,
+    degenerate: usize,
+    instances: Vec<job::Instance>,
+    warnings: Vec<String>,
 }
 
 /// Import: STL bytes → triangles → welded mesh → rotated, scaled, placed.
@@ -284,12 +418,45 @@ fn import(bytes: &[u8], file_name: &str, settings: &Settings) -> Result<Imported
     }
     let facets_in_file = tris.len();
     drop(tris);
+    let placement = mesh::Placement::of_settings(settings);
+    let frame = job::Frame::of(mesh.vertices.iter().copied(), &placement)
+        .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
+    let place = placement.place;
+    let name = job::clean_name(&import::stem(file_name));
+    let instance = job::Instance {
+        part: 0,
+        copy: 0,
+        copies: 1,
+        name,
+        file: job::clean_name(file_name),
+        item: None,
+        object: None,
+        rotate: placement.rotate,
+        scale: placement.scale,
+        place_angle: placement.place_angle,
+        placed: true,
+        at: place,
+        unit: 0,
+        matrix: frame.matrix(place),
+        min: [
+            frame.qmin.x + place[0],
+            frame.qmin.y + place[1],
+            frame.qmin.z,
+        ],
+        max: [
+            frame.qmax.x + place[0],
+            frame.qmax.y + place[1],
+            frame.qmax.z,
+        ],
+        shift: place,
+    };
     mesh.transform(settings);
     Ok(Imported {
         mesh,
         format,
         facets_in_file,
         degenerate,
+        instance,
     })
 }
 

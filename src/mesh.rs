@@ -4,7 +4,6 @@
 
 use crate::geom::{DMat3, DVec3, sin_cos_deg};
 use crate::settings::Settings;
-use crate::stl::Triangles;
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 /// A welded triangle mesh in millimetres.
@@ -87,7 +86,7 @@ pub const ENCLOSURE_BUDGET: u64 = 60_000_000;
 impl Mesh {
     /// Welds corners whose float32 coordinates are bit-identical (−0 = +0) and drops facets
     /// that collapse to a line or a point.
-    pub fn weld(tris: &Triangles) -> (Mesh, usize) {
+    pub fn weld(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
         let mut index: HashMap<[u32; 3], u32> =
             HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
         let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
@@ -126,17 +125,22 @@ impl Mesh {
     /// bounding box minimum to the origin, then rotate by `place_angle` about the z axis
     /// through the origin and move by (`place_x`, `place_y`).
     pub fn transform(&mut self, s: &Settings) {
-        let r = rot(2, s.rotate_z) * (rot(1, s.rotate_y) * rot(0, s.rotate_x));
-        let scale = DVec3::new(s.scale_x, s.scale_y, s.scale_z);
+        self.place(&Placement::of_settings(s));
+    }
+
+    /// [`Mesh::transform`] with the values of a [`Placement`] (a build job's part).
+    pub fn place(&mut self, p: &Placement) {
+        let r = rotation(p.rotate);
+        let scale = DVec3::from(p.scale);
         for v in &mut self.vertices {
             *v = (r * DVec3::from(*v) * scale).to_array();
         }
         let b = self.bounds();
-        let place = rot(2, s.place_angle);
+        let place = rot(2, p.place_angle);
         let min = DVec3::from(b.min);
         for v in &mut self.vertices {
             let q = place * (DVec3::from(*v) - min);
-            *v = [q.x + s.place_x, q.y + s.place_y, q.z];
+            *v = [q.x + p.place[0], q.y + p.place[1], q.z];
         }
     }
 
@@ -531,7 +535,35 @@ fn norm(a: [f64; 3]) -> f64 {
 }
 
 /// Rotation about axis `axis` (0 x, 1 y, 2 z) by `deg` degrees; exact for multiples of 90°.
-fn rot(axis: usize, deg: f64) -> DMat3 {
+/// A part's transform (SPEC.md): rotate about x, y, z (degrees, in that order), scale, bounding
+/// box minimum to the origin, rotate by `place_angle` (degrees) about z, move by `place`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub rotate: [f64; 3],
+    pub scale: [f64; 3],
+    pub place_angle: f64,
+    pub place: [f64; 2],
+}
+
+impl Placement {
+    /// The settings' `rotate_*`, `scale_*`, `place_*`.
+    pub fn of_settings(s: &Settings) -> Placement {
+        Placement {
+            rotate: [s.rotate_x, s.rotate_y, s.rotate_z],
+            scale: [s.scale_x, s.scale_y, s.scale_z],
+            place_angle: s.place_angle,
+            place: [s.place_x, s.place_y],
+        }
+    }
+}
+
+/// The rotation of [`Mesh::place`]: about x, then y, then z (degrees).
+pub fn rotation(rotate: [f64; 3]) -> DMat3 {
+    rot(2, rotate[2]) * (rot(1, rotate[1]) * rot(0, rotate[0]))
+}
+
+/// The rotation about one axis (0 = x, 1 = y, 2 = z) by `deg` degrees (exact at right angles).
+pub fn rot(axis: usize, deg: f64) -> DMat3 {
     let (s, c) = sin_cos_deg(deg);
     let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
     // Rows, then transposed into glam's columns.

@@ -3,7 +3,7 @@
 #![cfg(target_arch = "wasm32")]
 
 use dropslice::wasm::{
-    Session, Tally, default_settings, merge_summaries, settings_schema, version,
+    Models, Session, Tally, default_settings, merge_summaries, settings_schema, version,
 };
 use serde::Serialize;
 use wasm_bindgen::{JsCast, JsValue};
@@ -424,4 +424,131 @@ fn the_mask_of_parts_far_apart_has_tiles_near_them_only() {
         assert!(near(0.0) || near(1000.0), "tile at {t:?}");
     }
     assert_eq!(l.void_mask().length() as f64, cells);
+}
+
+/// A JSON array of numbers (integers and floats alike).
+fn nums(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+#[wasm_bindgen_test]
+fn models_give_infos_layouts_and_a_merged_session() {
+    let mut models = Models::new();
+    let info = json(
+        models
+            .add_bytes(box_stl(20.0, 10.0, 2.0).as_bytes(), "a.stl")
+            .unwrap(),
+    );
+    assert_eq!(info["name"], "a.stl");
+    assert_eq!(info["format"], "ascii");
+    assert_eq!(info["triangles"], 12);
+    assert_eq!(nums(&info["bounds"]["max"]), [20.0, 10.0, 2.0]);
+    assert_eq!(info["items"].as_array().unwrap().len(), 1);
+    assert_eq!(info["suggested_scale"], serde_json::Value::Null);
+    models
+        .add_bytes(box_stl(5.0, 5.0, 3.0).as_bytes(), "b.stl")
+        .unwrap();
+    assert_eq!(
+        json(models.names().unwrap()),
+        serde_json::json!(["a.stl", "b.stl"])
+    );
+    // The display mesh: the 12 triangles of the box, 9 floats each, in model coordinates.
+    let d = models.display_mesh("a.stl", None, 1000).unwrap().to_vec();
+    assert_eq!(d.len(), 12 * 9);
+    assert!(d.iter().all(|&c| (0.0..=20.0).contains(&c)));
+    // lay_flat of a box lying on its largest face: nothing to turn.
+    let flat = json(models.lay_flat("a.stl", None).unwrap());
+    let (rx, ry) = (
+        flat["rotate_x"].as_f64().unwrap(),
+        flat["rotate_y"].as_f64().unwrap(),
+    );
+    assert!(rx == 0.0 && ry == 0.0, "{flat}");
+    let job = serde_json::json!({
+        "settings": {"part_spacing": 3},
+        "parts": [
+            {"file": "a.stl", "place_x": 10, "place_y": 10},
+            {"file": "b.stl", "copies": 2}
+        ]
+    });
+    let layout = json(models.layout(js(job.clone())).unwrap());
+    let inst = layout["instances"].as_array().unwrap();
+    assert_eq!(inst.len(), 3);
+    assert_eq!(nums(&inst[0]["min"]), [10.0, 10.0, 0.0]);
+    assert_eq!(inst[0]["matrix"].as_array().unwrap().len(), 16);
+    // The matrix of the placed box: a translation by (10, 10, 0).
+    let m = nums(&inst[0]["matrix"]);
+    assert_eq!(
+        m,
+        [
+            1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 10., 10., 0., 1.
+        ]
+    );
+    assert_eq!(inst[1]["copy"], 0);
+    assert_eq!(inst[2]["copy"], 1);
+    // The merged session slices all three; its prepared mesh goes to another worker as usual.
+    let s = Session::from_models(&models, js(job.clone())).unwrap();
+    let info = json(s.info().unwrap());
+    assert_eq!(info["instances"].as_array().unwrap().len(), 3);
+    assert_eq!(info["layers"], 15);
+    assert_eq!(info["bounds"], layout["bounds"]);
+    let other = Session::from_prepared(
+        &s.vertices().to_vec(),
+        &s.facets().to_vec(),
+        s.info().unwrap(),
+        js(job["settings"].clone()),
+    )
+    .unwrap();
+    for i in [0, 7, 14] {
+        assert_eq!(
+            s.slice_layer(i).unwrap().gcode().to_vec(),
+            other.slice_layer(i).unwrap().gcode().to_vec()
+        );
+    }
+    // Layer 1 has the three footprints: 20×10 + 2 × 5×5 = 250 mm² of droplets at B² each.
+    let l = s.slice_layer(0).unwrap();
+    let n = l.outer() + l.inner() + l.fill();
+    let b = 0.2 * 1.04;
+    assert!((n * b * b - 250.0).abs() < 0.15 * 250.0, "{n} droplets");
+    let header = s.header(JsValue::NULL).unwrap();
+    assert!(header.contains("; part 2 = b.stl"), "{header}");
+    assert!(models.remove("b.stl"));
+    assert!(!models.remove("b.stl"));
+}
+
+#[wasm_bindgen_test]
+fn refused_jobs_throw_typed_errors() {
+    let mut models = Models::new();
+    models
+        .add_bytes(box_stl(100.0, 100.0, 2.0).as_bytes(), "big.stl")
+        .unwrap();
+    let job = js(serde_json::json!({"parts": [{"file": "big.stl", "copies": 2}]}));
+    let e = thrown(models.layout(job).unwrap_err());
+    assert_eq!(e["kind"], "job");
+    assert!(e["message"].as_str().unwrap().contains("do not"), "{e}");
+    let job = js(serde_json::json!({"parts": [{"file": "big.stl", "copies": 2}]}));
+    assert_eq!(
+        thrown(Session::from_models(&models, job).err().unwrap())["kind"],
+        "job"
+    );
+    let job = js(serde_json::json!({"parts": [{"file": "big.stl", "scale_x": 0}]}));
+    let e = thrown(models.layout(job).unwrap_err());
+    assert!(
+        e["message"].as_str().unwrap().contains("parts[0].scale_x"),
+        "{e}"
+    );
+    let job =
+        js(serde_json::json!({"settings": {"layer_height": 0}, "parts": [{"file": "big.stl"}]}));
+    let e = thrown(models.layout(job).unwrap_err());
+    assert_eq!(
+        (e["kind"].as_str(), e["setting"].as_str()),
+        (Some("setting"), Some("layer_height"))
+    );
+    let e = thrown(models.display_mesh("nope.stl", None, 10).unwrap_err());
+    assert_eq!(e["kind"], "job");
+    let e = thrown(models.add_bytes(b"not a model", "x.stl").unwrap_err());
+    assert_eq!(e["kind"], "import");
 }

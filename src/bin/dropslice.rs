@@ -1,4 +1,5 @@
-//! The command-line tool: `dropslice MODEL.stl [-o OUT.gco] [--set name=value]... [--settings FILE.json]`.
+//! The command-line tool: `dropslice MODEL... [-o OUT.gco] [--set name=value]... [--settings FILE.json]`,
+//! or `dropslice JOB.json` (a build job file, SPEC.md "Build jobs").
 //!
 //! The tool is native only: built for wasm32 (as a side effect of building the wasm tests)
 //! it is an empty program.
@@ -14,6 +15,7 @@ fn main() {}
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
     use dropslice::analysis::JobAnalysis;
+    use dropslice::job::{self, JobSpec, Model, PartSpec};
     use dropslice::{Error, Job, Settings, write_gcode_with};
     use staged::Staged;
     use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
@@ -22,10 +24,24 @@ mod cli {
     use std::time::Instant;
 
     const USAGE: &str = "\
-usage: dropslice MODEL [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
+usage: dropslice MODEL... [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
+       dropslice JOB.json [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
 
 Slices a model (STL, binary or ASCII; OBJ; or a 3MF build, all its items in their
 places) into droplet machine code (.gco: G01 travel, G25 droplet line, G26 droplet).
+
+Several models make a build job: one part each, arranged on the plate (plate_x, plate_y,
+part_spacing); rotate_* and scale_* then apply to every part, place_* is refused (give the
+parts' places in a job file). A job file (JSON: named *.json, or not named .stl/.obj/.3mf
+and starting with '{') lists
+the settings and the parts:
+  {\"settings\": {\"layer_height\": 0.2},
+   \"parts\": [{\"file\": \"a.stl\", \"rotate_z\": 90, \"place_x\": 30, \"place_y\": 5},
+             {\"file\": \"gear.3mf\", \"item\": 0, \"copies\": 3}]}
+Part keys: file (relative to the job file's folder), item (a 3MF build item, from 0;
+none: the whole build), rotate_x/y/z, scale_x/y/z, place_x + place_y (none: arranged),
+place_angle, copies (1..100), unit (0). --set and --settings override the job file's
+settings (not the parts').
 
   -o, --output FILE      where to write the code (default: MODEL.gco in the current directory)
   --set name=value       change one setting (repeatable; see --list-settings)
@@ -47,11 +63,21 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
 130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP.";
 
     struct Args {
-        model: PathBuf,
+        models: Vec<PathBuf>,
         output: Option<PathBuf>,
+        /// The defaults with `ops` applied.
         settings: Settings,
+        /// `--set` and `--settings` in order (applied again to a job file's settings).
+        ops: Vec<Op>,
         quiet: bool,
         report: Option<PathBuf>,
+    }
+
+    /// A settings option.
+    enum Op {
+        Set(String, String),
+        /// A settings file's object.
+        File(String, serde_json::Map<String, serde_json::Value>),
     }
 
     enum Parsed {
@@ -94,7 +120,8 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
     }
 
     fn parse_args(argv: &[String]) -> Result<Parsed, String> {
-        let mut model = None;
+        let mut models = Vec::new();
+        let mut ops = Vec::new();
         let mut output = None;
         let mut settings = Settings::default();
         let mut quiet = false;
@@ -121,29 +148,41 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                         .split_once('=')
                         .ok_or_else(|| format!("--set expects name=value, got '{kv}'"))?;
                     settings.set(k.trim(), v).map_err(|e| e.to_string())?;
+                    ops.push(Op::Set(k.trim().to_string(), v.to_string()));
                 }
                 "--settings" => {
                     let path = value(&mut it, a)?;
                     let text = std::fs::read_to_string(&path)
                         .map_err(|e| format!("cannot read the settings file {path}: {e}"))?;
                     settings = Settings::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
+                    if let Ok(serde_json::Value::Object(map)) = serde_json::from_str(&text) {
+                        ops.push(Op::File(path, map));
+                    }
                 }
                 s if s.starts_with('-') && s.len() > 1 => {
                     return Err(format!("unknown option '{s}'\n\n{USAGE}"));
                 }
                 s => {
-                    if model.replace(PathBuf::from(s)).is_some() {
-                        return Err(format!("give one model file only ('{s}' is a second one)"));
+                    if models.len() >= job::MAX_PARTS {
+                        return Err(format!(
+                            "more than {} model files given; a job has at most {} parts",
+                            job::MAX_PARTS,
+                            job::MAX_PARTS
+                        ));
                     }
+                    models.push(PathBuf::from(s));
                 }
             }
         }
-        let model = model.ok_or_else(|| format!("no model file given\n\n{USAGE}"))?;
+        if models.is_empty() {
+            return Err(format!("no model file given\n\n{USAGE}"));
+        }
         settings.validate().map_err(|e| e.to_string())?;
         Ok(Parsed::Run(Box::new(Args {
-            model,
+            models,
             output,
             settings,
+            ops,
             quiet,
             report,
         })))
@@ -173,8 +212,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
     /// The G-code's path: `-o`, else the model's name with `.gco` in the current directory.
     fn output_path(args: &Args) -> PathBuf {
         args.output.clone().unwrap_or_else(|| {
-            let stem = args
-                .model
+            let stem = args.models[0]
                 .file_stem()
                 .map(|s| s.to_os_string())
                 .unwrap_or_else(|| "out".into());
@@ -250,10 +288,10 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
     /// Where each file goes, checked and with its temporary file created, before any slicing.
     fn prepare(args: &Args) -> Result<(PathBuf, Staged, Option<Staged>), String> {
         let output = output_path(args);
-        let stem = args.model.file_stem().unwrap_or("model".as_ref());
+        let stem = args.models[0].file_stem().unwrap_or("model".as_ref());
         let example = Path::new(stem);
         check_destination(&output, "-o", &example.with_extension("gco"))?;
-        if same_file(&output, &args.model) {
+        if args.models.iter().any(|m| same_file(&output, m)) {
             return Err(format!(
                 "-o {}: that is the model file; give another name for the code",
                 output.display()
@@ -261,7 +299,8 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         }
         if let Some(report) = &args.report {
             check_destination(report, "--report", &example.with_extension("json"))?;
-            if same_file(report, &output) || same_file(report, &args.model) {
+            let model = args.models.iter().any(|m| same_file(report, m));
+            if same_file(report, &output) || model {
                 return Err(format!(
                     "--report {}: that is the {} file; give another name for the report",
                     report.display(),
@@ -294,17 +333,14 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         report: Option<Staged>,
     ) -> Result<(), Error> {
         let t0 = Instant::now();
-        let bytes = std::fs::read(&args.model)
-            .map_err(|e| Error::Import(format!("cannot open {}: {e}", args.model.display())))?;
-        let name = args
-            .model
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        let job = Job::new(&bytes, &name, args.settings.clone())?;
-        drop(bytes);
+        let (job, name) = load(args)?;
         for w in &job.info().warnings {
             eprintln!("dropslice: warning: {w}");
+        }
+        if !args.quiet {
+            for p in &job.info().instances {
+                eprintln!("dropslice: {}", dropslice::gcode::part_line(p));
+            }
         }
         // Written to a temporary file beside the target (`out`), put in place only at the end:
         // a failed or interrupted run never destroys an existing file nor leaves a partial one.
@@ -395,6 +431,172 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             );
         }
         Ok(())
+    }
+
+    /// The job to slice and its name for the summary: one model ([`Job::new`], as always),
+    /// several models (one part each, arranged) or a job file.
+    fn load(args: &Args) -> Result<(Job, String), Error> {
+        let file_name = |p: &Path| {
+            p.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        };
+        let read = |p: &Path| {
+            std::fs::read(p).map_err(|e| Error::Import(format!("cannot open {}: {e}", p.display())))
+        };
+        if let [one] = &args.models[..] {
+            if is_job_file(one)? {
+                return Ok((job_file(one, &args.ops)?, file_name(one)));
+            }
+            let bytes = read(one)?;
+            let name = file_name(one);
+            return Ok((Job::new(&bytes, &name, args.settings.clone())?, name));
+        }
+        // Several models: one part each, arranged; the part keys go to every part.
+        let s = &args.settings;
+        if s.place_x != 0.0 || s.place_y != 0.0 || s.place_angle != 0.0 {
+            return Err(Error::Job(
+                "place_x, place_y and place_angle cannot be given for several models at once: write a job file with each part's place (see --help), or leave them out and the parts are arranged".into(),
+            ));
+        }
+        let mut models: Vec<Model> = Vec::new();
+        let mut parts = Vec::new();
+        for m in &args.models {
+            let key = m.to_string_lossy().into_owned();
+            if !models.iter().any(|x| x.name == key) {
+                let bytes = read(m)?;
+                models.push(Model::read(&bytes, &key).map_err(|e| named(&key, e))?);
+            }
+            parts.push(PartSpec {
+                rotate_x: s.rotate_x,
+                rotate_y: s.rotate_y,
+                rotate_z: s.rotate_z,
+                scale_x: s.scale_x,
+                scale_y: s.scale_y,
+                scale_z: s.scale_z,
+                ..PartSpec::new(&key)
+            });
+        }
+        let spec = JobSpec {
+            settings: without_part_keys(s),
+            parts,
+        };
+        let names: Vec<String> = args.models.iter().map(|m| file_name(m)).collect();
+        Ok((Job::from_models(&models, &spec)?, names.join(" + ")))
+    }
+
+    /// An import error naming the file it is about.
+    fn named(file: &str, e: Error) -> Error {
+        match e {
+            Error::Import(m) => Error::Import(format!("{}: {m}", job::clean_name(file))),
+            e => e,
+        }
+    }
+
+    /// The settings with the part keys at their defaults (they went to the parts).
+    fn without_part_keys(s: &Settings) -> Settings {
+        let d = Settings::default();
+        Settings {
+            rotate_x: d.rotate_x,
+            rotate_y: d.rotate_y,
+            rotate_z: d.rotate_z,
+            scale_x: d.scale_x,
+            scale_y: d.scale_y,
+            scale_z: d.scale_z,
+            place_x: d.place_x,
+            place_y: d.place_y,
+            place_angle: d.place_angle,
+            ..s.clone()
+        }
+    }
+
+    /// A job file: named `*.json`, or not named as a model (`.stl`, `.obj`, `.3mf`) and its
+    /// first non-blank byte is `{` (a model file holding JSON gets the model reader's message).
+    fn is_job_file(path: &Path) -> Result<bool, Error> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("json") => return Ok(true),
+            Some("stl" | "obj" | "3mf") => return Ok(false),
+            _ => {}
+        }
+        use std::io::Read;
+        let mut start = [0u8; 64];
+        let n = std::fs::File::open(path)
+            .and_then(|mut f| f.read(&mut start))
+            .map_err(|e| Error::Import(format!("cannot open {}: {e}", path.display())))?;
+        Ok(start[..n]
+            .iter()
+            .find(|b| !b.is_ascii_whitespace())
+            .is_some_and(|&b| b == b'{'))
+    }
+
+    /// Reads a job file (at most [`job::MAX_JOB_FILE_BYTES`]) and its parts' files (relative
+    /// to its folder); `ops` override its settings.
+    fn job_file(path: &Path, ops: &[Op]) -> Result<Job, Error> {
+        use std::io::Read;
+        let shown = path.display();
+        let mut text = String::new();
+        std::fs::File::open(path)
+            .and_then(|f| {
+                f.take(job::MAX_JOB_FILE_BYTES as u64 + 1)
+                    .read_to_string(&mut text)
+            })
+            .map_err(|e| Error::Job(format!("cannot read the job file {shown}: {e}")))?;
+        let in_file = |e: Error| match e {
+            Error::Job(m) => Error::Job(format!("{shown}: {m}")),
+            e => e,
+        };
+        let mut spec = JobSpec::from_json(&text).map_err(in_file)?;
+        let base = spec.settings.clone();
+        let part_key = |k: &str| {
+            Error::Job(format!(
+                "{k} belongs to a part: give it in the job file's parts, not with --set or --settings"
+            ))
+        };
+        for op in ops {
+            match op {
+                Op::Set(k, v) => {
+                    if job::PART_KEYS.contains(&k.as_str()) {
+                        return Err(part_key(k));
+                    }
+                    spec.settings.set(k, v)?;
+                }
+                Op::File(file, map) => {
+                    spec.settings = base.clone();
+                    for (k, v) in map {
+                        if job::PART_KEYS.contains(&k.as_str()) {
+                            return Err(part_key(k));
+                        }
+                        spec.settings.set_value(k, v.clone()).map_err(|e| match e {
+                            Error::Setting { name, message } => Error::Setting {
+                                name,
+                                message: format!("{message} (in {file})"),
+                            },
+                            e => e,
+                        })?;
+                    }
+                }
+            }
+        }
+        spec.validate()?;
+        let dir = parent_dir(path);
+        let mut models: Vec<Model> = Vec::new();
+        for (i, p) in spec.parts.iter().enumerate() {
+            if models.iter().any(|m| m.name == p.file) {
+                continue;
+            }
+            let file = dir.join(&p.file);
+            let bytes = std::fs::read(&file).map_err(|e| {
+                Error::Import(format!(
+                    "parts[{i}].file: cannot open {} (named in {shown}): {e}",
+                    file.display()
+                ))
+            })?;
+            models.push(Model::read(&bytes, &p.file).map_err(|e| named(&p.file, e))?);
+        }
+        Job::from_models(&models, &spec).map_err(in_file)
     }
 
     /// A print time as the page shows it: "1 h 5 min", "3 min 2 s", "40 s".

@@ -107,7 +107,7 @@ pub fn read_merged(bytes: &[u8], file_name: &str) -> Result<(Triangles, Format),
 }
 
 /// The file name without folders and extension (`"part"` if nothing is left).
-fn stem(file_name: &str) -> String {
+pub fn stem(file_name: &str) -> String {
     let base = file_name.rsplit(['/', '\\']).next().unwrap_or(file_name);
     let s = match base.rfind('.') {
         Some(i) if i > 0 => &base[..i],
