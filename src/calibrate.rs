@@ -138,7 +138,7 @@ pub fn calibrate(
     let suggested = (volume / h).sqrt() / h;
     if !(filling >= FILLING_RANGE.0 && filling <= FILLING_RANGE.1) {
         return err(format!(
-            "impossible: {mass_g} g over {} droplets is {:.0} % of a droplet's B²H cell (sane: {:.0} … {:.0} %); check the mass, the density ({density_g_cm3} g/cm³) and that the file is the printed part's code",
+            "impossible: check the mass, the density ({density_g_cm3} g/cm³) and that the file is the printed part's code ({mass_g} g over {} droplets is {:.0} % of a droplet's B²H cell; sane: {:.0} … {:.0} %)",
             grouped(droplets),
             100.0 * filling,
             100.0 * FILLING_RANGE.0,

@@ -70,7 +70,7 @@ pub const EVEN_MIN_LENGTH_B: f64 = 3.0;
 fn even_droplets(points: &[Point], b: f64, shift: f64) -> Option<Vec<Point>> {
     let m = points.len();
     let length: f64 = (0..m).map(|i| dist(points[i], points[(i + 1) % m])).sum();
-    if !(length >= EVEN_MIN_LENGTH_B * b) || !(b > 0.0) {
+    if length.is_nan() || length < EVEN_MIN_LENGTH_B * b || b.is_nan() || b <= 0.0 {
         return None;
     }
     let path = unrolled(points, shift);
@@ -139,7 +139,7 @@ fn close_evenly(path: &[Point], b: f64, n: usize, chord_length: f64) -> Option<V
     let mut lo = chord_length / n as f64;
     let mut g_lo = g(lo, &mut buf);
     let mut tries = 0;
-    while !(g_lo > 0.0) {
+    while g_lo.is_nan() || g_lo <= 0.0 {
         if g_lo == 0.0 {
             return Some(buf);
         }

@@ -22,7 +22,9 @@ const MODELS: [&str; 4] = [
 
 /// The G25 lines of each layer as unordered segments in written units (order and direction
 /// depend on where the loops ended).
-fn fill_segments(text: &str) -> Vec<Vec<((i64, i64), (i64, i64))>> {
+type Segment = ((i64, i64), (i64, i64));
+
+fn fill_segments(text: &str) -> Vec<Vec<Segment>> {
     let mut layers: Vec<Vec<_>> = Vec::new();
     let (mut z, mut at) = ("", (0i64, 0i64));
     for line in text.lines().filter(|l| !l.starts_with(';')) {
