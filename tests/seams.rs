@@ -12,6 +12,7 @@ mod seams;
 
 use common::B;
 use seams::{Loop, SeamStats, TOL, d, key};
+use std::path::Path;
 
 const MODELS: [&str; 4] = [
     "cube_20mm_ascii.stl",
@@ -226,5 +227,63 @@ fn even_spacing_on_shared_models() {
             "{model}: loops repeating their first droplet"
         );
         let _ = d;
+    }
+}
+
+/// The void analysis of a whole job (as `--report` makes it).
+fn report(model: &str, s: dropslice::Settings) -> dropslice::analysis::Report {
+    let job = dropslice::Job::new(&common::model_bytes(model), model, s).expect("job");
+    let mut analysis = dropslice::analysis::JobAnalysis::new(&job);
+    dropslice::write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis)
+        .expect("slice");
+    analysis.finish()
+}
+
+/// Even spacing changes only where loop droplets sit: the part's coverage and 3D void
+/// fraction stay within half a point of exact's, and the analysed region of every layer is
+/// still the oracle's section (tests/fixtures/oracle, as tests/oracle.rs compares).
+#[test]
+fn coverage_unchanged_and_sections_match_the_oracle() {
+    for (model, fixture) in [
+        ("cube_20mm_ascii.stl", "cube_20mm_ascii"),
+        ("3DBenchy.stl", "3DBenchy"),
+    ] {
+        let exact = report(model, dropslice::Settings::default());
+        let mut s = dropslice::Settings::default();
+        s.set("loop_spacing", "even").unwrap();
+        let even = report(model, s);
+        let (a, b) = (&exact.part, &even.part);
+        eprintln!(
+            "{model}: coverage {:.4} → {:.4}, void fraction {:.4} → {:.4}, droplets {} → {}",
+            a.coverage, b.coverage, a.void_fraction, b.void_fraction, a.droplets, b.droplets
+        );
+        assert!((a.coverage - b.coverage).abs() <= 0.005, "{model}: coverage");
+        assert!(
+            (a.void_fraction - b.void_fraction).abs() <= 0.005,
+            "{model}: void fraction"
+        );
+        assert!(b.droplets < a.droplets, "{model}: no repeated droplets");
+        let oracle: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(
+                Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join(format!("tests/fixtures/oracle/{fixture}.json")),
+            )
+            .unwrap(),
+        )
+        .unwrap();
+        let layers = oracle["layers"].as_array().unwrap();
+        assert_eq!(even.layers.len(), layers.len(), "{model}: layers");
+        for (l, o) in even.layers.iter().zip(layers) {
+            if o.get("near_plane_faces").is_some() {
+                continue;
+            }
+            let want = o["nonzero"]["area"].as_f64().unwrap();
+            assert!(
+                (l.region_area - want).abs() <= (want * 0.005).max(0.05),
+                "{model} layer {}: area {} vs oracle {want}",
+                l.index + 1,
+                l.region_area
+            );
+        }
     }
 }
