@@ -12,7 +12,12 @@ fn main() {
     let mut paths: Vec<String> = std::env::args().skip(1).collect();
     if paths.is_empty() {
         let shared = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/models/");
-        for m in ["cube_20mm_ascii", "3DBenchy", "extruder_idler", "stanford_bunny"] {
+        for m in [
+            "cube_20mm_ascii",
+            "3DBenchy",
+            "extruder_idler",
+            "stanford_bunny",
+        ] {
             paths.push(format!("{shared}{m}.stl"));
         }
     }

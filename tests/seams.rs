@@ -257,7 +257,10 @@ fn coverage_unchanged_and_sections_match_the_oracle() {
             "{model}: coverage {:.4} → {:.4}, void fraction {:.4} → {:.4}, droplets {} → {}",
             a.coverage, b.coverage, a.void_fraction, b.void_fraction, a.droplets, b.droplets
         );
-        assert!((a.coverage - b.coverage).abs() <= 0.005, "{model}: coverage");
+        assert!(
+            (a.coverage - b.coverage).abs() <= 0.005,
+            "{model}: coverage"
+        );
         assert!(
             (a.void_fraction - b.void_fraction).abs() <= 0.005,
             "{model}: void fraction"
