@@ -70,6 +70,10 @@ pub struct GcodeReader {
     travels: u64,
     rest: String,
     done: VecDeque<ReadLayer>,
+    /// The header's `; droplets total = N`, if it has one (not the placeholder `pending`).
+    header_droplets: Option<u64>,
+    /// Count only: no droplet positions, roles or travel kept (`dropslice calibrate`).
+    counts_only: bool,
 }
 
 /// The header's droplet size must lie within the settings' ranges (greater than 0, at most
@@ -140,6 +144,24 @@ impl GcodeReader {
             width: f64::NAN,
             ..GcodeReader::default()
         }
+    }
+
+    /// A reader that only counts: layers come without droplet positions, roles and travel.
+    pub fn counting() -> GcodeReader {
+        GcodeReader {
+            counts_only: true,
+            ..GcodeReader::new()
+        }
+    }
+
+    /// Droplets the commands set so far (G26 one each, G25 as [`crate::geom::line_droplets`]).
+    pub fn droplets(&self) -> u64 {
+        self.droplets
+    }
+
+    /// The header's droplet total (`; droplets total = N`), if it gives one.
+    pub fn header_droplets(&self) -> Option<u64> {
+        self.header_droplets
     }
 
     /// Droplet width B from the header (NaN before it is known).
@@ -318,25 +340,32 @@ impl GcodeReader {
             });
         }
         let from = self.at;
+        let keep = !self.counts_only;
         let l = self.layer.as_mut().expect("a layer is open");
         let p = &mut l.preview;
         match code.as_str() {
             "G01" => {
-                p.travel.extend([from.x, from.y, x, y].map(|v| v as f32));
+                if keep {
+                    p.travel.extend([from.x, from.y, x, y].map(|v| v as f32));
+                }
                 l.travel_mm += len;
             }
             "G26" => {
                 if to != from {
                     l.travel_mm += len;
                 }
-                p.droplets.extend([x as f32, y as f32]);
-                p.roles.push(0);
+                if keep {
+                    p.droplets.extend([x as f32, y as f32]);
+                    p.roles.push(0);
+                }
                 l.counts.outer += 1;
             }
             _ => {
-                for d in line_droplets(from, to, self.width) {
-                    p.droplets.extend([d.x as f32, d.y as f32]);
-                    p.roles.push(2);
+                if keep {
+                    for d in line_droplets(from, to, self.width) {
+                        p.droplets.extend([d.x as f32, d.y as f32]);
+                        p.roles.push(2);
+                    }
                 }
                 l.counts.fill += n;
             }
@@ -347,6 +376,12 @@ impl GcodeReader {
 
     fn comment(&mut self, text: &str) -> Result<(), GcodeError> {
         if self.commands > 0 {
+            return Ok(());
+        }
+        // The header's droplet total (`pending` in a header that was never filled in).
+        if let Some(rest) = text.strip_prefix("droplets total") {
+            let value = rest.trim_start().strip_prefix('=').map(str::trim);
+            self.header_droplets = value.and_then(|v| v.parse::<u64>().ok());
             return Ok(());
         }
         // `name = value`: a lower-case name, then the value's first word.

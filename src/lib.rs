@@ -15,6 +15,7 @@
 //! time, so memory stays bounded however tall the part is.
 
 pub mod analysis;
+pub mod calibrate;
 pub mod contours;
 pub mod droplets;
 pub mod error;

@@ -2,7 +2,7 @@
 //! (SPEC.md `contour_order`, `print_order`).
 
 use crate::contours::{Loop, contours};
-use crate::droplets::loop_droplets;
+use crate::droplets::loop_droplets_spaced;
 use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
 use crate::hatch::{hatch_at, order_greedy};
 use crate::settings::{ContourOrder, PrintOrder, Settings};
@@ -156,7 +156,10 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
                 .iter()
                 .map(|l| {
                     let role = if l.k == 0 { Role::Outer } else { Role::Inner };
-                    (loop_droplets(&l.points, b, shift, s.close_loops), role)
+                    (
+                        loop_droplets_spaced(&l.points, b, shift, s.close_loops, s.loop_spacing),
+                        role,
+                    )
                 })
                 .filter(|(d, _)| !d.is_empty())
                 .collect();

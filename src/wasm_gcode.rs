@@ -70,6 +70,43 @@ impl GcodeStream {
     }
 }
 
+#[wasm_bindgen]
+impl GcodeStream {
+    /// After `finish`: the calibration of this file for a measured `mass` (g) and `density`
+    /// (g/cm³; `undefined`: the header's material_density, else the default) as a plain
+    /// `Calibration` object. Throws the refusal's message (calibrate.rs).
+    pub fn calibrate(&self, mass: f64, density: Option<f64>) -> Result<JsValue, JsValue> {
+        let c = crate::calibrate::calibrate_read(&self.reader, mass, density)
+            .map_err(|e| JsValue::from(JsError::new(&e.0)))?;
+        crate::wasm::to_js(&c, "the calibration")
+    }
+}
+
+/// The calibration from a slice's droplet count (its summary) and settings: `droplets`,
+/// `layer_height`, `droplet_aspect`, a measured `mass` (g) and `density` (g/cm³).
+#[wasm_bindgen]
+pub fn calibrate(
+    droplets: f64,
+    layer_height: f64,
+    droplet_aspect: f64,
+    mass: f64,
+    density: f64,
+) -> Result<JsValue, JsValue> {
+    if !(droplets.is_finite() && droplets >= 0.0 && droplets <= u64::MAX as f64) {
+        return Err(JsError::new("the droplet count must be a whole number ≥ 0").into());
+    }
+    let c = crate::calibrate::calibrate(
+        droplets as u64,
+        crate::calibrate::CountSource::Given,
+        layer_height,
+        droplet_aspect,
+        mass,
+        density,
+    )
+    .map_err(|e| JsValue::from(JsError::new(&e.0)))?;
+    crate::wasm::to_js(&c, "the calibration")
+}
+
 impl Default for GcodeStream {
     fn default() -> GcodeStream {
         GcodeStream::new()

@@ -26,6 +26,7 @@ mod cli {
     const USAGE: &str = "\
 usage: dropslice MODEL... [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
        dropslice JOB.json [-o OUT.gco] [--set name=value]... [--settings FILE.json] [-q]
+       dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]
 
 Slices a model (STL, binary or ASCII; OBJ; or a 3MF build, all its items in their
 places) into droplet machine code (.gco: G01 travel, G25 droplet line, G26 droplet).
@@ -54,6 +55,11 @@ settings (not the parts').
   -q, --quiet            no progress, only errors
   -h, --help             this text
   -V, --version          the version
+
+dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]: from a printed part's mass, its
+code's droplet count (header, else counted) and the material density (default: the header's
+material_density) prints the droplet volume, the filling degree of the B²H cells and the
+droplet_aspect that fills them exactly.
 
 The code (and the report) are written to a temporary file beside the target and put in
 place only when the run succeeds: a failed or interrupted run leaves no partial file and
@@ -87,6 +93,18 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
 
     pub fn main() -> ExitCode {
         let argv: Vec<String> = std::env::args().skip(1).collect();
+        if argv.first().is_some_and(|a| a == "calibrate") {
+            return match calibrate(&argv[1..]) {
+                Ok(text) => {
+                    println!("{text}");
+                    ExitCode::SUCCESS
+                }
+                Err(msg) => {
+                    eprintln!("dropslice calibrate: {msg}");
+                    ExitCode::from(2)
+                }
+            };
+        }
         let args = match parse_args(&argv) {
             Ok(Parsed::Run(a)) => a,
             Ok(Parsed::Exit(text)) => {
@@ -186,6 +204,100 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             quiet,
             report,
         })))
+    }
+
+    /// `dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]`: the figures, or why not.
+    fn calibrate(argv: &[String]) -> Result<String, String> {
+        const CAL_USAGE: &str =
+            "usage: dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]";
+        let (mut file, mut mass, mut density) = (None, None, None);
+        let mut it = argv.iter();
+        let number = |it: &mut std::slice::Iter<String>, opt: &str| -> Result<f64, String> {
+            let v = it
+                .next()
+                .ok_or_else(|| format!("{opt} needs a value\n\n{CAL_USAGE}"))?;
+            v.trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("{opt} {v}: not a number"))
+        };
+        while let Some(a) = it.next() {
+            match a.as_str() {
+                "-h" | "--help" => return Ok(CAL_USAGE.into()),
+                "--mass" => mass = Some(number(&mut it, a)?),
+                "--density" => density = Some(number(&mut it, a)?),
+                s if s.starts_with('-') && s.len() > 1 => {
+                    return Err(format!("unknown option '{s}'\n\n{CAL_USAGE}"));
+                }
+                s => {
+                    if file.replace(PathBuf::from(s)).is_some() {
+                        return Err(format!("give one .gco file only ('{s}' is a second one)"));
+                    }
+                }
+            }
+        }
+        let file = file.ok_or_else(|| format!("no .gco file given\n\n{CAL_USAGE}"))?;
+        let mass = mass.ok_or_else(|| format!("--mass GRAMS is needed\n\n{CAL_USAGE}"))?;
+        let reader = read_counting(&file)?;
+        let c = dropslice::calibrate::calibrate_read(&reader, mass, density)
+            .map_err(|e| format!("{}: {e}", file.display()))?;
+        Ok(format!(
+            "{}\n  droplets          {} ({})\n  droplet volume    {:.5} mm³ (m / (N ρ), ρ = {} g/cm³)\n  cell B²H          {:.5} mm³ (H = {} mm, droplet_aspect = {})\n  filling degree    {:.3}\n  droplet_aspect    {:.3} suggested (now {})",
+            c.explanation,
+            c.droplets,
+            match c.count_source {
+                dropslice::calibrate::CountSource::Header => "from the header",
+                _ => "counted from the commands",
+            },
+            c.droplet_volume_mm3,
+            c.density_g_cm3,
+            c.cell_volume_mm3,
+            c.layer_height,
+            c.current_droplet_aspect,
+            c.filling_degree,
+            c.suggested_droplet_aspect,
+            c.current_droplet_aspect
+        ))
+    }
+
+    /// Reads a `.gco` file through the core's reader (counting only), in pieces of whole lines.
+    fn read_counting(path: &Path) -> Result<dropslice::gcode_read::GcodeReader, String> {
+        use std::io::Read;
+        let shown = path.display();
+        let mut f = std::fs::File::open(path).map_err(|e| format!("cannot open {shown}: {e}"))?;
+        let mut r = dropslice::gcode_read::GcodeReader::counting();
+        let mut buf: Vec<u8> = Vec::new();
+        let mut chunk = vec![0u8; 1 << 20];
+        loop {
+            let n = f
+                .read(&mut chunk)
+                .map_err(|e| format!("cannot read {shown}: {e}"))?;
+            if n == 0 {
+                break;
+            }
+            buf.extend_from_slice(&chunk[..n]);
+            let Some(nl) = buf.iter().rposition(|&c| c == b'\n') else {
+                if buf.len() > 4 * dropslice::gcode_read::MAX_LINE_CHARS {
+                    return Err(format!(
+                        "{shown}: a line is longer than {} characters: not a G-code file",
+                        dropslice::gcode_read::MAX_LINE_CHARS
+                    ));
+                }
+                continue;
+            };
+            let text = std::str::from_utf8(&buf[..=nl])
+                .map_err(|_| format!("{shown}: not a text file (a .gco file is ASCII text)"))?;
+            r.feed(text).map_err(|e| format!("{shown}: {e}"))?;
+            while r.take_layer().is_some() {}
+            buf.drain(..=nl);
+        }
+        let rest = std::str::from_utf8(&buf)
+            .map_err(|_| format!("{shown}: not a text file (a .gco file is ASCII text)"))?;
+        r.feed(rest).map_err(|e| format!("{shown}: {e}"))?;
+        r.finish().map_err(|e| format!("{shown}: {e}"))?;
+        while r.take_layer().is_some() {}
+        Ok(r)
     }
 
     fn list_settings() -> String {

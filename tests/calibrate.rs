@@ -1,0 +1,209 @@
+//! `dropslice calibrate` (SPEC.md "Calibrating the droplet size from a printed part"): a part
+//! of known droplet count and a mass chosen for a known droplet volume give back exactly that
+//! volume, its filling degree and the aspect whose B²H cell holds it; every refusal exits 2
+//! with a message that says what to check.
+
+mod common;
+
+use common::{B, H, TempDir};
+use dropslice::calibrate::{CountSource, calibrate_gcode};
+use std::path::Path;
+use std::time::Duration;
+
+fn cli<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S], dir: &Path) -> common::Run {
+    let r = common::run_cli(args, dir, Duration::from_secs(60));
+    assert!(!r.timed_out, "{args:?} timed out");
+    r
+}
+
+/// The cube's code and its header's droplet total.
+fn cube_code(dir: &TempDir) -> (String, u64) {
+    let text = common::slice_cli(&common::model("cube_20mm_ascii.stl"), &[]);
+    let n = text
+        .lines()
+        .find_map(|l| l.strip_prefix("; droplets total"))
+        .and_then(|r| r.trim_start().strip_prefix('='))
+        .map(|v| v.trim().parse::<u64>().unwrap())
+        .expect("a droplet total in the header");
+    std::fs::write(dir.join("cube.gco"), &text).unwrap();
+    (text, n)
+}
+
+#[test]
+fn known_volume_gives_its_filling_and_aspect() {
+    let dir = TempDir::new("calibrate");
+    let (text, n) = cube_code(&dir);
+    // A 20 mm cube at B = 0.208, H = 0.2: about 8000 mm³ / B²H droplets.
+    assert!((800_000..1_000_000).contains(&n), "{n}");
+    let rho = 1.18;
+    let cell = B * B * H;
+    for fill in [0.85, 1.0, 1.12] {
+        let v = fill * cell; // mm³
+        let mass = n as f64 * rho * v / 1000.0; // g
+        let c = calibrate_gcode(&text, mass, Some(rho)).unwrap();
+        assert_eq!(c.droplets, n);
+        assert_eq!(c.count_source, CountSource::Header);
+        assert!(
+            (c.droplet_volume_mm3 - v).abs() < 1e-12 * v.max(1.0),
+            "{c:?}"
+        );
+        assert!((c.cell_volume_mm3 - cell).abs() < 1e-15);
+        assert!((c.filling_degree - fill).abs() < 1e-9, "{c:?}");
+        // The aspect a with (a·H)²·H = V.
+        let a = c.suggested_droplet_aspect;
+        assert!(((a * H).powi(2) * H - v).abs() < 1e-12, "{c:?}");
+        assert!((a - 1.04 * fill.sqrt()).abs() < 1e-9);
+        assert_eq!(c.current_droplet_aspect, 1.04);
+
+        // The CLI prints the same figures.
+        let r = cli(
+            &[
+                "calibrate",
+                "cube.gco",
+                "--mass",
+                &format!("{mass}"),
+                "--density",
+                &format!("{rho}"),
+            ],
+            dir.path(),
+        );
+        assert_eq!(r.code, Some(0), "{r:?}");
+        assert!(
+            r.stdout.contains(&format!("filling degree    {fill:.3}"))
+                && r.stdout.contains(&format!("{a:.3} suggested (now 1.04)"))
+                && r.stdout.contains(&format!("{} droplets of", grouped(n)))
+                && r.stdout.contains("from the header"),
+            "{}",
+            r.stdout
+        );
+    }
+}
+
+fn grouped(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[test]
+fn count_from_the_commands_without_a_header_total() {
+    let dir = TempDir::new("calibrate");
+    let (text, n) = cube_code(&dir);
+    let without: String = text
+        .lines()
+        .filter(|l| !l.starts_with("; droplets total"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(dir.join("bare.gco"), &without).unwrap();
+    let c = calibrate_gcode(&without, 10.0, None).unwrap();
+    assert_eq!(c.count_source, CountSource::Commands);
+    assert_eq!(c.droplets, n, "counted from G25/G26 as the header counts");
+    // The header's material_density (1.04) is the default density.
+    assert_eq!(c.density_g_cm3, 1.04);
+    let r = cli(&["calibrate", "bare.gco", "--mass", "10"], dir.path());
+    assert_eq!(r.code, Some(0), "{r:?}");
+    assert!(r.stdout.contains("counted from the code"), "{}", r.stdout);
+}
+
+#[test]
+fn refusals_exit_2_with_a_reason() {
+    let dir = TempDir::new("calibrate");
+    let (_, n) = cube_code(&dir);
+    // No count in the header and no droplets in the commands.
+    std::fs::write(
+        dir.join("empty.gco"),
+        "; layer_height = 0.2 (mm)\n; droplet_aspect = 1.04\nG01 X0.0000 Y0.0000 Z0.2000\n",
+    )
+    .unwrap();
+    // A droplet size whose suggestion leaves droplet_aspect's range (at most 10).
+    std::fs::write(
+        dir.join("wide.gco"),
+        "; layer_height = 0.2 (mm)\n; droplet_aspect = 8\n; droplets total = 1000\nG26 X0.0000 Y0.0000 Z0.2000\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("model.stl"), common::model_bytes("3DBenchy.stl")).unwrap();
+    let cell = B * B * H;
+    let sane = n as f64 * 1.04 * cell / 1000.0;
+    // wide: cell (1.6)²·0.2 = 0.512 mm³; a filling of 4 suggests aspect 16.
+    let wide_mass = 1000.0 * 1.04 * 4.0 * 0.512 / 1000.0;
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["empty.gco".into(), "--mass".into(), "1".into()],
+            "sets no droplets",
+        ),
+        (
+            vec!["cube.gco".into(), "--mass".into(), "0".into()],
+            "positive number of grams",
+        ),
+        (
+            vec!["cube.gco".into(), "--mass".into(), "-3".into()],
+            "positive number of grams",
+        ),
+        (
+            vec!["cube.gco".into(), "--mass".into(), "NaN".into()],
+            "not a number",
+        ),
+        (
+            vec!["cube.gco".into(), "--mass".into(), "inf".into()],
+            "not a number",
+        ),
+        (
+            vec![
+                "cube.gco".into(),
+                "--mass".into(),
+                format!("{}", sane * 10.0),
+            ],
+            "impossible: check the mass",
+        ),
+        (
+            vec![
+                "cube.gco".into(),
+                "--mass".into(),
+                format!("{}", sane / 10.0),
+            ],
+            "impossible",
+        ),
+        (
+            vec![
+                "cube.gco".into(),
+                "--mass".into(),
+                format!("{sane}"),
+                "--density".into(),
+                "0".into(),
+            ],
+            "density must be greater than 0",
+        ),
+        (
+            vec!["wide.gco".into(), "--mass".into(), format!("{wide_mass}")],
+            "outside its range",
+        ),
+        (
+            vec!["missing.gco".into(), "--mass".into(), "1".into()],
+            "cannot open",
+        ),
+        (
+            vec!["model.stl".into(), "--mass".into(), "1".into()],
+            "not a text file",
+        ),
+        (vec!["cube.gco".into()], "--mass GRAMS is needed"),
+        (vec!["--mass".into(), "1".into()], "no .gco file given"),
+    ];
+    for (args, want) in cases {
+        let mut all = vec!["calibrate".to_string()];
+        all.extend(args.iter().cloned());
+        let r = cli(&all, dir.path());
+        assert_eq!(r.code, Some(2), "{all:?}: {r:?}");
+        assert!(
+            r.stderr.contains(want),
+            "{all:?}: expected {want:?} in {:?}",
+            r.stderr
+        );
+        assert!(r.stdout.is_empty(), "{all:?}: {}", r.stdout);
+    }
+}
