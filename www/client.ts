@@ -1,7 +1,10 @@
 // The worker pool: one worker per core (hardwareConcurrency, 1 … 8), each with its own wasm
-// instance. A slice hands the model's File to one worker, which reads and prepares the job
-// (parse, weld, checks, repair) and returns the prepared mesh as transferable arrays; the
-// other workers build their session from that (no import work repeated). Each worker, as soon
+// instance. The first worker is the job worker: it holds the job's files (`Models`: added as
+// Files, read and imported there), answers layout, display meshes and lay-flat, and prepares a
+// slice (`Session.from_models`: place, merge, weld, checks, repair), returning the prepared
+// mesh as transferable arrays; the other workers build their session from that (no import work
+// repeated). The pool remembers which Files the job worker holds and adds them again to a
+// fresh worker (after a cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
 // flight, so it never waits for the page between units). Layers come back as progress replies
 // (buffers transferred) and are stored by index, so the page sees them in layer order however
@@ -11,6 +14,9 @@
 import type {
   GcodeParseResult,
   InitResult,
+  JobFile,
+  Layout,
+  ModelInfo,
   LayerData,
   OpenResult,
   PreparedMesh,
@@ -18,7 +24,6 @@ import type {
   RequestData,
   RequestKind,
   ResultOf,
-  Settings,
   SliceFigures,
   SliceUnit,
   Summary,
@@ -55,6 +60,8 @@ class WorkerHandle {
   broken = false;
   /** Whether the worker holds the current model. */
   hasModel = false;
+  /** The job's files this worker's `Models` holds, by job name (the job worker's). */
+  readonly models = new Map<string, File>();
 
   constructor() {
     this.worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module", name: "dropslice" });
@@ -147,25 +154,59 @@ function unitCounter(layers: number, workers: number): () => Unit | null {
   };
 }
 
-/** Opens a model: the first worker reads the File and prepares the job (and hashes the file
- *  when asked); the others take the prepared mesh. `ready(h, r)` runs for each worker as soon
- *  as it holds the model (for the first one before the others are asked). If the first worker
- *  refuses the model, no worker is touched and every one keeps its previous model. With
- *  `mesh`, the prepared mesh is shown to it first (synchronously, before it is handed on). */
+/** A file of the job: its name in the job (the key in `Models`) and the File. */
+export interface JobFileRef {
+  name: string;
+  file: File;
+}
+
+/** Makes the job worker `h` hold exactly `files` (adds the ones it lacks or holds as another
+ *  File, removes the others). */
+async function syncModels(h: WorkerHandle, files: JobFileRef[]): Promise<void> {
+  const wanted = new Map(files.map((f) => [f.name, f.file]));
+  const gone = [...h.models.keys()].filter((n) => !wanted.has(n));
+  if (gone.length) {
+    for (const n of gone) h.models.delete(n);
+    await h.call("models_remove", { names: gone });
+  }
+  const missing = files.filter((f) => h.models.get(f.name) !== f.file);
+  if (missing.length) await addTo(h, missing);
+}
+
+/** Adds `files` to `h`'s Models and records them; on a refusal the names are forgotten (the
+ *  worker may have replaced some of them before refusing one). */
+async function addTo(h: WorkerHandle, files: JobFileRef[]): Promise<ResultOf<"models_add">> {
+  try {
+    const r = await h.call("models_add", { files });
+    for (const f of files) h.models.set(f.name, f.file);
+    return r;
+  } catch (e) {
+    for (const f of files) h.models.delete(f.name);
+    throw e;
+  }
+}
+
+/** Opens a job: the job worker gets its files and prepares it; the others take the prepared
+ *  mesh. `ready(h, r)` runs for each worker as soon as it holds the job (for the first one
+ *  before the others are asked). If the first worker refuses the job, no worker is touched and
+ *  every one keeps its previous model. With `mesh`, the prepared mesh is shown to it first
+ *  (synchronously, before it is handed on). */
 async function openAll(
   handles: WorkerHandle[],
-  file: File,
-  settings: Settings,
+  files: JobFileRef[],
+  job: JobFile,
   ready: (h: WorkerHandle, r: OpenResult) => Promise<void>,
   mesh?: (prepared: PreparedMesh) => void,
 ): Promise<OpenResult> {
   const [first, ...others] = handles;
-  const r = await first.call("open", { file, settings, hash: true, prepare: others.length > 0 || mesh !== undefined });
+  await syncModels(first, files);
+  const r = await first.call("open_job", { job, prepare: others.length > 0 || mesh !== undefined });
   for (const h of handles) h.hasModel = false;
   first.hasModel = true;
   const prepared = r.prepared;
   delete r.prepared;
   if (prepared && mesh) mesh(prepared);
+  const settings = job.settings;
   const work = [ready(first, r)];
   if (prepared && others.length > 0) {
     others.forEach((h, k) => {
@@ -241,14 +282,15 @@ export class Pool {
     return this.guarded(() => this.handles[0].call("init", null));
   }
 
-  /** Slices a model: opens it (see [[openAll]]) and streams all layers through `cb.layer`. */
-  slice(file: File, settings: Settings, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
+  /** Slices a job of `files`: opens it (see [[openAll]]) and streams all layers through
+   *  `cb.layer`. */
+  slice(files: JobFileRef[], job: JobFile, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
     this.heal();
     return this.guarded(async () => {
       this.opening = null;
       let nextUnit: () => Unit | null = () => null;
       const handles = this.handles;
-      return openAll(handles, file, settings, async (h, r) => {
+      return openAll(handles, files, job, async (h, r) => {
         if (h === handles[0]) {
           nextUnit = unitCounter(r.layers, handles.length);
           cb.opened(r);
@@ -275,12 +317,12 @@ export class Pool {
     await Promise.all(Array.from({ length: UNITS_IN_FLIGHT }, lane));
   }
 
-  /** Opens a model in every worker without slicing it (to browse a finished slice again
+  /** Opens a job in every worker without slicing it (to browse a finished slice again
    *  after the workers were replaced by a cancel or a crash). */
-  open(file: File, settings: Settings): Promise<void> {
+  open(files: JobFileRef[], job: JobFile): Promise<void> {
     this.heal();
     const opening = this.guarded(async () => {
-      await openAll(this.handles, file, settings, async () => {});
+      await openAll(this.handles, files, job, async () => {});
     });
     this.opening = opening.catch(() => {});
     return opening;
@@ -313,6 +355,38 @@ export class Pool {
   /** The core's figures of the summaries `parts` (merged by the core, in any order). */
   figures(parts: Summary[]): Promise<SliceFigures> {
     return this.guarded(async () => (await this.pick()).call("figures", { parts }));
+  }
+
+  /** Adds files to the job worker (read and imported there): their info and SHA-256, in
+   *  order. A name it holds already is replaced. Nothing else of the job changes. */
+  addModels(files: JobFileRef[]): Promise<{ infos: ModelInfo[]; sha256: string[] }> {
+    this.heal();
+    return this.guarded(() => addTo(this.handles[0], files));
+  }
+
+  /** Where every instance of `job` goes (the core's arrangement; it checks the whole job). */
+  layout(files: JobFileRef[], job: JobFile): Promise<Layout> {
+    return this.onJobWorker(files, (h) => h.call("layout", { job }));
+  }
+
+  /** A decimated mesh of a file (or a 3MF item) for the 3D view. */
+  displayMesh(files: JobFileRef[], name: string, item: number | undefined, max: number): Promise<Float32Array> {
+    return this.onJobWorker(files, (h) => h.call("display_mesh", { name, item, max }));
+  }
+
+  /** The rotation (x, then y) that puts a file's largest flat face down. */
+  layFlat(files: JobFileRef[], name: string, item: number | undefined): Promise<{ rotate_x: number; rotate_y: number }> {
+    return this.onJobWorker(files, (h) => h.call("lay_flat", { name, item }));
+  }
+
+  /** Runs `run` on the job worker once it holds exactly `files`. */
+  private onJobWorker<T>(files: JobFileRef[], run: (h: WorkerHandle) => Promise<T>): Promise<T> {
+    this.heal();
+    return this.guarded(async () => {
+      const h = this.handles[0];
+      await syncModels(h, files);
+      return run(h);
+    });
   }
 
   /** SHA-256 of a file, hex, computed in a worker (the page never reads the file). */

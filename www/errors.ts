@@ -10,8 +10,8 @@ import { setState } from "./views/status";
 export function restoreModel(page: Page): void {
   const { store, pool } = page;
   const s = store.slice;
-  if (!s || !s.complete || s.source !== "stl" || !s.model || store.busy) return;
-  pool.open(s.model.file, s.settings).catch(() => {
+  if (!s || !s.complete || s.source !== "stl" || !s.job || store.busy) return;
+  pool.open(s.job.refs, s.job.file).catch(() => {
     // the slice stays visible; what needs a worker reports its own error
   });
 }

@@ -3,18 +3,18 @@
 // G-code's assembly for download. Opening files and links: open.ts.
 
 import { Cancelled, SliceError } from "./client";
-import type { Value } from "./form";
 import type { GcodeParseResult } from "./protocol";
 import type { View } from "./render";
 import { restoreModel, showError } from "./errors";
 import type { Page } from "./page";
-import type { Model, Slice } from "./store";
+import { jobSettings } from "./job";
+import { editParts } from "./jobflows";
+import type { Slice, SlicedJob } from "./store";
 import { errorBanner, hideBanner, showBanner, TITLES } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { saveGcode } from "./views/download";
 import { clampLayer, layerLabel, setLayers, show } from "./views/layer";
 import { showModel, writeStats } from "./views/stats";
-import { View3DPanel } from "./views/view3d";
 import { progress, setState } from "./views/status";
 
 export interface Target {
@@ -60,42 +60,47 @@ function cancelRunning(page: Page): void {
   }
 }
 
-export async function startSlice(page: Page, m: Model, target: Target = {}): Promise<void> {
+/** Slices the current job (its parts as they are now, the form's settings). */
+export async function startSlice(page: Page, target: Target = {}): Promise<void> {
   const { store, pool, renderer } = page;
   const form = page.form!;
+  const job = store.job;
+  if (!job || job.parts.length === 0) return;
   if (settingsProblem(page)) return;
   cancelRunning(page);
   hideBanner();
   if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone);
   const gen = ++store.generation;
   const values = form.values();
-  const json = form.json();
+  const settings = jobSettings(values);
+  const refs = job.refs();
+  const sliced: SlicedJob = { refs, file: job.file(settings), sha256: refs.map((r) => job.models.get(r.name)?.sha256 ?? "") };
+  const key = job.key(settings);
+  const name = job.name;
   // B is the core's (JobInfo.droplet_width, once the model is open)
-  const s = store.newSlice("stl", m.name, NaN, Number(values.layer_height), values, m);
+  const s = store.newSlice("stl", name, NaN, Number(values.layer_height), values, sliced);
+  s.key = key;
   if (store.fileChosenAt !== null) s.startedAt = store.fileChosenAt;
   store.fileChosenAt = null;
-  const before = store.slice?.model ?? null;
+  const before = store.slice?.job ?? null;
+  const sameModel = before !== null && before.sha256.join() === sliced.sha256.join() && !sliced.sha256.includes("");
   store.busy = true;
   setState("slicing");
-  progress(0, `Reading ${m.name}…`);
+  progress(0, `Reading ${name}…`);
   updateButtons(page);
   try {
     const figuresChanged = () => {
       if (store.slice === s && gen === store.generation) whileBusy(page, gen, () => writeStats(page));
     };
-    await pool.slice(m.file, values, {
+    await pool.slice(refs, sliced.file, {
       opened: (r) => {
         if (gen !== store.generation) return;
-        if (r.sha256) m.sha256 = r.sha256;
-        const sameModel = before !== null && (before === m || (before.sha256 !== "" && before.sha256 === m.sha256));
         s.open(r.layers, r.info);
         if (typeof r.info.droplet_width === "number") s.dropletWidth = r.info.droplet_width;
-        store.model = m;
         store.slice = s;
-        store.slicedSettings = json;
         setLayers(r.layers);
         progress(0);
-        showModel(m.name);
+        showModel(name);
         const wanted = target.layer ?? (sameModel ? store.current : Math.floor((r.layers - 1) * 0.3));
         store.current = clampLayer(wanted, r.layers);
         if (target.view) {
@@ -132,10 +137,6 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
           // the final refresh below reports what went wrong
         });
       },
-      // before `opened`, which shows the slice (and so the part in 3D)
-      mesh: (prepared) => {
-        if (gen === store.generation) s.part3d = View3DPanel.part(s, prepared);
-      },
     }, renderer.showVoids);
     if (gen !== store.generation) return;
     // the core's figures of every unit, before the slice counts as done
@@ -165,7 +166,7 @@ export async function startSlice(page: Page, m: Model, target: Target = {}): Pro
         store.slice = null;
         renderer.current = renderer.below = null;
         renderer.request();
-        page.view3d.sync(null, 0);
+        page.view3d.sync(page);
         writeStats(page);
       }
       showError(page, e);
@@ -258,7 +259,8 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.layerHeight = r.layerHeight;
     s.complete = true;
     store.slice = s;
-    store.model = null;
+    store.job = null;
+    page.parts.render();
     setLayers(r.layers);
     showModel(file.name);
     store.busy = false;
@@ -288,7 +290,7 @@ export function cancel(page: Page): void {
     store.slice = null;
     renderer.current = renderer.below = null;
     renderer.request();
-    page.view3d.sync(null, 0);
+    page.view3d.sync(page);
     writeStats(page);
     layerLabel(page);
   }
@@ -296,13 +298,17 @@ export function cancel(page: Page): void {
   updateButtons(page);
 }
 
-/** The unit fix: x, y and z scaled by `factor` in the form, and `s`'s model sliced again. */
-export function fixUnits(page: Page, s: Slice, factor: number): void {
-  const form = page.form!;
-  const scaled: Record<string, Value> = {};
-  for (const axis of ["scale_x", "scale_y", "scale_z"]) scaled[axis] = Number(form.get(axis) ?? 1) * factor;
-  form.set(scaled);
-  if (s.model) void startSlice(page, s.model);
+/** The unit fix: x, y and z of the parts whose file suggests `factor` (all parts when none
+ *  does) scaled by it, and the job sliced again. */
+export function fixUnits(page: Page, factor: number): void {
+  const job = page.store.job;
+  if (!job) return;
+  const suggests = job.parts.filter((p) => job.models.get(p.spec.file)?.info.suggested_scale === factor);
+  const which = suggests.length ? suggests : job.parts;
+  void editParts(page, which.map((p) => ({ id: p.id, changes: { scale_x: p.spec.scale_x * factor, scale_y: p.spec.scale_y * factor, scale_z: p.spec.scale_z * factor } })))
+    .then((ok) => {
+      if (ok) void startSlice(page);
+    });
 }
 
 /** The G-code of the finished slice: the core's header and footer around the layers' pieces. */
@@ -316,7 +322,7 @@ export async function download(page: Page): Promise<void> {
     const [header, footer] = await Promise.all([pool.header(summary), pool.footer(summary)]);
     const layers = s.gcodeParts();
     if (typeof layers === "number") throw new SliceError("internal", `layer ${layers + 1} has no G-code`);
-    saveGcode(new Blob([header, ...layers, footer], { type: "text/plain" }), s.name);
+    saveGcode(new Blob([header, ...layers, footer], { type: "text/plain" }), s.job?.refs[0]?.name ?? s.name, (s.job?.refs.length ?? 1) - 1);
   } catch (e) {
     showError(page, e);
   }

@@ -46,10 +46,16 @@ export class SettingsForm {
     container: HTMLElement,
     readonly schema: SettingSpec[],
     private onChange: () => void,
+    /** Settings kept at their defaults and not shown (a part's keys: the parts panel has them). */
+    hidden: readonly string[] = [],
   ) {
     container.replaceChildren();
     const groups = new Map<string, HTMLElement>();
     for (const spec of schema) {
+      if (hidden.includes(spec.name)) {
+        this.build(spec);
+        continue;
+      }
       let body = groups.get(spec.group);
       if (!body) {
         const details = document.createElement("details");

@@ -6,7 +6,9 @@ import { Cancelled, MAX_WORKERS, Pool } from "./client";
 import { showError } from "./errors";
 import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows";
 import { SettingsForm } from "./form";
-import { openFile, openLink, openSample } from "./open";
+import { PART_KEYS } from "./job";
+import { addParts, relayout } from "./jobflows";
+import { openFiles, openLink, openSample } from "./open";
 import type { Page } from "./page";
 import { Renderer, type View } from "./render";
 import { cacheBudgetBytes, Store } from "./store";
@@ -19,6 +21,7 @@ import { wirePlot } from "./views/plot";
 import { registerOffline } from "./offline";
 import { share } from "./views/share";
 import { setState } from "./views/status";
+import { PartsPanel } from "./views/parts";
 import { View3DPanel, wireView3D } from "./views/view3d";
 
 /** Tuning through the query string (used by the tests): `?workers=3&cache=2` (MB). */
@@ -41,8 +44,10 @@ const page: Page = {
   pool: asked === null ? new Pool() : new Pool(asked),
   renderer: new Renderer($<HTMLCanvasElement>("view")),
   view3d: new View3DPanel($("view3d")),
-  onUnitFix: (s, factor) => fixUnits(page, s, factor),
+  parts: null as unknown as PartsPanel,
+  onUnitFix: (factor) => fixUnits(page, factor),
 };
+(page as { parts: PartsPanel }).parts = new PartsPanel(page);
 const { store, pool, renderer } = page;
 const error = (e: unknown) => showError(page, e);
 
@@ -52,22 +57,29 @@ function wire(): void {
   $("btn-sample").addEventListener("click", () => void openSample(page));
   $<HTMLInputElement>("file-input").addEventListener("change", (ev) => {
     const input = ev.target as HTMLInputElement;
-    const f = input.files?.[0];
+    const files = [...(input.files ?? [])];
     input.value = "";
-    if (f) void openFile(page, f);
+    if (files.length) void openFiles(page, files);
   });
+  $<HTMLInputElement>("add-input").addEventListener("change", (ev) => {
+    const input = ev.target as HTMLInputElement;
+    const files = [...(input.files ?? [])];
+    input.value = "";
+    if (files.length) void addParts(page, files);
+  });
+  page.parts.wire();
   $("btn-download").addEventListener("click", () => void download(page));
   $("btn-share").addEventListener("click", () => void share(page).catch(error));
-  $("btn-slice").addEventListener("click", () => store.model && void startSlice(page, store.model));
+  $("btn-slice").addEventListener("click", () => void startSlice(page));
   $("btn-reset").addEventListener("click", () => page.form!.reset());
   $("btn-cancel").addEventListener("click", () => cancel(page));
   $("banner-close").addEventListener("click", hideBanner);
   // the form is never submitted (Enter slices, below); no inline handler: the page's CSP
   $("settings").addEventListener("submit", (ev) => ev.preventDefault());
   $("settings").addEventListener("keydown", (ev) => {
-    if ((ev as KeyboardEvent).key === "Enter" && store.model) {
+    if ((ev as KeyboardEvent).key === "Enter" && store.job) {
       ev.preventDefault();
-      void startSlice(page, store.model);
+      void startSlice(page);
     }
   });
 
@@ -104,8 +116,8 @@ function wire(): void {
     ev.preventDefault();
     depth = 0;
     overlay.hidden = true;
-    const f = ev.dataTransfer?.files[0];
-    if (f) void openFile(page, f);
+    const files = [...(ev.dataTransfer?.files ?? [])];
+    if (files.length) void openFiles(page, files);
   });
 
   window.addEventListener("error", (ev) => error(ev.error ?? ev.message));
@@ -161,6 +173,12 @@ window.dropslice = {
   view3d: () => page.view3d.testState(),
   /** The vertical cut (views/cut.ts): set(line), status(), setView(v), redraw(). */
   cut: () => cutHooks,
+  /** The build job: its parts (specs), the core's layout and the selected part's id. */
+  job: () => {
+    const job = store.job;
+    if (!job) return null;
+    return { name: job.name, parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: p.mesh ? p.mesh.positions.length / 9 : 0 })), layout: job.layout, selected: job.selected };
+  },
 };
 
 async function main(): Promise<void> {
@@ -173,7 +191,24 @@ async function main(): Promise<void> {
     return;
   }
   $("version").textContent = page.init.version;
-  page.form = new SettingsForm($("settings"), page.init.schema, () => updateButtons(page));
+  // the plate's settings lay the job out again (at most every 200 ms while typing)
+  let plateTimer = 0;
+  const plate = () => JSON.stringify(["plate_x", "plate_y", "part_spacing"].map((k) => page.form?.get(k)));
+  let lastPlate = "";
+  page.form = new SettingsForm(
+    $("settings"),
+    page.init.schema,
+    () => {
+      updateButtons(page);
+      if (plate() !== lastPlate) {
+        lastPlate = plate();
+        clearTimeout(plateTimer);
+        plateTimer = window.setTimeout(() => void relayout(page), 200);
+      }
+    },
+    PART_KEYS,
+  );
+  lastPlate = plate();
   updateButtons(page);
   if (!(await openLink(page))) await openSample(page);
 }

@@ -1,12 +1,18 @@
-// Opening what the user gives the page: a file (STL or .gco), the sample part, or the preview
-// link in the URL. Each ends in a flow of flows.ts.
+// Opening what the user gives the page: files (models become a new build job; a .gco file is
+// viewed; a job file opens its job and asks for its models), the sample part, or the preview
+// link in the URL (its job and, when they fit, its models). A job waiting for its models (a
+// job file, a link too big for them) takes the files dropped next: by name for a job file, by
+// SHA-256 for a link. Each ends in a flow of flows.ts.
 
 import type { Value } from "./form";
 import { openGcode, startSlice, type Target } from "./flows";
+import { PART_KEYS, PART_LIMITS } from "./job";
+import { adoptJob, newJob, type NewFile } from "./jobflows";
 import type { Page } from "./page";
+import type { JobFile, PartSpec } from "./protocol";
 import { sampleStl } from "./sample";
-import { LinkError, readLink, type SharedLink } from "./share";
-import type { Model } from "./store";
+import { LinkError, readLink, type ShareState, type SharedLink } from "./share";
+import type { PendingJob } from "./store";
 import { note, showBanner, TITLES } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { nf } from "./views/dom";
@@ -14,57 +20,157 @@ import { setShowTravel } from "./views/layer";
 import { showModel } from "./views/stats";
 import { setState } from "./views/status";
 
-export async function openFile(page: Page, file: File): Promise<void> {
+/** A job file is read on the page's thread: at most this many bytes. */
+export const JOB_FILE_MAX_BYTES = 1024 * 1024;
+
+const isGcode = (f: File) => /\.(gco|gcode)$/i.test(f.name);
+const isJobFile = (f: File) => /\.json$/i.test(f.name);
+
+/** Files opened (the picker or a drop): a .gco file is viewed on its own; a job file opens
+ *  its job with the models given along (and asks for the others); models make a new job, or
+ *  complete the job waiting for its models. */
+export async function openFiles(page: Page, files: File[]): Promise<void> {
   const store = page.store;
+  if (files.length === 0) return;
   const chosen = performance.now();
   setState("reading");
-  if (/\.(gco|gcode)$/i.test(file.name)) {
-    store.pendingLink = null;
-    note("", "none");
-    await openGcode(page, file);
+  const gcode = files.find(isGcode);
+  if (gcode) {
+    store.pending = null;
+    note(files.length > 1 ? `A .gco file is viewed on its own: only “${gcode.name}” was opened.` : "", files.length > 1 ? "warn" : "none");
+    await openGcode(page, gcode);
     return;
   }
-  // The File goes to a worker, which reads it and computes its SHA-256: the page never reads it.
-  const m: Model = { file, name: file.name, sha256: "" };
   store.fileChosenAt = chosen;
-  const link = store.pendingLink;
-  if (link) {
-    store.pendingLink = null;
-    let sha256: string;
-    try {
-      sha256 = await page.pool.hash(file);
-    } catch (e) {
-      showBanner(TITLES.import, `The browser could not read “${file.name}”: ${e instanceof Error ? e.message : String(e)}`);
+  const jobFile = files.find(isJobFile);
+  const models = files.filter((f) => !isJobFile(f));
+  if (jobFile) {
+    const job = await readJobFile(jobFile);
+    if (typeof job === "string") {
+      showBanner(TITLES.job, job);
+      setState("error");
       return;
     }
-    m.sha256 = sha256;
-    if (link.state.sha256 === m.sha256) {
-      note(`“${m.name}” matches the model of the preview link.`, "ok");
-      await startSlice(page, m, { layer: link.state.layer, view: link.state.view });
-      return;
-    }
-    note(
-      `“${m.name}” does not match the model of the preview link (“${link.state.name}”, SHA-256 ${link.state.sha256.slice(0, 12)}…): this is a different file. It is sliced with the link's settings.`,
-      "warn",
-    );
-  } else {
     note("", "none");
+    await openPending(page, pendingOf(job), models);
+    return;
   }
-  await startSlice(page, m);
+  if (store.pending) {
+    await openPending(page, store.pending, models);
+    return;
+  }
+  note("", "none");
+  await openJob(page, models.map((file) => ({ file })));
 }
 
-/** A model from bytes the page already holds (the sample, a link's model), as a File for
- *  the workers. */
-function modelOf(bytes: Uint8Array, name: string): Model {
-  return { file: new File([bytes as BlobPart], name, { type: "model/stl" }), name, sha256: "" };
+/** A new job of `files` (or of `specs`), sliced at once; 3D first when it has several
+ *  instances. */
+async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target: Target = {}): Promise<boolean> {
+  const job = await newJob(page, files, specs);
+  if (!job) return false;
+  adoptJob(page, job);
+  if (job.instances > 1) page.view3d.setActive(true);
+  await startSlice(page, target);
+  return true;
+}
+
+/** Reads a job file (bounded) into its JSON; a message when it is not one. The core checks
+ *  every field when the job is laid out. */
+async function readJobFile(file: File): Promise<JobFile | string> {
+  if (file.size > JOB_FILE_MAX_BYTES) return `“${file.name}” is ${nf.format(file.size)} bytes; a job file has at most ${nf.format(JOB_FILE_MAX_BYTES)}.`;
+  let raw: unknown;
+  try {
+    raw = JSON.parse(await file.text());
+  } catch (e) {
+    return `“${file.name}” is not a job file: it is not JSON (${e instanceof Error ? e.message : String(e)}).`;
+  }
+  const obj = raw as { settings?: unknown; parts?: unknown };
+  if (typeof raw !== "object" || raw === null || Array.isArray(raw)) return `“${file.name}” is not a job file: it must be an object {"settings": {…}, "parts": [{"file": "a.stl"}, …]}.`;
+  if (!Array.isArray(obj.parts) || obj.parts.length === 0) return `“${file.name}” lists no parts: a job file has "parts": [{"file": "a.stl"}, …].`;
+  if (obj.parts.length > PART_LIMITS.parts) return `“${file.name}” lists ${nf.format(obj.parts.length)} parts; at most ${PART_LIMITS.parts} are allowed.`;
+  const parts = obj.parts as unknown[];
+  const bad = parts.findIndex((p) => typeof p !== "object" || p === null || typeof (p as { file?: unknown }).file !== "string" || (p as { file: string }).file.length > PART_LIMITS.nameChars);
+  if (bad >= 0) return `“${file.name}”: parts[${bad}] has no "file" (the model's file name, at most ${PART_LIMITS.nameChars} characters).`;
+  const settings = obj.settings === undefined || obj.settings === null ? {} : obj.settings;
+  if (typeof settings !== "object" || Array.isArray(settings)) return `“${file.name}”: "settings" must be an object {"name": value, …}.`;
+  return { settings: settings as Record<string, Value>, parts: parts as PartSpec[] };
+}
+
+function pendingOf(job: JobFile, link?: ShareState): PendingJob {
+  if (link?.files) {
+    return { source: "link", job, link, files: link.files.map((f) => ({ name: f.name, sha256: f.sha256 })) };
+  }
+  const names = [...new Set(job.parts.map((p) => p.file))];
+  return { source: link ? "link" : "file", job, link, files: names.map((name) => ({ name, sha256: link && name === link.name ? link.sha256 : undefined })) };
+}
+
+/** Gives a waiting job the files `dropped`; opens it when none is missing any more, else says
+ *  which are. A job file's files are matched by name (the file name alone, any folder), a
+ *  link's by SHA-256. */
+async function openPending(page: Page, pending: PendingJob, dropped: File[]): Promise<void> {
+  const { store } = page;
+  const strangers: File[] = [];
+  for (const f of dropped) {
+    let slot: PendingJob["files"][number] | undefined;
+    if (pending.source === "link") {
+      const sha = await page.pool.hash(f).catch(() => "");
+      slot = pending.files.find((x) => !x.file && x.sha256 !== undefined && sha !== "" && sha.startsWith(x.sha256));
+    } else {
+      slot = pending.files.find((x) => x.name === f.name) ?? pending.files.find((x) => baseOf(x.name) === f.name);
+    }
+    if (slot) slot.file = f;
+    else strangers.push(f);
+  }
+  const missing = pending.files.filter((x) => !x.file);
+  const link = pending.link;
+  const target: Target = link ? { layer: link.layer, view: link.view } : {};
+  // a link of one model: a different file is sliced with the link's settings, and said so
+  if (missing.length === 1 && pending.files.length === 1 && pending.source === "link" && strangers.length === 1) {
+    store.pending = null;
+    const name = pending.files[0].name;
+    note(`“${strangers[0].name}” does not match the model of the preview link (“${name}”, SHA-256 ${(pending.files[0].sha256 ?? "").slice(0, 12)}…): this is a different file. It is sliced with the link's settings.`, "warn");
+    const job = { ...pending.job, parts: pending.job.parts.map((p) => ({ ...p, file: strangers[0].name })) };
+    await openJob(page, [{ file: strangers[0] }], job.parts);
+    return;
+  }
+  if (missing.length === 0) {
+    // a link's settings are in the form already
+    if (pending.source === "file") applyJobSettings(page, pending.job.settings);
+    if (pending.source === "link") note(pending.files.length > 1 ? "The dropped files match the models of the preview link." : `“${pending.files[0].file!.name}” matches the model of the preview link.`, "ok");
+    const extra = strangers.length ? ` (not part of it: ${strangers.map((f) => `“${f.name}”`).join(", ")})` : "";
+    if (extra) note(`The job's files are all here${extra}.`, "warn");
+    if (await openJob(page, pending.files.map((x) => ({ file: x.file!, name: x.name })), pending.job.parts, target)) store.pending = null;
+    else store.pending = pending;
+    return;
+  }
+  store.pending = pending;
+  store.fileChosenAt = null;
+  const list = missing.map((x) => `“${x.name}”${x.sha256 ? ` (SHA-256 ${x.sha256.slice(0, 12)}…)` : ""}`).join(", ");
+  const strange = strangers.length ? ` ${strangers.map((f) => `“${f.name}”`).join(", ")} ${strangers.length > 1 ? "are" : "is"} not one of them${pending.source === "link" ? " (a different SHA-256)" : ""}.` : "";
+  showBanner(
+    pending.source === "link" ? TITLES.linkFiles : TITLES.jobFiles,
+    `Still missing: ${list}. Drop ${missing.length > 1 ? "those files" : "that file"} here${strange}`,
+    "info",
+  );
+  setState("idle");
+  updateButtons(page);
+}
+
+const baseOf = (path: string) => path.replace(/^.*[\\/]/, "");
+
+/** The job's settings into the form (the defaults for the others); unknown names are said. */
+function applyJobSettings(page: Page, settings: JobFile["settings"]): void {
+  const clean: Record<string, Value> = {};
+  for (const [k, v] of Object.entries(settings)) if (typeof v === "number" || typeof v === "boolean" || typeof v === "string") clean[k] = v;
+  const unknown = page.form!.set({ ...page.init!.defaults, ...clean });
+  if (unknown.length) note(`Settings unknown here were ignored: ${unknown.join(", ")}.`, "warn");
 }
 
 export async function openSample(page: Page, notice?: Target["notice"]): Promise<void> {
   const s = sampleStl();
-  const m = modelOf(s.bytes, s.name);
-  page.store.pendingLink = null;
+  page.store.pending = null;
   note("", "none");
-  await startSlice(page, m, { notice });
+  await openJob(page, [{ file: new File([s.bytes as BlobPart], s.name, { type: "model/stl" }) }], undefined, { notice });
 }
 
 /** What a link's settings must be for each kind of setting (the form checks the ranges). */
@@ -92,8 +198,22 @@ function linkSettings(page: Page, settings: Record<string, Value>, ignored: stri
   return out;
 }
 
+/** The job of a link: its parts, or (a link of one model from an older page) one part of its
+ *  model, which takes the link's part settings (rotate_z, scale_x, …) as its own. */
+function linkJob(state: ShareState, settings: Record<string, Value>): JobFile {
+  const own: Record<string, Value> = {};
+  const part: PartSpec = { file: state.name };
+  for (const [k, v] of Object.entries(settings)) {
+    if ((PART_KEYS as readonly string[]).includes(k)) {
+      if (typeof v === "number") (part as unknown as Record<string, number>)[k] = v;
+    } else own[k] = v;
+  }
+  if ((part.place_x === undefined) !== (part.place_y === undefined)) (part.place_x === undefined ? (part.place_x = 0) : (part.place_y = 0));
+  return { settings: own, parts: state.parts ?? [part] };
+}
+
 /** Opens the preview link in the URL, if there is one (returns whether there was one that the
- *  page now shows or waits for a file of). A link too large or damaged is refused with a
+ *  page now shows or waits for files of). A link too large or damaged is refused with a
  *  message and the sample part is shown; fields it gets wrong are ignored and named. */
 export async function openLink(page: Page): Promise<boolean> {
   let link: SharedLink | null;
@@ -106,7 +226,9 @@ export async function openLink(page: Page): Promise<boolean> {
   }
   if (!link) return false;
   const ignored = [...link.ignored];
-  const unknown = page.form!.set({ ...page.init!.defaults, ...linkSettings(page, link.state.settings, ignored) });
+  const job = linkJob(link.state, linkSettings(page, link.state.settings, ignored));
+  const unknown = page.form!.set({ ...page.init!.defaults, ...job.settings });
+  job.settings = {};
   const extra = unknown.length
     ? ` The link comes from another version: its settings ${unknown.join(", ")} are unknown here and were ignored, so the slice may differ.`
     : "";
@@ -116,29 +238,36 @@ export async function openLink(page: Page): Promise<boolean> {
     ? { title: TITLES.linkPart, message: `This preview link is partly damaged: ${ignored.join("; ")}.`, tone: "info" }
     : undefined;
   const { layer, view, name, sha256 } = link.state;
-  if (link.model) {
-    const m = modelOf(link.model, name);
-    m.sha256 = await page.pool.hash(m.file);
-    if (m.sha256 === sha256) {
-      await startSlice(page, m, { layer, view, notice });
+  const files = link.state.files ?? [{ name, sha256, bytes: link.model?.length ?? 0 }];
+  if (link.models) {
+    const given = files.map((f, i) => ({ file: new File([link.models![i] as BlobPart], f.name), name: f.name }));
+    const hashes = await Promise.all(given.map((g) => page.pool.hash(g.file)));
+    const wrong = files.findIndex((f, i) => !hashes[i].startsWith(f.sha256));
+    if (wrong < 0) {
+      page.store.pending = null;
+      await openJob(page, given, job.parts, { layer, view, notice });
       return true;
     }
-    link.model = null;
-    link.modelError = "its model does not match the SHA-256 it carries";
+    link.models = null;
+    link.modelError = files.length > 1 ? `its model “${files[wrong].name}” does not match the SHA-256 it carries` : "its model does not match the SHA-256 it carries";
   }
-  page.store.pendingLink = link;
+  page.store.pending = pendingOf({ ...job, settings: {} }, link.state);
   showModel(null);
   const at = layer !== undefined ? ` to see layer ${nf.format(layer + 1)}` : "";
+  const several = files.length > 1;
+  const named = several ? `${files.length} models (${files.map((f) => `“${f.name}”`).join(", ")})` : `the model “${name}” (SHA-256 ${sha256.slice(0, 12)}…)`;
   if (link.modelError) {
     const also = ignored.length ? ` Also ignored: ${ignored.join("; ")}.` : "";
-    showBanner(TITLES.link, `This preview link is too large or damaged: ${link.modelError}. Its settings are applied; drop “${name}” here to see the slice.${also}`);
+    showBanner(TITLES.link, `This preview link is too large or damaged: ${link.modelError}. Its settings are applied; drop ${several ? "its models" : `“${name}”`} here to see the slice.${also}`);
   } else if (notice) {
     showBanner(notice.title, notice.message, notice.tone);
+  } else if (several) {
+    showBanner(TITLES.linkFiles, `Still missing: ${files.map((f) => `“${f.name}”`).join(", ")}. Drop those files here.`, "info");
   }
   note(
     link.modelError
-      ? `The model “${name}” (SHA-256 ${sha256.slice(0, 12)}…) could not be taken from the link. Drop that file here${at} with the link's settings.${extra}`
-      : `This preview link is for “${name}” (SHA-256 ${sha256.slice(0, 12)}…), which was too big to put in the link. Drop that file here${at} with the link's settings.${extra}`,
+      ? `${several ? "The models" : `The model “${name}” (SHA-256 ${sha256.slice(0, 12)}…)`} could not be taken from the link. Drop ${several ? "those files" : "that file"} here${at} with the link's settings.${extra}`
+      : `This preview link is for ${named}, too big to put in the link. Drop ${several ? "those files" : "that file"} here${at} with the link's settings.${extra}`,
     "warn",
   );
   setState("idle");

@@ -5,7 +5,8 @@ import type { Pool } from "./client";
 import type { SettingsForm } from "./form";
 import type { InitResult } from "./protocol";
 import type { Renderer } from "./render";
-import type { Slice, Store } from "./store";
+import type { Store } from "./store";
+import type { PartsPanel } from "./views/parts";
 import type { View3DPanel } from "./views/view3d";
 
 export interface Page {
@@ -14,10 +15,12 @@ export interface Page {
   readonly renderer: Renderer;
   /** The stage's 3D tab. */
   readonly view3d: View3DPanel;
+  /** The parts panel (left column). */
+  readonly parts: PartsPanel;
   /** The settings form, once init has answered. */
   form?: SettingsForm;
   /** The core's version, settings schema and defaults, once init has answered. */
   init?: InitResult;
-  /** The unit fix's button was pressed: scale the part by `factor` and slice `s`'s model again. */
-  onUnitFix(s: Slice, factor: number): void;
+  /** The unit fix's button was pressed: scale the parts by `factor` and slice again. */
+  onUnitFix(factor: number): void;
 }

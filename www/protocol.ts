@@ -8,6 +8,70 @@ export interface Counts {
   fill: number;
 }
 
+/** What the core says of an added file (src/job.rs `ModelInfo`); model coordinates in mm. */
+export interface ModelInfo {
+  name: string;
+  format: string;
+  triangles: number;
+  bounds: { min: [number, number, number]; max: [number, number, number] };
+  items: { name: string; triangles: number; bounds: { min: [number, number, number]; max: [number, number, number] } }[];
+  warnings: string[];
+  suggested_scale: number | null;
+}
+
+/** One part of a job file (docs/jobs.md): absent keys take the core's defaults. */
+export interface PartSpec {
+  file: string;
+  item?: number;
+  rotate_x?: number;
+  rotate_y?: number;
+  rotate_z?: number;
+  scale_x?: number;
+  scale_y?: number;
+  scale_z?: number;
+  place_x?: number;
+  place_y?: number;
+  place_angle?: number;
+  copies?: number;
+  unit?: number;
+  name?: string;
+}
+
+/** A job file (docs/jobs.md): the job's settings (no part keys) and its parts. */
+export interface JobFile {
+  settings: Settings;
+  parts: PartSpec[];
+}
+
+/** One copy of one part on the plate (src/job.rs `Instance`); `part` and `copy` from 0. */
+export interface Instance {
+  part: number;
+  copy: number;
+  copies: number;
+  name: string;
+  file: string;
+  item: number | null;
+  object: string | null;
+  rotate: [number, number, number];
+  scale: [number, number, number];
+  place_angle: number;
+  placed: boolean;
+  /** Where the instance's box minimum went (place_x, place_y when placed). */
+  at: [number, number];
+  unit: number;
+  /** Column-major 4×4, model → plate coordinates (mm). */
+  matrix: number[];
+  min: [number, number, number];
+  max: [number, number, number];
+}
+
+/** Where every instance of a job goes (src/job.rs `Layout`). */
+export interface Layout {
+  instances: Instance[];
+  bounds: { min: [number, number, number]; max: [number, number, number] };
+  warnings: string[];
+}
+
 /** Where a slice came from and what the core said about the mesh. */
 export interface JobInfo {
   file_name?: string;
@@ -18,6 +82,8 @@ export interface JobInfo {
   warnings?: string[];
   /** Scale for x, y and z when the size suggests inches (25.4) or micrometres (0.001). */
   suggested_scale?: number | null;
+  /** Every copy of every part (a build job; one for a single file). */
+  instances?: Instance[];
   [key: string]: unknown;
 }
 
@@ -116,8 +182,9 @@ export function coverageMaskOf(r: {
   return { cell: r.mask_cell, tiles };
 }
 
-/** An error as the core throws it (src/error.rs `ErrorReport`) and as a worker replies it;
- *  `crash` and `link` are the page's own kinds. */
+/** An error as the core throws it (src/error.rs `ErrorReport`: import, setting, job,
+ *  nothing_to_print, io, internal) and as a worker replies it; `crash` and `link` are the
+ *  page's own kinds. */
 export interface ErrorValue {
   kind: string;
   message: string;
@@ -220,8 +287,6 @@ export interface GcodeParseResult {
 /** Every request a worker answers: what it is sent and what it replies. */
 export interface Calls {
   init: { data: null; result: InitResult };
-  /** Reads and prepares the model (in the worker: the page never reads it). */
-  open: { data: { file: File; settings: Settings; hash?: boolean; prepare?: boolean }; result: OpenResult };
   /** Takes the job another worker prepared. */
   adopt: { data: { prepared: PreparedMesh; settings: Settings }; result: OpenResult };
   slice: { data: { from: number; to: number; analyse?: boolean; gcode?: boolean }; result: SliceUnit };
@@ -233,6 +298,16 @@ export interface Calls {
   hash: { data: { file: Blob }; result: string };
   parse_gcode: { data: { file: Blob }; result: GcodeParseResult };
   crash: { data: null; result: void };
+  /** Build jobs (the job worker's `Models`, src/wasm.rs): files added under their job names
+   *  (a name already there is replaced), with their info and SHA-256. */
+  models_add: { data: { files: { name: string; file: File }[] }; result: { infos: ModelInfo[]; sha256: string[] } };
+  models_remove: { data: { names: string[] }; result: void };
+  /** A decimated copy of a file's (or 3MF item's) triangles for the 3D view (9 floats each). */
+  display_mesh: { data: { name: string; item?: number; max: number }; result: Float32Array };
+  layout: { data: { job: JobFile }; result: Layout };
+  lay_flat: { data: { name: string; item?: number }; result: { rotate_x: number; rotate_y: number } };
+  /** Prepares the job `job` of the files added (Session.from_models); like "open". */
+  open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
   /** The vertical cut of layers [from, to) (views/cut.ts, src/wasm_cut.rs `Session.cut`). */
   cut: { data: CutRequest; result: CutReply };
 }

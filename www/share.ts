@@ -1,7 +1,8 @@
-// Preview links: settings, layer, view and the model in the URL fragment (never sent to a
-// server). The model is embedded (deflate-raw, base64url) when it compresses to at most
-// 256 KB; otherwise the link carries its SHA-256 and file name, and the receiver drops in
-// the same file, which the page checks against the hash.
+// Preview links: settings, layer, view, the build job and its models in the URL fragment (never
+// sent to a server). The models are embedded together (their bytes one after the other,
+// deflate-raw, base64url) when they compress to at most 256 KB in all; otherwise the link
+// carries each file's SHA-256 and name, and the receiver drops in the same files, which the
+// page matches by their hashes. A link of one model without a job (older pages) still opens.
 //
 // A link comes from anyone, so reading one is bounded: the encoded texts are measured before
 // they are decoded, both parts are inflated as a stream that is cancelled as soon as it grows
@@ -9,6 +10,8 @@
 // uses it. Fields that are wrong are dropped and named (`ignored`); a link that is too large or
 // damaged is refused with a [[LinkError]].
 
+import { PART_LIMITS } from "./job";
+import type { PartSpec } from "./protocol";
 import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./render";
 
 export const EMBED_LIMIT = 256 * 1024;
@@ -43,15 +46,29 @@ export interface ShareState {
   layer?: number;
   /** Absent when the link's view was unusable (the part is then fitted). */
   view?: View;
+  /** The first model's name and SHA-256 (the only ones in a link of one model). */
   name: string;
   sha256: string;
   showTravel?: boolean;
+  /** The job's files in the order their bytes are embedded: name (as the parts name it),
+   *  SHA-256 and size. Absent in a link of one model without a job. */
+  files?: LinkFile[];
+  /** The job's parts (their `file` names one of `files`). */
+  parts?: PartSpec[];
+}
+
+export interface LinkFile {
+  name: string;
+  sha256: string;
+  bytes: number;
 }
 
 export interface SharedLink {
   state: ShareState;
-  /** The model, when it was embedded. */
+  /** The embedded bytes (every model, one after the other), when there were any. */
   model: Uint8Array | null;
+  /** The embedded models, one per file of `state.files` (or the one model of an older link). */
+  models: Uint8Array[] | null;
   /** Why an embedded model was refused (too large or damaged): the state is still usable. */
   modelError?: string;
   /** Parts of the state that were dropped or limited, in words ("its view (…)"). */
@@ -149,11 +166,13 @@ export async function sha256Hex(bytes: Uint8Array): Promise<string> {
   return [...new Uint8Array(digest)].map((b) => b.toString(16).padStart(2, "0")).join("");
 }
 
-/** Builds the link; `embedded` tells whether the model travels inside it. The model is a
- *  Blob (the File the user gave): it is compressed as a stream, never read whole here. */
-export async function makeLink(base: string, state: ShareState, model: Blob): Promise<{ url: string; embedded: boolean }> {
+/** Builds the link; `embedded` tells whether the models travel inside it. The models are Blobs
+ *  (the Files the user gave), in the order of `state.files`: compressed together as a stream,
+ *  never read whole here. */
+export async function makeLink(base: string, state: ShareState, models: Blob | Blob[]): Promise<{ url: string; embedded: boolean }> {
   const p = toBase64Url(await deflate(new TextEncoder().encode(JSON.stringify(state))));
-  const packed = new Uint8Array(await new Response(model.stream().pipeThrough(new CompressionStream("deflate-raw"))).arrayBuffer());
+  const all = new Blob(Array.isArray(models) ? models : [models]);
+  const packed = new Uint8Array(await new Response(all.stream().pipeThrough(new CompressionStream("deflate-raw"))).arrayBuffer());
   const embedded = packed.length <= EMBED_LIMIT;
   const url = `${base.split("#")[0]}#p=${p}${embedded ? `&m=${toBase64Url(packed)}` : ""}`;
   return { url, embedded };
@@ -235,10 +254,86 @@ export function checkState(raw: unknown): { state: ShareState; ignored: string[]
   else if (raw.showTravel !== undefined) ignored.push(`its travel option (${shown(raw.showTravel)})`);
 
   const state: ShareState = { settings, name, sha256 };
+  if (raw.files !== undefined || raw.parts !== undefined) {
+    state.files = checkFiles(raw.files);
+    state.parts = checkParts(raw.parts, state.files, ignored);
+  }
   if (layer !== undefined) state.layer = layer;
   if (view !== undefined) state.view = view;
   if (showTravel !== undefined) state.showTravel = showTravel;
   return { state, ignored };
+}
+
+const HEX = /^[0-9a-fA-F]{1,64}$/;
+
+/** The job's files of a link: at most [[PART_LIMITS]].parts, names of at most 255 characters,
+ *  distinct; hexadecimal hashes; sizes that add up to at most [[MODEL_MAX_BYTES]]. Anything
+ *  else is a [[LinkError]] (the parts could not be matched to their files). */
+function checkFiles(raw: unknown): LinkFile[] {
+  if (!Array.isArray(raw) || raw.length === 0) throw new LinkError("its job's files are not a list of files");
+  if (raw.length > PART_LIMITS.parts) throw new LinkError(`its job lists ${nf.format(raw.length)} files; at most ${PART_LIMITS.parts} are accepted`);
+  const out: LinkFile[] = [];
+  let total = 0;
+  raw.forEach((f, i) => {
+    if (!isObject(f)) throw new LinkError(`its job's file ${i + 1} is not a file`);
+    if (typeof f.name !== "string" || f.name.length === 0 || f.name.length > NAME_MAX) throw new LinkError(`its job's file ${i + 1} has no name of 1 … ${NAME_MAX} characters`);
+    if (out.some((o) => o.name === f.name)) throw new LinkError(`its job lists the file ${shown(f.name)} twice`);
+    if (typeof f.sha256 !== "string" || !HEX.test(f.sha256)) throw new LinkError(`its job's file ${shown(f.name)} has no SHA-256 of hexadecimal digits (at most 64)`);
+    if (typeof f.bytes !== "number" || !Number.isInteger(f.bytes) || f.bytes < 0 || f.bytes > MODEL_MAX_BYTES) throw new LinkError(`its job's file ${shown(f.name)} has no size of 0 … ${size(MODEL_MAX_BYTES)}`);
+    total += f.bytes;
+    if (total > MODEL_MAX_BYTES) throw new LinkError(`its job's files are more than ${size(MODEL_MAX_BYTES)} in all`);
+    out.push({ name: f.name, sha256: f.sha256.toLowerCase(), bytes: f.bytes });
+  });
+  return out;
+}
+
+/** Numbers of a part: [min, max, whole number], as the core checks them (docs/jobs.md). */
+const PART_NUMBERS: Record<string, [number, number, boolean]> = {
+  rotate_x: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
+  rotate_y: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
+  rotate_z: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
+  scale_x: [Number.MIN_VALUE, PART_LIMITS.scaleMax, false],
+  scale_y: [Number.MIN_VALUE, PART_LIMITS.scaleMax, false],
+  scale_z: [Number.MIN_VALUE, PART_LIMITS.scaleMax, false],
+  place_x: [-PART_LIMITS.place, PART_LIMITS.place, false],
+  place_y: [-PART_LIMITS.place, PART_LIMITS.place, false],
+  place_angle: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
+  copies: [1, PART_LIMITS.copies, true],
+  unit: [0, 1, true],
+  item: [0, 1_000_000, true],
+};
+
+/** The parts of a link: each names one of `files`; a number that is not finite or out of
+ *  range is dropped (the default is used) and named in `ignored`; the core checks all again. */
+function checkParts(raw: unknown, files: LinkFile[], ignored: string[]): PartSpec[] {
+  if (!Array.isArray(raw) || raw.length === 0) throw new LinkError("its job's parts are not a list of parts");
+  if (raw.length > PART_LIMITS.parts) throw new LinkError(`its job has ${nf.format(raw.length)} parts; at most ${PART_LIMITS.parts} are accepted`);
+  return raw.map((p, i) => {
+    const at = `its part ${i + 1}`;
+    if (!isObject(p)) throw new LinkError(`${at} is not a part`);
+    if (typeof p.file !== "string" || !files.some((f) => f.name === p.file)) throw new LinkError(`${at} names no file of the link`);
+    const out: PartSpec = { file: p.file };
+    for (const [k, v] of Object.entries(p)) {
+      if (k === "file") continue;
+      const range = PART_NUMBERS[k];
+      if (k === "name") {
+        if (typeof v === "string" && v.length <= NAME_MAX) out.name = v;
+        else ignored.push(`${at}'s name (not a text of at most ${NAME_MAX} characters)`);
+      } else if (!range) {
+        ignored.push(`${at}'s ${/^[a-z_]{1,40}$/.test(k) ? k : "unknown key"} (not a part's setting)`);
+      } else if (typeof v !== "number" || !Number.isFinite(v) || v < range[0] || v > range[1] || (range[2] && !Number.isInteger(v))) {
+        ignored.push(`${at}'s ${k} (${shown(v)} is not ${range[2] ? "a whole number" : "a number"} in ${range[0] === Number.MIN_VALUE ? "(0" : range[0]} … ${range[1]}: the default is used)`);
+      } else {
+        (out as unknown as Record<string, number>)[k] = v;
+      }
+    }
+    if ((out.place_x === undefined) !== (out.place_y === undefined)) {
+      ignored.push(`${at}'s place (x and y go together: the part is arranged)`);
+      delete out.place_x;
+      delete out.place_y;
+    }
+    return out;
+  });
 }
 
 /** Reads a link's fragment; null when it holds no preview. Throws a [[LinkError]] on a link
@@ -259,14 +354,26 @@ export async function readLink(hash: string): Promise<SharedLink | null> {
   const { state, ignored } = checkState(raw);
   const m = params.get("m");
   let model: Uint8Array | null = null;
+  let models: Uint8Array[] | null = null;
   let modelError: string | undefined;
   if (m) {
+    const what = state.files && state.files.length > 1 ? "its models" : "its model";
     try {
-      model = await inflate(fromBase64Url(m, MODEL_TEXT_MAX, "its model"), MODEL_MAX_BYTES, "its model");
+      model = await inflate(fromBase64Url(m, MODEL_TEXT_MAX, what), MODEL_MAX_BYTES, what);
+      models = state.files ? split(model, state.files) : [model];
     } catch (e) {
       if (!(e instanceof LinkError)) throw e;
+      model = models = null;
       modelError = e.message;
     }
   }
-  return { state, model, modelError, ignored };
+  return { state, model, models, modelError, ignored };
+}
+
+/** The embedded bytes cut into the files' sizes, which must add up to them exactly. */
+function split(bytes: Uint8Array, files: LinkFile[]): Uint8Array[] {
+  const total = files.reduce((n, f) => n + f.bytes, 0);
+  if (total !== bytes.length) throw new LinkError(`its models are ${nf.format(bytes.length)} bytes, not the ${nf.format(total)} bytes its files add up to`);
+  let at = 0;
+  return files.map((f) => bytes.subarray(at, (at += f.bytes)));
 }

@@ -1,13 +1,14 @@
-// The page's state: the model, the slice (its layers in a bounded cache, their analyses and
+// The page's state: the build job (job.ts), the slice (its layers in a bounded cache, their analyses and
 // figures), the layer shown, and the generation counter that retires the callbacks of a run
 // that was replaced. No DOM here.
 
+import type { JobFileRef } from "./client";
 import type { Value } from "./form";
 import { Figures } from "./figures";
-import type { Counts, JobInfo, LayerAnalysis, LayerData, SliceUnit } from "./protocol";
+import type { Job } from "./job";
+import type { Counts, JobFile, JobInfo, LayerAnalysis, LayerData, SliceUnit } from "./protocol";
 import type { Bounds } from "./render";
-import type { SharedLink } from "./share";
-import type { View3DPart } from "./view3d";
+import type { ShareState } from "./share";
 
 /** Layer previews kept in the page (`?cache=MB`, 384 MB unless asked): beyond this, layers far
  *  from the one shown are dropped and re-planned by a worker when they are shown again. */
@@ -15,12 +16,23 @@ export function cacheBudgetBytes(query: URLSearchParams): number {
   return Math.min(4096, Math.max(1, Number(query.get("cache")) || 384)) * 2 ** 20;
 }
 
-/** A model to slice: its File is read in a worker, never on the page's thread. */
-export interface Model {
-  file: File;
-  name: string;
-  /** SHA-256 (hex) as a worker computed it; "" until the model was opened. */
-  sha256: string;
+/** What a slice was made of: the job's files and the job (to open it again in fresh workers,
+ *  and to tell whether a new slice is of the same models). */
+export interface SlicedJob {
+  refs: JobFileRef[];
+  file: JobFile;
+  /** The files' SHA-256, in the order of `refs`. */
+  sha256: string[];
+}
+
+/** A job waiting for its model files (a job file or a preview link without them): the parts,
+ *  and per file the name and, from a link, the SHA-256 the dropped file must have. */
+export interface PendingJob {
+  source: "link" | "file";
+  job: JobFile;
+  files: { name: string; sha256?: string; file?: File }[];
+  /** The link's state (layer, view, …) to show once the job is sliced. */
+  link?: ShareState;
 }
 
 /** Everything known about one slice (or one opened .gco file). */
@@ -47,8 +59,8 @@ export class Slice {
    *  layer's G-code was ready (the figure of the benchmark). */
   startedAt = performance.now();
   seconds: number | null = null;
-  /** The model's prepared mesh for the 3D view (a model's slice, once a worker prepared it). */
-  part3d: View3DPart | null = null;
+  /** The job's key (job.ts `Job.key`) the slice was made of. */
+  key = "";
 
   constructor(
     readonly source: "stl" | "gco",
@@ -56,7 +68,7 @@ export class Slice {
     public dropletWidth: number,
     public layerHeight: number,
     readonly settings: Record<string, Value>,
-    readonly model: Model | null,
+    readonly job: SlicedJob | null,
     /** Bytes of layers the cache keeps ([[cacheBudgetBytes]]). */
     readonly cacheBudget: number,
   ) {}
@@ -149,7 +161,8 @@ function layerBytes(l: LayerData): number {
 
 /** The page's state (one per page). */
 export class Store {
-  model: Model | null = null;
+  /** The build job (null before the first file, and while a .gco file is shown). */
+  job: Job | null = null;
   slice: Slice | null = null;
   /** The layer shown. */
   current = 0;
@@ -159,10 +172,10 @@ export class Store {
   busy = false;
   /** The user zoomed or panned (or a link set the view): a new slice of the same model keeps it. */
   viewTouched = false;
-  /** A preview link waiting for its model file (too big to be in the link). */
-  pendingLink: SharedLink | null = null;
-  /** The settings (JSON) of the slice shown, to tell when the form differs. */
-  slicedSettings = "";
+  /** A job (from a link or a job file) waiting for its model files. */
+  pending: PendingJob | null = null;
+  /** Bumped by every layout request: only the latest answer is applied. */
+  layoutSeq = 0;
   /** When the file being opened was chosen: a slice's time runs from there. */
   fileChosenAt: number | null = null;
   /** Layers being fetched from a worker (evicted, or wanted with their mask). */
@@ -173,7 +186,7 @@ export class Store {
   constructor(readonly cacheBudget: number) {}
 
   /** A new, empty slice with this store's cache budget. */
-  newSlice(source: "stl" | "gco", name: string, dropletWidth: number, layerHeight: number, settings: Record<string, Value>, model: Model | null): Slice {
-    return new Slice(source, name, dropletWidth, layerHeight, settings, model, this.cacheBudget);
+  newSlice(source: "stl" | "gco", name: string, dropletWidth: number, layerHeight: number, settings: Record<string, Value>, job: SlicedJob | null): Slice {
+    return new Slice(source, name, dropletWidth, layerHeight, settings, job, this.cacheBudget);
   }
 }

@@ -1,11 +1,12 @@
-// One worker = one wasm instance = at most one Session (one prepared slicing job).
-// Answers the requests of protocol.ts; streams layers as "progress" replies with their
-// buffers transferred. The model arrives as a File and is read here (by the core, with
-// FileReaderSync), never on the page's thread; the worker that prepares a job hands the
-// prepared mesh to the others ("adopt"). Everything from the core is a typed value; its
+// One worker = one wasm instance = at most one Session (one prepared slicing job), and in the
+// job worker (the pool's first) the job's `Models` (its imported files). Answers the requests
+// of protocol.ts; streams layers as "progress" replies with their buffers transferred. The
+// model files arrive as Files and are read here (by the core, with FileReaderSync), never on
+// the page's thread; the worker that prepares a job hands the prepared mesh to the others
+// ("adopt"). Everything from the core is a typed value; its
 // errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, { Session, Tally, crash_for_test, default_settings, settings_schema, version, type InitOutput } from "./pkg/dropslice.js";
+import init, { Models, Session, Tally, crash_for_test, default_settings, settings_schema, version, type InitOutput } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
 import {
   coverageMaskOf,
@@ -22,6 +23,8 @@ import {
   type ResultOf,
   type SliceUnit,
   type JobInfo,
+  type Layout,
+  type ModelInfo,
   type Summary,
   type LayerData,
 } from "./protocol";
@@ -31,6 +34,8 @@ const scope = self as unknown as DedicatedWorkerGlobalScope;
 let wasm: Promise<InitOutput> | null = null;
 let memory: WebAssembly.Memory | null = null;
 let session: Session | null = null;
+/** The job's files (only the job worker gets any). */
+let models: Models | null = null;
 let lastPanic = "";
 let broken = false;
 
@@ -138,6 +143,11 @@ function internal(message: string): ErrorValue {
   return { kind: "internal", message: `internal error (a bug in dropslice, please report it): ${message}` };
 }
 
+function needModels(): Models {
+  if (!models) throw internal("no model files were added in this worker");
+  return models;
+}
+
 function need(): Session {
   if (!session) throw internal("no model is open in this worker");
   return session;
@@ -151,19 +161,46 @@ async function handle(req: Request): Promise<void> {
       answer(req.kind, req.id, result);
       return;
     }
-    case "open": {
+    case "models_add": {
       await load();
-      const { file, settings } = req.data;
-      const hash = req.data.hash ? sha256Of(file) : undefined;
-      // the old session stays usable if the new model or settings are refused
-      const result = adopt(Session.from_file(file, settings));
+      models ??= new Models();
+      const infos: ModelInfo[] = [];
+      const sha256: string[] = [];
+      for (const { name, file } of req.data.files) {
+        const hash = sha256Of(file);
+        infos.push(models.add(file, name) as ModelInfo);
+        sha256.push(await hash);
+      }
+      answer(req.kind, req.id, { infos, sha256 });
+      return;
+    }
+    case "models_remove": {
+      for (const name of req.data.names) models?.remove(name);
+      answer(req.kind, req.id, undefined);
+      return;
+    }
+    case "display_mesh": {
+      const { name, item, max } = req.data;
+      const mesh = needModels().display_mesh(name, item, max);
+      answer(req.kind, req.id, mesh, [mesh.buffer]);
+      return;
+    }
+    case "layout":
+      answer(req.kind, req.id, needModels().layout(req.data.job) as Layout);
+      return;
+    case "lay_flat":
+      answer(req.kind, req.id, needModels().lay_flat(req.data.name, req.data.item) as { rotate_x: number; rotate_y: number });
+      return;
+    case "open_job": {
+      await load();
+      // the old session stays usable if the job is refused
+      const result = adopt(Session.from_models(needModels(), req.data.job));
       const transfer: Transferable[] = [];
       if (req.data.prepare) {
         const s = need();
         result.prepared = { vertices: s.vertices(), facets: s.facets(), info: result.info };
         transfer.push(result.prepared.vertices.buffer, result.prepared.facets.buffer);
       }
-      if (hash) result.sha256 = await hash;
       answer(req.kind, req.id, result, transfer);
       return;
     }

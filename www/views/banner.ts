@@ -11,6 +11,9 @@ export const TITLES: Record<string, string> = {
   internal: "Internal error.",
   link: "Cannot open this preview link.",
   linkPart: "Parts of this preview link were ignored.",
+  job: "Cannot lay out this job.",
+  jobFiles: "The job file needs its models.",
+  linkFiles: "The preview link needs its models.",
 };
 
 export function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error"): void {

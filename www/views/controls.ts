@@ -1,5 +1,6 @@
 // The buttons Download, Copy preview link and Slice, and the settings' status line.
 
+import { jobSettings } from "../job";
 import type { Page } from "../page";
 import { $ } from "./dom";
 
@@ -9,8 +10,8 @@ export function updateButtons(page: Page): void {
   const ready = !store.busy && s !== null && s.complete;
   // Like the CLI, no code for a part without a single droplet.
   ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && !s!.figures.nothingToPrint);
-  ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && store.model !== null);
-  ($("btn-slice") as HTMLButtonElement).disabled = store.model === null || form === undefined;
+  ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && s!.job !== null);
+  ($("btn-slice") as HTMLButtonElement).disabled = store.job === null || form === undefined;
   settingsStatus(page);
 }
 
@@ -27,8 +28,9 @@ function settingsStatus(page: Page): void {
     btn.classList.remove("attention");
     return;
   }
-  const stale = store.model !== null && store.slice?.source === "stl" && form.json() !== store.slicedSettings;
+  const job = store.job;
+  const stale = job !== null && !store.busy && (store.slice?.source !== "stl" || job.key(jobSettings(form.values())) !== store.slice.key);
   st.className = "hint";
-  st.textContent = stale ? "Settings changed: press Slice (or Enter) to update." : "";
+  st.textContent = stale ? "The job or the settings changed: press Slice (or Enter) to update." : "";
   btn.classList.toggle("attention", stale);
 }

@@ -39,7 +39,7 @@ export function show(page: Page, i: number): void {
   renderer.below = current > 0 ? (s.cache.get(current - 1) ?? null) : null;
   renderer.dropletWidth = s.dropletWidth;
   renderer.request();
-  page.view3d.sync(s, current);
+  page.view3d.sync(page);
   writeStats(page);
   for (const k of [current, current - 1]) {
     if (k >= 0 && !s.cache.has(k) && s.complete && s.source === "stl") fetchPreview(page, s, k);

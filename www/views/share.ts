@@ -2,22 +2,28 @@
 
 import type { Value } from "../form";
 import type { Page } from "../page";
+import { fullSpec, PART_KEYS, specOut } from "../job";
 import { makeLink } from "../share";
 import { $ } from "./dom";
 
 export async function share(page: Page): Promise<void> {
   const { store, renderer } = page;
   const s = store.slice;
-  const model = store.model;
-  if (!s || !model || s.source !== "stl") return;
+  const job = s?.job;
+  if (!s || !job || s.source !== "stl" || job.refs.length === 0) return;
+  // the job as it was sliced: its files (embedded in this order when they fit) and parts
+  const files = job.refs.map((r, i) => ({ name: r.name, sha256: job.sha256[i], bytes: r.file.size }));
   const { url, embedded } = await makeLink(location.href, {
     settings: changedFrom(page, s.settings),
     layer: store.current,
     view: { ...renderer.view },
-    name: model.name,
-    sha256: model.sha256,
+    name: files[0].name,
+    sha256: files[0].sha256,
     showTravel: renderer.showTravel,
-  }, model.file);
+    files,
+    parts: job.file.parts.map((p) => specOut(fullSpec(p))),
+  }, job.refs.map((r) => r.file));
+  const several = files.length > 1;
   let copied = false;
   try {
     // some browsers never settle the promise when they do not grant the permission
@@ -31,8 +37,10 @@ export async function share(page: Page): Promise<void> {
   $("share-text").textContent =
     (copied ? "Copied to the clipboard. " : "Copy this link. ") +
     (embedded
-      ? `The model is inside the link (${Math.round(url.length / 1024)} KB), so it opens the same slice anywhere.`
-      : `“${model.name}” is too big to embed, so the link carries its SHA-256: whoever opens it drops in the same file and the page checks that it matches.`);
+      ? `The ${several ? "models are" : "model is"} inside the link (${Math.round(url.length / 1024)} KB), so it opens the same slice anywhere.`
+      : several
+        ? `The models are too big to embed, so the link carries their SHA-256: whoever opens it drops in the same files and the page checks that they match.`
+        : `“${files[0].name}” is too big to embed, so the link carries its SHA-256: whoever opens it drops in the same file and the page checks that it matches.`);
   const input = $<HTMLInputElement>("share-url");
   input.value = url;
   $<HTMLDialogElement>("share-dialog").showModal();
@@ -42,6 +50,6 @@ export async function share(page: Page): Promise<void> {
 /** The settings that differ from the core's defaults (the link carries only those). */
 function changedFrom(page: Page, values: Record<string, Value>): Record<string, Value> {
   const out: Record<string, Value> = {};
-  for (const [k, v] of Object.entries(values)) if (page.init!.defaults[k] !== v) out[k] = v;
+  for (const [k, v] of Object.entries(values)) if (page.init!.defaults[k] !== v && !(PART_KEYS as readonly string[]).includes(k)) out[k] = v;
   return out;
 }

@@ -24,13 +24,14 @@ export function writeStats(page: Page): void {
   $("empty").hidden = s !== null;
   if (!s) {
     writeVoids(null, current);
-    for (const id of ["stat-model", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
+    for (const id of ["stat-model", "stat-parts", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
     $("warnings").hidden = true;
     requestPlot();
     return;
   }
   const f = s.figures;
   setText("stat-model", s.name);
+  setText("stat-parts", partsText(s));
   const b = s.info.bounds;
   if (b) setText("stat-size", `${fmtMm(b.max[0] - b.min[0])} × ${fmtMm(b.max[1] - b.min[1])} × ${fmtMm(b.max[2] - b.min[2])} mm`);
   else if (Number.isFinite(s.bbox.minX)) setText("stat-size", `${fmtMm(s.bbox.maxX - s.bbox.minX)} × ${fmtMm(s.bbox.maxY - s.bbox.minY)} mm (droplets)`);
@@ -80,11 +81,20 @@ export function writeStats(page: Page): void {
 function writeUnitFix(page: Page, s: Slice): void {
   const factor = s.info.suggested_scale;
   const btn = $("btn-unit-fix") as HTMLButtonElement;
-  btn.hidden = typeof factor !== "number" || s.model === null;
+  btn.hidden = typeof factor !== "number" || s.job === null || page.store.job === null;
   if (typeof factor !== "number" || btn.hidden) return;
   btn.textContent = factor > 1 ? `Scale ×${factor} (inches → mm)` : `Scale ×${factor} (µm → mm)`;
   btn.title = "Scale x, y and z by this factor and slice again";
-  btn.onclick = () => page.onUnitFix(s, factor);
+  btn.onclick = () => page.onUnitFix(factor);
+}
+
+/** The slice's parts as the core placed them: "gear.stl × 2, box.stl" (one line per part). */
+function partsText(s: Slice): string {
+  const insts = s.info.instances;
+  if (!insts || insts.length === 0) return s.source === "gco" ? "–" : "1";
+  const parts = new Map<number, { name: string; copies: number }>();
+  for (const i of insts) parts.set(i.part, { name: i.name, copies: i.copies });
+  return [...parts.values()].map((p) => (p.copies > 1 ? `${p.name} × ${p.copies}` : p.name)).join("\n");
 }
 
 /** The model's name in the header; the "open a file" hint hidden (or shown again). */

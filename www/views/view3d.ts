@@ -1,33 +1,21 @@
-// The stage's 3D tab: the sliced model on the plate in 3D (../view3d.ts), cut at the layer the
-// slider shows. The toggle "Layer | 3D" switches the stage between the layer canvas and this
-// view; the View3D (a WebGL context) is made the first time the tab is opened. Today the page
-// has one part: the prepared mesh the first worker returns, in plate coordinates.
+// The stage's 3D tab: the plate and every instance of the build job (../view3d.ts), from the
+// parts' display meshes and the core's layout matrices (one View3DPart per instance, id
+// `${part id}:${copy}`); after a slice of the job as it is, cut at the layer the slider shows.
+// A click selects the part in the parts panel; dragging an instance moves its part (re-laid
+// out by the core on release). The toggle "Layer | 3D" switches the stage between the layer
+// canvas and this view; the View3D (a WebGL context) is made the first time the tab is opened.
 
+import { jobSettings } from "../job";
+import { movePart, selectPart } from "../jobflows";
 import type { Page } from "../page";
-import type { PreparedMesh } from "../protocol";
-import type { Slice } from "../store";
 import { View3D, type View3DPart, type View3DSlice } from "../view3d";
 import { $ } from "./dom";
 
-/** The one part of today's page. */
-export const PART_ID = "part";
-
-const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
-
-/** Non-indexed triangle corners (9 floats per facet) of an indexed mesh; every index is
- *  checked against the vertices (the arrays cross a worker boundary). */
-export function trianglePositions(vertices: Float64Array, facets: Uint32Array): Float32Array {
-  if (vertices.length % 3 !== 0 || facets.length % 3 !== 0) throw new Error("the prepared mesh is malformed: its arrays are not triples");
-  const n = vertices.length / 3;
-  const out = new Float32Array(facets.length * 3);
-  for (let i = 0, o = 0; i < facets.length; i++, o += 3) {
-    const v = facets[i];
-    if (v >= n) throw new Error(`the prepared mesh is malformed: facet ${Math.floor(i / 3)} names vertex ${v} of ${n}`);
-    out[o] = vertices[3 * v];
-    out[o + 1] = vertices[3 * v + 1];
-    out[o + 2] = vertices[3 * v + 2];
-  }
-  return out;
+/** The 3D view's id of an instance, and back. */
+export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
+export function parseInstanceId(id: string): { part: number; copy: number } | null {
+  const m = /^(\d+):(\d+)$/.exec(id);
+  return m ? { part: Number(m[1]), copy: Number(m[2]) } : null;
 }
 
 export class View3DPanel {
@@ -35,29 +23,50 @@ export class View3DPanel {
   private parts: View3DPart[] = [];
   private plate = { x: 154, y: 134 };
   private slice: View3DSlice | null = null;
-  /** The model shown, and the one the camera was last fitted to: a new model is framed once
-   *  (slicing the same model again keeps the camera). */
+  private selected: string | null = null;
+  /** The job shown, and the one the camera was last fitted to: a new job is framed once
+   *  (editing or slicing it again keeps the camera). */
   private model: unknown = null;
   private framed: unknown = null;
+  private page: Page | null = null;
   active = false;
 
   constructor(private readonly container: HTMLElement) {}
 
-  /** The part of slice `s` (its prepared mesh, in plate coordinates). */
-  static part(s: Slice, prepared: PreparedMesh): View3DPart {
-    return { id: PART_ID, name: s.name, positions: trianglePositions(prepared.vertices, prepared.facets), matrix: IDENTITY };
+  /** Shows the page's job: its instances where the core's layout puts them, the plate of the
+   *  form's settings, and the slice's layers when the slice is of the job as it is now. */
+  sync(page: Page): void {
+    this.page = page;
+    const { store } = page;
+    const job = store.job;
+    const layout = job?.layout;
+    const parts: View3DPart[] = [];
+    if (job && layout) {
+      for (const inst of layout.instances) {
+        const p = job.parts[inst.part];
+        if (!p?.mesh) continue;
+        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: p.mesh.positions, matrix: inst.matrix, unit: inst.unit === 1 ? 1 : 0 });
+      }
+    }
+    this.parts = parts;
+    this.model = job && parts.length ? job : null;
+    const values = page.form?.values();
+    const px = Number(values?.plate_x);
+    const py = Number(values?.plate_y);
+    if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
+    const s = store.slice;
+    const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values));
+    this.slice = current && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current: store.current } : null;
+    // the selected part's instance clicked last stays tinted, else its first copy
+    const sel = job?.selected ?? null;
+    const keep = this.selected !== null && parts.some((p) => p.id === this.selected) && parseInstanceId(this.selected)?.part === sel;
+    if (!keep) this.selected = sel === null ? null : (parts.find((p) => parseInstanceId(p.id)?.part === sel)?.id ?? null);
+    this.apply();
   }
 
-  /** Shows what slice `s` has in 3D, cut at layer `current` (nothing for a .gco file). */
-  sync(s: Slice | null, current: number): void {
-    const part = s?.source === "stl" ? s.part3d : null;
-    this.parts = part ? [part] : [];
-    this.model = part ? (s?.model ?? part) : null;
-    const px = Number(s?.settings.plate_x);
-    const py = Number(s?.settings.plate_y);
-    if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
-    this.slice = part && s && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current } : null;
-    this.apply();
+  /** The selection of the page's job (the part's first copy is tinted). */
+  select(page: Page): void {
+    this.sync(page);
   }
 
   private apply(): void {
@@ -66,11 +75,12 @@ export class View3DPanel {
     v.setPlate(this.plate.x, this.plate.y);
     v.setParts(this.parts);
     v.setSlice(this.slice);
+    v.select(this.selected);
     if (this.model !== null && this.model !== this.framed) {
       this.framed = this.model;
       v.fit();
     }
-    $("view3d-empty").hidden = this.parts.length > 0;
+    $("view3d-empty").hidden = this.parts.length > 0 || this.page?.store.job !== null;
   }
 
   /** Layer canvas or 3D view. */
@@ -81,9 +91,24 @@ export class View3DPanel {
     $("mode-3d").setAttribute("aria-pressed", String(on));
     this.container.hidden = !on;
     if (on && !this.view) {
-      this.view = new View3D(this.container);
-      this.view.onSelect(() => {
-        // today's page only tints the part; the parts panel will listen here
+      const view = new View3D(this.container);
+      this.view = view;
+      view.onSelect((id) => {
+        const page = this.page;
+        if (!page) return;
+        this.selected = id;
+        const at = id === null ? null : parseInstanceId(id);
+        selectPart(page, at ? at.part : null);
+      });
+      view.onDrag((id, dx, dy, done) => {
+        const page = this.page;
+        const at = parseInstanceId(id);
+        if (!done || !page || !at) return;
+        this.selected = id;
+        selectPart(page, at.part);
+        if (Math.hypot(dx, dy) < 1e-6) return;
+        // refused (off the plate is allowed; a value out of range is not): back where it was
+        void movePart(page, at.part, at.copy, dx, dy).then((ok) => ok || this.sync(page));
       });
       this.apply();
     }

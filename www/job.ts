@@ -1,0 +1,168 @@
+// The build job as the page holds it (SPEC.md "Build jobs", docs/jobs.md): its files (each a
+// File the job worker's `Models` holds under a unique name), its ordered parts (a file, or one
+// 3MF item, with its own transform, place and copies) and the core's latest `Layout`. The page
+// computes no placement of its own: every matrix and box comes from the core's layout. No DOM.
+
+import type { JobFileRef } from "./client";
+import type { JobFile, Layout, ModelInfo, PartSpec, Settings } from "./protocol";
+
+/** The keys of a part (docs/jobs.md): the core refuses them in a job's settings, so the
+ *  settings form hides them and the page keeps them in each part's spec. */
+export const PART_KEYS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle"] as const;
+
+/** The core's bounds of a part's keys (src/job.rs): the page's panel and links check them too. */
+export const PART_LIMITS = {
+  rotate: 360,
+  scaleMax: 1000,
+  place: 10_000,
+  copies: 100,
+  parts: 256,
+  nameChars: 255,
+} as const;
+
+/** Triangles the 3D view draws for a whole job, shared by its instances. */
+export const DISPLAY_BUDGET = 300_000;
+
+/** A file of the job. */
+export interface JobModel {
+  /** Unique within the job ("gear.stl", "gear (2).stl"): the key in the worker's `Models`. */
+  name: string;
+  file: File;
+  sha256: string;
+  info: ModelInfo;
+}
+
+/** A display mesh of a part (decimated for drawing only) and the budget it was made with. */
+export interface DisplayMesh {
+  positions: Float32Array;
+  budget: number;
+}
+
+/** One part: a stable id (the 3D view's ids are `${id}:${copy}`), its file and its spec. */
+export interface Part {
+  id: number;
+  spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "place_angle" | "copies" | "unit">> & Pick<PartSpec, "item" | "place_x" | "place_y" | "name">;
+  mesh: DisplayMesh | null;
+}
+
+export type Spec = Part["spec"];
+
+/** A spec with every default filled in (the core's defaults, docs/jobs.md). */
+export function fullSpec(p: PartSpec): Spec {
+  const s: Spec = {
+    file: p.file,
+    rotate_x: p.rotate_x ?? 0,
+    rotate_y: p.rotate_y ?? 0,
+    rotate_z: p.rotate_z ?? 0,
+    scale_x: p.scale_x ?? 1,
+    scale_y: p.scale_y ?? 1,
+    scale_z: p.scale_z ?? 1,
+    place_angle: p.place_angle ?? 0,
+    copies: p.copies ?? 1,
+    unit: p.unit ?? 0,
+  };
+  if (p.item !== undefined && p.item !== null) s.item = p.item;
+  if (typeof p.place_x === "number" && typeof p.place_y === "number" && Number.isFinite(p.place_x) && Number.isFinite(p.place_y)) {
+    s.place_x = p.place_x;
+    s.place_y = p.place_y;
+  }
+  if (p.name !== undefined) s.name = p.name;
+  return s;
+}
+
+/** A part as a job file writes it: only what differs from the defaults (never NaN: a place
+ *  is both numbers or absent). */
+export function specOut(s: Spec): PartSpec {
+  const out: PartSpec = { file: s.file };
+  if (s.item !== undefined) out.item = s.item;
+  for (const k of ["rotate_x", "rotate_y", "rotate_z", "place_angle"] as const) if (s[k] !== 0) out[k] = s[k];
+  for (const k of ["scale_x", "scale_y", "scale_z"] as const) if (s[k] !== 1) out[k] = s[k];
+  if (s.place_x !== undefined && s.place_y !== undefined && Number.isFinite(s.place_x) && Number.isFinite(s.place_y)) {
+    out.place_x = s.place_x;
+    out.place_y = s.place_y;
+  }
+  if (s.copies !== 1) out.copies = s.copies;
+  if (s.unit !== 0) out.unit = s.unit;
+  if (s.name !== undefined) out.name = s.name;
+  return out;
+}
+
+/** `name` made unique among `taken`: "gear.stl", "gear (2).stl", "gear (3).stl", … */
+export function uniqueName(name: string, taken: (n: string) => boolean): string {
+  if (!taken(name)) return name;
+  const dot = name.lastIndexOf(".");
+  const [stem, ext] = dot > 0 ? [name.slice(0, dot), name.slice(dot)] : [name, ""];
+  for (let k = 2; ; k++) {
+    const n = `${stem} (${k})${ext}`;
+    if (!taken(n)) return n;
+  }
+}
+
+/** The settings the core takes for a job: the form's, without the part keys. */
+export function jobSettings(values: Settings): Settings {
+  const out: Settings = {};
+  for (const [k, v] of Object.entries(values)) if (!(PART_KEYS as readonly string[]).includes(k)) out[k] = v;
+  return out;
+}
+
+export class Job {
+  /** The files, in the order they were added. */
+  readonly models = new Map<string, JobModel>();
+  parts: Part[] = [];
+  /** The core's layout of `parts` (null until the first answer). */
+  layout: Layout | null = null;
+  /** The part selected in the panel and the 3D view (an id). */
+  selected: number | null = null;
+  private nextId = 0;
+
+  /** A new part of `model` (ids count from 0 in each job). */
+  newPart(spec: PartSpec): Part {
+    return { id: this.nextId++, spec: fullSpec(spec), mesh: null };
+  }
+
+  part(id: number | null): Part | undefined {
+    return id === null ? undefined : this.parts.find((p) => p.id === id);
+  }
+
+  /** The job as the core reads it: `settings` and the parts (every default written out). */
+  file(settings: Settings, parts: Part[] = this.parts): JobFile {
+    return { settings, parts: parts.map((p) => ({ ...p.spec })) };
+  }
+
+  /** The files the parts use, as the pool needs them. */
+  refs(parts: Part[] = this.parts): JobFileRef[] {
+    const used = new Set(parts.map((p) => p.spec.file));
+    return [...this.models.values()].filter((m) => used.has(m.name)).map((m) => ({ name: m.name, file: m.file }));
+  }
+
+  /** Drops the files no part uses any more. */
+  prune(): void {
+    const used = new Set(this.parts.map((p) => p.spec.file));
+    for (const n of [...this.models.keys()]) if (!used.has(n)) this.models.delete(n);
+  }
+
+  /** The job's name: its first file, "+ N more" for the others. */
+  get name(): string {
+    const files = [...new Set(this.parts.map((p) => p.spec.file))];
+    if (files.length === 0) return "";
+    return files.length === 1 ? files[0] : `${files[0]} + ${files.length - 1} more`;
+  }
+
+  /** Instances in all (copies of every part). */
+  get instances(): number {
+    return this.parts.reduce((n, p) => n + p.spec.copies, 0);
+  }
+
+  /** What the slice shown was made of: settings and parts (to tell when it is out of date). */
+  key(settings: Settings): string {
+    return JSON.stringify({ settings, parts: this.parts.map((p) => p.spec), files: this.refs().map((r) => r.name) });
+  }
+}
+
+/** The display name of a part: its own, or its file's (with the 3MF item). */
+export function partName(job: Job, p: Part): string {
+  if (p.spec.name) return p.spec.name;
+  const m = job.models.get(p.spec.file);
+  if (p.spec.item !== undefined && m) return `${m.info.items[p.spec.item]?.name ?? `item ${p.spec.item}`} (${p.spec.file})`;
+  return p.spec.file;
+}

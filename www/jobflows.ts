@@ -1,0 +1,254 @@
+// The build job's runs: a new job of files, adding parts, every edit of a part (re-laid out by
+// the core at once; refused edits leave the job as it was), selection, lay flat, duplicate,
+// remove, arrange, the display meshes of the 3D view, and saving the job file. The slice of a
+// job: flows.ts startSlice.
+
+import type { Page } from "./page";
+import { DISPLAY_BUDGET, Job, jobSettings, specOut, uniqueName, type JobModel, type Part, type Spec } from "./job";
+import type { PartSpec } from "./protocol";
+import { errorBanner, hideBanner } from "./views/banner";
+import { updateButtons } from "./views/controls";
+import { saveFile } from "./views/download";
+import { showError } from "./errors";
+
+/** A file to add to a job: the File and, from a job file or a link, the name it has there. */
+export interface NewFile {
+  file: File;
+  name?: string;
+}
+
+/** Imports `files` into the job worker under names unique in `job` (a job's own names kept
+ *  when given); returns the job's models, or throws the core's error (nothing changed). */
+async function importFiles(page: Page, job: Job, files: NewFile[]): Promise<JobModel[]> {
+  const taken = new Set(job.models.keys());
+  const named = files.map((f) => {
+    const name = f.name ?? uniqueName(f.file.name, (n) => taken.has(n));
+    taken.add(name);
+    return { name, file: f.file };
+  });
+  const { infos, sha256 } = await page.pool.addModels(named);
+  return named.map((f, i) => ({ name: f.name, file: f.file, sha256: sha256[i], info: infos[i] }));
+}
+
+/** A new job of `files` (one part each: a 3MF's whole build is one part), or of the parts
+ *  `specs` (a job file or a link; their `file` names the files). Laid out by the core; on any
+ *  error the banner says why and the page keeps its current job. Returns the job or null. */
+export async function newJob(page: Page, files: NewFile[], specs?: PartSpec[]): Promise<Job | null> {
+  const job = new Job();
+  try {
+    for (const m of await importFiles(page, job, files)) job.models.set(m.name, m);
+    const parts = (specs ?? [...job.models.values()].map((m) => ({ file: m.name }))).map((s) => job.newPart(s));
+    job.layout = await page.pool.layout(job.refs(parts), job.file(settingsOf(page), parts));
+    job.parts = parts;
+  } catch (e) {
+    showError(page, e);
+    return null;
+  }
+  return job;
+}
+
+/** Makes `job` the page's job: the panel, the 3D view, the meshes. */
+export function adoptJob(page: Page, job: Job): void {
+  page.store.job = job;
+  page.store.pending = null;
+  page.parts.render();
+  page.view3d.sync(page);
+  void ensureMeshes(page);
+  updateButtons(page);
+}
+
+function settingsOf(page: Page) {
+  return jobSettings(page.form!.values());
+}
+
+/**
+ * Lays out `parts` (the job's parts after an edit) and, when the core accepts them, makes them
+ * the job's parts (the 3D view, the panel and the Slice button follow). When it refuses (a job
+ * that does not fit, a value out of range) its message is shown and nothing changes. Only the
+ * latest of overlapping requests is applied. Returns whether the parts were taken.
+ */
+export async function applyParts(page: Page, parts: Part[]): Promise<boolean> {
+  const { store } = page;
+  const job = store.job;
+  if (!job) return false;
+  const seq = ++store.layoutSeq;
+  try {
+    const layout = await page.pool.layout(job.refs(parts), job.file(settingsOf(page), parts));
+    if (seq !== store.layoutSeq || store.job !== job) return false;
+    job.parts = parts;
+    job.layout = layout;
+    if (job.part(job.selected) === undefined) job.selected = null;
+    job.prune();
+    hideLayoutBanner();
+  } catch (e) {
+    if (seq === store.layoutSeq && store.job === job) {
+      errorBanner(e);
+      document.getElementById("banner")!.dataset.layout = "1";
+      page.parts.render();
+    }
+    return false;
+  }
+  page.parts.render();
+  page.view3d.sync(page);
+  void ensureMeshes(page);
+  updateButtons(page);
+  return true;
+}
+
+/** A layout error's banner goes once a layout succeeds. */
+function hideLayoutBanner(): void {
+  const b = document.getElementById("banner")!;
+  if (b.dataset.layout === "1") {
+    delete b.dataset.layout;
+    hideBanner();
+  }
+}
+
+/** The job laid out again as it is (the plate or the spacing changed in the form). */
+export function relayout(page: Page): Promise<boolean> {
+  const job = page.store.job;
+  if (!job || page.form!.errors().length) return Promise.resolve(false);
+  return applyParts(page, job.parts);
+}
+
+/** Changes of parts' specs: `place: null` clears a placement (the part is arranged). */
+export type Changes = Partial<Omit<Spec, "file">> & { place?: null };
+
+export function editParts(page: Page, edits: { id: number; changes: Changes }[]): Promise<boolean> {
+  const job = page.store.job;
+  if (!job) return Promise.resolve(false);
+  const parts = job.parts.map((p) => {
+    const e = edits.find((x) => x.id === p.id);
+    if (!e) return p;
+    const spec: Spec = { ...p.spec };
+    const { place, ...changes } = e.changes;
+    Object.assign(spec, changes);
+    if (place === null) {
+      delete spec.place_x;
+      delete spec.place_y;
+    }
+    return { ...p, spec };
+  });
+  return applyParts(page, parts);
+}
+
+export function selectPart(page: Page, id: number | null): void {
+  const job = page.store.job;
+  if (!job || (id !== null && !job.part(id))) return;
+  job.selected = id;
+  page.parts.render();
+  page.view3d.select(page);
+}
+
+/** Adds files to the current job as new parts (arranged). */
+export async function addParts(page: Page, files: File[]): Promise<void> {
+  const job = page.store.job;
+  if (!job) return;
+  let models: JobModel[];
+  try {
+    models = await importFiles(page, job, files.map((file) => ({ file })));
+  } catch (e) {
+    showError(page, e);
+    return;
+  }
+  for (const m of models) job.models.set(m.name, m);
+  const added = models.map((m) => job.newPart({ file: m.name }));
+  if (await applyParts(page, [...job.parts, ...added])) {
+    selectPart(page, added[added.length - 1].id);
+  } else {
+    // refused (does not fit): the files go again
+    job.prune();
+  }
+}
+
+export function duplicatePart(page: Page, id: number): void {
+  const job = page.store.job;
+  const p = job?.part(id);
+  if (!job || !p) return;
+  const copy = job.newPart(specOut(p.spec));
+  // a copy of a placed part is arranged (it would lie on the original)
+  delete copy.spec.place_x;
+  delete copy.spec.place_y;
+  copy.mesh = p.mesh;
+  const at = job.parts.indexOf(p) + 1;
+  void applyParts(page, [...job.parts.slice(0, at), copy, ...job.parts.slice(at)]).then((ok) => ok && selectPart(page, copy.id));
+}
+
+export function removePart(page: Page, id: number): void {
+  const job = page.store.job;
+  if (!job || job.parts.length <= 1) return;
+  void applyParts(page, job.parts.filter((p) => p.id !== id));
+}
+
+/** Every placement cleared: the core arranges all parts. */
+export function arrangeAll(page: Page): void {
+  const job = page.store.job;
+  if (!job) return;
+  void editParts(page, job.parts.map((p) => ({ id: p.id, changes: { place: null } })));
+}
+
+/** The core's lay-flat angles put into the part (its z rotation and scale kept). */
+export async function layFlat(page: Page, id: number): Promise<void> {
+  const job = page.store.job;
+  const p = job?.part(id);
+  if (!job || !p) return;
+  try {
+    const a = await page.pool.layFlat(job.refs(), p.spec.file, p.spec.item);
+    await editParts(page, [{ id, changes: { rotate_x: a.rotate_x, rotate_y: a.rotate_y } }]);
+  } catch (e) {
+    showError(page, e);
+  }
+}
+
+/** A drag in the 3D view (or the layer view) ended: the part's first copy goes where the
+ *  dragged instance was dropped. */
+export function movePart(page: Page, id: number, copy: number, dx: number, dy: number): Promise<boolean> {
+  const job = page.store.job;
+  const inst = job?.layout?.instances.find((x) => job.parts[x.part]?.id === id && x.copy === copy);
+  if (!job || !inst || !Number.isFinite(dx + dy)) return Promise.resolve(false);
+  const round = (v: number) => Math.round(v * 100) / 100;
+  return editParts(page, [{ id, changes: { place_x: round(inst.at[0] + dx), place_y: round(inst.at[1] + dy) } }]);
+}
+
+/** Fetches the display meshes the 3D view lacks: the job's budget shared by its instances
+ *  (parts of many copies are drawn coarser); a mesh far off its share is fetched again. */
+export async function ensureMeshes(page: Page): Promise<void> {
+  const job = page.store.job;
+  if (!job) return;
+  const budget = Math.max(2000, Math.floor(DISPLAY_BUDGET / Math.max(1, job.instances)));
+  const want = job.parts.filter((p) => !p.mesh || p.mesh.budget > 2 * budget || (p.mesh.budget < budget / 2 && p.mesh.positions.length / 9 >= p.mesh.budget * 0.8));
+  // parts of the same file and item share one mesh
+  const byKey = new Map<string, Part[]>();
+  for (const p of want) {
+    const k = `${p.spec.file}\u0000${p.spec.item ?? ""}`;
+    byKey.set(k, [...(byKey.get(k) ?? []), p]);
+  }
+  for (const parts of byKey.values()) {
+    const p = parts[0];
+    try {
+      const positions = await page.pool.displayMesh(job.refs(), p.spec.file, p.spec.item, budget);
+      if (page.store.job !== job) return;
+      for (const q of parts) q.mesh = { positions, budget };
+      page.view3d.sync(page);
+    } catch (e) {
+      if (page.store.job === job) showError(page, e);
+      return;
+    }
+  }
+}
+
+/** The job file (docs/jobs.md): the settings that differ from the defaults and the parts. */
+export function jobFileText(page: Page): string | null {
+  const job = page.store.job;
+  if (!job) return null;
+  const settings: Record<string, number | boolean | string> = {};
+  for (const [k, v] of Object.entries(settingsOf(page))) if (page.init!.defaults[k] !== v) settings[k] = v;
+  return JSON.stringify({ settings, parts: job.parts.map((p) => specOut(p.spec)) }, null, 2) + "\n";
+}
+
+export function saveJob(page: Page): void {
+  const text = jobFileText(page);
+  const job = page.store.job;
+  if (!text || !job) return;
+  saveFile(new Blob([text], { type: "application/json" }), "job.json");
+}

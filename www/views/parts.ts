@@ -1,0 +1,185 @@
+// The parts panel (left column, above the settings): the job's parts (name, triangles, size on
+// the plate, copies), the selected part's editor (rotation, scale with a uniform lock, place or
+// "auto", place angle, copies, lay flat, duplicate, remove) and the job's buttons (add part,
+// arrange, save job). Every change goes to jobflows.ts, which has the core lay the job out
+// again; what is shown comes from the job and the core's layout only.
+
+import { PART_LIMITS, partName, type Part } from "../job";
+import { arrangeAll, duplicatePart, editParts, layFlat, removePart, saveJob, selectPart, type Changes } from "../jobflows";
+import type { Page } from "../page";
+import { $, nf } from "./dom";
+
+const NUMBER_FIELDS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "copies"] as const;
+type NumberField = (typeof NUMBER_FIELDS)[number];
+
+const fmt = (v: number) => String(+v.toFixed(4));
+const mm = (v: number) => v.toFixed(1);
+
+/** A number typed into a field ("0,5" too): the value, or why not. */
+function parseField(k: NumberField, raw: string): { value?: number; error?: string } {
+  const x = Number(raw.trim().replace(",", "."));
+  if (raw.trim() === "" || !Number.isFinite(x)) return { error: "a number is needed" };
+  if (k.startsWith("rotate") || k === "place_angle") {
+    if (Math.abs(x) > PART_LIMITS.rotate) return { error: `−${PART_LIMITS.rotate} … ${PART_LIMITS.rotate}°` };
+  } else if (k.startsWith("scale")) {
+    if (!(x > 0) || x > PART_LIMITS.scaleMax) return { error: `> 0 and ≤ ${PART_LIMITS.scaleMax}` };
+  } else if (k.startsWith("place")) {
+    if (Math.abs(x) > PART_LIMITS.place) return { error: `±${nf.format(PART_LIMITS.place)} mm` };
+  } else if (k === "copies") {
+    if (!Number.isInteger(x) || x < 1 || x > PART_LIMITS.copies) return { error: `a whole number 1 … ${PART_LIMITS.copies}` };
+  }
+  return { value: x };
+}
+
+export class PartsPanel {
+  constructor(private readonly page: Page) {}
+
+  /** Wires the panel's inputs and buttons (once). */
+  wire(): void {
+    const page = this.page;
+    for (const k of NUMBER_FIELDS) {
+      const input = $<HTMLInputElement>(`part-${k}`);
+      input.addEventListener("change", () => this.changed(k, input));
+      input.addEventListener("keydown", (ev) => {
+        if (ev.key === "Enter") {
+          ev.preventDefault();
+          this.changed(k, input);
+        }
+      });
+    }
+    $<HTMLInputElement>("part-auto").addEventListener("change", (ev) => {
+      const p = this.part();
+      if (!p) return;
+      const auto = (ev.target as HTMLInputElement).checked;
+      if (auto) void this.edit(p, { place: null });
+      else {
+        const at = this.at(p);
+        if (at) void this.edit(p, { place_x: +at[0].toFixed(2), place_y: +at[1].toFixed(2) });
+      }
+    });
+    $("part-lay-flat").addEventListener("click", () => this.part() && void layFlat(page, this.part()!.id));
+    $("part-duplicate").addEventListener("click", () => this.part() && duplicatePart(page, this.part()!.id));
+    $("part-remove").addEventListener("click", () => this.part() && removePart(page, this.part()!.id));
+    $("btn-arrange").addEventListener("click", () => arrangeAll(page));
+    $("btn-save-job").addEventListener("click", () => saveJob(page));
+  }
+
+  /** The part the editor edits: the selected one, or the only one. */
+  part(): Part | undefined {
+    const job = this.page.store.job;
+    if (!job) return undefined;
+    return job.part(job.selected) ?? (job.parts.length === 1 ? job.parts[0] : undefined);
+  }
+
+  /** Where the part's first copy is (the core's layout). */
+  private at(p: Part): [number, number] | null {
+    const job = this.page.store.job!;
+    const inst = job.layout?.instances.find((x) => job.parts[x.part] === p && x.copy === 0);
+    return inst ? inst.at : null;
+  }
+
+  private edit(p: Part, changes: Changes): Promise<boolean> {
+    return editParts(this.page, [{ id: p.id, changes }]);
+  }
+
+  private changed(k: NumberField, input: HTMLInputElement): void {
+    const p = this.part();
+    if (!p) return;
+    const r = parseField(k, input.value);
+    input.setAttribute("aria-invalid", r.error ? "true" : "false");
+    input.title = r.error ?? "";
+    if (r.value === undefined) return;
+    const v = r.value;
+    if ((k === "place_x" || k === "place_y") && (p.spec.place_x === undefined || p.spec.place_y === undefined)) {
+      // placing one axis of an arranged part keeps the other where the arrangement put it
+      const at = this.at(p) ?? [0, 0];
+      const other = k === "place_x" ? { place_y: +at[1].toFixed(2) } : { place_x: +at[0].toFixed(2) };
+      void this.edit(p, { [k]: v, ...other });
+      return;
+    }
+    if (k.startsWith("scale") && $<HTMLInputElement>("part-scale-lock").checked) {
+      const f = v / p.spec[k as "scale_x"];
+      void this.edit(p, { scale_x: p.spec.scale_x * f, scale_y: p.spec.scale_y * f, scale_z: p.spec.scale_z * f });
+      return;
+    }
+    if (v !== p.spec[k]) void this.edit(p, { [k]: v });
+  }
+
+  /** Redraws the list and the editor from the job. */
+  render(): void {
+    const { store } = this.page;
+    const job = store.job;
+    $("parts-panel").hidden = !job;
+    if (!job) return;
+    const list = $("part-list");
+    const items = job.parts.map((p, i) => {
+      const li = document.createElement("li");
+      li.className = "part-item";
+      li.dataset.id = String(p.id);
+      li.setAttribute("aria-selected", String(job.selected === p.id));
+      li.tabIndex = 0;
+      const name = document.createElement("span");
+      name.className = "part-name";
+      name.textContent = partName(job, p);
+      name.title = name.textContent;
+      const meta = document.createElement("span");
+      meta.className = "part-meta";
+      const m = job.models.get(p.spec.file);
+      const tris = p.spec.item !== undefined ? m?.info.items[p.spec.item]?.triangles : m?.info.triangles;
+      const inst = job.layout?.instances.find((x) => x.part === i && x.copy === 0);
+      const size = inst ? `${mm(inst.max[0] - inst.min[0])} × ${mm(inst.max[1] - inst.min[1])} × ${mm(inst.max[2] - inst.min[2])} mm` : "";
+      meta.textContent = [tris !== undefined ? `${nf.format(tris)} triangles` : "", size].filter(Boolean).join(" · ");
+      const copies = document.createElement("span");
+      copies.className = "part-copies";
+      copies.textContent = p.spec.copies > 1 ? `× ${p.spec.copies}` : "";
+      li.append(name, copies, meta);
+      const pick = () => selectPart(this.page, job.selected === p.id ? null : p.id);
+      li.addEventListener("click", pick);
+      li.addEventListener("keydown", (ev) => {
+        if (ev.key === "Enter" || ev.key === " ") {
+          ev.preventDefault();
+          pick();
+        }
+      });
+      return li;
+    });
+    list.replaceChildren(...items);
+    const warnings = job.layout?.warnings ?? [];
+    $("parts-warnings").hidden = warnings.length === 0;
+    $("parts-warnings").textContent = warnings.join(" ");
+    this.renderEditor();
+  }
+
+  private renderEditor(): void {
+    const p = this.part();
+    const editor = $("part-editor");
+    editor.hidden = !p;
+    if (!p) return;
+    const job = this.page.store.job!;
+    $("part-editor-title").textContent = partName(job, p);
+    const at = this.at(p);
+    const auto = p.spec.place_x === undefined || p.spec.place_y === undefined;
+    const values: Record<NumberField, number> = {
+      rotate_x: p.spec.rotate_x,
+      rotate_y: p.spec.rotate_y,
+      rotate_z: p.spec.rotate_z,
+      scale_x: p.spec.scale_x,
+      scale_y: p.spec.scale_y,
+      scale_z: p.spec.scale_z,
+      place_x: auto ? (at?.[0] ?? 0) : p.spec.place_x!,
+      place_y: auto ? (at?.[1] ?? 0) : p.spec.place_y!,
+      place_angle: p.spec.place_angle,
+      copies: p.spec.copies,
+    };
+    for (const k of NUMBER_FIELDS) {
+      const input = $<HTMLInputElement>(`part-${k}`);
+      const text = k.startsWith("place_") && k !== "place_angle" ? values[k].toFixed(2) : fmt(values[k]);
+      if (input.value !== text) input.value = text;
+      input.setAttribute("aria-invalid", "false");
+      input.title = "";
+    }
+    $<HTMLInputElement>("part-auto").checked = auto;
+    $("part-place-row").classList.toggle("auto", auto);
+    ($("part-remove") as HTMLButtonElement).disabled = job.parts.length <= 1;
+  }
+}
