@@ -9,6 +9,7 @@ import type { PartSpec } from "./protocol";
 import { errorBanner, hideBanner } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { saveFile } from "./views/download";
+import { SliceError } from "./client";
 import { showError } from "./errors";
 
 /** A file to add to a job: the File and, from a job file or a link, the name it has there. */
@@ -31,20 +32,38 @@ async function importFiles(page: Page, job: Job, files: NewFile[]): Promise<JobM
 }
 
 /** A new job of `files` (one part each: a 3MF's whole build is one part), or of the parts
- *  `specs` (a job file or a link; their `file` names the files). Laid out by the core; on any
- *  error the banner says why and the page keeps its current job. Returns the job or null. */
+ *  `specs` (a job file or a link; their `file` names the files). Laid out by the core. When a
+ *  file cannot be read, or a job file's parts are refused, the banner says why and the page
+ *  keeps its current job (null). Files that do not fit the plate together still make the job
+ *  (without a layout, the banner says what does not fit) so that its parts can be changed. */
 export async function newJob(page: Page, files: NewFile[], specs?: PartSpec[]): Promise<Job | null> {
   const job = new Job();
+  let parts: Part[];
   try {
     for (const m of await importFiles(page, job, files)) job.models.set(m.name, m);
-    const parts = (specs ?? [...job.models.values()].map((m) => ({ file: m.name }))).map((s) => job.newPart(s));
-    job.layout = await page.pool.layout(job.refs(parts), job.file(settingsOf(page), parts));
-    job.parts = parts;
+    parts = (specs ?? [...job.models.values()].map((m) => ({ file: m.name }))).map((s) => job.newPart(s));
   } catch (e) {
     showError(page, e);
     return null;
   }
+  try {
+    job.layout = await page.pool.layout(job.refs(parts), job.file(settingsOf(page), parts));
+    job.parts = parts;
+  } catch (e) {
+    if (specs !== undefined || !(e instanceof SliceError) || e.kind !== "job") {
+      showError(page, e);
+      return null;
+    }
+    job.parts = parts;
+    layoutBanner(e);
+  }
   return job;
+}
+
+/** A layout's refusal: shown until a layout succeeds. */
+function layoutBanner(e: unknown): void {
+  errorBanner(e);
+  document.getElementById("banner")!.dataset.layout = "1";
 }
 
 /** Makes `job` the page's job: the panel, the 3D view, the meshes. */
@@ -82,8 +101,7 @@ export async function applyParts(page: Page, parts: Part[]): Promise<boolean> {
     hideLayoutBanner();
   } catch (e) {
     if (seq === store.layoutSeq && store.job === job) {
-      errorBanner(e);
-      document.getElementById("banner")!.dataset.layout = "1";
+      layoutBanner(e);
       page.parts.render();
     }
     return false;

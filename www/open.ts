@@ -70,6 +70,11 @@ async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target:
   if (!job) return false;
   adoptJob(page, job);
   if (job.instances > 1) page.view3d.setActive(true);
+  if (!job.layout) {
+    // the parts do not fit together: the banner says so; change them, then slice
+    setState("error");
+    return true;
+  }
   await startSlice(page, target);
   return true;
 }

@@ -70,7 +70,7 @@ test("a part in inches: warned, not rescaled, fixed by the button", async () => 
   assert.equal(after.state, "done");
   assert.equal(after.layers, 100);
   assert.match(await page.locator("#stat-size").innerText(), /^20(\.0+)? × 20(\.0+)? × 20(\.0+)? mm/);
-  assert.equal(await page.inputValue('[name="scale_x"]'), "25.4");
+  assert.equal(await page.inputValue("#part-scale_x"), "25.4", "the part's scale, in the parts panel");
   assert.equal(await page.isVisible("#btn-unit-fix"), false);
   const status1 = await status(page);
   assert.ok(status1.droplets > 900_000, `${status1.droplets} droplets for the 20 mm cube`);

@@ -6,8 +6,46 @@
 //   VOIDS=1 SCREENSHOT=docs/screenshot-voids.png node tests/e2e/screenshot.mjs worst
 // With VIEW3D=1 the stage shows the 3D tab (the part cut at the layer):
 //   VIEW3D=1 SCREENSHOT=docs/images/view3d.png node tests/e2e/screenshot.mjs 100
+// With JOB=1 a build job of four files (3DBenchy, extruder_idler_quads.obj, cube_gears.3mf and
+// two copies of M3x10_screw.stl), arranged on the plate, in 3D with the screw selected:
+//   JOB=1 SCREENSHOT=docs/images/job3d.png node tests/e2e/screenshot.mjs
 import { join } from "node:path";
-import { benchy, openPage, repo, start, waitSettled } from "./helpers.mjs";
+import { benchy, openPage, repo, shared, start, waitSettled } from "./helpers.mjs";
+
+if (process.env.JOB) {
+  const env = await start();
+  try {
+    const { page } = await openPage(env.browser, env.url, { width: 1440, height: 860, scale: 1 });
+    await waitSettled(page, 60_000);
+    // cube_gears' build alone is 168 mm wide: a larger plate than the default 154 × 134 mm
+    await page.click("summary:text('Plate')");
+    await page.fill("#set-plate_x", "250");
+    await page.fill("#set-plate_y", "200");
+    await page.evaluate(() => (document.body.dataset.state = "picking"));
+    const files = ["3DBenchy.stl", "extruder_idler_quads.obj", "cube_gears.3mf", "M3x10_screw.stl"].map((f) => join(shared, "models", f));
+    await page.setInputFiles("#file-input", files);
+    const s = await waitSettled(page, 240_000);
+    if (s.state !== "done") throw new Error(`slice failed: ${s.state}`);
+    // two copies of the screw, then slice the job again
+    await page.click(".part-item:nth-child(4)");
+    await page.fill("#part-copies", "2");
+    await page.press("#part-copies", "Enter");
+    await page.waitForFunction(() => window.dropslice.job().layout.instances.length === 5);
+    await page.evaluate(() => (document.body.dataset.state = "picking"));
+    await page.click("#btn-slice");
+    const again = await waitSettled(page, 240_000);
+    if (again.state !== "done") throw new Error(`slice failed: ${again.state}`);
+    await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
+    await page.waitForFunction(() => window.dropslice.job().parts.every((p) => p.mesh > 0));
+    await page.waitForTimeout(300);
+    const out = process.env.SCREENSHOT ?? join(repo, "docs/images/job3d.png");
+    await page.screenshot({ path: out });
+    console.log(`wrote ${out}`);
+  } finally {
+    await env.close();
+  }
+  process.exit(0);
+}
 
 const worst = process.argv[2] === "worst";
 const layer = worst ? -1 : Number(process.argv[2] ?? 60);

@@ -104,7 +104,7 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   // the top layer: the whole boat
   await page.locator("#layer").fill("239");
   const whole = await pixels3d(page);
-  assert.deepEqual(whole.state.parts, ["part"]);
+  assert.deepEqual(whole.state.parts, ["0:0"], "one instance: part 0, copy 0");
   assert.equal(whole.state.slice.current, 239);
   assert.ok(Math.abs(whole.state.slice.top - 48) < 1e-9, `top ${whole.state.slice.top}`);
   assert.ok(whole.width > 400 && whole.height > 400, `canvas ${whole.width}×${whole.height}`);
@@ -118,7 +118,7 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   assert.ok(whole.partPixel, "a part pixel to click");
   const onPart = await clientPoint(page, whole.partPixel.x + 0.5, whole.partPixel.y + 0.5);
   await page.mouse.click(onPart.x, onPart.y);
-  assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, "part", "a click on the part selects it");
+  assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, "0:0", "a click on the part selects it");
   const tinted = await pixels3d(page);
   assert.ok(tinted.selected.n > whole.part.n * 0.5, `selected pixels ${tinted.selected.n}`);
   assert.ok(tinted.part.n < whole.part.n * 0.2, `unselected part pixels ${tinted.part.n}`);

@@ -1,0 +1,348 @@
+// Build jobs in the page (www/job.ts, jobflows.ts, views/parts.ts, views/view3d.ts, open.ts,
+// share.ts): several files become one job, the core lays it out, the 3D view draws and moves
+// its parts, job files and preview links carry it. G-code is checked against the core's layout
+// (every droplet inside an instance's box) and against the page's own earlier output.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import { openPage, parseGcode, shared, start, waitSettled } from "./helpers.mjs";
+
+let env;
+let main;
+const tmp = mkdtempSync(join(tmpdir(), "dropslice-jobs-"));
+const model = (f) => join(shared, "models", f);
+const cube = model("cube_20mm_ascii.stl");
+const idler = model("extruder_idler_quads.obj");
+const benchy = model("3DBenchy.stl");
+
+before(async () => {
+  env = await start();
+  main = await openPage(env.browser, env.url);
+  await waitSettled(main.page, 60_000);
+});
+
+after(async () => {
+  await env?.close();
+  rmSync(tmp, { recursive: true, force: true });
+});
+
+async function waitDone(page, timeout = 240_000) {
+  const s = await waitSettled(page, timeout);
+  const banner = await page.locator("#banner").innerText().catch(() => "");
+  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
+  return s;
+}
+
+async function pick(page, files) {
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.setInputFiles("#file-input", files);
+}
+
+const job = (page) => page.evaluate(() => window.dropslice.job());
+
+async function download(page, name) {
+  const [d] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
+  const file = join(tmp, name);
+  await d.saveAs(file);
+  return readFileSync(file, "utf8");
+}
+
+/** Droplet centres of a .gco: every G26 and both ends of every G25 line. */
+function droplets(text) {
+  const out = [];
+  let x = NaN;
+  let y = NaN;
+  for (const c of parseGcode(text)) {
+    if (c.code === "G25") out.push([x, y], [c.x, c.y]);
+    if (c.code === "G26") out.push([c.x, c.y]);
+    if (!Number.isNaN(c.x)) x = c.x;
+    if (!Number.isNaN(c.y)) y = c.y;
+  }
+  return out.filter(([a, b]) => Number.isFinite(a) && Number.isFinite(b));
+}
+
+const commands = (text) => parseGcode(text).map((c) => `${c.code} ${c.x} ${c.y} ${c.z}`);
+
+/** Draws the 3D view and returns the count and centroid of the selected part's pixels (the
+ *  accent blue) and of the other parts' (steel blue), in device pixels. */
+function pixels3d(page) {
+  return page.evaluate(() => {
+    window.dropslice.view3d();
+    const c = document.querySelector("#view3d canvas");
+    const t = document.createElement("canvas");
+    t.width = c.width;
+    t.height = c.height;
+    const g = t.getContext("2d");
+    g.drawImage(c, 0, 0);
+    const d = g.getImageData(0, 0, t.width, t.height).data;
+    const acc = { selected: [0, 0, 0], part: [0, 0, 0] };
+    const sel = [];
+    for (let i = 0, p = 0; i < d.length; i += 4, p++) {
+      const r = d[i], gr = d[i + 1], b = d[i + 2];
+      const k = b - r > 120 && r < 90 ? "selected" : b - r > 40 && b > gr ? "part" : null;
+      if (!k) continue;
+      acc[k][0]++;
+      acc[k][1] += p % t.width;
+      acc[k][2] += (p / t.width) | 0;
+      if (k === "selected") sel.push(p);
+    }
+    const out = { width: t.width, height: t.height };
+    for (const [k, [n, sx, sy]] of Object.entries(acc)) out[k] = { n, x: sx / n, y: sy / n };
+    // a selected pixel with selected pixels 4 px around it, nearest the centroid (to grab)
+    const isSel = (x, y) => {
+      const i = 4 * (y * t.width + x);
+      return d[i + 2] - d[i] > 120 && d[i] < 90;
+    };
+    let best = null;
+    for (const p of sel) {
+      const x = p % t.width, y = (p / t.width) | 0;
+      if (x < 4 || y < 4 || x >= t.width - 4 || y >= t.height - 4) continue;
+      if (!(isSel(x - 4, y) && isSel(x + 4, y) && isSel(x, y - 4) && isSel(x, y + 4))) continue;
+      const dist = Math.hypot(x - out.selected.x, y - out.selected.y);
+      if (!best || dist < best.dist) best = { x, y, dist };
+    }
+    out.grab = best;
+    return out;
+  });
+}
+
+async function clientPoint(page, px, py) {
+  const r = await page.locator("#view3d canvas").boundingBox();
+  const dims = await page.evaluate(() => {
+    const c = document.querySelector("#view3d canvas");
+    return { w: c.width, h: c.height };
+  });
+  return { x: r.x + (px * r.width) / dims.w, y: r.y + (py * r.height) / dims.h };
+}
+
+let twoPartGcode = "";
+
+test("two files opened at once: one job, both names shown, the G-code's droplets in the layout's two boxes", async () => {
+  const { page, errors } = main;
+  await pick(page, [cube, idler]);
+  const s = await waitDone(page);
+  assert.equal(s.name, "cube_20mm_ascii.stl + 1 more");
+  const names = await page.locator(".part-item .part-name").allInnerTexts();
+  assert.deepEqual(names, ["cube_20mm_ascii.stl", "extruder_idler_quads.obj"]);
+  const stats = await page.locator("#stat-parts").innerText();
+  assert.match(stats, /cube_20mm_ascii/);
+  assert.match(stats, /extruder_idler_quads/);
+  // several instances: the 3D tab is shown first
+  assert.equal(await page.isVisible("#view3d canvas"), true);
+
+  const j = await job(page);
+  assert.equal(j.layout.instances.length, 2);
+  const text = await download(page, "two.gco");
+  twoPartGcode = text;
+  assert.equal(text.split("\n").filter((l) => /^; part \d+ = /.test(l)).length, 2, "two part lines in the header");
+  // every droplet lies in one instance's box (the core's layout), and both boxes have droplets
+  const boxes = j.layout.instances.map((i) => ({ min: i.min, max: i.max, n: 0 }));
+  const B = 0.2 * 1.04;
+  const outside = [];
+  for (const [x, y] of droplets(text)) {
+    const box = boxes.find((b) => x >= b.min[0] - B && x <= b.max[0] + B && y >= b.min[1] - B && y <= b.max[1] + B);
+    if (box) box.n++;
+    else outside.push([x, y]);
+  }
+  assert.deepEqual(outside.slice(0, 5), [], `${outside.length} droplets outside the layout's boxes`);
+  for (const b of boxes) assert.ok(b.n > 1000, `droplets in a box: ${b.n}`);
+  // the arrangement keeps part_spacing (5 mm) between the boxes
+  const [a, b] = boxes;
+  const gap = Math.max(b.min[0] - a.max[0], a.min[0] - b.max[0], b.min[1] - a.max[1], a.min[1] - b.max[1]);
+  assert.ok(gap >= 5 - 1e-6, `gap ${gap}`);
+  assert.deepEqual(errors, []);
+});
+
+test("the 3D view draws both parts, each where the layout puts it", async () => {
+  const { page } = main;
+  await page.click("#mode-3d");
+  const state = await page.evaluate(() => window.dropslice.view3d());
+  assert.deepEqual(state.parts.sort(), ["0:0", "1:0"]);
+  const seen = [];
+  for (const k of [1, 2]) {
+    await page.click(`.part-item:nth-child(${k})`);
+    const px = await pixels3d(page);
+    assert.ok(px.selected.n > 500, `selected part ${k}: ${px.selected.n} pixels`);
+    assert.ok(px.part.n > 500, `the other part: ${px.part.n} pixels`);
+    seen.push(px.selected);
+  }
+  assert.ok(Math.hypot(seen[0].x - seen[1].x, seen[0].y - seen[1].y) > 40, `two places: ${JSON.stringify(seen)}`);
+});
+
+test("dragging a part in 3D places it: the core lays the job out again", async () => {
+  const { page } = main;
+  await page.click(".part-item:nth-child(1)");
+  const before = await job(page);
+  assert.equal(before.parts[0].place_x, undefined, "arranged at first");
+  const px = await pixels3d(page);
+  assert.ok(px.grab, "a pixel of the part to grab");
+  const from = await clientPoint(page, px.grab.x + 0.5, px.grab.y + 0.5);
+  await page.mouse.move(from.x, from.y);
+  await page.mouse.down();
+  await page.mouse.move(from.x + 60, from.y - 30, { steps: 8 });
+  await page.mouse.up();
+  await page.waitForFunction(() => window.dropslice.job().parts[0].place_x !== undefined);
+  const after = await job(page);
+  const p = after.parts[0];
+  const inst = after.layout.instances.find((i) => i.part === 0);
+  assert.ok(inst.placed, "placed");
+  assert.deepEqual(inst.at, [p.place_x, p.place_y], "the layout puts it where the part says");
+  const was = before.layout.instances.find((i) => i.part === 0).at;
+  assert.ok(Math.hypot(inst.at[0] - was[0], inst.at[1] - was[1]) > 5, `moved from ${was} to ${inst.at}`);
+  // the panel shows the place; Slice says the slice is out of date
+  assert.equal(await page.inputValue("#part-place_x"), p.place_x.toFixed(2));
+  assert.equal(await page.isChecked("#part-auto"), false);
+  assert.match(await page.locator("#settings-status").innerText(), /changed/);
+  // Arrange clears it again
+  await page.click("#btn-arrange");
+  await page.waitForFunction(() => window.dropslice.job().parts[0].place_x === undefined);
+  assert.deepEqual((await job(page)).layout.instances.find((i) => i.part === 0).at, was);
+});
+
+test("a job that does not fit says so and keeps the previous state", async () => {
+  const { page } = main;
+  await page.click(".part-item:nth-child(2)");
+  const before = await job(page);
+  await page.fill("#part-copies", "100");
+  await page.press("#part-copies", "Enter");
+  await page.waitForFunction(() => !document.getElementById("banner").hidden);
+  const text = await page.locator("#banner").innerText();
+  assert.match(text, /does not fit|do not fit|not every part fits/i);
+  assert.match(text, /extruder_idler_quads/);
+  const after = await job(page);
+  assert.deepEqual(after.parts, before.parts, "the parts are as they were");
+  assert.deepEqual(after.layout, before.layout);
+  assert.equal(await page.inputValue("#part-copies"), "1", "the panel shows the part as it is");
+  // a change that fits clears the message
+  await page.fill("#part-copies", "2");
+  await page.press("#part-copies", "Enter");
+  await page.waitForFunction(() => window.dropslice.job().layout.instances.length === 3);
+  assert.equal(await page.isVisible("#banner"), false);
+  await page.fill("#part-copies", "1");
+  await page.press("#part-copies", "Enter");
+  await page.waitForFunction(() => window.dropslice.job().layout.instances.length === 2);
+});
+
+test("lay flat turns the part as the core says: a tilted slab ends up lying on its largest face", async () => {
+  const { page } = main;
+  // a 30 × 20 × 4 mm slab turned 30° about x: lying flat it is 4 mm tall
+  const slab = slabStl(30, 20, 4, 30);
+  writeFileSync(join(tmp, "slab.stl"), slab);
+  await page.setInputFiles("#add-input", join(tmp, "slab.stl"));
+  await page.waitForFunction(() => window.dropslice.job().parts.length === 3);
+  const inst = (j) => j.layout.instances.find((i) => i.part === 2);
+  const tilted = inst(await job(page));
+  assert.ok(tilted.max[2] - tilted.min[2] > 10, `tilted height ${tilted.max[2] - tilted.min[2]}`);
+  await page.click("#part-lay-flat");
+  await page.waitForFunction(() => window.dropslice.job().parts[2].rotate_x !== 0 || window.dropslice.job().parts[2].rotate_y !== 0);
+  const j = await job(page);
+  const flat = inst(j);
+  assert.ok(Math.abs(flat.max[2] - flat.min[2] - 4) < 1e-3, `flat height ${flat.max[2] - flat.min[2]}`);
+  assert.deepEqual(flat.rotate, [j.parts[2].rotate_x, j.parts[2].rotate_y, 0]);
+  assert.equal(await page.inputValue("#part-rotate_x"), String(+j.parts[2].rotate_x.toFixed(4)));
+  await page.click("#part-remove");
+  await page.waitForFunction(() => window.dropslice.job().parts.length === 2);
+});
+
+/** A binary STL of the box [0,a]×[0,b]×[0,c] turned by `deg` about x. */
+function slabStl(a, b, c, deg) {
+  const t = (deg * Math.PI) / 180;
+  const v = (x, y, z) => [x * a, y * b * Math.cos(t) - z * c * Math.sin(t), y * b * Math.sin(t) + z * c * Math.cos(t)];
+  const quads = [
+    [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
+    [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
+    [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
+    [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
+    [v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)],
+    [v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)],
+  ];
+  const tris = quads.flatMap(([p, q, r, s]) => [[p, q, r], [p, r, s]]);
+  const buf = Buffer.alloc(84 + 50 * tris.length);
+  buf.writeUInt32LE(tris.length, 80);
+  tris.forEach((tri, i) => tri.flat().forEach((x, k) => buf.writeFloatLE(x, 84 + 50 * i + 12 + 4 * k)));
+  return buf;
+}
+
+test("save job → open job.json with its files in a fresh page: same layout, same G-code", async () => {
+  const { page } = main;
+  // slice the job as it is now (placed part, two copies) to compare with
+  await page.click(".part-item:nth-child(2)");
+  await page.fill("#part-copies", "2");
+  await page.press("#part-copies", "Enter");
+  await page.waitForFunction(() => window.dropslice.job().layout.instances.length === 3);
+  await page.fill("#part-place_x", "40");
+  await page.press("#part-place_x", "Enter");
+  await page.waitForFunction(() => window.dropslice.job().parts[1].place_x === 40);
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click("#btn-slice");
+  await waitDone(page);
+  const here = await job(page);
+  const gcode = await download(page, "saved-job.gco");
+  const [d] = await Promise.all([page.waitForEvent("download"), page.click("#btn-save-job")]);
+  assert.equal(d.suggestedFilename(), "job.json");
+  const jobFile = join(tmp, "job.json");
+  await d.saveAs(jobFile);
+  const saved = JSON.parse(readFileSync(jobFile, "utf8"));
+  assert.deepEqual(saved.parts.map((p) => p.file), ["cube_20mm_ascii.stl", "extruder_idler_quads.obj"]);
+  assert.equal(saved.parts[1].copies, 2);
+  assert.equal(saved.parts[1].place_x, 40);
+
+  // the job file first, its models later (asked for by name)
+  const other = await openPage(env.browser, env.url);
+  await waitDone(other.page, 60_000);
+  await pick(other.page, jobFile);
+  await other.page.waitForFunction(() => document.body.dataset.state === "idle");
+  const banner = await other.page.locator("#banner").innerText();
+  assert.match(banner, /Still missing: “cube_20mm_ascii\.stl”, “extruder_idler_quads\.obj”/);
+  await pick(other.page, [idler, cube]);
+  await waitDone(other.page);
+  const there = await job(other.page);
+  assert.deepEqual(there.layout.instances.map((i) => [i.part, i.copy, i.matrix]), here.layout.instances.map((i) => [i.part, i.copy, i.matrix]));
+  assert.deepEqual(commands(await download(other.page, "reopened.gco")), commands(gcode));
+  await other.context.close();
+});
+
+test("a two-part preview link (models embedded) gives the same G-code in a fresh page", async () => {
+  const { page } = main;
+  const url = await shareLink(page);
+  assert.match(url, /#p=.*&m=/, "models embedded");
+  const other = await openPage(env.browser, url);
+  await waitDone(other.page);
+  assert.deepEqual((await job(other.page)).parts.map((p) => p.file), ["cube_20mm_ascii.stl", "extruder_idler_quads.obj"]);
+  assert.deepEqual(commands(await download(other.page, "linked.gco")), commands(await download(page, "linked-here.gco")));
+  await other.context.close();
+  assert.ok(twoPartGcode.length > 0);
+});
+
+test("a job link too big to embed asks for its files, says which are missing, and takes them", async () => {
+  const { page } = main;
+  await pick(page, [benchy, cube]);
+  const here = await waitDone(page);
+  const url = await shareLink(page);
+  assert.doesNotMatch(url, /&m=/, "3DBenchy is too big to embed");
+  const other = await openPage(env.browser, url);
+  await other.page.waitForFunction(() => !document.getElementById("link-note").hidden);
+  assert.match(await other.page.locator("#link-note").innerText(), /3DBenchy\.stl/);
+  // one of the two: the other is named as missing
+  await pick(other.page, cube);
+  await other.page.waitForFunction(() => /Still missing: “3DBenchy\.stl”/.test(document.getElementById("banner").innerText));
+  // a file that is not one of the link's is named
+  await pick(other.page, idler);
+  await other.page.waitForFunction(() => /extruder_idler_quads\.obj” is not one of them/.test(document.getElementById("banner").innerText));
+  await pick(other.page, benchy);
+  const there = await waitDone(other.page);
+  assert.equal(there.droplets, here.droplets);
+  assert.equal(there.layer, here.layer);
+  await other.context.close();
+});
+
+async function shareLink(page) {
+  await page.click("#btn-share");
+  await page.waitForSelector("#share-dialog[open]");
+  const url = await page.inputValue("#share-url");
+  await page.click("#share-dialog button");
+  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
+  return url;
+}
