@@ -108,6 +108,7 @@ export async function applyParts(page: Page, parts: Part[]): Promise<boolean> {
   }
   page.parts.render();
   page.view3d.sync(page);
+  page.renderer.request();
   void ensureMeshes(page);
   updateButtons(page);
   return true;
@@ -156,6 +157,7 @@ export function selectPart(page: Page, id: number | null): void {
   job.selected = id;
   page.parts.render();
   page.view3d.select(page);
+  page.renderer.request();
 }
 
 /** Adds files to the current job as new parts (arranged). */

@@ -21,6 +21,7 @@ import { wirePlot } from "./views/plot";
 import { registerOffline } from "./offline";
 import { share } from "./views/share";
 import { setState } from "./views/status";
+import { wirePartDrag } from "./views/partdrag";
 import { PartsPanel } from "./views/parts";
 import { View3DPanel, wireView3D } from "./views/view3d";
 
@@ -86,6 +87,7 @@ function wire(): void {
   wireLayerView(page);
   wireView3D(page);
   cutHooks = wireCut(page);
+  wirePartDrag(page);
   wirePlot(page, (i) => show(page, i));
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;

@@ -201,6 +201,30 @@ test("dragging a part in 3D places it: the core lays the job out again", async (
   assert.deepEqual((await job(page)).layout.instances.find((i) => i.part === 0).at, was);
 });
 
+test("dragging the selected part in the layer view moves it by the mm dragged", async () => {
+  const { page } = main;
+  await page.click("#mode-layer");
+  await page.click(".part-item:nth-child(1)");
+  const before = (await job(page)).layout.instances.find((i) => i.part === 0);
+  const { view } = await page.evaluate(() => window.dropslice.status());
+  const box = await page.locator("#view").boundingBox();
+  const toPx = (x, y) => [box.x + (x - view.cx) * view.scale + box.width / 2, box.y - (y - view.cy) * view.scale + box.height / 2];
+  const [sx, sy] = toPx((before.min[0] + before.max[0]) / 2, (before.min[1] + before.max[1]) / 2);
+  await page.mouse.move(sx, sy);
+  await page.mouse.down();
+  await page.mouse.move(sx + 40, sy - 20, { steps: 5 });
+  await page.mouse.up();
+  await page.waitForFunction(() => window.dropslice.job().parts[0].place_x !== undefined);
+  const after = (await job(page)).layout.instances.find((i) => i.part === 0);
+  assert.ok(Math.abs(after.at[0] - (before.at[0] + 40 / view.scale)) < 0.02, `x ${after.at[0]} vs ${before.at[0]} + ${40 / view.scale}`);
+  assert.ok(Math.abs(after.at[1] - (before.at[1] + 20 / view.scale)) < 0.02, `y ${after.at[1]} vs ${before.at[1]} + ${20 / view.scale}`);
+  const v = (await page.evaluate(() => window.dropslice.status())).view;
+  assert.deepEqual(v, view, "the drag moved the part, not the view");
+  await page.click("#btn-arrange");
+  await page.waitForFunction(() => window.dropslice.job().parts[0].place_x === undefined);
+  await page.click("#mode-3d");
+});
+
 test("a job that does not fit says so and keeps the previous state", async () => {
   const { page } = main;
   await page.click(".part-item:nth-child(2)");

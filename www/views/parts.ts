@@ -133,7 +133,7 @@ export class PartsPanel {
       copies.className = "part-copies";
       copies.textContent = p.spec.copies > 1 ? `× ${p.spec.copies}` : "";
       li.append(name, copies, meta);
-      const pick = () => selectPart(this.page, job.selected === p.id ? null : p.id);
+      const pick = () => selectPart(this.page, p.id);
       li.addEventListener("click", pick);
       li.addEventListener("keydown", (ev) => {
         if (ev.key === "Enter" || ev.key === " ") {
