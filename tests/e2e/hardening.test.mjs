@@ -100,6 +100,11 @@ function stateText(over = {}) {
   return `{${Object.entries(parts).filter(([, v]) => v !== undefined).map(([k, v]) => `"${k}":${v}`).join(",")}}`;
 }
 
+/** The job files of a link of the cube (`files` as JSON text). */
+function jobFiles(name = "cube.stl") {
+  return JSON.stringify([{ name, sha256: cubeSha, bytes: cube.length }]);
+}
+
 /** A link's fragment: the state deflated, the cube embedded (unless `m` is given). */
 function link(state, { p, m } = {}) {
   const pp = p ?? b64url(deflateRawSync(Buffer.from(state)));
@@ -189,6 +194,18 @@ const LINKS = [
   ["a deflate bomb in p=", { p: b64url(deflateRawSync(Buffer.alloc(50e6, 32))) }, /too large or damaged: its state unpacks to more than 64 KB/],
   ["a deflate bomb in m=", { state: stateText(), m: b64url(deflateRawSync(Buffer.alloc(200e6))) }, /too large or damaged: its model unpacks to more than 64 MB/, (s) => assert.equal(s.state, "idle")],
   ["a damaged model", { state: stateText(), m: b64url(Buffer.from("not deflate")) }, /too large or damaged: its model is not valid compressed data/],
+  // a build job's link: its files and parts are bounded and checked like the rest
+  ["a job link", stateText({ files: jobFiles(), parts: '[{"file":"cube.stl","rotate_z":90,"copies":2}]' }), null, (s) => assert.ok(s.droplets > 0)],
+  ["a job of 257 parts", stateText({ files: jobFiles(), parts: JSON.stringify(Array.from({ length: 257 }, () => ({ file: "cube.stl" }))) }), /too large or damaged: its job has 257 parts; at most 256 are accepted/],
+  ["a job file name of 300 characters", stateText({ files: jobFiles("x".repeat(300)), parts: '[{"file":"cube.stl"}]' }), /too large or damaged: its job's file 1 has no name of 1 … 255 characters/],
+  ["a job part naming no file", stateText({ files: jobFiles(), parts: '[{"file":"other.stl"}]' }), /too large or damaged: its part 1 names no file of the link/],
+  ["a job file of 1e400 bytes", stateText({ files: `[{"name":"cube.stl","sha256":"${cubeSha}","bytes":1e400}]`, parts: '[{"file":"cube.stl"}]' }), /too large or damaged: its job's file "cube.stl" has no size/],
+  ["job part numbers out of range", stateText({ files: jobFiles(), parts: '[{"file":"cube.stl","rotate_z":1e400,"scale_x":-2,"copies":2.5,"place_x":3,"evil":1}]' }),
+    /partly damaged: its part 1's rotate_z \(Infinity is not a number in -360 … 360: the default is used\)/,
+    async (s, text) => {
+      for (const part of [/part 1's scale_x \(-2 is not a number in \(0 … 1000/, /part 1's copies \(2\.5 is not a whole number in 1 … 100/, /part 1's evil \(not a part's setting\)/, /part 1's place \(x and y go together/]) assert.match(text, part);
+      assert.ok(s.droplets > 0);
+    }],
   ["a model that does not match", { state: stateText({ sha256: JSON.stringify("0".repeat(64)) }) }, /too large or damaged: its model does not match the SHA-256 it carries/, (s) => assert.equal(s.state, "idle")],
 ];
 
