@@ -7,7 +7,7 @@
 // With VIEW3D=1 the stage shows the 3D tab (the part cut at the layer):
 //   VIEW3D=1 SCREENSHOT=docs/images/view3d.png node tests/e2e/screenshot.mjs 100
 // With JOB=1 a build job of four files (3DBenchy, extruder_idler_quads.obj, cube_gears.3mf and
-// two copies of M3x10_screw.stl), arranged on the plate, in 3D with the screw selected:
+// two copies of M3x10_screw.stl), arranged on a 250 × 200 mm plate, in 3D with 3DBenchy selected:
 //   JOB=1 SCREENSHOT=docs/images/job3d.png node tests/e2e/screenshot.mjs
 import { join } from "node:path";
 import { benchy, openPage, repo, shared, start, waitSettled } from "./helpers.mjs";
@@ -37,6 +37,8 @@ if (process.env.JOB) {
     if (again.state !== "done") throw new Error(`slice failed: ${again.state}`);
     await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
     await page.waitForFunction(() => window.dropslice.job().parts.every((p) => p.mesh > 0));
+    // 3DBenchy selected: tinted in 3D, its transform in the panel
+    await page.click(".part-item:nth-child(1)");
     await page.waitForTimeout(300);
     const out = process.env.SCREENSHOT ?? join(repo, "docs/images/job3d.png");
     await page.screenshot({ path: out });
