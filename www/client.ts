@@ -19,7 +19,6 @@ import type {
   ModelInfo,
   LayerData,
   OpenResult,
-  PreparedMesh,
   Reply,
   RequestData,
   RequestKind,
@@ -128,10 +127,6 @@ export interface SliceCallbacks {
   layer(layer: LayerData): void;
   /** A run of layers is complete: its G-code and summary (after all its layers). */
   unit(unit: SliceUnit): void;
-  /** The prepared (placed, repaired) mesh, for the 3D view: called once, after the first
-   *  worker opened the model and before `opened`; the arrays are the page's until it returns
-   *  (then they are handed on to the other workers). */
-  mesh?(prepared: PreparedMesh): void;
 }
 
 /** A run of consecutive layers [from, to). */
@@ -189,23 +184,20 @@ async function addTo(h: WorkerHandle, files: JobFileRef[]): Promise<ResultOf<"mo
 /** Opens a job: the job worker gets its files and prepares it; the others take the prepared
  *  mesh. `ready(h, r)` runs for each worker as soon as it holds the job (for the first one
  *  before the others are asked). If the first worker refuses the job, no worker is touched and
- *  every one keeps its previous model. With `mesh`, the prepared mesh is shown to it first
- *  (synchronously, before it is handed on). */
+ *  every one keeps its previous model. */
 async function openAll(
   handles: WorkerHandle[],
   files: JobFileRef[],
   job: JobFile,
   ready: (h: WorkerHandle, r: OpenResult) => Promise<void>,
-  mesh?: (prepared: PreparedMesh) => void,
 ): Promise<OpenResult> {
   const [first, ...others] = handles;
   await syncModels(first, files);
-  const r = await first.call("open_job", { job, prepare: others.length > 0 || mesh !== undefined });
+  const r = await first.call("open_job", { job, prepare: others.length > 0 });
   for (const h of handles) h.hasModel = false;
   first.hasModel = true;
   const prepared = r.prepared;
   delete r.prepared;
-  if (prepared && mesh) mesh(prepared);
   const settings = job.settings;
   const work = [ready(first, r)];
   if (prepared && others.length > 0) {
@@ -296,7 +288,7 @@ export class Pool {
           cb.opened(r);
         }
         await this.units(h, nextUnit, { analyse }, cb.layer, cb.unit);
-      }, cb.mesh);
+      });
     });
   }
 

@@ -7,7 +7,7 @@ import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { openPage, parseGcode, shared, start, waitSettled } from "./helpers.mjs";
+import { openPage, parseGcode, shared, start, torusStl, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -370,3 +370,23 @@ async function shareLink(page) {
   await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
   return url;
 }
+
+test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 300,000 triangles)", async () => {
+  const big = await openPage(env.browser, env.url);
+  const { page, errors } = big;
+  await waitDone(page, 60_000);
+  await page.click("#mode-3d");
+  await pick(page, { name: "torus-1m.stl", mimeType: "model/stl", buffer: torusStl(1000, 500, 40, 12) });
+  await page.waitForFunction(() => (window.dropslice.job()?.parts[0]?.mesh ?? 0) > 0 && window.dropslice.job().name === "torus-1m.stl", null, { timeout: 240_000 });
+  const j = await job(page);
+  assert.ok(j.parts[0].mesh <= 300_000 && j.parts[0].mesh > 10_000, `display triangles ${j.parts[0].mesh}`);
+  const px = await pixels3d(page);
+  assert.ok(px.part.n > 5000, `part pixels ${px.part.n}`);
+  // the slice uses the full mesh
+  await page.waitForFunction(() => window.dropslice.status().layers > 0, null, { timeout: 240_000 });
+  const facets = await page.locator("#stat-facets").innerText();
+  assert.equal(facets, "1,000,000");
+  if (await page.isVisible("#btn-cancel")) await page.click("#btn-cancel");
+  assert.deepEqual(errors, []);
+  await big.context.close();
+});
