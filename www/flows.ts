@@ -305,9 +305,12 @@ export function fixUnits(page: Page, factor: number): void {
   if (!job) return;
   const suggests = job.parts.filter((p) => job.models.get(p.spec.file)?.info.suggested_scale === factor);
   const which = suggests.length ? suggests : job.parts;
+  // busy from the click on (the layout comes first, then the slice)
+  setState("reading");
   void editParts(page, which.map((p) => ({ id: p.id, changes: { scale_x: p.spec.scale_x * factor, scale_y: p.spec.scale_y * factor, scale_z: p.spec.scale_z * factor } })))
     .then((ok) => {
       if (ok) void startSlice(page);
+      else setState("error");
     });
 }
 

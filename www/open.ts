@@ -173,6 +173,7 @@ function applyJobSettings(page: Page, settings: JobFile["settings"]): void {
 
 export async function openSample(page: Page, notice?: Target["notice"]): Promise<void> {
   const s = sampleStl();
+  setState("reading");
   page.store.pending = null;
   note("", "none");
   await openJob(page, [{ file: new File([s.bytes as BlobPart], s.name, { type: "model/stl" }) }], undefined, { notice });

@@ -380,10 +380,11 @@ test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 30
   await page.waitForFunction(() => (window.dropslice.job()?.parts[0]?.mesh ?? 0) > 0 && window.dropslice.job().name === "torus-1m.stl", null, { timeout: 240_000 });
   const j = await job(page);
   assert.ok(j.parts[0].mesh <= 300_000 && j.parts[0].mesh > 10_000, `display triangles ${j.parts[0].mesh}`);
+  // the slice uses the full mesh; the whole part is drawn at its top layer
+  await page.waitForFunction(() => window.dropslice.status().layers > 0, null, { timeout: 240_000 });
+  await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
   const px = await pixels3d(page);
   assert.ok(px.part.n > 5000, `part pixels ${px.part.n}`);
-  // the slice uses the full mesh
-  await page.waitForFunction(() => window.dropslice.status().layers > 0, null, { timeout: 240_000 });
   const facets = await page.locator("#stat-facets").innerText();
   assert.equal(facets, "1,000,000");
   if (await page.isVisible("#btn-cancel")) await page.click("#btn-cancel");

@@ -138,7 +138,7 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   assert.ok(Math.hypot(orbited.part.x - whole.part.x, orbited.part.y - whole.part.y) > 20, "the view turned");
   await page.click("#btn-fit");
   const fitted = await pixels3d(page);
-  assert.ok(Math.hypot(fitted.part.x - whole.part.x, fitted.part.y - whole.part.y) < 2, "Fit restores the framing");
+  assert.ok(Math.hypot(fitted.part.x - whole.part.x, fitted.part.y - whole.part.y) < 2, `Fit restores the framing: ${JSON.stringify([whole.part, fitted.part, fitted.selected])}`);
 
   // a low layer: the boat cut at 4 mm (of 48): far fewer part pixels, none high up, a cap
   await page.locator("#layer").fill("19");

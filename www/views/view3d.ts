@@ -79,6 +79,8 @@ export class View3DPanel {
     if (this.model !== null && this.model !== this.framed) {
       this.framed = this.model;
       v.fit();
+      // once more after the canvas took its size (a view made just now is resized later)
+      requestAnimationFrame(() => v.fit());
     }
     $("view3d-empty").hidden = this.parts.length > 0 || this.page?.store.job !== null;
   }
