@@ -559,6 +559,7 @@ pub fn droplet_plan<P: Copy + Into<dropslice::geom::Point>>(
                 kind: MoveKind::Droplet,
                 role: Role::Fill,
                 to: to.into(),
+                unit: 0,
             })
             .collect(),
         ..LayerPlan::default()
