@@ -279,6 +279,19 @@ impl PartAnalysis {
             self.max_boundary_deviation = o.max_boundary_deviation;
             self.max_deviation_layer = o.max_deviation_layer;
         }
+        self.unsupported_area += o.unsupported_area;
+        if o.max_unsupported_area_layer.is_some()
+            && (self.max_unsupported_area_layer.is_none()
+                || better(
+                    o.max_unsupported_area,
+                    o.max_unsupported_area_layer,
+                    self.max_unsupported_area,
+                    self.max_unsupported_area_layer,
+                ))
+        {
+            self.max_unsupported_area = o.max_unsupported_area;
+            self.max_unsupported_area_layer = o.max_unsupported_area_layer;
+        }
         self.volume += o.volume;
         self.void_volume += o.void_volume;
         self.void_fraction = if self.volume > 0.0 {

@@ -197,7 +197,12 @@ pub fn support_layers(
         if needs[i].is_empty() {
             return Shapes::new();
         }
-        let keep_off = grow_within(&regions[i], gap_xy, SUPPORT_TOLERANCE_MM);
+        // Chords lie inside the arcs: grown by the tolerance more, never less than the gap.
+        let keep_off = if gap_xy > 0.0 {
+            grow_within(&regions[i], gap_xy + SUPPORT_TOLERANCE_MM, SUPPORT_TOLERANCE_MM)
+        } else {
+            Shapes::new()
+        };
         let mut region = difference(&needs[i], &keep_off);
         for k in 1..=gap_z.min(n - 1 - i) {
             region = difference(&region, &grown[i + k]);
