@@ -104,11 +104,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
             "; droplets support     = {}",
             field(c.map(|c| c.support))
         );
-        let _ = writeln!(
-            h,
-            "; droplets of unit 1   = {}",
-            field(c.map(|c| c.unit1))
-        );
+        let _ = writeln!(h, "; droplets of unit 1   = {}", field(c.map(|c| c.unit1)));
     }
     let _ = writeln!(
         h,

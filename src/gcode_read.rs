@@ -84,15 +84,13 @@ pub struct GcodeReader {
 /// The header's droplet size must lie within the settings' ranges (greater than 0, at most
 /// this).
 fn header_max(name: &str) -> Option<(f64, &'static str)> {
-    let spec = crate::settings::schema()
-        .into_iter()
-        .find(|s| {
-            s.name == name
-                && matches!(
-                    name,
-                    "layer_height" | "droplet_aspect" | "unit1_droplet_aspect"
-                )
-        })?;
+    let spec = crate::settings::schema().into_iter().find(|s| {
+        s.name == name
+            && matches!(
+                name,
+                "layer_height" | "droplet_aspect" | "unit1_droplet_aspect"
+            )
+    })?;
     Some((spec.max?, spec.unit))
 }
 
@@ -393,7 +391,9 @@ impl GcodeReader {
         let name_len = text
             .bytes()
             .enumerate()
-            .take_while(|(i, b)| b.is_ascii_lowercase() || *b == b'_' || (*i > 0 && b.is_ascii_digit()))
+            .take_while(|(i, b)| {
+                b.is_ascii_lowercase() || *b == b'_' || (*i > 0 && b.is_ascii_digit())
+            })
             .count();
         if name_len == 0 {
             return Ok(());
@@ -554,7 +554,9 @@ mod tests {
         assert_eq!(layers[0].units, vec![0, 1, 1, 1, 1, 0, 0, 0, 0, 0]);
         assert_eq!(layers[0].counts.unit1, 4);
         assert_eq!(layers[0].counts.total(), 10);
-        let err = read_gcode(&format!("{head}T2\nG26 X0 Y0 Z0.2\n")).unwrap_err().0;
+        let err = read_gcode(&format!("{head}T2\nG26 X0 Y0 Z0.2\n"))
+            .unwrap_err()
+            .0;
         assert_eq!(
             err,
             "line 4: \"T2\" selects a discharge unit this slicer does not have: only T0 and T1 are known"

@@ -218,9 +218,7 @@ impl Job {
             let n = self.layer_count();
             let regions = support::par_map(n, &|i| self.section(i).region);
             if self.uses_unit1() {
-                support::support_layers(&regions, &self.settings, |n, f| {
-                    support::par_map(n, f)
-                })
+                support::support_layers(&regions, &self.settings, |n, f| support::par_map(n, f))
             } else {
                 support::par_map(n, &|i| support::LayerSupport {
                     unsupported_area: geom::region_area(&support::overhang(
@@ -297,7 +295,12 @@ impl Job {
         if self.uses_unit1() {
             let layer = &self.support_layers()[i];
             plan.unsupported_area = layer.unsupported_area;
-            plan::plan_unit1(&mut plan, &layer.region, plan::Role::Support, &self.settings);
+            plan::plan_unit1(
+                &mut plan,
+                &layer.region,
+                plan::Role::Support,
+                &self.settings,
+            );
         } else {
             // Layers stay independent: the overhang needs only the section below.
             let below = i.checked_sub(1).map(|j| self.section(j).region);

@@ -51,11 +51,13 @@ impl WorstLayer {
     /// The worse of two (larger area; of equal areas the lower layer, so merges commute).
     fn worse(a: Option<WorstLayer>, b: Option<WorstLayer>) -> Option<WorstLayer> {
         match (a, b) {
-            (Some(x), Some(y)) => Some(if y.area > x.area || (y.area == x.area && y.index < x.index) {
-                y
-            } else {
-                x
-            }),
+            (Some(x), Some(y)) => Some(
+                if y.area > x.area || (y.area == x.area && y.index < x.index) {
+                    y
+                } else {
+                    x
+                },
+            ),
             (x, None) => x,
             (None, y) => y,
         }

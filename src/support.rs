@@ -16,7 +16,8 @@
 //! need(n) = (need(n + 1) ∪ grow(overhang(n + 1), [`support_reach`])) − region(n) (the part
 //! below carries what it covers), support(n) = need(n) − grow(region(n), `support_gap_xy`·B)
 //! − the grown overhangs of the `support_gap_z` layers directly above. The overhang is grown
-//! by B₁ before it is carried down so that the support reaches under the overhang's edge: unit
+//! by B₁/2 before it is carried down so that the support reaches under the overhang's edge:
+//! unit
 //! 1 prints a support region as the part is printed (one contour loop B₁/2 inside its boundary
 //! and hatch fill, [`crate::plan::plan_unit1`]), and a support band narrower than B₁ would
 //! have no loop. `tests/support.rs` checks the rule on the printed droplets.
@@ -93,6 +94,14 @@ pub fn difference(a: &Shapes, b: &Shapes) -> Shapes {
     cleaned(nested(a).overlay(&nested(b), OverlayRule::Difference, FillRule::NonZero))
 }
 
+/// a ∩ b.
+pub fn intersection(a: &Shapes, b: &Shapes) -> Shapes {
+    if a.is_empty() || b.is_empty() {
+        return Shapes::new();
+    }
+    cleaned(nested(a).overlay(&nested(b), OverlayRule::Intersect, FillRule::NonZero))
+}
+
 /// a ∪ b.
 pub fn union(a: &Shapes, b: &Shapes) -> Shapes {
     if a.is_empty() {
@@ -150,10 +159,12 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
     difference(&fresh, &grow(below, s.overhang_limit * s.droplet_width()))
 }
 
-/// How far beyond an overhang its support reaches, mm: one unit-1 droplet width B₁, so the
-/// support under the edge of any overhang is at least B₁ wide and gets its contour loop.
+/// How far beyond an overhang its support reaches, mm: half a unit-1 droplet width B₁, so
+/// the support's contour loop (B₁/2 inside its boundary) runs under the overhang's outline
+/// and the support under an overhang's edge is wider. One whole B₁ measured worse: support
+/// then hangs beyond the edges of the part below (U_overhang.obj), see docs/support.md.
 pub fn support_reach(s: &Settings) -> f64 {
-    s.unit1_droplet_width()
+    0.5 * s.unit1_droplet_width()
 }
 
 /// One layer's overhang area and the support region unit 1 prints in it.
@@ -193,17 +204,24 @@ pub fn support_layers(
     }
     let gap_xy = s.support_gap_xy * s.droplet_width();
     let gap_z = s.support_gap_z as usize;
+    // Each layer's part and the gap around it (chords lie inside the arcs: grown by the
+    // tolerance more, never less than the gap).
+    let keep_off: Vec<Shapes> = par_map(n, &|i| {
+        if gap_xy > 0.0 && !needs[i].is_empty() {
+            grow_within(
+                &regions[i],
+                gap_xy + SUPPORT_TOLERANCE_MM,
+                SUPPORT_TOLERANCE_MM,
+            )
+        } else {
+            Shapes::new()
+        }
+    });
     let supports = par_map(n, &|i| {
         if needs[i].is_empty() {
             return Shapes::new();
         }
-        // Chords lie inside the arcs: grown by the tolerance more, never less than the gap.
-        let keep_off = if gap_xy > 0.0 {
-            grow_within(&regions[i], gap_xy + SUPPORT_TOLERANCE_MM, SUPPORT_TOLERANCE_MM)
-        } else {
-            Shapes::new()
-        };
-        let mut region = difference(&needs[i], &keep_off);
+        let mut region = difference(&needs[i], &keep_off[i]);
         for k in 1..=gap_z.min(n - 1 - i) {
             region = difference(&region, &grown[i + k]);
         }
@@ -283,7 +301,11 @@ mod tests {
         assert!(overhang(&square(0.0, 0.0, 10.0), Some(&square(0.0, 0.0, 10.0)), &s).is_empty());
         assert!(overhang(&square(0.0, 0.0, 10.0), None, &s).is_empty());
         // Within the limit: none.
-        let o = overhang(&square(0.4 * b, 0.0, 10.0), Some(&square(0.0, 0.0, 10.0)), &s);
+        let o = overhang(
+            &square(0.4 * b, 0.0, 10.0),
+            Some(&square(0.0, 0.0, 10.0)),
+            &s,
+        );
         assert!(region_area(&o) < 1e-9);
     }
 
@@ -299,10 +321,17 @@ mod tests {
         // A post (layers 0..5) and a slab beside it on layers 5..8.
         let s = Settings::default();
         let mut regions = vec![square(0.0, 0.0, 2.0); 5];
-        regions.extend(vec![union(&square(0.0, 0.0, 2.0), &square(2.0, 0.0, 4.0)); 3]);
+        regions.extend(vec![
+            union(&square(0.0, 0.0, 2.0), &square(2.0, 0.0, 4.0));
+            3
+        ]);
         let serial = |n: usize, f: &(dyn Fn(usize) -> Shapes + Sync)| (0..n).map(f).collect();
         let layers = support_layers(&regions, &s, serial);
-        assert!(layers[5].unsupported_area > 7.0, "{}", layers[5].unsupported_area);
+        assert!(
+            layers[5].unsupported_area > 7.0,
+            "{}",
+            layers[5].unsupported_area
+        );
         assert_eq!(layers[6].unsupported_area, 0.0);
         for (i, l) in layers.iter().enumerate() {
             // Under the slab on layers 0..5, nothing from layer 5 up.
@@ -310,7 +339,10 @@ mod tests {
             if i < 5 {
                 // The slab's area beyond the post less the gap, plus the reach around it.
                 let a = region_area(&l.region);
-                assert!(a > 4.0 * 4.0 - 4.0 * 0.5 * s.droplet_width() && a < 30.0, "{a}");
+                assert!(
+                    a > 4.0 * 4.0 - 4.0 * 0.5 * s.droplet_width() && a < 30.0,
+                    "{a}"
+                );
                 // Kept the gap away from the post.
                 let gap = s.support_gap_xy * s.droplet_width() - 1e-3;
                 let apart = difference(&l.region, &grow(&square(0.0, 0.0, 2.0), gap));
