@@ -327,31 +327,3 @@ fn unsupported_area_in_the_report() {
     assert!(cube.len() > 90 && cube.iter().all(|&a| a < 1e-6));
 }
 
-#[test]
-#[ignore]
-fn diagnose() {
-    let name = std::env::var("MODEL").unwrap();
-    let on = slice(&name, &["support=unit1"]);
-    let layers = all_droplets(&on);
-    let bad = unsupported(&on, &layers);
-    for n in 1..layers.len() {
-        if bad[n] == 0 {
-            continue;
-        }
-        for &(p, u) in &layers[n] {
-            let best = layers[n - 1]
-                .iter()
-                .map(|&(q, v)| (((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt(), v))
-                .min_by(|a, b| a.0.total_cmp(&b.0))
-                .unwrap();
-            if best.0 > 0.208 + 1e-6 && (best.1 == 0 || best.0 > 0.208) {
-                eprintln!(
-                    "layer {} unit {u} at {p:?}: nearest below {:.4} (unit {})",
-                    n + 1,
-                    best.0,
-                    best.1
-                );
-            }
-        }
-    }
-}
