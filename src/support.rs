@@ -156,7 +156,9 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
     if region_area(&fresh) < MIN_AREA_MM2 {
         return Shapes::new();
     }
-    difference(&fresh, &grow(below, s.overhang_limit * s.droplet_width()))
+    // Chords within the support's tolerance: the area is a figure, not an outline to print.
+    let d = s.overhang_limit * s.droplet_width();
+    difference(&fresh, &grow_within(below, d, SUPPORT_TOLERANCE_MM))
 }
 
 /// How far beyond an overhang its support reaches, mm: half a unit-1 droplet width B₁, so
