@@ -326,4 +326,3 @@ fn unsupported_area_in_the_report() {
     assert!(cube_total < 1e-6, "{cube_total}");
     assert!(cube.len() > 90 && cube.iter().all(|&a| a < 1e-6));
 }
-
