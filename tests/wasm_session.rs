@@ -552,3 +552,55 @@ fn refused_jobs_throw_typed_errors() {
     let e = thrown(models.add_bytes(b"not a model", "x.stl").unwrap_err());
     assert_eq!(e["kind"], "import");
 }
+
+/// `stl` (ASCII) with every vertex moved by (dx, dy, dz), as the facets of a second solid.
+fn moved_facets(stl: &str, dx: f64, dy: f64, dz: f64) -> String {
+    stl.lines()
+        .filter(|l| l.starts_with("vertex") || l.contains("facet") || l.contains("loop"))
+        .map(|l| match l.strip_prefix("vertex ") {
+            Some(xyz) => {
+                let v: Vec<f64> = xyz.split(' ').map(|c| c.parse().unwrap()).collect();
+                format!("vertex {} {} {}\n", v[0] + dx, v[1] + dy, v[2] + dz)
+            }
+            None => format!("{l}\n"),
+        })
+        .collect()
+}
+
+#[wasm_bindgen_test]
+fn units_of_work_in_different_sessions_join_with_the_right_t_lines() {
+    // A post with a slab on top that overhangs it: support under the slab.
+    let post = box_stl(2.0, 2.0, 3.0);
+    let slab = moved_facets(&box_stl(6.0, 2.0, 1.0), -2.0, 0.0, 3.0);
+    let stl = post.replace("endsolid box\n", &slab) + "endsolid box\n";
+    let settings = js(serde_json::json!({"layer_height": 0.25, "support": "unit1"}));
+    let whole = Session::new(stl.as_bytes(), "t.stl", settings.clone()).unwrap();
+    let a = Session::new(stl.as_bytes(), "t.stl", settings.clone()).unwrap();
+    let b = Session::new(stl.as_bytes(), "t.stl", settings).unwrap();
+    let n = whole.layer_count();
+    let mut one = Vec::new();
+    for i in 0..n {
+        one.extend(whole.slice_layer(i).unwrap().gcode().to_vec());
+    }
+    // Blocks of 3 layers, alternately in two other sessions (as the page's workers take them).
+    let mut joined = Vec::new();
+    for start in (0..n).step_by(3) {
+        let s = if (start / 3) % 2 == 0 { &a } else { &b };
+        for i in start..(start + 3).min(n) {
+            joined.extend(s.slice_layer(i).unwrap().gcode().to_vec());
+        }
+    }
+    assert_eq!(
+        String::from_utf8(joined).unwrap(),
+        String::from_utf8(one.clone()).unwrap()
+    );
+    let text = String::from_utf8(one).unwrap();
+    let mut unit = "T0";
+    let mut changes = 0;
+    for l in text.lines().filter(|l| l.starts_with('T')) {
+        assert_ne!(l, unit, "a T line without a change");
+        unit = l;
+        changes += 1;
+    }
+    assert!(changes >= 2, "{changes} unit changes");
+}

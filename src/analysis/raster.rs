@@ -61,6 +61,9 @@ pub struct LayerAnalysis {
     pub boundary_deviation: f64,
     /// Where the larger deviation was found.
     pub deviation_at: Option<Point>,
+    /// The layer's overhang area, mm² (from its plan: [`crate::support::overhang`]).
+    #[serde(default)]
+    pub unsupported_area: f64,
 }
 
 /// A coarse picture of a layer for an overlay: per square cell the share (0 … 255) of it that
@@ -121,7 +124,10 @@ impl CoverageMask {
 
 /// Analyses one layer: its plan against its region (the section, before any offset).
 pub fn analyse_layer(plan: &LayerPlan, region: &Shapes, s: &Settings) -> LayerAnalysis {
-    Raster::new(plan, region, s).analysis()
+    LayerAnalysis {
+        unsupported_area: plan.unsupported_area,
+        ..Raster::new(plan, region, s).analysis()
+    }
 }
 
 /// [`analyse_layer`] and a [`CoverageMask`] with square cells of about `mask_cell` mm (at least
@@ -133,7 +139,11 @@ pub fn analyse_layer_with_mask(
     mask_cell: f64,
 ) -> (LayerAnalysis, CoverageMask) {
     let r = Raster::new(plan, region, s);
-    (r.analysis(), r.mask(mask_cell))
+    let a = LayerAnalysis {
+        unsupported_area: plan.unsupported_area,
+        ..r.analysis()
+    };
+    (a, r.mask(mask_cell))
 }
 
 /// Rows of the 2D grid per band of the sparse raster, and words (of 64 columns) per tile: tiles
@@ -799,6 +809,7 @@ impl Raster {
             deviation_outward: dev_out.max,
             boundary_deviation,
             deviation_at,
+            unsupported_area: 0.0,
         }
     }
 
