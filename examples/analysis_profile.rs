@@ -8,7 +8,8 @@ fn main() {
     let s = Settings::default();
     let job = Job::new(&bytes, &path, s.clone()).expect("job");
     let b = s.droplet_width();
-    let (mut tp, mut tr, mut ta, mut th, mut tv) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut tp, mut tr, mut ta, mut th, mut tv, mut tm) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut tmr = 0.0;
     let mut nvoids = 0;
     let bounds = job.info().bounds;
     let grid = Grid3 {
@@ -31,6 +32,12 @@ fn main() {
         nvoids += la.voids;
         ta += t.elapsed().as_secs_f64();
         let t = Instant::now();
+        std::hint::black_box(r.mask(b / 4.0));
+        tm += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        std::hint::black_box(r.mask_reference(b / 4.0));
+        tmr += t.elapsed().as_secs_f64();
+        let t = Instant::now();
         let m = HeightMap::new(&c, &grid, footprint_diameter(&s));
         th += t.elapsed().as_secs_f64();
         let t = Instant::now();
@@ -38,6 +45,6 @@ fn main() {
         tv += t.elapsed().as_secs_f64();
     }
     println!(
-        "plan+gcode text {tp:.3} raster {tr:.3} analysis {ta:.3} heightmap {th:.3} slab {tv:.3} voids {nvoids}"
+        "plan+gcode text {tp:.3} raster {tr:.3} analysis {ta:.3} mask {tm:.3} (before {tmr:.3}) heightmap {th:.3} slab {tv:.3} voids {nvoids}"
     );
 }
