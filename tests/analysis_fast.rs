@@ -45,3 +45,18 @@ fn masks_are_those_counted_range_by_range() {
         }
     }
 }
+
+#[test]
+fn layer_figures_are_those_of_the_reference_labelling() {
+    for model in MODELS {
+        for stagger in [false, true] {
+            for r in rasters(model, stagger, 29) {
+                assert_eq!(
+                    r.analysis(),
+                    r.analysis_reference(),
+                    "{model} stagger {stagger}"
+                );
+            }
+        }
+    }
+}

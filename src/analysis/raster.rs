@@ -595,6 +595,16 @@ impl Raster {
 
     /// The figures of the layer.
     pub fn analysis(&self) -> LayerAnalysis {
+        self.analysis_with(false)
+    }
+
+    /// [`analysis`](Self::analysis) as it was before the fast paths (for tests comparing both).
+    #[doc(hidden)]
+    pub fn analysis_reference(&self) -> LayerAnalysis {
+        self.analysis_with(true)
+    }
+
+    fn analysis_with(&self, reference: bool) -> LayerAnalysis {
         let g = self.grid;
         let tiles = &self.tiles;
         let cell = g.gx * g.gy;
@@ -673,8 +683,12 @@ impl Raster {
                         seg += 1;
                     }
                     let shift = 64 * row.segs[seg].shift();
-                    let boundary =
-                        count_range(&edge, s as usize - shift, e as usize - 1 - shift) > 0;
+                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                    let boundary = if !reference && c1 - c0 < 64 {
+                        window(&edge, c0, c1) != 0
+                    } else {
+                        count_range(&edge, c0, c1) > 0
+                    };
                     runs.push((k as u32, s, e));
                     touches.push(boundary);
                     uf.parent.push(uf.parent.len() as u32);
@@ -685,7 +699,13 @@ impl Raster {
                     let (_, s1, e1) = runs[i];
                     let (_, s2, e2) = runs[j];
                     if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                        uf.union(i, j);
+                        if !reference && uf.parent[j] as usize == j {
+                            // The first run above j it joins: j is still alone (a later run
+                            // is never the root of an earlier one).
+                            uf.parent[j] = uf.find(i) as u32;
+                        } else {
+                            uf.union(i, j);
+                        }
                     }
                     if e1 < e2 { i += 1 } else { j += 1 }
                 }
