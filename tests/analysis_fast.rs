@@ -15,8 +15,10 @@ const MODELS: [&str; 4] = [
 
 /// Every `step`-th layer of `model` with `stagger`, as (section region, raster).
 fn rasters(model: &str, stagger: bool, step: usize) -> Vec<Raster> {
-    let mut s = Settings::default();
-    s.stagger = stagger;
+    let s = Settings {
+        stagger,
+        ..Settings::default()
+    };
     let path = common::model(model);
     let job = Job::new(
         &common::model_bytes(model),
