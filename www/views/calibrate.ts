@@ -91,6 +91,12 @@ function message(text: string, tone: "hint" | "bad" | "ok" = "hint"): void {
   m.className = `calib-message ${tone}`;
 }
 
+/** The panel's `data-state`: "pending" from an input until the answer (or the message) is
+ *  shown, then "result", "refused" (a message of the checks or the core) or "idle". */
+function settle(st: "pending" | "result" | "refused" | "idle"): void {
+  $("calib").dataset.state = st;
+}
+
 function showResult(c: Calibration | null): void {
   state.result = c;
   $("calib-result").hidden = c === null;
@@ -116,6 +122,7 @@ function suggestion(c: Calibration): string {
 function schedule(page: Page, now = false): void {
   clearTimeout(state.timer);
   state.seq++;
+  settle("pending");
   if (now) void run(page);
   else state.timer = window.setTimeout(() => void run(page), DEBOUNCE_MS);
 }
@@ -123,14 +130,19 @@ function schedule(page: Page, now = false): void {
 async function run(page: Page): Promise<void> {
   const src = state.source;
   const seq = ++state.seq;
-  if (!src) return showResult(null);
+  if (!src) {
+    settle("idle");
+    return showResult(null);
+  }
   const mass = positive(input("calib-mass").value, "measured mass", "grams");
   const density = positive(input("calib-density").value, "density", "g/cm³");
   input("calib-mass").setAttribute("aria-invalid", String(Boolean(mass.error) && input("calib-mass").value.trim() !== ""));
   input("calib-density").setAttribute("aria-invalid", String(Boolean(density.error)));
   if (mass.value === undefined || density.value === undefined) {
     showResult(null);
-    if (mass.value === undefined) return message(mass.error!, input("calib-mass").value.trim() === "" ? "hint" : "bad");
+    const empty = input("calib-mass").value.trim() === "";
+    settle(mass.value === undefined && empty ? "idle" : "refused");
+    if (mass.value === undefined) return message(mass.error!, empty ? "hint" : "bad");
     return message(density.error!, "bad");
   }
   message("Calculating…");
@@ -139,9 +151,11 @@ async function run(page: Page): Promise<void> {
     if (seq !== state.seq || state.source !== src) return;
     message("");
     showResult(c);
+    settle("result");
   } catch (e) {
     if (seq !== state.seq || state.source !== src) return;
     showResult(null);
+    settle("refused");
     if (e instanceof Cancelled) return message("The calculation was cancelled: type the mass again.");
     message(e instanceof SliceError || e instanceof Error ? e.message : String(e), "bad");
   }
@@ -165,7 +179,10 @@ export function writeCalibration(page: Page): void {
   setText("calib-source", ready ? src.label : src);
   input("calib-mass").disabled = !ready;
   input("calib-density").disabled = !ready;
-  if (!ready) return message("");
+  if (!ready) {
+    settle("idle");
+    return message("");
+  }
   input("calib-density").value = String(src.density);
   schedule(page, true);
 }
