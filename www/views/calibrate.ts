@@ -103,12 +103,14 @@ function showResult(c: Calibration | null): void {
   $("calib-explanation").hidden = c === null;
   $("calib-use").hidden = c === null;
   if (!c) return;
-  const from = { header: "from the header", commands: "counted in the code", given: "of the slice" }[c.count_source];
-  setText("calib-droplets", `${nf.format(c.droplets)} (${from})`);
+  const from = { header: "header", commands: "counted", given: "slice" }[c.count_source];
+  setText("calib-droplets-label", `Droplets N (${from})`);
+  setText("calib-droplets", nf.format(c.droplets));
   setText("calib-volume", `${c.droplet_volume_mm3.toFixed(5)} mm³`);
   setText("calib-cell", `${c.cell_volume_mm3.toFixed(5)} mm³`);
   setText("calib-filling", `${(100 * c.filling_degree).toFixed(1)} %`);
-  setText("calib-aspect", `${suggestion(c)} (now ${c.current_droplet_aspect})`);
+  setText("calib-now", String(c.current_droplet_aspect));
+  setText("calib-aspect", suggestion(c));
   setText("calib-explanation", c.explanation);
   setText("calib-use", `Use droplet_aspect = ${suggestion(c)}`);
 }
