@@ -572,7 +572,10 @@ fn calibrates_a_slice() {
     let c = json(calibrate(n, h, 1.0, mass, rho).unwrap());
     let close = |key: &str, want: f64| {
         let got = c[key].as_f64().unwrap();
-        assert!((got - want).abs() <= 1e-9 * want.abs(), "{key}: {got} ≠ {want}");
+        assert!(
+            (got - want).abs() <= 1e-9 * want.abs(),
+            "{key}: {got} ≠ {want}"
+        );
     };
     close("droplet_volume_mm3", cell(1.1));
     close("cell_volume_mm3", cell(1.0));
@@ -604,7 +607,8 @@ fn calibrates_a_slice() {
 #[wasm_bindgen_test]
 fn calibrates_a_gcode_stream() {
     let stl = box_stl(10.0, 6.0, 2.0);
-    let settings = serde_json::json!({"layer_height": 0.25, "droplet_aspect": 1.1, "material_density": 1.3});
+    let settings =
+        serde_json::json!({"layer_height": 0.25, "droplet_aspect": 1.1, "material_density": 1.3});
     let s = Session::new(stl.as_bytes(), "box.stl", js(settings)).unwrap();
     let mut body = String::new();
     let mut tally = Tally::new();
@@ -617,7 +621,10 @@ fn calibrates_a_gcode_stream() {
     }
     let summary = tally.summary().unwrap();
     let text = s.header(summary.clone()).unwrap() + &body + &s.footer(summary).unwrap();
-    assert!(text.contains("; droplets total"), "the header gives the total");
+    assert!(
+        text.contains("; droplets total"),
+        "the header gives the total"
+    );
     let read = |text: &str, counting: bool| {
         let mut r = if counting {
             GcodeStream::counting()
@@ -658,7 +665,12 @@ fn calibrates_a_gcode_stream() {
     let c = json(read(&bare, true).calibrate(mass, None).unwrap());
     assert_eq!(c["droplets"].as_f64(), Some(n));
     assert_eq!(c["count_source"], "commands");
-    assert!(c["explanation"].as_str().unwrap().contains("counted from the code"));
+    assert!(
+        c["explanation"]
+            .as_str()
+            .unwrap()
+            .contains("counted from the code")
+    );
     // an impossible mass is refused with the core's message
     let m = error_message(read(&text, true).calibrate(1.0e6, None).unwrap_err());
     assert!(m.starts_with("impossible"), "{m}");
