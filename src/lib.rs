@@ -40,7 +40,7 @@ pub mod wasm;
 #[cfg(target_arch = "wasm32")]
 mod wasm_cut;
 #[cfg(target_arch = "wasm32")]
-mod wasm_gcode;
+pub mod wasm_gcode;
 
 pub use error::Error;
 pub use settings::Settings;

@@ -13,6 +13,7 @@ import { cacheBudgetBytes, Store } from "./store";
 import { hideBanner } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
+import { wireCalibrate } from "./views/calibrate";
 import { wireCut } from "./views/cut";
 import { show, wireLayerView } from "./views/layer";
 import { wirePlot } from "./views/plot";
@@ -75,6 +76,7 @@ function wire(): void {
   wireView3D(page);
   cutHooks = wireCut(page);
   wirePlot(page, (i) => show(page, i));
+  wireCalibrate(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;

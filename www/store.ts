@@ -49,6 +49,8 @@ export class Slice {
   seconds: number | null = null;
   /** The model's prepared mesh for the 3D view (a model's slice, once a worker prepared it). */
   part3d: View3DPart | null = null;
+  /** An opened .gco file and its header (source "gco"), for the calibration (views/calibrate.ts). */
+  gcodeFile: { file: Blob; header: Record<string, string> } | null = null;
 
   constructor(
     readonly source: "stl" | "gco",

@@ -7,6 +7,7 @@
 
 import init, { Session, Tally, crash_for_test, default_settings, settings_schema, version, type InitOutput } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
+import { calibrateRequest } from "./calibration";
 import {
   coverageMaskOf,
   isErrorValue,
@@ -223,6 +224,10 @@ async function handle(req: Request): Promise<void> {
       }
       return;
     }
+    case "calibrate":
+      await load();
+      answer(req.kind, req.id, await calibrateRequest(req.data));
+      return;
     case "crash":
       await load();
       crash_for_test();
