@@ -604,6 +604,8 @@ fn units_of_work_in_different_sessions_join_with_the_right_t_lines() {
         changes += 1;
     }
     assert!(changes >= 2, "{changes} unit changes");
+}
+
 /// The message of an error the `.gco` facade throws (a JS `Error`, as `JsError` makes it).
 fn error_message(e: JsValue) -> String {
     assert!(e.is_instance_of::<js_sys::Error>(), "an Error: {e:?}");
