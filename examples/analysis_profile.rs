@@ -1,43 +1,73 @@
-//! Times the analysis stages on one model: `cargo run --release --example analysis_profile -- MODEL.stl`.
+//! Times the analysis stages on one model, single-threaded:
+//! `cargo run --release --example analysis_profile -- MODEL.stl [--set stagger=true]`.
+//! Times are seconds the thread ran on a CPU (Linux: /proc/thread-self/schedstat), so waiting
+//! for a core on a busy machine is not counted; elsewhere wall time. "before" is the path
+//! the fast one replaced (`analysis_reference`, `mask_reference`), on the same raster.
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
+use std::sync::OnceLock;
 use std::time::Instant;
+
+fn cpu() -> f64 {
+    static START: OnceLock<Instant> = OnceLock::new();
+    let on_cpu = std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
+    on_cpu.map_or_else(
+        || START.get_or_init(Instant::now).elapsed().as_secs_f64(),
+        |ns| ns * 1e-9,
+    )
+}
+
 fn main() {
-    let path = std::env::args().nth(1).expect("model path");
-    let bytes = std::fs::read(&path).expect("read");
-    let s = Settings::default();
-    let job = Job::new(&bytes, &path, s.clone()).expect("job");
+    let args: Vec<String> = std::env::args().collect();
+    let path = args.get(1).expect("model path");
+    let mut s = Settings::default();
+    if args.get(2).map(String::as_str) == Some("--set") {
+        let (k, v) = args[3].split_once('=').expect("--set key=value");
+        s.set(k, v).expect("setting");
+    }
+    let bytes = std::fs::read(path).expect("read");
+    let job = Job::new(&bytes, path, s.clone()).expect("job");
     let b = s.droplet_width();
-    let (mut tp, mut tr, mut ta, mut th, mut tv) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    // plan, raster, analysis (before), mask (before), height map, slab
+    let mut t = [0.0f64; 8];
     let mut nvoids = 0;
     let bounds = job.info().bounds;
     let grid = Grid3 {
         origin: [bounds.min[0] - b, bounds.min[1] - b].into(),
         cell: b / GRID3_PER_B,
     };
+    let mut lap = |i: usize, from: &mut f64| {
+        let now = cpu();
+        t[i] += now - *from;
+        *from = now;
+    };
     for i in 0..job.layer_count() {
-        let t = Instant::now();
+        let mut at = cpu();
         let sec = job.section(i);
         let plan = dropslice::plan::plan_layer(&sec.region, i, &s);
-        let text = dropslice::gcode::layer_text(&plan);
-        tp += t.elapsed().as_secs_f64();
-        std::hint::black_box(text);
-        let t = Instant::now();
+        std::hint::black_box(dropslice::gcode::layer_text(&plan));
+        lap(0, &mut at);
         let c = droplet_centres(&plan, b);
         let r = Raster::from_centres(i, plan.z, &c, &sec.region, &s);
-        tr += t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        lap(1, &mut at);
         let la = r.analysis();
         nvoids += la.voids;
-        ta += t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        lap(2, &mut at);
+        std::hint::black_box(r.analysis_reference());
+        lap(3, &mut at);
+        std::hint::black_box(r.mask(b / 4.0));
+        lap(4, &mut at);
+        std::hint::black_box(r.mask_reference(b / 4.0));
+        lap(5, &mut at);
         let m = HeightMap::new(&c, &grid, footprint_diameter(&s));
-        th += t.elapsed().as_secs_f64();
-        let t = Instant::now();
+        lap(6, &mut at);
         let _ = slab_voids(&sec.region, &grid, Some(&m), &m, Some(&m), &s);
-        tv += t.elapsed().as_secs_f64();
+        lap(7, &mut at);
     }
     println!(
-        "plan+gcode text {tp:.3} raster {tr:.3} analysis {ta:.3} heightmap {th:.3} slab {tv:.3} voids {nvoids}"
+        "plan+gcode text {:.3} | raster {:.3} | analysis {:.3} (before {:.3}) | page mask {:.3} (before {:.3}) | 3D height maps {:.3} | 3D slabs {:.3} | voids {nvoids}",
+        t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7]
     );
 }

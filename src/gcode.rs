@@ -100,6 +100,14 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
     let _ = writeln!(h, "; droplets outer loops = {}", field(c.map(|c| c.outer)));
     let _ = writeln!(h, "; droplets inner loops = {}", field(c.map(|c| c.inner)));
     let _ = writeln!(h, "; droplets fill        = {}", field(c.map(|c| c.fill)));
+    if input.unit1_used {
+        let _ = writeln!(
+            h,
+            "; droplets support     = {}",
+            field(c.map(|c| c.support))
+        );
+        let _ = writeln!(h, "; droplets of unit 1   = {}", field(c.map(|c| c.unit1)));
+    }
     let _ = writeln!(
         h,
         "; droplets total       = {}",
@@ -153,12 +161,25 @@ pub fn part_line(p: &crate::job::Instance) -> String {
     )
 }
 
-/// One layer's commands.
+/// One layer's commands, with a `T` line wherever the unit changes within the layer (none
+/// before its first move: see [`layer_text_after`]).
 pub fn layer_text(plan: &LayerPlan) -> String {
+    layer_text_after(plan, plan.first_unit().unwrap_or(0))
+}
+
+/// One layer's commands after a layer that left unit `before` selected: a `T` line (right
+/// after the layer's comment line) wherever the unit of the next move differs from the one
+/// selected, and nowhere else (SPEC.md "Two discharge units").
+pub fn layer_text_after(plan: &LayerPlan, before: u8) -> String {
     let mut t = String::with_capacity(plan.moves.len() * 34 + 40);
     let z = coord(plan.z);
     let _ = writeln!(t, "; layer {} z = {}", plan.index + 1, z);
+    let mut unit = before;
     for m in &plan.moves {
+        if m.unit != unit {
+            unit = m.unit;
+            let _ = writeln!(t, "T{unit}");
+        }
         t.push_str(match m.kind {
             MoveKind::Travel => "G01 X",
             MoveKind::Droplet => "G26 X",
@@ -174,6 +195,13 @@ pub fn layer_text(plan: &LayerPlan) -> String {
     t
 }
 
+/// Puts a `T{unit}` line after the first line (the layer's comment) of a layer's text made by
+/// [`layer_text`], for a layer that follows one which left another unit selected.
+pub fn insert_unit_line(text: &mut String, unit: u8) {
+    let at = text.find('\n').map_or(text.len(), |i| i + 1);
+    text.insert_str(at, &format!("T{unit}\n"));
+}
+
 /// Closing comments: the totals and what slicing repaired.
 pub fn footer(summary: &Summary) -> String {
     let mut f = format!(
@@ -184,6 +212,13 @@ pub fn footer(summary: &Summary) -> String {
         summary.counts.inner,
         summary.counts.fill
     );
+    if summary.counts.unit1 > 0 {
+        let _ = writeln!(
+            f,
+            "; support: {} droplets, {} printed by unit 1",
+            summary.counts.support, summary.counts.unit1
+        );
+    }
     for r in summary.repairs() {
         let _ = writeln!(f, "; repaired: {r}");
     }

@@ -6,7 +6,10 @@
 //! travels and sets one droplet. B = `layer_height` × `droplet_aspect`, read from the header's
 //! `; name = value` lines before the first command. G-code does not say which loop a droplet
 //! belongs to: every `G26` droplet counts as a loop droplet (role 0), every `G25` droplet as
-//! fill (role 2). A new layer starts where Z changes by more than 1e-6 mm.
+//! fill (role 2). A new layer starts where Z changes by more than 1e-6 mm. `T0`/`T1` select
+//! the discharge unit of the commands that follow (a file starts with unit 0); every droplet
+//! is tagged with its unit ([`ReadLayer::units`]), and unit 1's `G25` lines set droplets every
+//! B₁ = `layer_height` × `unit1_droplet_aspect` (default 1.04).
 //!
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
 //! filling its memory, and every refusal names the line and the reason.
@@ -52,6 +55,8 @@ pub struct ReadLayer {
     pub travel_mm: f64,
     /// Droplet centres, roles and travel moves, as the slicer's preview gives them.
     pub preview: PreviewLayer,
+    /// The discharge unit of each droplet (0 or 1), in the order of `preview.roles`.
+    pub units: Vec<u8>,
 }
 
 /// Streaming reader: feed text or lines, take finished layers.
@@ -60,6 +65,10 @@ pub struct GcodeReader {
     /// The header's `name = value` lines before the first command, in file order.
     pub header: Vec<(String, String)>,
     width: f64,
+    /// B₁, unit 1's droplet width.
+    width1: f64,
+    /// The selected discharge unit.
+    unit: u8,
     at: DVec2,
     z: f64,
     layer: Option<ReadLayer>,
@@ -79,9 +88,13 @@ pub struct GcodeReader {
 /// The header's droplet size must lie within the settings' ranges (greater than 0, at most
 /// this).
 fn header_max(name: &str) -> Option<(f64, &'static str)> {
-    let spec = crate::settings::schema()
-        .into_iter()
-        .find(|s| s.name == name && (name == "layer_height" || name == "droplet_aspect"))?;
+    let spec = crate::settings::schema().into_iter().find(|s| {
+        s.name == name
+            && matches!(
+                name,
+                "layer_height" | "droplet_aspect" | "unit1_droplet_aspect"
+            )
+    })?;
     Some((spec.max?, spec.unit))
 }
 
@@ -142,6 +155,7 @@ impl GcodeReader {
     pub fn new() -> GcodeReader {
         GcodeReader {
             width: f64::NAN,
+            width1: f64::NAN,
             ..GcodeReader::default()
         }
     }
@@ -227,6 +241,20 @@ impl GcodeReader {
         if let Some(c) = line.strip_prefix(';') {
             return self.comment(c.trim());
         }
+        if let Some(n) = line.strip_prefix(['T', 't']) {
+            let n = n.split(';').next().unwrap_or("").trim();
+            self.unit = match n {
+                "0" => 0,
+                "1" => 1,
+                _ => {
+                    return Err(GcodeError(format!(
+                        "line {no}: \"{}\" selects a discharge unit this slicer does not have: only T0 and T1 are known",
+                        shown(line)
+                    )));
+                }
+            };
+            return Ok(());
+        }
         let code = line.get(..3).map(str::to_ascii_uppercase);
         let code = match code.as_deref() {
             Some(c @ ("G01" | "G25" | "G26")) => c.to_string(),
@@ -283,6 +311,11 @@ impl GcodeReader {
         let to = DVec2::new(x, y);
         // What this line adds, checked before anything is stored.
         let len = dist(self.at, to);
+        let width = if self.unit == 1 {
+            self.width1
+        } else {
+            self.width
+        };
         let too_many = || {
             GcodeError(format!(
                 "line {no}: the file holds more than {} droplets, the most this viewer expands; it was not opened",
@@ -291,14 +324,14 @@ impl GcodeReader {
         };
         let n: u64 = match code.as_str() {
             "G25" => {
-                let n = line_droplet_count_f64(len, self.width);
+                let n = line_droplet_count_f64(len, width);
                 if n.is_nan() || self.droplets as f64 + n > MAX_DROPLETS as f64 {
                     return Err(if n > MAX_DROPLETS as f64 / 10.0 || !n.is_finite() {
                         GcodeError(format!(
                             "line {no}: a G25 of {} mm would expand to {} droplets (one every {} mm); this viewer expands at most {} droplets per file",
                             precise(len, 6),
                             count(n),
-                            precise(self.width, 4),
+                            precise(width, 4),
                             count(MAX_DROPLETS as f64)
                         ))
                     } else {
@@ -359,16 +392,21 @@ impl GcodeReader {
                     p.roles.push(0);
                 }
                 l.counts.outer += 1;
+                l.units.push(self.unit);
             }
             _ => {
                 if keep {
-                    for d in line_droplets(from, to, self.width) {
+                    for d in line_droplets(from, to, width) {
                         p.droplets.extend([d.x as f32, d.y as f32]);
                         p.roles.push(2);
                     }
                 }
                 l.counts.fill += n;
+                l.units.extend(std::iter::repeat_n(self.unit, n as usize));
             }
+        }
+        if self.unit == 1 {
+            l.counts.unit1 += n;
         }
         (self.at, self.z) = (to, z);
         Ok(())
@@ -387,7 +425,10 @@ impl GcodeReader {
         // `name = value`: a lower-case name, then the value's first word.
         let name_len = text
             .bytes()
-            .take_while(|b| b.is_ascii_lowercase() || *b == b'_')
+            .enumerate()
+            .take_while(|(i, b)| {
+                b.is_ascii_lowercase() || *b == b'_' || (*i > 0 && b.is_ascii_digit())
+            })
             .count();
         if name_len == 0 {
             return Ok(());
@@ -425,8 +466,12 @@ impl GcodeReader {
         };
         let h = num("layer_height").unwrap_or(f64::NAN);
         let a = num("droplet_aspect").unwrap_or(1.04);
+        let a1 = num("unit1_droplet_aspect").unwrap_or(1.04);
         if h > 0.0 && a > 0.0 {
             self.width = h * a;
+        }
+        if h > 0.0 && a1 > 0.0 {
+            self.width1 = h * a1;
         }
         Ok(())
     }
@@ -485,7 +530,8 @@ mod tests {
             Counts {
                 outer: 2,
                 inner: 0,
-                fill: 11
+                fill: 11,
+                ..Counts::default()
             }
         );
         assert_eq!(layers[0].preview.roles.len(), 13);
@@ -529,6 +575,26 @@ mod tests {
         assert_eq!(
             err("; layer_height = 7\n"),
             "line 1: the header's layer_height = 7 is out of range: it must be greater than 0 and at most 5 mm"
+        );
+    }
+
+    #[test]
+    fn t_lines_tag_droplets_with_their_unit() {
+        let head = "; layer_height = 0.2\n; droplet_aspect = 1.0\n; unit1_droplet_aspect = 2.0\n";
+        let text = format!(
+            "{head}G26 X0.0000 Y0.0000 Z0.2000\nT1\nG01 X0.0000 Y0.0000 Z0.2000\nG25 X1.2000 Y0.0000 Z0.2000\nT0\nG25 X2.0000 Y0.0000 Z0.2000\n"
+        );
+        let (layers, _) = read_gcode(&text).unwrap();
+        // Unit 1's line: droplets every 0.4 mm (4); unit 0's: every 0.2 mm (5).
+        assert_eq!(layers[0].units, vec![0, 1, 1, 1, 1, 0, 0, 0, 0, 0]);
+        assert_eq!(layers[0].counts.unit1, 4);
+        assert_eq!(layers[0].counts.total(), 10);
+        let err = read_gcode(&format!("{head}T2\nG26 X0 Y0 Z0.2\n"))
+            .unwrap_err()
+            .0;
+        assert_eq!(
+            err,
+            "line 4: \"T2\" selects a discharge unit this slicer does not have: only T0 and T1 are known"
         );
     }
 

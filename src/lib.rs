@@ -34,12 +34,13 @@ pub mod settings;
 pub mod slice;
 pub mod stl;
 pub mod summary;
+pub mod support;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 #[cfg(target_arch = "wasm32")]
 mod wasm_cut;
 #[cfg(target_arch = "wasm32")]
-mod wasm_gcode;
+pub mod wasm_gcode;
 
 pub use error::Error;
 pub use settings::Settings;
@@ -102,6 +103,9 @@ pub struct Job {
     buckets: FacetBuckets,
     zs: Vec<f64>,
     info: JobInfo,
+    /// Every layer's overhang area and support region, computed on first use when
+    /// `support` is on (it needs all layers' sections; see [`Job::support_layers`]).
+    support: std::sync::OnceLock<Vec<support::LayerSupport>>,
 }
 
 impl Job {
@@ -319,7 +323,54 @@ impl Job {
             buckets,
             zs,
             info,
+            support: std::sync::OnceLock::new(),
         }
+    }
+
+    /// Whether discharge unit 1 prints in this job (today: support is on).
+    pub fn uses_unit1(&self) -> bool {
+        self.settings.support == settings::Support::Unit1
+    }
+
+    /// Every layer's overhang area and support region (empty regions with `support = off`).
+    ///
+    /// With support on this is computed once per job, on first use: all sections (in parallel
+    /// natively), then [`support::support_layers`]. In the page every worker has its own job
+    /// and so computes it once for itself (the cost of one pass of sections and offsets over
+    /// the part, docs/support.md).
+    pub fn support_layers(&self) -> &[support::LayerSupport] {
+        self.support.get_or_init(|| {
+            let n = self.layer_count();
+            let regions = support::par_map(n, &|i| self.section(i).region);
+            if self.uses_unit1() {
+                support::support_layers(&regions, &self.settings, |n, f| support::par_map(n, f))
+            } else {
+                support::par_map(n, &|i| support::LayerSupport {
+                    unsupported_area: geom::region_area(&support::overhang(
+                        &regions[i],
+                        i.checked_sub(1).map(|j| &regions[j]),
+                        &self.settings,
+                    )),
+                    region: geom::Shapes::new(),
+                })
+            }
+        })
+    }
+
+    /// The unit selected when layer `i` starts: the unit of the last move of the nearest
+    /// layer below that has moves (0 at the start of the file). Without unit 1, 0 at once;
+    /// otherwise that layer is planned again (the page's workers ask this once per run of
+    /// layers, [`crate::wasm`]).
+    pub fn unit_before(&self, i: usize) -> u8 {
+        if !self.uses_unit1() {
+            return 0;
+        }
+        for j in (0..i.min(self.layer_count())).rev() {
+            if let Some(m) = self.plan_layer(j).moves.last() {
+                return m.unit;
+            }
+        }
+        0
     }
 
     /// The placed, repaired mesh that is sliced (for [`Job::from_prepared`]).
@@ -366,6 +417,21 @@ impl Job {
         let mut plan = plan::plan_layer(&section.region, i, &self.settings);
         plan.open_chains = section.open_chains;
         plan.reoriented_loops = section.reoriented_loops;
+        if self.uses_unit1() {
+            let layer = &self.support_layers()[i];
+            plan.unsupported_area = layer.unsupported_area;
+            plan::plan_unit1(
+                &mut plan,
+                &layer.region,
+                plan::Role::Support,
+                &self.settings,
+            );
+        } else {
+            // Layers stay independent: the overhang needs only the section below.
+            let below = i.checked_sub(1).map(|j| self.section(j).region);
+            let over = support::overhang(&section.region, below.as_ref(), &self.settings);
+            plan.unsupported_area = geom::region_area(&over);
+        }
         (plan, section.region)
     }
 
@@ -381,7 +447,7 @@ impl Job {
                 bounds: (b.min, b.max),
                 warnings: &self.info.warnings,
                 instances: &self.info.instances,
-                unit1_used: self.settings.support == settings::Support::Unit1,
+                unit1_used: self.uses_unit1(),
             },
             summary,
         )
@@ -764,7 +830,8 @@ where
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
     use std::sync::{Condvar, Mutex};
 
-    type Done<T> = Result<(String, LayerPlan, T), String>;
+    /// A layer's text, plan (without its moves), sink output, and first and last unit.
+    type Done<T> = Result<(String, LayerPlan, T, Option<u8>, Option<u8>), String>;
     struct Shared<T> {
         done: BTreeMap<usize, Done<T>>,
         written: usize,
@@ -784,6 +851,8 @@ where
     });
     let changed = Condvar::new();
     let mut summary = Summary::default();
+    // The unit selected after the layers written so far (a file starts with unit 0).
+    let mut unit = 0u8;
     let states: Vec<K::State> = (0..threads).map(|_| sink.init()).collect();
     std::thread::scope(|scope| -> Result<(), Error> {
         for mut state in states {
@@ -807,8 +876,9 @@ where
                         let (mut p, region) = job.plan_layer_and_region(i);
                         let text = gcode::layer_text(&p);
                         let extra = K::per_layer(&mut state, i, &region, &p);
+                        let units = (p.first_unit(), p.moves.last().map(|m| m.unit));
                         p.moves = Vec::new();
-                        (text, p, extra)
+                        (text, p, extra, units.0, units.1)
                     }))
                     .map_err(|e| {
                         e.downcast_ref::<&str>()
@@ -835,8 +905,16 @@ where
                         g = changed.wait(g).unwrap_or_else(|p| p.into_inner());
                     }
                 };
-                let (text, plan, extra) =
+                let (mut text, plan, extra, first, last) =
                     done.map_err(|m| Error::Internal(format!("layer {}: {m}", i + 1)))?;
+                // The layer's text has `T` lines only within it; the unit change at its start
+                // depends on the layers below.
+                if let Some(u) = first
+                    && u != unit
+                {
+                    gcode::insert_unit_line(&mut text, u);
+                }
+                unit = last.unwrap_or(unit);
                 out.write_all(text.as_bytes()).map_err(io)?;
                 summary.add(&plan);
                 sink.ordered(i, extra);

@@ -29,6 +29,8 @@ pub enum Role {
     Inner = 1,
     /// Hatch fill.
     Fill = 2,
+    /// Support under overhangs (discharge unit 1, see [`crate::support`]).
+    Support = 3,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,25 +38,42 @@ pub struct Move {
     pub kind: MoveKind,
     pub role: Role,
     pub to: Point,
+    /// The discharge unit that prints it (0 or 1; SPEC.md "Two discharge units"). A travel
+    /// belongs to the unit whose droplets follow it.
+    pub unit: u8,
 }
 
-/// Droplet counts by role.
+/// Droplet counts by role (the roles partition the droplets), and how many of them discharge
+/// unit 1 prints.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
     pub outer: u64,
     pub inner: u64,
     pub fill: u64,
+    /// Support droplets (all printed by unit 1).
+    #[serde(default)]
+    pub support: u64,
+    /// Droplets of any role printed by unit 1 (today: the support).
+    #[serde(default)]
+    pub unit1: u64,
 }
 
 impl Counts {
     pub fn total(&self) -> u64 {
-        self.outer + self.inner + self.fill
+        self.outer + self.inner + self.fill + self.support
+    }
+
+    /// Droplets printed by unit 0.
+    pub fn unit0(&self) -> u64 {
+        self.total() - self.unit1
     }
 
     pub fn add(&mut self, o: &Counts) {
         self.outer += o.outer;
         self.inner += o.inner;
         self.fill += o.fill;
+        self.support += o.support;
+        self.unit1 += o.unit1;
     }
 }
 
@@ -73,6 +92,28 @@ pub struct LayerPlan {
     /// the direction of some of their facets.
     pub open_chains: usize,
     pub reoriented_loops: usize,
+    /// The layer's overhang area, mm² (its region farther than `overhang_limit`·B from the
+    /// region below, [`crate::support::overhang`]).
+    pub unsupported_area: f64,
+    /// Droplet width B₁ of the unit-1 moves (0 when there are none).
+    pub unit1_width: f64,
+}
+
+impl LayerPlan {
+    /// The droplet width of a move's unit.
+    pub fn width_of(&self, m: &Move, b: f64) -> f64 {
+        if m.unit == 1 { self.unit1_width } else { b }
+    }
+
+    /// The unit of the first move, if any.
+    pub fn first_unit(&self) -> Option<u8> {
+        self.moves.first().map(|m| m.unit)
+    }
+
+    /// The unit selected after this layer, given the one selected before it.
+    pub fn unit_after(&self, before: u8) -> u8 {
+        self.moves.last().map_or(before, |m| m.unit)
+    }
 }
 
 /// Hatch angle of a layer (from 0): α_s + index·α_v.
@@ -133,8 +174,14 @@ fn fill_margin(s: &Settings) -> f64 {
     ((f + last + extra) * s.droplet_width()).max(0.0)
 }
 
-/// Plans one layer from its region.
+/// Plans one layer from its region (unit 0, starting at the origin).
 pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
+    plan_layer_from(region, index, s, Point::ZERO)
+}
+
+/// Plans one layer's region with the droplet width of `s`, starting at `start`; every move is
+/// unit 0's (see [`plan_unit1`]).
+pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point) -> LayerPlan {
     let b = s.droplet_width();
     let layer = contours(region, s);
     let mut plan = LayerPlan {
@@ -142,7 +189,7 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
         z: (index + 1) as f64 * s.layer_height,
         ..LayerPlan::default()
     };
-    let mut at = Point::ZERO;
+    let mut at = start;
     let add_contours = |plan: &mut LayerPlan, at: &mut Point| {
         let mut loops: Vec<&Loop> = layer.loops.iter().collect();
         loops.sort_by_key(|l| match s.contour_order {
@@ -176,6 +223,7 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
                         kind: MoveKind::Droplet,
                         role,
                         to: p,
+                        unit: 0,
                     });
                     *at = p;
                 }
@@ -202,11 +250,13 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
                 kind: MoveKind::Travel,
                 role: Role::Fill,
                 to: l.a,
+                unit: 0,
             });
             plan.moves.push(Move {
                 kind: MoveKind::Line,
                 role: Role::Fill,
                 to: l.b,
+                unit: 0,
             });
             *at = l.b;
         }
@@ -229,22 +279,84 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
     plan
 }
 
-/// Droplet counts of a move list.
+/// Droplet counts of a move list of one droplet width.
 pub fn count(moves: &[Move], b: f64) -> Counts {
+    count_units(moves, b, b)
+}
+
+/// Droplet counts of a move list: unit 0's droplets `b` apart on `G25` lines, unit 1's `b1`.
+pub fn count_units(moves: &[Move], b: f64, b1: f64) -> Counts {
     let mut c = Counts::default();
     let mut at = DVec2::ZERO;
     for m in moves {
+        let w = if m.unit == 1 { b1 } else { b };
         let n = match m.kind {
             MoveKind::Travel => 0,
             MoveKind::Droplet => 1,
-            MoveKind::Line => line_droplet_count(dist(at, m.to), b),
+            MoveKind::Line => line_droplet_count(dist(at, m.to), w),
         };
         match m.role {
             Role::Outer => c.outer += n,
             Role::Inner => c.inner += n,
             Role::Fill => c.fill += n,
+            Role::Support => c.support += n,
+        }
+        if m.unit == 1 {
+            c.unit1 += n;
         }
         at = m.to;
     }
     c
+}
+
+/// The settings unit 1 prints a support region with: droplet width B₁
+/// (`unit1_droplet_aspect`), one contour loop by the same rules as unit 0's, and hatch fill
+/// at `support_density`.
+pub fn support_settings(s: &Settings) -> Settings {
+    Settings {
+        droplet_aspect: s.unit1_droplet_aspect,
+        fill_density: s.support_density,
+        contours: 1,
+        ..s.clone()
+    }
+}
+
+/// Adds unit 1's moves for `region` (today the support region; later also the sections of
+/// unit-1 parts) to a planned layer, in the order `unit_order` gives, as `role`. Unit 0's
+/// droplets stay exactly as planned; only the travel between the two units' moves changes.
+pub fn plan_unit1(plan: &mut LayerPlan, region: &Shapes, role: Role, s: &Settings) {
+    if region.is_empty() {
+        return;
+    }
+    let s1 = support_settings(s);
+    let b1 = s1.droplet_width();
+    let unit0_first = s.unit_order == crate::settings::UnitOrder::Unit0First;
+    let start = if unit0_first {
+        plan.moves.last().map_or(Point::ZERO, |m| m.to)
+    } else {
+        Point::ZERO
+    };
+    let mut p1 = plan_layer_from(region, plan.index, &s1, start);
+    if p1.moves.is_empty() {
+        return;
+    }
+    for m in &mut p1.moves {
+        m.unit = 1;
+        m.role = role;
+    }
+    let c1 = count_units(&p1.moves, b1, b1);
+    plan.counts.add(&c1);
+    plan.unit1_width = b1;
+    plan.travel_mm += p1.travel_mm;
+    if unit0_first {
+        plan.moves.extend(p1.moves);
+    } else {
+        // Unit 0 was planned from the origin; it now starts where unit 1 ends.
+        let end = p1.moves.last().map_or(Point::ZERO, |m| m.to);
+        if let Some(first) = plan.moves.first() {
+            plan.travel_mm += dist(end, first.to) - dist(Point::ZERO, first.to);
+        }
+        p1.moves.append(&mut plan.moves);
+        plan.moves = p1.moves;
+    }
 }

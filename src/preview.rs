@@ -7,13 +7,14 @@ use crate::plan::{LayerPlan, MoveKind};
 pub struct PreviewLayer {
     /// x, y of every droplet (each droplet of a `G25` line too), in print order.
     pub droplets: Vec<f32>,
-    /// Role of each droplet: 0 outermost loop, 1 inner loops, 2 fill.
+    /// Role of each droplet: 0 outermost loop, 1 inner loops, 2 fill, 3 support (unit 1).
     pub roles: Vec<u8>,
     /// x0, y0, x1, y1 of every move without material (G01, and G26's way to its droplet).
     pub travel: Vec<f32>,
 }
 
 impl PreviewLayer {
+    /// `b` is unit 0's droplet width (unit 1's comes with the plan).
     pub fn from_plan(plan: &LayerPlan, b: f64) -> PreviewLayer {
         let n = plan.counts.total() as usize;
         let mut p = PreviewLayer {
@@ -35,7 +36,7 @@ impl PreviewLayer {
                     }
                 }
                 MoveKind::Line => {
-                    for d in line_droplets(at, m.to, b) {
+                    for d in line_droplets(at, m.to, plan.width_of(m, b)) {
                         p.droplets.extend([d.x as f32, d.y as f32]);
                         p.roles.push(m.role as u8);
                     }

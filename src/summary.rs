@@ -30,28 +30,60 @@ pub struct Summary {
     /// `analysis.layers` of them), in 2D (no slab volumes).
     #[serde(default)]
     pub analysis: PartAnalysis,
+    /// Overhang area summed over the layers, mm² (support on or off).
+    #[serde(default)]
+    pub unsupported_area: f64,
+    /// The layer with the largest overhang area (none without overhangs).
+    #[serde(default)]
+    pub worst_overhang: Option<WorstLayer>,
 }
 
-/// The layer with the largest connected void.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+/// The worst layer by some area: the largest connected void, or the largest overhang.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WorstLayer {
     /// Layer number from 0.
     pub index: usize,
-    /// Area of its largest void, mm².
+    /// Its area (of the largest void, or of the overhang), mm².
     pub area: f64,
 }
 
-/// The estimated print time of `droplets` droplets and `travel_mm` of travel, s: droplets /
-/// droplet_rate + travel / travel_speed. The one estimate of the job's figures
+/// The estimated print time, s: unit 0's droplets / droplet_rate + unit 1's droplets /
+/// unit1_droplet_rate + travel / travel_speed. The one estimate of the job's figures
 /// ([`Figures::print_seconds`]) and of each layer ([`layer_seconds`]), so the layers' times
 /// add up to the job's.
-pub fn print_seconds(droplets: u64, travel_mm: f64, settings: &Settings) -> f64 {
-    droplets as f64 / settings.droplet_rate + travel_mm / settings.travel_speed
+pub fn print_seconds(counts: &Counts, travel_mm: f64, settings: &Settings) -> f64 {
+    let (t0, t1) = unit_seconds(counts, settings);
+    t0 + t1 + travel_mm / settings.travel_speed
+}
+
+/// The droplet time of each discharge unit, s.
+pub fn unit_seconds(counts: &Counts, settings: &Settings) -> (f64, f64) {
+    (
+        counts.unit0() as f64 / settings.droplet_rate,
+        counts.unit1 as f64 / settings.unit1_droplet_rate,
+    )
 }
 
 /// The estimated print time of one planned layer, s (the page's per-layer plot).
 pub fn layer_seconds(plan: &LayerPlan, settings: &Settings) -> f64 {
-    print_seconds(plan.counts.total(), plan.travel_mm, settings)
+    print_seconds(&plan.counts, plan.travel_mm, settings)
+}
+
+impl WorstLayer {
+    /// The worse of two (larger area; of equal areas the lower layer, so merges commute).
+    fn worse(a: Option<WorstLayer>, b: Option<WorstLayer>) -> Option<WorstLayer> {
+        match (a, b) {
+            (Some(x), Some(y)) => Some(
+                if y.area > x.area || (y.area == x.area && y.index < x.index) {
+                    y
+                } else {
+                    x
+                },
+            ),
+            (x, None) => x,
+            (None, y) => y,
+        }
+    }
 }
 
 /// What the CLI prints and the page shows about a slice.
@@ -60,12 +92,28 @@ pub struct Figures {
     pub layers: usize,
     pub counts: Counts,
     pub droplets: u64,
-    /// Droplets × B²H, mm³.
+    /// Unit 0's droplets × B²H, mm³ (the part).
     pub volume_mm3: f64,
     /// volume × material_density, g.
     pub mass_g: f64,
-    /// droplets / droplet_rate + travel / travel_speed, s ([`print_seconds`]).
+    /// Droplets printed by unit 1 (today: the support).
+    pub unit1_droplets: u64,
+    /// Unit 1's droplets × B₁²H, mm³.
+    pub unit1_volume_mm3: f64,
+    /// unit-1 volume × unit1_material_density, g.
+    pub unit1_mass_g: f64,
+    /// unit-0 droplets / droplet_rate + unit-1 droplets / unit1_droplet_rate
+    /// + travel / travel_speed, s ([`print_seconds`]).
     pub print_seconds: f64,
+    /// Unit 0's droplets / droplet_rate, s.
+    pub unit0_seconds: f64,
+    /// Unit 1's droplets / unit1_droplet_rate, s.
+    pub unit1_seconds: f64,
+    /// Overhang area summed over the layers, mm² (support on or off: what would be printed
+    /// in the air without support).
+    pub unsupported_area: f64,
+    /// The layer with the largest overhang area.
+    pub worst_overhang: Option<WorstLayer>,
     pub travel_mm: f64,
     /// Layers with a void analysis.
     pub analysed_layers: usize,
@@ -86,6 +134,16 @@ impl Summary {
         self.travel_mm += plan.travel_mm;
         self.layers_with_open_chains += usize::from(plan.open_chains > 0);
         self.reoriented_loops += plan.reoriented_loops;
+        self.unsupported_area += plan.unsupported_area;
+        if plan.unsupported_area > 0.0 {
+            self.worst_overhang = WorstLayer::worse(
+                self.worst_overhang,
+                Some(WorstLayer {
+                    index: plan.index,
+                    area: plan.unsupported_area,
+                }),
+            );
+        }
     }
 
     /// A summary of one planned layer.
@@ -109,6 +167,8 @@ impl Summary {
         self.layers_with_open_chains += other.layers_with_open_chains;
         self.reoriented_loops += other.reoriented_loops;
         self.analysis.merge(&other.analysis);
+        self.unsupported_area += other.unsupported_area;
+        self.worst_overhang = WorstLayer::worse(self.worst_overhang, other.worst_overhang);
     }
 
     /// The merge of `parts`.
@@ -141,8 +201,16 @@ impl Summary {
     /// The figures shown to the user, with the estimates of `settings`.
     pub fn figures(&self, settings: &Settings) -> Figures {
         let droplets = self.counts.total();
+        let (d0, d1) = (self.counts.unit0(), self.counts.unit1);
         let b = settings.droplet_width();
-        let volume = droplets as f64 * b * b * settings.layer_height;
+        let b1 = settings.unit1_droplet_width();
+        let h = settings.layer_height;
+        let volume = d0 as f64 * b * b * h;
+        let volume1 = d1 as f64 * b1 * b1 * h;
+        let (t0, t1) = (
+            d0 as f64 / settings.droplet_rate,
+            d1 as f64 / settings.unit1_droplet_rate,
+        );
         let a = &self.analysis;
         let analysed = a.layers > 0;
         Figures {
@@ -151,7 +219,14 @@ impl Summary {
             droplets,
             volume_mm3: volume,
             mass_g: volume / 1000.0 * settings.material_density,
-            print_seconds: print_seconds(droplets, self.travel_mm, settings),
+            unit1_droplets: d1,
+            unit1_volume_mm3: volume1,
+            unit1_mass_g: volume1 / 1000.0 * settings.unit1_material_density,
+            print_seconds: print_seconds(&self.counts, self.travel_mm, settings),
+            unit0_seconds: t0,
+            unit1_seconds: t1,
+            unsupported_area: self.unsupported_area,
+            worst_overhang: self.worst_overhang,
             travel_mm: self.travel_mm,
             analysed_layers: a.layers,
             coverage: analysed.then_some(a.coverage),
@@ -227,6 +302,19 @@ impl PartAnalysis {
         {
             self.max_boundary_deviation = o.max_boundary_deviation;
             self.max_deviation_layer = o.max_deviation_layer;
+        }
+        self.unsupported_area += o.unsupported_area;
+        if o.max_unsupported_area_layer.is_some()
+            && (self.max_unsupported_area_layer.is_none()
+                || better(
+                    o.max_unsupported_area,
+                    o.max_unsupported_area_layer,
+                    self.max_unsupported_area,
+                    self.max_unsupported_area_layer,
+                ))
+        {
+            self.max_unsupported_area = o.max_unsupported_area;
+            self.max_unsupported_area_layer = o.max_unsupported_area_layer;
         }
         self.volume += o.volume;
         self.void_volume += o.void_volume;

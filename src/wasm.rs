@@ -268,7 +268,26 @@ impl Session {
 
     fn with(job: Job) -> Session {
         let settings = job.settings().clone();
-        Session { job, settings }
+        Session {
+            job,
+            settings,
+            unit_after: std::cell::Cell::new(None),
+        }
+    }
+
+    /// Plans layer `i` and writes its text after the unit the layers below leave selected: the
+    /// unit after the layer this session planned last if that was layer i − 1 (the layers of a
+    /// unit of work come in order), else [`Job::unit_before`] (which plans the layers below
+    /// again, only when the job uses unit 1).
+    fn planned(&self, i: usize) -> (LayerPlan, crate::geom::Shapes, String) {
+        let (plan, region) = self.job.plan_layer_and_region(i);
+        let before = match self.unit_after.get() {
+            Some((j, u)) if j + 1 == i => u,
+            _ => self.job.unit_before(i),
+        };
+        self.unit_after.set(Some((i, plan.unit_after(before))));
+        let text = gcode::layer_text_after(&plan, before);
+        (plan, region, text)
     }
 }
 
@@ -286,6 +305,8 @@ struct SliceFigures {
 pub struct Session {
     pub(crate) job: Job,
     pub(crate) settings: Settings,
+    /// The last layer planned and the unit selected after it.
+    unit_after: std::cell::Cell<Option<(usize, u8)>>,
 }
 
 #[wasm_bindgen]
@@ -369,8 +390,8 @@ impl Session {
     /// Plans layer `i`: its G-code text, droplet counts and preview arrays.
     pub fn slice_layer(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
-        let plan = self.job.plan_layer(i);
-        Ok(LayerResult::new(&plan, &self.settings))
+        let (plan, _, text) = self.planned(i);
+        Ok(LayerResult::new(&plan, &self.settings, text))
     }
 
     /// [`Session::slice_layer`] plus the void analysis of the same plan (no second planning):
@@ -378,10 +399,10 @@ impl Session {
     /// times the work of planning the layer.
     pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
-        let (plan, region) = self.job.plan_layer_and_region(i);
+        let (plan, region, text) = self.planned(i);
         let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
         let (a, mask) = analysis::analyse_layer_with_mask(&plan, &region, &self.settings, cell);
-        let mut r = LayerResult::new(&plan, &self.settings);
+        let mut r = LayerResult::new(&plan, &self.settings, text);
         r.analysis = Some(a);
         r.mask = Some(mask);
         Ok(r)
@@ -474,7 +495,7 @@ pub struct LayerResult {
 }
 
 impl LayerResult {
-    fn new(plan: &LayerPlan, settings: &Settings) -> LayerResult {
+    fn new(plan: &LayerPlan, settings: &Settings, gcode: String) -> LayerResult {
         LayerResult {
             index: plan.index,
             z: plan.z,
@@ -482,7 +503,7 @@ impl LayerResult {
             travel_mm: plan.travel_mm,
             seconds: summary::layer_seconds(plan, settings),
             summary: Summary::of_layer(plan),
-            gcode: gcode::layer_text(plan),
+            gcode,
             preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
             analysis: None,
             mask: None,
@@ -537,7 +558,7 @@ impl LayerResult {
     pub fn droplets(&self) -> Float32Array {
         Float32Array::from(&self.preview.droplets[..])
     }
-    /// Role per droplet: 0 outermost loop, 1 inner loops, 2 fill.
+    /// Role per droplet: 0 outermost loop, 1 inner loops, 2 fill, 3 support (unit 1).
     #[wasm_bindgen(getter)]
     pub fn roles(&self) -> Uint8Array {
         Uint8Array::from(&self.preview.roles[..])

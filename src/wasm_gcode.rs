@@ -27,6 +27,14 @@ impl GcodeStream {
         }
     }
 
+    /// A reader that only counts (layers without droplet positions, roles or travel): for
+    /// [`GcodeStream::calibrate`], which needs the header and the droplet count only.
+    pub fn counting() -> GcodeStream {
+        GcodeStream {
+            reader: GcodeReader::counting(),
+        }
+    }
+
     /// Reads a piece of the file (lines may be split across pieces).
     pub fn feed(&mut self, text: &str) -> Result<(), JsError> {
         self.reader.feed(text).map_err(|e| JsError::new(&e.0))

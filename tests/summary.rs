@@ -188,7 +188,13 @@ fn the_cli_prints_the_librarys_figures() {
     let text = String::from_utf8_lossy(&run.stderr);
     let (job, layers) = layer_summaries("cube_20mm_ascii.stl", Settings::default());
     let f = Summary::merged(&layers).figures(job.settings());
-    let line = text.lines().last().unwrap();
+    let line = text.lines().find(|l| l.contains(" layers, ")).unwrap();
+    // The overhang line follows it: a cube has none.
+    assert_eq!(f.worst_overhang, None);
+    assert_eq!(
+        text.lines().last().unwrap(),
+        "dropslice: no overhangs (every layer rests on the one below)"
+    );
     let c = f.counts;
     let expected = format!(
         "{} layers, {} droplets ({} outer, {} inner, {} fill), {:.2} cm³, {:.2} g, print time ",

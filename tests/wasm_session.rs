@@ -5,6 +5,7 @@
 use dropslice::wasm::{
     Models, Session, Tally, default_settings, merge_summaries, settings_schema, version,
 };
+use dropslice::wasm_gcode::{GcodeStream, calibrate};
 use serde::Serialize;
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -551,4 +552,178 @@ fn refused_jobs_throw_typed_errors() {
     assert_eq!(e["kind"], "job");
     let e = thrown(models.add_bytes(b"not a model", "x.stl").unwrap_err());
     assert_eq!(e["kind"], "import");
+}
+
+/// `stl` (ASCII) with every vertex moved by (dx, dy, dz), as the facets of a second solid.
+fn moved_facets(stl: &str, dx: f64, dy: f64, dz: f64) -> String {
+    stl.lines()
+        .filter(|l| l.starts_with("vertex") || l.contains("facet") || l.contains("loop"))
+        .map(|l| match l.strip_prefix("vertex ") {
+            Some(xyz) => {
+                let v: Vec<f64> = xyz.split(' ').map(|c| c.parse().unwrap()).collect();
+                format!("vertex {} {} {}\n", v[0] + dx, v[1] + dy, v[2] + dz)
+            }
+            None => format!("{l}\n"),
+        })
+        .collect()
+}
+
+#[wasm_bindgen_test]
+fn units_of_work_in_different_sessions_join_with_the_right_t_lines() {
+    // A post with a slab on top that overhangs it: support under the slab.
+    let post = box_stl(2.0, 2.0, 3.0);
+    let slab = moved_facets(&box_stl(6.0, 2.0, 1.0), -2.0, 0.0, 3.0);
+    let stl = post.replace("endsolid box\n", &slab) + "endsolid box\n";
+    let settings = js(serde_json::json!({"layer_height": 0.25, "support": "unit1"}));
+    let whole = Session::new(stl.as_bytes(), "t.stl", settings.clone()).unwrap();
+    let a = Session::new(stl.as_bytes(), "t.stl", settings.clone()).unwrap();
+    let b = Session::new(stl.as_bytes(), "t.stl", settings).unwrap();
+    let n = whole.layer_count();
+    let mut one = Vec::new();
+    for i in 0..n {
+        one.extend(whole.slice_layer(i).unwrap().gcode().to_vec());
+    }
+    // Blocks of 3 layers, alternately in two other sessions (as the page's workers take them).
+    let mut joined = Vec::new();
+    for start in (0..n).step_by(3) {
+        let s = if (start / 3) % 2 == 0 { &a } else { &b };
+        for i in start..(start + 3).min(n) {
+            joined.extend(s.slice_layer(i).unwrap().gcode().to_vec());
+        }
+    }
+    assert_eq!(
+        String::from_utf8(joined).unwrap(),
+        String::from_utf8(one.clone()).unwrap()
+    );
+    let text = String::from_utf8(one).unwrap();
+    let mut unit = "T0";
+    let mut changes = 0;
+    for l in text.lines().filter(|l| l.starts_with('T')) {
+        assert_ne!(l, unit, "a T line without a change");
+        unit = l;
+        changes += 1;
+    }
+    assert!(changes >= 2, "{changes} unit changes");
+}
+
+/// The message of an error the `.gco` facade throws (a JS `Error`, as `JsError` makes it).
+fn error_message(e: JsValue) -> String {
+    assert!(e.is_instance_of::<js_sys::Error>(), "an Error: {e:?}");
+    String::from(e.unchecked_into::<js_sys::Error>().message())
+}
+
+/// The page's calibration of a slice (`calibrate`) against SPEC.md's formula computed here:
+/// V = m / (N ρ) · 1000 mm³, filling V / (B² H), aspect √(V/H) / H; refusals are Errors.
+#[wasm_bindgen_test]
+fn calibrates_a_slice() {
+    // 15,000 droplets of H 0.25 at aspect 1.1 (B = 0.275): cell 0.275² · 0.25 mm³. A mass
+    // that fills each cell of aspect 1.1 exactly, printed at aspect 1.0, density 1.2.
+    let (n, h, rho) = (15_000.0, 0.25, 1.2);
+    let cell = |aspect: f64| (aspect * h) * (aspect * h) * h;
+    let mass = n * cell(1.1) * rho / 1000.0;
+    let c = json(calibrate(n, h, 1.0, mass, rho).unwrap());
+    let close = |key: &str, want: f64| {
+        let got = c[key].as_f64().unwrap();
+        assert!(
+            (got - want).abs() <= 1e-9 * want.abs(),
+            "{key}: {got} ≠ {want}"
+        );
+    };
+    close("droplet_volume_mm3", cell(1.1));
+    close("cell_volume_mm3", cell(1.0));
+    close("filling_degree", 1.21);
+    close("suggested_droplet_aspect", 1.1);
+    close("current_droplet_aspect", 1.0);
+    assert_eq!(c["droplets"], 15_000);
+    assert_eq!(c["count_source"], "given");
+    let text = c["explanation"].as_str().unwrap();
+    assert!(
+        text.contains("15,000 droplets") && text.contains("121 %") && text.contains("1.10"),
+        "{text}"
+    );
+    // refusals: an impossible mass, none, a bad density, no droplets, a bad count
+    let m = error_message(calibrate(n, h, 1.0, 1.0e6, rho).unwrap_err());
+    assert!(m.starts_with("impossible"), "{m}");
+    let m = error_message(calibrate(n, h, 1.0, f64::NAN, rho).unwrap_err());
+    assert!(m.contains("mass"), "{m}");
+    let m = error_message(calibrate(n, h, 1.0, mass, 0.0).unwrap_err());
+    assert!(m.contains("density"), "{m}");
+    let m = error_message(calibrate(0.0, h, 1.0, mass, rho).unwrap_err());
+    assert!(m.contains("no droplets"), "{m}");
+    let m = error_message(calibrate(-1.0, h, 1.0, mass, rho).unwrap_err());
+    assert!(m.contains("droplet count"), "{m}");
+}
+
+/// A `.gco` made by a session, read back by `GcodeStream` (counting, and the full reader): its
+/// header's count, H, aspect and density; without the header's total, the commands' count.
+#[wasm_bindgen_test]
+fn calibrates_a_gcode_stream() {
+    let stl = box_stl(10.0, 6.0, 2.0);
+    let settings =
+        serde_json::json!({"layer_height": 0.25, "droplet_aspect": 1.1, "material_density": 1.3});
+    let s = Session::new(stl.as_bytes(), "box.stl", js(settings)).unwrap();
+    let mut body = String::new();
+    let mut tally = Tally::new();
+    let mut n = 0.0;
+    for i in 0..s.layer_count() {
+        let l = s.slice_layer(i).unwrap();
+        n += l.outer() + l.inner() + l.fill();
+        body.push_str(&String::from_utf8(l.gcode().to_vec()).unwrap());
+        tally.add_layer(&l);
+    }
+    let summary = tally.summary().unwrap();
+    let text = s.header(summary.clone()).unwrap() + &body + &s.footer(summary).unwrap();
+    assert!(
+        text.contains("; droplets total"),
+        "the header gives the total"
+    );
+    let read = |text: &str, counting: bool| {
+        let mut r = if counting {
+            GcodeStream::counting()
+        } else {
+            GcodeStream::new()
+        };
+        for piece in text.as_bytes().chunks(1000) {
+            r.feed(std::str::from_utf8(piece).unwrap()).unwrap();
+            while r.take_layer().is_some() {}
+        }
+        r.finish().unwrap();
+        while r.take_layer().is_some() {}
+        r
+    };
+    // a mass that fills cells of aspect 1.2 (B = 0.3) at the header's density 1.3
+    let h = 0.25;
+    let mass = n * (1.2 * h) * (1.2 * h) * h * 1.3 / 1000.0;
+    for counting in [true, false] {
+        let c = json(read(&text, counting).calibrate(mass, None).unwrap());
+        assert_eq!(c["droplets"].as_f64(), Some(n));
+        assert_eq!(c["count_source"], "header");
+        assert_eq!(c["density_g_cm3"], 1.3);
+        assert_eq!(c["layer_height"], 0.25);
+        assert_eq!(c["current_droplet_aspect"], 1.1);
+        let a = c["suggested_droplet_aspect"].as_f64().unwrap();
+        assert!((a - 1.2).abs() < 1e-9, "{a}");
+    }
+    // a density given wins over the header's: ρ 2.6 halves V, aspect 1.2 / √2
+    let c = json(read(&text, true).calibrate(mass, Some(2.6)).unwrap());
+    let a = c["suggested_droplet_aspect"].as_f64().unwrap();
+    assert!((a - 1.2 / 2f64.sqrt()).abs() < 1e-9, "{a}");
+    // no total in the header: the commands' droplets, said so
+    let bare: String = text
+        .lines()
+        .filter(|l| !l.starts_with("; droplets total"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let c = json(read(&bare, true).calibrate(mass, None).unwrap());
+    assert_eq!(c["droplets"].as_f64(), Some(n));
+    assert_eq!(c["count_source"], "commands");
+    assert!(
+        c["explanation"]
+            .as_str()
+            .unwrap()
+            .contains("counted from the code")
+    );
+    // an impossible mass is refused with the core's message
+    let m = error_message(read(&text, true).calibrate(1.0e6, None).unwrap_err());
+    assert!(m.starts_with("impossible"), "{m}");
 }

@@ -408,6 +408,12 @@ export class Pool {
     return this.guarded(async () => (await this.pick()).call("cut", data, undefined, [data.sent.buffer, data.centres.buffer]));
   }
 
+  /** The core's droplet calibration (views/calibrate.ts); needs no model. */
+  calibrate(data: RequestData<"calibrate">): Promise<ResultOf<"calibrate">> {
+    this.heal();
+    return this.guarded(() => this.handles[0].call("calibrate", data));
+  }
+
   /** For tests: makes the wasm panic in one worker. */
   crash(): Promise<void> {
     return this.guarded(() => this.handles[this.handles.length - 1].call("crash", null));

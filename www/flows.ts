@@ -257,6 +257,7 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.open(r.layers, {});
     s.dropletWidth = r.dropletWidth;
     s.layerHeight = r.layerHeight;
+    s.gcodeFile = { file, header: r.header };
     s.complete = true;
     store.slice = s;
     store.job = null;

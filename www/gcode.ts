@@ -5,7 +5,7 @@
 // layers, line length), with the messages that name the line and the reason.
 
 import init, { GcodeStream } from "./pkg/dropslice.js";
-import type { LayerData } from "./protocol";
+import type { Calibration, LayerData } from "./protocol";
 
 export class GcodeError extends Error {}
 
@@ -29,11 +29,29 @@ function refusal(e: unknown): unknown {
 export class GcodeReader {
   private s: GcodeStream | null = null;
 
-  constructor(private emit: (layer: LayerData) => void) {}
+  /** `counting`: the core keeps counts only (layers come without droplets, roles or travel),
+   *  for [[calibrate]]. */
+  constructor(
+    private emit: (layer: LayerData) => void,
+    private counting = false,
+  ) {}
 
   private get stream(): GcodeStream {
-    this.s ??= new GcodeStream();
+    this.s ??= this.counting ? GcodeStream.counting() : new GcodeStream();
     return this.s;
+  }
+
+  /** After [[finish]]: the core's calibration of the file for a measured `mass` (g) and
+   *  `density` (g/cm³; null: the header's material_density, else the default). Throws the
+   *  core's refusal as a plain Error (not a GcodeError: the file itself was read). */
+  calibrate(mass: number, density: number | null): Calibration {
+    return this.stream.calibrate(mass, density ?? undefined) as Calibration;
+  }
+
+  /** Frees the core's reader (the object is unusable afterwards). */
+  free(): void {
+    this.s?.free();
+    this.s = null;
   }
 
   /** The header's `name = value` lines (before the first command). */

@@ -15,6 +15,7 @@ import { cacheBudgetBytes, Store } from "./store";
 import { hideBanner } from "./views/banner";
 import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
+import { wireCalibrate } from "./views/calibrate";
 import { wireCut } from "./views/cut";
 import { show, wireLayerView } from "./views/layer";
 import { wirePlot } from "./views/plot";
@@ -89,6 +90,7 @@ function wire(): void {
   cutHooks = wireCut(page);
   wirePartDrag(page);
   wirePlot(page, (i) => show(page, i));
+  wireCalibrate(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
     $("legend-voids").hidden = !renderer.showVoids;

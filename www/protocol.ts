@@ -310,6 +310,32 @@ export interface Calls {
   open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
   /** The vertical cut of layers [from, to) (views/cut.ts, src/wasm_cut.rs `Session.cut`). */
   cut: { data: CutRequest; result: CutReply };
+  /** The droplet size from a printed part's mass (views/calibrate.ts, src/calibrate.rs). */
+  calibrate: { data: CalibrateRequest; result: Calibration };
+}
+
+/** A calibration: of a slice (its droplet total, H and aspect as sliced; the core's
+ *  `calibrate`) or of a .gco file (re-read by the core's counting reader: its header's count,
+ *  else its commands', its H and aspect; `density` null: the header's). Refusals are errors
+ *  of kind "calibration" (the core's message); a file it cannot read, kind "import". */
+export type CalibrateRequest =
+  | { from: "slice"; droplets: number; layer_height: number; droplet_aspect: number; mass: number; density: number }
+  | { from: "gcode"; file: Blob; mass: number; density: number | null };
+
+/** src/calibrate.rs `Calibration`. */
+export interface Calibration {
+  droplets: number;
+  count_source: "header" | "commands" | "given";
+  mass_g: number;
+  density_g_cm3: number;
+  layer_height: number;
+  droplet_volume_mm3: number;
+  cell_volume_mm3: number;
+  filling_degree: number;
+  suggested_droplet_aspect: number;
+  current_droplet_aspect: number;
+  /** One line for people, ending in the suggestion. */
+  explanation: string;
 }
 
 /** A vertical cut along `line` = [ax, ay, bx, by] for layers [from, to): `sent` per layer of

@@ -61,6 +61,8 @@ export class Slice {
   seconds: number | null = null;
   /** The job's key (job.ts `Job.key`) the slice was made of. */
   key = "";
+  /** An opened .gco file and its header (source "gco"), for the calibration (views/calibrate.ts). */
+  gcodeFile: { file: Blob; header: Record<string, string> } | null = null;
 
   constructor(
     readonly source: "stl" | "gco",

@@ -8,6 +8,7 @@
 
 import init, { Models, Session, Tally, crash_for_test, default_settings, settings_schema, version, type InitOutput } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
+import { calibrateRequest } from "./calibration";
 import {
   coverageMaskOf,
   isErrorValue,
@@ -260,6 +261,10 @@ async function handle(req: Request): Promise<void> {
       }
       return;
     }
+    case "calibrate":
+      await load();
+      answer(req.kind, req.id, await calibrateRequest(req.data));
+      return;
     case "crash":
       await load();
       crash_for_test();

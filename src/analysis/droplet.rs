@@ -22,11 +22,16 @@ pub fn spheroid_half_height(s: &Settings) -> f64 {
     3.0 * b * b * s.layer_height / (PI * d * d)
 }
 
-/// Every droplet centre of a layer (each droplet of a `G25` line too), in print order.
+/// Every droplet centre of a layer's part (each droplet of a `G25` line too), in print order:
+/// unit 0's droplets (support, printed by unit 1, is not the part the analysis measures).
 pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
-    let mut out = Vec::with_capacity(plan.counts.total() as usize);
+    let mut out = Vec::with_capacity(plan.counts.unit0() as usize);
     let mut at = Point::ZERO;
     for m in &plan.moves {
+        if m.unit != 0 {
+            at = m.to;
+            continue;
+        }
         match m.kind {
             MoveKind::Travel => {}
             MoveKind::Droplet => out.push(m.to),

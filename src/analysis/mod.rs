@@ -41,6 +41,13 @@
 //! the region of a covered point outside it. Both are sampled at the ends and the middle of
 //! each run of cells, so they are exact to about a grid step.
 //!
+//! # Speed
+//! The page's coverage mask takes each cell's share from a table of the counts a cell can
+//! hold (the same rounding as before), and the labelling joins a run to the component above
+//! it without a second search; the figures and masks are those of the paths they replaced,
+//! kept as `Raster::analysis_reference` and `Raster::mask_reference` for tests
+//! (tests/analysis_fast.rs). docs/quality.md (*Analysis speed*) has the profile.
+//!
 //! # Memory
 //! The grids span the layer's bounding box, but only tiles near its region and droplets are
 //! stored ([`Tiles`]): the 2D bitmaps in tiles of 64 rows × 256 columns (1.3 mm square with the

@@ -61,6 +61,9 @@ pub struct LayerAnalysis {
     pub boundary_deviation: f64,
     /// Where the larger deviation was found.
     pub deviation_at: Option<Point>,
+    /// The layer's overhang area, mm² (from its plan: [`crate::support::overhang`]).
+    #[serde(default)]
+    pub unsupported_area: f64,
 }
 
 /// A coarse picture of a layer for an overlay: per square cell the share (0 … 255) of it that
@@ -121,7 +124,10 @@ impl CoverageMask {
 
 /// Analyses one layer: its plan against its region (the section, before any offset).
 pub fn analyse_layer(plan: &LayerPlan, region: &Shapes, s: &Settings) -> LayerAnalysis {
-    Raster::new(plan, region, s).analysis()
+    LayerAnalysis {
+        unsupported_area: plan.unsupported_area,
+        ..Raster::new(plan, region, s).analysis()
+    }
 }
 
 /// [`analyse_layer`] and a [`CoverageMask`] with square cells of about `mask_cell` mm (at least
@@ -133,7 +139,11 @@ pub fn analyse_layer_with_mask(
     mask_cell: f64,
 ) -> (LayerAnalysis, CoverageMask) {
     let r = Raster::new(plan, region, s);
-    (r.analysis(), r.mask(mask_cell))
+    let a = LayerAnalysis {
+        unsupported_area: plan.unsupported_area,
+        ..r.analysis()
+    };
+    (a, r.mask(mask_cell))
 }
 
 /// Rows of the 2D grid per band of the sparse raster, and words (of 64 columns) per tile: tiles
@@ -224,6 +234,18 @@ fn count_range(row: &[u64], c0: usize, c1: usize) -> u32 {
             + row[w0 + 1..w1].iter().map(|w| w.count_ones()).sum::<u32>()
             + (row[w1] & m1).count_ones()
     }
+}
+
+/// Bits c0..=c1 of `row` (c1 − c0 < 64) shifted down to bit 0.
+#[inline]
+fn window(row: &[u64], c0: usize, c1: usize) -> u64 {
+    let (w, o) = (c0 >> 6, c0 & 63);
+    let mut v = row[w] >> o;
+    if o != 0 && (c1 >> 6) != w {
+        v |= row[w + 1] << (64 - o);
+    }
+    let n = c1 - c0 + 1;
+    if n < 64 { v & ((1u64 << n) - 1) } else { v }
 }
 
 /// Calls `span(row, xa, xb)` for every inside span (non-zero rule) of `region` on rows at
@@ -583,6 +605,16 @@ impl Raster {
 
     /// The figures of the layer.
     pub fn analysis(&self) -> LayerAnalysis {
+        self.analysis_with(false)
+    }
+
+    /// [`analysis`](Self::analysis) as it was before the fast paths (for tests comparing both).
+    #[doc(hidden)]
+    pub fn analysis_reference(&self) -> LayerAnalysis {
+        self.analysis_with(true)
+    }
+
+    fn analysis_with(&self, reference: bool) -> LayerAnalysis {
         let g = self.grid;
         let tiles = &self.tiles;
         let cell = g.gx * g.gy;
@@ -661,8 +693,12 @@ impl Raster {
                         seg += 1;
                     }
                     let shift = 64 * row.segs[seg].shift();
-                    let boundary =
-                        count_range(&edge, s as usize - shift, e as usize - 1 - shift) > 0;
+                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                    let boundary = if !reference && c1 - c0 < 64 {
+                        window(&edge, c0, c1) != 0
+                    } else {
+                        count_range(&edge, c0, c1) > 0
+                    };
                     runs.push((k as u32, s, e));
                     touches.push(boundary);
                     uf.parent.push(uf.parent.len() as u32);
@@ -673,7 +709,13 @@ impl Raster {
                     let (_, s1, e1) = runs[i];
                     let (_, s2, e2) = runs[j];
                     if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                        uf.union(i, j);
+                        if !reference && uf.parent[j] as usize == j {
+                            // The first run above j it joins: j is still alone (a later run
+                            // is never the root of an earlier one).
+                            uf.parent[j] = uf.find(i) as u32;
+                        } else {
+                            uf.union(i, j);
+                        }
                     }
                     if e1 < e2 { i += 1 } else { j += 1 }
                 }
@@ -799,11 +841,23 @@ impl Raster {
             deviation_outward: dev_out.max,
             boundary_deviation,
             deviation_at,
+            unsupported_area: 0.0,
         }
     }
 
     /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
     pub fn mask(&self, cell: f64) -> CoverageMask {
+        self.mask_with(cell, false)
+    }
+
+    /// [`mask`](Self::mask) counting each cell's bits range by range, as before the window
+    /// counts (for tests comparing both).
+    #[doc(hidden)]
+    pub fn mask_reference(&self, cell: f64) -> CoverageMask {
+        self.mask_with(cell, true)
+    }
+
+    fn mask_with(&self, cell: f64, reference: bool) -> CoverageMask {
         let g = self.grid;
         let tiles = &self.tiles;
         let rows = ((cell / g.gy).round() as usize).max(1);
@@ -868,10 +922,12 @@ impl Raster {
                     group += 1;
                 }
                 let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
-                for w in lo..hi {
-                    void[w] = r[w] & !d[w];
-                    over[w] = d[w] & !r[w];
-                    cov[w] = d[w] & r[w];
+                if reference {
+                    for w in lo..hi {
+                        void[w] = r[w] & !d[w];
+                        over[w] = d[w] & !r[w];
+                        cov[w] = d[w] & r[w];
+                    }
                 }
                 let mut t = groups[group].1.start;
                 for seg in row.segs {
@@ -889,15 +945,41 @@ impl Raster {
                         }
                         let tile = &out[t];
                         let slot = &mut counts[t][(my - tile.row) * tile.width + cx - tile.col];
-                        slot[0] += count_range(&void, c0 - shift, c1 - shift);
-                        slot[1] += count_range(&over, c0 - shift, c1 - shift);
-                        slot[2] += count_range(&cov, c0 - shift, c1 - shift);
+                        let (c0, c1) = (c0 - shift, c1 - shift);
+                        if !reference && c1 - c0 < 64 {
+                            // The cell's bits of both rows in one word each.
+                            let (rw, dw) = (window(r, c0, c1), window(d, c0, c1));
+                            slot[0] += (rw & !dw).count_ones();
+                            slot[1] += (dw & !rw).count_ones();
+                            slot[2] += (rw & dw).count_ones();
+                        } else {
+                            if !reference {
+                                for w in c0 >> 6..=c1 >> 6 {
+                                    void[w] = r[w] & !d[w];
+                                    over[w] = d[w] & !r[w];
+                                    cov[w] = d[w] & r[w];
+                                }
+                            }
+                            slot[0] += count_range(&void, c0, c1);
+                            slot[1] += count_range(&over, c0, c1);
+                            slot[2] += count_range(&cov, c0, c1);
+                        }
                     }
                 }
             }
         }
         let full = (rows * cols) as f64;
-        let share = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
+        let share_of = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
+        // The shares of every count a cell can hold, when there are not too many.
+        let table: Vec<u8> = if reference || rows * cols > 1 << 16 {
+            Vec::new()
+        } else {
+            (0..=(rows * cols) as u32).map(share_of).collect()
+        };
+        let share = |n: u32| match table.get(n as usize) {
+            Some(&v) => v,
+            None => share_of(n),
+        };
         for (tile, counts) in out.iter_mut().zip(&counts) {
             tile.void = counts.iter().map(|c| share(c[0])).collect();
             tile.overfill = counts.iter().map(|c| share(c[1])).collect();

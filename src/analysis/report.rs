@@ -32,6 +32,14 @@ pub struct PartAnalysis {
     pub void_volume: f64,
     /// void_volume / volume.
     pub void_fraction: f64,
+    /// Overhang area summed over the layers, mm².
+    #[serde(default)]
+    pub unsupported_area: f64,
+    /// The largest overhang area of a layer, mm², and its layer (from 0).
+    #[serde(default)]
+    pub max_unsupported_area: f64,
+    #[serde(default)]
+    pub max_unsupported_area_layer: Option<usize>,
 }
 
 impl PartAnalysis {
@@ -58,6 +66,11 @@ impl PartAnalysis {
         if l.boundary_deviation > self.max_boundary_deviation {
             self.max_boundary_deviation = l.boundary_deviation;
             self.max_deviation_layer = Some(l.index);
+        }
+        self.unsupported_area += l.unsupported_area;
+        if l.unsupported_area > self.max_unsupported_area {
+            self.max_unsupported_area = l.unsupported_area;
+            self.max_unsupported_area_layer = Some(l.index);
         }
         self.volume += slab_volume;
         self.void_volume += slab_void;
@@ -152,8 +165,10 @@ impl LayerStage {
         let s = &self.settings;
         let centres = droplet_centres(plan, s.droplet_width());
         raster.rebuild(plan.index, plan.z, &centres, region, s);
+        let mut analysis = raster.analysis();
+        analysis.unsupported_area = plan.unsupported_area;
         AnalysedLayer {
-            analysis: raster.analysis(),
+            analysis,
             region: region.clone(),
             map: HeightMap::new(&centres, &self.grid, footprint_diameter(s)),
         }

@@ -541,6 +541,17 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 duration(f.print_seconds),
                 t0.elapsed().as_secs_f64()
             );
+            eprintln!("dropslice: {}", overhang_line(&f));
+            if f.unit1_droplets > 0 {
+                eprintln!(
+                    "dropslice: support (unit 1): {} droplets, {:.2} cm³, {:.2} g, {} of unit 1 and {} of unit 0",
+                    f.unit1_droplets,
+                    f.unit1_volume_mm3 / 1000.0,
+                    f.unit1_mass_g,
+                    duration(f.unit1_seconds),
+                    duration(f.unit0_seconds)
+                );
+            }
         }
         Ok(())
     }
@@ -709,6 +720,19 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             models.push(Model::read(&bytes, &p.file).map_err(|e| named(&p.file, e))?);
         }
         Job::from_models(&models, &spec).map_err(in_file)
+    }
+
+    /// The unsupported area (support on or off): total and the worst layer.
+    fn overhang_line(f: &dropslice::Figures) -> String {
+        match f.worst_overhang {
+            Some(w) => format!(
+                "unsupported (overhang) area {:.1} mm² over all layers; worst layer {}: {:.1} mm²",
+                f.unsupported_area,
+                w.index + 1,
+                w.area
+            ),
+            None => "no overhangs (every layer rests on the one below)".into(),
+        }
     }
 
     /// A print time as the page shows it: "1 h 5 min", "3 min 2 s", "40 s".

@@ -183,6 +183,8 @@ pub struct Cmd {
     pub x: f64,
     pub y: f64,
     pub z: f64,
+    /// The discharge unit selected by the last `T0`/`T1` line before it (0 at the start).
+    pub unit: u8,
 }
 
 impl Cmd {
@@ -205,8 +207,10 @@ pub struct Gcode {
     pub header: Vec<(String, String)>,
     pub layers: Vec<Layer>,
     /// Lines that break SPEC.md's format (not a comment, not `G01/G25/G26 Xx Yy Zz` with
-    /// exactly 4 decimals), with their line numbers.
+    /// exactly 4 decimals, nor `T0`/`T1`), with their line numbers.
     pub bad_lines: Vec<String>,
+    /// `T0`/`T1` lines: (line number from 1, unit).
+    pub unit_lines: Vec<(usize, u8)>,
 }
 
 impl Gcode {
@@ -246,7 +250,17 @@ fn parse_coord(tok: &str, axis: char) -> Option<f64> {
 pub fn parse_gcode(text: &str) -> Gcode {
     let mut g = Gcode::default();
     let mut seen_command = false;
+    let mut unit = 0u8;
     for (n, line) in text.lines().enumerate() {
+        if let Some(u) = match line {
+            "T0" => Some(0),
+            "T1" => Some(1),
+            _ => None,
+        } {
+            unit = u;
+            g.unit_lines.push((n + 1, u));
+            continue;
+        }
         if let Some(c) = line.strip_prefix(';') {
             if !seen_command && let Some((k, v)) = c.split_once(" = ") {
                 let v = v.trim();
@@ -271,6 +285,7 @@ pub fn parse_gcode(text: &str) -> Gcode {
                         x,
                         y,
                         z,
+                        unit,
                     }),
                     _ => None,
                 }
@@ -559,6 +574,7 @@ pub fn droplet_plan<P: Copy + Into<dropslice::geom::Point>>(
                 kind: MoveKind::Droplet,
                 role: Role::Fill,
                 to: to.into(),
+                unit: 0,
             })
             .collect(),
         ..LayerPlan::default()

@@ -194,7 +194,7 @@ test("dragging a part in 3D places it: the core lays the job out again", async (
   // the panel shows the place; Slice says the slice is out of date
   assert.equal(await page.inputValue("#part-place_x"), p.place_x.toFixed(2));
   assert.equal(await page.isChecked("#part-auto"), false);
-  assert.match(await page.locator("#settings-status").innerText(), /changed/);
+  assert.match(await page.locator("#settings-status").innerText(), /The parts changed/);
   // Arrange clears it again
   await page.click("#btn-arrange");
   await page.waitForFunction(() => window.dropslice.job().parts[0].place_x === undefined);

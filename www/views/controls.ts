@@ -29,8 +29,11 @@ function settingsStatus(page: Page): void {
     return;
   }
   const job = store.job;
-  const stale = job !== null && !store.busy && (store.slice?.source !== "stl" || job.key(jobSettings(form.values())) !== store.slice.key);
+  const slice = store.slice;
+  const settings = jobSettings(form.values());
+  const stale = job !== null && !store.busy && (slice?.source !== "stl" || job.key(settings) !== slice.key);
+  const settingsChanged = slice?.source === "stl" && JSON.stringify(settings) !== JSON.stringify(jobSettings(slice.settings));
   st.className = "hint";
-  st.textContent = stale ? "The job or the settings changed: press Slice (or Enter) to update." : "";
+  st.textContent = !stale ? "" : settingsChanged ? "Settings changed: press Slice (or Enter) to update." : "The parts changed: press Slice (or Enter) to update.";
   btn.classList.toggle("attention", stale);
 }

@@ -3,6 +3,7 @@
 
 import type { Page } from "../page";
 import type { Slice } from "../store";
+import { writeCalibration } from "./calibrate";
 import { $, duration, nf, setText } from "./dom";
 import { requestPlot } from "./plot";
 import { writeVoids } from "./voids";
@@ -21,6 +22,7 @@ export function writeStats(page: Page): void {
   const s = store.slice;
   const current = store.current;
   roleLabels(s?.source ?? "stl");
+  writeCalibration(page);
   $("empty").hidden = s !== null;
   if (!s) {
     writeVoids(null, current);

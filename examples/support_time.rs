@@ -1,0 +1,62 @@
+//! Times the support computation's stages on a model (docs/performance.md, "Support"):
+//! `cargo run --release --example support_time -- MODEL.stl`; `AREAS=1` also prints the
+//! overhang and support areas of some layers.
+use dropslice::geom::{Shapes, region_area};
+use dropslice::support::{self, overhang, par_map};
+use dropslice::{Job, Settings};
+use std::time::Instant;
+
+fn points(r: &Shapes) -> usize {
+    r.iter()
+        .map(|s| s.contours().map(|c| c.len()).sum::<usize>())
+        .sum()
+}
+
+fn main() {
+    let path = std::env::args()
+        .nth(1)
+        .expect("usage: support_time MODEL.stl");
+    let bytes = std::fs::read(&path).expect("read the model");
+    let s = Settings {
+        support: dropslice::settings::Support::Unit1,
+        ..Settings::default()
+    };
+    let job = Job::new(&bytes, &path, s.clone()).expect("job");
+    let n = job.layer_count();
+    let t = Instant::now();
+    let regions: Vec<Shapes> = par_map(n, &|i| job.section(i).region);
+    println!("sections        {:.3} s", t.elapsed().as_secs_f64());
+    let t = Instant::now();
+    let _o: Vec<Shapes> = par_map(n, &|i| {
+        overhang(&regions[i], i.checked_sub(1).map(|j| &regions[j]), &s)
+    });
+    println!("overhangs       {:.3} s", t.elapsed().as_secs_f64());
+    let t = Instant::now();
+    let layers = support::support_layers(&regions, &s, |n, f| par_map(n, f));
+    println!(
+        "support_layers  {:.3} s (overhangs included; {} points in the support regions)",
+        t.elapsed().as_secs_f64(),
+        layers.iter().map(|l| points(&l.region)).sum::<usize>()
+    );
+    if std::env::var_os("AREAS").is_some() {
+        for (i, l) in layers.iter().enumerate() {
+            if i % 10 == 0 || l.unsupported_area > 5.0 {
+                println!(
+                    "layer {}: overhang {:.2} mm², support {:.2} mm², part {:.2} mm²",
+                    i + 1,
+                    l.unsupported_area,
+                    region_area(&l.region),
+                    region_area(&regions[i])
+                );
+            }
+        }
+    }
+    let s1 = dropslice::plan::support_settings(&s);
+    let t = Instant::now();
+    let _p: Vec<usize> = par_map(n, &|i| {
+        dropslice::plan::plan_layer(&layers[i].region, i, &s1)
+            .moves
+            .len()
+    });
+    println!("support plans   {:.3} s", t.elapsed().as_secs_f64());
+}

@@ -1,0 +1,355 @@
+//! Overhangs and support (SPEC.md "Two discharge units"; docs/support.md): layer regions →
+//! each layer's overhang (area for the figures) and the support region unit 1 prints.
+//!
+//! **The rule.** A droplet is *supported* when the layer below has material within
+//! `overhang_limit`·B of its centre. Material is the droplets' footprints: discs of diameter B
+//! (B₁ for unit-1 droplets) around their centres. So a droplet centre c of layer n is supported
+//! iff some droplet centre d of layer n − 1 lies within B_d/2 + `overhang_limit`·B of c, where
+//! B_d is d's droplet width (with the defaults: within B). Layer 1 rests on the plate.
+//!
+//! **Region form.** overhang(n) = region(n) − grow(region(n − 1), `overhang_limit`·B): the part
+//! of a layer farther than the limit from the region below (none on layer 1). Its area per
+//! layer and for the part is reported whether or not support is on.
+//!
+//! **Support regions**, top-down, one union, one offset and one clip per layer (no 3D
+//! computation):
+//! need(n) = (need(n + 1) ∪ grow(overhang(n + 1), [`support_reach`])) − region(n) (the part
+//! below carries what it covers), support(n) = need(n) − grow(region(n), `support_gap_xy`·B)
+//! − the grown overhangs of the `support_gap_z` layers directly above. The overhang is grown
+//! by B₁/2 before it is carried down so that the support reaches under the overhang's edge:
+//! unit
+//! 1 prints a support region as the part is printed (one contour loop B₁/2 inside its boundary
+//! and hatch fill, [`crate::plan::plan_unit1`]), and a support band narrower than B₁ would
+//! have no loop. `tests/support.rs` checks the rule on the printed droplets.
+
+use crate::geom::{Shape, Shapes, region_area, shapes_from_overlay, signed_area};
+use crate::offset::CHORD_TOLERANCE_MM;
+use crate::settings::Settings;
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::float::single::SingleFloatOverlay;
+use i_overlay::mesh::float::outline::offset::OutlineOffset;
+use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
+
+/// Loops enclosing less than this are slivers of rounding, not geometry.
+const MIN_AREA_MM2: f64 = 1e-6;
+
+/// A region in the boolean engine's nested form (each shape: outer boundary, then holes).
+fn nested(region: &Shapes) -> Vec<Vec<Vec<[f64; 2]>>> {
+    region
+        .iter()
+        .map(|s| {
+            s.contours()
+                .map(|c| c.iter().map(|p| p.to_array()).collect())
+                .collect()
+        })
+        .collect()
+}
+
+/// Shapes from the engine, without loops of less than [`MIN_AREA_MM2`].
+fn cleaned(shapes: Vec<Vec<Vec<[f64; 2]>>>) -> Shapes {
+    shapes_from_overlay(shapes)
+        .into_iter()
+        .filter(|s| signed_area(&s.outer).abs() >= MIN_AREA_MM2)
+        .map(|s| {
+            let holes = s
+                .holes
+                .into_iter()
+                .filter(|h| signed_area(h).abs() >= MIN_AREA_MM2)
+                .collect();
+            Shape::new(s.outer, holes)
+        })
+        .collect()
+}
+
+/// The region moved outward by `d` mm (round joins, chords within [`CHORD_TOLERANCE_MM`]).
+pub fn grow(region: &Shapes, d: f64) -> Shapes {
+    grow_within(region, d, CHORD_TOLERANCE_MM)
+}
+
+/// How far the support's outlines may stray from the exact construction, mm: its offsets'
+/// chords and its simplified outlines. Support needs no micrometres; fewer points keep its
+/// booleans and its planning fast.
+pub const SUPPORT_TOLERANCE_MM: f64 = 0.005;
+
+/// [`grow`] with chords within `tolerance` of the arcs (the chords lie inside the arcs: the
+/// region grows by between d − tolerance and d).
+pub fn grow_within(region: &Shapes, d: f64, tolerance: f64) -> Shapes {
+    if region.is_empty() || d <= 0.0 {
+        return region.clone();
+    }
+    let angle = 2.0 * (1.0 - (tolerance / d).min(1.0)).acos();
+    let style = OutlineStyle::default()
+        .outer_offset(d)
+        .inner_offset(d)
+        .line_join(LineJoin::Round(angle));
+    cleaned(nested(region).outline(&style))
+}
+
+/// a − b.
+pub fn difference(a: &Shapes, b: &Shapes) -> Shapes {
+    if a.is_empty() || b.is_empty() {
+        return a.clone();
+    }
+    cleaned(nested(a).overlay(&nested(b), OverlayRule::Difference, FillRule::NonZero))
+}
+
+/// a ∩ b.
+pub fn intersection(a: &Shapes, b: &Shapes) -> Shapes {
+    if a.is_empty() || b.is_empty() {
+        return Shapes::new();
+    }
+    cleaned(nested(a).overlay(&nested(b), OverlayRule::Intersect, FillRule::NonZero))
+}
+
+/// a ∪ b.
+pub fn union(a: &Shapes, b: &Shapes) -> Shapes {
+    if a.is_empty() {
+        return b.clone();
+    }
+    if b.is_empty() {
+        return a.clone();
+    }
+    cleaned(nested(a).overlay(&nested(b), OverlayRule::Union, FillRule::NonZero))
+}
+
+/// (a ∪ b) − c in one pass of the boolean engine (the subject's loops under the non-zero rule
+/// are the union), with a's and b's outlines simplified within [`SUPPORT_TOLERANCE_MM`] first.
+fn carried(a: &Shapes, b: &Shapes, c: &Shapes) -> Shapes {
+    if a.is_empty() && b.is_empty() {
+        return Shapes::new();
+    }
+    let simple = |r: &Shapes| -> Vec<Vec<Vec<[f64; 2]>>> {
+        r.iter()
+            .map(|s| {
+                s.contours()
+                    .map(|c| {
+                        crate::slice::simplify_closed(c, SUPPORT_TOLERANCE_MM)
+                            .iter()
+                            .map(|p| p.to_array())
+                            .collect()
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    let mut subject = simple(a);
+    subject.extend(simple(b));
+    if c.is_empty() {
+        return cleaned(subject.overlay(
+            &Vec::<Vec<Vec<[f64; 2]>>>::new(),
+            OverlayRule::Union,
+            FillRule::NonZero,
+        ));
+    }
+    cleaned(subject.overlay(&nested(c), OverlayRule::Difference, FillRule::NonZero))
+}
+
+/// The overhang of a layer: its region farther than `overhang_limit`·B from the region of the
+/// layer below (`None` for layer 1, which rests on the plate: no overhang).
+pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
+    let Some(below) = below else {
+        return Shapes::new();
+    };
+    // What is new in this layer first (a cheap clip): most layers of most parts have little.
+    let fresh = difference(region, below);
+    if region_area(&fresh) < MIN_AREA_MM2 {
+        return Shapes::new();
+    }
+    // Chords within the support's tolerance: the area is a figure, not an outline to print.
+    let d = s.overhang_limit * s.droplet_width();
+    difference(&fresh, &grow_within(below, d, SUPPORT_TOLERANCE_MM))
+}
+
+/// How far beyond an overhang its support reaches, mm: half a unit-1 droplet width B₁, so
+/// the support's contour loop (B₁/2 inside its boundary) runs under the overhang's outline
+/// and the support under an overhang's edge is wider. One whole B₁ measured worse: support
+/// then hangs beyond the edges of the part below (U_overhang.obj), see docs/support.md.
+pub fn support_reach(s: &Settings) -> f64 {
+    0.5 * s.unit1_droplet_width()
+}
+
+/// One layer's overhang area and the support region unit 1 prints in it.
+#[derive(Clone, Debug, Default)]
+pub struct LayerSupport {
+    /// Area of the layer's overhang, mm².
+    pub unsupported_area: f64,
+    /// Where unit 1 prints support (empty with `support = off`).
+    pub region: Shapes,
+}
+
+/// Every layer's overhang and support region from all layers' regions (bottom first).
+/// `par_map(n, f)` evaluates `f(0..n)` (on several threads natively; in order in a worker).
+pub fn support_layers(
+    regions: &[Shapes],
+    s: &Settings,
+    par_map: impl Fn(usize, &(dyn Fn(usize) -> Shapes + Sync)) -> Vec<Shapes>,
+) -> Vec<LayerSupport> {
+    let n = regions.len();
+    let overhangs = par_map(n, &|i| {
+        overhang(&regions[i], i.checked_sub(1).map(|j| &regions[j]), s)
+    });
+    let reach = support_reach(s);
+    let grown: Vec<Shapes> = par_map(n, &|i| {
+        grow_within(&overhangs[i], reach, SUPPORT_TOLERANCE_MM)
+    });
+    // Top-down: what the layers above still need carried (the part below carries what it
+    // covers).
+    let mut needs = vec![Shapes::new(); n];
+    let mut need = Shapes::new();
+    for i in (0..n.saturating_sub(1)).rev() {
+        if need.is_empty() && grown[i + 1].is_empty() {
+            continue;
+        }
+        need = carried(&need, &grown[i + 1], &regions[i]);
+        needs[i] = need.clone();
+    }
+    let gap_xy = s.support_gap_xy * s.droplet_width();
+    let gap_z = s.support_gap_z as usize;
+    // Each layer's part and the gap around it (chords lie inside the arcs: grown by the
+    // tolerance more, never less than the gap).
+    let keep_off: Vec<Shapes> = par_map(n, &|i| {
+        if gap_xy > 0.0 && !needs[i].is_empty() {
+            grow_within(
+                &regions[i],
+                gap_xy + SUPPORT_TOLERANCE_MM,
+                SUPPORT_TOLERANCE_MM,
+            )
+        } else {
+            Shapes::new()
+        }
+    });
+    let supports = par_map(n, &|i| {
+        if needs[i].is_empty() {
+            return Shapes::new();
+        }
+        let mut region = difference(&needs[i], &keep_off[i]);
+        for k in 1..=gap_z.min(n - 1 - i) {
+            region = difference(&region, &grown[i + k]);
+        }
+        region
+    });
+    overhangs
+        .iter()
+        .zip(supports)
+        .map(|(o, region)| LayerSupport {
+            unsupported_area: region_area(o),
+            region,
+        })
+        .collect()
+}
+
+/// `f(0..n)` on all cores (natively), in index order of the result.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn par_map<R: Send>(n: usize, f: &(dyn Fn(usize) -> R + Sync)) -> Vec<R> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |t| t.get())
+        .min(n.max(1));
+    let next = AtomicUsize::new(0);
+    let mut parts: Vec<Vec<(usize, R)>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut mine = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        if i >= n {
+                            break mine;
+                        }
+                        mine.push((i, f(i)));
+                    }
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    let mut all: Vec<(usize, R)> = parts.drain(..).flatten().collect();
+    all.sort_unstable_by_key(|(i, _)| *i);
+    all.into_iter().map(|(_, r)| r).collect()
+}
+
+/// `f(0..n)` in order (a wasm worker is single-threaded).
+#[cfg(target_arch = "wasm32")]
+pub fn par_map<R: Send>(n: usize, f: &(dyn Fn(usize) -> R + Sync)) -> Vec<R> {
+    (0..n).map(f).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::DVec2;
+
+    fn square(x0: f64, y0: f64, a: f64) -> Shapes {
+        let outer = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
+            .map(DVec2::from)
+            .into();
+        vec![Shape::new(outer, vec![])]
+    }
+
+    #[test]
+    fn a_wider_layer_overhangs_by_its_band_beyond_the_limit() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        // 10 mm square on a 10 mm square shifted 2 mm in x: the overhang is the strip
+        // 2 − 0.5·B wide.
+        let o = overhang(&square(2.0, 0.0, 10.0), Some(&square(0.0, 0.0, 10.0)), &s);
+        let want = (2.0 - 0.5 * b) * 10.0;
+        assert!((region_area(&o) - want).abs() < 1e-3, "{}", region_area(&o));
+        // The same square above: none; the first layer: none.
+        assert!(overhang(&square(0.0, 0.0, 10.0), Some(&square(0.0, 0.0, 10.0)), &s).is_empty());
+        assert!(overhang(&square(0.0, 0.0, 10.0), None, &s).is_empty());
+        // Within the limit: none.
+        let o = overhang(
+            &square(0.4 * b, 0.0, 10.0),
+            Some(&square(0.0, 0.0, 10.0)),
+            &s,
+        );
+        assert!(region_area(&o) < 1e-9);
+    }
+
+    #[test]
+    fn grow_moves_a_square_outward_with_round_corners() {
+        let g = grow(&square(0.0, 0.0, 10.0), 1.0);
+        let want = 100.0 + 4.0 * 10.0 + std::f64::consts::PI;
+        assert!((region_area(&g) - want).abs() < 0.01, "{}", region_area(&g));
+    }
+
+    #[test]
+    fn support_fills_under_a_floating_slab_down_to_the_plate() {
+        // A post (layers 0..5) and a slab beside it on layers 5..8.
+        let s = Settings::default();
+        let mut regions = vec![square(0.0, 0.0, 2.0); 5];
+        regions.extend(vec![
+            union(&square(0.0, 0.0, 2.0), &square(2.0, 0.0, 4.0));
+            3
+        ]);
+        let serial = |n: usize, f: &(dyn Fn(usize) -> Shapes + Sync)| (0..n).map(f).collect();
+        let layers = support_layers(&regions, &s, serial);
+        assert!(
+            layers[5].unsupported_area > 7.0,
+            "{}",
+            layers[5].unsupported_area
+        );
+        assert_eq!(layers[6].unsupported_area, 0.0);
+        for (i, l) in layers.iter().enumerate() {
+            // Under the slab on layers 0..5, nothing from layer 5 up.
+            assert_eq!(l.region.is_empty(), i >= 5, "layer {i}");
+            if i < 5 {
+                // The slab's area beyond the post less the gap, plus the reach around it.
+                let a = region_area(&l.region);
+                assert!(
+                    a > 4.0 * 4.0 - 4.0 * 0.5 * s.droplet_width() && a < 30.0,
+                    "{a}"
+                );
+                // Kept the gap away from the post.
+                let gap = s.support_gap_xy * s.droplet_width() - 1e-3;
+                let apart = difference(&l.region, &grow(&square(0.0, 0.0, 2.0), gap));
+                assert!((region_area(&apart) - a).abs() < 1e-6);
+            }
+        }
+    }
+}
