@@ -161,6 +161,15 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
     difference(&fresh, &grow_within(below, d, SUPPORT_TOLERANCE_MM))
 }
 
+/// Experimental: [`overhang`] without the fresh prefilter.
+pub fn overhang_fast(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
+    let Some(below) = below else {
+        return Shapes::new();
+    };
+    let d = s.overhang_limit * s.droplet_width();
+    difference(region, &grow_within(below, d, SUPPORT_TOLERANCE_MM))
+}
+
 /// How far beyond an overhang its support reaches, mm: half a unit-1 droplet width B₁, so
 /// the support's contour loop (B₁/2 inside its boundary) runs under the overhang's outline
 /// and the support under an overhang's edge is wider. One whole B₁ measured worse: support
