@@ -53,7 +53,7 @@ pub struct Counts {
     /// Support droplets (all printed by unit 1).
     #[serde(default)]
     pub support: u64,
-    /// Droplets of any role printed by unit 1 (today: the support).
+    /// Droplets of any role printed by unit 1 (its parts' and the support).
     #[serde(default)]
     pub unit1: u64,
 }
