@@ -495,7 +495,24 @@ impl Job {
     /// [`plan_layer`](Self::plan_layer) and the region unit 0 prints in the layer (its section
     /// in a job without unit-1 parts), which the analysis needs.
     pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
-        let section = self.section(i);
+        self.plan_layer_with(i, self.section(i), None)
+    }
+
+    /// Whether planning a layer needs the section of the layer below (for the overhang
+    /// figure: with support off; with support on it comes from [`Job::support_layers`]).
+    pub fn needs_below(&self) -> bool {
+        self.settings.support != settings::Support::Unit1
+    }
+
+    /// [`plan_layer_and_region`](Self::plan_layer_and_region) given the layer's section and,
+    /// when known, the region of layer i − 1's section (else it is sliced again when
+    /// [`Job::needs_below`]): the native writer hands it from layer to layer.
+    pub fn plan_layer_with(
+        &self,
+        i: usize,
+        section: Section,
+        below: Option<&geom::Shapes>,
+    ) -> (LayerPlan, geom::Shapes) {
         let (mut plan, own) = if self.groups.is_empty() {
             (plan::plan_layer(&section.region, i, &self.settings), None)
         } else {
@@ -511,8 +528,16 @@ impl Job {
             &layer.region
         } else {
             // Layers stay independent: the overhang needs only the section below.
-            let below = i.checked_sub(1).map(|j| self.section(j).region);
-            let over = support::overhang(&section.region, below.as_ref(), &self.settings);
+            let sliced;
+            let below = match (i.checked_sub(1), below) {
+                (None, _) => None,
+                (Some(_), Some(b)) => Some(b),
+                (Some(j), None) => {
+                    sliced = self.section(j).region;
+                    Some(&sliced)
+                }
+            };
+            let over = support::overhang(&section.region, below, &self.settings);
             plan.unsupported_area = geom::region_area(&over);
             &no_support
         };
@@ -957,9 +982,13 @@ where
     W: std::io::Write + ?Sized,
     K: LayerSink,
 {
-    use std::collections::BTreeMap;
+    use std::collections::{BTreeMap, HashMap};
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-    use std::sync::{Condvar, Mutex};
+    use std::sync::{Condvar, Mutex, MutexGuard};
+
+    fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+        m.lock().unwrap_or_else(|p| p.into_inner())
+    }
 
     /// A layer's text, plan (without its moves), sink output, and first and last unit.
     type Done<T> = Result<(String, LayerPlan, T, Option<u8>, Option<u8>), String>;
@@ -981,6 +1010,12 @@ where
         written: 0,
     });
     let changed = Condvar::new();
+    // Each layer's region, from its worker to the worker of the layer above (the overhang
+    // needs it; slicing it again cost about a fifth of the time). `None`: its worker failed.
+    let regions: Mutex<HashMap<usize, Option<std::sync::Arc<geom::Shapes>>>> =
+        Mutex::new(HashMap::new());
+    let published = Condvar::new();
+    let needs_below = job.needs_below();
     let mut summary = Summary::default();
     // The unit selected after the layers written so far (a file starts with unit 0).
     let mut unit = 0u8;
@@ -988,6 +1023,7 @@ where
     std::thread::scope(|scope| -> Result<(), Error> {
         for mut state in states {
             let (next, stop, shared, changed) = (&next, &stop, &shared, &changed);
+            let (regions, published) = (&regions, &published);
             scope.spawn(move || {
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
@@ -1003,8 +1039,38 @@ where
                     if stop.load(Ordering::Relaxed) {
                         break;
                     }
+                    let section =
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.section(i)));
+                    if needs_below {
+                        let mine = section
+                            .as_ref()
+                            .ok()
+                            .map(|s| std::sync::Arc::new(s.region.clone()));
+                        lock(regions).insert(i, mine);
+                        published.notify_all();
+                    }
+                    // The region below from its worker (it took its layer before this one and
+                    // publishes it first thing); sliced here if that worker failed or stopped.
+                    let below = match i.checked_sub(1) {
+                        Some(j) if needs_below => {
+                            let mut g = lock(regions);
+                            loop {
+                                if let Some(r) = g.remove(&j) {
+                                    break r;
+                                }
+                                if stop.load(Ordering::Relaxed) {
+                                    break None;
+                                }
+                                g = published
+                                    .wait_timeout(g, std::time::Duration::from_millis(20))
+                                    .map_or_else(|p| p.into_inner().0, |r| r.0);
+                            }
+                        }
+                        _ => None,
+                    };
                     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                        let (mut p, region) = job.plan_layer_and_region(i);
+                        let section = section.unwrap_or_else(|p| std::panic::resume_unwind(p));
+                        let (mut p, region) = job.plan_layer_with(i, section, below.as_deref());
                         let text = gcode::layer_text(&p);
                         let extra = K::per_layer(&mut state, i, &region, &p);
                         let units = (p.first_unit(), p.moves.last().map(|m| m.unit));
