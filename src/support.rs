@@ -200,8 +200,7 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
     }
     let m = d + 1.0;
     let (lo, hi) = (lo - DVec2::splat(m), hi + DVec2::splat(m));
-    let frame: crate::geom::Contour =
-        vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)].into();
+    let frame: crate::geom::Contour = vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
     let holes = below
         .iter()
         .flat_map(|s| s.contours())
