@@ -35,6 +35,7 @@ pub mod slice;
 pub mod stl;
 pub mod summary;
 pub mod support;
+pub mod support_droplets;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 #[cfg(target_arch = "wasm32")]
@@ -106,6 +107,9 @@ pub struct Job {
     /// Every layer's overhang area and support region, computed on first use when
     /// `support` is on (it needs all layers' sections; see [`Job::support_layers`]).
     support: std::sync::OnceLock<Vec<support::LayerSupport>>,
+    /// Every layer's plan with support (`support = unit1`), computed on first use: the
+    /// droplet-level pass needs all layers' droplets (see [`Job::supported_plans`]).
+    supported: std::sync::OnceLock<(Vec<LayerPlan>, support_droplets::PassFigures)>,
 }
 
 impl Job {
@@ -324,6 +328,7 @@ impl Job {
             zs,
             info,
             support: std::sync::OnceLock::new(),
+            supported: std::sync::OnceLock::new(),
         }
     }
 
@@ -354,6 +359,76 @@ impl Job {
                     region: geom::Shapes::new(),
                 })
             }
+        })
+    }
+
+    /// Every layer's plan with support on (`support = unit1`), computed once per job on first
+    /// use: each layer's part planned as without support, its support region hatched by unit 1
+    /// ([`plan::support_moves`]), then the droplet-level pass over all layers
+    /// ([`support_droplets::complete`]) adds unit-1 droplets under every droplet the layer
+    /// below leaves unsupported. Natively the layers are planned in parallel; in the page each
+    /// worker's job plans them all once (docs/support.md).
+    pub fn supported_plans(&self) -> &[LayerPlan] {
+        &self.supported_pass().0
+    }
+
+    /// [`Job::supported_plans`] and what the droplet-level pass added.
+    pub fn supported_pass(&self) -> &(Vec<LayerPlan>, support_droplets::PassFigures) {
+        self.supported.get_or_init(|| {
+            let n = self.layer_count();
+            let layers = self.support_layers();
+            let s = &self.settings;
+            // The part's plan and unit 1's hatch moves of each layer.
+            let planned: Vec<(LayerPlan, Vec<plan::Move>, geom::Shapes)> =
+                support::par_map(n, &|i| {
+                    let section = self.section(i);
+                    let mut p = plan::plan_layer(&section.region, i, s);
+                    p.open_chains = section.open_chains;
+                    p.reoriented_loops = section.reoriented_loops;
+                    p.unsupported_area = layers[i].unsupported_area;
+                    let start = plan::unit1_start(&p, s);
+                    let moves = plan::support_moves(&layers[i].region, &[], i, s, start);
+                    (p, moves, section.region)
+                });
+            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+            let droplets = |moves: &[plan::Move], out: &mut Vec<support_droplets::Droplet>| {
+                let mut at = geom::Point::ZERO;
+                for m in moves {
+                    let w = if m.unit == 1 { b1 } else { b };
+                    match m.kind {
+                        plan::MoveKind::Droplet => out.push((m.to, w)),
+                        plan::MoveKind::Line => {
+                            out.extend(geom::line_droplets(at, m.to, w).map(|p| (p, w)))
+                        }
+                        plan::MoveKind::Travel => {}
+                    }
+                    at = m.to;
+                }
+            };
+            let all: Vec<Vec<support_droplets::Droplet>> = support::par_map(n, &|i| {
+                let mut out = Vec::new();
+                droplets(&planned[i].0.moves, &mut out);
+                droplets(&planned[i].1, &mut out);
+                out
+            });
+            let regions: Vec<geom::Shapes> = planned.iter().map(|p| p.2.clone()).collect();
+            let (extra, figures) =
+                support_droplets::complete(&all, &regions, s, |n, f| support::par_map(n, f));
+            drop(all);
+            let planned = std::sync::Mutex::new(planned.into_iter().map(Some).collect::<Vec<_>>());
+            let plans = support::par_map(n, &|i| {
+                let (mut p, mut moves, _) = planned.lock().unwrap_or_else(|e| e.into_inner())[i]
+                    .take()
+                    .expect("each layer once");
+                if !extra[i].is_empty() {
+                    let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+                    let more = plan::support_moves(&geom::Shapes::new(), &extra[i], i, s, start);
+                    moves.extend(more);
+                }
+                plan::add_unit1(&mut p, moves, s);
+                p
+            });
+            (plans, figures)
         })
     }
 
@@ -413,25 +488,17 @@ impl Job {
     /// [`plan_layer`](Self::plan_layer) and the layer's region (its section), which the
     /// analysis needs.
     pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
+        if self.uses_unit1() {
+            return (self.supported_plans()[i].clone(), self.section(i).region);
+        }
         let section = self.section(i);
         let mut plan = plan::plan_layer(&section.region, i, &self.settings);
         plan.open_chains = section.open_chains;
         plan.reoriented_loops = section.reoriented_loops;
-        if self.uses_unit1() {
-            let layer = &self.support_layers()[i];
-            plan.unsupported_area = layer.unsupported_area;
-            plan::plan_unit1(
-                &mut plan,
-                &layer.region,
-                plan::Role::Support,
-                &self.settings,
-            );
-        } else {
-            // Layers stay independent: the overhang needs only the section below.
-            let below = i.checked_sub(1).map(|j| self.section(j).region);
-            let over = support::overhang(&section.region, below.as_ref(), &self.settings);
-            plan.unsupported_area = geom::region_area(&over);
-        }
+        // Layers stay independent: the overhang needs only the section below.
+        let below = i.checked_sub(1).map(|j| self.section(j).region);
+        let over = support::overhang(&section.region, below.as_ref(), &self.settings);
+        plan.unsupported_area = geom::region_area(&over);
         (plan, section.region)
     }
 

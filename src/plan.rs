@@ -329,34 +329,109 @@ pub fn plan_unit1(plan: &mut LayerPlan, region: &Shapes, role: Role, s: &Setting
         return;
     }
     let s1 = support_settings(s);
-    let b1 = s1.droplet_width();
-    let unit0_first = s.unit_order == crate::settings::UnitOrder::Unit0First;
-    let start = if unit0_first {
+    let mut p1 = plan_layer_from(region, plan.index, &s1, unit1_start(plan, s));
+    for m in &mut p1.moves {
+        m.role = role;
+    }
+    add_unit1(plan, p1.moves, s);
+}
+
+/// Where unit 1 starts in a layer whose unit-0 moves are planned: after them, or at the origin
+/// with `unit_order = unit1_first`.
+pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
+    if s.unit_order == crate::settings::UnitOrder::Unit0First {
         plan.moves.last().map_or(Point::ZERO, |m| m.to)
     } else {
         Point::ZERO
-    };
-    let mut p1 = plan_layer_from(region, plan.index, &s1, start);
-    if p1.moves.is_empty() {
+    }
+}
+
+/// Unit 1's moves for a support region (SPEC.md: "printed by unit 1 as hatch fill at
+/// `support_density`"), from `start`: the region hatched directly at the layer's hatch angle,
+/// lines B₁ / `support_density` apart, every line's droplets on a lattice of pitch B₁ along it
+/// (ends moved inward to lattice points, so no droplet centre leaves the region), then single
+/// droplets at `extra` (the droplet-level pass, [`crate::support_droplets`]), nearest first.
+/// No offsets: the region is printed up to its boundary. Positions are rounded as written.
+pub fn support_moves(
+    region: &Shapes,
+    extra: &[Point],
+    index: usize,
+    s: &Settings,
+    start: Point,
+) -> Vec<Move> {
+    let s1 = support_settings(s);
+    let b1 = s1.droplet_width();
+    let mut moves = Vec::new();
+    let mut at = start;
+    if s1.fill_density > 0.0 && !region.is_empty() {
+        let lines = hatch_at(
+            region,
+            hatch_angle(s, index),
+            b1 / s1.fill_density,
+            0.5,
+            Some((b1, 0.0, 0.0)),
+        );
+        for l in order_greedy(lines, at) {
+            moves.push(Move {
+                kind: MoveKind::Travel,
+                role: Role::Support,
+                to: round_output(l.a),
+                unit: 1,
+            });
+            moves.push(Move {
+                kind: MoveKind::Line,
+                role: Role::Support,
+                to: round_output(l.b),
+                unit: 1,
+            });
+            at = l.b;
+        }
+    }
+    let mut left: Vec<Point> = extra.to_vec();
+    while !left.is_empty() {
+        let next = (0..left.len())
+            .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
+            .expect("non-empty");
+        let p = left.swap_remove(next);
+        moves.push(Move {
+            kind: MoveKind::Droplet,
+            role: Role::Support,
+            to: round_output(p),
+            unit: 1,
+        });
+        at = p;
+    }
+    moves
+}
+
+/// Adds unit-1 moves (planned from [`unit1_start`]) to a layer planned for unit 0, in the
+/// order `unit_order` gives: the counts, B₁ and the travel follow. Unit 0's moves stay
+/// exactly as planned; only the travel between the two units' moves changes.
+pub fn add_unit1(plan: &mut LayerPlan, mut moves: Vec<Move>, s: &Settings) {
+    if moves.is_empty() {
         return;
     }
-    for m in &mut p1.moves {
+    let b1 = support_settings(s).droplet_width();
+    let unit0_first = s.unit_order == crate::settings::UnitOrder::Unit0First;
+    let mut at = unit1_start(plan, s);
+    for m in &mut moves {
         m.unit = 1;
-        m.role = role;
+        if m.kind != MoveKind::Line {
+            plan.travel_mm += dist(at, m.to);
+        }
+        at = m.to;
     }
-    let c1 = count_units(&p1.moves, b1, b1);
+    let c1 = count_units(&moves, b1, b1);
     plan.counts.add(&c1);
     plan.unit1_width = b1;
-    plan.travel_mm += p1.travel_mm;
     if unit0_first {
-        plan.moves.extend(p1.moves);
+        plan.moves.extend(moves);
     } else {
         // Unit 0 was planned from the origin; it now starts where unit 1 ends.
-        let end = p1.moves.last().map_or(Point::ZERO, |m| m.to);
         if let Some(first) = plan.moves.first() {
-            plan.travel_mm += dist(end, first.to) - dist(Point::ZERO, first.to);
+            plan.travel_mm += dist(at, first.to) - dist(Point::ZERO, first.to);
         }
-        p1.moves.append(&mut plan.moves);
-        plan.moves = p1.moves;
+        moves.append(&mut plan.moves);
+        plan.moves = moves;
     }
 }
