@@ -97,6 +97,13 @@ pub fn suggested_scale(size: &[f64; 3]) -> Option<f64> {
     }
 }
 
+/// Every layer's plan and region with support on, and what the droplet-level pass added
+/// ([`Job::supported_pass`]).
+pub struct SupportedPlans {
+    pub layers: Vec<(LayerPlan, geom::Shapes)>,
+    pub figures: support_droplets::PassFigures,
+}
+
 /// One prepared slicing job: the placed mesh, its plane heights and a facet index per layer.
 pub struct Job {
     settings: Settings,
@@ -109,7 +116,7 @@ pub struct Job {
     support: std::sync::OnceLock<Vec<support::LayerSupport>>,
     /// Every layer's plan with support (`support = unit1`), computed on first use: the
     /// droplet-level pass needs all layers' droplets (see [`Job::supported_plans`]).
-    supported: std::sync::OnceLock<(Vec<LayerPlan>, support_droplets::PassFigures)>,
+    supported: std::sync::OnceLock<SupportedPlans>,
 }
 
 impl Job {
@@ -368,28 +375,18 @@ impl Job {
     /// ([`support_droplets::complete`]) adds unit-1 droplets under every droplet the layer
     /// below leaves unsupported. Natively the layers are planned in parallel; in the page each
     /// worker's job plans them all once (docs/support.md).
-    pub fn supported_plans(&self) -> &[LayerPlan] {
-        &self.supported_pass().0
+    pub fn supported_plans(&self) -> &[(LayerPlan, geom::Shapes)] {
+        &self.supported_pass().layers
     }
 
     /// [`Job::supported_plans`] and what the droplet-level pass added.
-    pub fn supported_pass(&self) -> &(Vec<LayerPlan>, support_droplets::PassFigures) {
+    pub fn supported_pass(&self) -> &SupportedPlans {
         self.supported.get_or_init(|| {
             let n = self.layer_count();
-            let layers = self.support_layers();
             let s = &self.settings;
-            // The part's plan and unit 1's hatch moves of each layer.
-            let planned: Vec<(LayerPlan, Vec<plan::Move>, geom::Shapes)> =
-                support::par_map(n, &|i| {
-                    let section = self.section(i);
-                    let mut p = plan::plan_layer(&section.region, i, s);
-                    p.open_chains = section.open_chains;
-                    p.reoriented_loops = section.reoriented_loops;
-                    p.unsupported_area = layers[i].unsupported_area;
-                    let start = plan::unit1_start(&p, s);
-                    let moves = plan::support_moves(&layers[i].region, &[], i, s, start);
-                    (p, moves, section.region)
-                });
+            let sections = support::par_map(n, &|i| self.section(i));
+            let regions: Vec<geom::Shapes> = sections.iter().map(|x| x.region.clone()).collect();
+            let layers = support::support_layers(&regions, s, |n, f| support::par_map(n, f));
             let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
             let droplets = |moves: &[plan::Move], out: &mut Vec<support_droplets::Droplet>| {
                 let mut at = geom::Point::ZERO;
@@ -405,30 +402,46 @@ impl Job {
                     at = m.to;
                 }
             };
-            let all: Vec<Vec<support_droplets::Droplet>> = support::par_map(n, &|i| {
-                let mut out = Vec::new();
-                droplets(&planned[i].0.moves, &mut out);
-                droplets(&planned[i].1, &mut out);
-                out
+            // Each layer's part plan, unit 1's hatch moves and all their droplets.
+            type Planned = (LayerPlan, Vec<plan::Move>, Vec<support_droplets::Droplet>);
+            let planned: Vec<Planned> = support::par_map(n, &|i| {
+                let section = &sections[i];
+                let mut p = plan::plan_layer(&section.region, i, s);
+                p.open_chains = section.open_chains;
+                p.reoriented_loops = section.reoriented_loops;
+                p.unsupported_area = layers[i].unsupported_area;
+                let start = plan::unit1_start(&p, s);
+                let moves =
+                    plan::support_moves(&layers[i].region, &section.region, &[], i, s, start);
+                let mut all = Vec::new();
+                droplets(&p.moves, &mut all);
+                droplets(&moves, &mut all);
+                (p, moves, all)
             });
-            let regions: Vec<geom::Shapes> = planned.iter().map(|p| p.2.clone()).collect();
-            let (extra, figures) =
-                support_droplets::complete(&all, &regions, s, |n, f| support::par_map(n, f));
-            drop(all);
-            let planned = std::sync::Mutex::new(planned.into_iter().map(Some).collect::<Vec<_>>());
-            let plans = support::par_map(n, &|i| {
-                let (mut p, mut moves, _) = planned.lock().unwrap_or_else(|e| e.into_inner())[i]
-                    .take()
-                    .expect("each layer once");
-                if !extra[i].is_empty() {
-                    let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
-                    let more = plan::support_moves(&geom::Shapes::new(), &extra[i], i, s, start);
-                    moves.extend(more);
-                }
-                plan::add_unit1(&mut p, moves, s);
-                p
-            });
-            (plans, figures)
+            drop(layers);
+            let (extra, figures) = {
+                let all: Vec<&[support_droplets::Droplet]> =
+                    planned.iter().map(|p| &p.2[..]).collect();
+                support_droplets::complete(&all, &regions, s, |n, f| support::par_map(n, f))
+            };
+            let plans = planned
+                .into_iter()
+                .zip(regions)
+                .enumerate()
+                .map(|(i, ((mut p, mut moves, _), region))| {
+                    if !extra[i].is_empty() {
+                        let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+                        let none = geom::Shapes::new();
+                        moves.extend(plan::support_moves(&none, &none, &extra[i], i, s, start));
+                    }
+                    plan::add_unit1(&mut p, moves, s);
+                    (p, region)
+                })
+                .collect();
+            SupportedPlans {
+                layers: plans,
+                figures,
+            }
         })
     }
 
@@ -489,7 +502,7 @@ impl Job {
     /// analysis needs.
     pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
         if self.uses_unit1() {
-            return (self.supported_plans()[i].clone(), self.section(i).region);
+            return self.supported_plans()[i].clone();
         }
         let section = self.section(i);
         let mut plan = plan::plan_layer(&section.region, i, &self.settings);

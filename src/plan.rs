@@ -3,7 +3,7 @@
 
 use crate::contours::{Loop, contours};
 use crate::droplets::loop_droplets_spaced;
-use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, line_droplets, round_output};
 use crate::hatch::{hatch_at, order_greedy};
 use crate::settings::{ContourOrder, PrintOrder, Settings};
 use serde::{Deserialize, Serialize};
@@ -349,11 +349,13 @@ pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
 /// Unit 1's moves for a support region (SPEC.md: "printed by unit 1 as hatch fill at
 /// `support_density`"), from `start`: the region hatched directly at the layer's hatch angle,
 /// lines B₁ / `support_density` apart, every line's droplets on a lattice of pitch B₁ along it
-/// (ends moved inward to lattice points, so no droplet centre leaves the region), then single
-/// droplets at `extra` (the droplet-level pass, [`crate::support_droplets`]), nearest first.
-/// No offsets: the region is printed up to its boundary. Positions are rounded as written.
+/// (ends moved inward to lattice points, so no droplet centre leaves the region), without the
+/// droplets closer than `support_gap_xy`·B to the part's region `part` (a line is split
+/// there); then single droplets at `extra` (the droplet-level pass,
+/// [`crate::support_droplets`]), nearest first. No offsets. Positions are rounded as written.
 pub fn support_moves(
     region: &Shapes,
+    part: &Shapes,
     extra: &[Point],
     index: usize,
     s: &Settings,
@@ -371,19 +373,58 @@ pub fn support_moves(
             0.5,
             Some((b1, 0.0, 0.0)),
         );
-        for l in order_greedy(lines, at) {
-            moves.push(Move {
-                kind: MoveKind::Travel,
-                role: Role::Support,
-                to: round_output(l.a),
-                unit: 1,
-            });
-            moves.push(Move {
-                kind: MoveKind::Line,
-                role: Role::Support,
-                to: round_output(l.b),
-                unit: 1,
-            });
+        let edges = crate::support_droplets::edges_of(part);
+        let clear = crate::support_droplets::Clearance::new(
+            &edges,
+            s.support_gap_xy * s.droplet_width(),
+            b1,
+        );
+        let mut runs = Vec::with_capacity(lines.len());
+        for l in lines {
+            let mut run: Option<(Point, Point)> = None;
+            // Droplets within `free` of the last one checked keep the gap too.
+            let mut free = f64::NEG_INFINITY;
+            let mut from = l.a;
+            for p in line_droplets(l.a, l.b, b1) {
+                let ok = if dist(p, from) < free {
+                    true
+                } else {
+                    from = p;
+                    free = clear.slack(p, 8.0 * b1);
+                    free > 0.0
+                };
+                if ok {
+                    run = Some(run.map_or((p, p), |(a, _)| (a, p)));
+                } else if let Some((a, b)) = run.take() {
+                    runs.push(crate::hatch::HatchLine { a, b });
+                }
+            }
+            if let Some((a, b)) = run {
+                runs.push(crate::hatch::HatchLine { a, b });
+            }
+        }
+        for l in order_greedy(runs, at) {
+            if dist(l.a, l.b) < 0.5 * b1 {
+                moves.push(Move {
+                    kind: MoveKind::Droplet,
+                    role: Role::Support,
+                    to: round_output(l.a),
+                    unit: 1,
+                });
+            } else {
+                moves.push(Move {
+                    kind: MoveKind::Travel,
+                    role: Role::Support,
+                    to: round_output(l.a),
+                    unit: 1,
+                });
+                moves.push(Move {
+                    kind: MoveKind::Line,
+                    role: Role::Support,
+                    to: round_output(l.b),
+                    unit: 1,
+                });
+            }
             at = l.b;
         }
     }

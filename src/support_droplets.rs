@@ -82,20 +82,25 @@ impl Grid {
 
     /// Whether some droplet d lies within `reach(d's width)` of `p` (reach ≤ the cell).
     fn any_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> bool {
+        self.find_within(p, reach).is_some()
+    }
+
+    /// A droplet d within `reach(d's width)` of `p` (reach ≤ the cell), if any.
+    fn find_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> Option<Droplet> {
         let (cx, cy) = self.key(p);
         for y in (cy - 1).max(0)..=(cy + 1).min(self.ny - 1) {
             for x in (cx - 1).max(0)..=(cx + 1).min(self.nx - 1) {
                 let c = (y * self.nx + x) as usize;
                 let cell = &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize];
-                if cell.iter().any(|&(q, w)| {
+                if let Some(&d) = cell.iter().find(|&&(q, w)| {
                     let r = reach(w);
                     (p - q).length_squared() <= r * r
                 }) {
-                    return true;
+                    return Some(d);
                 }
             }
         }
-        false
+        None
     }
 }
 
@@ -148,27 +153,52 @@ fn inside(region: &Shapes, p: Point) -> bool {
     winding != 0
 }
 
-/// Where a layer may take support droplets: outside its part's region grown by the gap.
-struct Room<'a> {
-    region: &'a Shapes,
-    edges: Vec<(Point, Point)>,
+/// A region's boundary edges.
+pub fn edges_of(region: &Shapes) -> Vec<(Point, Point)> {
+    all_contours(region)
+        .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
+        .collect()
+}
+
+/// Whether points keep `gap` from a region's boundary (edges from [`edges_of`]).
+pub struct Clearance<'a> {
+    edges: &'a [(Point, Point)],
+    index: EdgeIndex<'a>,
     gap: f64,
 }
 
-impl<'a> Room<'a> {
-    fn new(region: &'a Shapes, gap: f64) -> Room<'a> {
-        let edges = all_contours(region)
-            .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
-            .collect();
-        Room { region, edges, gap }
+impl<'a> Clearance<'a> {
+    pub fn new(edges: &'a [(Point, Point)], gap: f64, cell: f64) -> Clearance<'a> {
+        Clearance {
+            edges,
+            index: EdgeIndex::new(edges, cell.max(gap).max(1e-3)),
+            gap,
+        }
     }
 
-    fn allows(&self, index: &EdgeIndex, p: Point) -> bool {
-        let g2 = self.gap * self.gap;
-        !index.any_near(p, self.gap, |e| {
+    /// How far `p` may move and still keep the gap (≤ 0: it does not keep it now), at most
+    /// `most`.
+    pub fn slack(&self, p: Point, most: f64) -> f64 {
+        let r = self.gap + most;
+        let far = !self.index.any_near(p, r, |e| {
             let (a, b) = self.edges[e];
-            segment_distance2(p, a, b) < g2
-        }) && !inside(self.region, p)
+            segment_distance2(p, a, b) < r * r
+        });
+        if far {
+            most
+        } else {
+            self.index.distance(p, 0.0) - self.gap
+        }
+    }
+
+    /// No edge closer than the gap to `p`.
+    pub fn keeps(&self, p: Point) -> bool {
+        let g2 = self.gap * self.gap;
+        self.gap <= 0.0
+            || !self.index.any_near(p, self.gap, |e| {
+                let (a, b) = self.edges[e];
+                segment_distance2(p, a, b) < g2
+            })
     }
 }
 
@@ -201,7 +231,7 @@ pub struct PassFigures {
 /// such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
 /// support deliberately stops below overhangs, and the pass adds nothing.
 pub fn complete(
-    droplets: &[Vec<Droplet>],
+    droplets: &[&[Droplet]],
     regions: &[Shapes],
     s: &Settings,
     par_map: impl Fn(usize, &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>>,
@@ -222,11 +252,28 @@ pub fn complete(
         if i == 0 {
             return Vec::new();
         }
-        let below = Grid::new(cell, &droplets[i - 1]);
+        let below = Grid::new(cell, droplets[i - 1]);
+        // Consecutive droplets are neighbours: the droplet below that supported the last one
+        // most often supports the next.
+        let mut last: Option<Droplet> = None;
         droplets[i]
             .iter()
             .copied()
-            .filter(|&(p, _)| !below.any_within(p, reach))
+            .filter(|&(p, _)| {
+                if let Some((q, w)) = last {
+                    let r = reach(w);
+                    if (p - q).length_squared() <= r * r {
+                        return false;
+                    }
+                }
+                match below.find_within(p, reach) {
+                    Some(d) => {
+                        last = Some(d);
+                        false
+                    }
+                    None => true,
+                }
+            })
             .collect()
     });
     let gap = s.support_gap_xy * b;
@@ -235,7 +282,7 @@ pub fn complete(
     for i in (1..n).rev() {
         let mut todo: Vec<Droplet> = open[i].clone();
         if !extra[i].is_empty() {
-            let below = Grid::new(cell, &droplets[i - 1]);
+            let below = Grid::new(cell, droplets[i - 1]);
             todo.extend(
                 extra[i]
                     .iter()
@@ -246,8 +293,9 @@ pub fn complete(
         if todo.is_empty() {
             continue;
         }
-        let room = Room::new(&regions[i - 1], gap);
-        let index = EdgeIndex::new(&room.edges, gap.max(b));
+        let region = &regions[i - 1];
+        let edges = edges_of(region);
+        let clear = Clearance::new(&edges, gap, b);
         let mut added = Added {
             cell,
             cells: HashMap::new(),
@@ -259,8 +307,8 @@ pub fn complete(
             }
             // Outside the part and its gap; failing that, outside the part (in the gap).
             let found = candidates(c, place)
-                .find(|&p| room.allows(&index, p))
-                .or_else(|| candidates(c, place).find(|&p| !inside(room.region, p)));
+                .find(|&p| clear.keeps(p) && !inside(region, p))
+                .or_else(|| candidates(c, place).find(|&p| !inside(region, p)));
             // As written: the layer below checks the rounded position.
             match found.map(round_output) {
                 Some(p) => {
@@ -288,6 +336,15 @@ mod tests {
         vec![Shape::new(outer, vec![])]
     }
 
+    fn run(
+        droplets: &[Vec<Droplet>],
+        regions: &[Shapes],
+        s: &Settings,
+    ) -> (Vec<Vec<Point>>, PassFigures) {
+        let refs: Vec<&[Droplet]> = droplets.iter().map(|v| &v[..]).collect();
+        complete(&refs, regions, s, serial)
+    }
+
     fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
         (0..n).map(f).collect()
     }
@@ -301,7 +358,7 @@ mod tests {
         let far = (DVec2::new(1.0, 1.0), b);
         let droplets = vec![vec![far], vec![far], vec![far, (DVec2::new(5.0, 5.0), b)]];
         let regions = vec![part.clone(), part.clone(), part];
-        let (extra, figures) = complete(&droplets, &regions, &s, serial);
+        let (extra, figures) = run(&droplets, &regions, &s);
         assert_eq!(figures.unplaceable, 0);
         // One droplet under it on layer 1 and one under that on layer 0.
         assert_eq!(extra[2].len(), 0);
@@ -320,7 +377,7 @@ mod tests {
         let c = DVec2::new(2.0 + 0.2 * b, 1.0);
         let droplets = vec![vec![(DVec2::new(0.5, 1.0), b)], vec![(c, b)]];
         let regions = vec![part.clone(), Shapes::new()];
-        let (extra, figures) = complete(&droplets, &regions, &s, serial);
+        let (extra, figures) = run(&droplets, &regions, &s);
         assert_eq!(figures.added, 1);
         let p = extra[0][0];
         assert!(p.x >= 2.0 + gap - 1e-9, "{p}");
@@ -338,7 +395,7 @@ mod tests {
         let d = |x: f64| (DVec2::new(x, 0.0), b);
         let droplets = vec![vec![d(0.0)], vec![d(0.9 * b)], vec![d(1.8 * b)]];
         let regions = vec![Shapes::new(); 3];
-        let (extra, figures) = complete(&droplets, &regions, &s, serial);
+        let (extra, figures) = run(&droplets, &regions, &s);
         assert!(extra.iter().all(|e| e.is_empty()));
         assert_eq!(figures, PassFigures::default());
         let far = vec![vec![d(0.0)], vec![d(5.0)]];
@@ -346,7 +403,7 @@ mod tests {
             support_gap_z: 1,
             ..s
         };
-        let (extra, _) = complete(&far, &regions[..2], &gap_z, serial);
+        let (extra, _) = run(&far, &regions[..2], &gap_z);
         assert!(extra.iter().all(|e| e.is_empty()));
     }
 }
