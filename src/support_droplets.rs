@@ -20,8 +20,8 @@ pub type Droplet = (Point, f64);
 /// cannot break it (positions are rounded to 0.05 µm).
 const MARGIN_MM: f64 = 1e-3;
 
-/// Droplets of a layer in cells of a fixed size over their bounding box (counts, then the
-/// droplets sorted by cell).
+/// Droplets of a layer in cells over their bounding box (counts, then the droplets sorted by
+/// cell), cells at least the rule's distance.
 struct Grid {
     cell: f64,
     min: Point,
@@ -42,6 +42,10 @@ impl Grid {
         if droplets.is_empty() {
             (min, max) = (DVec2::ZERO, DVec2::ZERO);
         }
+        // About one cell per droplet at most, however large the layer: memory stays
+        // proportional to the droplets (larger cells still hold every droplet within reach).
+        let spread = ((max.x - min.x) * (max.y - min.y) / droplets.len().max(1) as f64).sqrt();
+        let cell = cell.max(spread);
         let nx = ((max.x - min.x) / cell).floor() as i64 + 1;
         let ny = ((max.y - min.y) / cell).floor() as i64 + 1;
         let mut g = Grid {
