@@ -51,12 +51,33 @@ fn main() {
             }
         }
     }
-    let s1 = dropslice::plan::support_settings(&s);
     let t = Instant::now();
     let _p: Vec<usize> = par_map(n, &|i| {
-        dropslice::plan::plan_layer(&layers[i].region, i, &s1)
-            .moves
-            .len()
+        dropslice::plan::support_moves(
+            &layers[i].region,
+            &regions[i],
+            &[],
+            i,
+            &s,
+            Default::default(),
+        )
+        .len()
     });
-    println!("support plans   {:.3} s", t.elapsed().as_secs_f64());
+    println!("support hatch   {:.3} s", t.elapsed().as_secs_f64());
+    let t = Instant::now();
+    let _p: Vec<usize> = par_map(n, &|i| {
+        dropslice::plan::plan_layer(&regions[i], i, &s).moves.len()
+    });
+    println!("part plans      {:.3} s", t.elapsed().as_secs_f64());
+    // The job's own pass: sections, support regions, all plans and the droplet pass.
+    let t = Instant::now();
+    let pass = job.supported_pass();
+    let (plans, figures) = (&pass.layers, &pass.figures);
+    println!(
+        "supported plans {:.3} s (everything: {} droplets added, {} unplaceable; {} moves)",
+        t.elapsed().as_secs_f64(),
+        figures.added,
+        figures.unplaceable,
+        plans.iter().map(|p| p.0.moves.len()).sum::<usize>()
+    );
 }

@@ -35,6 +35,7 @@ pub mod slice;
 pub mod stl;
 pub mod summary;
 pub mod support;
+pub mod support_droplets;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 #[cfg(target_arch = "wasm32")]
@@ -122,6 +123,13 @@ pub fn suggested_scale(size: &[f64; 3]) -> Option<f64> {
     }
 }
 
+/// Every layer's plan and region with support on, and what the droplet-level pass added
+/// ([`Job::supported_pass`]).
+pub struct SupportedPlans {
+    pub layers: Vec<(LayerPlan, geom::Shapes)>,
+    pub figures: support_droplets::PassFigures,
+}
+
 /// One prepared slicing job: the placed mesh, its plane heights and a facet index per layer.
 pub struct Job {
     settings: Settings,
@@ -134,6 +142,9 @@ pub struct Job {
     support: std::sync::OnceLock<Vec<support::LayerSupport>>,
     /// The facet runs of [`JobInfo::groups`] as ranges of facet numbers (empty: all unit 0).
     groups: Vec<(std::ops::Range<u32>, u8)>,
+    /// Every layer's plan with support (`support = unit1`), computed on first use: the
+    /// droplet-level pass needs all layers' droplets (see [`Job::supported_plans`]).
+    supported: std::sync::OnceLock<SupportedPlans>,
 }
 
 impl Job {
@@ -401,6 +412,7 @@ impl Job {
             info,
             support: std::sync::OnceLock::new(),
             groups,
+            supported: std::sync::OnceLock::new(),
         }
     }
 
@@ -435,6 +447,84 @@ impl Job {
                     )),
                     region: geom::Shapes::new(),
                 })
+            }
+        })
+    }
+
+    /// Every layer's plan with support on (`support = unit1`), computed once per job on first
+    /// use: each layer's part planned as without support, its support region hatched by unit 1
+    /// ([`plan::support_moves`]), then the droplet-level pass over all layers
+    /// ([`support_droplets::complete`]) adds unit-1 droplets under every droplet the layer
+    /// below leaves unsupported. Natively the layers are planned in parallel; in the page each
+    /// worker's job plans them all once (docs/support.md).
+    pub fn supported_plans(&self) -> &[(LayerPlan, geom::Shapes)] {
+        &self.supported_pass().layers
+    }
+
+    /// [`Job::supported_plans`] and what the droplet-level pass added.
+    pub fn supported_pass(&self) -> &SupportedPlans {
+        self.supported.get_or_init(|| {
+            let n = self.layer_count();
+            let s = &self.settings;
+            let sections = support::par_map(n, &|i| self.section(i));
+            let regions: Vec<geom::Shapes> = sections.iter().map(|x| x.region.clone()).collect();
+            let layers = support::support_layers(&regions, s, |n, f| support::par_map(n, f));
+            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+            let droplets = |moves: &[plan::Move], out: &mut Vec<support_droplets::Droplet>| {
+                let mut at = geom::Point::ZERO;
+                for m in moves {
+                    let w = if m.unit == 1 { b1 } else { b };
+                    match m.kind {
+                        plan::MoveKind::Droplet => out.push((m.to, w)),
+                        plan::MoveKind::Line => {
+                            out.extend(geom::line_droplets(at, m.to, w).map(|p| (p, w)))
+                        }
+                        plan::MoveKind::Travel => {}
+                    }
+                    at = m.to;
+                }
+            };
+            // Each layer's part plan, unit 1's hatch moves and all their droplets.
+            type Planned = (
+                LayerPlan,
+                geom::Shapes,
+                Vec<plan::Move>,
+                Vec<support_droplets::Droplet>,
+            );
+            let planned: Vec<Planned> = support::par_map(n, &|i| {
+                let section = &sections[i];
+                let (mut p, own) = self.plan_parts(i, section);
+                p.unsupported_area = layers[i].unsupported_area;
+                let start = plan::unit1_start(&p, s);
+                let moves =
+                    plan::support_moves(&layers[i].region, &section.region, &[], i, s, start);
+                let mut all = Vec::new();
+                droplets(&p.moves, &mut all);
+                droplets(&moves, &mut all);
+                (p, own, moves, all)
+            });
+            drop(layers);
+            let (extra, figures) = {
+                let all: Vec<&[support_droplets::Droplet]> =
+                    planned.iter().map(|p| &p.3[..]).collect();
+                support_droplets::complete(&all, &regions, s, |n, f| support::par_map(n, f))
+            };
+            let plans = planned
+                .into_iter()
+                .enumerate()
+                .map(|(i, (mut p, region, mut moves, _))| {
+                    if !extra[i].is_empty() {
+                        let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+                        let none = geom::Shapes::new();
+                        moves.extend(plan::support_moves(&none, &none, &extra[i], i, s, start));
+                    }
+                    plan::add_unit1(&mut p, moves, s);
+                    (p, region)
+                })
+                .collect();
+            SupportedPlans {
+                layers: plans,
+                figures,
             }
         })
     }
@@ -495,6 +585,9 @@ impl Job {
     /// [`plan_layer`](Self::plan_layer) and the region unit 0 prints in the layer (its section
     /// in a job without unit-1 parts), which the analysis needs.
     pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
+        if self.settings.support == settings::Support::Unit1 {
+            return self.supported_plans()[i].clone();
+        }
         self.plan_layer_with(i, self.section(i), None)
     }
 
@@ -513,6 +606,28 @@ impl Job {
         section: Section,
         below: Option<&geom::Shapes>,
     ) -> (LayerPlan, geom::Shapes) {
+        if self.settings.support == settings::Support::Unit1 {
+            return self.supported_plans()[i].clone();
+        }
+        let (mut plan, region) = self.plan_parts(i, &section);
+        // Layers stay independent: the overhang needs only the section below.
+        let sliced;
+        let below = match (i.checked_sub(1), below) {
+            (None, _) => None,
+            (Some(_), Some(b)) => Some(b),
+            (Some(j), None) => {
+                sliced = self.section(j).region;
+                Some(&sliced)
+            }
+        };
+        let over = support::overhang(&section.region, below, &self.settings);
+        plan.unsupported_area = geom::region_area(&over);
+        (plan, region)
+    }
+
+    /// Layer `i`'s plan without support: unit 0's region, then unit 1's parts (with B₁, in
+    /// the order `unit_order` gives), and the region unit 0 prints.
+    fn plan_parts(&self, i: usize, section: &Section) -> (LayerPlan, geom::Shapes) {
         let (mut plan, own) = if self.groups.is_empty() {
             (plan::plan_layer(&section.region, i, &self.settings), None)
         } else {
@@ -521,38 +636,19 @@ impl Job {
         };
         plan.open_chains = section.open_chains;
         plan.reoriented_loops = section.reoriented_loops;
-        let no_support = geom::Shapes::new();
-        let support_region = if self.settings.support == settings::Support::Unit1 {
-            let layer = &self.support_layers()[i];
-            plan.unsupported_area = layer.unsupported_area;
-            &layer.region
-        } else {
-            // Layers stay independent: the overhang needs only the section below.
-            let sliced;
-            let below = match (i.checked_sub(1), below) {
-                (None, _) => None,
-                (Some(_), Some(b)) => Some(b),
-                (Some(j), None) => {
-                    sliced = self.section(j).region;
-                    Some(&sliced)
-                }
-            };
-            let over = support::overhang(&section.region, below, &self.settings);
-            plan.unsupported_area = geom::region_area(&over);
-            &no_support
-        };
-        if self.uses_unit1() {
-            let parts = own.as_ref().map_or(&no_support, |(_, r1)| r1);
-            plan::plan_unit1_layer(
-                &mut plan,
-                parts,
-                support_region,
-                plan::Role::Support,
-                &self.settings,
-            );
+        match own {
+            None => (plan, section.region.clone()),
+            Some((r0, r1)) => {
+                plan::plan_unit1_layer(
+                    &mut plan,
+                    &r1,
+                    &geom::Shapes::new(),
+                    plan::Role::Support,
+                    &self.settings,
+                );
+                (plan, r0)
+            }
         }
-        let region = own.map_or(section.region, |(r0, _)| r0);
-        (plan, region)
     }
 
     /// The regions units 0 and 1 print in layer `i` (SPEC.md "Two discharge units"): each

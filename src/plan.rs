@@ -3,7 +3,7 @@
 
 use crate::contours::{Loop, contours};
 use crate::droplets::loop_droplets_spaced;
-use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, line_droplets, round_output};
 use crate::hatch::{hatch_at, order_greedy};
 use crate::settings::{ContourOrder, PrintOrder, Settings};
 use serde::{Deserialize, Serialize};
@@ -393,6 +393,147 @@ pub fn plan_unit1_layer(
         let end = moves.last().map_or(Point::ZERO, |m| m.to);
         if let Some(first) = plan.moves.first() {
             plan.travel_mm += dist(end, first.to) - dist(Point::ZERO, first.to);
+        }
+        moves.append(&mut plan.moves);
+        plan.moves = moves;
+    }
+}
+
+/// Where unit 1 starts in a layer whose unit-0 moves are planned: after them, or at the origin
+/// with `unit_order = unit1_first`.
+pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
+    if s.unit_order == crate::settings::UnitOrder::Unit0First {
+        plan.moves.last().map_or(Point::ZERO, |m| m.to)
+    } else {
+        Point::ZERO
+    }
+}
+
+/// Unit 1's moves for a support region (SPEC.md: "printed by unit 1 as hatch fill at
+/// `support_density`"), from `start`: the region hatched directly at the layer's hatch angle,
+/// lines B₁ / `support_density` apart, every line's droplets on a lattice of pitch B₁ along it
+/// (ends moved inward to lattice points, so no droplet centre leaves the region), without the
+/// droplets closer than `support_gap_xy`·B to the part's region `part` (a line is split
+/// there); then single droplets at `extra` (the droplet-level pass,
+/// [`crate::support_droplets`]), nearest first. No offsets. Positions are rounded as written.
+pub fn support_moves(
+    region: &Shapes,
+    part: &Shapes,
+    extra: &[Point],
+    index: usize,
+    s: &Settings,
+    start: Point,
+) -> Vec<Move> {
+    let s1 = support_settings(s);
+    let b1 = s1.droplet_width();
+    let mut moves = Vec::new();
+    let mut at = start;
+    if s1.fill_density > 0.0 && !region.is_empty() {
+        let lines = hatch_at(
+            region,
+            hatch_angle(s, index),
+            b1 / s1.fill_density,
+            0.5,
+            Some((b1, 0.0, 0.0)),
+        );
+        let edges = crate::support_droplets::edges_of(part);
+        let clear = crate::support_droplets::Clearance::new(
+            &edges,
+            s.support_gap_xy * s.droplet_width(),
+            b1,
+        );
+        let mut runs = Vec::with_capacity(lines.len());
+        for l in lines {
+            let mut run: Option<(Point, Point)> = None;
+            // Droplets within `free` of the last one checked keep the gap too.
+            let mut free = f64::NEG_INFINITY;
+            let mut from = l.a;
+            for p in line_droplets(l.a, l.b, b1) {
+                let ok = if dist(p, from) < free {
+                    true
+                } else {
+                    from = p;
+                    free = clear.slack(p, 8.0 * b1);
+                    free > 0.0
+                };
+                if ok {
+                    run = Some(run.map_or((p, p), |(a, _)| (a, p)));
+                } else if let Some((a, b)) = run.take() {
+                    runs.push(crate::hatch::HatchLine { a, b });
+                }
+            }
+            if let Some((a, b)) = run {
+                runs.push(crate::hatch::HatchLine { a, b });
+            }
+        }
+        for l in order_greedy(runs, at) {
+            if dist(l.a, l.b) < 0.5 * b1 {
+                moves.push(Move {
+                    kind: MoveKind::Droplet,
+                    role: Role::Support,
+                    to: round_output(l.a),
+                    unit: 1,
+                });
+            } else {
+                moves.push(Move {
+                    kind: MoveKind::Travel,
+                    role: Role::Support,
+                    to: round_output(l.a),
+                    unit: 1,
+                });
+                moves.push(Move {
+                    kind: MoveKind::Line,
+                    role: Role::Support,
+                    to: round_output(l.b),
+                    unit: 1,
+                });
+            }
+            at = l.b;
+        }
+    }
+    let mut left: Vec<Point> = extra.to_vec();
+    while !left.is_empty() {
+        let next = (0..left.len())
+            .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
+            .expect("non-empty");
+        let p = left.swap_remove(next);
+        moves.push(Move {
+            kind: MoveKind::Droplet,
+            role: Role::Support,
+            to: round_output(p),
+            unit: 1,
+        });
+        at = p;
+    }
+    moves
+}
+
+/// Adds unit-1 moves (planned from [`unit1_start`]) to a layer planned for unit 0, in the
+/// order `unit_order` gives: the counts, B₁ and the travel follow. Unit 0's moves stay
+/// exactly as planned; only the travel between the two units' moves changes.
+pub fn add_unit1(plan: &mut LayerPlan, mut moves: Vec<Move>, s: &Settings) {
+    if moves.is_empty() {
+        return;
+    }
+    let b1 = support_settings(s).droplet_width();
+    let unit0_first = s.unit_order == crate::settings::UnitOrder::Unit0First;
+    let mut at = unit1_start(plan, s);
+    for m in &mut moves {
+        m.unit = 1;
+        if m.kind != MoveKind::Line {
+            plan.travel_mm += dist(at, m.to);
+        }
+        at = m.to;
+    }
+    let c1 = count_units(&moves, b1, b1);
+    plan.counts.add(&c1);
+    plan.unit1_width = b1;
+    if unit0_first {
+        plan.moves.extend(moves);
+    } else {
+        // Unit 0 was planned from the origin; it now starts where unit 1 ends.
+        if let Some(first) = plan.moves.first() {
+            plan.travel_mm += dist(at, first.to) - dist(Point::ZERO, first.to);
         }
         moves.append(&mut plan.moves);
         plan.moves = moves;

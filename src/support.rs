@@ -14,13 +14,13 @@
 //! **Support regions**, top-down, one union, one offset and one clip per layer (no 3D
 //! computation):
 //! need(n) = (need(n + 1) ∪ grow(overhang(n + 1), [`support_reach`])) − region(n) (the part
-//! below carries what it covers), support(n) = need(n) − grow(region(n), `support_gap_xy`·B)
-//! − the grown overhangs of the `support_gap_z` layers directly above. The overhang is grown
-//! by B₁/2 before it is carried down so that the support reaches under the overhang's edge:
-//! unit
-//! 1 prints a support region as the part is printed (one contour loop B₁/2 inside its boundary
-//! and hatch fill, [`crate::plan::plan_unit1`]), and a support band narrower than B₁ would
-//! have no loop. `tests/support.rs` checks the rule on the printed droplets.
+//! below carries what it covers), support(n) = need(n) − the grown overhangs of the
+//! `support_gap_z` layers directly above. The overhang is grown by B₁/2 before it is carried
+//! down so that the support reaches under the overhang's edge. Unit 1 hatches a support
+//! region directly ([`crate::plan::support_moves`]), leaving out the droplets within
+//! `support_gap_xy`·B of the part (no offset of the part); the droplet-level pass
+//! ([`crate::support_droplets`]) then adds droplets wherever the rule still fails.
+//! `tests/support.rs` checks the rule on the printed droplets.
 
 use crate::geom::{DVec2, Shape, Shapes, region_area, shapes_from_overlay, signed_area};
 use crate::offset::CHORD_TOLERANCE_MM;
@@ -228,7 +228,8 @@ pub fn support_reach(s: &Settings) -> f64 {
 pub struct LayerSupport {
     /// Area of the layer's overhang, mm².
     pub unsupported_area: f64,
-    /// Where unit 1 prints support (empty with `support = off`).
+    /// Where unit 1 prints support (empty with `support = off`), up to the part: droplets
+    /// within `support_gap_xy`·B of the part are left out when it is planned.
     pub region: Shapes,
 }
 
@@ -258,26 +259,11 @@ pub fn support_layers(
         need = carried(&need, &grown[i + 1], &regions[i]);
         needs[i] = need.clone();
     }
-    let gap_xy = s.support_gap_xy * s.droplet_width();
+    // The gap to the part in the layer is kept droplet by droplet when the region is planned
+    // (`plan::support_moves`): no offset of the part here.
     let gap_z = s.support_gap_z as usize;
-    // Each layer's part and the gap around it (chords lie inside the arcs: grown by the
-    // tolerance more, never less than the gap).
-    let keep_off: Vec<Shapes> = par_map(n, &|i| {
-        if gap_xy > 0.0 && !needs[i].is_empty() {
-            grow_within(
-                &regions[i],
-                gap_xy + SUPPORT_TOLERANCE_MM,
-                SUPPORT_TOLERANCE_MM,
-            )
-        } else {
-            Shapes::new()
-        }
-    });
     let supports = par_map(n, &|i| {
-        if needs[i].is_empty() {
-            return Shapes::new();
-        }
-        let mut region = difference(&needs[i], &keep_off[i]);
+        let mut region = needs[i].clone();
         for k in 1..=gap_z.min(n - 1 - i) {
             region = difference(&region, &grown[i + k]);
         }
@@ -393,16 +379,12 @@ mod tests {
             // Under the slab on layers 0..5, nothing from layer 5 up.
             assert_eq!(l.region.is_empty(), i >= 5, "layer {i}");
             if i < 5 {
-                // The slab's area beyond the post less the gap, plus the reach around it.
+                // The slab's area beyond the post, plus the reach around it.
                 let a = region_area(&l.region);
-                assert!(
-                    a > 4.0 * 4.0 - 4.0 * 0.5 * s.droplet_width() && a < 30.0,
-                    "{a}"
-                );
-                // Kept the gap away from the post.
-                let gap = s.support_gap_xy * s.droplet_width() - 1e-3;
-                let apart = difference(&l.region, &grow(&square(0.0, 0.0, 2.0), gap));
-                assert!((region_area(&apart) - a).abs() < 1e-6);
+                assert!(a > 4.0 * 4.0 - 1e-6 && a < 30.0, "{a}");
+                // Outside the post (the gap is kept when it is planned).
+                let inside = intersection(&l.region, &square(0.0, 0.0, 2.0));
+                assert!(region_area(&inside) < 1e-6);
             }
         }
     }

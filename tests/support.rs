@@ -121,11 +121,9 @@ fn without_support_3dbenchy_has_unsupported_droplets() {
     assert!(total > 1000 && bad[worst] > 1000 && bad[1] > 100, "{total}");
 }
 
-/// Slices with support and checks the rule, the T lines and the unit-0 commands. The rule
-/// must hold for every droplet when `exact`; otherwise (docs/support.md, "Limits": support
-/// hanging a fraction of a droplet beyond an edge below) for all but 1 % of the droplets that
-/// break it without support.
-fn check_with_support(name: &str, exact: bool) {
+/// Slices with support and checks the rule (for every droplet above the first layer), the
+/// T lines and the unit-0 commands.
+fn check_with_support(name: &str) {
     let on = slice(name, &["support=unit1"]);
     let off = slice(name, &[]);
     let layers = all_droplets(&on);
@@ -141,17 +139,10 @@ fn check_with_support(name: &str, exact: bool) {
         "{name}: {before} unsupported droplets without support; with support {support} support droplets and {total} unsupported {where_:?}"
     );
     assert!(before > 0, "{name}: nothing to support");
-    if exact {
-        assert_eq!(
-            total, 0,
-            "{name}: unsupported droplets (layer, count): {where_:?}"
-        );
-    } else {
-        assert!(
-            100 * total <= before,
-            "{name}: unsupported droplets (layer, count): {where_:?}"
-        );
-    }
+    assert_eq!(
+        total, 0,
+        "{name}: unsupported droplets (layer, count): {where_:?}"
+    );
     // The part's own commands are exactly those without support (unit 0 prints first).
     let unit0 = |g: &Gcode| -> Vec<(String, P, f64)> {
         g.layers
@@ -192,14 +183,14 @@ fn check_with_support(name: &str, exact: bool) {
 
 #[test]
 fn support_makes_every_droplet_supported_on_the_overhang_models() {
-    check_with_support("overhang.obj", true);
-    check_with_support("bridge.obj", true);
-    check_with_support("U_overhang.obj", true);
+    check_with_support("overhang.obj");
+    check_with_support("bridge.obj");
+    check_with_support("U_overhang.obj");
 }
 
 #[test]
 fn support_makes_every_droplet_supported_on_3dbenchy() {
-    check_with_support("3DBenchy.stl", false);
+    check_with_support("3DBenchy.stl");
 }
 
 /// The mesh cut by the plane z: segments, without chaining them into loops.

@@ -1,0 +1,413 @@
+//! The support's droplet-level pass (SPEC.md "Two discharge units"; docs/support.md): after
+//! every layer is planned with its support region, find the droplets the layer below does not
+//! support by the overhang rule and add single unit-1 droplets under them, top-down, so that
+//! the rule holds for every droplet of the code (the added droplets need support too).
+//!
+//! The region form ([`crate::support`]) leaves a few droplets unsupported: where a support
+//! region is a sliver, or where a part droplet lies beyond the edge of the part below by less
+//! than the limit but the droplets below sit B/2 inside that edge. The pass works on droplet
+//! centres only (hash grids of the layers' droplets), so it is cheap.
+
+use crate::geom::{DVec2, Point, Shapes, all_contours, dist, round_output, segment_distance2};
+use crate::grid::EdgeIndex;
+use crate::settings::Settings;
+use std::collections::HashMap;
+
+/// A droplet centre and its width (B or B₁).
+pub type Droplet = (Point, f64);
+
+/// Centres kept this much inside the rule's distance, so rounding the written positions
+/// cannot break it (positions are rounded to 0.05 µm).
+const MARGIN_MM: f64 = 1e-3;
+
+/// Droplets of a layer in cells over their bounding box (counts, then the droplets sorted by
+/// cell), cells at least the rule's distance.
+struct Grid {
+    cell: f64,
+    min: Point,
+    nx: i64,
+    ny: i64,
+    offsets: Vec<u32>,
+    items: Vec<Droplet>,
+}
+
+impl Grid {
+    fn new(cell: f64, droplets: &[Droplet]) -> Grid {
+        let mut min = DVec2::INFINITY;
+        let mut max = DVec2::NEG_INFINITY;
+        for (p, _) in droplets {
+            min = min.min(*p);
+            max = max.max(*p);
+        }
+        if droplets.is_empty() {
+            (min, max) = (DVec2::ZERO, DVec2::ZERO);
+        }
+        // About one cell per droplet at most, however large the layer: memory stays
+        // proportional to the droplets (larger cells still hold every droplet within reach).
+        let spread = ((max.x - min.x) * (max.y - min.y) / droplets.len().max(1) as f64).sqrt();
+        let cell = cell.max(spread);
+        let nx = ((max.x - min.x) / cell).floor() as i64 + 1;
+        let ny = ((max.y - min.y) / cell).floor() as i64 + 1;
+        let mut g = Grid {
+            cell,
+            min,
+            nx,
+            ny,
+            offsets: vec![0; (nx * ny) as usize + 1],
+            items: vec![(DVec2::ZERO, 0.0); droplets.len()],
+        };
+        let keys: Vec<usize> = droplets
+            .iter()
+            .map(|(p, _)| {
+                let (x, y) = g.key(*p);
+                (y * nx + x) as usize
+            })
+            .collect();
+        for &k in &keys {
+            g.offsets[k + 1] += 1;
+        }
+        for i in 1..g.offsets.len() {
+            g.offsets[i] += g.offsets[i - 1];
+        }
+        let mut fill = g.offsets.clone();
+        for (d, &k) in droplets.iter().zip(&keys) {
+            g.items[fill[k] as usize] = *d;
+            fill[k] += 1;
+        }
+        g
+    }
+
+    fn key(&self, p: Point) -> (i64, i64) {
+        (
+            ((p.x - self.min.x) / self.cell).floor() as i64,
+            ((p.y - self.min.y) / self.cell).floor() as i64,
+        )
+    }
+
+    /// Whether some droplet d lies within `reach(d's width)` of `p` (reach ≤ the cell).
+    fn any_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> bool {
+        self.find_within(p, reach).is_some()
+    }
+
+    /// A droplet d within `reach(d's width)` of `p` (reach ≤ the cell), if any.
+    fn find_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> Option<Droplet> {
+        let (cx, cy) = self.key(p);
+        for y in (cy - 1).max(0)..=(cy + 1).min(self.ny - 1) {
+            for x in (cx - 1).max(0)..=(cx + 1).min(self.nx - 1) {
+                let c = (y * self.nx + x) as usize;
+                let cell = &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize];
+                if let Some(&d) = cell.iter().find(|&&(q, w)| {
+                    let r = reach(w);
+                    (p - q).length_squared() <= r * r
+                }) {
+                    return Some(d);
+                }
+            }
+        }
+        None
+    }
+}
+
+/// Droplets added to a layer, in a hash grid (few).
+struct Added {
+    cell: f64,
+    cells: HashMap<(i64, i64), Vec<Point>>,
+}
+
+impl Added {
+    fn key(&self, p: Point) -> (i64, i64) {
+        (
+            (p.x / self.cell).floor() as i64,
+            (p.y / self.cell).floor() as i64,
+        )
+    }
+
+    fn add(&mut self, p: Point) {
+        let k = self.key(p);
+        self.cells.entry(k).or_default().push(p);
+    }
+
+    /// Whether an added droplet lies within `r` (≤ the cell) of `p`.
+    fn any_within(&self, p: Point, r: f64) -> bool {
+        let (cx, cy) = self.key(p);
+        (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| {
+                self.cells
+                    .get(&(cx + dx, cy + dy))
+                    .is_some_and(|v| v.iter().any(|&q| (p - q).length_squared() <= r * r))
+            })
+        })
+    }
+}
+
+/// Whether `p` lies inside `region` (non-zero winding of its loops).
+fn inside(region: &Shapes, p: Point) -> bool {
+    let mut winding = 0i32;
+    for c in all_contours(region) {
+        for k in 0..c.len() {
+            let (a, b) = (c[k], c[(k + 1) % c.len()]);
+            if (a[1] <= p[1]) != (b[1] <= p[1]) {
+                let t = (p[1] - a[1]) / (b[1] - a[1]);
+                if a[0] + t * (b[0] - a[0]) > p[0] {
+                    winding += if b[1] > a[1] { 1 } else { -1 };
+                }
+            }
+        }
+    }
+    winding != 0
+}
+
+/// A region's boundary edges.
+pub fn edges_of(region: &Shapes) -> Vec<(Point, Point)> {
+    all_contours(region)
+        .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
+        .collect()
+}
+
+/// Whether points keep `gap` from a region's boundary (edges from [`edges_of`]).
+pub struct Clearance<'a> {
+    edges: &'a [(Point, Point)],
+    index: EdgeIndex<'a>,
+    gap: f64,
+}
+
+impl<'a> Clearance<'a> {
+    pub fn new(edges: &'a [(Point, Point)], gap: f64, cell: f64) -> Clearance<'a> {
+        Clearance {
+            edges,
+            index: EdgeIndex::new(edges, cell.max(gap).max(1e-3)),
+            gap,
+        }
+    }
+
+    /// How far `p` may move and still keep the gap (≤ 0: it does not keep it now), at most
+    /// `most`.
+    pub fn slack(&self, p: Point, most: f64) -> f64 {
+        let r = self.gap + most;
+        let far = !self.index.any_near(p, r, |e| {
+            let (a, b) = self.edges[e];
+            segment_distance2(p, a, b) < r * r
+        });
+        if far {
+            most
+        } else {
+            self.index.distance(p, 0.0) - self.gap
+        }
+    }
+
+    /// No edge closer than the gap to `p`.
+    pub fn keeps(&self, p: Point) -> bool {
+        let g2 = self.gap * self.gap;
+        self.gap <= 0.0
+            || !self.index.any_near(p, self.gap, |e| {
+                let (a, b) = self.edges[e];
+                segment_distance2(p, a, b) < g2
+            })
+    }
+}
+
+/// Candidate places for a support droplet under `c`: c itself, then rings around it out to
+/// `r` (nearest first).
+fn candidates(c: Point, r: f64) -> impl Iterator<Item = Point> {
+    std::iter::once(c).chain((1..=4).flat_map(move |ring| {
+        let rr = r * ring as f64 / 4.0;
+        let n = 8 * ring;
+        (0..n).map(move |k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            c + rr * DVec2::new(a.cos(), a.sin())
+        })
+    }))
+}
+
+/// What the pass did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PassFigures {
+    /// Unit-1 droplets added.
+    pub added: usize,
+    /// Droplets left unsupported: no place within the rule outside the part and its gap.
+    pub unplaceable: usize,
+}
+
+/// The unit-1 droplets to add to each layer so that every droplet above the first layer is
+/// supported: `droplets[i]` are layer i's planned droplets (both units), `regions[i]` its
+/// part's region. Works top-down; an added droplet needs support from the layer below as any
+/// other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with no
+/// such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
+/// support deliberately stops below overhangs, and the pass adds nothing.
+pub fn complete(
+    droplets: &[&[Droplet]],
+    regions: &[Shapes],
+    s: &Settings,
+    par_map: impl Fn(usize, &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>>,
+) -> (Vec<Vec<Point>>, PassFigures) {
+    let n = droplets.len();
+    let mut extra: Vec<Vec<Point>> = vec![Vec::new(); n];
+    let mut figures = PassFigures::default();
+    if n < 2 || s.support_gap_z > 0 {
+        return (extra, figures);
+    }
+    let b = s.droplet_width();
+    let b1 = s.unit1_droplet_width();
+    let limit = s.overhang_limit * b;
+    let reach = |w: f64| w / 2.0 + limit;
+    let cell = reach(b.max(b1));
+    // Layer i's droplets that layer i − 1's planned droplets leave unsupported (in parallel).
+    let open = par_map(n, &|i| {
+        if i == 0 {
+            return Vec::new();
+        }
+        let below = Grid::new(cell, droplets[i - 1]);
+        // Consecutive droplets are neighbours: the droplet below that supported the last one
+        // most often supports the next.
+        let mut last: Option<Droplet> = None;
+        droplets[i]
+            .iter()
+            .copied()
+            .filter(|&(p, _)| {
+                if let Some((q, w)) = last {
+                    let r = reach(w);
+                    if (p - q).length_squared() <= r * r {
+                        return false;
+                    }
+                }
+                match below.find_within(p, reach) {
+                    Some(d) => {
+                        last = Some(d);
+                        false
+                    }
+                    None => true,
+                }
+            })
+            .collect()
+    });
+    let gap = s.support_gap_xy * b;
+    let place = reach(b1) - MARGIN_MM;
+    // Top-down: layer i's unsupported droplets (planned or added) get droplets in layer i − 1.
+    for i in (1..n).rev() {
+        let mut todo: Vec<Droplet> = open[i].clone();
+        if !extra[i].is_empty() {
+            let below = Grid::new(cell, droplets[i - 1]);
+            todo.extend(
+                extra[i]
+                    .iter()
+                    .map(|&p| (p, b1))
+                    .filter(|&(p, _)| !below.any_within(p, reach)),
+            );
+        }
+        if todo.is_empty() {
+            continue;
+        }
+        let region = &regions[i - 1];
+        let edges = edges_of(region);
+        let clear = Clearance::new(&edges, gap, b);
+        let mut added = Added {
+            cell,
+            cells: HashMap::new(),
+        };
+        for &(c, _) in &todo {
+            // Within the rule of an added droplet: within B₁/2 + limit.
+            if added.any_within(c, reach(b1) - MARGIN_MM) {
+                continue;
+            }
+            // Outside the part and its gap; failing that, outside the part (in the gap).
+            let found = candidates(c, place)
+                .find(|&p| clear.keeps(p) && !inside(region, p))
+                .or_else(|| candidates(c, place).find(|&p| !inside(region, p)));
+            // As written: the layer below checks the rounded position.
+            match found.map(round_output) {
+                Some(p) => {
+                    debug_assert!(dist(p, c) <= reach(b1));
+                    added.add(p);
+                    extra[i - 1].push(p);
+                    figures.added += 1;
+                }
+                None => figures.unplaceable += 1,
+            }
+        }
+    }
+    (extra, figures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Shape;
+
+    fn square(x0: f64, y0: f64, a: f64) -> Shapes {
+        let outer = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
+            .map(DVec2::from)
+            .into();
+        vec![Shape::new(outer, vec![])]
+    }
+
+    fn run(
+        droplets: &[Vec<Droplet>],
+        regions: &[Shapes],
+        s: &Settings,
+    ) -> (Vec<Vec<Point>>, PassFigures) {
+        let refs: Vec<&[Droplet]> = droplets.iter().map(|v| &v[..]).collect();
+        complete(&refs, regions, s, serial)
+    }
+
+    fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
+        (0..n).map(f).collect()
+    }
+
+    #[test]
+    fn a_droplet_over_nothing_gets_a_column_down_to_the_plate() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        // Three layers: a droplet at (5, 5) on layer 2, a part (a square far away) on each.
+        let part = square(0.0, 0.0, 2.0);
+        let far = (DVec2::new(1.0, 1.0), b);
+        let droplets = vec![vec![far], vec![far], vec![far, (DVec2::new(5.0, 5.0), b)]];
+        let regions = vec![part.clone(), part.clone(), part];
+        let (extra, figures) = run(&droplets, &regions, &s);
+        assert_eq!(figures.unplaceable, 0);
+        // One droplet under it on layer 1 and one under that on layer 0.
+        assert_eq!(extra[2].len(), 0);
+        assert_eq!(extra[1], vec![DVec2::new(5.0, 5.0)]);
+        assert_eq!(extra[0], vec![DVec2::new(5.0, 5.0)]);
+    }
+
+    #[test]
+    fn added_droplets_keep_the_gap_from_the_part() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        let gap = s.support_gap_xy * b;
+        // Layer 0: a 2 mm square; layer 1: a droplet just beyond its edge, unsupported by the
+        // droplet far inside the square.
+        let part = square(0.0, 0.0, 2.0);
+        let c = DVec2::new(2.0 + 0.2 * b, 1.0);
+        let droplets = vec![vec![(DVec2::new(0.5, 1.0), b)], vec![(c, b)]];
+        let regions = vec![part.clone(), Shapes::new()];
+        let (extra, figures) = run(&droplets, &regions, &s);
+        assert_eq!(figures.added, 1);
+        let p = extra[0][0];
+        assert!(p.x >= 2.0 + gap - 1e-9, "{p}");
+        assert!(dist(p, c) <= b1_reach(&s), "{p}");
+    }
+
+    fn b1_reach(s: &Settings) -> f64 {
+        s.unit1_droplet_width() / 2.0 + s.overhang_limit * s.droplet_width()
+    }
+
+    #[test]
+    fn supported_droplets_need_nothing_and_a_gap_z_adds_nothing() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        let d = |x: f64| (DVec2::new(x, 0.0), b);
+        let droplets = vec![vec![d(0.0)], vec![d(0.9 * b)], vec![d(1.8 * b)]];
+        let regions = vec![Shapes::new(); 3];
+        let (extra, figures) = run(&droplets, &regions, &s);
+        assert!(extra.iter().all(|e| e.is_empty()));
+        assert_eq!(figures, PassFigures::default());
+        let far = vec![vec![d(0.0)], vec![d(5.0)]];
+        let gap_z = Settings {
+            support_gap_z: 1,
+            ..s
+        };
+        let (extra, _) = run(&far, &regions[..2], &gap_z);
+        assert!(extra.iter().all(|e| e.is_empty()));
+    }
+}
