@@ -190,6 +190,8 @@ window.dropslice = {
     renderer.request();
   },
   show: (i: number) => show(page, i),
+  /** Per layer of the slice: support droplets, unit-1 droplets (null: not in yet). */
+  layerUnits: () => store.slice?.counts.map((c) => (c ? [c.support ?? 0, c.unit1 ?? 0] : null)) ?? [],
   /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
    *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
   view3d: () => page.view3d.testState(),
