@@ -100,6 +100,7 @@ export function setShowOverhangs(page: Page, on: boolean): void {
   page.renderer.showOverhangs = on;
   $<HTMLInputElement>("opt-overhangs").checked = on;
   $("legend-overhangs").hidden = !on;
+  $("legend3d-overhang").hidden = !on;
   if (page.store.slice) show(page, page.store.current);
   else page.renderer.request();
   page.view3d.sync(page);
