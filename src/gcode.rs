@@ -215,8 +215,8 @@ pub fn footer(summary: &Summary) -> String {
     if summary.counts.unit1 > 0 {
         let _ = writeln!(
             f,
-            "; support: {} droplets, {} printed by unit 1",
-            summary.counts.support, summary.counts.unit1
+            "; unit 1: {} droplets ({} of them support)",
+            summary.counts.unit1, summary.counts.support
         );
     }
     for r in summary.repairs() {

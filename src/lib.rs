@@ -78,6 +78,32 @@ pub struct JobInfo {
     /// Every copy of every part: its file, transform, placement, matrix and bounds.
     #[serde(default)]
     pub instances: Vec<job::Instance>,
+    /// Which discharge unit prints which facets of the prepared mesh: runs of facets in mesh
+    /// order, each the instances of consecutive parts of one unit, in the order the parts are
+    /// listed (the order that decides who keeps an overlap). Empty: every facet is unit 0's
+    /// (every job without unit-1 parts).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<FacetGroup>,
+}
+
+/// A run of facets of the prepared mesh printed by one discharge unit ([`JobInfo::groups`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct FacetGroup {
+    /// How many facets (they follow the run before).
+    pub facets: usize,
+    /// The discharge unit, 0 or 1.
+    pub unit: u8,
+}
+
+/// Drops the facets that were not kept from the runs' counts.
+fn keep_groups(groups: &mut [FacetGroup], kept: &[bool]) {
+    let mut at = 0;
+    for g in groups {
+        let end = (at + g.facets).min(kept.len());
+        let n = kept[at.min(end)..end].iter().filter(|&&k| k).count();
+        at = end;
+        g.facets = n;
+    }
 }
 
 /// Vertices closer than this are merged when exact welding leaves the surface open.
@@ -106,6 +132,8 @@ pub struct Job {
     /// Every layer's overhang area and support region, computed on first use when
     /// `support` is on (it needs all layers' sections; see [`Job::support_layers`]).
     support: std::sync::OnceLock<Vec<support::LayerSupport>>,
+    /// The facet runs of [`JobInfo::groups`] as ranges of facet numbers (empty: all unit 0).
+    groups: Vec<(std::ops::Range<u32>, u8)>,
 }
 
 impl Job {
@@ -128,6 +156,7 @@ impl Job {
             degenerate,
             instances: vec![instance],
             warnings: Vec::new(),
+            groups: Vec::new(),
         };
         Job::build(mesh, input, settings)
     }
@@ -150,12 +179,16 @@ impl Job {
         spec.validate()?;
         let settings = spec.settings.clone();
         let by_part = job::models_of(models, spec)?;
-        if let Some((i, p)) = spec.parts.iter().enumerate().find(|(_, p)| p.unit != 0) {
-            return Err(Error::Job(format!(
-                "parts[{i}] ({}): parts of discharge unit {} are not printed yet; set its unit to 0",
-                job::clean_name(&by_part[i].part_name(p.item)),
-                p.unit
-            )));
+        // Runs of consecutive parts of one unit (SPEC.md: where parts of different units
+        // overlap, the part listed first keeps the overlap).
+        let mut run_of = Vec::with_capacity(spec.parts.len());
+        for (i, p) in spec.parts.iter().enumerate() {
+            let run = match i.checked_sub(1) {
+                Some(j) if spec.parts[j].unit == p.unit => run_of[j],
+                Some(j) => run_of[j] + 1,
+                None => 0,
+            };
+            run_of.push(run);
         }
         let mut welded = Vec::with_capacity(spec.parts.len());
         let mut frames = Vec::with_capacity(spec.parts.len());
@@ -194,15 +227,30 @@ impl Job {
             vertices: Vec::with_capacity(vertices),
             facets: Vec::with_capacity(facets),
         };
-        for inst in &layout.instances {
+        // The instances run by run (a job of unit 0 alone: one run, in the layout's order).
+        let mut order: Vec<&job::Instance> = layout.instances.iter().collect();
+        order.sort_by_key(|inst| run_of[inst.part]);
+        let mut groups: Vec<FacetGroup> = Vec::new();
+        for inst in order {
             let mut m = welded[inst.part].clone();
             m.place(&spec.parts[inst.part].placement(inst.shift));
             let base = mesh.vertices.len() as u32;
             mesh.vertices.extend_from_slice(&m.vertices);
             mesh.facets
                 .extend(m.facets.iter().map(|f| f.map(|v| v + base)));
+            // Runs are numbered from 0 in order: run r is the (r + 1)-th group.
+            match groups.get_mut(run_of[inst.part]) {
+                Some(g) => g.facets += m.facets.len(),
+                None => groups.push(FacetGroup {
+                    facets: m.facets.len(),
+                    unit: spec.parts[inst.part].unit,
+                }),
+            }
         }
         drop(welded);
+        if groups.iter().all(|g| g.unit == 0) {
+            groups.clear();
+        }
         let mut names: Vec<String> = Vec::new();
         for p in &spec.parts {
             let n = job::clean_name(&p.file);
@@ -228,6 +276,7 @@ impl Job {
             degenerate,
             instances: layout.instances,
             warnings: layout.warnings,
+            groups,
         };
         Job::build(mesh, input, settings)
     }
@@ -242,7 +291,10 @@ impl Job {
         // closed shell as its author meant it (inside-out shells turned outward, cavities kept),
         // so the volume below counts what will be printed: shells of opposite orientation can
         // no longer cancel.
-        let duplicates = mesh.remove_duplicate_facets();
+        let mut groups = input.groups;
+        let kept = mesh.remove_duplicate_facets_kept();
+        let duplicates = kept.iter().filter(|&&k| !k).count();
+        keep_groups(&mut groups, &kept);
         let shells = mesh.orient_shells();
         check_volume(&mesh, &shells, &size, &settings)?;
         let zs = plane_heights(&size, &settings)?;
@@ -253,6 +305,7 @@ impl Job {
             duplicates,
             input.facets_in_file,
             input.degenerate,
+            &mut groups,
         );
         if shells.open > 0 {
             // Open shells enclose no definite volume: estimate what will be printed from the
@@ -272,6 +325,7 @@ impl Job {
             layers: zs.len(),
             droplet_width: settings.droplet_width(),
             instances: input.instances,
+            groups,
         };
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
@@ -305,6 +359,21 @@ impl Job {
         if mesh.facets.iter().flatten().any(|&v| v as usize >= n) {
             return Err(bad("a facet refers to a vertex that does not exist".into()));
         }
+        if !info.groups.is_empty() {
+            let total = info
+                .groups
+                .iter()
+                .try_fold(0usize, |t, g| t.checked_add(g.facets));
+            if total != Some(mesh.facets.len())
+                || info.groups.len() > job::MAX_INSTANCES
+                || info.groups.iter().any(|g| g.unit > 1)
+            {
+                return Err(bad(
+                    "the facet groups do not cover the facets, or name a unit other than 0 or 1"
+                        .into(),
+                ));
+            }
+        }
         let buckets = FacetBuckets::new(&mesh, &zs);
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
@@ -317,6 +386,13 @@ impl Job {
         zs: Vec<f64>,
         info: JobInfo,
     ) -> Job {
+        let mut groups = Vec::with_capacity(info.groups.len());
+        let mut at = 0u32;
+        for g in &info.groups {
+            let end = at + g.facets as u32;
+            groups.push((at..end, g.unit));
+            at = end;
+        }
         Job {
             settings,
             mesh,
@@ -324,12 +400,18 @@ impl Job {
             zs,
             info,
             support: std::sync::OnceLock::new(),
+            groups,
         }
     }
 
-    /// Whether discharge unit 1 prints in this job (today: support is on).
+    /// Whether discharge unit 1 prints in this job: support is on, or a part is unit 1's.
     pub fn uses_unit1(&self) -> bool {
-        self.settings.support == settings::Support::Unit1
+        self.settings.support == settings::Support::Unit1 || self.has_unit1_parts()
+    }
+
+    /// Whether a part of this job is printed by unit 1.
+    pub fn has_unit1_parts(&self) -> bool {
+        self.groups.iter().any(|(_, u)| *u == 1)
     }
 
     /// Every layer's overhang area and support region (empty regions with `support = off`).
@@ -410,29 +492,99 @@ impl Job {
         self.plan_layer_and_region(i).0
     }
 
-    /// [`plan_layer`](Self::plan_layer) and the layer's region (its section), which the
-    /// analysis needs.
+    /// [`plan_layer`](Self::plan_layer) and the region unit 0 prints in the layer (its section
+    /// in a job without unit-1 parts), which the analysis needs.
     pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
-        let section = self.section(i);
-        let mut plan = plan::plan_layer(&section.region, i, &self.settings);
+        self.plan_layer_with(i, self.section(i), None)
+    }
+
+    /// Whether planning a layer needs the section of the layer below (for the overhang
+    /// figure: with support off; with support on it comes from [`Job::support_layers`]).
+    pub fn needs_below(&self) -> bool {
+        self.settings.support != settings::Support::Unit1
+    }
+
+    /// [`plan_layer_and_region`](Self::plan_layer_and_region) given the layer's section and,
+    /// when known, the region of layer i − 1's section (else it is sliced again when
+    /// [`Job::needs_below`]): the native writer hands it from layer to layer.
+    pub fn plan_layer_with(
+        &self,
+        i: usize,
+        section: Section,
+        below: Option<&geom::Shapes>,
+    ) -> (LayerPlan, geom::Shapes) {
+        let (mut plan, own) = if self.groups.is_empty() {
+            (plan::plan_layer(&section.region, i, &self.settings), None)
+        } else {
+            let [r0, r1] = self.unit_regions(i);
+            (plan::plan_layer(&r0, i, &self.settings), Some((r0, r1)))
+        };
         plan.open_chains = section.open_chains;
         plan.reoriented_loops = section.reoriented_loops;
-        if self.uses_unit1() {
+        let no_support = geom::Shapes::new();
+        let support_region = if self.settings.support == settings::Support::Unit1 {
             let layer = &self.support_layers()[i];
             plan.unsupported_area = layer.unsupported_area;
-            plan::plan_unit1(
+            &layer.region
+        } else {
+            // Layers stay independent: the overhang needs only the section below.
+            let sliced;
+            let below = match (i.checked_sub(1), below) {
+                (None, _) => None,
+                (Some(_), Some(b)) => Some(b),
+                (Some(j), None) => {
+                    sliced = self.section(j).region;
+                    Some(&sliced)
+                }
+            };
+            let over = support::overhang(&section.region, below, &self.settings);
+            plan.unsupported_area = geom::region_area(&over);
+            &no_support
+        };
+        if self.uses_unit1() {
+            let parts = own.as_ref().map_or(&no_support, |(_, r1)| r1);
+            plan::plan_unit1_layer(
                 &mut plan,
-                &layer.region,
+                parts,
+                support_region,
                 plan::Role::Support,
                 &self.settings,
             );
-        } else {
-            // Layers stay independent: the overhang needs only the section below.
-            let below = i.checked_sub(1).map(|j| self.section(j).region);
-            let over = support::overhang(&section.region, below.as_ref(), &self.settings);
-            plan.unsupported_area = geom::region_area(&over);
         }
-        (plan, section.region)
+        let region = own.map_or(section.region, |(r0, _)| r0);
+        (plan, region)
+    }
+
+    /// The regions units 0 and 1 print in layer `i` (SPEC.md "Two discharge units"): each
+    /// run of consecutive parts of one unit ([`JobInfo::groups`]) is sliced on its own, and
+    /// keeps its section less the sections of the runs listed before it (where parts of
+    /// different units overlap, the part listed first keeps the overlap). A job without
+    /// unit-1 parts: unit 0 prints the whole section.
+    pub fn unit_regions(&self, i: usize) -> [geom::Shapes; 2] {
+        if self.groups.is_empty() {
+            return [self.section(i).region, geom::Shapes::new()];
+        }
+        let facets = self.buckets.layer(i);
+        let mut regions = [geom::Shapes::new(), geom::Shapes::new()];
+        let mut covered = geom::Shapes::new();
+        for (k, (range, unit)) in self.groups.iter().enumerate() {
+            let mine: Vec<u32> = facets
+                .iter()
+                .copied()
+                .filter(|f| range.contains(f))
+                .collect();
+            if mine.is_empty() {
+                continue;
+            }
+            let section = slice::slice_layer(&self.mesh, &mine, self.zs[i]).region;
+            let own = support::difference(&section, &covered);
+            if k + 1 < self.groups.len() {
+                covered = support::union(&covered, &section);
+            }
+            let r = &mut regions[usize::from(*unit).min(1)];
+            *r = support::union(r, &own);
+        }
+        regions
     }
 
     /// The header; with `None` the droplet counts are fixed-width placeholders.
@@ -471,6 +623,8 @@ struct Input {
     degenerate: usize,
     instances: Vec<job::Instance>,
     warnings: Vec<String>,
+    /// [`JobInfo::groups`] of the merged mesh (before the repair drops facets).
+    groups: Vec<FacetGroup>,
 }
 
 /// Import: STL bytes → triangles → welded mesh → rotated, scaled, placed.
@@ -598,6 +752,7 @@ fn repair(
     duplicates: usize,
     facets_in_file: usize,
     degenerate: usize,
+    groups: &mut [FacetGroup],
 ) -> (Mesh, FacetBuckets, MeshStats) {
     // The statistics and the facet index are independent: build them side by side.
     let (stats, mut buckets) = both(
@@ -611,11 +766,12 @@ fn repair(
     if stats.open_edges > 0 {
         // Cracks between near-coincident corners: try a tolerance weld, keep it if it helps.
         let mut welded = mesh.clone();
-        let merged = welded.weld_tolerance(WELD_TOLERANCE_MM);
+        let (merged, kept) = welded.weld_tolerance_kept(WELD_TOLERANCE_MM);
         let dropped = mesh.facets.len() - welded.facets.len();
         let better = welded.stats(facets_in_file, degenerate + dropped);
         if merged > 0 && better.open_edges < stats.open_edges {
             mesh = welded;
+            keep_groups(groups, &kept);
             // Shells the weld closed can now be oriented too (the facet index does not depend
             // on the facets' orientation).
             let again = mesh.orient_shells();
@@ -826,9 +982,13 @@ where
     W: std::io::Write + ?Sized,
     K: LayerSink,
 {
-    use std::collections::BTreeMap;
+    use std::collections::{BTreeMap, HashMap};
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-    use std::sync::{Condvar, Mutex};
+    use std::sync::{Condvar, Mutex, MutexGuard};
+
+    fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+        m.lock().unwrap_or_else(|p| p.into_inner())
+    }
 
     /// A layer's text, plan (without its moves), sink output, and first and last unit.
     type Done<T> = Result<(String, LayerPlan, T, Option<u8>, Option<u8>), String>;
@@ -850,6 +1010,12 @@ where
         written: 0,
     });
     let changed = Condvar::new();
+    // Each layer's region, from its worker to the worker of the layer above (the overhang
+    // needs it; slicing it again cost about a fifth of the time). `None`: its worker failed.
+    let regions: Mutex<HashMap<usize, Option<std::sync::Arc<geom::Shapes>>>> =
+        Mutex::new(HashMap::new());
+    let published = Condvar::new();
+    let needs_below = job.needs_below();
     let mut summary = Summary::default();
     // The unit selected after the layers written so far (a file starts with unit 0).
     let mut unit = 0u8;
@@ -857,6 +1023,7 @@ where
     std::thread::scope(|scope| -> Result<(), Error> {
         for mut state in states {
             let (next, stop, shared, changed) = (&next, &stop, &shared, &changed);
+            let (regions, published) = (&regions, &published);
             scope.spawn(move || {
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
@@ -872,8 +1039,38 @@ where
                     if stop.load(Ordering::Relaxed) {
                         break;
                     }
+                    let section =
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.section(i)));
+                    if needs_below {
+                        let mine = section
+                            .as_ref()
+                            .ok()
+                            .map(|s| std::sync::Arc::new(s.region.clone()));
+                        lock(regions).insert(i, mine);
+                        published.notify_all();
+                    }
+                    // The region below from its worker (it took its layer before this one and
+                    // publishes it first thing); sliced here if that worker failed or stopped.
+                    let below = match i.checked_sub(1) {
+                        Some(j) if needs_below => {
+                            let mut g = lock(regions);
+                            loop {
+                                if let Some(r) = g.remove(&j) {
+                                    break r;
+                                }
+                                if stop.load(Ordering::Relaxed) {
+                                    break None;
+                                }
+                                g = published
+                                    .wait_timeout(g, std::time::Duration::from_millis(20))
+                                    .map_or_else(|p| p.into_inner().0, |r| r.0);
+                            }
+                        }
+                        _ => None,
+                    };
                     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                        let (mut p, region) = job.plan_layer_and_region(i);
+                        let section = section.unwrap_or_else(|p| std::panic::resume_unwind(p));
+                        let (mut p, region) = job.plan_layer_with(i, section, below.as_deref());
                         let text = gcode::layer_text(&p);
                         let extra = K::per_layer(&mut state, i, &region, &p);
                         let units = (p.first_unit(), p.moves.last().map(|m| m.unit));

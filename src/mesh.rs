@@ -150,23 +150,43 @@ impl Mesh {
     /// Returns how many were dropped.
     pub fn remove_duplicate_facets(&mut self) -> usize {
         let before = self.facets.len();
-        let mut seen = HashSet::with_capacity_and_hasher(before, Default::default());
-        self.facets.retain(|f| {
-            // The cyclic rotation starting at the smallest vertex id.
-            let k = f
-                .iter()
-                .enumerate()
-                .min_by_key(|(_, v)| **v)
-                .map_or(0, |(k, _)| k);
-            seen.insert([f[k], f[(k + 1) % 3], f[(k + 2) % 3]])
-        });
+        self.remove_duplicate_facets_kept();
         before - self.facets.len()
+    }
+
+    /// [`remove_duplicate_facets`](Self::remove_duplicate_facets), returning which of the
+    /// facets before were kept (the others keep their order).
+    pub fn remove_duplicate_facets_kept(&mut self) -> Vec<bool> {
+        let before = self.facets.len();
+        let mut seen = HashSet::with_capacity_and_hasher(before, Default::default());
+        let kept: Vec<bool> = self
+            .facets
+            .iter()
+            .map(|f| {
+                // The cyclic rotation starting at the smallest vertex id.
+                let k = f
+                    .iter()
+                    .enumerate()
+                    .min_by_key(|(_, v)| **v)
+                    .map_or(0, |(k, _)| k);
+                seen.insert([f[k], f[(k + 1) % 3], f[(k + 2) % 3]])
+            })
+            .collect();
+        let mut it = kept.iter();
+        self.facets.retain(|_| *it.next().unwrap_or(&true));
+        kept
     }
 
     /// Merges vertices closer than `tol` (mm) to an earlier vertex (cracks left by exporters
     /// that write near-coincident corners), drops facets that collapse, and returns how many
     /// vertices were merged. Used only as a fallback when the exact weld leaves open edges.
     pub fn weld_tolerance(&mut self, tol: f64) -> usize {
+        self.weld_tolerance_kept(tol).0
+    }
+
+    /// [`weld_tolerance`](Self::weld_tolerance), also returning which of the facets before
+    /// were kept (the others keep their order).
+    pub fn weld_tolerance_kept(&mut self, tol: f64) -> (usize, Vec<bool>) {
         let cell = |p: &[f64; 3]| p.map(|c| (c / tol).floor() as i64);
         let mut grid: HashMap<[i64; 3], Vec<u32>> =
             HashMap::with_capacity_and_hasher(self.vertices.len(), Default::default());
@@ -204,13 +224,21 @@ impl Mesh {
             remap.push(id);
         }
         self.vertices = kept;
-        self.facets = self
+        let facets: Vec<[u32; 3]> = self
             .facets
             .iter()
             .map(|f| f.map(|i| remap[i as usize]))
-            .filter(|f| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
             .collect();
-        merged
+        let alive: Vec<bool> = facets
+            .iter()
+            .map(|f| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+            .collect();
+        self.facets = facets
+            .into_iter()
+            .zip(&alive)
+            .filter_map(|(f, &a)| a.then_some(f))
+            .collect();
+        (merged, alive)
     }
 
     /// Number of connected bodies (facets sharing a vertex belong to one body).

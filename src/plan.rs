@@ -53,7 +53,7 @@ pub struct Counts {
     /// Support droplets (all printed by unit 1).
     #[serde(default)]
     pub support: u64,
-    /// Droplets of any role printed by unit 1 (today: the support).
+    /// Droplets of any role printed by unit 1 (its parts' and the support).
     #[serde(default)]
     pub unit1: u64,
 }
@@ -321,42 +321,80 @@ pub fn support_settings(s: &Settings) -> Settings {
     }
 }
 
-/// Adds unit 1's moves for `region` (today the support region; later also the sections of
-/// unit-1 parts) to a planned layer, in the order `unit_order` gives, as `role`. Unit 0's
-/// droplets stay exactly as planned; only the travel between the two units' moves changes.
+/// The settings unit 1 prints its parts with (SPEC.md "Two discharge units"): the same
+/// contour and fill rules as unit 0, with unit 1's droplet width B₁ (`unit1_droplet_aspect`).
+pub fn unit1_part_settings(s: &Settings) -> Settings {
+    Settings {
+        droplet_aspect: s.unit1_droplet_aspect,
+        ..s.clone()
+    }
+}
+
+/// Adds unit 1's moves for `region` (the support region) to a planned layer as `role`; see
+/// [`plan_unit1_layer`].
 pub fn plan_unit1(plan: &mut LayerPlan, region: &Shapes, role: Role, s: &Settings) {
-    if region.is_empty() {
+    plan_unit1_layer(plan, &Shapes::new(), region, role, s);
+}
+
+/// Adds unit 1's moves to a planned layer, in the order `unit_order` gives: first the region
+/// of its parts (`parts`, contours and fill as unit 0's with B₁, roles outer/inner/fill),
+/// then `support` (one loop and hatch at `support_density`, [`support_settings`], as
+/// `support_role`). Unit 0's droplets stay exactly as planned; only the travel between the
+/// two units' moves changes.
+pub fn plan_unit1_layer(
+    plan: &mut LayerPlan,
+    parts: &Shapes,
+    support: &Shapes,
+    support_role: Role,
+    s: &Settings,
+) {
+    if parts.is_empty() && support.is_empty() {
         return;
     }
-    let s1 = support_settings(s);
-    let b1 = s1.droplet_width();
+    let b1 = s.unit1_droplet_width();
     let unit0_first = s.unit_order == crate::settings::UnitOrder::Unit0First;
     let start = if unit0_first {
         plan.moves.last().map_or(Point::ZERO, |m| m.to)
     } else {
         Point::ZERO
     };
-    let mut p1 = plan_layer_from(region, plan.index, &s1, start);
-    if p1.moves.is_empty() {
+    let mut moves: Vec<Move> = Vec::new();
+    let mut travel = 0.0;
+    let mut at = start;
+    for (region, role, s1) in [
+        (parts, None, unit1_part_settings(s)),
+        (support, Some(support_role), support_settings(s)),
+    ] {
+        if region.is_empty() {
+            continue;
+        }
+        let p1 = plan_layer_from(region, plan.index, &s1, at);
+        travel += p1.travel_mm;
+        for mut m in p1.moves {
+            m.unit = 1;
+            if let Some(r) = role {
+                m.role = r;
+            }
+            moves.push(m);
+        }
+        at = moves.last().map_or(at, |m| m.to);
+    }
+    if moves.is_empty() {
         return;
     }
-    for m in &mut p1.moves {
-        m.unit = 1;
-        m.role = role;
-    }
-    let c1 = count_units(&p1.moves, b1, b1);
+    let c1 = count_units(&moves, b1, b1);
     plan.counts.add(&c1);
     plan.unit1_width = b1;
-    plan.travel_mm += p1.travel_mm;
+    plan.travel_mm += travel;
     if unit0_first {
-        plan.moves.extend(p1.moves);
+        plan.moves.extend(moves);
     } else {
         // Unit 0 was planned from the origin; it now starts where unit 1 ends.
-        let end = p1.moves.last().map_or(Point::ZERO, |m| m.to);
+        let end = moves.last().map_or(Point::ZERO, |m| m.to);
         if let Some(first) = plan.moves.first() {
             plan.travel_mm += dist(end, first.to) - dist(Point::ZERO, first.to);
         }
-        p1.moves.append(&mut plan.moves);
-        plan.moves = p1.moves;
+        moves.append(&mut plan.moves);
+        plan.moves = moves;
     }
 }

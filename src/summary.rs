@@ -92,11 +92,11 @@ pub struct Figures {
     pub layers: usize,
     pub counts: Counts,
     pub droplets: u64,
-    /// Unit 0's droplets × B²H, mm³ (the part).
+    /// Unit 0's droplets × B²H, mm³ (the parts of unit 0).
     pub volume_mm3: f64,
     /// volume × material_density, g.
     pub mass_g: f64,
-    /// Droplets printed by unit 1 (today: the support).
+    /// Droplets printed by unit 1 (its parts and the support).
     pub unit1_droplets: u64,
     /// Unit 1's droplets × B₁²H, mm³.
     pub unit1_volume_mm3: f64,

@@ -22,7 +22,7 @@
 //! and hatch fill, [`crate::plan::plan_unit1`]), and a support band narrower than B₁ would
 //! have no loop. `tests/support.rs` checks the rule on the printed droplets.
 
-use crate::geom::{Shape, Shapes, region_area, shapes_from_overlay, signed_area};
+use crate::geom::{DVec2, Shape, Shapes, region_area, shapes_from_overlay, signed_area};
 use crate::offset::CHORD_TOLERANCE_MM;
 use crate::settings::Settings;
 use i_overlay::core::fill_rule::FillRule;
@@ -145,9 +145,11 @@ fn carried(a: &Shapes, b: &Shapes, c: &Shapes) -> Shapes {
     cleaned(subject.overlay(&nested(c), OverlayRule::Difference, FillRule::NonZero))
 }
 
-/// The overhang of a layer: its region farther than `overhang_limit`·B from the region of the
-/// layer below (`None` for layer 1, which rests on the plate: no overhang).
-pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
+/// [`overhang`] as it was computed before (kept for `tests/support.rs`, which compares the
+/// two): the region less i_overlay's outward outline of the layer below, chords within
+/// [`SUPPORT_TOLERANCE_MM`] (inside the arcs: it overstates the area by up to ~2·10⁻³ mm² a
+/// layer on 3DBenchy).
+pub fn overhang_reference(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
     let Some(below) = below else {
         return Shapes::new();
     };
@@ -159,6 +161,58 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
     // Chords within the support's tolerance: the area is a figure, not an outline to print.
     let d = s.overhang_limit * s.droplet_width();
     difference(&fresh, &grow_within(below, d, SUPPORT_TOLERANCE_MM))
+}
+
+/// The overhang of a layer: its region farther than `overhang_limit`·B from the region of the
+/// layer below (`None` for layer 1, which rests on the plate: no overhang).
+///
+/// Computed as region ∩ inset(complement of below, d): the complement is a frame around both
+/// layers with every loop of the layer below reversed as a hole, moved inward by d with the
+/// fast offset of [`crate::offset::inset_within`] (arcs within
+/// [`CHORD_TOLERANCE_MM`]), then one intersection. About 2.5 times faster than
+/// growing the layer below with i_overlay's outline and two differences
+/// ([`overhang_reference`]); per layer the areas agree within ~10⁻³ mm² with that
+/// construction at the same chord tolerance (tests/support.rs).
+pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
+    let Some(below) = below else {
+        return Shapes::new();
+    };
+    if region.is_empty() {
+        return Shapes::new();
+    }
+    let d = s.overhang_limit * s.droplet_width();
+    if below.is_empty() || d <= 0.0 {
+        return if d <= 0.0 {
+            difference(region, below)
+        } else {
+            region.clone()
+        };
+    }
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in region
+        .iter()
+        .chain(below)
+        .flat_map(|s| s.contours())
+        .flatten()
+    {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let m = d + 1.0;
+    let (lo, hi) = (lo - DVec2::splat(m), hi + DVec2::splat(m));
+    let frame: crate::geom::Contour = vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+    let holes = below
+        .iter()
+        .flat_map(|s| s.contours())
+        .map(|c| {
+            let mut r = c.clone();
+            r.reverse();
+            r
+        })
+        .collect();
+    let far =
+        crate::offset::inset_within(&vec![Shape::new(frame, holes)], d, d, CHORD_TOLERANCE_MM);
+    intersection(region, &far)
 }
 
 /// How far beyond an overhang its support reaches, mm: half a unit-1 droplet width B₁, so

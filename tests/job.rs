@@ -427,15 +427,15 @@ fn placed_and_arranged_parts_mix() {
 }
 
 #[test]
-fn unit_1_parts_are_refused_for_now_and_files_must_be_known() {
+fn unit_1_parts_are_printed_and_files_must_be_known() {
     let models = [box_model("a.stl", 10.0, 10.0, 5.0)];
     let s = spec(json!({"parts": [{"file": "a.stl", "unit": 1}]})).unwrap();
-    let e = Job::from_models(&models, &s).err().unwrap();
-    assert!(
-        e.to_string()
-            .contains("parts of discharge unit 1 are not printed yet"),
-        "{e}"
-    );
+    let j = Job::from_models(&models, &s).unwrap();
+    assert!(j.uses_unit1());
+    // All of the box is unit 1's: every droplet of a layer is printed by unit 1.
+    let p = j.plan_layer(3);
+    assert!(p.counts.total() > 0 && p.counts.unit1 == p.counts.total());
+    assert!(p.moves.iter().all(|m| m.unit == 1));
     let s = spec(json!({"parts": [{"file": "b.stl"}]})).unwrap();
     let e = Job::from_models(&models, &s).err().unwrap();
     assert!(

@@ -389,3 +389,39 @@ fn the_overlay_marks_the_droplets_the_gcode_breaks_the_rule_with() {
         }
     }
 }
+
+#[test]
+fn the_overhang_figure_agrees_with_the_outline_construction() {
+    // `support::overhang` (the layer below's complement moved inward by the fast offset, one
+    // intersection) against the construction it replaced: the region less i_overlay's outward
+    // outline of the layer below (`overhang_reference`, chords within 5 µm, inside the arcs)
+    // and the same outline with chords within 1 µm, layer by layer on 3DBenchy and the
+    // overhang models.
+    use dropslice::{geom::region_area, offset::CHORD_TOLERANCE_MM, support};
+    for name in ["3DBenchy.stl", "U_overhang.obj", "extruder_idler.stl"] {
+        let bytes = common::model_bytes(name);
+        let job = dropslice::Job::new(&bytes, name, dropslice::Settings::default()).unwrap();
+        let s = job.settings();
+        let d = s.overhang_limit * s.droplet_width();
+        let regions: Vec<_> = (0..job.layer_count())
+            .map(|i| job.section(i).region)
+            .collect();
+        let (mut worst, mut worst_ref, mut total) = (0.0f64, 0.0f64, 0.0);
+        for i in 1..regions.len() {
+            let (r, below) = (&regions[i], &regions[i - 1]);
+            let got = region_area(&support::overhang(r, Some(below), s));
+            let fine = support::grow_within(below, d, CHORD_TOLERANCE_MM);
+            let want = region_area(&support::difference(r, &fine));
+            let reference = region_area(&support::overhang_reference(r, Some(below), s));
+            worst = worst.max((got - want).abs());
+            worst_ref = worst_ref.max((got - reference).abs());
+            total += got;
+        }
+        eprintln!(
+            "{name}: {total:.3} mm² of overhang; largest difference per layer {worst:.2e} mm² (1 µm chords), {worst_ref:.2e} mm² (the former 5 µm)"
+        );
+        assert!(worst < 1.5e-3, "{name}: {worst}");
+        assert!(worst_ref < 3e-3, "{name}: {worst_ref}");
+        assert!(support::overhang(&regions[0], None, s).is_empty());
+    }
+}

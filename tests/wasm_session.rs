@@ -554,6 +554,81 @@ fn refused_jobs_throw_typed_errors() {
     assert_eq!(e["kind"], "import");
 }
 
+#[wasm_bindgen_test]
+fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
+    let mut models = Models::new();
+    models
+        .add_bytes(box_stl(10.0, 10.0, 2.0).as_bytes(), "a.stl")
+        .unwrap();
+    models
+        .add_bytes(box_stl(10.0, 10.0, 3.0).as_bytes(), "b.stl")
+        .unwrap();
+    // b overlaps a by 4 mm in x; a is listed first and keeps the overlap.
+    let job = serde_json::json!({
+        "settings": {"unit1_droplet_aspect": 1.5},
+        "parts": [
+            {"file": "a.stl", "place_x": 0, "place_y": 0},
+            {"file": "b.stl", "place_x": 6, "place_y": 0, "unit": 1}
+        ]
+    });
+    let s = Session::from_models(&models, js(job.clone())).unwrap();
+    let other = Session::from_prepared(
+        &s.vertices().to_vec(),
+        &s.facets().to_vec(),
+        s.info().unwrap(),
+        js(job["settings"].clone()),
+    )
+    .unwrap();
+    assert_eq!(json(other.info().unwrap()), json(s.info().unwrap()));
+    assert_eq!(
+        other.header(JsValue::NULL).unwrap(),
+        s.header(JsValue::NULL).unwrap()
+    );
+    let header = s.header(JsValue::NULL).unwrap();
+    assert!(header.contains("unit1_droplet_aspect = 1.5"), "{header}");
+    let (mut ta, mut tb) = (Tally::new(), Tally::new());
+    let mut text = String::new();
+    for i in 0..s.layer_count() {
+        let (x, y) = (s.slice_layer(i).unwrap(), other.slice_layer(i).unwrap());
+        assert_eq!(x.gcode().to_vec(), y.gcode().to_vec(), "layer {i}");
+        ta.add_layer(&x);
+        tb.add_layer(&y);
+        text.push_str(&String::from_utf8(x.gcode().to_vec()).unwrap());
+    }
+    let summary = json(ta.summary().unwrap());
+    assert_eq!(summary, json(tb.summary().unwrap()));
+    // Unit 1 prints b less the overlap: 6 × 10 mm² on each of its 15 layers (B₁ = 0.3 mm
+    // cells), and b alone on the top 5.
+    let unit1 = summary["counts"]["unit1"].as_f64().unwrap();
+    let b1: f64 = 0.2 * 1.5;
+    let want = (10.0 * 60.0 + 5.0 * 100.0) / (b1 * b1);
+    assert!((unit1 - want).abs() < 0.1 * want, "{unit1} vs {want}");
+    // Every unit-1 droplet beside a (z ≤ 2 mm) lies right of it (x > 10), above it from
+    // x > 6: read from the code after T1.
+    let mut unit = 0;
+    let mut checked = 0;
+    for l in text.lines() {
+        match l {
+            "T0" => unit = 0,
+            "T1" => unit = 1,
+            _ if unit == 1 && (l.starts_with("G26") || l.starts_with("G25")) => {
+                let word = |c: char| -> f64 {
+                    l.split(' ')
+                        .find_map(|w| w.strip_prefix(c))
+                        .unwrap()
+                        .parse()
+                        .unwrap()
+                };
+                let left = if word('Z') <= 2.0 + 1e-9 { 10.0 } else { 6.0 };
+                assert!(word('X') > left, "{l}");
+                checked += 1;
+            }
+            _ => {}
+        }
+    }
+    assert!(checked > 100, "{checked}");
+}
+
 /// `stl` (ASCII) with every vertex moved by (dx, dy, dz), as the facets of a second solid.
 fn moved_facets(stl: &str, dx: f64, dy: f64, dz: f64) -> String {
     stl.lines()

@@ -41,8 +41,9 @@ the settings and the parts:
              {\"file\": \"gear.3mf\", \"item\": 0, \"copies\": 3}]}
 Part keys: file (relative to the job file's folder), item (a 3MF build item, from 0;
 none: the whole build), rotate_x/y/z, scale_x/y/z, place_x + place_y (none: arranged),
-place_angle, copies (1..100), unit (0). --set and --settings override the job file's
-settings (not the parts').
+place_angle, copies (1..100), unit (0 or 1: the discharge unit; where parts of
+different units overlap, the part listed first keeps the overlap). --set and --settings
+override the job file's settings (not the parts').
 
   -o, --output FILE      where to write the code (default: MODEL.gco in the current directory)
   --set name=value       change one setting (repeatable; see --list-settings)
@@ -544,8 +545,9 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             eprintln!("dropslice: {}", overhang_line(&f));
             if f.unit1_droplets > 0 {
                 eprintln!(
-                    "dropslice: support (unit 1): {} droplets, {:.2} cm³, {:.2} g, {} of unit 1 and {} of unit 0",
+                    "dropslice: unit 1: {} droplets ({} support), {:.2} cm³, {:.2} g, {} of unit 1 and {} of unit 0",
                     f.unit1_droplets,
+                    f.counts.support,
                     f.unit1_volume_mm3 / 1000.0,
                     f.unit1_mass_g,
                     duration(f.unit1_seconds),
