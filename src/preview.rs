@@ -9,6 +9,8 @@ pub struct PreviewLayer {
     pub droplets: Vec<f32>,
     /// Role of each droplet: 0 outermost loop, 1 inner loops, 2 fill, 3 support (unit 1).
     pub roles: Vec<u8>,
+    /// Discharge unit of each droplet (0 or 1), in the order of `roles`.
+    pub units: Vec<u8>,
     /// x0, y0, x1, y1 of every move without material (G01, and G26's way to its droplet).
     pub travel: Vec<f32>,
 }
@@ -20,6 +22,7 @@ impl PreviewLayer {
         let mut p = PreviewLayer {
             droplets: Vec::with_capacity(2 * n),
             roles: Vec::with_capacity(n),
+            units: Vec::with_capacity(n),
             travel: Vec::new(),
         };
         let mut at = DVec2::ZERO;
@@ -33,12 +36,14 @@ impl PreviewLayer {
                     if m.kind == MoveKind::Droplet {
                         p.droplets.extend([m.to[0] as f32, m.to[1] as f32]);
                         p.roles.push(m.role as u8);
+                        p.units.push(m.unit);
                     }
                 }
                 MoveKind::Line => {
                     for d in line_droplets(at, m.to, plan.width_of(m, b)) {
                         p.droplets.extend([d.x as f32, d.y as f32]);
                         p.roles.push(m.role as u8);
+                        p.units.push(m.unit);
                     }
                 }
             }

@@ -223,6 +223,61 @@ pub fn support_reach(s: &Settings) -> f64 {
     0.5 * s.unit1_droplet_width()
 }
 
+/// The droplet form of the rule: which droplets of a layer have no droplet of the layer below
+/// within B_d/2 + `limit_mm` (B_d: the width of the droplet d below; `limit_mm` =
+/// `overhang_limit`·B). `layer`: the layer's droplet centres; `below`: the layer below's
+/// centres with their widths, `None` for the first layer (it rests on the plate: every droplet
+/// supported). A hash grid of the layer below: O(droplets) for any layer.
+pub fn unsupported_droplets(
+    layer: &[[f64; 2]],
+    below: Option<&[([f64; 2], f64)]>,
+    limit_mm: f64,
+) -> Vec<bool> {
+    let Some(below) = below else {
+        return vec![false; layer.len()];
+    };
+    let reach = below
+        .iter()
+        .map(|&(_, w)| w / 2.0 + limit_mm)
+        .fold(0.0_f64, f64::max);
+    if !(reach > 0.0 && reach.is_finite()) {
+        return vec![true; layer.len()];
+    }
+    let key = |p: [f64; 2]| ((p[0] / reach).floor() as i64, (p[1] / reach).floor() as i64);
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> =
+        std::collections::HashMap::with_capacity(below.len());
+    for (j, &(p, _)) in below.iter().enumerate() {
+        grid.entry(key(p)).or_default().push(j);
+    }
+    layer
+        .iter()
+        .map(|&c| {
+            let (cx, cy) = key(c);
+            !(-1..=1).any(|dx| {
+                (-1..=1).any(|dy| {
+                    grid.get(&(cx.saturating_add(dx), cy.saturating_add(dy)))
+                        .is_some_and(|v| {
+                            v.iter().any(|&j| {
+                                let (d, w) = below[j];
+                                let r = w / 2.0 + limit_mm;
+                                (c[0] - d[0]).powi(2) + (c[1] - d[1]).powi(2) <= r * r + 1e-9
+                            })
+                        })
+                })
+            })
+        })
+        .collect()
+}
+
+/// The steepest face that needs no support, as the z of its outward normal: a face whose unit
+/// normal has n_z < −this overhangs. A face at angle θ from the vertical moves H·tan θ per layer;
+/// the rule carries a layer offset of up to `overhang_limit`·B, so the face overhangs when
+/// tan θ > `overhang_limit`·B/H, and a downward face's normal has n_z = −sin θ.
+pub fn overhang_face_normal_z(s: &Settings) -> f64 {
+    let t = s.overhang_limit * s.droplet_width() / s.layer_height;
+    t / (1.0 + t * t).sqrt()
+}
+
 /// One layer's overhang area and the support region unit 1 prints in it.
 #[derive(Clone, Debug, Default)]
 pub struct LayerSupport {
@@ -387,5 +442,60 @@ mod tests {
                 assert!(region_area(&inside) < 1e-6);
             }
         }
+    }
+
+    #[test]
+    fn unsupported_droplets_agree_with_every_pair() {
+        // Pseudo-random droplets of two layers, both widths: the grid's answer is the answer
+        // of comparing every pair.
+        let mut seed = 12345_u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let layer: Vec<[f64; 2]> = (0..400).map(|_| [rnd() * 6.0 - 3.0, rnd() * 6.0]).collect();
+        let below: Vec<([f64; 2], f64)> = (0..150)
+            .map(|_| {
+                (
+                    [rnd() * 6.0 - 3.0, rnd() * 6.0],
+                    if rnd() < 0.5 { 0.2 } else { 0.5 },
+                )
+            })
+            .collect();
+        let limit = 0.1;
+        let got = unsupported_droplets(&layer, Some(&below), limit);
+        let want: Vec<bool> = layer
+            .iter()
+            .map(|c| {
+                !below.iter().any(|(d, w)| {
+                    ((c[0] - d[0]).powi(2) + (c[1] - d[1]).powi(2)).sqrt() <= w / 2.0 + limit
+                })
+            })
+            .collect();
+        assert_eq!(got, want);
+        assert!(want.iter().any(|&u| u) && want.iter().any(|&u| !u));
+        // The first layer rests on the plate; nothing below a higher layer: all unsupported.
+        assert!(
+            unsupported_droplets(&layer, None, limit)
+                .iter()
+                .all(|&u| !u)
+        );
+        assert!(
+            unsupported_droplets(&layer, Some(&[]), limit)
+                .iter()
+                .all(|&u| u)
+        );
+    }
+
+    #[test]
+    fn a_face_overhangs_beyond_the_angle_the_limit_carries() {
+        // Defaults: limit 0.5, B = 1.04 H: tan θ = 0.52, θ ≈ 27.47° from the vertical.
+        let s = Settings::default();
+        let z = overhang_face_normal_z(&s);
+        let theta = (0.5_f64 * 1.04).atan();
+        assert!((z - theta.sin()).abs() < 1e-12, "{z}");
+        assert!((theta.to_degrees() - 27.47).abs() < 0.01);
     }
 }

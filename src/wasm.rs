@@ -134,6 +134,65 @@ pub fn merge_summaries(parts: JsValue) -> Result<JsValue, JsValue> {
     to_js(&Summary::merged(&parts), "a summary")
 }
 
+/// The overhang overlay (docs/support.md "The rule", [`crate::support::unsupported_droplets`]):
+/// per droplet of a layer (`droplets` x,y pairs, `units` its discharge units) 1 if no droplet
+/// of the layer below (`below`, `below_units`) lies within B_d/2 + `limit_mm`, else 0; B_d is
+/// `widths[u]` for unit u (`[B, B₁]`), `limit_mm` = `overhang_limit`·B. `on_plate`: the layer is
+/// the first (every droplet supported). Throws `{kind: "internal"}` on arrays that do not pair
+/// up, a unit other than 0 or 1, or a width or coordinate that is not a finite number.
+#[wasm_bindgen]
+pub fn unsupported_droplets(
+    droplets: &[f32],
+    units: &[u8],
+    below: &[f32],
+    below_units: &[u8],
+    widths: &[f64],
+    limit_mm: f64,
+    on_plate: bool,
+) -> Result<Uint8Array, JsValue> {
+    let bad = |m: &str| js_error(Error::Internal(format!("overhang overlay: {m}")));
+    if droplets.len() != 2 * units.len() || below.len() != 2 * below_units.len() {
+        return Err(bad("the droplets and their units do not pair up"));
+    }
+    let [b, b1] = widths else {
+        return Err(bad("two droplet widths are needed, B and B₁"));
+    };
+    let (b, b1) = (*b, *b1);
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    if !(positive(b) && positive(b1) && limit_mm.is_finite() && limit_mm >= 0.0) {
+        return Err(bad(
+            "the droplet widths must be positive and the limit at least 0",
+        ));
+    }
+    if units.iter().chain(below_units).any(|&u| u > 1) {
+        return Err(bad("a droplet's unit is neither 0 nor 1"));
+    }
+    if !droplets.iter().chain(below).all(|v| v.is_finite()) {
+        return Err(bad("a droplet centre is not a number"));
+    }
+    let layer: Vec<[f64; 2]> = droplets
+        .chunks_exact(2)
+        .map(|c| [c[0] as f64, c[1] as f64])
+        .collect();
+    let under: Vec<([f64; 2], f64)> = below
+        .chunks_exact(2)
+        .zip(below_units)
+        .map(|(c, &u)| ([c[0] as f64, c[1] as f64], if u == 1 { b1 } else { b }))
+        .collect();
+    let mask =
+        crate::support::unsupported_droplets(&layer, (!on_plate).then_some(&under[..]), limit_mm);
+    let bytes: Vec<u8> = mask.into_iter().map(u8::from).collect();
+    Ok(Uint8Array::from(&bytes[..]))
+}
+
+/// The 3D view's overhang tint for `settings`: a face whose unit normal (plate coordinates, z
+/// up) has z below minus this overhangs ([`crate::support::overhang_face_normal_z`]).
+#[wasm_bindgen]
+pub fn overhang_face_normal_z(settings: JsValue) -> Result<f64, JsValue> {
+    let s = settings_of(settings)?;
+    Ok(crate::support::overhang_face_normal_z(&s))
+}
+
 /// A job (`{settings, parts}`, the job file's JSON) from a JS object.
 fn job_of(value: JsValue) -> Result<JobSpec, JsValue> {
     let value: serde_json::Value = serde_wasm_bindgen::from_value(value).map_err(|e| {
@@ -487,6 +546,7 @@ pub struct LayerResult {
     counts: Counts,
     travel_mm: f64,
     seconds: f64,
+    unsupported_area: f64,
     summary: Summary,
     gcode: String,
     preview: PreviewLayer,
@@ -502,6 +562,7 @@ impl LayerResult {
             counts: plan.counts,
             travel_mm: plan.travel_mm,
             seconds: summary::layer_seconds(plan, settings),
+            unsupported_area: plan.unsupported_area,
             summary: Summary::of_layer(plan),
             gcode,
             preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
@@ -563,10 +624,31 @@ impl LayerResult {
     pub fn roles(&self) -> Uint8Array {
         Uint8Array::from(&self.preview.roles[..])
     }
+    /// Discharge unit per droplet (0 or 1), in the order of `roles`.
+    #[wasm_bindgen(getter)]
+    pub fn units(&self) -> Uint8Array {
+        Uint8Array::from(&self.preview.units[..])
+    }
     /// Travel moves, x0,y0,x1,y1 per move, in mm.
     #[wasm_bindgen(getter)]
     pub fn travel(&self) -> Float32Array {
         Float32Array::from(&self.preview.travel[..])
+    }
+    /// The layer's overhang area, mm² (its region farther than `overhang_limit`·B from the
+    /// region below; 0 on the first layer).
+    #[wasm_bindgen(getter)]
+    pub fn unsupported_area(&self) -> f64 {
+        self.unsupported_area
+    }
+    /// Support droplets (unit 1).
+    #[wasm_bindgen(getter)]
+    pub fn support(&self) -> f64 {
+        self.counts.support as f64
+    }
+    /// Droplets printed by unit 1 (support and unit-1 parts).
+    #[wasm_bindgen(getter)]
+    pub fn unit1(&self) -> f64 {
+        self.counts.unit1 as f64
     }
     /// The layer's void analysis (`analysis::LayerAnalysis`: coverage, void_area,
     /// largest_void {area, centroid, min, max, at_boundary}, overfill_area,

@@ -29,7 +29,7 @@ pub struct CutResult {
 #[wasm_bindgen]
 impl CutResult {
     /// Droplets near the line of the layers the worker planned: layer, t, distance from the
-    /// plane, role (0 outer loop, 1 inner loops, 2 fill) per droplet.
+    /// plane, role (0 outer loop, 1 inner loops, 2 fill, 3 support), unit (0 or 1) per droplet.
     #[wasm_bindgen(getter)]
     pub fn droplets(&self) -> Float64Array {
         Float64Array::from(&self.droplets[..])
@@ -127,7 +127,13 @@ impl Session {
                 let hits = line.near(points, reach);
                 if wanted {
                     for &(j, t, d) in &hits {
-                        out.droplets.extend([i as f64, t, d, f64::from(p.roles[j])]);
+                        out.droplets.extend([
+                            i as f64,
+                            t,
+                            d,
+                            f64::from(p.roles[j]),
+                            f64::from(p.units[j]),
+                        ]);
                     }
                     regions.push(region);
                 }

@@ -152,6 +152,17 @@ impl GcodeLayer {
         Uint8Array::from(&self.layer.preview.roles[..])
     }
 
+    /// Discharge unit per droplet (0 or 1; `T1` selects unit 1), in the order of `roles`.
+    pub fn units(&self) -> Uint8Array {
+        Uint8Array::from(&self.layer.units[..])
+    }
+
+    /// Droplets printed by unit 1.
+    #[wasm_bindgen(getter)]
+    pub fn unit1(&self) -> f64 {
+        self.layer.counts.unit1 as f64
+    }
+
     pub fn travel(&self) -> Float32Array {
         Float32Array::from(&self.layer.preview.travel[..])
     }

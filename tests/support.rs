@@ -318,6 +318,69 @@ fn unsupported_area_in_the_report() {
     assert!(cube.len() > 90 && cube.iter().all(|&a| a < 1e-6));
 }
 
+/// The page's overhang overlay ([`dropslice::support::unsupported_droplets`] on the preview's
+/// droplets, as `src/wasm.rs` passes them) marks, layer by layer, as many droplets as this
+/// file's independent reading of the CLI's G-code finds: with support off (unit 0 only) and on
+/// (droplets of both widths below).
+#[test]
+fn the_overlay_marks_the_droplets_the_gcode_breaks_the_rule_with() {
+    for (name, sets) in [
+        ("overhang.obj", &[][..]),
+        ("U_overhang.obj", &[][..]),
+        ("3DBenchy.stl", &["support=unit1"][..]),
+    ] {
+        let g = slice(name, sets);
+        let want = unsupported(&g, &all_droplets(&g));
+        let mut json = serde_json::Map::new();
+        for kv in sets {
+            let (k, v) = kv.split_once('=').unwrap();
+            json.insert(k.into(), v.into());
+        }
+        let settings = dropslice::settings::Settings::from_value(json.into()).unwrap();
+        let (b, b1) = (settings.droplet_width(), settings.unit1_droplet_width());
+        let limit = settings.overhang_limit * b;
+        let job = dropslice::Job::new(&common::model_bytes(name), name, settings).unwrap();
+        assert_eq!(job.layer_count(), want.len(), "{name}");
+        let preview = |i: usize| dropslice::preview::PreviewLayer::from_plan(&job.plan_layer(i), b);
+        // 3DBenchy: the layers where the G-code reading finds droplets, and a few others.
+        let layers: Vec<usize> = if name == "3DBenchy.stl" {
+            let mut l: Vec<usize> = (0..want.len()).filter(|&i| want[i] > 0).collect();
+            l.extend([1, 60, 183]);
+            l
+        } else {
+            (0..want.len()).collect()
+        };
+        let mut marked_total = 0;
+        for i in layers {
+            let p = preview(i);
+            let centres: Vec<[f64; 2]> = p
+                .droplets
+                .chunks_exact(2)
+                .map(|c| [c[0] as f64, c[1] as f64])
+                .collect();
+            let below = (i > 0).then(|| {
+                let q = preview(i - 1);
+                q.droplets
+                    .chunks_exact(2)
+                    .zip(&q.units)
+                    .map(|(c, &u)| ([c[0] as f64, c[1] as f64], if u == 1 { b1 } else { b }))
+                    .collect::<Vec<_>>()
+            });
+            let marked =
+                dropslice::support::unsupported_droplets(&centres, below.as_deref(), limit)
+                    .iter()
+                    .filter(|&&u| u)
+                    .count();
+            assert_eq!(marked, want[i], "{name} layer {}", i + 1);
+            marked_total += marked;
+        }
+        eprintln!("{name} {sets:?}: {marked_total} droplets marked");
+        if sets.is_empty() {
+            assert!(marked_total > 0, "{name}: nothing overhangs");
+        }
+    }
+}
+
 #[test]
 fn the_overhang_figure_agrees_with_the_outline_construction() {
     // `support::overhang` (the layer below's complement moved inward by the fast offset, one

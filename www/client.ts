@@ -408,6 +408,23 @@ export class Pool {
     return this.guarded(async () => (await this.pick()).call("cut", data, undefined, [data.sent.buffer, data.centres.buffer]));
   }
 
+  /** The overhang overlay of a layer (the core's rule on its droplets and the layer below's);
+   *  needs no model: the least busy worker answers. The arrays are copied, not transferred. */
+  unsupported(data: RequestData<"unsupported">): Promise<ResultOf<"unsupported">> {
+    this.heal();
+    return this.guarded(() => {
+      const ready = this.handles.filter((h) => !h.broken);
+      const h = ready.length ? ready.reduce((a, b) => (b.load < a.load ? b : a)) : this.handles[0];
+      return h.call("unsupported", data);
+    });
+  }
+
+  /** The 3D view's overhang tint for `settings` (the core's threshold); needs no model. */
+  overhangFace(settings: RequestData<"overhang_face">["settings"]): Promise<number> {
+    this.heal();
+    return this.guarded(() => this.handles[0].call("overhang_face", { settings }));
+  }
+
   /** The core's droplet calibration (views/calibrate.ts); needs no model. */
   calibrate(data: RequestData<"calibrate">): Promise<ResultOf<"calibrate">> {
     this.heal();

@@ -6,7 +6,7 @@
 // at 6 heights per slab) over them; the current layer outlined. Only layers and droplets in
 // view are drawn, batched into one Path2D per colour.
 
-import { ROLE_COLORS, VOID_RGB, clampView, MAX_SCALE, MIN_SCALE } from "./render";
+import { CLASS_COLORS, dropletClass, VOID_RGB, clampView, MAX_SCALE, MIN_SCALE } from "./render";
 
 /** One layer of the cut: what the page or the core found along the line. */
 export interface CutLayer {
@@ -18,10 +18,10 @@ export interface CutLayer {
   voids: Float64Array | null;
 }
 
-/** Colour of a droplet of the cut by its role. A droplet's discharge unit, once the layers
- *  carry one, goes here too (e.g. `unit === 1 ? UNIT1_COLOR : …`): one line. */
-export function cutColor(role: number, _unit = 0): string {
-  return ROLE_COLORS[Math.min(2, Math.max(0, role))];
+/** Colour of a droplet of the cut by its role and discharge unit (render.ts `dropletClass`:
+ *  support and unit-1 parts have colours of their own). */
+export function cutColor(role: number, unit = 0): string {
+  return CLASS_COLORS[dropletClass(role, unit)];
 }
 
 const SECTION_COLOR = "#e3e8ef";
@@ -155,7 +155,8 @@ export class CutRenderer {
     // mm -> device px: x' = X + t k, y' = Y − z k
     ctx.setTransform(k, 0, 0, -k, X, Y);
     const section = new Path2D();
-    const roles = [new Path2D(), new Path2D(), new Path2D()];
+    // per colour class (render.ts `dropletClass`: near's third value)
+    const roles = CLASS_COLORS.map(() => new Path2D());
     const voids = new Path2D();
     const r2 = this.radius * this.radius;
     // a hairline gap between droplets once they are a few pixels wide
@@ -175,7 +176,7 @@ export class CutRenderer {
         if (w2 <= 0) continue;
         const w = Math.sqrt(w2);
         const g = 2 * w * k > 5 ? gap : 0;
-        roles[Math.min(2, n[j + 2])].rect(t - w + g, bottom + inset, 2 * (w - g), h - 2 * inset);
+        roles[Math.min(4, Math.max(0, n[j + 2]))].rect(t - w + g, bottom + inset, 2 * (w - g), h - 2 * inset);
       }
       const v = layer.voids;
       if (v && this.showVoids) {
@@ -189,9 +190,9 @@ export class CutRenderer {
     }
     ctx.fillStyle = SECTION_COLOR;
     ctx.fill(section);
-    for (const role of [2, 1, 0]) {
-      ctx.fillStyle = cutColor(role);
-      ctx.fill(roles[role]);
+    for (const cls of [3, 4, 2, 1, 0]) {
+      ctx.fillStyle = CLASS_COLORS[cls];
+      ctx.fill(roles[cls]);
     }
     ctx.fillStyle = `rgba(${VOID_RGB.join(", ")}, 0.9)`;
     ctx.fill(voids);

@@ -19,7 +19,7 @@ export class Figures {
   /** Set by the core when every layer is in and not one droplet fits. */
   nothingToPrint: ErrorValue | null = null;
   /** A .gco file's droplets and travel, as read. */
-  private read: Counts = { outer: 0, inner: 0, fill: 0 };
+  private read: Counts = { outer: 0, inner: 0, fill: 0, support: 0, unit1: 0 };
   private readTravel = 0;
   private running: Promise<void> | null = null;
   private again = false;
@@ -29,6 +29,7 @@ export class Figures {
     this.read.outer += l.counts.outer;
     this.read.inner += l.counts.inner;
     this.read.fill += l.counts.fill;
+    this.read.unit1 = (this.read.unit1 ?? 0) + (l.counts.unit1 ?? 0);
     this.readTravel += l.travelMm;
   }
 
@@ -81,8 +82,28 @@ export class Figures {
   }
 
   get droplets(): number {
+    if (this.core) return this.core.droplets;
     const t = this.totals;
-    return t.outer + t.inner + t.fill;
+    return t.outer + t.inner + t.fill + (t.support ?? 0);
+  }
+
+  /** Unit 1's droplets (support and unit-1 parts; a .gco file's after `T1`), and, for a
+   *  slice, their material (mm³), mass (g, unit1_material_density) and each unit's droplet
+   *  time (s). */
+  get unit1(): { droplets: number; volume: number | null; mass: number | null; seconds0: number | null; seconds1: number | null } {
+    const c = this.core;
+    if (!c) return { droplets: this.read.unit1 ?? 0, volume: null, mass: null, seconds0: null, seconds1: null };
+    return { droplets: c.unit1_droplets ?? 0, volume: c.unit1_volume_mm3 ?? 0, mass: c.unit1_mass_g ?? 0, seconds0: c.unit0_seconds ?? null, seconds1: c.unit1_seconds ?? null };
+  }
+
+  /** Overhang area of the part, mm² (summed over the layers; null for a .gco file). */
+  get unsupportedArea(): number | null {
+    return this.core?.unsupported_area ?? null;
+  }
+
+  /** The layer with the largest overhang area. */
+  get worstOverhang(): { index: number; area: number } | null {
+    return this.core?.worst_overhang ?? null;
   }
 
   /** Layers analysed (the core's count). */

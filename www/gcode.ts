@@ -90,10 +90,11 @@ export class GcodeReader {
       this.emit({
         index: l.index,
         z: l.z,
-        counts: { outer, inner, fill },
+        counts: { outer, inner, fill, support: 0, unit1: l.unit1 },
         travelMm: l.travel_mm,
         droplets: l.droplets(),
         roles: l.roles(),
+        units: l.units(),
         travel: l.travel(),
       });
       l.free();

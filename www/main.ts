@@ -17,7 +17,7 @@ import { updateButtons } from "./views/controls";
 import { $ } from "./views/dom";
 import { wireCalibrate } from "./views/calibrate";
 import { wireCut } from "./views/cut";
-import { show, wireLayerView } from "./views/layer";
+import { setShowOverhangs, show, wireLayerView } from "./views/layer";
 import { wirePlot } from "./views/plot";
 import { registerOffline } from "./offline";
 import { share } from "./views/share";
@@ -98,6 +98,18 @@ function wire(): void {
     if (renderer.showVoids && store.slice) void analyseVoids(page, store.slice);
     renderer.request();
   });
+  $<HTMLInputElement>("opt-overhangs").addEventListener("change", (ev) => setShowOverhangs(page, (ev.target as HTMLInputElement).checked));
+  $("btn-worst-overhang").addEventListener("click", () => {
+    const worst = store.slice?.figures.worstOverhang;
+    if (worst) show(page, worst.index);
+  });
+  // the support switch sets the setting `support` (the Support group has its details)
+  $<HTMLInputElement>("opt-support").addEventListener("change", (ev) => {
+    const form = page.form;
+    if (!form) return;
+    form.set({ support: (ev.target as HTMLInputElement).checked ? "unit1" : "off" });
+    updateButtons(page);
+  });
   $("btn-worst").addEventListener("click", () => {
     const worst = store.slice?.figures.worst;
     if (worst) show(page, worst.index);
@@ -147,6 +159,12 @@ window.dropslice = {
       layer: store.current,
       droplets: slice?.droplets ?? 0,
       counts: slice ? { ...slice.figures.totals } : null,
+      /** Unit 1's droplets (support and unit-1 parts; a .gco file's after T1). */
+      unit1: slice?.figures.unit1.droplets ?? 0,
+      worstOverhang: slice?.figures.worstOverhang?.index ?? null,
+      unsupportedArea: slice?.figures.unsupportedArea ?? null,
+      /** The overhang overlay of the layer on the canvas: droplets marked (null: none yet). */
+      overhangsMarked: renderer.overhangs ? renderer.overhangs.reduce((a, v) => a + v, 0) : null,
       layerDroplets: slice?.counts[store.current] ?? null,
       view: { ...renderer.view },
       name: slice?.name ?? null,
@@ -172,6 +190,8 @@ window.dropslice = {
     renderer.request();
   },
   show: (i: number) => show(page, i),
+  /** Per layer of the slice: support droplets, unit-1 droplets (null: not in yet). */
+  layerUnits: () => store.slice?.counts.map((c) => (c ? [c.support ?? 0, c.unit1 ?? 0] : null)) ?? [],
   /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
    *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
   view3d: () => page.view3d.testState(),

@@ -6,6 +6,10 @@ export interface Counts {
   outer: number;
   inner: number;
   fill: number;
+  /** Support droplets (unit 1; the core's figures and a slice's layers). */
+  support?: number;
+  /** Droplets printed by unit 1 (support and unit-1 parts; a .gco file's after `T1`). */
+  unit1?: number;
 }
 
 /** What the core says of an added file (src/job.rs `ModelInfo`); model coordinates in mm. */
@@ -98,8 +102,12 @@ export interface LayerData {
   seconds?: number;
   /** x,y pairs in mm, every droplet (each one of a G25 line too). */
   droplets: Float32Array;
-  /** 0 outermost loop, 1 inner loops, 2 fill; one per droplet. */
+  /** 0 outermost loop, 1 inner loops, 2 fill, 3 support; one per droplet. */
   roles: Uint8Array;
+  /** The discharge unit of each droplet (0 or 1). */
+  units: Uint8Array;
+  /** The layer's overhang area, mm² (the core's, slices only). */
+  unsupportedArea?: number;
   /** x0,y0,x1,y1 per travel move, mm. */
   travel: Float32Array;
   /** Share of the input read so far, 0..1 (.gco files only). */
@@ -213,7 +221,16 @@ export interface Figures {
   droplets: number;
   volume_mm3: number;
   mass_g: number;
+  /** Droplets printed by unit 1, their volume (× B₁²H) and mass (unit1_material_density). */
+  unit1_droplets: number;
+  unit1_volume_mm3: number;
+  unit1_mass_g: number;
   print_seconds: number;
+  unit0_seconds: number;
+  unit1_seconds: number;
+  /** Overhang area summed over the layers, mm², and the layer with the largest. */
+  unsupported_area: number;
+  worst_overhang: { index: number; area: number } | null;
   travel_mm: number;
   analysed_layers: number;
   coverage: number | null;
@@ -308,6 +325,11 @@ export interface Calls {
   lay_flat: { data: { name: string; item?: number }; result: { rotate_x: number; rotate_y: number } };
   /** Prepares the job `job` of the files added (Session.from_models); like "open". */
   open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
+  /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
+   *  within the rule (src/wasm.rs `unsupported_droplets`); `below` null for the first layer. */
+  unsupported: { data: UnsupportedRequest; result: Uint8Array };
+  /** The 3D view's overhang tint: faces with normal z below minus this overhang. */
+  overhang_face: { data: { settings: Settings }; result: number };
   /** The vertical cut of layers [from, to) (views/cut.ts, src/wasm_cut.rs `Session.cut`). */
   cut: { data: CutRequest; result: CutReply };
   /** The droplet size from a printed part's mass (views/calibrate.ts, src/calibrate.rs). */
@@ -321,6 +343,16 @@ export interface Calls {
 export type CalibrateRequest =
   | { from: "slice"; droplets: number; layer_height: number; droplet_aspect: number; mass: number; density: number }
   | { from: "gcode"; file: Blob; mass: number; density: number | null };
+
+/** A layer's droplets and units, the layer below's (null: the first layer), the droplet widths
+ *  [B, B₁] and `overhang_limit`·B (mm). */
+export interface UnsupportedRequest {
+  droplets: Float32Array;
+  units: Uint8Array;
+  below: { droplets: Float32Array; units: Uint8Array } | null;
+  widths: [number, number];
+  limitMm: number;
+}
 
 /** src/calibrate.rs `Calibration`. */
 export interface Calibration {
@@ -350,7 +382,7 @@ export interface CutRequest {
 }
 export const NOT_SENT = 0xffffffff;
 
-/** src/wasm_cut.rs `CutResult`: droplets (layer, t, d, role; only layers not sent), spans
+/** src/wasm_cut.rs `CutResult`: droplets (layer, t, d, role, unit; only layers not sent), spans
  *  (layer, t0, t1), voids (layer, band, t0, t1) of `bands` heights per slab. */
 export interface CutReply {
   droplets: Float64Array;
@@ -376,7 +408,7 @@ export function isErrorValue(e: unknown): e is ErrorValue {
 }
 
 export function transferablesOf(layer: LayerData): Transferable[] {
-  const out = [layer.droplets.buffer, layer.roles.buffer, layer.travel.buffer] as Transferable[];
+  const out = [layer.droplets.buffer, layer.roles.buffer, layer.units.buffer, layer.travel.buffer] as Transferable[];
   for (const t of layer.mask?.tiles ?? []) out.push(t.void.buffer, t.overfill.buffer);
   return out;
 }

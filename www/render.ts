@@ -9,6 +9,21 @@ import type { CoverageMask, LayerData } from "./protocol";
 
 export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
 export const ROLE_NAMES = ["Outer loop", "Inner loops", "Fill"] as const;
+/** Support droplets (role 3, printed by discharge unit 1) and the droplets of unit-1 parts. */
+export const SUPPORT_COLOR = "#1098ad";
+export const UNIT1_COLOR = "#7048e8";
+/** A droplet's colour class: 0–2 its role (unit 0), 3 support, 4 a unit-1 part's droplet (or,
+ *  in a .gco file, any droplet after `T1`). */
+export const CLASS_COLORS = [...ROLE_COLORS, SUPPORT_COLOR, UNIT1_COLOR] as const;
+export function dropletClass(role: number, unit: number): number {
+  if (role === 3) return 3;
+  if (unit === 1) return 4;
+  return Math.min(2, Math.max(0, role));
+}
+/** Drawn first to last: support at the bottom, the outer loop on top. */
+const CLASS_ORDER = [3, 4, 2, 1, 0] as const;
+/** The overhang overlay: droplets without a droplet of the layer below within the rule. */
+export const OVERHANG_COLOR = "#e8107a";
 const BELOW_COLOR = "#dde2ea";
 /** Largest droplet, in device pixels, drawn as a square of pixels rather than a disc. */
 const PIXEL_MODE_MAX = 3;
@@ -81,6 +96,11 @@ export class Renderer {
   showBelow = true;
   /** The void overlay of the current layer (when it carries a coverage mask). */
   showVoids = false;
+  /** The overhang overlay: per droplet of `current`, 1 when it is unsupported (the core's
+   *  `unsupported_droplets`); null while unknown or off. */
+  overhangs: Uint8Array | null = null;
+  /** Whether the overhang overlay is on (the page fetches `overhangs` for each layer). */
+  showOverhangs = false;
   /** Called after every draw (for the zoom read-out). */
   onDraw: (() => void) | null = null;
   private frame = 0;
@@ -186,6 +206,9 @@ export class Renderer {
       if (this.showBelow && this.below) this.drawDroplets(ctx, this.below, k, vis, true);
       if (this.current) this.drawDroplets(ctx, this.current, k, vis, false);
     }
+    if (this.current && this.overhangs && this.overhangs.length === this.current.roles.length && !(many && this.dropletWidth * k <= PIXEL_MODE_MAX)) {
+      this.drawOverhangs(ctx, this.current, this.overhangs, vis);
+    }
     if (this.current && this.showTravel) this.drawTravel(ctx, this.current, k);
     if (this.current?.mask && this.showVoids) this.drawVoids(ctx, this.current.mask);
     ctx.setTransform(1, 0, 0, 1, 0, 0);
@@ -211,22 +234,33 @@ export class Renderer {
     const { cx, cy } = this.view;
     const ox = W / 2 - cx * k - size / 2;
     const oy = H / 2 + cy * k - size / 2;
-    const plot = (layer: LayerData, role: number, color: number) => {
+    const square = (x: number, y: number, n: number, color: number) => {
+      const ix = Math.round(x * k + ox - (n - size) / 2);
+      const iy = Math.round(-y * k + oy - (n - size) / 2);
+      if (ix < 0 || iy < 0 || ix + n > W || iy + n > H) return;
+      for (let r = 0; r < n; r++) {
+        const row = (iy + r) * W + ix;
+        for (let c = 0; c < n; c++) buf[row + c] = color;
+      }
+    };
+    /** `cls` < 0: every droplet in `color`; else only that colour class. */
+    const plot = (layer: LayerData, cls: number, color: number) => {
       const d = layer.droplets;
       const roles = layer.roles;
+      const units = layer.units;
       for (let i = 0; i < roles.length; i++) {
-        if (role >= 0 && roles[i] !== role) continue;
-        const ix = Math.round(d[2 * i] * k + ox);
-        const iy = Math.round(-d[2 * i + 1] * k + oy);
-        if (ix < 0 || iy < 0 || ix + size > W || iy + size > H) continue;
-        for (let y = 0; y < size; y++) {
-          const row = (iy + y) * W + ix;
-          for (let x = 0; x < size; x++) buf[row + x] = color;
-        }
+        if (cls >= 0 && dropletClass(roles[i], units?.[i] ?? 0) !== cls) continue;
+        square(d[2 * i], d[2 * i + 1], size, color);
       }
     };
     if (this.showBelow && this.below) plot(this.below, -1, pixel(BELOW_COLOR));
-    if (this.current) for (const role of [2, 1, 0]) plot(this.current, role, pixel(ROLE_COLORS[role]));
+    if (this.current) for (const cls of CLASS_ORDER) plot(this.current, cls, pixel(CLASS_COLORS[cls]));
+    const marks = this.overhangs;
+    if (this.current && marks && marks.length === this.current.roles.length) {
+      const d = this.current.droplets;
+      const color = pixel(OVERHANG_COLOR);
+      for (let i = 0; i < marks.length; i++) if (marks[i]) square(d[2 * i], d[2 * i + 1], size + 2, color);
+    }
     const sctx = this.scratch!.getContext("2d")!;
     sctx.putImageData(this.image, 0, 0);
     ctx.save();
@@ -238,14 +272,15 @@ export class Renderer {
   private drawDroplets(ctx: CanvasRenderingContext2D, layer: LayerData, _k: number, vis: Bounds, faint: boolean): void {
     const d = layer.droplets;
     const roles = layer.roles;
+    const units = layer.units;
     const r = this.dropletWidth / 2;
-    const paths = faint ? [new Path2D()] : [new Path2D(), new Path2D(), new Path2D()];
+    const paths = faint ? [new Path2D()] : CLASS_COLORS.map(() => new Path2D());
     const n = roles.length;
     for (let i = 0; i < n; i++) {
       const x = d[2 * i];
       const y = d[2 * i + 1];
       if (x < vis.minX || x > vis.maxX || y < vis.minY || y > vis.maxY) continue;
-      const p = faint ? paths[0] : paths[Math.min(roles[i], 2)];
+      const p = faint ? paths[0] : paths[dropletClass(roles[i], units?.[i] ?? 0)];
       p.moveTo(x + r, y);
       p.arc(x, y, r, 0, 2 * Math.PI);
     }
@@ -254,11 +289,28 @@ export class Renderer {
       ctx.fill(paths[0]);
       return;
     }
-    // fill first, then inner loops, then the outer loop on top
-    for (const role of [2, 1, 0]) {
-      ctx.fillStyle = ROLE_COLORS[role];
-      ctx.fill(paths[role]);
+    // support first, then fill, inner loops, the outer loop on top
+    for (const cls of CLASS_ORDER) {
+      ctx.fillStyle = CLASS_COLORS[cls];
+      ctx.fill(paths[cls]);
     }
+  }
+
+  /** The unsupported droplets of the layer, as larger discs over the droplets. */
+  private drawOverhangs(ctx: CanvasRenderingContext2D, layer: LayerData, marks: Uint8Array, vis: Bounds): void {
+    const d = layer.droplets;
+    const r = this.dropletWidth * 0.62;
+    const p = new Path2D();
+    for (let i = 0; i < marks.length; i++) {
+      if (!marks[i]) continue;
+      const x = d[2 * i];
+      const y = d[2 * i + 1];
+      if (x < vis.minX || x > vis.maxX || y < vis.minY || y > vis.maxY) continue;
+      p.moveTo(x + r, y);
+      p.arc(x, y, r, 0, 2 * Math.PI);
+    }
+    ctx.fillStyle = OVERHANG_COLOR;
+    ctx.fill(p);
   }
 
   private maskImage: { mask: CoverageMask; canvases: (OffscreenCanvas | null)[] } | null = null;

@@ -44,6 +44,11 @@ export class Slice {
   travelMm: number[] = [];
   /** The core's print time per layer, s (slices only; the per-layer plot). */
   layerSeconds: number[] = [];
+  /** The core's overhang area per layer, mm² (slices only). */
+  unsupportedArea: number[] = [];
+  /** The overhang overlay per layer (the core's `unsupported_droplets` of the cached layer and
+   *  the one below), made when the overlay is on; dropped with the layer. */
+  overhangs = new Map<number, Uint8Array>();
   /** G-code by runs of layers, keyed by the run's first layer. */
   gcode = new Map<number, { to: number; blob: Blob }>();
   cache = new Map<number, LayerData>();
@@ -87,6 +92,7 @@ export class Slice {
       this.z[l.index] = l.z;
       this.travelMm[l.index] = l.travelMm;
       if (l.seconds !== undefined) this.layerSeconds[l.index] = l.seconds;
+      if (l.unsupportedArea !== undefined) this.unsupportedArea[l.index] = l.unsupportedArea;
       if (this.source === "gco") this.figures.addReadLayer(l);
       const d = l.droplets;
       const b = this.bbox;
@@ -136,6 +142,7 @@ export class Slice {
       const l = this.cache.get(i)!;
       this.cacheBytes -= layerBytes(l);
       this.cache.delete(i);
+      this.overhangs.delete(i);
     }
   }
 
@@ -158,7 +165,7 @@ export class Slice {
 function layerBytes(l: LayerData): number {
   let m = 0;
   for (const t of l.mask?.tiles ?? []) m += t.void.byteLength + t.overfill.byteLength;
-  return l.droplets.byteLength + l.roles.byteLength + l.travel.byteLength + m;
+  return l.droplets.byteLength + l.roles.byteLength + l.units.byteLength + l.travel.byteLength + m;
 }
 
 /** The page's state (one per page). */

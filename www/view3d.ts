@@ -25,7 +25,11 @@
 // Extensions (documented here, used by the page and its tests):
 //   renderNow()                  draws at once (the view otherwise draws on demand, in the next
 //                                animation frame after a change, and never when idle)
-//   state()                      {parts, selected, slice, frames, width, height} for the tests
+//   state()                      {parts, selected, slice, overhang, frames, width, height} for
+//                                the tests
+//   setOverhang(z | null)        tints the faces whose unit normal (plate coordinates) has
+//                                z < −z (overhanging: the core's `overhang_face_normal_z` for
+//                                the job's settings); null = no tint
 //
 // Input is checked (finite numbers, lengths, bounds): bad input throws an Error naming what is
 // wrong. Per frame nothing is allocated and nothing is O(triangles) but the GPU's draw: a part
@@ -94,7 +98,10 @@ export const COLORS = {
   gridMajor: 0xc5cdd7,
   outline: 0x7d8a99,
   part: 0x7f9cc4,
-  unit1: 0x3bb99a,
+  /** Parts printed by discharge unit 1 (the layer view's unit-1 colour). */
+  unit1: 0x7048e8,
+  /** Overhanging faces (the layer view's overhang overlay colour). */
+  overhang: 0xe8107a,
   selected: 0x1c7ed6,
   /** The current layer's slab (the outer-loop colour of the layer view). */
   slab: 0xe8590c,
@@ -170,6 +177,8 @@ export class View3D {
   private readonly clipBody = new Plane(new Vector3(0, 0, -1), NO_CLIP);
   private readonly clipTop = new Plane(new Vector3(0, 0, -1), NO_CLIP);
   private readonly clipSlabBottom = new Plane(new Vector3(0, 0, 1), NO_CLIP);
+  /** The overhang tint's uniforms, shared by the body materials (z > 1: no tint). */
+  private readonly overhangUniforms = { uOverhangZ: { value: 2 }, uOverhangColor: { value: new Color(COLORS.overhang) } };
   private readonly materials = {
     part: this.bodyMaterial(COLORS.part),
     unit1: this.bodyMaterial(COLORS.unit1),
@@ -236,13 +245,35 @@ export class View3D {
   }
 
   private bodyMaterial(color: number): MeshStandardMaterial {
-    return new MeshStandardMaterial({
+    const m = new MeshStandardMaterial({
       color,
       roughness: 0.62,
       metalness: 0,
       side: FrontSide,
       clippingPlanes: [this.clipBody],
     });
+    // the overhang tint: the face's normal in plate coordinates (the inverse transpose of the
+    // model matrix: right for any scale), compared in the fragment shader
+    m.onBeforeCompile = (shader) => {
+      shader.uniforms.uOverhangZ = this.overhangUniforms.uOverhangZ;
+      shader.uniforms.uOverhangColor = this.overhangUniforms.uOverhangColor;
+      shader.vertexShader = shader.vertexShader
+        .replace("#include <common>", "#include <common>\nvarying vec3 vPlateNormal;")
+        .replace("#include <beginnormal_vertex>", "#include <beginnormal_vertex>\nvPlateNormal = transpose(inverse(mat3(modelMatrix))) * objectNormal;");
+      shader.fragmentShader = shader.fragmentShader
+        .replace("#include <common>", "#include <common>\nvarying vec3 vPlateNormal;\nuniform float uOverhangZ;\nuniform vec3 uOverhangColor;")
+        .replace("#include <color_fragment>", "#include <color_fragment>\nif (normalize(vPlateNormal).z < -uOverhangZ) diffuseColor.rgb = mix(diffuseColor.rgb, uOverhangColor, 0.8);");
+    };
+    return m;
+  }
+
+  /** Tints the faces steeper than `z` allows (see the header); null: no tint. */
+  setOverhang(z: number | null): void {
+    if (z !== null && !(Number.isFinite(z) && z >= 0 && z <= 1)) throw new Error(`overhang: ${z} must be a number from 0 to 1`);
+    const v = z === null ? 2 : z;
+    if (this.overhangUniforms.uOverhangZ.value === v) return;
+    this.overhangUniforms.uOverhangZ.value = v;
+    this.request();
   }
 
   // ---- plate ----
@@ -472,11 +503,13 @@ export class View3D {
     this.request();
   }
 
-  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; frames: number; width: number; height: number } {
+  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; frames: number; width: number; height: number } {
+    const z = this.overhangUniforms.uOverhangZ.value;
     return {
       parts: [...this.entries.keys()],
       selected: this.selected,
       slice: this.slice ? { ...this.slice } : null,
+      overhang: z > 1 ? null : z,
       frames: this.frames,
       width: this.canvas.width,
       height: this.canvas.height,

@@ -6,7 +6,7 @@
 // ("adopt"). Everything from the core is a typed value; its
 // errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, { Models, Session, Tally, crash_for_test, default_settings, settings_schema, version, type InitOutput } from "./pkg/dropslice.js";
+import init, { Models, Session, Tally, crash_for_test, default_settings, overhang_face_normal_z, settings_schema, unsupported_droplets, version, type InitOutput } from "./pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
@@ -97,11 +97,13 @@ function layerOf(s: Session, index: number, unit: { gcode: Uint8Array[]; tally: 
     const layer: LayerData = {
       index: r.index,
       z: r.z,
-      counts: { outer: r.outer, inner: r.inner, fill: r.fill },
+      counts: { outer: r.outer, inner: r.inner, fill: r.fill, support: r.support, unit1: r.unit1 },
       travelMm: r.travel_mm,
       seconds: r.seconds,
       droplets: r.droplets,
       roles: r.roles,
+      units: r.units,
+      unsupportedArea: r.unsupported_area,
       travel: r.travel,
     };
     if (analyse) {
@@ -250,6 +252,17 @@ async function handle(req: Request): Promise<void> {
       });
       return;
     }
+    case "unsupported": {
+      await load();
+      const { droplets, units, below, widths, limitMm } = req.data;
+      const mask = unsupported_droplets(droplets, units, below?.droplets ?? new Float32Array(0), below?.units ?? new Uint8Array(0), Float64Array.from(widths), limitMm, below === null);
+      answer(req.kind, req.id, mask, [mask.buffer]);
+      return;
+    }
+    case "overhang_face":
+      await load();
+      answer(req.kind, req.id, overhang_face_normal_z(req.data.settings));
+      return;
     case "cut": {
       const { line, from, to, sent, centres } = req.data;
       const r = need().cut(Float64Array.from(line), from, to, sent, centres);

@@ -49,13 +49,25 @@ test("G-code reader: G25 lines expand to droplets every B, layers split on Z", (
   );
   assert.equal(reader.dropletWidth, B);
   assert.equal(layers.length, 2);
-  assert.deepEqual(layers[0].counts, { outer: 2, inner: 0, fill: 11 });
+  assert.deepEqual(layers[0].counts, { outer: 2, inner: 0, fill: 11, support: 0, unit1: 0 });
   assert.equal(layers[0].roles.length, 13);
   assert.ok(Math.abs(layers[0].droplets[2 * 12] - 10 * B) < 1e-4, "last droplet at the line's end");
   assert.ok(Math.abs(layers[0].droplets[2 * 3] - B) < 1e-6, "second droplet one B along");
   assert.equal(layers[0].travel.length, 4);
   assert.equal(layers[1].z, 0.4);
   assert.equal(layers[1].counts.outer, 1);
+});
+
+test("G-code reader: after T1 droplets are unit 1's, every B₁ along a G25 line", () => {
+  const B1 = 0.2 * 2.0;
+  const { layers } = read(
+    "; layer_height = 0.2\n; droplet_aspect = 1.0\n; unit1_droplet_aspect = 2.0\n" +
+      "G26 X0.0000 Y0.0000 Z0.2000\nT1\nG01 X0.0000 Y1.0000 Z0.2000\n" +
+      `G25 X${(3 * B1).toFixed(4)} Y1.0000 Z0.2000\nT0\nG26 X0.0000 Y2.0000 Z0.2000\n`,
+  );
+  assert.deepEqual([...layers[0].units], [0, 1, 1, 1, 1, 0]);
+  assert.equal(layers[0].counts.unit1, 4);
+  assert.ok(Math.abs(layers[0].droplets[2 * 2] - B1) < 1e-4, "unit 1's droplets B₁ apart");
 });
 
 test("G-code reader: refuses files it cannot understand", () => {

@@ -12,6 +12,8 @@ export function updateButtons(page: Page): void {
   ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && !s!.figures.nothingToPrint);
   ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && s!.job !== null);
   ($("btn-slice") as HTMLButtonElement).disabled = store.job === null || form === undefined;
+  // the support switch shows the setting (a link, a job file or the form may have set it)
+  if (form) $<HTMLInputElement>("opt-support").checked = form.get("support") === "unit1";
   settingsStatus(page);
 }
 

@@ -14,6 +14,7 @@ import { CutRenderer, type CutLayer } from "../cutrender";
 import { showError } from "../errors";
 import type { Page } from "../page";
 import { NOT_SENT, type CutReply, type LayerData } from "../protocol";
+import { dropletClass } from "../render";
 import type { Slice } from "../store";
 import { $ } from "./dom";
 
@@ -72,7 +73,7 @@ function length(l: Line): number {
   return Math.hypot(l.b[0] - l.a[0], l.b[1] - l.a[1]);
 }
 
-/** t, d, role of a layer's droplets whose footprint (radius `radius`) the plane crosses, and
+/** t, d, colour class (render.ts `dropletClass`) of a layer's droplets whose footprint (radius `radius`) the plane crosses, and
  *  x, y of those within `reach` of the line (sent to the core). */
 function bin(layer: LayerData, l: Line, reach: number, radius: number): { near: Float64Array; xy: Float64Array } {
   const len = length(l);
@@ -89,7 +90,7 @@ function bin(layer: LayerData, l: Line, reach: number, radius: number): { near: 
     const t = ux * x + uy * y;
     if (t < -reach || t > len + reach) continue;
     xy.push(d[2 * i], d[2 * i + 1]);
-    if (Math.abs(dist) < radius && t > -radius && t < len + radius) near.push(t, Math.abs(dist), layer.roles[i]);
+    if (Math.abs(dist) < radius && t > -radius && t < len + radius) near.push(t, Math.abs(dist), dropletClass(layer.roles[i], layer.units?.[i] ?? 0));
   }
   return { near: Float64Array.from(near), xy: Float64Array.from(xy) };
 }
@@ -186,7 +187,7 @@ function take(r: CutReply, from: number, to: number, sent: Uint32Array, lo: numb
   const planned = new Map<number, number[]>();
   per(r.spans, 3, (i, j) => (spans.get(i) ?? spans.set(i, []).get(i)!).push(r.spans[j + 1], r.spans[j + 2]));
   per(r.voids, 4, (i, j) => (voids.get(i) ?? voids.set(i, []).get(i)!).push(r.voids[j + 1], r.voids[j + 2], r.voids[j + 3]));
-  per(r.droplets, 4, (i, j) => (planned.get(i) ?? planned.set(i, []).get(i)!).push(r.droplets[j + 1], r.droplets[j + 2], r.droplets[j + 3]));
+  per(r.droplets, 5, (i, j) => (planned.get(i) ?? planned.set(i, []).get(i)!).push(r.droplets[j + 1], r.droplets[j + 2], dropletClass(r.droplets[j + 3], r.droplets[j + 4])));
   for (let i = from; i < to; i++) {
     const old = cut.layers.get(i);
     const near = sent[i - lo] === NOT_SENT ? Float64Array.from(planned.get(i) ?? []) : (old?.near ?? new Float64Array(0));

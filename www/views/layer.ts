@@ -38,6 +38,8 @@ export function show(page: Page, i: number): void {
   renderer.current = s.cache.get(current) ?? null;
   renderer.below = current > 0 ? (s.cache.get(current - 1) ?? null) : null;
   renderer.dropletWidth = s.dropletWidth;
+  renderer.overhangs = renderer.showOverhangs ? (s.overhangs.get(current) ?? null) : null;
+  if (renderer.showOverhangs && !renderer.overhangs) requestOverhangs(page, s, current);
   renderer.request();
   page.view3d.sync(page);
   writeStats(page);
@@ -47,6 +49,61 @@ export function show(page: Page, i: number): void {
   // the overlay needs the current layer's mask (evicted, or sliced without analysis)
   const shown = s.cache.get(current);
   if (renderer.showVoids && shown && !shown.mask && s.complete && s.source === "stl") fetchPreview(page, s, current);
+}
+
+/** The overhang rule's numbers for a slice: [B, B₁] and `overhang_limit`·B (mm), from the
+ *  slice's settings, or a .gco file's header (the core's defaults where it says nothing). */
+function overhangRule(page: Page, s: Slice): { widths: [number, number]; limitMm: number } | null {
+  const header = s.gcodeFile?.header ?? {};
+  const get = (k: string) => {
+    const v = Number(s.source === "gco" ? (header[k] ?? page.init?.defaults[k]) : s.settings[k]);
+    return Number.isFinite(v) ? v : NaN;
+  };
+  const b = s.dropletWidth;
+  const b1 = s.layerHeight * get("unit1_droplet_aspect");
+  const limitMm = get("overhang_limit") * b;
+  if (!(b > 0 && b1 > 0 && limitMm >= 0)) return null;
+  return { widths: [b, b1], limitMm };
+}
+
+const overhangRequests = new Set<string>();
+
+/** Asks a worker for the overhang overlay of layer `i` once it and the layer below are held. */
+function requestOverhangs(page: Page, s: Slice, i: number): void {
+  const layer = s.cache.get(i);
+  const below = i > 0 ? s.cache.get(i - 1) : null;
+  if (!layer?.units || (i > 0 && !below?.units)) return; // show() fetches them; asked again then
+  const rule = overhangRule(page, s);
+  const key = `${s.startedAt}:${i}`;
+  if (!rule || overhangRequests.has(key)) return;
+  overhangRequests.add(key);
+  page.pool
+    .unsupported({
+      droplets: layer.droplets,
+      units: layer.units,
+      below: below ? { droplets: below.droplets, units: below.units } : null,
+      ...rule,
+    })
+    .then((mask) => {
+      if (page.store.slice !== s) return;
+      s.overhangs.set(i, mask);
+      if (i === page.store.current) show(page, i);
+    })
+    .catch((e) => {
+      if (!(e instanceof Cancelled)) showError(page, e);
+    })
+    .finally(() => overhangRequests.delete(key));
+}
+
+/** The overhang overlay on or off (the checkbox, the legend, and the 3D view's tint). */
+export function setShowOverhangs(page: Page, on: boolean): void {
+  page.renderer.showOverhangs = on;
+  $<HTMLInputElement>("opt-overhangs").checked = on;
+  $("legend-overhangs").hidden = !on;
+  $("legend3d-overhang").hidden = !on;
+  if (page.store.slice) show(page, page.store.current);
+  else page.renderer.request();
+  page.view3d.sync(page);
 }
 
 /** A layer index within [0, layers): rounded, clamped; 0 when it is not a number. */

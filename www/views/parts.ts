@@ -57,6 +57,11 @@ export class PartsPanel {
         if (at) void this.edit(p, { place_x: +at[0].toFixed(2), place_y: +at[1].toFixed(2) });
       }
     });
+    $<HTMLSelectElement>("part-unit").addEventListener("change", (ev) => {
+      const p = this.part();
+      const unit = Number((ev.target as HTMLSelectElement).value);
+      if (p && (unit === 0 || unit === 1) && unit !== p.spec.unit) void this.edit(p, { unit }).then((ok) => ok || this.renderEditor());
+    });
     $("part-lay-flat").addEventListener("click", () => this.part() && void layFlat(page, this.part()!.id));
     $("part-duplicate").addEventListener("click", () => this.part() && duplicatePart(page, this.part()!.id));
     $("part-remove").addEventListener("click", () => this.part() && removePart(page, this.part()!.id));
@@ -132,7 +137,14 @@ export class PartsPanel {
       const copies = document.createElement("span");
       copies.className = "part-copies";
       copies.textContent = p.spec.copies > 1 ? `× ${p.spec.copies}` : "";
-      li.append(name, copies, meta);
+      const unit = document.createElement("span");
+      unit.className = "part-unit";
+      unit.textContent = p.spec.unit === 1 ? "unit 1" : "";
+      unit.title = "Printed by discharge unit 1";
+      const right = document.createElement("span");
+      right.className = "part-tags";
+      right.append(unit, copies);
+      li.append(name, right, meta);
       const pick = () => selectPart(this.page, p.id);
       li.addEventListener("click", pick);
       li.addEventListener("keydown", (ev) => {
@@ -150,7 +162,7 @@ export class PartsPanel {
     this.renderEditor();
   }
 
-  private renderEditor(): void {
+  renderEditor(): void {
     const p = this.part();
     const editor = $("part-editor");
     editor.hidden = !p;
@@ -179,6 +191,7 @@ export class PartsPanel {
       input.title = "";
     }
     $<HTMLInputElement>("part-auto").checked = auto;
+    $<HTMLSelectElement>("part-unit").value = String(p.spec.unit === 1 ? 1 : 0);
     $("part-place-row").classList.toggle("auto", auto);
     ($("part-remove") as HTMLButtonElement).disabled = job.parts.length <= 1;
   }

@@ -15,6 +15,50 @@ function roleLabels(source: "stl" | "gco"): void {
   $("legend-0").textContent = $("stat-label-0").textContent = gco ? "Loop droplets (G26)" : "Outer loop";
   $("legend-2").textContent = $("stat-label-2").textContent = gco ? "Fill lines (G25)" : "Fill";
   $("legend-1-wrap").hidden = gco;
+  $("legend-unit1-label").textContent = $("stat-unit1-label").textContent = gco ? "Unit 1 (after T1)" : "Unit-1 part";
+  $("stat-support-label").hidden = $("stat-support").hidden = gco;
+  if (!gco) $("stat-unit1-label").textContent = "Unit 1, all";
+}
+
+const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
+
+/** Support and unit-1 droplets: the legend's entries, the droplet rows, unit 1's material,
+ *  mass and time, and the overhang block. All figures are the core's. */
+function writeUnit1(s: Slice | null, current: number): void {
+  const f = s?.figures;
+  const u = f?.unit1;
+  const support = f?.totals.support ?? 0;
+  const layer = s?.cache.get(current);
+  let layerSupport = 0;
+  let layerUnit1Part = 0;
+  if (layer?.units) {
+    for (let i = 0; i < layer.roles.length; i++) {
+      if (layer.roles[i] === 3) layerSupport++;
+      else if (layer.units[i] === 1) layerUnit1Part++;
+    }
+  }
+  const unit1Parts = (u?.droplets ?? 0) - support;
+  $("legend-support").hidden = !(support > 0 || layerSupport > 0);
+  $("legend-unit1").hidden = !(unit1Parts > 0 || layerUnit1Part > 0);
+  setText("stat-support", s ? nf.format(support) : "–");
+  setText("stat-unit1", s ? nf.format(u?.droplets ?? 0) : "–");
+  const any = (u?.droplets ?? 0) > 0 && s?.source === "stl";
+  $("unit1-stats").hidden = !any;
+  if (any && u) {
+    setText("stat-volume1", u.volume !== null ? `${(u.volume / 1000).toFixed(2)} cm³` : "–");
+    setText("stat-mass1", u.mass !== null ? `${u.mass.toFixed(2)} g` : "–");
+    setText("stat-unit-times", u.seconds0 !== null && u.seconds1 !== null ? `${duration(u.seconds0)} · ${duration(u.seconds1)}` : "–");
+  }
+  // overhangs (the core's areas: per layer as the layers come in, the part's and the worst)
+  const stl = s?.source === "stl";
+  const a = stl ? s!.unsupportedArea[current] : undefined;
+  setText("stat-overhang-layer", a !== undefined ? (a > 0 ? mm2(a) : "none") : "–");
+  const part = stl ? f!.unsupportedArea : null;
+  setText("stat-overhang-part", part !== null && part !== undefined ? (part > 0 ? mm2(part) + (s!.complete ? "" : " so far") : "none") : "–");
+  const worst = stl ? f!.worstOverhang : null;
+  setText("stat-overhang-worst", worst ? `${nf.format(worst.index + 1)} · ${mm2(worst.area)}` : "–");
+  ($("btn-worst-overhang") as HTMLButtonElement).disabled = !worst;
+  $("overhangs-hint").textContent = s?.source === "gco" ? "Overhang areas are computed for sliced parts." : "";
 }
 
 export function writeStats(page: Page): void {
@@ -26,6 +70,7 @@ export function writeStats(page: Page): void {
   $("empty").hidden = s !== null;
   if (!s) {
     writeVoids(null, current);
+    writeUnit1(null, current);
     for (const id of ["stat-model", "stat-parts", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
     $("warnings").hidden = true;
     requestPlot();
@@ -53,8 +98,9 @@ export function writeStats(page: Page): void {
   setText("stat-travel", `${(f.travelTotal / 1000).toFixed(2)} m`);
   const c = s.counts[current];
   setText("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
-  setText("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill) : "–");
+  setText("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill + (c.support ?? 0)) : "–");
   writeVoids(s, current);
+  writeUnit1(s, current);
   const warnings = [...((s.info.warnings ?? []) as string[]), ...s.repairs];
   $("warnings").hidden = warnings.length === 0;
   const list = $("warning-list");

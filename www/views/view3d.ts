@@ -29,6 +29,10 @@ export class View3DPanel {
   private model: unknown = null;
   private framed: unknown = null;
   private page: Page | null = null;
+  /** The overhang tint: the core's threshold for the settings `overhangFor` (null: off, or
+   *  not known yet). */
+  private overhang: number | null = null;
+  private overhangFor = "";
   active = false;
 
   constructor(private readonly container: HTMLElement) {}
@@ -54,6 +58,7 @@ export class View3DPanel {
     const px = Number(values?.plate_x);
     const py = Number(values?.plate_y);
     if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
+    this.syncOverhang(page, values);
     const s = store.slice;
     const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values));
     this.slice = current && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current: store.current } : null;
@@ -62,6 +67,32 @@ export class View3DPanel {
     const keep = this.selected !== null && parts.some((p) => p.id === this.selected) && parseInstanceId(this.selected)?.part === sel;
     if (!keep) this.selected = sel === null ? null : (parts.find((p) => parseInstanceId(p.id)?.part === sel)?.id ?? null);
     this.apply();
+  }
+
+  /** With the overhang overlay on, the core's threshold for the form's settings (asked again
+   *  when the settings it depends on change). */
+  private syncOverhang(page: Page, values: Record<string, unknown> | undefined): void {
+    if (!page.renderer.showOverhangs || !values || !page.form || page.form.errors().length) {
+      this.overhang = null;
+      this.overhangFor = "";
+      return;
+    }
+    const settings = jobSettings(page.form.values());
+    const key = JSON.stringify(["overhang_limit", "droplet_aspect", "layer_height"].map((k) => settings[k]));
+    if (key === this.overhangFor) return;
+    this.overhangFor = key;
+    this.overhang = null;
+    page.pool
+      .overhangFace(settings)
+      .then((z) => {
+        if (this.overhangFor !== key) return;
+        this.overhang = z;
+        this.apply();
+      })
+      .catch(() => {
+        // a refused setting is shown by the form; the tint stays off
+        if (this.overhangFor === key) this.overhangFor = "";
+      });
   }
 
   /** The selection of the page's job (the part's first copy is tinted). */
@@ -76,6 +107,7 @@ export class View3DPanel {
     v.setParts(this.parts);
     v.setSlice(this.slice);
     v.select(this.selected);
+    v.setOverhang(this.overhang);
     if (this.model !== null && this.model !== this.framed) {
       this.framed = this.model;
       v.fit();
