@@ -127,7 +127,12 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, null, "a click on empty space clears");
   assert.ok((await pixels3d(page)).part.n > whole.part.n * 0.9, "the part's own colour again");
 
-  // a drag from empty space orbits: the part moves on the screen; Fit brings the view back
+  // a drag from empty space orbits: the part moves on the screen; Fit brings the view back.
+  // The framing to come back to is Fit's own, taken now: the first framing was made while the
+  // page was still laying out (the per-layer plot's height settles after the slice), so under
+  // load the canvas may have been resized since.
+  await page.click("#btn-fit");
+  const framed = await pixels3d(page);
   const from = await clientPoint(page, whole.width * 0.85, whole.height * 0.15);
   await page.mouse.move(from.x, from.y);
   await page.mouse.down();
@@ -135,19 +140,19 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   await page.mouse.up();
   const orbited = await pixels3d(page);
   assert.equal(orbited.state.selected, null, "an orbit is not a click");
-  assert.ok(Math.hypot(orbited.part.x - whole.part.x, orbited.part.y - whole.part.y) > 20, "the view turned");
+  assert.ok(Math.hypot(orbited.part.x - framed.part.x, orbited.part.y - framed.part.y) > 20, "the view turned");
   await page.click("#btn-fit");
   const fitted = await pixels3d(page);
-  assert.ok(Math.hypot(fitted.part.x - whole.part.x, fitted.part.y - whole.part.y) < 2, `Fit restores the framing: ${JSON.stringify([whole.part, fitted.part, fitted.selected])}`);
+  assert.ok(Math.hypot(fitted.part.x - framed.part.x, fitted.part.y - framed.part.y) < 2, `Fit restores the framing: ${JSON.stringify([framed.part, fitted.part, fitted.selected])}`);
 
   // a low layer: the boat cut at 4 mm (of 48): far fewer part pixels, none high up, a cap
   await page.locator("#layer").fill("19");
   const low = await pixels3d(page);
   assert.equal(low.state.slice.current, 19);
-  assert.ok(low.part.n < whole.part.n * 0.7, `part pixels ${low.part.n} vs ${whole.part.n} whole`);
+  assert.ok(low.part.n < framed.part.n * 0.7, `part pixels ${low.part.n} vs ${framed.part.n} whole`);
   assert.ok(low.cut.n > 2000, `cut pixels: ${low.cut.n}`);
   // the chimney and the cabin roof are gone: the drawing starts lower on the screen
-  assert.ok(low.top > whole.top + 40, `top row ${low.top} vs ${whole.top}`);
+  assert.ok(low.top > framed.top + 40, `top row ${low.top} vs ${framed.top}`);
 
   // back to the layer canvas
   await page.click("#mode-layer");
