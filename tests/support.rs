@@ -11,7 +11,7 @@
 
 mod common;
 
-use common::{Gcode, Layer, TempDir, model, parse_gcode, run_cli, slice_cli};
+use common::{Gcode, Layer, TempDir, deep_inside, model, parse_gcode, run_cli, slice_cli};
 use std::collections::HashMap;
 use std::time::Duration;
 
@@ -194,49 +194,13 @@ fn support_makes_every_droplet_supported_on_3dbenchy() {
 }
 
 /// The mesh cut by the plane z: segments, without chaining them into loops.
-fn cut(mesh: &dropslice::mesh::Mesh, z: f64) -> Vec<(P, P)> {
-    let mut out = Vec::new();
-    for f in &mesh.facets {
-        let v = f.map(|i| mesh.vertices[i as usize]);
-        let mut pts = Vec::new();
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            if (a[2] < z) != (b[2] < z) {
-                let t = (z - a[2]) / (b[2] - a[2]);
-                pts.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
-            }
-        }
-        if pts.len() == 2 {
-            out.push((pts[0], pts[1]));
-        }
-    }
-    out
-}
-
-/// Whether p lies in the section (odd crossings of a ray to +x) farther than d from its
-/// boundary.
-fn deep_inside(segs: &[(P, P)], p: P, d: f64) -> bool {
-    let mut crossings = 0;
-    for &(a, b) in segs {
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let l2 = dx * dx + dy * dy;
-        let t = if l2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let (ex, ey) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-        if ex * ex + ey * ey < d * d {
-            return false;
-        }
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * dx;
-            if x > p[0] {
-                crossings += 1;
-            }
-        }
-    }
-    crossings % 2 == 1
+fn cut_mesh(mesh: &dropslice::mesh::Mesh, z: f64) -> Vec<(P, P)> {
+    let tris: Vec<[[f64; 3]; 3]> = mesh
+        .facets
+        .iter()
+        .map(|f| f.map(|i| mesh.vertices[i as usize]))
+        .collect();
+    common::cut(&tris, z)
 }
 
 #[test]
@@ -255,7 +219,7 @@ fn support_stays_out_of_the_part() {
         let mut checked = 0;
         for (n, l) in on.layers.iter().enumerate().step_by(every) {
             let i = common::layer_index(l.z, h);
-            let segs = cut(job.mesh(), job.plane_z(i));
+            let segs = cut_mesh(job.mesh(), job.plane_z(i));
             for &(p, u) in &layers[n] {
                 if u == 1 {
                     checked += 1;

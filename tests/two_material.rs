@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::{Gcode, Layer, TempDir, model_bytes, parse_gcode, run_cli};
+use common::{Gcode, Layer, TempDir, cut, deep_inside, model_bytes, parse_gcode, run_cli};
 use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::time::Duration;
@@ -130,51 +130,6 @@ fn placed(file: &str, at: P) -> Vec<Tri> {
     tris.into_iter()
         .map(|t| t.map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]))
         .collect()
-}
-
-/// The triangles cut by the plane z: segments, not chained into loops.
-fn cut(tris: &[Tri], z: f64) -> Vec<(P, P)> {
-    let mut out = Vec::new();
-    for v in tris {
-        let mut pts = Vec::new();
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            if (a[2] < z) != (b[2] < z) {
-                let t = (z - a[2]) / (b[2] - a[2]);
-                pts.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
-            }
-        }
-        if pts.len() == 2 {
-            out.push((pts[0], pts[1]));
-        }
-    }
-    out
-}
-
-/// Whether p lies in the section (odd crossings of a ray to +x) at least d from its boundary
-/// (a droplet centre on a section of the part, kept d inside it).
-fn deep_inside(segs: &[(P, P)], p: P, d: f64) -> bool {
-    let mut crossings = 0;
-    for &(a, b) in segs {
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let l2 = dx * dx + dy * dy;
-        let t = if l2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let (ex, ey) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
-        if ex * ex + ey * ey < d * d {
-            return false;
-        }
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * dx;
-            if x > p[0] {
-                crossings += 1;
-            }
-        }
-    }
-    crossings % 2 == 1
 }
 
 /// The oracle's nonzero area of every layer of an STL (None: a layer with faces in its
