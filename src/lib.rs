@@ -137,9 +137,6 @@ pub struct Job {
     buckets: FacetBuckets,
     zs: Vec<f64>,
     info: JobInfo,
-    /// Every layer's overhang area and support region, computed on first use when
-    /// `support` is on (it needs all layers' sections; see [`Job::support_layers`]).
-    support: std::sync::OnceLock<Vec<support::LayerSupport>>,
     /// The facet runs of [`JobInfo::groups`] as ranges of facet numbers (empty: all unit 0).
     groups: Vec<(std::ops::Range<u32>, u8)>,
     /// Every layer's plan with support (`support = unit1`), computed on first use: the
@@ -410,7 +407,6 @@ impl Job {
             buckets,
             zs,
             info,
-            support: std::sync::OnceLock::new(),
             groups,
             supported: std::sync::OnceLock::new(),
         }
@@ -424,31 +420,6 @@ impl Job {
     /// Whether a part of this job is printed by unit 1.
     pub fn has_unit1_parts(&self) -> bool {
         self.groups.iter().any(|(_, u)| *u == 1)
-    }
-
-    /// Every layer's overhang area and support region (empty regions with `support = off`).
-    ///
-    /// With support on this is computed once per job, on first use: all sections (in parallel
-    /// natively), then [`support::support_layers`]. In the page every worker has its own job
-    /// and so computes it once for itself (the cost of one pass of sections and offsets over
-    /// the part, docs/support.md).
-    pub fn support_layers(&self) -> &[support::LayerSupport] {
-        self.support.get_or_init(|| {
-            let n = self.layer_count();
-            let regions = support::par_map(n, &|i| self.section(i).region);
-            if self.uses_unit1() {
-                support::support_layers(&regions, &self.settings, |n, f| support::par_map(n, f))
-            } else {
-                support::par_map(n, &|i| support::LayerSupport {
-                    unsupported_area: geom::region_area(&support::overhang(
-                        &regions[i],
-                        i.checked_sub(1).map(|j| &regions[j]),
-                        &self.settings,
-                    )),
-                    region: geom::Shapes::new(),
-                })
-            }
-        })
     }
 
     /// Every layer's plan with support on (`support = unit1`), computed once per job on first
@@ -592,7 +563,7 @@ impl Job {
     }
 
     /// Whether planning a layer needs the section of the layer below (for the overhang
-    /// figure: with support off; with support on it comes from [`Job::support_layers`]).
+    /// figure: with support off; with support on it comes from [`Job::supported_plans`]).
     pub fn needs_below(&self) -> bool {
         self.settings.support != settings::Support::Unit1
     }

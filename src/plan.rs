@@ -180,7 +180,7 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
 }
 
 /// Plans one layer's region with the droplet width of `s`, starting at `start`; every move is
-/// unit 0's (see [`plan_unit1`]).
+/// unit 0's (see [`plan_unit1_layer`]).
 pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point) -> LayerPlan {
     let b = s.droplet_width();
     let layer = contours(region, s);
@@ -328,12 +328,6 @@ pub fn unit1_part_settings(s: &Settings) -> Settings {
         droplet_aspect: s.unit1_droplet_aspect,
         ..s.clone()
     }
-}
-
-/// Adds unit 1's moves for `region` (the support region) to a planned layer as `role`; see
-/// [`plan_unit1_layer`].
-pub fn plan_unit1(plan: &mut LayerPlan, region: &Shapes, role: Role, s: &Settings) {
-    plan_unit1_layer(plan, &Shapes::new(), region, role, s);
 }
 
 /// Adds unit 1's moves to a planned layer, in the order `unit_order` gives: first the region
