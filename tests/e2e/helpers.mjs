@@ -72,6 +72,20 @@ export async function waitSettled(page, timeout = 240_000) {
   return status(page);
 }
 
+/** Opens the 3D tab and waits until its view is made (its code, three.js, is a chunk the page
+ *  loads the first time the tab is opened); returns the view's state. */
+export async function open3d(page, timeout = 30_000) {
+  await page.click("#mode-3d");
+  return view3dReady(page, timeout);
+}
+
+/** Waits until the 3D view is made (the tab was opened, by a click or by the page itself, and
+ *  its code is in); returns the view's state. */
+export async function view3dReady(page, timeout = 30_000) {
+  await page.waitForFunction(() => window.dropslice.view3d() !== null, null, { timeout, polling: 100 });
+  return page.evaluate(() => window.dropslice.view3d());
+}
+
 /** Number of canvas pixels whose colour passes `test` (a JS expression over r, g, b). The
  *  expression goes in the evaluated source (run by the DevTools protocol): a `new Function`
  *  inside the page would be refused by its Content-Security-Policy (no 'unsafe-eval'). */

@@ -7,7 +7,7 @@ import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { openPage, parseGcode, shared, start, torusStl, waitSettled } from "./helpers.mjs";
+import { open3d, openPage, parseGcode, shared, start, torusStl, view3dReady, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -130,6 +130,7 @@ test("two files opened at once: one job, both names shown, the G-code's droplets
   assert.match(stats, /cube_20mm_ascii/);
   assert.match(stats, /extruder_idler_quads/);
   // several instances: the 3D tab is shown first
+  await view3dReady(page);
   assert.equal(await page.isVisible("#view3d canvas"), true);
 
   const j = await job(page);
@@ -157,8 +158,7 @@ test("two files opened at once: one job, both names shown, the G-code's droplets
 
 test("the 3D view draws both parts, each where the layout puts it", async () => {
   const { page } = main;
-  await page.click("#mode-3d");
-  const state = await page.evaluate(() => window.dropslice.view3d());
+  const state = await open3d(page);
   assert.deepEqual(state.parts.sort(), ["0:0", "1:0"]);
   const seen = [];
   for (const k of [1, 2]) {
@@ -222,7 +222,7 @@ test("dragging the selected part in the layer view moves it by the mm dragged", 
   assert.deepEqual(v, view, "the drag moved the part, not the view");
   await page.click("#btn-arrange");
   await page.waitForFunction(() => window.dropslice.job().parts[0].place_x === undefined);
-  await page.click("#mode-3d");
+  await open3d(page);
 });
 
 test("a job that does not fit says so and keeps the previous state", async () => {
@@ -375,7 +375,7 @@ test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 30
   const big = await openPage(env.browser, env.url);
   const { page, errors } = big;
   await waitDone(page, 60_000);
-  await page.click("#mode-3d");
+  await open3d(page);
   await pick(page, { name: "torus-1m.stl", mimeType: "model/stl", buffer: torusStl(1000, 500, 40, 12) });
   await page.waitForFunction(() => (window.dropslice.job()?.parts[0]?.mesh ?? 0) > 0 && window.dropslice.job().name === "torus-1m.stl", null, { timeout: 240_000 });
   const j = await job(page);

@@ -9,7 +9,7 @@ import { cpSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:f
 import { tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { serve } from "../../scripts/serve.mjs";
-import { launchBrowser, repo, status, waitSettled } from "./helpers.mjs";
+import { launchBrowser, open3d, repo, status, waitSettled } from "./helpers.mjs";
 
 const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-offline-"));
@@ -132,6 +132,11 @@ test("after the first visit the page loads and slices offline, with the same G-c
   const gcodeOffline = await downloadText(page);
   assert.ok(gcodeOffline.split("\n").filter((l) => /^G2[56]\b/.test(l)).length > 1000, "droplet commands");
   assert.equal(gcodeOffline, gcodeOnline);
+  // the 3D view's code (a chunk the page loads only now, when the tab is first opened) comes
+  // from the cache too, and draws the part
+  const view = await open3d(page);
+  assert.deepEqual(view.parts, ["0:0"]);
+  assert.ok(view.frames > 0 && view.width > 0 && view.height > 0, JSON.stringify(view));
   assert.deepEqual(errors, []);
   await context.close();
 });

@@ -3,7 +3,7 @@
 // classified by colour: the part's steel blue, the selected part's accent blue, the cut's orange.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { benchy, openPage, start, waitSettled } from "./helpers.mjs";
+import { benchy, open3d, openPage, start, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -96,7 +96,10 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   assert.equal(s.layers, 240);
 
   assert.equal(await page.evaluate(() => window.dropslice.view3d()), null, "no WebGL context before the tab is opened");
-  await page.click("#mode-3d");
+  const chunk = (u) => /\/view3d-[0-9A-Z]+\.js$/.test(u);
+  assert.equal((await page.evaluate(() => performance.getEntriesByType("resource").map((e) => e.name))).filter(chunk).length, 0, "the 3D view's code is not loaded before the tab is opened");
+  await open3d(page);
+  assert.equal((await page.evaluate(() => performance.getEntriesByType("resource").map((e) => e.name))).filter(chunk).length, 1, "the 3D view's code is loaded once the tab is opened");
   assert.equal(await page.isVisible("#view3d canvas"), true);
   assert.equal(await page.isVisible("#legend3d"), true);
   assert.equal(await page.isVisible("#legend"), false);
@@ -165,7 +168,7 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
 
 test("a .gco file has no mesh: the 3D tab says so", async () => {
   const { page } = main;
-  await page.click("#mode-3d");
+  await open3d(page);
   const gco = "; dropslice test\n; layer_height = 0.2 (mm)\n; droplet_aspect = 1.04\nG01 X0 Y0 Z0.2\nG25 X10 Y0\nG26 X10 Y1\n";
   await page.evaluate(() => (document.body.dataset.state = "picking"));
   await page.setInputFiles("#file-input", { name: "tiny.gco", mimeType: "text/plain", buffer: Buffer.from(gco) });
