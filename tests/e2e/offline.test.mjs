@@ -9,7 +9,7 @@ import { cpSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:f
 import { tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { serve } from "../../scripts/serve.mjs";
-import { launchBrowser, open3d, repo, status, waitSettled } from "./helpers.mjs";
+import { downloadText, launchBrowser, open3d, pixels3d, repo, status, waitSettled } from "./helpers.mjs";
 
 const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-offline-"));
@@ -62,11 +62,6 @@ async function sliced(page) {
   const banner = await page.locator("#banner").innerText().catch(() => "");
   assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
   return s;
-}
-
-async function downloadText(page) {
-  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
-  return readFileSync(await download.path(), "utf8");
 }
 
 test("the manifest is linked, parses and names icons that load", async () => {
@@ -136,7 +131,8 @@ test("after the first visit the page loads and slices offline, with the same G-c
   // from the cache too, and draws the part
   const view = await open3d(page);
   assert.deepEqual(view.parts, ["0:0"]);
-  assert.ok(view.frames > 0 && view.width > 0 && view.height > 0, JSON.stringify(view));
+  const px = await pixels3d(page);
+  assert.ok(px.part.n > 1000, `part pixels in 3D: ${px.part.n}`);
   assert.deepEqual(errors, []);
   await context.close();
 });
