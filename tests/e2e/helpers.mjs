@@ -97,6 +97,16 @@ export async function downloadText(page) {
   return readFileSync(await download.path(), "utf8");
 }
 
+/** Clicks "Copy preview link" and reads the link from the dialog. */
+export async function shareLink(page) {
+  await page.click("#btn-share");
+  await page.waitForSelector("#share-dialog[open]");
+  const url = await page.inputValue("#share-url");
+  await page.click("#share-dialog button");
+  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
+  return url;
+}
+
 /** Opens the 3D tab and waits until its view is made (its code, three.js, is a chunk the page
  *  loads the first time the tab is opened); returns the view's state. */
 export async function open3d(page, timeout = 30_000) {

@@ -7,7 +7,7 @@ import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { boxStl, clientPoint3d, downloadText, open3d, openPage, parseGcode, pick, pixels3d, shared, start, torusStl, view3dReady, waitDone, waitSettled } from "./helpers.mjs";
+import { boxStl, clientPoint3d, downloadText, open3d, openPage, parseGcode, pick, pixels3d, shareLink, shared, start, torusStl, view3dReady, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -271,15 +271,6 @@ test("a job link too big to embed asks for its files, says which are missing, an
   assert.equal(there.layer, here.layer);
   await other.context.close();
 });
-
-async function shareLink(page) {
-  await page.click("#btn-share");
-  await page.waitForSelector("#share-dialog[open]");
-  const url = await page.inputValue("#share-url");
-  await page.click("#share-dialog button");
-  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
-  return url;
-}
 
 test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 300,000 triangles)", async () => {
   const big = await openPage(env.browser, env.url);

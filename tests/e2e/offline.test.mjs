@@ -9,7 +9,7 @@ import { cpSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:f
 import { tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { serve } from "../../scripts/serve.mjs";
-import { downloadText, launchBrowser, open3d, pixels3d, repo, status, waitSettled } from "./helpers.mjs";
+import { downloadText, launchBrowser, open3d, openPage, pixels3d, repo, status, waitSettled } from "./helpers.mjs";
 
 const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-offline-"));
@@ -39,17 +39,7 @@ async function servedCopy(name) {
 }
 
 /** A fresh browser context on `url`, recording page and console errors. */
-async function visit(url) {
-  const context = await browser.newContext({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
-  const page = await context.newPage();
-  const errors = [];
-  page.on("pageerror", (e) => errors.push(String(e)));
-  page.on("console", (m) => {
-    if (m.type() === "error") errors.push(m.text());
-  });
-  await page.goto(url);
-  return { context, page, errors };
-}
+const visit = (url) => openPage(browser, url, { width: 1280, height: 800 });
 
 /** Waits until a service worker controls the page; returns its cache names. */
 async function controlled(page) {
