@@ -281,8 +281,12 @@ test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 30
   await page.waitForFunction(() => (window.dropslice.job()?.parts[0]?.mesh ?? 0) > 0 && window.dropslice.job().name === "torus-1m.stl", null, { timeout: 240_000 });
   const j = await job(page);
   assert.ok(j.parts[0].mesh <= 300_000 && j.parts[0].mesh > 10_000, `display triangles ${j.parts[0].mesh}`);
-  // the slice uses the full mesh; the whole part is drawn at its top layer
-  await page.waitForFunction(() => window.dropslice.status().layers > 0, null, { timeout: 240_000 });
+  // the slice uses the full mesh; the whole part is drawn at its top layer (the torus' slice:
+  // until it has layers the status may still be the sample's)
+  await page.waitForFunction(() => {
+    const s = window.dropslice.status();
+    return s.name === "torus-1m.stl" && s.layers > 0;
+  }, null, { timeout: 240_000 });
   await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
   const px = await pixels3d(page);
   assert.ok(px.part.n > 5000, `part pixels ${px.part.n}`);
