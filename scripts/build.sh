@@ -17,7 +17,14 @@ node_modules/.bin/tsc --noEmit -p www
 echo "== bundle: esbuild" >&2
 rm -rf dist
 mkdir -p dist
-node_modules/.bin/esbuild www/main.ts www/worker.ts --bundle --format=esm --target=es2022 \
+# The page: split (format esm), so the code that only the 3D tab needs (three.js: the bulk of
+# the script) is a chunk of its own, loaded by a dynamic import() when the tab is first opened;
+# code both share goes into chunks too. Chunks sit beside main.js (dist/NAME-HASH.js), so
+# URLs made from import.meta.url (the worker's) mean the same in any of them. The worker is
+# bundled alone, unsplit: one file.
+node_modules/.bin/esbuild www/main.ts --bundle --splitting --format=esm --target=es2022 \
+  --minify --sourcemap --outdir=dist --log-level=warning
+node_modules/.bin/esbuild www/worker.ts --bundle --format=esm --target=es2022 \
   --minify --sourcemap --outdir=dist --log-level=warning
 cp www/index.html www/style.css dist/
 # No wasm-opt: Debian's binaryen 108 produced a module whose function table Chromium rejects
@@ -26,11 +33,18 @@ cp www/pkg/dropslice_bg.wasm dist/
 cp www/manifest.webmanifest dist/
 mkdir -p dist/icons
 cp www/icons/icon.svg www/icons/icon-192.png www/icons/icon-512.png dist/icons/
-# The service worker last: its cache is named after a hash of the app shell it precaches
-# (www/sw.ts SHELL), so a build that changes any of them is a new cache and a new sw.js.
-build_id=$(cd dist && cat index.html main.js worker.js style.css dropslice_bg.wasm \
-  manifest.webmanifest icons/icon.svg icons/icon-192.png icons/icon-512.png | sha256sum | cut -c1-16)
+# The service worker last. It precaches the app shell: every file in dist/ but source maps
+# (the chunks' names change with their content, so the list is made here, from the listing,
+# and injected as SHELL). Its cache is named after a hash of those files (BUILD_ID), so a
+# build that changes any of them is a new cache and a new sw.js.
+mapfile -t shell < <(cd dist && find . -type f ! -name '*.map' -printf '%P\n' | LC_ALL=C sort)
+shell_json=$(printf '%s\n' "${shell[@]}" | node -e \
+  'process.stdout.write(JSON.stringify(require("fs").readFileSync(0, "utf8").split("\n").filter(Boolean)))')
+for f in index.html main.js worker.js dropslice_bg.wasm; do
+  [[ " ${shell[*]} " == *" $f "* ]] || { echo "build: dist/$f is missing from the shell" >&2; exit 1; }
+done
+build_id=$(cd dist && cat "${shell[@]}" | sha256sum | cut -c1-16)
 node_modules/.bin/esbuild www/sw.ts --bundle --format=iife --target=es2022 --minify \
-  "--define:BUILD_ID=\"$build_id\"" --outfile=dist/sw.js --log-level=warning
+  "--define:BUILD_ID=\"$build_id\"" "--define:SHELL=$shell_json" --outfile=dist/sw.js --log-level=warning
 echo "== build id $build_id" >&2
 echo "== built dist/ ($(du -sh dist | cut -f1))" >&2

@@ -55,17 +55,10 @@ pub struct Calibration {
     pub explanation: String,
 }
 
-/// Why a calibration was refused (the message says what to check).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CalibrationError(pub String);
-
-impl std::fmt::Display for CalibrationError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
+crate::error::message_error! {
+    /// Why a calibration was refused (the message says what to check).
+    CalibrationError
 }
-
-impl std::error::Error for CalibrationError {}
 
 fn err<T>(msg: String) -> Result<T, CalibrationError> {
     Err(CalibrationError(msg))

@@ -81,3 +81,24 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {}
+
+/// Defines an error that is one message (what is wrong and what to do, shown as it is): a
+/// `pub struct $name(pub String)` whose `Display` is the message. The `.gco` reader's
+/// [`crate::gcode_read::GcodeError`] and [`crate::calibrate::CalibrationError`] are such
+/// errors: two types, so that a signature says which step refused.
+macro_rules! message_error {
+    ($(#[$attr:meta])* $name:ident) => {
+        $(#[$attr])*
+        #[derive(Clone, Debug, PartialEq, Eq)]
+        pub struct $name(pub String);
+
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(&self.0)
+            }
+        }
+
+        impl std::error::Error for $name {}
+    };
+}
+pub(crate) use message_error;

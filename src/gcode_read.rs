@@ -32,17 +32,10 @@ pub const MAX_TRAVEL_MOVES: u64 = 20_000_000;
 /// Layers (distinct heights): 100,000, e.g. 1 m at 0.01 mm.
 pub const MAX_LAYERS: usize = 100_000;
 
-/// Why a file was refused.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct GcodeError(pub String);
-
-impl std::fmt::Display for GcodeError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
+crate::error::message_error! {
+    /// Why a file was refused.
+    GcodeError
 }
-
-impl std::error::Error for GcodeError {}
 
 /// One layer read from a file.
 #[derive(Clone, Debug, Default, PartialEq)]

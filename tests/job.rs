@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{Rng, TempDir, model, model_bytes, run_cli};
+use common::{Rng, TempDir, model, model_bytes, on_plate, run_cli};
 use dropslice::job::{self, JobSpec, Model, Rect, arrange};
 use dropslice::{Error, Job, Settings};
 use serde_json::{Value, json};
@@ -468,20 +468,11 @@ fn transform_point(p: [f64; 3], rot: [f64; 3], scale: [f64; 3]) -> [f64; 3] {
 
 /// The part rotated and scaled, its box minimum moved to (at, 0).
 fn placed(tris: &[Tri], rot: [f64; 3], scale: [f64; 3], at: [f64; 2]) -> Vec<[[f64; 3]; 3]> {
-    let t: Vec<[[f64; 3]; 3]> = tris
+    let t = tris
         .iter()
         .map(|t| t.map(|p| transform_point(p.map(f64::from), rot, scale)))
         .collect();
-    let mut lo = [f64::INFINITY; 3];
-    for p in t.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-        }
-    }
-    let shift = [at[0] - lo[0], at[1] - lo[1], -lo[2]];
-    t.into_iter()
-        .map(|t| t.map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]))
-        .collect()
+    on_plate(t, at)
 }
 
 fn all_triangles(file: &str) -> Vec<Tri> {

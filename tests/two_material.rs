@@ -12,7 +12,9 @@
 
 mod common;
 
-use common::{Gcode, Layer, TempDir, cut, deep_inside, model_bytes, parse_gcode, run_cli};
+use common::{
+    Gcode, Layer, TempDir, cut, deep_inside, model_bytes, on_plate, parse_gcode, run_cli,
+};
 use serde_json::{Value, json};
 use std::collections::HashMap;
 use std::time::Duration;
@@ -114,22 +116,13 @@ fn box_tris(x0: f64, y0: f64, x1: f64, y1: f64, h: f64) -> Vec<Tri> {
 /// A model's triangles moved so that their box minimum is at (at, 0) (no rotation, no scale).
 fn placed(file: &str, at: P) -> Vec<Tri> {
     let bytes = model_bytes(file);
-    let tris: Vec<Tri> = dropslice::import::read_parts(&bytes, file)
+    let tris = dropslice::import::read_parts(&bytes, file)
         .unwrap()
         .into_iter()
         .flat_map(|p| p.triangles)
         .map(|t| t.map(|p| p.map(f64::from)))
         .collect();
-    let mut lo = [f64::INFINITY; 3];
-    for p in tris.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-        }
-    }
-    let shift = [at[0] - lo[0], at[1] - lo[1], -lo[2]];
-    tris.into_iter()
-        .map(|t| t.map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]))
-        .collect()
+    on_plate(tris, at)
 }
 
 /// The oracle's nonzero area of every layer of an STL (None: a layer with faces in its

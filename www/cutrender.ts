@@ -6,6 +6,7 @@
 // at 6 heights per slab) over them; the current layer outlined. Only layers and droplets in
 // view are drawn, batched into one Path2D per colour.
 
+import { sizeCanvas, watchCanvas } from "./hidpi";
 import { CLASS_COLORS, dropletClass, VOID_RGB, clampView, MAX_SCALE, MIN_SCALE } from "./render";
 
 /** One layer of the cut: what the page or the core found along the line. */
@@ -55,17 +56,12 @@ export class CutRenderer {
   private dpr = 1;
 
   constructor(readonly canvas: HTMLCanvasElement) {
-    new ResizeObserver(() => this.resize()).observe(canvas);
+    watchCanvas(canvas, () => this.resize());
     this.resize();
   }
 
   private resize(): void {
-    const r = this.canvas.getBoundingClientRect();
-    this.dpr = window.devicePixelRatio || 1;
-    this.cssW = Math.max(1, r.width);
-    this.cssH = Math.max(1, r.height);
-    this.canvas.width = Math.round(this.cssW * this.dpr);
-    this.canvas.height = Math.round(this.cssH * this.dpr);
+    ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
     if (!this.touched) this.fit();
     this.draw();
   }

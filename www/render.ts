@@ -5,6 +5,7 @@
 // pixels wide, over 60,000 droplets), droplets are written straight into a pixel buffer as
 // small squares: ~330,000 droplets then take ~10 ms instead of ~100 ms of path filling.
 
+import { sizeCanvas, watchCanvas } from "./hidpi";
 import type { CoverageMask, LayerData } from "./protocol";
 
 export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
@@ -109,27 +110,12 @@ export class Renderer {
   private dpr = 1;
 
   constructor(readonly canvas: HTMLCanvasElement) {
-    new ResizeObserver(() => this.resize()).observe(canvas);
+    watchCanvas(canvas, () => this.resize());
     this.resize();
-    this.watchPixelRatio();
-  }
-
-  /** Redraws crisply when the window moves to a screen with another pixel ratio (or zooms). */
-  private watchPixelRatio(): void {
-    const mq = matchMedia(`(resolution: ${window.devicePixelRatio || 1}dppx)`);
-    mq.addEventListener("change", () => {
-      this.resize();
-      this.watchPixelRatio();
-    }, { once: true });
   }
 
   private resize(): void {
-    const r = this.canvas.getBoundingClientRect();
-    this.dpr = window.devicePixelRatio || 1;
-    this.cssW = Math.max(1, r.width);
-    this.cssH = Math.max(1, r.height);
-    this.canvas.width = Math.round(this.cssW * this.dpr);
-    this.canvas.height = Math.round(this.cssH * this.dpr);
+    ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
     this.draw();
   }
 

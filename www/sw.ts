@@ -1,8 +1,8 @@
 // The service worker (dist/sw.js): the page works without network after the first visit.
 //
-// * The app shell (SHELL) is precached on install, as one unit, in a cache named after the
-//   build (BUILD_ID: a hash of the built files, injected by scripts/build.sh), and served
-//   cache-first. Old builds' caches are deleted on activate.
+// * The app shell (SHELL: every built file, the chunks the page loads on demand too) is
+//   precached on install, as one unit, in a cache named after the build (BUILD_ID: a hash of
+//   the built files; both injected by scripts/build.sh), and served cache-first. Old builds' caches are deleted on activate.
 // * Navigations to the page are served cache-first too, from the same build's cache. Not
 //   network-first: a fresh index.html from the network would run with the old build's
 //   main.js, worker.js and wasm from the cache, two builds mixed. Updates are still seen when
@@ -19,23 +19,15 @@
 export {};
 
 declare const BUILD_ID: string;
+/** The page's files, relative to the worker's scope (the folder of sw.js): every file of the
+ *  build but source maps and sw.js itself, the 3D view's chunks included (listed by
+ *  scripts/build.sh, which injects the list: chunk names carry a hash of their content). */
+declare const SHELL: readonly string[];
 
 const sw = self as unknown as ServiceWorkerGlobalScope;
 
 const PREFIX = "dropslice-shell-";
 const CACHE = PREFIX + BUILD_ID;
-/** The page's files, relative to the worker's scope (the folder of sw.js). */
-const SHELL = [
-  "index.html",
-  "main.js",
-  "worker.js",
-  "style.css",
-  "dropslice_bg.wasm",
-  "manifest.webmanifest",
-  "icons/icon.svg",
-  "icons/icon-192.png",
-  "icons/icon-512.png",
-];
 
 const scope = () => new URL(sw.registration.scope);
 

@@ -581,6 +581,20 @@ pub fn droplet_plan<P: Copy + Into<dropslice::geom::Point>>(
     }
 }
 
+/// Triangles moved onto the plate: their box minimum to (at, 0).
+pub fn on_plate(tris: Vec<[[f64; 3]; 3]>, at: Point) -> Vec<[[f64; 3]; 3]> {
+    let mut lo = [f64::INFINITY; 3];
+    for p in tris.iter().flatten() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+        }
+    }
+    let shift = [at[0] - lo[0], at[1] - lo[1], -lo[2]];
+    tris.into_iter()
+        .map(|t| t.map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]))
+        .collect()
+}
+
 /// The triangles cut by the plane z: segments, not chained into loops (an independent cut
 /// for checks against the part's true section).
 pub fn cut(tris: &[[[f64; 3]; 3]], z: f64) -> Vec<(Point, Point)> {

@@ -9,7 +9,7 @@ import { execFileSync } from "node:child_process";
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { openPage, repo, shared, start, status, waitSettled } from "./helpers.mjs";
+import { openPage, pick, repo, shared, start, status, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
@@ -25,13 +25,6 @@ after(async () => {
   await env?.close();
   rmSync(tmp, { recursive: true, force: true });
 });
-
-async function waitDone(page, timeout = 120_000) {
-  const s = await waitSettled(page, timeout);
-  const banner = await page.locator("#banner").innerText().catch(() => "");
-  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
-  return s;
-}
 
 /** SPEC.md's figures for N droplets of a code with layer height h and aspect a, mass m (g)
  *  and density rho (g/cm³). */
@@ -160,8 +153,7 @@ test("an opened .gco: its header's count, H, aspect and density; or its commands
   const n = Number(/^; droplets total\s*=\s*(\d+)/m.exec(text)[1]);
   assert.ok(n > 1000, `header total ${n}`);
 
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", gco);
+  await pick(page, gco);
   const s = await waitDone(page);
   assert.equal(s.name, "screw.gco");
   assert.equal(s.droplets, n, "the page read as many droplets as the header says");
@@ -182,8 +174,7 @@ test("an opened .gco: its header's count, H, aspect and density; or its commands
   // the same code without the header's total: counted from its commands, said so
   const bare = join(tmp, "bare.gco");
   writeFileSync(bare, text.replace(/^; droplets total.*\n/m, ""));
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", bare);
+  await pick(page, bare);
   await waitDone(page);
   await page.waitForFunction(() => document.getElementById("calib-source").innerText.startsWith("bare.gco"));
   assert.equal(await typeMass(page, mass), "result");
@@ -196,8 +187,7 @@ test("an opened .gco: its header's count, H, aspect and density; or its commands
   const empty = join(tmp, "empty.gco");
   const header = text.slice(0, text.search(/^[GM]\d/m));
   writeFileSync(empty, `${header.replace(/^; droplets total.*\n/m, "")}G01 X1 Y1 Z0.25\n`);
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", empty);
+  await pick(page, empty);
   await waitDone(page);
   await page.waitForFunction(() => document.getElementById("calib-source").innerText.startsWith("empty.gco"));
   assert.equal(await typeMass(page, "1"), "refused");

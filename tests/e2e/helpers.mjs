@@ -1,6 +1,9 @@
 // Shared helpers of the browser tests: a static server for dist/, Debian's Chromium through
-// playwright-core, paths of the shared models, and a G-code parser for comparisons.
-import { existsSync } from "node:fs";
+// playwright-core, paths of the shared models, opening files and waiting for their slice, the
+// download, the pixels of the layer canvas and of the 3D view, test meshes, and a G-code parser
+// for comparisons.
+import assert from "node:assert/strict";
+import { existsSync, readFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
@@ -72,6 +75,123 @@ export async function waitSettled(page, timeout = 240_000) {
   return status(page);
 }
 
+/** Opens files with the page's file input: paths, or { name, mimeType, buffer }. The page's
+ *  state is set to "picking" first, so that waitSettled / waitDone wait for this slice. */
+export async function pick(page, files) {
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.setInputFiles("#file-input", files);
+}
+
+/** Waits for the slice and asserts that it finished (state "done"; else the banner says why);
+ *  returns the page's status. */
+export async function waitDone(page, timeout = 240_000) {
+  const s = await waitSettled(page, timeout);
+  const banner = s.state === "done" ? "" : await page.locator("#banner").innerText().catch(() => "");
+  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
+  return s;
+}
+
+/** The text of the .gco that the Download button gives. */
+export async function downloadText(page) {
+  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
+  return readFileSync(await download.path(), "utf8");
+}
+
+/** Clicks "Copy preview link" and reads the link from the dialog. */
+export async function shareLink(page) {
+  await page.click("#btn-share");
+  await page.waitForSelector("#share-dialog[open]");
+  const url = await page.inputValue("#share-url");
+  await page.click("#share-dialog button");
+  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
+  return url;
+}
+
+/** Opens the 3D tab and waits until its view is made (its code, three.js, is a chunk the page
+ *  loads the first time the tab is opened); returns the view's state. */
+export async function open3d(page, timeout = 30_000) {
+  await page.click("#mode-3d");
+  return view3dReady(page, timeout);
+}
+
+/** Waits until the 3D view is made (the tab was opened, by a click or by the page itself, and
+ *  its code is in); returns the view's state. */
+export async function view3dReady(page, timeout = 30_000) {
+  await page.waitForFunction(() => window.dropslice.view3d() !== null, null, { timeout, polling: 100 });
+  return page.evaluate(() => window.dropslice.view3d());
+}
+
+/** Draws the 3D view now and classifies the pixels of its WebGL canvas (device pixels; the
+ *  view keeps its drawing buffer), each pixel in the first class it fits: the selected part's
+ *  accent blue, the other parts' steel blue, the cut's orange, the background. Per class its
+ *  count n and centroid x, y; for parts and the selected part also `inner`: the pixel of the
+ *  class nearest the centroid with pixels of the class 4 px around it (to click or grab; null
+ *  if none). Also the view's state, the
+ *  canvas' size, `top` (the highest row of part, selected or cut pixels) and `tint` (the number
+ *  of pixels of the overhang tint, magenta-red and dim, counted apart from the classes). */
+export function pixels3d(page) {
+  return page.evaluate(() => {
+    const state = window.dropslice.view3d();
+    const c = document.querySelector("#view3d canvas");
+    const t = document.createElement("canvas");
+    t.width = c.width;
+    t.height = c.height;
+    const g = t.getContext("2d");
+    g.drawImage(c, 0, 0);
+    const d = g.getImageData(0, 0, t.width, t.height).data;
+    const classOf = (i) => {
+      const r = d[i], gr = d[i + 1], b = d[i + 2];
+      if (b - r > 120 && r < 90) return "selected";
+      if (b - r > 40 && b > gr) return "part";
+      if (r - b > 80 && r > 180) return "cut";
+      if (Math.abs(r - 0xee) < 4 && Math.abs(gr - 0xf1) < 4 && Math.abs(b - 0xf5) < 4) return "background";
+      return null;
+    };
+    const cls = { part: [0, 0, 0], selected: [0, 0, 0], cut: [0, 0, 0], background: [0, 0, 0] };
+    let top = t.height;
+    let tint = 0;
+    for (let i = 0, p = 0; i < d.length; i += 4, p++) {
+      if (d[i] > d[i + 2] + 15 && d[i + 2] > d[i + 1] + 30) tint++;
+      const k = classOf(i);
+      if (k === null) continue;
+      const x = p % t.width, y = (p / t.width) | 0;
+      cls[k][0]++;
+      cls[k][1] += x;
+      cls[k][2] += y;
+      if (k !== "background" && y < top) top = y;
+    }
+    const out = { state, width: t.width, height: t.height, top, tint };
+    const R = 4;
+    const is = (k, x, y) => classOf(4 * (y * t.width + x)) === k;
+    for (const [k, [n, sx, sy]] of Object.entries(cls)) {
+      const e = { n, x: n ? sx / n : NaN, y: n ? sy / n : NaN, inner: null };
+      if (n && (k === "part" || k === "selected")) {
+        let best = null;
+        for (let y = R; y < t.height - R; y++) {
+          for (let x = R; x < t.width - R; x++) {
+            if (!(is(k, x, y) && is(k, x - R, y) && is(k, x + R, y) && is(k, x, y - R) && is(k, x, y + R))) continue;
+            const dist = Math.hypot(x - e.x, y - e.y);
+            if (!best || dist < best.dist) best = { x, y, dist };
+          }
+        }
+        e.inner = best;
+      }
+      out[k] = e;
+    }
+    return out;
+  });
+}
+
+/** Client coordinates of a device pixel of the 3D view's canvas. */
+export async function clientPoint3d(page, px, py) {
+  const r = await page.locator("#view3d canvas").boundingBox();
+  const dims = await page.evaluate(() => {
+    const c = document.querySelector("#view3d canvas");
+    return { w: c.width, h: c.height };
+  });
+  return { x: r.x + (px * r.width) / dims.w, y: r.y + (py * r.height) / dims.h };
+}
+
 /** Number of canvas pixels whose colour passes `test` (a JS expression over r, g, b). The
  *  expression goes in the evaluated source (run by the DevTools protocol): a `new Function`
  *  inside the page would be refused by its Content-Security-Policy (no 'unsafe-eval'). */
@@ -101,6 +221,26 @@ export function parseGcode(text) {
     out.push(c);
   }
   return out;
+}
+
+/** A binary STL of the box [0,a]×[0,b]×[0,c], outward facets, turned by `deg` about x;
+ *  `dropFacet` leaves one facet out (an open mesh). */
+export function boxStl(a, b, c, { deg = 0, dropFacet = -1 } = {}) {
+  const t = (deg * Math.PI) / 180;
+  const v = (x, y, z) => [x * a, y * b * Math.cos(t) - z * c * Math.sin(t), y * b * Math.sin(t) + z * c * Math.cos(t)];
+  const quads = [
+    [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)], // bottom, facing -z
+    [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)], // top
+    [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)], // front, -y
+    [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)], // right, +x
+    [v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)], // back, +y
+    [v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)], // left, -x
+  ];
+  const tris = quads.flatMap(([p, q, r, s]) => [[p, q, r], [p, r, s]]).filter((_, i) => i !== dropFacet);
+  const buf = Buffer.alloc(84 + 50 * tris.length);
+  buf.writeUInt32LE(tris.length, 80);
+  tris.forEach((tri, i) => tri.flat().forEach((x, k) => buf.writeFloatLE(x, 84 + 50 * i + 12 + 4 * k)));
+  return buf;
 }
 
 /** A closed torus as a binary STL with 2·nu·nv facets (R, r in mm). */

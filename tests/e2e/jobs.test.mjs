@@ -7,7 +7,7 @@ import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { openPage, parseGcode, shared, start, torusStl, waitSettled } from "./helpers.mjs";
+import { boxStl, clientPoint3d, downloadText, open3d, openPage, parseGcode, pick, pixels3d, shareLink, shared, start, torusStl, view3dReady, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -28,26 +28,7 @@ after(async () => {
   rmSync(tmp, { recursive: true, force: true });
 });
 
-async function waitDone(page, timeout = 240_000) {
-  const s = await waitSettled(page, timeout);
-  const banner = await page.locator("#banner").innerText().catch(() => "");
-  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
-  return s;
-}
-
-async function pick(page, files) {
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", files);
-}
-
 const job = (page) => page.evaluate(() => window.dropslice.job());
-
-async function download(page, name) {
-  const [d] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
-  const file = join(tmp, name);
-  await d.saveAs(file);
-  return readFileSync(file, "utf8");
-}
 
 /** Droplet centres of a .gco: every G26 and both ends of every G25 line. */
 function droplets(text) {
@@ -65,58 +46,6 @@ function droplets(text) {
 
 const commands = (text) => parseGcode(text).map((c) => `${c.code} ${c.x} ${c.y} ${c.z}`);
 
-/** Draws the 3D view and returns the count and centroid of the selected part's pixels (the
- *  accent blue) and of the other parts' (steel blue), in device pixels. */
-function pixels3d(page) {
-  return page.evaluate(() => {
-    window.dropslice.view3d();
-    const c = document.querySelector("#view3d canvas");
-    const t = document.createElement("canvas");
-    t.width = c.width;
-    t.height = c.height;
-    const g = t.getContext("2d");
-    g.drawImage(c, 0, 0);
-    const d = g.getImageData(0, 0, t.width, t.height).data;
-    const acc = { selected: [0, 0, 0], part: [0, 0, 0] };
-    const sel = [];
-    for (let i = 0, p = 0; i < d.length; i += 4, p++) {
-      const r = d[i], gr = d[i + 1], b = d[i + 2];
-      const k = b - r > 120 && r < 90 ? "selected" : b - r > 40 && b > gr ? "part" : null;
-      if (!k) continue;
-      acc[k][0]++;
-      acc[k][1] += p % t.width;
-      acc[k][2] += (p / t.width) | 0;
-      if (k === "selected") sel.push(p);
-    }
-    const out = { width: t.width, height: t.height };
-    for (const [k, [n, sx, sy]] of Object.entries(acc)) out[k] = { n, x: sx / n, y: sy / n };
-    // a selected pixel with selected pixels 4 px around it, nearest the centroid (to grab)
-    const isSel = (x, y) => {
-      const i = 4 * (y * t.width + x);
-      return d[i + 2] - d[i] > 120 && d[i] < 90;
-    };
-    let best = null;
-    for (const p of sel) {
-      const x = p % t.width, y = (p / t.width) | 0;
-      if (x < 4 || y < 4 || x >= t.width - 4 || y >= t.height - 4) continue;
-      if (!(isSel(x - 4, y) && isSel(x + 4, y) && isSel(x, y - 4) && isSel(x, y + 4))) continue;
-      const dist = Math.hypot(x - out.selected.x, y - out.selected.y);
-      if (!best || dist < best.dist) best = { x, y, dist };
-    }
-    out.grab = best;
-    return out;
-  });
-}
-
-async function clientPoint(page, px, py) {
-  const r = await page.locator("#view3d canvas").boundingBox();
-  const dims = await page.evaluate(() => {
-    const c = document.querySelector("#view3d canvas");
-    return { w: c.width, h: c.height };
-  });
-  return { x: r.x + (px * r.width) / dims.w, y: r.y + (py * r.height) / dims.h };
-}
-
 let twoPartGcode = "";
 
 test("two files opened at once: one job, both names shown, the G-code's droplets in the layout's two boxes", async () => {
@@ -130,11 +59,12 @@ test("two files opened at once: one job, both names shown, the G-code's droplets
   assert.match(stats, /cube_20mm_ascii/);
   assert.match(stats, /extruder_idler_quads/);
   // several instances: the 3D tab is shown first
+  await view3dReady(page);
   assert.equal(await page.isVisible("#view3d canvas"), true);
 
   const j = await job(page);
   assert.equal(j.layout.instances.length, 2);
-  const text = await download(page, "two.gco");
+  const text = await downloadText(page);
   twoPartGcode = text;
   assert.equal(text.split("\n").filter((l) => /^; part \d+ = /.test(l)).length, 2, "two part lines in the header");
   // every droplet lies in one instance's box (the core's layout), and both boxes have droplets
@@ -157,8 +87,7 @@ test("two files opened at once: one job, both names shown, the G-code's droplets
 
 test("the 3D view draws both parts, each where the layout puts it", async () => {
   const { page } = main;
-  await page.click("#mode-3d");
-  const state = await page.evaluate(() => window.dropslice.view3d());
+  const state = await open3d(page);
   assert.deepEqual(state.parts.sort(), ["0:0", "1:0"]);
   const seen = [];
   for (const k of [1, 2]) {
@@ -177,8 +106,8 @@ test("dragging a part in 3D places it: the core lays the job out again", async (
   const before = await job(page);
   assert.equal(before.parts[0].place_x, undefined, "arranged at first");
   const px = await pixels3d(page);
-  assert.ok(px.grab, "a pixel of the part to grab");
-  const from = await clientPoint(page, px.grab.x + 0.5, px.grab.y + 0.5);
+  assert.ok(px.selected.inner, "a pixel of the part to grab");
+  const from = await clientPoint3d(page, px.selected.inner.x + 0.5, px.selected.inner.y + 0.5);
   await page.mouse.move(from.x, from.y);
   await page.mouse.down();
   await page.mouse.move(from.x + 60, from.y - 30, { steps: 8 });
@@ -222,7 +151,7 @@ test("dragging the selected part in the layer view moves it by the mm dragged", 
   assert.deepEqual(v, view, "the drag moved the part, not the view");
   await page.click("#btn-arrange");
   await page.waitForFunction(() => window.dropslice.job().parts[0].place_x === undefined);
-  await page.click("#mode-3d");
+  await open3d(page);
 });
 
 test("a job that does not fit says so and keeps the previous state", async () => {
@@ -252,7 +181,7 @@ test("a job that does not fit says so and keeps the previous state", async () =>
 test("lay flat turns the part as the core says: a tilted slab ends up lying on its largest face", async () => {
   const { page } = main;
   // a 30 × 20 × 4 mm slab turned 30° about x: lying flat it is 4 mm tall
-  const slab = slabStl(30, 20, 4, 30);
+  const slab = boxStl(30, 20, 4, { deg: 30 });
   writeFileSync(join(tmp, "slab.stl"), slab);
   await page.setInputFiles("#add-input", join(tmp, "slab.stl"));
   await page.waitForFunction(() => window.dropslice.job().parts.length === 3);
@@ -270,25 +199,6 @@ test("lay flat turns the part as the core says: a tilted slab ends up lying on i
   await page.waitForFunction(() => window.dropslice.job().parts.length === 2);
 });
 
-/** A binary STL of the box [0,a]×[0,b]×[0,c] turned by `deg` about x. */
-function slabStl(a, b, c, deg) {
-  const t = (deg * Math.PI) / 180;
-  const v = (x, y, z) => [x * a, y * b * Math.cos(t) - z * c * Math.sin(t), y * b * Math.sin(t) + z * c * Math.cos(t)];
-  const quads = [
-    [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
-    [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
-    [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
-    [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
-    [v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)],
-    [v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)],
-  ];
-  const tris = quads.flatMap(([p, q, r, s]) => [[p, q, r], [p, r, s]]);
-  const buf = Buffer.alloc(84 + 50 * tris.length);
-  buf.writeUInt32LE(tris.length, 80);
-  tris.forEach((tri, i) => tri.flat().forEach((x, k) => buf.writeFloatLE(x, 84 + 50 * i + 12 + 4 * k)));
-  return buf;
-}
-
 test("save job → open job.json with its files in a fresh page: same layout, same G-code", async () => {
   const { page } = main;
   // slice the job as it is now (placed part, two copies) to compare with
@@ -303,7 +213,7 @@ test("save job → open job.json with its files in a fresh page: same layout, sa
   await page.click("#btn-slice");
   await waitDone(page);
   const here = await job(page);
-  const gcode = await download(page, "saved-job.gco");
+  const gcode = await downloadText(page);
   const [d] = await Promise.all([page.waitForEvent("download"), page.click("#btn-save-job")]);
   assert.equal(d.suggestedFilename(), "job.json");
   const jobFile = join(tmp, "job.json");
@@ -324,7 +234,7 @@ test("save job → open job.json with its files in a fresh page: same layout, sa
   await waitDone(other.page);
   const there = await job(other.page);
   assert.deepEqual(there.layout.instances.map((i) => [i.part, i.copy, i.matrix]), here.layout.instances.map((i) => [i.part, i.copy, i.matrix]));
-  assert.deepEqual(commands(await download(other.page, "reopened.gco")), commands(gcode));
+  assert.deepEqual(commands(await downloadText(other.page)), commands(gcode));
   await other.context.close();
 });
 
@@ -335,7 +245,7 @@ test("a two-part preview link (models embedded) gives the same G-code in a fresh
   const other = await openPage(env.browser, url);
   await waitDone(other.page);
   assert.deepEqual((await job(other.page)).parts.map((p) => p.file), ["cube_20mm_ascii.stl", "extruder_idler_quads.obj"]);
-  assert.deepEqual(commands(await download(other.page, "linked.gco")), commands(await download(page, "linked-here.gco")));
+  assert.deepEqual(commands(await downloadText(other.page)), commands(await downloadText(page)));
   await other.context.close();
   assert.ok(twoPartGcode.length > 0);
 });
@@ -362,32 +272,32 @@ test("a job link too big to embed asks for its files, says which are missing, an
   await other.context.close();
 });
 
-async function shareLink(page) {
-  await page.click("#btn-share");
-  await page.waitForSelector("#share-dialog[open]");
-  const url = await page.inputValue("#share-url");
-  await page.click("#share-dialog button");
-  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
-  return url;
-}
-
 test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 300,000 triangles)", async () => {
   const big = await openPage(env.browser, env.url);
   const { page, errors } = big;
   await waitDone(page, 60_000);
-  await page.click("#mode-3d");
+  await open3d(page);
   await pick(page, { name: "torus-1m.stl", mimeType: "model/stl", buffer: torusStl(1000, 500, 40, 12) });
   await page.waitForFunction(() => (window.dropslice.job()?.parts[0]?.mesh ?? 0) > 0 && window.dropslice.job().name === "torus-1m.stl", null, { timeout: 240_000 });
   const j = await job(page);
   assert.ok(j.parts[0].mesh <= 300_000 && j.parts[0].mesh > 10_000, `display triangles ${j.parts[0].mesh}`);
-  // the slice uses the full mesh; the whole part is drawn at its top layer
-  await page.waitForFunction(() => window.dropslice.status().layers > 0, null, { timeout: 240_000 });
+  // the slice uses the full mesh; the whole part is drawn at its top layer (the torus' slice:
+  // until it has layers the status may still be the sample's)
+  await page.waitForFunction(() => {
+    const s = window.dropslice.status();
+    return s.name === "torus-1m.stl" && s.layers > 0;
+  }, null, { timeout: 240_000 });
   await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
   const px = await pixels3d(page);
   assert.ok(px.part.n > 5000, `part pixels ${px.part.n}`);
   const facets = await page.locator("#stat-facets").innerText();
   assert.equal(facets, "1,000,000");
-  if (await page.isVisible("#btn-cancel")) await page.click("#btn-cancel");
+  // a slice still running is cancelled; checked and clicked in one step in the page (the
+  // slice may end between a check here and a click)
+  await page.evaluate(() => {
+    const b = document.getElementById("btn-cancel");
+    if (b && b.checkVisibility()) b.click();
+  });
   assert.deepEqual(errors, []);
   await big.context.close();
 });

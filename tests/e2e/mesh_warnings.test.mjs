@@ -3,7 +3,7 @@
 // scales it by 25.4 and slices again. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { openPage, start, status, waitSettled } from "./helpers.mjs";
+import { boxStl, openPage, pick, start, status, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -18,27 +18,9 @@ after(async () => {
   await env?.close();
 });
 
-/** A binary STL of an axis-aligned box from (0,0,0) to (a,a,a), outward facets. */
-function boxStl(a, { dropFacet = -1 } = {}) {
-  const v = (x, y, z) => [x * a, y * a, z * a];
-  const quads = [
-    [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)], // bottom, facing -z
-    [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)], // top
-    [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)], // front, -y
-    [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)], // right, +x
-    [v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)], // back, +y
-    [v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)], // left, -x
-  ];
-  const tris = quads.flatMap(([p, q, r, s]) => [[p, q, r], [p, r, s]]).filter((_, i) => i !== dropFacet);
-  const buf = Buffer.alloc(84 + 50 * tris.length);
-  buf.writeUInt32LE(tris.length, 80);
-  tris.forEach((t, i) => t.flat().forEach((c, k) => buf.writeFloatLE(c, 84 + 50 * i + 12 + 4 * k)));
-  return buf;
-}
-
-async function pick(page, name, buffer) {
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", { name, mimeType: "model/stl", buffer });
+/** Opens one STL (a buffer) and waits for its slice; returns the page's status. */
+async function open(page, name, buffer) {
+  await pick(page, { name, mimeType: "model/stl", buffer });
   return waitSettled(page, 60_000);
 }
 
@@ -47,7 +29,7 @@ const warningTexts = (page) => page.$$eval("#warning-list li", (lis) => lis.map(
 test("an open mesh: open edges and repaired layers are listed", async () => {
   const { page } = main;
   // one side facet missing: every layer's section is an open chain, closed across the gap
-  const s = await pick(page, "open-box.stl", boxStl(20, { dropFacet: 4 }));
+  const s = await open(page, "open-box.stl", boxStl(20, 20, 20, { dropFacet: 4 }));
   assert.equal(s.state, "done");
   assert.ok(s.droplets > 0);
   assert.equal(await page.isVisible("#warnings"), true);
@@ -59,7 +41,7 @@ test("an open mesh: open edges and repaired layers are listed", async () => {
 
 test("a part in inches: warned, not rescaled, fixed by the button", async () => {
   const { page } = main;
-  const s = await pick(page, "inch-box.stl", boxStl(20 / 25.4));
+  const s = await open(page, "inch-box.stl", boxStl(20 / 25.4, 20 / 25.4, 20 / 25.4));
   assert.equal(s.state, "done");
   assert.match(await page.locator("#stat-size").innerText(), /^0\.8 × 0\.8 × 0\.8 mm/);
   const w = await warningTexts(page);
@@ -80,20 +62,7 @@ test("a part too thin for any droplet: a clear message, no download, the page st
   const { page } = main;
   await page.click("#btn-reset"); // the previous test scaled the part by 25.4
   // a box 0.1 mm wide: thinner than one droplet (B = 0.208 mm)
-  const v = (x, y, z) => [x * 0.1, y * 20, z * 20];
-  const quads = [
-    [v(0, 0, 0), v(0, 1, 0), v(1, 1, 0), v(1, 0, 0)],
-    [v(0, 0, 1), v(1, 0, 1), v(1, 1, 1), v(0, 1, 1)],
-    [v(0, 0, 0), v(1, 0, 0), v(1, 0, 1), v(0, 0, 1)],
-    [v(1, 0, 0), v(1, 1, 0), v(1, 1, 1), v(1, 0, 1)],
-    [v(1, 1, 0), v(0, 1, 0), v(0, 1, 1), v(1, 1, 1)],
-    [v(0, 1, 0), v(0, 0, 0), v(0, 0, 1), v(0, 1, 1)],
-  ];
-  const tris = quads.flatMap(([p, q, r, s]) => [[p, q, r], [p, r, s]]);
-  const buf = Buffer.alloc(84 + 50 * tris.length);
-  buf.writeUInt32LE(tris.length, 80);
-  tris.forEach((t, i) => t.flat().forEach((c, k) => buf.writeFloatLE(c, 84 + 50 * i + 12 + 4 * k)));
-  const s = await pick(page, "sheet.stl", buf);
+  const s = await open(page, "sheet.stl", boxStl(0.1, 20, 20));
   assert.equal(s.state, "done");
   assert.equal(s.droplets, 0);
   assert.equal(await page.isVisible("#banner"), true);

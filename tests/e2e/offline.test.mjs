@@ -9,7 +9,7 @@ import { cpSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:f
 import { tmpdir } from "node:os";
 import { join, resolve } from "node:path";
 import { serve } from "../../scripts/serve.mjs";
-import { launchBrowser, repo, status, waitSettled } from "./helpers.mjs";
+import { downloadText, launchBrowser, open3d, openPage, pixels3d, repo, status, waitSettled } from "./helpers.mjs";
 
 const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-offline-"));
@@ -39,17 +39,7 @@ async function servedCopy(name) {
 }
 
 /** A fresh browser context on `url`, recording page and console errors. */
-async function visit(url) {
-  const context = await browser.newContext({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
-  const page = await context.newPage();
-  const errors = [];
-  page.on("pageerror", (e) => errors.push(String(e)));
-  page.on("console", (m) => {
-    if (m.type() === "error") errors.push(m.text());
-  });
-  await page.goto(url);
-  return { context, page, errors };
-}
+const visit = (url) => openPage(browser, url, { width: 1280, height: 800 });
 
 /** Waits until a service worker controls the page; returns its cache names. */
 async function controlled(page) {
@@ -62,11 +52,6 @@ async function sliced(page) {
   const banner = await page.locator("#banner").innerText().catch(() => "");
   assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
   return s;
-}
-
-async function downloadText(page) {
-  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
-  return readFileSync(await download.path(), "utf8");
 }
 
 test("the manifest is linked, parses and names icons that load", async () => {
@@ -132,6 +117,12 @@ test("after the first visit the page loads and slices offline, with the same G-c
   const gcodeOffline = await downloadText(page);
   assert.ok(gcodeOffline.split("\n").filter((l) => /^G2[56]\b/.test(l)).length > 1000, "droplet commands");
   assert.equal(gcodeOffline, gcodeOnline);
+  // the 3D view's code (a chunk the page loads only now, when the tab is first opened) comes
+  // from the cache too, and draws the part
+  const view = await open3d(page);
+  assert.deepEqual(view.parts, ["0:0"]);
+  const px = await pixels3d(page);
+  assert.ok(px.part.n > 1000, `part pixels in 3D: ${px.part.n}`);
   assert.deepEqual(errors, []);
   await context.close();
 });

@@ -6,7 +6,7 @@ import { execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, canvasPixels, openPage, parseGcode, repo, start, status, torusStl, waitSettled, countPixels } from "./helpers.mjs";
+import { benchy, canvasPixels, countPixels, openPage, parseGcode, pick, repo, shareLink, start, status, torusStl, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main; // the page most tests share
@@ -26,29 +26,6 @@ after(async () => {
 /** Coloured (non-background, non-grid) pixels of the canvas. */
 function inkPixels(page) {
   return countPixels(page, "Math.max(r, g, b) - Math.min(r, g, b) > 60");
-}
-
-/** Opens a file through the file picker (same code path as drag and drop). */
-async function pick(page, file) {
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", file);
-}
-
-/** Clicks "Copy preview link" and reads the link from the dialog. */
-async function shareLink(page) {
-  await page.click("#btn-share");
-  await page.waitForSelector("#share-dialog[open]");
-  const url = await page.inputValue("#share-url");
-  await page.click("#share-dialog button");
-  await page.waitForSelector("#share-dialog:not([open])", { state: "attached" });
-  return url;
-}
-
-async function waitDone(page, timeout) {
-  const s = await waitSettled(page, timeout);
-  const banner = await page.locator("#banner").innerText().catch(() => "");
-  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
-  return s;
 }
 
 test("the sample part is sliced and drawn on first visit", async () => {

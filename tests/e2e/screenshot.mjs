@@ -10,7 +10,7 @@
 // two copies of M3x10_screw.stl), arranged on a 250 × 200 mm plate, in 3D with 3DBenchy selected:
 //   JOB=1 SCREENSHOT=docs/images/job3d.png node tests/e2e/screenshot.mjs
 import { join } from "node:path";
-import { benchy, openPage, repo, shared, start, waitSettled } from "./helpers.mjs";
+import { benchy, open3d, openPage, repo, shared, start, waitSettled } from "./helpers.mjs";
 
 if (process.env.JOB) {
   const env = await start();
@@ -67,7 +67,7 @@ try {
     await page.evaluate((v) => window.dropslice.setView(v), { scale, cx, cy });
     await page.check("#opt-travel");
   }
-  if (process.env.VIEW3D) await page.click("#mode-3d");
+  if (process.env.VIEW3D) await open3d(page);
   await page.waitForTimeout(300);
   const out = process.env.SCREENSHOT ?? join(repo, "docs/screenshot-benchy.png");
   await page.screenshot({ path: out });

@@ -4,10 +4,10 @@
 // download), the 3D view's overhang tint, and a two-material job. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { copyFileSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
+import { copyFileSync, mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, countPixels, openPage, start, status, waitSettled } from "./helpers.mjs";
+import { benchy, countPixels, downloadText, open3d, openPage, pick, pixels3d, start, status, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -30,25 +30,6 @@ const SUPPORT = "r === 0x10 && g === 0x98 && b === 0xad";
 const UNIT1 = "Math.abs(r - 0x70) < 12 && Math.abs(g - 0x48) < 12 && Math.abs(b - 0xe8) < 12";
 const OVERHANG = "r === 0xe8 && g === 0x10 && b === 0x7a";
 const ROLE0 = "r === 0xd9 && g === 0x48 && b === 0x0f";
-
-async function waitDone(page, timeout = 240_000) {
-  const s = await waitSettled(page, timeout);
-  const banner = await page.locator("#banner").innerText().catch(() => "");
-  assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
-  return s;
-}
-
-async function pick(page, files) {
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", files);
-}
-
-async function downloadText(page, name) {
-  const [download] = await Promise.all([page.waitForEvent("download"), page.click("#btn-download")]);
-  const file = join(tmp, name);
-  await download.saveAs(file);
-  return readFileSync(file, "utf8");
-}
 
 /**
  * This test's own reading of a .gco: per layer (a Z change) the droplet centres with their unit
@@ -151,7 +132,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   assert.match(await page.locator("#stat-overhang-part").innerText(), /^[\d.]+ mm²$/);
 
   // the overlay marks exactly the droplets this test's reading of the download finds unsupported
-  const off = readBack(await downloadText(page, "benchy-off.gco"));
+  const off = readBack(await downloadText(page));
   assert.equal(off.tLines, 0, "no T lines without support");
   assert.equal(off.layers.length, s.layers);
   const roof = s.layer;
@@ -195,7 +176,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   assert.ok(supportPixels > 300, `support pixels ${supportPixels}`);
 
   // the download: T lines, as many unit-1 droplets as the statistics, and the roof carried
-  const on = readBack(await downloadText(page, "benchy-on.gco"));
+  const on = readBack(await downloadText(page));
   assert.ok(on.tLines > 0, "T lines");
   assert.equal(on.unit1, s.counts.support);
   await page.evaluate((i) => window.dropslice.show(i), roof);
@@ -204,7 +185,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   assert.ok(after * 50 < marked, `with support the roof layer has ${after} unsupported droplets (without: ${marked})`);
 
   // the 3D view tints the overhanging faces with the core's threshold for the settings
-  await page.click("#mode-3d");
+  await open3d(page);
   await page.waitForFunction(() => window.dropslice.view3d()?.overhang != null, null, { timeout: 30_000 });
   // the whole part (the hull's flared underside faces down beyond the rule), framed
   await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
@@ -212,16 +193,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   const state = await page.evaluate(() => window.dropslice.view3d());
   const t = 0.5 * 1.04; // overhang_limit · B / H with the defaults
   assert.ok(Math.abs(state.overhang - t / Math.hypot(1, t)) < 1e-9, `threshold ${state.overhang}`);
-  const tinted = await page.evaluate(() => {
-    window.dropslice.view3d();
-    const c = document.querySelector("#view3d canvas");
-    const g = Object.assign(document.createElement("canvas"), { width: c.width, height: c.height }).getContext("2d");
-    g.drawImage(c, 0, 0);
-    const d = g.getImageData(0, 0, c.width, c.height).data;
-    let n = 0;
-    for (let i = 0; i < d.length; i += 4) if (d[i] > d[i + 2] + 15 && d[i + 2] > d[i + 1] + 30) n++; // the tint: magenta-red, dim (faces down)
-    return n;
-  });
+  const tinted = (await pixels3d(page)).tint; // magenta-red, dim (faces down)
   console.log(`# 3D view: ${tinted} pixels of overhanging faces`);
   assert.ok(tinted > 100, `tinted pixels ${tinted}`);
   await page.click("#mode-layer");
@@ -253,7 +225,7 @@ test("a two-material job: two colours on the canvas, T lines in the download", a
   assert.ok((await countPixels(page, UNIT1)) > 300, "the unit-1 part in its colour");
   assert.ok((await countPixels(page, ROLE0)) > 300, "the unit-0 part in the role colours");
   assert.equal(await page.isVisible("#legend-unit1"), true);
-  const g = readBack(await downloadText(page, "two.gco"));
+  const g = readBack(await downloadText(page));
   assert.ok(g.tLines > 0, "T lines");
   assert.equal(g.unit1, s.unit1);
   // each unit's droplets lie in its part's box on the plate (the core's layout)

@@ -1,9 +1,9 @@
 // The 3D tab (www/view3d.ts, www/views/view3d.ts) in headless Chromium: WebGL2 renders in
-// software here. The canvas' pixels are read back (the view keeps its drawing buffer) and
-// classified by colour: the part's steel blue, the selected part's accent blue, the cut's orange.
+// software here. The canvas' pixels are read back and classified by colour (helpers.mjs
+// pixels3d): the part's steel blue, the selected part's accent blue, the cut's orange.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { benchy, openPage, start, waitSettled } from "./helpers.mjs";
+import { benchy, clientPoint3d, open3d, openPage, pick, pixels3d, start, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
@@ -22,81 +22,18 @@ after(async () => {
   await env?.close();
 });
 
-/** Draws the 3D view now and classifies its pixels (device pixels of the WebGL canvas):
- *  counts and centroids of part (steel blue), selected (accent blue) and cut (orange) pixels,
- *  and whether a given pixel is background. */
-function pixels3d(page) {
-  return page.evaluate(() => {
-    const state = window.dropslice.view3d();
-    const c = document.querySelector("#view3d canvas");
-    const t = document.createElement("canvas");
-    t.width = c.width;
-    t.height = c.height;
-    const g = t.getContext("2d");
-    g.drawImage(c, 0, 0);
-    const d = g.getImageData(0, 0, t.width, t.height).data;
-    const cls = { part: [0, 0, 0], selected: [0, 0, 0], cut: [0, 0, 0], background: [0, 0, 0] };
-    let top = t.height; // the highest row with part or cut pixels
-    for (let i = 0, p = 0; i < d.length; i += 4, p++) {
-      const r = d[i], gr = d[i + 1], b = d[i + 2];
-      const x = p % t.width, y = (p / t.width) | 0;
-      let k = null;
-      if (b - r > 120 && r < 90) k = "selected";
-      else if (b - r > 40 && b > gr) k = "part";
-      else if (r - b > 80 && r > 180) k = "cut";
-      else if (Math.abs(r - 0xee) < 4 && Math.abs(gr - 0xf1) < 4 && Math.abs(b - 0xf5) < 4) k = "background";
-      if (k === null) continue;
-      cls[k][0]++;
-      cls[k][1] += x;
-      cls[k][2] += y;
-      if (k !== "background" && y < top) top = y;
-    }
-    const out = { state, width: t.width, height: t.height, top };
-    for (const [k, [n, sx, sy]] of Object.entries(cls)) out[k] = { n, x: n ? sx / n : NaN, y: n ? sy / n : NaN };
-    // the part pixel nearest the part's centroid, with part pixels all around it (to click)
-    const isPart = (x, y) => {
-      const i = 4 * (y * t.width + x);
-      return d[i + 2] - d[i] > 40 && d[i + 2] > d[i + 1];
-    };
-    let best = null;
-    for (let y = 3; y < t.height - 3; y++) {
-      for (let x = 3; x < t.width - 3; x++) {
-        if (!(isPart(x, y) && isPart(x - 3, y) && isPart(x + 3, y) && isPart(x, y - 3) && isPart(x, y + 3))) continue;
-        const dist = Math.hypot(x - out.part.x, y - out.part.y);
-        if (!best || dist < best.dist) best = { x, y, dist };
-      }
-    }
-    out.partPixel = best;
-    return out;
-  });
-}
-
-async function waitDone(page, timeout) {
-  const s = await waitSettled(page, timeout);
-  assert.equal(s.state, "done", `page state ${s.state}`);
-  return s;
-}
-
-/** Client coordinates of a device pixel of the 3D canvas. */
-async function clientPoint(page, px, py) {
-  const r = await page.locator("#view3d canvas").boundingBox();
-  const dims = await page.evaluate(() => {
-    const c = document.querySelector("#view3d canvas");
-    return { w: c.width, h: c.height };
-  });
-  return { x: r.x + (px * r.width) / dims.w, y: r.y + (py * r.height) / dims.h };
-}
-
 test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbited by a drag", async () => {
   const { page, errors } = main;
   await waitDone(page, 60_000);
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", benchy);
+  await pick(page, benchy);
   const s = await waitDone(page, 240_000);
   assert.equal(s.layers, 240);
 
   assert.equal(await page.evaluate(() => window.dropslice.view3d()), null, "no WebGL context before the tab is opened");
-  await page.click("#mode-3d");
+  const chunk = (u) => /\/view3d-[0-9A-Z]+\.js$/.test(u);
+  assert.equal((await page.evaluate(() => performance.getEntriesByType("resource").map((e) => e.name))).filter(chunk).length, 0, "the 3D view's code is not loaded before the tab is opened");
+  await open3d(page);
+  assert.equal((await page.evaluate(() => performance.getEntriesByType("resource").map((e) => e.name))).filter(chunk).length, 1, "the 3D view's code is loaded once the tab is opened");
   assert.equal(await page.isVisible("#view3d canvas"), true);
   assert.equal(await page.isVisible("#legend3d"), true);
   assert.equal(await page.isVisible("#legend"), false);
@@ -115,14 +52,14 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   assert.ok(whole.background.n > 10_000, "the background shows around the plate");
 
   // a click on the part selects it (tinted in the accent colour); a click on empty space clears
-  assert.ok(whole.partPixel, "a part pixel to click");
-  const onPart = await clientPoint(page, whole.partPixel.x + 0.5, whole.partPixel.y + 0.5);
+  assert.ok(whole.part.inner, "a part pixel to click");
+  const onPart = await clientPoint3d(page, whole.part.inner.x + 0.5, whole.part.inner.y + 0.5);
   await page.mouse.click(onPart.x, onPart.y);
   assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, "0:0", "a click on the part selects it");
   const tinted = await pixels3d(page);
   assert.ok(tinted.selected.n > whole.part.n * 0.5, `selected pixels ${tinted.selected.n}`);
   assert.ok(tinted.part.n < whole.part.n * 0.2, `unselected part pixels ${tinted.part.n}`);
-  const empty = await clientPoint(page, 20, tinted.height - 20);
+  const empty = await clientPoint3d(page, 20, tinted.height - 20);
   await page.mouse.click(empty.x, empty.y);
   assert.equal((await page.evaluate(() => window.dropslice.view3d())).selected, null, "a click on empty space clears");
   assert.ok((await pixels3d(page)).part.n > whole.part.n * 0.9, "the part's own colour again");
@@ -133,7 +70,7 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   // load the canvas may have been resized since.
   await page.click("#btn-fit");
   const framed = await pixels3d(page);
-  const from = await clientPoint(page, whole.width * 0.85, whole.height * 0.15);
+  const from = await clientPoint3d(page, whole.width * 0.85, whole.height * 0.15);
   await page.mouse.move(from.x, from.y);
   await page.mouse.down();
   await page.mouse.move(from.x - 150, from.y + 40, { steps: 6 });
@@ -165,10 +102,9 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
 
 test("a .gco file has no mesh: the 3D tab says so", async () => {
   const { page } = main;
-  await page.click("#mode-3d");
+  await open3d(page);
   const gco = "; dropslice test\n; layer_height = 0.2 (mm)\n; droplet_aspect = 1.04\nG01 X0 Y0 Z0.2\nG25 X10 Y0\nG26 X10 Y1\n";
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", { name: "tiny.gco", mimeType: "text/plain", buffer: Buffer.from(gco) });
+  await pick(page, { name: "tiny.gco", mimeType: "text/plain", buffer: Buffer.from(gco) });
   await waitDone(page, 60_000);
   const st = await page.evaluate(() => window.dropslice.view3d());
   assert.deepEqual(st.parts, []);

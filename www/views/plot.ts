@@ -7,6 +7,7 @@
 // draw costs O(layers + width) whatever the count; while the workers run it is redrawn at most
 // every [[BUSY_REDRAW_MS]].
 
+import { sizeCanvas, watchCanvas } from "../hidpi";
 import type { Page } from "../page";
 import type { Slice } from "../store";
 import { $, duration, nf } from "./dom";
@@ -103,16 +104,9 @@ export function drawPlot(): void {
   if (!page || !canvas) return;
   lastDraw = performance.now();
   writeLabel();
-  const dpr = window.devicePixelRatio || 1;
-  const r = canvas.getBoundingClientRect();
-  const cssW = Math.max(1, r.width);
-  const cssH = Math.max(1, r.height);
-  const W = Math.round(cssW * dpr);
-  const H = Math.round(cssH * dpr);
-  if (canvas.width !== W || canvas.height !== H) {
-    canvas.width = W;
-    canvas.height = H;
-  }
+  const { cssW, cssH, dpr } = sizeCanvas(canvas);
+  const W = canvas.width;
+  const H = canvas.height;
   const g = canvas.getContext("2d");
   if (!g) return;
   g.setTransform(1, 0, 0, 1, 0, 0);
@@ -270,7 +264,7 @@ export function wirePlot(p: Page, goTo: (layer: number) => void): void {
   page = p;
   const c = $<HTMLCanvasElement>("plot");
   canvas = c;
-  new ResizeObserver(() => requestPlot()).observe(c);
+  watchCanvas(c, () => requestPlot());
   const at = (ev: PointerEvent) => {
     const s = p.store.slice;
     if (!s || s.layers === 0) return null;

@@ -3,12 +3,16 @@
 // `${part id}:${copy}`); after a slice of the job as it is, cut at the layer the slider shows.
 // A click selects the part in the parts panel; dragging an instance moves its part (re-laid
 // out by the core on release). The toggle "Layer | 3D" switches the stage between the layer
-// canvas and this view; the View3D (a WebGL context) is made the first time the tab is opened.
+// canvas and this view; the View3D (a WebGL context) is made the first time the tab is opened,
+// and its code (../view3d.ts with three.js, most of the page's script) is loaded then: a chunk
+// of its own (dynamic import; scripts/build.sh splits the bundle), precached by the service
+// worker like the rest of the page.
 
 import { jobSettings } from "../job";
 import { movePart, selectPart } from "../jobflows";
 import type { Page } from "../page";
-import { View3D, type View3DPart, type View3DSlice } from "../view3d";
+import type { View3D, View3DPart, View3DSlice } from "../view3d";
+import { errorBanner } from "./banner";
 import { $ } from "./dom";
 
 /** The 3D view's id of an instance, and back. */
@@ -20,6 +24,8 @@ export function parseInstanceId(id: string): { part: number; copy: number } | nu
 
 export class View3DPanel {
   private view: View3D | null = null;
+  /** Whether the view's code was asked for (it loads once; the view is made when it is in). */
+  private loading = false;
   private parts: View3DPart[] = [];
   private plate = { x: 154, y: 134 };
   private slice: View3DSlice | null = null;
@@ -124,35 +130,49 @@ export class View3DPanel {
     $("mode-layer").setAttribute("aria-pressed", String(!on));
     $("mode-3d").setAttribute("aria-pressed", String(on));
     this.container.hidden = !on;
-    if (on && !this.view) {
-      const view = new View3D(this.container);
-      this.view = view;
-      view.onSelect((id) => {
-        const page = this.page;
-        if (!page) return;
-        this.selected = id;
-        const at = id === null ? null : parseInstanceId(id);
-        selectPart(page, at ? at.part : null);
-      });
-      view.onDrag((id, dx, dy, done) => {
-        const page = this.page;
-        const at = parseInstanceId(id);
-        if (!done || !page || !at) return;
-        this.selected = id;
-        selectPart(page, at.part);
-        if (Math.hypot(dx, dy) < 1e-6) return;
-        // refused (off the plate is allowed; a value out of range is not): back where it was
-        void movePart(page, at.part, at.copy, dx, dy).then((ok) => ok || this.sync(page));
-      });
-      this.apply();
+    if (on && !this.loading) {
+      this.loading = true;
+      import("../view3d").then(
+        ({ View3D }) => this.create(View3D),
+        (e: unknown) => {
+          this.loading = false; // asked again the next time the tab is opened
+          errorBanner(new Error(`The 3D view could not be loaded (${e instanceof Error ? e.message : String(e)}). Reload the page to try again.`));
+        },
+      );
     }
+  }
+
+  /** The view, made once its code is in (the tab may have been left meanwhile: it is made
+   *  all the same, hidden with its container). */
+  private create(Ctor: typeof View3D): void {
+    const view = new Ctor(this.container);
+    this.view = view;
+    view.onSelect((id) => {
+      const page = this.page;
+      if (!page) return;
+      this.selected = id;
+      const at = id === null ? null : parseInstanceId(id);
+      selectPart(page, at ? at.part : null);
+    });
+    view.onDrag((id, dx, dy, done) => {
+      const page = this.page;
+      const at = parseInstanceId(id);
+      if (!done || !page || !at) return;
+      this.selected = id;
+      selectPart(page, at.part);
+      if (Math.hypot(dx, dy) < 1e-6) return;
+      // refused (off the plate is allowed; a value out of range is not): back where it was
+      void movePart(page, at.part, at.copy, dx, dy).then((ok) => ok || this.sync(page));
+    });
+    this.apply();
   }
 
   fit(): void {
     this.view?.fit();
   }
 
-  /** For the tests: the view's state and a synchronous draw (null before the tab was opened). */
+  /** For the tests: the view's state and a synchronous draw (null before the tab was opened
+   *  and while the view's code is loading). */
   testState(): ReturnType<View3D["state"]> | null {
     this.view?.renderNow();
     return this.view?.state() ?? null;
