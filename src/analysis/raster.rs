@@ -642,177 +642,23 @@ impl Raster {
                 }
             }
         }
-        // Voids: runs of region & !droplets, joined across rows.
-        let mut runs: Vec<(u32, u32, u32)> = Vec::new(); // (row, start, end)
-        let mut touches: Vec<bool> = Vec::new();
-        let mut uf = UnionFind::new(0);
-        let mut buf = Vec::new();
-        // The runs of the row before, and the row after the last one looked at.
-        let mut prev = 0..0;
-        let mut next_k = 0;
-        // Region cells with a neighbour (left, right, above, below) outside the region.
-        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
-        let mut edge = vec![0u64; widest];
-        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                if k != next_k {
-                    prev = runs.len()..runs.len();
-                }
-                next_k = k + 1;
-                let row = tiles.row_in(bi, k);
-                buf.clear();
-                self.runs(&row, |r, d| r & !d, &mut buf);
-                if buf.is_empty() {
-                    prev = runs.len()..runs.len();
-                    continue;
-                }
-                let (lo, hi) = self.extent[row.slot];
-                let bits = &self.region_bits[row.range()];
-                let up = (k + 1 < g.ny)
-                    .then(|| self.region_row_as(&row, k + 1, &mut up_buf))
-                    .flatten();
-                let down = (k > 0)
-                    .then(|| self.region_row_as(&row, k - 1, &mut down_buf))
-                    .flatten();
-                for seg in row.segs {
-                    let end = seg.end();
-                    for w in seg.at.max(lo as usize)..end.min(hi as usize) {
-                        let r = bits[w];
-                        let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
-                        let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
-                        let u = up.map_or(0, |x| x[w]);
-                        let d = down.map_or(0, |x| x[w]);
-                        edge[w] = r & !(left & right & u & d);
-                    }
-                }
-                let first = runs.len();
-                let mut seg = 0;
-                for &(s, e) in &buf {
-                    while row.segs[seg].c1 * 64 <= s as usize {
-                        seg += 1;
-                    }
-                    let shift = 64 * row.segs[seg].shift();
-                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
-                    let boundary = if !reference && c1 - c0 < 64 {
-                        window(&edge, c0, c1) != 0
-                    } else {
-                        count_range(&edge, c0, c1) > 0
-                    };
-                    runs.push((k as u32, s, e));
-                    touches.push(boundary);
-                    uf.parent.push(uf.parent.len() as u32);
-                }
-                let cur = first..runs.len();
-                let (mut i, mut j) = (prev.start, cur.start);
-                while i < prev.end && j < cur.end {
-                    let (_, s1, e1) = runs[i];
-                    let (_, s2, e2) = runs[j];
-                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                        if !reference && uf.parent[j] as usize == j {
-                            // The first run above j it joins: j is still alone (a later run
-                            // is never the root of an earlier one).
-                            uf.parent[j] = uf.find(i) as u32;
-                        } else {
-                            uf.union(i, j);
-                        }
-                    }
-                    if e1 < e2 { i += 1 } else { j += 1 }
-                }
-                prev = cur;
-            }
-        }
-        // Components, numbered in order of their first run (a root precedes its members).
-        #[derive(Clone, Copy)]
-        struct Acc {
-            cells: u64,
-            /// Sums of column·cells (twice, to stay whole) and row·cells.
-            sx2: u64,
-            sy: u64,
-            min: [u32; 2],
-            max: [u32; 2],
-            boundary: bool,
-        }
-        let mut comp = vec![0u32; runs.len()];
-        let mut accs: Vec<Acc> = Vec::new();
-        for (i, &(k, s, e)) in runs.iter().enumerate() {
-            let root = uf.find(i);
-            let id = if root == i {
-                accs.push(Acc {
-                    cells: 0,
-                    sx2: 0,
-                    sy: 0,
-                    min: [u32::MAX; 2],
-                    max: [0; 2],
-                    boundary: false,
-                });
-                accs.len() - 1
-            } else {
-                comp[root] as usize
-            };
-            comp[i] = id as u32;
-            let a = &mut accs[id];
-            let n = (e - s) as u64;
-            a.cells += n;
-            a.sx2 += n * (s + e - 1) as u64;
-            a.sy += n * k as u64;
-            a.min = [a.min[0].min(s), a.min[1].min(k)];
-            a.max = [a.max[0].max(e), a.max[1].max(k + 1)];
-            a.boundary |= touches[i];
-        }
-        let mut enclosed = 0u64;
-        let mut largest: Option<Void> = None;
-        for a in &accs {
-            if !a.boundary {
-                enclosed += a.cells;
-            }
-            let area = a.cells as f64 * cell;
-            if largest.is_none_or(|l| area > l.area) {
-                let n = a.cells as f64;
-                largest = Some(Void {
-                    area,
-                    centroid: DVec2::new(
-                        g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
-                        g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
-                    ),
-                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
-                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
-                    at_boundary: a.boundary,
-                });
-            }
-        }
-        // Inward deviation: runs of voids that reach the boundary; outward: overfill runs.
         let index = EdgeIndex::new(&self.edges, self.b);
-        let mut dev_in = Deviation::default();
-        let mut dev_out = Deviation::default();
-        let probe = |best: &mut Deviation, k: usize, s: u32, e: u32| {
-            let y = g.ry(k);
-            for c in [s, (s + e - 1) / 2, e - 1] {
-                let p = DVec2::new(g.cx(c as usize), y);
-                // The distance to the boundary changes no faster than the point moves: a point
-                // this close to the last one probed cannot beat the maximum.
-                if best.last_d + dist(p, best.last) <= best.max {
-                    continue;
-                }
-                let d = index.distance(p, best.max);
-                (best.last, best.last_d) = (p, d);
-                if d > best.max {
-                    (best.max, best.at) = (d, Some(p));
-                }
-            }
+        let v = if reference {
+            self.voids_reference(&index)
+        } else {
+            self.voids_fast(&index)
         };
-        for (i, &(k, s, e)) in runs.iter().enumerate() {
-            if accs[comp[i] as usize].boundary {
-                probe(&mut dev_in, k as usize, s, e);
-            }
-        }
+        let dev_in = v.dev_in;
+        // Outward deviation: overfill runs.
+        let mut dev_out = Deviation::default();
+        let mut buf = Vec::new();
         for &k in &over_rows {
             buf.clear();
             if let Some(row) = tiles.row(k) {
                 self.runs(&row, |r, d| d & !r, &mut buf);
             }
             for &(s, e) in &buf {
-                probe(&mut dev_out, k, s, e);
+                probe(&g, &index, &mut dev_out, k, s, e);
             }
         }
         let coverage = if n_region > 0 {
@@ -833,9 +679,9 @@ impl Raster {
             covered_area: n_covered as f64 * cell,
             coverage,
             void_area: (n_region - n_covered) as f64 * cell,
-            enclosed_void_area: enclosed as f64 * cell,
-            voids: accs.len(),
-            largest_void: largest,
+            enclosed_void_area: v.enclosed as f64 * cell,
+            voids: v.count,
+            largest_void: v.largest,
             overfill_area: n_over as f64 * cell,
             deviation_inward: dev_in.max,
             deviation_outward: dev_out.max,
@@ -843,6 +689,215 @@ impl Raster {
             deviation_at,
             unsupported_area: 0.0,
         }
+    }
+
+    /// Sets `edge` to the cells of row `k` (laid out as `row`) in the region with a
+    /// neighbour (left, right, above, below) outside it, over the row's extent.
+    fn edge_row(
+        &self,
+        row: &Row,
+        k: usize,
+        edge: &mut [u64],
+        up_buf: &mut Vec<u64>,
+        down_buf: &mut Vec<u64>,
+    ) {
+        let (lo, hi) = self.extent[row.slot];
+        let bits = &self.region_bits[row.range()];
+        let up = (k + 1 < self.grid.ny)
+            .then(|| self.region_row_as(row, k + 1, up_buf))
+            .flatten();
+        let down = (k > 0)
+            .then(|| self.region_row_as(row, k - 1, down_buf))
+            .flatten();
+        for seg in row.segs {
+            let end = seg.end();
+            for w in seg.at.max(lo as usize)..end.min(hi as usize) {
+                let r = bits[w];
+                let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
+                let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
+                let u = up.map_or(0, |x| x[w]);
+                let d = down.map_or(0, |x| x[w]);
+                edge[w] = r & !(left & right & u & d);
+            }
+        }
+    }
+
+    /// The voids by one union-find node per void run, components summed after the
+    /// labelling (the labelling as it was before the fast path, for tests comparing both).
+    fn voids_reference(&self, index: &EdgeIndex) -> Voids {
+        let g = self.grid;
+        let tiles = &self.tiles;
+        // Voids: runs of region & !droplets, joined across rows.
+        let mut runs: Vec<(u32, u32, u32)> = Vec::new(); // (row, start, end)
+        let mut touches: Vec<bool> = Vec::new();
+        let mut uf = UnionFind::new(0);
+        let mut buf = Vec::new();
+        // The runs of the row before, and the row after the last one looked at.
+        let mut prev = 0..0;
+        let mut next_k = 0;
+        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
+        let mut edge = vec![0u64; widest];
+        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                if k != next_k {
+                    prev = runs.len()..runs.len();
+                }
+                next_k = k + 1;
+                let row = tiles.row_in(bi, k);
+                buf.clear();
+                self.runs(&row, |r, d| r & !d, &mut buf);
+                if buf.is_empty() {
+                    prev = runs.len()..runs.len();
+                    continue;
+                }
+                self.edge_row(&row, k, &mut edge, &mut up_buf, &mut down_buf);
+                let first = runs.len();
+                let mut seg = 0;
+                for &(s, e) in &buf {
+                    while row.segs[seg].c1 * 64 <= s as usize {
+                        seg += 1;
+                    }
+                    let shift = 64 * row.segs[seg].shift();
+                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                    runs.push((k as u32, s, e));
+                    touches.push(count_range(&edge, c0, c1) > 0);
+                    uf.parent.push(uf.parent.len() as u32);
+                }
+                let cur = first..runs.len();
+                let (mut i, mut j) = (prev.start, cur.start);
+                while i < prev.end && j < cur.end {
+                    let (_, s1, e1) = runs[i];
+                    let (_, s2, e2) = runs[j];
+                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                        uf.union(i, j);
+                    }
+                    if e1 < e2 { i += 1 } else { j += 1 }
+                }
+                prev = cur;
+            }
+        }
+        // Components, numbered in order of their first run (a root precedes its members).
+        let mut comp = vec![0u32; runs.len()];
+        let mut accs: Vec<Acc> = Vec::new();
+        for (i, &(k, s, e)) in runs.iter().enumerate() {
+            let root = uf.find(i);
+            let id = if root == i {
+                accs.push(Acc::default());
+                accs.len() - 1
+            } else {
+                comp[root] as usize
+            };
+            comp[i] = id as u32;
+            accs[id].add(k, s, e, touches[i]);
+        }
+        // Inward deviation: runs of voids that reach the boundary.
+        let mut dev_in = Deviation::default();
+        for (i, &(k, s, e)) in runs.iter().enumerate() {
+            if accs[comp[i] as usize].boundary {
+                probe(&g, index, &mut dev_in, k as usize, s, e);
+            }
+        }
+        Voids::of(&g, accs.iter(), dev_in)
+    }
+
+    /// [`voids_reference`](Self::voids_reference) in one pass over the rows: a run takes the
+    /// label of the first run above it joins (a new label when none), labels are joined by
+    /// union-find, and each label's sums are kept at its root as runs come in, so there are
+    /// as many union-find nodes as runs that start a void, not as runs. Figures identical.
+    fn voids_fast(&self, index: &EdgeIndex) -> Voids {
+        const NONE: u32 = u32::MAX;
+        let g = self.grid;
+        let tiles = &self.tiles;
+        // (row, start, end, label)
+        let mut runs: Vec<(u32, u32, u32, u32)> = Vec::new();
+        let mut bnd: Vec<bool> = Vec::new();
+        let mut labels = UnionFind::new(0);
+        let mut accs: Vec<Acc> = Vec::new();
+        let mut buf = Vec::new();
+        let mut prev = 0..0;
+        let mut next_k = 0;
+        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
+        let mut edge = vec![0u64; widest];
+        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                if k != next_k {
+                    prev = runs.len()..runs.len();
+                }
+                next_k = k + 1;
+                let row = tiles.row_in(bi, k);
+                buf.clear();
+                self.runs(&row, |r, d| r & !d, &mut buf);
+                if buf.is_empty() {
+                    prev = runs.len()..runs.len();
+                    continue;
+                }
+                self.edge_row(&row, k, &mut edge, &mut up_buf, &mut down_buf);
+                let first = runs.len();
+                bnd.clear();
+                let mut seg = 0;
+                for &(s, e) in &buf {
+                    while row.segs[seg].c1 * 64 <= s as usize {
+                        seg += 1;
+                    }
+                    let shift = 64 * row.segs[seg].shift();
+                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                    bnd.push(if c1 - c0 < 64 {
+                        window(&edge, c0, c1) != 0
+                    } else {
+                        count_range(&edge, c0, c1) > 0
+                    });
+                    runs.push((k as u32, s, e, NONE));
+                }
+                let (mut i, mut j) = (prev.start, first);
+                while i < prev.end && j < runs.len() {
+                    let (_, s1, e1, l1) = runs[i];
+                    let (_, s2, e2, l2) = runs[j];
+                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                        if l2 == NONE {
+                            runs[j].3 = l1;
+                        } else {
+                            let (a, b) = (labels.find(l1 as usize), labels.find(l2 as usize));
+                            if a != b {
+                                // The earlier label stays the root: roots in order of their
+                                // component's first run, as the reference numbers them.
+                                let (lo, hi) = (a.min(b), a.max(b));
+                                labels.parent[hi] = lo as u32;
+                                let h = accs[hi];
+                                accs[lo].merge(&h);
+                            }
+                        }
+                    }
+                    if e1 < e2 { i += 1 } else { j += 1 }
+                }
+                for (run, &b) in runs[first..].iter_mut().zip(&bnd) {
+                    let l = if run.3 == NONE {
+                        labels.parent.push(accs.len() as u32);
+                        accs.push(Acc::default());
+                        accs.len() - 1
+                    } else {
+                        labels.find(run.3 as usize)
+                    };
+                    run.3 = l as u32;
+                    accs[l].add(run.0, run.1, run.2, b);
+                }
+                prev = first..runs.len();
+            }
+        }
+        // Each label's component: whether it reaches the boundary.
+        let mut at_boundary = vec![false; accs.len()];
+        for l in 0..accs.len() {
+            at_boundary[l] = accs[labels.find(l)].boundary;
+        }
+        let mut dev_in = Deviation::default();
+        for &(k, s, e, l) in &runs {
+            if at_boundary[l as usize] {
+                probe(&g, index, &mut dev_in, k as usize, s, e);
+            }
+        }
+        let roots = (0..accs.len()).filter(|&l| labels.parent[l] as usize == l);
+        Voids::of(&g, roots.map(|l| &accs[l]), dev_in)
     }
 
     /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
@@ -989,6 +1044,116 @@ impl Raster {
             origin: DVec2::new(g.x0, g.y0),
             cell: rows as f64 * g.gy,
             tiles: out,
+        }
+    }
+}
+
+/// A void's sums while labelling.
+#[derive(Clone, Copy)]
+struct Acc {
+    cells: u64,
+    /// Sums of column·cells (twice, to stay whole) and row·cells.
+    sx2: u64,
+    sy: u64,
+    min: [u32; 2],
+    max: [u32; 2],
+    boundary: bool,
+}
+
+impl Default for Acc {
+    fn default() -> Acc {
+        Acc {
+            cells: 0,
+            sx2: 0,
+            sy: 0,
+            min: [u32::MAX; 2],
+            max: [0; 2],
+            boundary: false,
+        }
+    }
+}
+
+impl Acc {
+    /// Adds the run [s, e) of row k.
+    #[inline]
+    fn add(&mut self, k: u32, s: u32, e: u32, boundary: bool) {
+        let n = (e - s) as u64;
+        self.cells += n;
+        self.sx2 += n * (s + e - 1) as u64;
+        self.sy += n * k as u64;
+        self.min = [self.min[0].min(s), self.min[1].min(k)];
+        self.max = [self.max[0].max(e), self.max[1].max(k + 1)];
+        self.boundary |= boundary;
+    }
+
+    fn merge(&mut self, o: &Acc) {
+        self.cells += o.cells;
+        self.sx2 += o.sx2;
+        self.sy += o.sy;
+        self.min = [self.min[0].min(o.min[0]), self.min[1].min(o.min[1])];
+        self.max = [self.max[0].max(o.max[0]), self.max[1].max(o.max[1])];
+        self.boundary |= o.boundary;
+    }
+}
+
+/// A layer's voids: how many, the cells of those that do not reach the boundary, the largest
+/// (the first of equal ones in the order of their first runs) and the inward deviation.
+struct Voids {
+    count: usize,
+    enclosed: u64,
+    largest: Option<Void>,
+    dev_in: Deviation,
+}
+
+impl Voids {
+    fn of<'a>(g: &Grid, accs: impl Iterator<Item = &'a Acc>, dev_in: Deviation) -> Voids {
+        let cell = g.gx * g.gy;
+        let (mut count, mut enclosed) = (0, 0u64);
+        let mut largest: Option<Void> = None;
+        for a in accs {
+            count += 1;
+            if !a.boundary {
+                enclosed += a.cells;
+            }
+            let area = a.cells as f64 * cell;
+            if largest.is_none_or(|l| area > l.area) {
+                let n = a.cells as f64;
+                largest = Some(Void {
+                    area,
+                    centroid: DVec2::new(
+                        g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
+                        g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
+                    ),
+                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
+                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
+                    at_boundary: a.boundary,
+                });
+            }
+        }
+        Voids {
+            count,
+            enclosed,
+            largest,
+            dev_in,
+        }
+    }
+}
+
+/// Probes the run [s, e) of row k (its ends and middle) for a larger distance to the
+/// boundary than `best`'s.
+fn probe(g: &Grid, index: &EdgeIndex, best: &mut Deviation, k: usize, s: u32, e: u32) {
+    let y = g.ry(k);
+    for c in [s, (s + e - 1) / 2, e - 1] {
+        let p = DVec2::new(g.cx(c as usize), y);
+        // The distance to the boundary changes no faster than the point moves: a point
+        // this close to the last one probed cannot beat the maximum.
+        if best.last_d + dist(p, best.last) <= best.max {
+            continue;
+        }
+        let d = index.distance(p, best.max);
+        (best.last, best.last_d) = (p, d);
+        if d > best.max {
+            (best.max, best.at) = (d, Some(p));
         }
     }
 }
