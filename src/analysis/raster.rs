@@ -150,6 +150,9 @@ pub fn analyse_layer_with_mask(
 /// of 64 × 256 cells, 1.33 mm square with the default B.
 const BAND_ROWS: usize = 64;
 const TILE_WORDS: usize = 4;
+/// Mask cells of at most this many grid rows are counted by 4-bit groups
+/// ([`Raster::count_by_nibbles`]).
+const NIBBLE_ROWS: usize = 3;
 /// Mask rows per band of a [`CoverageMask`]'s tiles.
 const MASK_BAND_ROWS: usize = 64;
 
@@ -174,6 +177,22 @@ pub struct Raster {
     /// phase and centre column, between marking and setting.
     spans: Vec<(u32, u32, u32)>,
     places: Vec<(usize, usize, f64)>,
+    /// The labelling's buffers, kept from layer to layer (a worker analyses many layers).
+    scratch: std::sync::Mutex<Scratch>,
+}
+
+/// Buffers of [`Raster::voids_fast`].
+#[derive(Default)]
+struct Scratch {
+    runs: Vec<(u32, u32, u32, u32)>,
+    bnd: Vec<bool>,
+    parent: Vec<u32>,
+    accs: Vec<Acc>,
+    buf: Vec<(u32, u32)>,
+    edge: Vec<u64>,
+    up: Vec<u64>,
+    down: Vec<u64>,
+    at_boundary: Vec<bool>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -334,6 +353,7 @@ impl Raster {
             edges: Vec::new(),
             spans: Vec::new(),
             places: Vec::new(),
+            scratch: Default::default(),
         }
     }
 
@@ -809,17 +829,30 @@ impl Raster {
         const NONE: u32 = u32::MAX;
         let g = self.grid;
         let tiles = &self.tiles;
+        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let Scratch {
+            runs,
+            bnd,
+            parent,
+            accs,
+            buf,
+            edge,
+            up: up_buf,
+            down: down_buf,
+            at_boundary,
+        } = &mut *scratch;
         // (row, start, end, label)
-        let mut runs: Vec<(u32, u32, u32, u32)> = Vec::new();
-        let mut bnd: Vec<bool> = Vec::new();
-        let mut labels = UnionFind::new(0);
-        let mut accs: Vec<Acc> = Vec::new();
-        let mut buf = Vec::new();
+        runs.clear();
+        accs.clear();
+        let mut labels = UnionFind {
+            parent: std::mem::take(parent),
+        };
+        labels.parent.clear();
         let mut prev = 0..0;
         let mut next_k = 0;
         let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
-        let mut edge = vec![0u64; widest];
-        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
+        edge.clear();
+        edge.resize(widest, 0);
         for (bi, band) in tiles.bands().iter().enumerate() {
             for k in band.first_row..band.end_row {
                 if k != next_k {
@@ -828,25 +861,25 @@ impl Raster {
                 next_k = k + 1;
                 let row = tiles.row_in(bi, k);
                 buf.clear();
-                self.runs(&row, |r, d| r & !d, &mut buf);
+                self.runs(&row, |r, d| r & !d, buf);
                 if buf.is_empty() {
                     prev = runs.len()..runs.len();
                     continue;
                 }
-                self.edge_row(&row, k, &mut edge, &mut up_buf, &mut down_buf);
+                self.edge_row(&row, k, edge, up_buf, down_buf);
                 let first = runs.len();
                 bnd.clear();
                 let mut seg = 0;
-                for &(s, e) in &buf {
+                for &(s, e) in buf.iter() {
                     while row.segs[seg].c1 * 64 <= s as usize {
                         seg += 1;
                     }
                     let shift = 64 * row.segs[seg].shift();
                     let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
                     bnd.push(if c1 - c0 < 64 {
-                        window(&edge, c0, c1) != 0
+                        window(edge, c0, c1) != 0
                     } else {
-                        count_range(&edge, c0, c1) > 0
+                        count_range(edge, c0, c1) > 0
                     });
                     runs.push((k as u32, s, e, NONE));
                 }
@@ -871,7 +904,7 @@ impl Raster {
                     }
                     if e1 < e2 { i += 1 } else { j += 1 }
                 }
-                for (run, &b) in runs[first..].iter_mut().zip(&bnd) {
+                for (run, &b) in runs[first..].iter_mut().zip(bnd.iter()) {
                     let l = if run.3 == NONE {
                         labels.parent.push(accs.len() as u32);
                         accs.push(Acc::default());
@@ -886,18 +919,21 @@ impl Raster {
             }
         }
         // Each label's component: whether it reaches the boundary.
-        let mut at_boundary = vec![false; accs.len()];
+        at_boundary.clear();
         for l in 0..accs.len() {
-            at_boundary[l] = accs[labels.find(l)].boundary;
+            let b = accs[labels.find(l)].boundary;
+            at_boundary.push(b);
         }
         let mut dev_in = Deviation::default();
-        for &(k, s, e, l) in &runs {
+        for &(k, s, e, l) in runs.iter() {
             if at_boundary[l as usize] {
                 probe(&g, index, &mut dev_in, k as usize, s, e);
             }
         }
         let roots = (0..accs.len()).filter(|&l| labels.parent[l] as usize == l);
-        Voids::of(&g, roots.map(|l| &accs[l]), dev_in)
+        let v = Voids::of(&g, roots.map(|l| &accs[l]), dev_in);
+        *parent = labels.parent;
+        v
     }
 
     /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
@@ -912,53 +948,19 @@ impl Raster {
         self.mask_with(cell, true)
     }
 
-    fn mask_with(&self, cell: f64, reference: bool) -> CoverageMask {
+    /// Adds each mask cell's counts [void, overfill, covered] to `counts` (per tile of `out`,
+    /// `groups` the tiles of each mask band), cell by cell in each grid row.
+    fn count_by_windows(
+        &self,
+        rows: usize,
+        reference: bool,
+        out: &[MaskTile],
+        groups: &[(usize, std::ops::Range<usize>)],
+        counts: &mut [Vec<[u32; 3]>],
+    ) {
         let g = self.grid;
         let tiles = &self.tiles;
-        let rows = ((cell / g.gy).round() as usize).max(1);
         let cols = rows * COLS_PER_ROW as usize;
-        let height = g.ny.div_ceil(rows);
-        // In each band of MASK_BAND_ROWS mask rows, the mask columns over the raster's segments
-        // in those rows, merged: (mask band, first column, last column).
-        let mut spans = Vec::new();
-        for band in tiles.bands() {
-            let mb0 = band.first_row / rows / MASK_BAND_ROWS;
-            let mb1 = (band.end_row - 1) / rows / MASK_BAND_ROWS;
-            for seg in tiles.segments(band) {
-                let (c0, c1) = (64 * seg.c0 / cols, ((64 * seg.c1).min(g.nx) - 1) / cols);
-                spans.extend((mb0..=mb1).map(|mb| (mb, c0, c1)));
-            }
-        }
-        spans.sort_unstable();
-        // The tiles, and per mask band the range of its tiles.
-        let mut out: Vec<MaskTile> = Vec::new();
-        let mut groups: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
-        let mut i = 0;
-        while i < spans.len() {
-            let mb = spans[i].0;
-            let first = out.len();
-            while i < spans.len() && spans[i].0 == mb {
-                let (_, c0, mut c1) = spans[i];
-                i += 1;
-                while i < spans.len() && spans[i].0 == mb && spans[i].1 <= c1 + 1 {
-                    c1 = c1.max(spans[i].2);
-                    i += 1;
-                }
-                let row = mb * MASK_BAND_ROWS;
-                out.push(MaskTile {
-                    col: c0,
-                    row,
-                    width: c1 - c0 + 1,
-                    height: MASK_BAND_ROWS.min(height - row),
-                    ..MaskTile::default()
-                });
-            }
-            groups.push((mb, first..out.len()));
-        }
-        let mut counts: Vec<Vec<[u32; 3]>> = out
-            .iter()
-            .map(|t| vec![[0; 3]; t.width * t.height])
-            .collect();
         let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
         let mut void = vec![0u64; widest];
         let mut over = vec![0u64; widest];
@@ -1022,6 +1024,153 @@ impl Raster {
                     }
                 }
             }
+        }
+    }
+
+    /// [`count_by_windows`](Self::count_by_windows) for cells of at most [`NIBBLE_ROWS`] rows
+    /// (the page's cells of B/4): a cell is `rows` × 4·`rows` columns, so its columns are
+    /// whole 4-bit groups of the words, and a cell's bits in one row count at most 4 per
+    /// group. Each grid row adds the bit counts of its 4-bit groups (SWAR, a word at a time)
+    /// into the mask row's words, at most 4·`rows` ≤ 15 per group; when the mask row is
+    /// done, each cell sums its `rows` groups. Counts identical, per cell once a mask row.
+    fn count_by_nibbles(
+        &self,
+        rows: usize,
+        out: &[MaskTile],
+        groups: &[(usize, std::ops::Range<usize>)],
+        counts: &mut [Vec<[u32; 3]>],
+    ) {
+        debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
+        let g = self.grid;
+        let tiles = &self.tiles;
+        let nw = g.nx.div_ceil(64);
+        // Per grid word (of the whole width), the 4-bit counts of void, overfill, covered.
+        let mut acc = vec![[0u64; 3]; nw];
+        let nibbles = |x: u64| {
+            let x = x - ((x >> 1) & 0x5555_5555_5555_5555);
+            (x & 0x3333_3333_3333_3333) + ((x >> 2) & 0x3333_3333_3333_3333)
+        };
+        // The cells of mask row `my` from `acc`, then `acc` cleared.
+        let flush = |my: usize, acc: &mut [[u64; 3]], counts: &mut [Vec<[u32; 3]>]| {
+            let Some(gi) = groups
+                .binary_search_by_key(&(my / MASK_BAND_ROWS), |x| x.0)
+                .ok()
+            else {
+                return;
+            };
+            let range = groups[gi].1.clone();
+            for t in range.clone() {
+                let tile = &out[t];
+                let base = (my - tile.row) * tile.width;
+                for (i, slot) in counts[t][base..base + tile.width].iter_mut().enumerate() {
+                    // Global 4-bit group of the cell's first columns.
+                    let n0 = (tile.col + i) * rows;
+                    for n in n0..n0 + rows {
+                        let (w, sh) = (n >> 4, 4 * (n & 15));
+                        if w >= nw {
+                            break;
+                        }
+                        let a = &acc[w];
+                        slot[0] += ((a[0] >> sh) & 15) as u32;
+                        slot[1] += ((a[1] >> sh) & 15) as u32;
+                        slot[2] += ((a[2] >> sh) & 15) as u32;
+                    }
+                }
+            }
+            for t in range {
+                let tile = &out[t];
+                let w0 = tile.col * rows / 16;
+                let w1 = ((tile.col + tile.width) * rows).div_ceil(16).min(nw);
+                for a in &mut acc[w0..w1] {
+                    *a = [0; 3];
+                }
+            }
+        };
+        let mut current: Option<usize> = None;
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                let row = tiles.row_in(bi, k);
+                let (lo, hi) = self.extent[row.slot];
+                if lo >= hi {
+                    continue;
+                }
+                let my = k / rows;
+                if current != Some(my) {
+                    if let Some(c) = current {
+                        flush(c, &mut acc, counts);
+                    }
+                    current = Some(my);
+                }
+                let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+                for seg in row.segs {
+                    let (a, e) = (seg.at.max(lo as usize), seg.end().min(hi as usize));
+                    let shift = seg.shift();
+                    for w in a..e {
+                        let (rw, dw) = (r[w], d[w]);
+                        let x = &mut acc[w + shift];
+                        x[0] += nibbles(rw & !dw);
+                        x[1] += nibbles(dw & !rw);
+                        x[2] += nibbles(rw & dw);
+                    }
+                }
+            }
+        }
+        if let Some(c) = current {
+            flush(c, &mut acc, counts);
+        }
+    }
+
+    fn mask_with(&self, cell: f64, reference: bool) -> CoverageMask {
+        let g = self.grid;
+        let tiles = &self.tiles;
+        let rows = ((cell / g.gy).round() as usize).max(1);
+        let cols = rows * COLS_PER_ROW as usize;
+        let height = g.ny.div_ceil(rows);
+        // In each band of MASK_BAND_ROWS mask rows, the mask columns over the raster's segments
+        // in those rows, merged: (mask band, first column, last column).
+        let mut spans = Vec::new();
+        for band in tiles.bands() {
+            let mb0 = band.first_row / rows / MASK_BAND_ROWS;
+            let mb1 = (band.end_row - 1) / rows / MASK_BAND_ROWS;
+            for seg in tiles.segments(band) {
+                let (c0, c1) = (64 * seg.c0 / cols, ((64 * seg.c1).min(g.nx) - 1) / cols);
+                spans.extend((mb0..=mb1).map(|mb| (mb, c0, c1)));
+            }
+        }
+        spans.sort_unstable();
+        // The tiles, and per mask band the range of its tiles.
+        let mut out: Vec<MaskTile> = Vec::new();
+        let mut groups: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
+        let mut i = 0;
+        while i < spans.len() {
+            let mb = spans[i].0;
+            let first = out.len();
+            while i < spans.len() && spans[i].0 == mb {
+                let (_, c0, mut c1) = spans[i];
+                i += 1;
+                while i < spans.len() && spans[i].0 == mb && spans[i].1 <= c1 + 1 {
+                    c1 = c1.max(spans[i].2);
+                    i += 1;
+                }
+                let row = mb * MASK_BAND_ROWS;
+                out.push(MaskTile {
+                    col: c0,
+                    row,
+                    width: c1 - c0 + 1,
+                    height: MASK_BAND_ROWS.min(height - row),
+                    ..MaskTile::default()
+                });
+            }
+            groups.push((mb, first..out.len()));
+        }
+        let mut counts: Vec<Vec<[u32; 3]>> = out
+            .iter()
+            .map(|t| vec![[0; 3]; t.width * t.height])
+            .collect();
+        if !reference && rows <= NIBBLE_ROWS {
+            self.count_by_nibbles(rows, &out, &groups, &mut counts);
+        } else {
+            self.count_by_windows(rows, reference, &out, &groups, &mut counts);
         }
         let full = (rows * cols) as f64;
         let share_of = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
