@@ -565,33 +565,29 @@ impl Raster {
             // Grid column of the slice's column 0 in this segment.
             let shift = (64 * seg.shift()) as u32;
             let mut carry = 0u64;
-            let mut start = 0u32;
+            // Starts are pushed as they come, ends fill the runs in order (`open` the first
+            // run without its end): no branch on which comes first.
+            let mut open = out.len();
             for w in a..e {
                 let v = mask(r[w], d[w]);
                 let prev = (v << 1) | carry;
                 let mut starts = v & !prev;
                 let mut ends = !v & prev;
                 let base = (w * 64) as u32 + shift;
-                while starts != 0 || ends != 0 {
-                    let s = if starts != 0 {
-                        starts.trailing_zeros()
-                    } else {
-                        64
-                    };
-                    let e = if ends != 0 { ends.trailing_zeros() } else { 64 };
-                    if s < e {
-                        start = base + s;
-                        starts &= starts - 1;
-                    } else {
-                        out.push((start, base + e));
-                        ends &= ends - 1;
-                    }
+                while starts != 0 {
+                    out.push((base + starts.trailing_zeros(), 0));
+                    starts &= starts - 1;
+                }
+                while ends != 0 {
+                    out[open].1 = base + ends.trailing_zeros();
+                    open += 1;
+                    ends &= ends - 1;
                 }
                 carry = v >> 63;
             }
             // The segment's next word is not stored (zero) or beyond the row's bits.
             if carry != 0 {
-                out.push((start, (e * 64) as u32 + shift));
+                out[open].1 = (e * 64) as u32 + shift;
             }
         }
     }
@@ -825,6 +821,7 @@ impl Raster {
     /// label of the first run above it joins (a new label when none), labels are joined by
     /// union-find, and each label's sums are kept at its root as runs come in, so there are
     /// as many union-find nodes as runs that start a void, not as runs. Figures identical.
+    #[inline(never)]
     fn voids_fast(&self, index: &EdgeIndex) -> Voids {
         const NONE: u32 = u32::MAX;
         let g = self.grid;
@@ -887,22 +884,24 @@ impl Raster {
                 while i < prev.end && j < runs.len() {
                     let (_, s1, e1, l1) = runs[i];
                     let (_, s2, e2, l2) = runs[j];
-                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                        if l2 == NONE {
-                            runs[j].3 = l1;
-                        } else {
-                            let (a, b) = (labels.find(l1 as usize), labels.find(l2 as usize));
-                            if a != b {
-                                // The earlier label stays the root: roots in order of their
-                                // component's first run, as the reference numbers them.
-                                let (lo, hi) = (a.min(b), a.max(b));
-                                labels.parent[hi] = lo as u32;
-                                let h = accs[hi];
-                                accs[lo].merge(&h);
-                            }
+                    let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
+                    if joined && l2 != NONE {
+                        // A second run above: rare.
+                        let (a, b) = (labels.find(l1 as usize), labels.find(l2 as usize));
+                        if a != b {
+                            // The earlier label stays the root: roots in order of their
+                            // component's first run, as the reference numbers them.
+                            let (lo, hi) = (a.min(b), a.max(b));
+                            labels.parent[hi] = lo as u32;
+                            let h = accs[hi];
+                            accs[lo].merge(&h);
                         }
                     }
-                    if e1 < e2 { i += 1 } else { j += 1 }
+                    // Without branches on the data: the first run above gives its label.
+                    runs[j].3 = if joined && l2 == NONE { l1 } else { l2 };
+                    let step = (e1 < e2) as usize;
+                    i += step;
+                    j += 1 - step;
                 }
                 for (run, &b) in runs[first..].iter_mut().zip(bnd.iter()) {
                     let l = if run.3 == NONE {
