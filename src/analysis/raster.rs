@@ -1040,35 +1040,34 @@ impl Raster {
         counts: &mut [Vec<[u32; 3]>],
     ) {
         debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
-        let g = self.grid;
         let tiles = &self.tiles;
-        let nw = g.nx.div_ceil(64);
-        // Per grid word (of the whole width), the 4-bit counts of void, overfill, covered.
-        let mut acc = vec![[0u64; 3]; nw];
+        // Grid words [first, end) under tile t's cells: its 4-bit groups are
+        // [col·rows, (col + width)·rows).
+        let words = |t: &MaskTile| (t.col * rows / 16, ((t.col + t.width) * rows).div_ceil(16));
+        // Per grid word under the current mask band's tiles (tile by tile, `at[t]` where tile
+        // t's words start), the 4-bit counts of void, overfill, covered: memory for the
+        // tiles, not for the grid's width.
+        let mut acc: Vec<[u64; 3]> = Vec::new();
+        let mut at: Vec<usize> = Vec::new();
         let nibbles = |x: u64| {
             let x = x - ((x >> 1) & 0x5555_5555_5555_5555);
             (x & 0x3333_3333_3333_3333) + ((x >> 2) & 0x3333_3333_3333_3333)
         };
-        // The cells of mask row `my` from `acc`, then `acc` cleared.
-        let flush = |my: usize, acc: &mut [[u64; 3]], counts: &mut [Vec<[u32; 3]>]| {
-            let Some(gi) = groups
-                .binary_search_by_key(&(my / MASK_BAND_ROWS), |x| x.0)
-                .ok()
-            else {
-                return;
-            };
-            let range = groups[gi].1.clone();
-            for t in range.clone() {
+        // The cells of mask row `my` (tiles `range`) from `acc`, then `acc` cleared.
+        let flush = |my: usize,
+                     range: std::ops::Range<usize>,
+                     acc: &mut [[u64; 3]],
+                     at: &[usize],
+                     counts: &mut [Vec<[u32; 3]>]| {
+            for (t, &base_at) in range.zip(at) {
                 let tile = &out[t];
+                let w0 = words(tile).0;
                 let base = (my - tile.row) * tile.width;
                 for (i, slot) in counts[t][base..base + tile.width].iter_mut().enumerate() {
-                    // Global 4-bit group of the cell's first columns.
+                    // The cell's 4-bit groups.
                     let n0 = (tile.col + i) * rows;
                     for n in n0..n0 + rows {
-                        let (w, sh) = (n >> 4, 4 * (n & 15));
-                        if w >= nw {
-                            break;
-                        }
+                        let (w, sh) = (base_at + (n >> 4) - w0, 4 * (n & 15));
                         let a = &acc[w];
                         slot[0] += ((a[0] >> sh) & 15) as u32;
                         slot[1] += ((a[1] >> sh) & 15) as u32;
@@ -1076,16 +1075,13 @@ impl Raster {
                     }
                 }
             }
-            for t in range {
-                let tile = &out[t];
-                let w0 = tile.col * rows / 16;
-                let w1 = ((tile.col + tile.width) * rows).div_ceil(16).min(nw);
-                for a in &mut acc[w0..w1] {
-                    *a = [0; 3];
-                }
-            }
+            acc.fill([0; 3]);
         };
-        let mut current: Option<usize> = None;
+        // The mask row being summed and its band's tiles.
+        let mut current: Option<(usize, std::ops::Range<usize>)> = None;
+        // The tiles `acc` is laid out for.
+        let mut laid: Option<std::ops::Range<usize>> = None;
+        let mut group = 0;
         for (bi, band) in tiles.bands().iter().enumerate() {
             for k in band.first_row..band.end_row {
                 let row = tiles.row_in(bi, k);
@@ -1094,28 +1090,62 @@ impl Raster {
                     continue;
                 }
                 let my = k / rows;
-                if current != Some(my) {
-                    if let Some(c) = current {
-                        flush(c, &mut acc, counts);
+                if current.as_ref().is_none_or(|c| c.0 != my) {
+                    if let Some((c, range)) = current.take() {
+                        flush(c, range, &mut acc, &at, counts);
                     }
-                    current = Some(my);
+                    while groups[group].0 < my / MASK_BAND_ROWS {
+                        group += 1;
+                    }
+                    let range = groups[group].1.clone();
+                    if laid.as_ref() != Some(&range) {
+                        at.clear();
+                        let mut n = 0;
+                        for t in &out[range.clone()] {
+                            at.push(n);
+                            let (w0, w1) = words(t);
+                            n += w1 - w0;
+                        }
+                        acc.clear();
+                        acc.resize(n, [0; 3]);
+                        laid = Some(range.clone());
+                    }
+                    current = Some((my, range));
                 }
+                let range = current.as_ref().map_or(0..0, |c| c.1.clone());
                 let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+                // The tiles' word ranges are in order along the row, as the words are.
+                let mut t = range.start;
                 for seg in row.segs {
                     let (a, e) = (seg.at.max(lo as usize), seg.end().min(hi as usize));
                     let shift = seg.shift();
                     for w in a..e {
                         let (rw, dw) = (r[w], d[w]);
-                        let x = &mut acc[w + shift];
-                        x[0] += nibbles(rw & !dw);
-                        x[1] += nibbles(dw & !rw);
-                        x[2] += nibbles(rw & dw);
+                        if rw | dw == 0 {
+                            continue;
+                        }
+                        let gw = w + shift;
+                        while t < range.end && words(&out[t]).1 <= gw {
+                            t += 1;
+                        }
+                        let add = [nibbles(rw & !dw), nibbles(dw & !rw), nibbles(rw & dw)];
+                        // Every tile whose words hold word gw (two when they are closer
+                        // than a word); a set bit always lies under a tile.
+                        let mut u = t;
+                        while u < range.end && words(&out[u]).0 <= gw {
+                            let x = &mut acc[at[u - range.start] + gw - words(&out[u]).0];
+                            for (x, a) in x.iter_mut().zip(add) {
+                                *x += a;
+                            }
+                            u += 1;
+                        }
+                        debug_assert!(u > t, "mask bits outside the mask's tiles");
                     }
                 }
             }
         }
-        if let Some(c) = current {
-            flush(c, &mut acc, counts);
+        if let Some((c, range)) = current {
+            flush(c, range, &mut acc, &at, counts);
         }
     }
 
