@@ -1,5 +1,8 @@
 //! The fast paths of the analysis against the exact ones they replace, on real models: the
-//! page's coverage mask cell for cell, and the layer figures within 0.1 % (absolute).
+//! page's coverage mask cell for cell (the 4-bit-group counts for cells of B/4, the window
+//! counts for larger cells) against the masks counted range by range, and the layer figures
+//! of the one-pass labelling against the run-per-node labelling, equal (the 0.1 % the
+//! analysis may differ by is not needed).
 
 mod common;
 
@@ -13,12 +16,16 @@ const MODELS: [&str; 4] = [
     "esca_nonmanifold.stl",
 ];
 
-/// Every `step`-th layer of `model` with `stagger`, as (section region, raster).
+/// Every `step`-th layer of `model` with `stagger`, as rasters.
 fn rasters(model: &str, stagger: bool, step: usize) -> Vec<Raster> {
     let s = Settings {
         stagger,
         ..Settings::default()
     };
+    rasters_with(model, s, step)
+}
+
+fn rasters_with(model: &str, s: Settings, step: usize) -> Vec<Raster> {
     let path = common::model(model);
     let job = Job::new(
         &common::model_bytes(model),
@@ -40,9 +47,21 @@ fn rasters(model: &str, stagger: bool, step: usize) -> Vec<Raster> {
 fn masks_are_those_counted_range_by_range() {
     let b = Settings::default().droplet_width();
     for model in MODELS {
-        for r in rasters(model, false, 23) {
-            for cell in [b / 4.0, b, 7.3 * b] {
-                assert_eq!(r.mask(cell), r.mask_reference(cell), "{model}, cell {cell}");
+        for stagger in [false, true] {
+            for r in rasters(model, stagger, 23) {
+                // B/4: the page's cells (4-bit groups); B, 7.3 B: by windows.
+                let cells: &[f64] = if stagger {
+                    &[b / 4.0]
+                } else {
+                    &[b / 4.0, b / 6.0, b, 7.3 * b]
+                };
+                for &cell in cells {
+                    assert_eq!(
+                        r.mask(cell),
+                        r.mask_reference(cell),
+                        "{model}, stagger {stagger}, cell {cell}"
+                    );
+                }
             }
         }
     }
@@ -60,5 +79,16 @@ fn layer_figures_are_those_of_the_reference_labelling() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn figures_and_masks_with_evenly_spaced_loops() {
+    let mut s = Settings::default();
+    s.set("loop_spacing", "even").unwrap();
+    let b = s.droplet_width();
+    for r in rasters_with("3DBenchy.stl", s, 31) {
+        assert_eq!(r.analysis(), r.analysis_reference());
+        assert_eq!(r.mask(b / 4.0), r.mask_reference(b / 4.0));
     }
 }

@@ -42,11 +42,15 @@
 //! each run of cells, so they are exact to about a grid step.
 //!
 //! # Speed
-//! The page's coverage mask takes each cell's share from a table of the counts a cell can
-//! hold (the same rounding as before), and the labelling joins a run to the component above
-//! it without a second search; the figures and masks are those of the paths they replaced,
-//! kept as `Raster::analysis_reference` and `Raster::mask_reference` for tests
-//! (tests/analysis_fast.rs). docs/quality.md (*Analysis speed*) has the profile.
+//! The voids are labelled in one pass over the rows: a void run takes the label of the first
+//! run above it joins, labels (one per run that starts a void) are joined by union-find and
+//! keep their sums at the root. The page's coverage mask (cells of at most 3 rows, B/4 in
+//! the page) adds each row's bit counts per group of 4 columns, a word at a time, and sums a
+//! cell's groups once per mask row; a cell's share comes from a table of the counts it can
+//! hold. The figures and masks are those of the paths they replaced, kept as
+//! `Raster::analysis_reference` and `Raster::mask_reference` for tests
+//! (tests/analysis_fast.rs). docs/quality.md (*Analysis speed*) has the profile, and why the
+//! periodic interior of the hatch does not help on this axis-aligned grid.
 //!
 //! # Memory
 //! The grids span the layer's bounding box, but only tiles near its region and droplets are

@@ -150,6 +150,9 @@ pub fn analyse_layer_with_mask(
 /// of 64 × 256 cells, 1.33 mm square with the default B.
 const BAND_ROWS: usize = 64;
 const TILE_WORDS: usize = 4;
+/// Mask cells of at most this many grid rows are counted by 4-bit groups
+/// ([`Raster::count_by_nibbles`]).
+const NIBBLE_ROWS: usize = 3;
 /// Mask rows per band of a [`CoverageMask`]'s tiles.
 const MASK_BAND_ROWS: usize = 64;
 
@@ -174,6 +177,22 @@ pub struct Raster {
     /// phase and centre column, between marking and setting.
     spans: Vec<(u32, u32, u32)>,
     places: Vec<(usize, usize, f64)>,
+    /// The labelling's buffers, kept from layer to layer (a worker analyses many layers).
+    scratch: std::sync::Mutex<Scratch>,
+}
+
+/// Buffers of [`Raster::voids_fast`].
+#[derive(Default)]
+struct Scratch {
+    runs: Vec<(u32, u32, u32, u32)>,
+    bnd: Vec<bool>,
+    parent: Vec<u32>,
+    accs: Vec<Acc>,
+    buf: Vec<(u32, u32)>,
+    edge: Vec<u64>,
+    up: Vec<u64>,
+    down: Vec<u64>,
+    at_boundary: Vec<bool>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -334,6 +353,7 @@ impl Raster {
             edges: Vec::new(),
             spans: Vec::new(),
             places: Vec::new(),
+            scratch: Default::default(),
         }
     }
 
@@ -545,33 +565,29 @@ impl Raster {
             // Grid column of the slice's column 0 in this segment.
             let shift = (64 * seg.shift()) as u32;
             let mut carry = 0u64;
-            let mut start = 0u32;
+            // Starts are pushed as they come, ends fill the runs in order (`open` the first
+            // run without its end): no branch on which comes first.
+            let mut open = out.len();
             for w in a..e {
                 let v = mask(r[w], d[w]);
                 let prev = (v << 1) | carry;
                 let mut starts = v & !prev;
                 let mut ends = !v & prev;
                 let base = (w * 64) as u32 + shift;
-                while starts != 0 || ends != 0 {
-                    let s = if starts != 0 {
-                        starts.trailing_zeros()
-                    } else {
-                        64
-                    };
-                    let e = if ends != 0 { ends.trailing_zeros() } else { 64 };
-                    if s < e {
-                        start = base + s;
-                        starts &= starts - 1;
-                    } else {
-                        out.push((start, base + e));
-                        ends &= ends - 1;
-                    }
+                while starts != 0 {
+                    out.push((base + starts.trailing_zeros(), 0));
+                    starts &= starts - 1;
+                }
+                while ends != 0 {
+                    out[open].1 = base + ends.trailing_zeros();
+                    open += 1;
+                    ends &= ends - 1;
                 }
                 carry = v >> 63;
             }
             // The segment's next word is not stored (zero) or beyond the row's bits.
             if carry != 0 {
-                out.push((start, (e * 64) as u32 + shift));
+                out[open].1 = (e * 64) as u32 + shift;
             }
         }
     }
@@ -642,177 +658,23 @@ impl Raster {
                 }
             }
         }
-        // Voids: runs of region & !droplets, joined across rows.
-        let mut runs: Vec<(u32, u32, u32)> = Vec::new(); // (row, start, end)
-        let mut touches: Vec<bool> = Vec::new();
-        let mut uf = UnionFind::new(0);
-        let mut buf = Vec::new();
-        // The runs of the row before, and the row after the last one looked at.
-        let mut prev = 0..0;
-        let mut next_k = 0;
-        // Region cells with a neighbour (left, right, above, below) outside the region.
-        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
-        let mut edge = vec![0u64; widest];
-        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                if k != next_k {
-                    prev = runs.len()..runs.len();
-                }
-                next_k = k + 1;
-                let row = tiles.row_in(bi, k);
-                buf.clear();
-                self.runs(&row, |r, d| r & !d, &mut buf);
-                if buf.is_empty() {
-                    prev = runs.len()..runs.len();
-                    continue;
-                }
-                let (lo, hi) = self.extent[row.slot];
-                let bits = &self.region_bits[row.range()];
-                let up = (k + 1 < g.ny)
-                    .then(|| self.region_row_as(&row, k + 1, &mut up_buf))
-                    .flatten();
-                let down = (k > 0)
-                    .then(|| self.region_row_as(&row, k - 1, &mut down_buf))
-                    .flatten();
-                for seg in row.segs {
-                    let end = seg.end();
-                    for w in seg.at.max(lo as usize)..end.min(hi as usize) {
-                        let r = bits[w];
-                        let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
-                        let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
-                        let u = up.map_or(0, |x| x[w]);
-                        let d = down.map_or(0, |x| x[w]);
-                        edge[w] = r & !(left & right & u & d);
-                    }
-                }
-                let first = runs.len();
-                let mut seg = 0;
-                for &(s, e) in &buf {
-                    while row.segs[seg].c1 * 64 <= s as usize {
-                        seg += 1;
-                    }
-                    let shift = 64 * row.segs[seg].shift();
-                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
-                    let boundary = if !reference && c1 - c0 < 64 {
-                        window(&edge, c0, c1) != 0
-                    } else {
-                        count_range(&edge, c0, c1) > 0
-                    };
-                    runs.push((k as u32, s, e));
-                    touches.push(boundary);
-                    uf.parent.push(uf.parent.len() as u32);
-                }
-                let cur = first..runs.len();
-                let (mut i, mut j) = (prev.start, cur.start);
-                while i < prev.end && j < cur.end {
-                    let (_, s1, e1) = runs[i];
-                    let (_, s2, e2) = runs[j];
-                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                        if !reference && uf.parent[j] as usize == j {
-                            // The first run above j it joins: j is still alone (a later run
-                            // is never the root of an earlier one).
-                            uf.parent[j] = uf.find(i) as u32;
-                        } else {
-                            uf.union(i, j);
-                        }
-                    }
-                    if e1 < e2 { i += 1 } else { j += 1 }
-                }
-                prev = cur;
-            }
-        }
-        // Components, numbered in order of their first run (a root precedes its members).
-        #[derive(Clone, Copy)]
-        struct Acc {
-            cells: u64,
-            /// Sums of column·cells (twice, to stay whole) and row·cells.
-            sx2: u64,
-            sy: u64,
-            min: [u32; 2],
-            max: [u32; 2],
-            boundary: bool,
-        }
-        let mut comp = vec![0u32; runs.len()];
-        let mut accs: Vec<Acc> = Vec::new();
-        for (i, &(k, s, e)) in runs.iter().enumerate() {
-            let root = uf.find(i);
-            let id = if root == i {
-                accs.push(Acc {
-                    cells: 0,
-                    sx2: 0,
-                    sy: 0,
-                    min: [u32::MAX; 2],
-                    max: [0; 2],
-                    boundary: false,
-                });
-                accs.len() - 1
-            } else {
-                comp[root] as usize
-            };
-            comp[i] = id as u32;
-            let a = &mut accs[id];
-            let n = (e - s) as u64;
-            a.cells += n;
-            a.sx2 += n * (s + e - 1) as u64;
-            a.sy += n * k as u64;
-            a.min = [a.min[0].min(s), a.min[1].min(k)];
-            a.max = [a.max[0].max(e), a.max[1].max(k + 1)];
-            a.boundary |= touches[i];
-        }
-        let mut enclosed = 0u64;
-        let mut largest: Option<Void> = None;
-        for a in &accs {
-            if !a.boundary {
-                enclosed += a.cells;
-            }
-            let area = a.cells as f64 * cell;
-            if largest.is_none_or(|l| area > l.area) {
-                let n = a.cells as f64;
-                largest = Some(Void {
-                    area,
-                    centroid: DVec2::new(
-                        g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
-                        g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
-                    ),
-                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
-                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
-                    at_boundary: a.boundary,
-                });
-            }
-        }
-        // Inward deviation: runs of voids that reach the boundary; outward: overfill runs.
         let index = EdgeIndex::new(&self.edges, self.b);
-        let mut dev_in = Deviation::default();
-        let mut dev_out = Deviation::default();
-        let probe = |best: &mut Deviation, k: usize, s: u32, e: u32| {
-            let y = g.ry(k);
-            for c in [s, (s + e - 1) / 2, e - 1] {
-                let p = DVec2::new(g.cx(c as usize), y);
-                // The distance to the boundary changes no faster than the point moves: a point
-                // this close to the last one probed cannot beat the maximum.
-                if best.last_d + dist(p, best.last) <= best.max {
-                    continue;
-                }
-                let d = index.distance(p, best.max);
-                (best.last, best.last_d) = (p, d);
-                if d > best.max {
-                    (best.max, best.at) = (d, Some(p));
-                }
-            }
+        let v = if reference {
+            self.voids_reference(&index)
+        } else {
+            self.voids_fast(&index)
         };
-        for (i, &(k, s, e)) in runs.iter().enumerate() {
-            if accs[comp[i] as usize].boundary {
-                probe(&mut dev_in, k as usize, s, e);
-            }
-        }
+        let dev_in = v.dev_in;
+        // Outward deviation: overfill runs.
+        let mut dev_out = Deviation::default();
+        let mut buf = Vec::new();
         for &k in &over_rows {
             buf.clear();
             if let Some(row) = tiles.row(k) {
                 self.runs(&row, |r, d| d & !r, &mut buf);
             }
             for &(s, e) in &buf {
-                probe(&mut dev_out, k, s, e);
+                probe(&g, &index, &mut dev_out, k, s, e);
             }
         }
         let coverage = if n_region > 0 {
@@ -833,9 +695,9 @@ impl Raster {
             covered_area: n_covered as f64 * cell,
             coverage,
             void_area: (n_region - n_covered) as f64 * cell,
-            enclosed_void_area: enclosed as f64 * cell,
-            voids: accs.len(),
-            largest_void: largest,
+            enclosed_void_area: v.enclosed as f64 * cell,
+            voids: v.count,
+            largest_void: v.largest,
             overfill_area: n_over as f64 * cell,
             deviation_inward: dev_in.max,
             deviation_outward: dev_out.max,
@@ -843,6 +705,234 @@ impl Raster {
             deviation_at,
             unsupported_area: 0.0,
         }
+    }
+
+    /// Sets `edge` to the cells of row `k` (laid out as `row`) in the region with a
+    /// neighbour (left, right, above, below) outside it, over the row's extent.
+    fn edge_row(
+        &self,
+        row: &Row,
+        k: usize,
+        edge: &mut [u64],
+        up_buf: &mut Vec<u64>,
+        down_buf: &mut Vec<u64>,
+    ) {
+        let (lo, hi) = self.extent[row.slot];
+        let bits = &self.region_bits[row.range()];
+        let up = (k + 1 < self.grid.ny)
+            .then(|| self.region_row_as(row, k + 1, up_buf))
+            .flatten();
+        let down = (k > 0)
+            .then(|| self.region_row_as(row, k - 1, down_buf))
+            .flatten();
+        for seg in row.segs {
+            let end = seg.end();
+            for w in seg.at.max(lo as usize)..end.min(hi as usize) {
+                let r = bits[w];
+                let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
+                let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
+                let u = up.map_or(0, |x| x[w]);
+                let d = down.map_or(0, |x| x[w]);
+                edge[w] = r & !(left & right & u & d);
+            }
+        }
+    }
+
+    /// The voids by one union-find node per void run, components summed after the
+    /// labelling (the labelling as it was before the fast path, for tests comparing both).
+    fn voids_reference(&self, index: &EdgeIndex) -> Voids {
+        let g = self.grid;
+        let tiles = &self.tiles;
+        // Voids: runs of region & !droplets, joined across rows.
+        let mut runs: Vec<(u32, u32, u32)> = Vec::new(); // (row, start, end)
+        let mut touches: Vec<bool> = Vec::new();
+        let mut uf = UnionFind::new(0);
+        let mut buf = Vec::new();
+        // The runs of the row before, and the row after the last one looked at.
+        let mut prev = 0..0;
+        let mut next_k = 0;
+        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
+        let mut edge = vec![0u64; widest];
+        let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                if k != next_k {
+                    prev = runs.len()..runs.len();
+                }
+                next_k = k + 1;
+                let row = tiles.row_in(bi, k);
+                buf.clear();
+                self.runs(&row, |r, d| r & !d, &mut buf);
+                if buf.is_empty() {
+                    prev = runs.len()..runs.len();
+                    continue;
+                }
+                self.edge_row(&row, k, &mut edge, &mut up_buf, &mut down_buf);
+                let first = runs.len();
+                let mut seg = 0;
+                for &(s, e) in &buf {
+                    while row.segs[seg].c1 * 64 <= s as usize {
+                        seg += 1;
+                    }
+                    let shift = 64 * row.segs[seg].shift();
+                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                    runs.push((k as u32, s, e));
+                    touches.push(count_range(&edge, c0, c1) > 0);
+                    uf.parent.push(uf.parent.len() as u32);
+                }
+                let cur = first..runs.len();
+                let (mut i, mut j) = (prev.start, cur.start);
+                while i < prev.end && j < cur.end {
+                    let (_, s1, e1) = runs[i];
+                    let (_, s2, e2) = runs[j];
+                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                        uf.union(i, j);
+                    }
+                    if e1 < e2 { i += 1 } else { j += 1 }
+                }
+                prev = cur;
+            }
+        }
+        // Components, numbered in order of their first run (a root precedes its members).
+        let mut comp = vec![0u32; runs.len()];
+        let mut accs: Vec<Acc> = Vec::new();
+        for (i, &(k, s, e)) in runs.iter().enumerate() {
+            let root = uf.find(i);
+            let id = if root == i {
+                accs.push(Acc::default());
+                accs.len() - 1
+            } else {
+                comp[root] as usize
+            };
+            comp[i] = id as u32;
+            accs[id].add(k, s, e, touches[i]);
+        }
+        // Inward deviation: runs of voids that reach the boundary.
+        let mut dev_in = Deviation::default();
+        for (i, &(k, s, e)) in runs.iter().enumerate() {
+            if accs[comp[i] as usize].boundary {
+                probe(&g, index, &mut dev_in, k as usize, s, e);
+            }
+        }
+        Voids::of(&g, accs.iter(), dev_in)
+    }
+
+    /// [`voids_reference`](Self::voids_reference) in one pass over the rows: a run takes the
+    /// label of the first run above it joins (a new label when none), labels are joined by
+    /// union-find, and each label's sums are kept at its root as runs come in, so there are
+    /// as many union-find nodes as runs that start a void, not as runs. Figures identical.
+    #[inline(never)]
+    fn voids_fast(&self, index: &EdgeIndex) -> Voids {
+        const NONE: u32 = u32::MAX;
+        let g = self.grid;
+        let tiles = &self.tiles;
+        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let Scratch {
+            runs,
+            bnd,
+            parent,
+            accs,
+            buf,
+            edge,
+            up: up_buf,
+            down: down_buf,
+            at_boundary,
+        } = &mut *scratch;
+        // (row, start, end, label)
+        runs.clear();
+        accs.clear();
+        let mut labels = UnionFind {
+            parent: std::mem::take(parent),
+        };
+        labels.parent.clear();
+        let mut prev = 0..0;
+        let mut next_k = 0;
+        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
+        edge.clear();
+        edge.resize(widest, 0);
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                if k != next_k {
+                    prev = runs.len()..runs.len();
+                }
+                next_k = k + 1;
+                let row = tiles.row_in(bi, k);
+                buf.clear();
+                self.runs(&row, |r, d| r & !d, buf);
+                if buf.is_empty() {
+                    prev = runs.len()..runs.len();
+                    continue;
+                }
+                self.edge_row(&row, k, edge, up_buf, down_buf);
+                let first = runs.len();
+                bnd.clear();
+                let mut seg = 0;
+                for &(s, e) in buf.iter() {
+                    while row.segs[seg].c1 * 64 <= s as usize {
+                        seg += 1;
+                    }
+                    let shift = 64 * row.segs[seg].shift();
+                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                    bnd.push(if c1 - c0 < 64 {
+                        window(edge, c0, c1) != 0
+                    } else {
+                        count_range(edge, c0, c1) > 0
+                    });
+                    runs.push((k as u32, s, e, NONE));
+                }
+                let (mut i, mut j) = (prev.start, first);
+                while i < prev.end && j < runs.len() {
+                    let (_, s1, e1, l1) = runs[i];
+                    let (_, s2, e2, l2) = runs[j];
+                    let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
+                    if joined && l2 != NONE {
+                        // A second run above: rare.
+                        let (a, b) = (labels.find(l1 as usize), labels.find(l2 as usize));
+                        if a != b {
+                            // The earlier label stays the root: roots in order of their
+                            // component's first run, as the reference numbers them.
+                            let (lo, hi) = (a.min(b), a.max(b));
+                            labels.parent[hi] = lo as u32;
+                            let h = accs[hi];
+                            accs[lo].merge(&h);
+                        }
+                    }
+                    // Without branches on the data: the first run above gives its label.
+                    runs[j].3 = if joined && l2 == NONE { l1 } else { l2 };
+                    let step = (e1 < e2) as usize;
+                    i += step;
+                    j += 1 - step;
+                }
+                for (run, &b) in runs[first..].iter_mut().zip(bnd.iter()) {
+                    let l = if run.3 == NONE {
+                        labels.parent.push(accs.len() as u32);
+                        accs.push(Acc::default());
+                        accs.len() - 1
+                    } else {
+                        labels.find(run.3 as usize)
+                    };
+                    run.3 = l as u32;
+                    accs[l].add(run.0, run.1, run.2, b);
+                }
+                prev = first..runs.len();
+            }
+        }
+        // Each label's component: whether it reaches the boundary.
+        at_boundary.clear();
+        for l in 0..accs.len() {
+            let b = accs[labels.find(l)].boundary;
+            at_boundary.push(b);
+        }
+        let mut dev_in = Deviation::default();
+        for &(k, s, e, l) in runs.iter() {
+            if at_boundary[l as usize] {
+                probe(&g, index, &mut dev_in, k as usize, s, e);
+            }
+        }
+        let roots = (0..accs.len()).filter(|&l| labels.parent[l] as usize == l);
+        let v = Voids::of(&g, roots.map(|l| &accs[l]), dev_in);
+        *parent = labels.parent;
+        v
     }
 
     /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
@@ -857,53 +947,19 @@ impl Raster {
         self.mask_with(cell, true)
     }
 
-    fn mask_with(&self, cell: f64, reference: bool) -> CoverageMask {
+    /// Adds each mask cell's counts [void, overfill, covered] to `counts` (per tile of `out`,
+    /// `groups` the tiles of each mask band), cell by cell in each grid row.
+    fn count_by_windows(
+        &self,
+        rows: usize,
+        reference: bool,
+        out: &[MaskTile],
+        groups: &[(usize, std::ops::Range<usize>)],
+        counts: &mut [Vec<[u32; 3]>],
+    ) {
         let g = self.grid;
         let tiles = &self.tiles;
-        let rows = ((cell / g.gy).round() as usize).max(1);
         let cols = rows * COLS_PER_ROW as usize;
-        let height = g.ny.div_ceil(rows);
-        // In each band of MASK_BAND_ROWS mask rows, the mask columns over the raster's segments
-        // in those rows, merged: (mask band, first column, last column).
-        let mut spans = Vec::new();
-        for band in tiles.bands() {
-            let mb0 = band.first_row / rows / MASK_BAND_ROWS;
-            let mb1 = (band.end_row - 1) / rows / MASK_BAND_ROWS;
-            for seg in tiles.segments(band) {
-                let (c0, c1) = (64 * seg.c0 / cols, ((64 * seg.c1).min(g.nx) - 1) / cols);
-                spans.extend((mb0..=mb1).map(|mb| (mb, c0, c1)));
-            }
-        }
-        spans.sort_unstable();
-        // The tiles, and per mask band the range of its tiles.
-        let mut out: Vec<MaskTile> = Vec::new();
-        let mut groups: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
-        let mut i = 0;
-        while i < spans.len() {
-            let mb = spans[i].0;
-            let first = out.len();
-            while i < spans.len() && spans[i].0 == mb {
-                let (_, c0, mut c1) = spans[i];
-                i += 1;
-                while i < spans.len() && spans[i].0 == mb && spans[i].1 <= c1 + 1 {
-                    c1 = c1.max(spans[i].2);
-                    i += 1;
-                }
-                let row = mb * MASK_BAND_ROWS;
-                out.push(MaskTile {
-                    col: c0,
-                    row,
-                    width: c1 - c0 + 1,
-                    height: MASK_BAND_ROWS.min(height - row),
-                    ..MaskTile::default()
-                });
-            }
-            groups.push((mb, first..out.len()));
-        }
-        let mut counts: Vec<Vec<[u32; 3]>> = out
-            .iter()
-            .map(|t| vec![[0; 3]; t.width * t.height])
-            .collect();
         let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
         let mut void = vec![0u64; widest];
         let mut over = vec![0u64; widest];
@@ -968,6 +1024,183 @@ impl Raster {
                 }
             }
         }
+    }
+
+    /// [`count_by_windows`](Self::count_by_windows) for cells of at most [`NIBBLE_ROWS`] rows
+    /// (the page's cells of B/4): a cell is `rows` × 4·`rows` columns, so its columns are
+    /// whole 4-bit groups of the words, and a cell's bits in one row count at most 4 per
+    /// group. Each grid row adds the bit counts of its 4-bit groups (SWAR, a word at a time)
+    /// into the mask row's words, at most 4·`rows` ≤ 15 per group; when the mask row is
+    /// done, each cell sums its `rows` groups. Counts identical, per cell once a mask row.
+    fn count_by_nibbles(
+        &self,
+        rows: usize,
+        out: &[MaskTile],
+        groups: &[(usize, std::ops::Range<usize>)],
+        counts: &mut [Vec<[u32; 3]>],
+    ) {
+        debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
+        let tiles = &self.tiles;
+        // Grid words [first, end) under tile t's cells: its 4-bit groups are
+        // [col·rows, (col + width)·rows).
+        let words = |t: &MaskTile| (t.col * rows / 16, ((t.col + t.width) * rows).div_ceil(16));
+        // Per grid word under the current mask band's tiles (tile by tile, `at[t]` where tile
+        // t's words start), the 4-bit counts of void, overfill, covered: memory for the
+        // tiles, not for the grid's width.
+        let mut acc: Vec<[u64; 3]> = Vec::new();
+        let mut at: Vec<usize> = Vec::new();
+        let nibbles = |x: u64| {
+            let x = x - ((x >> 1) & 0x5555_5555_5555_5555);
+            (x & 0x3333_3333_3333_3333) + ((x >> 2) & 0x3333_3333_3333_3333)
+        };
+        // The cells of mask row `my` (tiles `range`) from `acc`, then `acc` cleared.
+        let flush = |my: usize,
+                     range: std::ops::Range<usize>,
+                     acc: &mut [[u64; 3]],
+                     at: &[usize],
+                     counts: &mut [Vec<[u32; 3]>]| {
+            for (t, &base_at) in range.zip(at) {
+                let tile = &out[t];
+                let w0 = words(tile).0;
+                let base = (my - tile.row) * tile.width;
+                for (i, slot) in counts[t][base..base + tile.width].iter_mut().enumerate() {
+                    // The cell's 4-bit groups.
+                    let n0 = (tile.col + i) * rows;
+                    for n in n0..n0 + rows {
+                        let (w, sh) = (base_at + (n >> 4) - w0, 4 * (n & 15));
+                        let a = &acc[w];
+                        slot[0] += ((a[0] >> sh) & 15) as u32;
+                        slot[1] += ((a[1] >> sh) & 15) as u32;
+                        slot[2] += ((a[2] >> sh) & 15) as u32;
+                    }
+                }
+            }
+            acc.fill([0; 3]);
+        };
+        // The mask row being summed and its band's tiles.
+        let mut current: Option<(usize, std::ops::Range<usize>)> = None;
+        // The tiles `acc` is laid out for.
+        let mut laid: Option<std::ops::Range<usize>> = None;
+        let mut group = 0;
+        for (bi, band) in tiles.bands().iter().enumerate() {
+            for k in band.first_row..band.end_row {
+                let row = tiles.row_in(bi, k);
+                let (lo, hi) = self.extent[row.slot];
+                if lo >= hi {
+                    continue;
+                }
+                let my = k / rows;
+                if current.as_ref().is_none_or(|c| c.0 != my) {
+                    if let Some((c, range)) = current.take() {
+                        flush(c, range, &mut acc, &at, counts);
+                    }
+                    while groups[group].0 < my / MASK_BAND_ROWS {
+                        group += 1;
+                    }
+                    let range = groups[group].1.clone();
+                    if laid.as_ref() != Some(&range) {
+                        at.clear();
+                        let mut n = 0;
+                        for t in &out[range.clone()] {
+                            at.push(n);
+                            let (w0, w1) = words(t);
+                            n += w1 - w0;
+                        }
+                        acc.clear();
+                        acc.resize(n, [0; 3]);
+                        laid = Some(range.clone());
+                    }
+                    current = Some((my, range));
+                }
+                let range = current.as_ref().map_or(0..0, |c| c.1.clone());
+                let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+                // The tiles' word ranges are in order along the row, as the words are.
+                let mut t = range.start;
+                for seg in row.segs {
+                    let (a, e) = (seg.at.max(lo as usize), seg.end().min(hi as usize));
+                    let shift = seg.shift();
+                    for w in a..e {
+                        let (rw, dw) = (r[w], d[w]);
+                        if rw | dw == 0 {
+                            continue;
+                        }
+                        let gw = w + shift;
+                        while t < range.end && words(&out[t]).1 <= gw {
+                            t += 1;
+                        }
+                        let add = [nibbles(rw & !dw), nibbles(dw & !rw), nibbles(rw & dw)];
+                        // Every tile whose words hold word gw (two when they are closer
+                        // than a word); a set bit always lies under a tile.
+                        let mut u = t;
+                        while u < range.end && words(&out[u]).0 <= gw {
+                            let x = &mut acc[at[u - range.start] + gw - words(&out[u]).0];
+                            for (x, a) in x.iter_mut().zip(add) {
+                                *x += a;
+                            }
+                            u += 1;
+                        }
+                        debug_assert!(u > t, "mask bits outside the mask's tiles");
+                    }
+                }
+            }
+        }
+        if let Some((c, range)) = current {
+            flush(c, range, &mut acc, &at, counts);
+        }
+    }
+
+    fn mask_with(&self, cell: f64, reference: bool) -> CoverageMask {
+        let g = self.grid;
+        let tiles = &self.tiles;
+        let rows = ((cell / g.gy).round() as usize).max(1);
+        let cols = rows * COLS_PER_ROW as usize;
+        let height = g.ny.div_ceil(rows);
+        // In each band of MASK_BAND_ROWS mask rows, the mask columns over the raster's segments
+        // in those rows, merged: (mask band, first column, last column).
+        let mut spans = Vec::new();
+        for band in tiles.bands() {
+            let mb0 = band.first_row / rows / MASK_BAND_ROWS;
+            let mb1 = (band.end_row - 1) / rows / MASK_BAND_ROWS;
+            for seg in tiles.segments(band) {
+                let (c0, c1) = (64 * seg.c0 / cols, ((64 * seg.c1).min(g.nx) - 1) / cols);
+                spans.extend((mb0..=mb1).map(|mb| (mb, c0, c1)));
+            }
+        }
+        spans.sort_unstable();
+        // The tiles, and per mask band the range of its tiles.
+        let mut out: Vec<MaskTile> = Vec::new();
+        let mut groups: Vec<(usize, std::ops::Range<usize>)> = Vec::new();
+        let mut i = 0;
+        while i < spans.len() {
+            let mb = spans[i].0;
+            let first = out.len();
+            while i < spans.len() && spans[i].0 == mb {
+                let (_, c0, mut c1) = spans[i];
+                i += 1;
+                while i < spans.len() && spans[i].0 == mb && spans[i].1 <= c1 + 1 {
+                    c1 = c1.max(spans[i].2);
+                    i += 1;
+                }
+                let row = mb * MASK_BAND_ROWS;
+                out.push(MaskTile {
+                    col: c0,
+                    row,
+                    width: c1 - c0 + 1,
+                    height: MASK_BAND_ROWS.min(height - row),
+                    ..MaskTile::default()
+                });
+            }
+            groups.push((mb, first..out.len()));
+        }
+        let mut counts: Vec<Vec<[u32; 3]>> = out
+            .iter()
+            .map(|t| vec![[0; 3]; t.width * t.height])
+            .collect();
+        if !reference && rows <= NIBBLE_ROWS {
+            self.count_by_nibbles(rows, &out, &groups, &mut counts);
+        } else {
+            self.count_by_windows(rows, reference, &out, &groups, &mut counts);
+        }
         let full = (rows * cols) as f64;
         let share_of = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
         // The shares of every count a cell can hold, when there are not too many.
@@ -989,6 +1222,116 @@ impl Raster {
             origin: DVec2::new(g.x0, g.y0),
             cell: rows as f64 * g.gy,
             tiles: out,
+        }
+    }
+}
+
+/// A void's sums while labelling.
+#[derive(Clone, Copy)]
+struct Acc {
+    cells: u64,
+    /// Sums of column·cells (twice, to stay whole) and row·cells.
+    sx2: u64,
+    sy: u64,
+    min: [u32; 2],
+    max: [u32; 2],
+    boundary: bool,
+}
+
+impl Default for Acc {
+    fn default() -> Acc {
+        Acc {
+            cells: 0,
+            sx2: 0,
+            sy: 0,
+            min: [u32::MAX; 2],
+            max: [0; 2],
+            boundary: false,
+        }
+    }
+}
+
+impl Acc {
+    /// Adds the run [s, e) of row k.
+    #[inline]
+    fn add(&mut self, k: u32, s: u32, e: u32, boundary: bool) {
+        let n = (e - s) as u64;
+        self.cells += n;
+        self.sx2 += n * (s + e - 1) as u64;
+        self.sy += n * k as u64;
+        self.min = [self.min[0].min(s), self.min[1].min(k)];
+        self.max = [self.max[0].max(e), self.max[1].max(k + 1)];
+        self.boundary |= boundary;
+    }
+
+    fn merge(&mut self, o: &Acc) {
+        self.cells += o.cells;
+        self.sx2 += o.sx2;
+        self.sy += o.sy;
+        self.min = [self.min[0].min(o.min[0]), self.min[1].min(o.min[1])];
+        self.max = [self.max[0].max(o.max[0]), self.max[1].max(o.max[1])];
+        self.boundary |= o.boundary;
+    }
+}
+
+/// A layer's voids: how many, the cells of those that do not reach the boundary, the largest
+/// (the first of equal ones in the order of their first runs) and the inward deviation.
+struct Voids {
+    count: usize,
+    enclosed: u64,
+    largest: Option<Void>,
+    dev_in: Deviation,
+}
+
+impl Voids {
+    fn of<'a>(g: &Grid, accs: impl Iterator<Item = &'a Acc>, dev_in: Deviation) -> Voids {
+        let cell = g.gx * g.gy;
+        let (mut count, mut enclosed) = (0, 0u64);
+        let mut largest: Option<Void> = None;
+        for a in accs {
+            count += 1;
+            if !a.boundary {
+                enclosed += a.cells;
+            }
+            let area = a.cells as f64 * cell;
+            if largest.is_none_or(|l| area > l.area) {
+                let n = a.cells as f64;
+                largest = Some(Void {
+                    area,
+                    centroid: DVec2::new(
+                        g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
+                        g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
+                    ),
+                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
+                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
+                    at_boundary: a.boundary,
+                });
+            }
+        }
+        Voids {
+            count,
+            enclosed,
+            largest,
+            dev_in,
+        }
+    }
+}
+
+/// Probes the run [s, e) of row k (its ends and middle) for a larger distance to the
+/// boundary than `best`'s.
+fn probe(g: &Grid, index: &EdgeIndex, best: &mut Deviation, k: usize, s: u32, e: u32) {
+    let y = g.ry(k);
+    for c in [s, (s + e - 1) / 2, e - 1] {
+        let p = DVec2::new(g.cx(c as usize), y);
+        // The distance to the boundary changes no faster than the point moves: a point
+        // this close to the last one probed cannot beat the maximum.
+        if best.last_d + dist(p, best.last) <= best.max {
+            continue;
+        }
+        let d = index.distance(p, best.max);
+        (best.last, best.last_d) = (p, d);
+        if d > best.max {
+            (best.max, best.at) = (d, Some(p));
         }
     }
 }
