@@ -63,6 +63,9 @@ pub fn loop_droplets_spaced(
 /// The shortest loop (polyline length, in B) spaced evenly.
 pub const EVEN_MIN_LENGTH_B: f64 = 3.0;
 
+/// The longest loop (droplets) searched exhaustively where the faster placements fail.
+const GRID_MAX_N: usize = 40;
+
 /// The least straight-line distance of two consecutive droplets of an `even` loop, in B.
 pub const EVEN_MIN_CHORD_B: f64 = 2.0 / 3.0;
 
@@ -253,7 +256,7 @@ impl<'a> EvenSpacing<'a> {
         if bad.is_empty() {
             return;
         }
-        if self.gates() {
+        if self.gates() || self.grid_search() {
             return;
         }
         self.rotate(&bad);
@@ -480,6 +483,97 @@ impl<'a> EvenSpacing<'a> {
             (self.anchors, self.dev, self.pts) = saved;
         }
         ok
+    }
+
+    /// Exhaustive search for short loops (n ≤ [`GRID_MAX_N`]), whose gaps have room to differ
+    /// (B/n each): every droplet on a grid of δ = min(B/n, B/24)/8 of arc from a first one at
+    /// each grid point of [0, B) (some droplet lies there in any placement), the next within
+    /// [B·(1 − 1/n), B] and at least 2/3 B away, round to the first again. True if found.
+    fn grid_search(&mut self) -> bool {
+        let n = self.n;
+        if n > GRID_MAX_N {
+            return false;
+        }
+        let (lo, hi) = (self.step - self.shrink, self.step + self.grow);
+        let length = self.arc.length();
+        let delta = (hi - lo).min(hi / 24.0) / 8.0;
+        if !(delta > 0.0) {
+            return false;
+        }
+        let cells = (length / delta).ceil() as usize + 1;
+        let (klo, khi) = (
+            |i: usize| ((i as f64 * lo).max(length - (n - i) as f64 * hi) / delta).ceil() as i64,
+            |i: usize| ((i as f64 * hi).min(length - (n - i) as f64 * lo) / delta).floor() as i64,
+        );
+        let starts = (hi / delta).ceil() as usize;
+        let mut pts = Vec::with_capacity(cells);
+        for s0 in 0..starts {
+            let t0 = s0 as f64 * delta;
+            pts.clear();
+            pts.extend((0..cells).map(|k| self.arc.point(t0 + k as f64 * delta)));
+            // prev[i][k − klo(i)]: the k of droplet i − 1 it is reached from.
+            let mut prev: Vec<Vec<i64>> = vec![vec![0]];
+            let mut ok = true;
+            for i in 1..n {
+                let (a, b) = (klo(i), khi(i));
+                if b < a {
+                    ok = false;
+                    break;
+                }
+                let (pa, pb) = (klo(i - 1).max(0), khi(i - 1));
+                let pa = if i == 1 { 0 } else { pa };
+                let pb = if i == 1 { 0 } else { pb };
+                let mut row = vec![-1i64; (b - a + 1) as usize];
+                for (r, k) in (a..=b).enumerate() {
+                    for j in pa..=pb {
+                        let reached = i == 1 || prev[i - 1][(j - pa) as usize] >= 0;
+                        let gap = (k - j) as f64 * delta;
+                        if reached
+                            && gap >= lo
+                            && gap <= hi
+                            && (k as usize) < cells
+                            && dist(pts[j as usize], pts[k as usize]) >= self.min_chord
+                        {
+                            row[r] = j;
+                            break;
+                        }
+                    }
+                }
+                if row.iter().all(|&x| x < 0) {
+                    ok = false;
+                    break;
+                }
+                prev.push(row);
+            }
+            if !ok {
+                continue;
+            }
+            // The last droplet back to the first.
+            let (a, b) = (klo(n - 1), khi(n - 1));
+            let last = (a..=b).find(|&k| {
+                let gap = length - k as f64 * delta;
+                prev[n - 1][(k - a) as usize] >= 0
+                    && gap >= lo
+                    && gap <= hi
+                    && dist(pts[k as usize], pts[0]) >= self.min_chord
+            });
+            let Some(mut k) = last else { continue };
+            let mut ks = vec![0i64; n];
+            for i in (1..n).rev() {
+                ks[i] = k;
+                k = prev[i][(k - klo(i)) as usize];
+            }
+            for i in 0..n {
+                let t = t0 + ks[i] as f64 * delta;
+                self.dev[i] = t - i as f64 * self.step;
+                self.pts[i] = pts[ks[i] as usize];
+            }
+            self.dev[n] = self.dev[0];
+            self.pts[n] = self.pts[0];
+            self.anchors = (0..=n).map(|i| (i, self.dev[i])).collect();
+            return true;
+        }
+        false
     }
 
     /// Turns every droplet along the loop by the same arc length (gaps unchanged) where that

@@ -152,19 +152,21 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
                 // Where a pair is too close, is there a placement at all? (see
                 // seams::infeasible_near)
                 let path = &lp[l.path];
-                let proven = (0..n)
-                    .filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL)
-                    .all(|j| {
-                        seams::infeasible_near(
-                            path,
-                            l.at[j] + l.arc[j] / 2.0,
-                            4.0 * B,
-                            (lower, B),
-                            2.0 / 3.0 * B,
-                            2e-3,
-                            2_000_000,
-                        )
-                    });
+                let proven = (n <= 50
+                    && seams::infeasible_loop(path, n, (lower, B), 2.0 / 3.0 * B, 1e-3))
+                    || (0..n)
+                        .filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL)
+                        .all(|j| {
+                            seams::infeasible_near(
+                                path,
+                                l.at[j] + l.arc[j] / 2.0,
+                                4.0 * B,
+                                (lower, B),
+                                2.0 / 3.0 * B,
+                                2e-3,
+                                2_000_000,
+                            )
+                        });
                 let only_chords = amin >= lower - ARC_TOL
                     && amax <= B + ARC_TOL
                     && cmax <= B + TOL
@@ -301,7 +303,15 @@ fn coverage_unchanged_and_sections_match_the_oracle() {
             (a.void_fraction - b.void_fraction).abs() <= 0.005,
             "{model}: void fraction"
         );
-        assert!(b.droplets < a.droplets, "{model}: no repeated droplets");
+        // n = ⌈L/B⌉ per loop, its arc length: a droplet more than the exact walk's (chords
+        // across corners are shorter than the arc) where one less is repeated. (No droplet
+        // repeated: even_spacing_on_shared_models.)
+        assert!(
+            (b.droplets as f64 - a.droplets as f64).abs() <= 0.001 * a.droplets as f64,
+            "{model}: droplets {} → {}",
+            a.droplets,
+            b.droplets
+        );
         let oracle: serde_json::Value = serde_json::from_str(
             &std::fs::read_to_string(
                 Path::new(env!("CARGO_MANIFEST_DIR"))

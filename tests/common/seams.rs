@@ -493,3 +493,58 @@ pub fn infeasible_near(
     }
     left > 0
 }
+
+/// A proof that no placement of n droplets round a whole (short) loop meets the bounds: arc
+/// gaps in [`lower`, `upper`], the seam's included, and every straight-line gap at least
+/// `min_chord`. Some droplet lies in any arc interval as long as `upper`, so the first is put
+/// in each cell of `cell` mm of [0, upper); the others in cells of the same grid from it,
+/// droplet by droplet (the set of cells each can reach), a pair of cells allowed where some
+/// points in them could meet the gap bounds and their centres' chord plus `cell` reaches
+/// `min_chord` (each point is within cell/2 of its cell's centre). True when no cell of the
+/// last droplet reaches back to the first: then no placement exists.
+pub fn infeasible_loop(
+    path: &LoopPath,
+    n: usize,
+    (lower, upper): (f64, f64),
+    min_chord: f64,
+    cell: f64,
+) -> bool {
+    let length = path.length;
+    let cells = (length / cell).ceil() as i64 + 2;
+    // Cell steps k' − k whose gaps could lie in [lower, upper].
+    let (smin, smax) = (
+        ((lower - cell) / cell).ceil() as i64,
+        ((upper + cell) / cell).floor() as i64,
+    );
+    let mut x0 = 0.0;
+    while x0 < upper {
+        let mid: Vec<P> = (0..cells)
+            .map(|k| path.point(x0 + (k as f64 + 0.5) * cell))
+            .collect();
+        let mut reach = vec![false; cells as usize];
+        reach[0] = true;
+        for _ in 1..n {
+            let mut next = vec![false; cells as usize];
+            for k in (0..cells).filter(|&k| reach[k as usize]) {
+                for s in smin..=smax {
+                    let j = k + s;
+                    if j < cells && d(mid[k as usize], mid[j as usize]) + cell >= min_chord {
+                        next[j as usize] = true;
+                    }
+                }
+            }
+            reach = next;
+        }
+        let closes = (0..cells).filter(|&k| reach[k as usize]).any(|k| {
+            let gap = length - k as f64 * cell;
+            gap + cell >= lower
+                && gap - cell <= upper
+                && d(mid[k as usize], mid[0]) + cell >= min_chord
+        });
+        if closes {
+            return false;
+        }
+        x0 += cell;
+    }
+    true
+}
