@@ -150,23 +150,28 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
             }
             if !wrong.is_empty() {
                 // Where a pair is too close, is there a placement at all? (see
-                // seams::infeasible_near)
+                // seams::infeasible_loop and seams::infeasible_in)
                 let path = &lp[l.path];
                 let proven = (n <= 50
                     && seams::infeasible_loop(path, n, (lower, B), 2.0 / 3.0 * B, 1e-3))
-                    || (0..n)
-                        .filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL)
-                        .all(|j| {
-                            seams::infeasible_near(
-                                path,
-                                l.at[j] + l.arc[j] / 2.0,
-                                4.0 * B,
-                                (lower, B),
-                                2.0 / 3.0 * B,
-                                2e-3,
-                                2_000_000,
-                            )
-                        });
+                    || (0..n).filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL).any(|j| {
+                        // Windows round the short pair, growing (a narrow bend conflicts with
+                        // another one up to many droplets away: the gaps may differ by B/n
+                        // each).
+                        let s = l.at[j] + l.arc[j] / 2.0;
+                        [4.0 * B, 1.0, 3.0, 8.0, 20.0]
+                            .into_iter()
+                            .filter(|&w| 2.0 * w < path.length - 2.0 * B)
+                            .any(|w| {
+                                seams::infeasible_in(
+                                    path,
+                                    (s - w, s + w),
+                                    (lower, B),
+                                    2.0 / 3.0 * B,
+                                    1e-4,
+                                )
+                            })
+                    });
                 let only_chords = amin >= lower - ARC_TOL
                     && amax <= B + ARC_TOL
                     && cmax <= B + TOL
@@ -245,8 +250,10 @@ fn even_spacing_on_shared_models() {
         }
         assert_eq!(f.seams_below_quarter_b, 0, "{model}: even seams < B/4");
         // Loops with no placement at all (two sharp bends closer than the spacing allows, proven
-        // by seams::infeasible_near) keep the best placement found: at most 0.5 % of the loops.
-        if f.infeasible.len() * 200 > f.loops {
+        // by seams::infeasible_loop or seams::infeasible_in) keep the best placement found: at
+        // most 1 % of the loops (0.1 % of 3DBenchy's, 0.5 % of the bunny's, on its noisy lower
+        // layers).
+        if f.infeasible.len() * 100 > f.loops {
             failures.push(format!(
                 "{model}: {} of {} loops proven infeasible",
                 f.infeasible.len(),
@@ -254,9 +261,9 @@ fn even_spacing_on_shared_models() {
             ));
         }
         // Loops the placement does not meet the bounds on and for which no proof was found
-        // (sharp bends on the bunny's noisy lower layers, a narrow V after a tight U-turn on
-        // 3DBenchy): a known weakness of the search (docs/quality.md), kept at most 1.25 %.
-        if f.bad.len() * 80 > f.loops {
+        // either (sharp bends close together on the bunny's noisy lower layers): the search
+        // or the proof falls short, a known weakness (docs/quality.md); at most 0.5 %.
+        if f.bad.len() * 200 > f.loops {
             failures.push(format!(
                 "{model}: {} of {} loops break the even bounds, e.g.\n{}",
                 f.bad.len(),

@@ -293,8 +293,9 @@ pub fn even_loops(
             ));
         }
         let ld = drops[i..i + n].to_vec();
-        // Arc positions: the first droplet's nearest projection, then each the least step
-        // forward from the one before (a point near a narrow bend is near both its sides).
+        // Arc positions: the first droplet's nearest projection, then each forward from the
+        // one before; where a droplet is on two parts of the path (the two sides of a bend
+        // narrower than the rounding, one place in space), the step nearest L/n.
         let mut arcs = Vec::with_capacity(n);
         for (j, &q) in ld.iter().enumerate() {
             let proj = path.on(q, ON_PATH);
@@ -307,10 +308,12 @@ pub fn even_loops(
                 proj[0]
             } else {
                 let prev: f64 = arcs[j - 1];
+                let nominal = path.length / n as f64;
                 proj.iter()
                     .map(|&s| (s - prev).rem_euclid(path.length))
                     .filter(|&f| f > 1e-7)
-                    .fold(f64::INFINITY, f64::min)
+                    .min_by(|a, b| (a - nominal).abs().total_cmp(&(b - nominal).abs()))
+                    .unwrap_or(f64::INFINITY)
                     + prev
             };
             if !a.is_finite() {
@@ -433,65 +436,47 @@ pub fn exact_stats(text: &str, b: f64) -> SeamStats {
     s
 }
 
-/// A proof that no placement of a loop meets the bounds near arc position `s`: every way to
-/// put consecutive droplets with arc gaps in [`lower`, `upper`] through the window
-/// [s − w/2, s + w/2] puts two of them closer than `min_chord` in a straight line. Branch and
-/// bound over cells of `cell` mm of arc: the first droplet at or after the window's start
-/// lies within `upper` of it; a pair of cells is ruled out where the chord of their centres
-/// plus `cell` (each point moves at most cell/2 along the path, so at most that in a straight
-/// line) is below `min_chord`. True when every branch is ruled out before leaving the window
-/// (a placement of the whole loop would give one that is not). Gives up (false) after
-/// `budget` cells.
-pub fn infeasible_near(
+/// A proof that no placement of a loop meets the bounds in the arc window [a, b]: every way
+/// to put consecutive droplets with arc gaps in [`lower`, `upper`] through it puts two of them
+/// closer than `min_chord` in a straight line. The first droplet at or after a lies within
+/// `upper` of it; the window is cut into cells of `cell` mm of arc from a, and the cells each
+/// next droplet can reach are found droplet by droplet (from all first cells at once), a pair
+/// of cells allowed where some points in them could meet the gap bounds and their centres'
+/// chord plus `cell` reaches `min_chord` (each point is within cell/2 of its centre). True
+/// when no droplet reaches past b: a placement of the whole loop would.
+pub fn infeasible_in(
     path: &LoopPath,
-    s: f64,
-    w: f64,
+    (a, b): (f64, f64),
     (lower, upper): (f64, f64),
     min_chord: f64,
     cell: f64,
-    budget: usize,
 ) -> bool {
-    let (a, end) = (s - w / 2.0, s + w / 2.0);
-    let mut left = budget;
-    // Depth-first: (cell start of the droplet).
-    fn open(
-        path: &LoopPath,
-        x: f64,
-        end: f64,
-        (lower, upper): (f64, f64),
-        min_chord: f64,
-        cell: f64,
-        left: &mut usize,
-    ) -> bool {
-        if x > end {
-            return true;
-        }
-        if *left == 0 {
-            return true;
-        }
-        *left -= 1;
-        let c = path.point(x + cell / 2.0);
-        // Next cells: gap (x2 − x) ± cell within [lower, upper].
-        let mut x2 = x + lower - cell;
-        while x2 - x - cell <= upper {
-            let c2 = path.point(x2 + cell / 2.0);
-            if d(c, c2) + cell >= min_chord
-                && open(path, x2, end, (lower, upper), min_chord, cell, left)
-            {
-                return true;
+    let cells = ((b - a) / cell).ceil() as usize + 1;
+    let mid: Vec<P> = (0..cells)
+        .map(|k| path.point(a + (k as f64 + 0.5) * cell))
+        .collect();
+    let (smin, smax) = (
+        ((lower - cell) / cell).ceil().max(1.0) as usize,
+        ((upper + cell) / cell).floor() as usize,
+    );
+    let first = ((upper / cell).ceil() as usize).min(cells);
+    let mut reach: Vec<usize> = (0..first).collect();
+    while !reach.is_empty() {
+        let mut next = vec![false; cells];
+        for &k in &reach {
+            for j in k + smin..=k + smax {
+                if j >= cells {
+                    // A droplet past b.
+                    return false;
+                }
+                if !next[j] && d(mid[k], mid[j]) + cell >= min_chord {
+                    next[j] = true;
+                }
             }
-            x2 += cell;
         }
-        false
+        reach = (0..cells).filter(|&j| next[j]).collect();
     }
-    let mut x = a;
-    while x < a + upper {
-        if open(path, x, end, (lower, upper), min_chord, cell, &mut left) {
-            return false;
-        }
-        x += cell;
-    }
-    left > 0
+    true
 }
 
 /// A proof that no placement of n droplets round a whole (short) loop meets the bounds: arc
