@@ -350,7 +350,7 @@ impl<'a> EvenSpacing<'a> {
         }
         let (shrink, grow) = (self.shrink, self.grow);
         // Intervals reachable at `to` (index j) from `from` sets.
-        let step_sets = |from: &[(usize, Vec<(f64, f64)>)], j: usize, allowed: (f64, f64)| {
+        let step_sets = |from: &[Reach], j: usize, allowed: (f64, f64)| {
             let mut out: Vec<(f64, f64)> = Vec::new();
             for (i, set) in from {
                 if *i > j {
@@ -375,8 +375,7 @@ impl<'a> EvenSpacing<'a> {
             for t in 0..=16 {
                 let d0 = lo0 + (hi0 - lo0) * t as f64 / 16.0;
                 // reach[g]: per option of gate g, its reachable deviations.
-                let mut table: Vec<Vec<(usize, Vec<(f64, f64)>)>> =
-                    vec![vec![(i0, vec![(d0, d0)])]];
+                let mut table: Vec<Vec<Reach>> = vec![vec![(i0, vec![(d0, d0)])]];
                 for g in 1..=k {
                     let (gi, shift) = if g == k { (0, n) } else { (g, 0) };
                     let mut row = Vec::new();
@@ -497,7 +496,7 @@ impl<'a> EvenSpacing<'a> {
         let (lo, hi) = (self.step - self.shrink, self.step + self.grow);
         let length = self.arc.length();
         let delta = (hi - lo).min(hi / 24.0) / 8.0;
-        if !(delta > 0.0) {
+        if delta.is_nan() || delta <= 0.0 {
             return false;
         }
         let cells = (length / delta).ceil() as usize + 1;
@@ -842,6 +841,9 @@ fn circle_exit(p: Point, q: Point, c: Point, r: f64) -> Option<Point> {
         .then(|| DVec2::new(p[0] + t * d[0], p[1] + t * d[1]))
 }
 
+/// A droplet index and the deviations it can have there (sorted disjoint intervals).
+type Reach = (usize, Vec<(f64, f64)>);
+
 /// Sorts and merges overlapping intervals.
 fn merge(v: &mut Vec<(f64, f64)>) {
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -883,13 +885,6 @@ mod tests {
             .map(Point::from)
             .into();
         assert_eq!(loop_droplets(&tri, 0.2, 0.0, true).len(), 1);
-    }
-
-    /// Gaps between consecutive droplets, the seam (last → first) included.
-    fn gaps(d: &[Point]) -> Vec<f64> {
-        (0..d.len())
-            .map(|i| dist(d[i], d[(i + 1) % d.len()]))
-            .collect()
     }
 
     /// Arc positions of droplets on a loop (the nearest projection, each forward of the last).

@@ -154,24 +154,26 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
                 let path = &lp[l.path];
                 let proven = (n <= 50
                     && seams::infeasible_loop(path, n, (lower, B), 2.0 / 3.0 * B, 1e-3))
-                    || (0..n).filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL).any(|j| {
-                        // Windows round the short pair, growing (a narrow bend conflicts with
-                        // another one up to many droplets away: the gaps may differ by B/n
-                        // each).
-                        let s = l.at[j] + l.arc[j] / 2.0;
-                        [4.0 * B, 1.0, 3.0, 8.0, 20.0]
-                            .into_iter()
-                            .filter(|&w| 2.0 * w < path.length - 2.0 * B)
-                            .any(|w| {
-                                seams::infeasible_in(
-                                    path,
-                                    (s - w, s + w),
-                                    (lower, B),
-                                    2.0 / 3.0 * B,
-                                    1e-4,
-                                )
-                            })
-                    });
+                    || (0..n)
+                        .filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL)
+                        .any(|j| {
+                            // Windows round the short pair, growing (a narrow bend conflicts with
+                            // another one up to many droplets away: the gaps may differ by B/n
+                            // each).
+                            let s = l.at[j] + l.arc[j] / 2.0;
+                            [4.0 * B, 1.0, 3.0, 8.0, 20.0]
+                                .into_iter()
+                                .filter(|&w| 2.0 * w < path.length - 2.0 * B)
+                                .any(|w| {
+                                    seams::infeasible_in(
+                                        path,
+                                        (s - w, s + w),
+                                        (lower, B),
+                                        2.0 / 3.0 * B,
+                                        1e-4,
+                                    )
+                                })
+                        });
                 let only_chords = amin >= lower - ARC_TOL
                     && amax <= B + ARC_TOL
                     && cmax <= B + TOL
