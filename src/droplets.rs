@@ -20,7 +20,9 @@
 //! start (chord below 2/3 B, sampled at L/128n) are found, and the deviation that puts the
 //! droplet before each interval in [b − B·(1 − 1/n), a] is propagated round the loop as
 //! intervals from samples of the first interval's; a start that reaches itself again gives the
-//! anchors. Failing that, the whole loop is turned (a droplet onto a corner tip) and droplets
+//! anchors. Failing that, loops of at most 64 droplets are searched on a grid of arc
+//! positions (exhaustively, from every first position), and failing that the whole loop is
+//! turned (a droplet onto a corner tip) and droplets
 //! near the worst pair are anchored one by one where they help. Where nothing helps (two sharp
 //! bends closer than the spacing allows) the best placement found is kept: rare (0–1 % of the
 //! loops of the shared models, docs/quality.md). Only loops that need it pay for the search.
@@ -64,7 +66,7 @@ pub fn loop_droplets_spaced(
 pub const EVEN_MIN_LENGTH_B: f64 = 3.0;
 
 /// The longest loop (droplets) searched exhaustively where the faster placements fail.
-const GRID_MAX_N: usize = 40;
+const GRID_MAX_N: usize = 64;
 
 /// The least straight-line distance of two consecutive droplets of an `even` loop, in B.
 pub const EVEN_MIN_CHORD_B: f64 = 2.0 / 3.0;
@@ -262,7 +264,8 @@ impl<'a> EvenSpacing<'a> {
         self.rotate(&bad);
         self.pin_bends();
         let mut stuck = vec![false; n];
-        let mut budget = 8 + 4 * bad.len();
+        // Bounded: each try costs O(n), and a loop of many hairpins must not hang the slicer.
+        let mut budget = (8 + 4 * bad.len()).min(200);
         while budget > 0 {
             budget -= 1;
             let worst = (0..n)
@@ -323,6 +326,10 @@ impl<'a> EvenSpacing<'a> {
     /// that reaches itself again is traced back. True if a placement was found and checked.
     fn gates(&mut self) -> bool {
         let n = self.n;
+        // (Sampling costs 384 points a droplet: loops up to 10 m.)
+        if n > 50_000 {
+            return false;
+        }
         let gates = self.bad_intervals();
         let lo_gap = self.step - self.shrink;
         if gates.is_empty() || gates.len() > 4 * n || gates.iter().any(|g| g.1 - g.0 > lo_gap) {
@@ -505,11 +512,13 @@ impl<'a> EvenSpacing<'a> {
             |i: usize| ((i as f64 * hi).min(length - (n - i) as f64 * lo) / delta).floor() as i64,
         );
         let starts = (hi / delta).ceil() as usize;
-        let mut pts = Vec::with_capacity(cells);
+        // Every droplet lies on the grid of δ from 0: the points once.
+        let all: Vec<Point> = (0..cells + starts)
+            .map(|k| self.arc.point(k as f64 * delta))
+            .collect();
         for s0 in 0..starts {
             let t0 = s0 as f64 * delta;
-            pts.clear();
-            pts.extend((0..cells).map(|k| self.arc.point(t0 + k as f64 * delta)));
+            let pts = &all[s0..];
             // prev[i][k − klo(i)]: the k of droplet i − 1 it is reached from.
             let mut prev: Vec<Vec<i64>> = vec![vec![0]];
             let mut ok = true;
