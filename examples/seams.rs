@@ -1,7 +1,9 @@
 //! Loop seams and voids, `loop_spacing` exact against even (the table of docs/quality.md):
 //! `cargo run --release --example seams -- MODEL...` (default: the four shared models the
 //! tests use). Seams are measured on the written code as tests/seams.rs does
-//! (tests/common/seams.rs); the void fraction is `--report`'s.
+//! (tests/common/seams.rs: `exact` loops end at their repeated first droplet, `even` loops are
+//! found on the layer's contour paths and their arc gaps measured along them); the void
+//! fraction is `--report`'s.
 #[path = "../tests/common/seams.rs"]
 mod seams;
 
@@ -22,9 +24,9 @@ fn main() {
         }
     }
     println!(
-        "| model | loop_spacing | loops (≥ 3 droplets) | seams < B/4 | smallest seam mm | gap min / mean mm | loops arc-spaced / with extra droplets | 3D void fraction | coverage |"
+        "| model | loop_spacing | loops (≥ 3 droplets) | seams < B/4 | min arc gap mm | min straight-line gap mm | loops adjusted | loops breaking a bound | 3D void fraction | coverage |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for path in &paths {
         let bytes = std::fs::read(path).expect("read model");
         let name = std::path::Path::new(path)
@@ -32,72 +34,70 @@ fn main() {
             .unwrap()
             .to_string_lossy()
             .into_owned();
-        let mut texts: Vec<String> = Vec::new();
         for even in [false, true] {
             let mut s = Settings::default();
             if even {
                 s.set("loop_spacing", "even").unwrap();
             }
             let b = s.droplet_width();
+            let h = s.layer_height;
             let job = Job::new(&bytes, &name, s).expect("job");
             let mut analysis = JobAnalysis::new(&job);
             let mut code = Vec::new();
             write_gcode_with(&job, &mut code, |_, _| {}, &mut analysis).expect("slice");
             let r = analysis.finish();
             let text = String::from_utf8(code).expect("text");
-            let mut st = seams::SeamStats::new();
-            let (mut arc, mut extra) = (0, 0);
-            let layers = seams::g26_layers(&text);
-            if !even {
-                for l in &layers {
-                    for lp in seams::exact_loops(l, b) {
-                        st.add(&lp, b);
-                    }
-                }
+            let row = if !even {
+                let st = seams::exact_stats(&text, b);
+                format!(
+                    "{} | {:.1} % | {:.4} (the seam) | {:.4} | – | – ",
+                    st.loops,
+                    100.0 * st.close_share(),
+                    st.min_seam,
+                    st.min_chord
+                )
             } else {
-                let exact_layers = seams::g26_layers(&texts[0]);
-                for (l, e) in layers.iter().zip(&exact_layers) {
-                    let el = seams::exact_loops(e, b);
-                    let starts: Vec<_> = el.iter().map(|l| l.points[0]).collect();
-                    let n: std::collections::HashMap<_, _> = el
-                        .iter()
-                        .map(|l| (seams::key(l.points[0]), l.points.len()))
-                        .collect();
-                    for lp in seams::loops_from_starts(l, &starts).expect("loops") {
-                        let g = lp.gaps();
-                        if g.is_empty() {
-                            continue;
-                        }
-                        st.add(&lp, b);
-                        let inner = &g[..g.len() - 1];
-                        let (lo, hi) = inner
-                            .iter()
-                            .fold((f64::MAX, 0f64), |(a, c), &x| (a.min(x), c.max(x)));
-                        if hi - lo > 2.0 * seams::TOL {
-                            arc += 1;
-                        } else if lp.points.len() > n[&seams::key(lp.points[0])] {
-                            extra += 1;
-                        }
+                let lp = seams::loop_paths(&job);
+                let (mut loops, mut below, mut adjusted, mut bad) = (0, 0, 0, 0);
+                let (mut min_arc, mut min_chord) = (f64::INFINITY, f64::INFINITY);
+                for (z, drops) in seams::g26_layers_z(&text) {
+                    let i = (z / h).round() as usize - 1;
+                    let ms = seams::even_loops(
+                        &drops,
+                        &lp[i],
+                        b,
+                        dropslice::droplets::EVEN_MIN_LENGTH_B * b,
+                    )
+                    .expect("loops");
+                    for m in ms {
+                        let n = m.drops.len();
+                        loops += 1;
+                        let amin = m.arc.iter().cloned().fold(f64::INFINITY, f64::min);
+                        let amax = m.arc.iter().cloned().fold(0f64, f64::max);
+                        let cmin = m.chord.iter().cloned().fold(f64::INFINITY, f64::min);
+                        min_arc = min_arc.min(amin);
+                        min_chord = min_chord.min(cmin);
+                        below += usize::from(m.chord[n - 1] < b / 4.0);
+                        adjusted += usize::from(amax - amin > 2.0 * seams::TOL);
+                        let lower = b * (1.0 - 1.0 / n as f64);
+                        bad += usize::from(
+                            amin < lower - 2.5e-4
+                                || amax > b + 2.5e-4
+                                || cmin < 2.0 / 3.0 * b - seams::TOL,
+                        );
                     }
                 }
-            }
+                format!(
+                    "{loops} | {:.1} % | {min_arc:.4} | {min_chord:.4} | {adjusted} | {bad} ",
+                    100.0 * below as f64 / loops.max(1) as f64
+                )
+            };
             println!(
-                "| {name} | {} | {} | {:.1} % | {:.4} | {:.4} / {:.4} | {} | {:.4} | {:.4} |",
+                "| {name} | {} | {row}| {:.4} | {:.4} |",
                 if even { "even" } else { "exact" },
-                st.loops,
-                100.0 * st.close_share(),
-                st.min_seam,
-                st.min_gap,
-                st.mean_gap(),
-                if even {
-                    format!("{arc} / {extra}")
-                } else {
-                    "–".into()
-                },
                 r.part.void_fraction,
                 r.part.coverage
             );
-            texts.push(text);
         }
     }
 }
