@@ -37,7 +37,7 @@ pub fn overhang_area(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> f
         return 0.0;
     }
     let d = s.overhang_limit * s.droplet_width();
-    if below.is_empty() || !(d > 2.0 * CHORD_TOLERANCE_MM) || !d.is_finite() {
+    if below.is_empty() || !d.is_finite() || d <= 2.0 * CHORD_TOLERANCE_MM {
         return region_area(&overhang(region, Some(below), s));
     }
     one_pass(region, below, d).unwrap_or_else(|| region_area(&overhang(region, Some(below), s)))
