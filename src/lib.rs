@@ -28,6 +28,7 @@ pub mod import;
 pub mod job;
 pub mod mesh;
 pub mod offset;
+pub mod overhang;
 pub mod plan;
 pub mod preview;
 pub mod settings;
@@ -591,8 +592,7 @@ impl Job {
                 Some(&sliced)
             }
         };
-        let over = support::overhang(&section.region, below, &self.settings);
-        plan.unsupported_area = geom::region_area(&over);
+        plan.unsupported_area = overhang::overhang_area(&section.region, below, &self.settings);
         (plan, region)
     }
 

@@ -331,6 +331,7 @@ impl Session {
             job,
             settings,
             unit_after: std::cell::Cell::new(None),
+            last_section: std::cell::RefCell::new(None),
         }
     }
 
@@ -339,7 +340,20 @@ impl Session {
     /// unit of work come in order), else [`Job::unit_before`] (which plans the layers below
     /// again, only when the job uses unit 1).
     fn planned(&self, i: usize) -> (LayerPlan, crate::geom::Shapes, String) {
-        let (plan, region) = self.job.plan_layer_and_region(i);
+        let (plan, region) = if self.job.needs_below() {
+            // The overhang figure needs the layer below's section: the one this session sliced
+            // last when that was layer i − 1 (a unit of work's layers come in order), else
+            // `plan_layer_with` slices it (once per unit of work).
+            let section = self.job.section(i);
+            let mine = section.region.clone();
+            let mut last = self.last_section.borrow_mut();
+            let below = last.take().filter(|(j, _)| j + 1 == i).map(|(_, r)| r);
+            let planned = self.job.plan_layer_with(i, section, below.as_ref());
+            *last = Some((i, mine));
+            planned
+        } else {
+            self.job.plan_layer_and_region(i)
+        };
         let before = match self.unit_after.get() {
             Some((j, u)) if j + 1 == i => u,
             _ => self.job.unit_before(i),
@@ -366,6 +380,9 @@ pub struct Session {
     pub(crate) settings: Settings,
     /// The last layer planned and the unit selected after it.
     unit_after: std::cell::Cell<Option<(usize, u8)>>,
+    /// The last layer planned with support off and its section's region (the overhang figure
+    /// of the next layer needs it).
+    last_section: std::cell::RefCell<Option<(usize, crate::geom::Shapes)>>,
 }
 
 #[wasm_bindgen]

@@ -681,6 +681,54 @@ fn units_of_work_in_different_sessions_join_with_the_right_t_lines() {
     assert!(changes >= 2, "{changes} unit changes");
 }
 
+#[wasm_bindgen_test]
+fn the_overhang_figure_is_the_same_in_any_order_of_layers() {
+    // A 2 × 2 mm post under a 6 × 2 mm slab reaching 2 mm beyond it on both sides in x, support
+    // off: only the slab's first layer overhangs, by the slab less the post grown by
+    // d = overhang_limit·B (cut to the slab's width in y: straight edges only), 12 − 2·(2 + 2d)
+    // mm². A session keeps the section it planned last for the next layer's figure; layers
+    // out of order or in blocks must give the same figures.
+    let post = box_stl(2.0, 2.0, 3.0);
+    let slab = moved_facets(&box_stl(6.0, 2.0, 1.0), -2.0, 0.0, 3.0);
+    let stl = post.replace("endsolid box\n", &slab) + "endsolid box\n";
+    let settings = js(serde_json::json!({"layer_height": 0.25}));
+    let whole = Session::new(stl.as_bytes(), "t.stl", settings.clone()).unwrap();
+    let n = whole.layer_count();
+    let areas: Vec<f64> = (0..n)
+        .map(|i| whole.slice_layer(i).unwrap().unsupported_area())
+        .collect();
+    let info = json(whole.info().unwrap());
+    let d = 0.5 * info["droplet_width"].as_f64().unwrap();
+    let over: Vec<usize> = (0..n).filter(|&i| areas[i] > 1e-9).collect();
+    assert_eq!(over.len(), 1, "{areas:?}");
+    let want = 12.0 - 2.0 * (2.0 + 2.0 * d);
+    assert!(
+        (areas[over[0]] - want).abs() < 1e-6,
+        "{} ≠ {want}",
+        areas[over[0]]
+    );
+    // Out of order, repeated, and in blocks of 3 in one other session.
+    let other = Session::new(stl.as_bytes(), "t.stl", settings).unwrap();
+    let k = over[0];
+    for i in [k, k - 1, k, k + 1, k + 1, 0, n - 1, k - 2, k] {
+        assert_eq!(
+            other.slice_layer(i).unwrap().unsupported_area(),
+            areas[i],
+            "layer {i}"
+        );
+    }
+    for start in (0..n).rev().step_by(3) {
+        let block = start.saturating_sub(2)..start + 1;
+        for (i, &want) in areas.iter().enumerate().take(block.end).skip(block.start) {
+            assert_eq!(
+                other.slice_layer(i).unwrap().unsupported_area(),
+                want,
+                "layer {i}"
+            );
+        }
+    }
+}
+
 /// The message of an error the `.gco` facade throws (a JS `Error`, as `JsError` makes it).
 fn error_message(e: JsValue) -> String {
     assert!(e.is_instance_of::<js_sys::Error>(), "an Error: {e:?}");
