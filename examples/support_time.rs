@@ -38,6 +38,9 @@ fn main() {
         t.elapsed().as_secs_f64(),
         layers.iter().map(|l| points(&l.region)).sum::<usize>()
     );
+    if std::env::var_os("REGIONS_ONLY").is_some() {
+        return;
+    }
     if std::env::var_os("AREAS").is_some() {
         for (i, l) in layers.iter().enumerate() {
             if i % 10 == 0 || l.unsupported_area > 5.0 {

@@ -10,6 +10,7 @@
 
 use crate::geom::{DVec2, Point, Shapes, all_contours, dist, round_output, segment_distance2};
 use crate::grid::EdgeIndex;
+use crate::plan::{Move, MoveKind};
 use crate::settings::Settings;
 use std::collections::HashMap;
 
@@ -79,8 +80,8 @@ impl Grid {
 
     fn key(&self, p: Point) -> (i64, i64) {
         (
-            ((p.x - self.min.x) / self.cell).floor() as i64,
-            ((p.y - self.min.y) / self.cell).floor() as i64,
+            floor((p.x - self.min.x) / self.cell),
+            floor((p.y - self.min.y) / self.cell),
         )
     }
 
@@ -105,6 +106,27 @@ impl Grid {
             }
         }
         None
+    }
+}
+
+/// ⌊x⌋ for |x| < 2⁶³ (without a call into the maths library: this runs per droplet).
+fn floor(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
+}
+
+/// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
+/// order they are set.
+pub fn droplets_of(moves: &[Move], b: f64, b1: f64, out: &mut Vec<Droplet>) {
+    let mut at = Point::ZERO;
+    for m in moves {
+        let w = if m.unit == 1 { b1 } else { b };
+        match m.kind {
+            MoveKind::Droplet => out.push((m.to, w)),
+            MoveKind::Line => out.extend(crate::geom::line_droplets(at, m.to, w).map(|p| (p, w))),
+            MoveKind::Travel => {}
+        }
+        at = m.to;
     }
 }
 
@@ -229,18 +251,19 @@ pub struct PassFigures {
 }
 
 /// The unit-1 droplets to add to each layer so that every droplet above the first layer is
-/// supported: `droplets[i]` are layer i's planned droplets (both units), `regions[i]` its
-/// part's region. Works top-down; an added droplet needs support from the layer below as any
-/// other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with no
-/// such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
+/// supported: `droplets(i, out)` appends layer i's planned droplets (both units) to `out`
+/// (called about twice per layer, so that no layer's droplets need be kept), `regions[i]` is
+/// its part's region. Works top-down; an added droplet needs support from the layer below as
+/// any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
+/// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
 /// support deliberately stops below overhangs, and the pass adds nothing.
 pub fn complete(
-    droplets: &[&[Droplet]],
+    droplets: &(dyn Fn(usize, &mut Vec<Droplet>) + Sync),
     regions: &[Shapes],
     s: &Settings,
     par_map: impl Fn(usize, &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>>,
 ) -> (Vec<Vec<Point>>, PassFigures) {
-    let n = droplets.len();
+    let n = regions.len();
     let mut extra: Vec<Vec<Point>> = vec![Vec::new(); n];
     let mut figures = PassFigures::default();
     if n < 2 || s.support_gap_z > 0 {
@@ -256,42 +279,72 @@ pub fn complete(
         if i == 0 {
             return Vec::new();
         }
-        let below = Grid::new(cell, droplets[i - 1]);
+        let mut buf = Vec::new();
+        droplets(i - 1, &mut buf);
+        let below = Grid::new(cell, &buf);
+        buf.clear();
+        droplets(i, &mut buf);
         // Consecutive droplets are neighbours: the droplet below that supported the last one
         // most often supports the next.
         let mut last: Option<Droplet> = None;
-        droplets[i]
-            .iter()
-            .copied()
-            .filter(|&(p, _)| {
-                if let Some((q, w)) = last {
-                    let r = reach(w);
-                    if (p - q).length_squared() <= r * r {
-                        return false;
-                    }
+        buf.retain(|&(p, _)| {
+            if let Some((q, w)) = last {
+                let r = reach(w);
+                if (p - q).length_squared() <= r * r {
+                    return false;
                 }
-                match below.find_within(p, reach) {
-                    Some(d) => {
-                        last = Some(d);
-                        false
-                    }
-                    None => true,
+            }
+            match below.find_within(p, reach) {
+                Some(d) => {
+                    last = Some(d);
+                    false
                 }
-            })
-            .collect()
+                None => true,
+            }
+        });
+        buf.shrink_to_fit();
+        buf
     });
     let gap = s.support_gap_xy * b;
     let place = reach(b1) - MARGIN_MM;
+    let mut buf = Vec::new();
     // Top-down: layer i's unsupported droplets (planned or added) get droplets in layer i − 1.
     for i in (1..n).rev() {
         let mut todo: Vec<Droplet> = open[i].clone();
         if !extra[i].is_empty() {
-            let below = Grid::new(cell, droplets[i - 1]);
+            // The droplets added to layer i against layer i − 1's planned droplets: few, so
+            // the layer's droplets are scanned once (a grid only for many).
+            buf.clear();
+            droplets(i - 1, &mut buf);
+            let adds: Vec<Droplet> = extra[i].iter().map(|&p| (p, b1)).collect();
+            let mut held = vec![false; adds.len()];
+            if adds.len() > 16 {
+                let below = Grid::new(cell, &buf);
+                for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                    *h = below.any_within(p, reach);
+                }
+            } else {
+                let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+                for (p, _) in &adds {
+                    lo = lo.min(*p);
+                    hi = hi.max(*p);
+                }
+                let (lo, hi) = (lo - DVec2::splat(cell), hi + DVec2::splat(cell));
+                for &(q, w) in &buf {
+                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
+                        continue;
+                    }
+                    let r = reach(w);
+                    for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                        *h = *h || (p - q).length_squared() <= r * r;
+                    }
+                }
+            }
             todo.extend(
-                extra[i]
-                    .iter()
-                    .map(|&p| (p, b1))
-                    .filter(|&(p, _)| !below.any_within(p, reach)),
+                adds.iter()
+                    .zip(&held)
+                    .filter(|(_, h)| !**h)
+                    .map(|(d, _)| *d),
             );
         }
         if todo.is_empty() {
@@ -345,8 +398,13 @@ mod tests {
         regions: &[Shapes],
         s: &Settings,
     ) -> (Vec<Vec<Point>>, PassFigures) {
-        let refs: Vec<&[Droplet]> = droplets.iter().map(|v| &v[..]).collect();
-        complete(&refs, regions, s, serial)
+        assert_eq!(droplets.len(), regions.len());
+        complete(
+            &|i, out: &mut Vec<Droplet>| out.extend_from_slice(&droplets[i]),
+            regions,
+            s,
+            serial,
+        )
     }
 
     fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
