@@ -109,69 +109,6 @@ impl Grid {
     }
 }
 
-/// A sufficient test of the rule on a raster: a cell is marked when a droplet lies in it or
-/// in one of its 8 neighbours. Cells are (r/2√2) wide for the least reach r of any droplet,
-/// so every point of a marked cell lies within that reach of the droplet (two cells apart at
-/// most in x and in y): a droplet in a marked cell is supported without a search. Most
-/// droplets of a layer lie over the layer below's droplets and are settled by one look-up.
-struct Cover {
-    min: Point,
-    cell: f64,
-    nx: usize,
-    ny: usize,
-    marked: Vec<bool>,
-}
-
-impl Cover {
-    /// `None` when the layer's droplets are too sparse for a raster of their box to pay.
-    fn new(droplets: &[Droplet], least_reach: f64) -> Option<Cover> {
-        if droplets.is_empty() || !(least_reach > 0.0) {
-            return None;
-        }
-        let cell = least_reach / (2.0 * std::f64::consts::SQRT_2);
-        let mut min = DVec2::INFINITY;
-        let mut max = DVec2::NEG_INFINITY;
-        for (p, _) in droplets {
-            min = min.min(*p);
-            max = max.max(*p);
-        }
-        let (wx, wy) = ((max.x - min.x) / cell, (max.y - min.y) / cell);
-        // About 64 cells per droplet at most (a dense layer has fewer than 10).
-        if !(wx.is_finite() && wy.is_finite()) || (wx + 3.0) * (wy + 3.0) > 64.0 * droplets.len() as f64 {
-            return None;
-        }
-        // A cell of margin on every side: the neighbours of every droplet's cell exist.
-        let min = min - DVec2::splat(cell);
-        let nx = wx as usize + 3;
-        let ny = wy as usize + 3;
-        let mut marked = vec![false; nx * ny];
-        for (p, _) in droplets {
-            let x = ((p.x - min.x) / cell) as usize;
-            let y = ((p.y - min.y) / cell) as usize;
-            for row in y - 1..=y + 1 {
-                marked[row * nx + x - 1..=row * nx + x + 1].fill(true);
-            }
-        }
-        Some(Cover {
-            min,
-            cell,
-            nx,
-            ny,
-            marked,
-        })
-    }
-
-    /// Whether `p` lies in a marked cell (then a droplet lies within the least reach of it).
-    fn covers(&self, p: Point) -> bool {
-        let (fx, fy) = ((p.x - self.min.x) / self.cell, (p.y - self.min.y) / self.cell);
-        if !(fx >= 0.0 && fy >= 0.0) {
-            return false;
-        }
-        let (x, y) = (fx as usize, fy as usize);
-        x < self.nx && y < self.ny && self.marked[y * self.nx + x]
-    }
-}
-
 /// ⌊x⌋ for |x| < 2⁶³ (without a call into the maths library: this runs per droplet).
 fn floor(x: f64) -> i64 {
     let t = x as i64;
@@ -484,21 +421,15 @@ pub fn complete(
         if i == 0 {
             return Vec::new();
         }
-        let mut below_buf = Vec::new();
-        droplets(i - 1, &mut below_buf);
-        // Kept within the margin: the written positions are rounded.
-        let cover = Cover::new(&below_buf, reach(b.min(b1)) - MARGIN_MM);
-        let mut grid: Option<Grid> = None;
         let mut buf = Vec::new();
+        droplets(i - 1, &mut buf);
+        let below = Grid::new(cell, &buf);
+        buf.clear();
         droplets(i, &mut buf);
         // Consecutive droplets are neighbours: the droplet below that supported the last one
         // most often supports the next.
         let mut last: Option<Droplet> = None;
         buf.retain(|&(p, _)| {
-            if cover.as_ref().is_some_and(|c| c.covers(p)) {
-                return false;
-            }
-            let below = grid.get_or_insert_with(|| Grid::new(cell, &below_buf));
             if let Some((q, w)) = last {
                 let r = reach(w);
                 if (p - q).length_squared() <= r * r {
