@@ -447,8 +447,10 @@ impl Job {
             );
             drop(sections);
             // Each layer's part plan and unit 1's hatch moves.
-            let parts: Vec<std::sync::Mutex<Option<(LayerPlan, geom::Shapes)>>> =
-                parts.into_iter().map(|p| std::sync::Mutex::new(Some(p))).collect();
+            let parts: Vec<std::sync::Mutex<Option<(LayerPlan, geom::Shapes)>>> = parts
+                .into_iter()
+                .map(|p| std::sync::Mutex::new(Some(p)))
+                .collect();
             let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> =
                 support::par_map(n, &|i| {
                     let (mut p, own) = parts[i]

@@ -310,9 +310,9 @@ pub fn support_layers(
         regions[i]
             .iter()
             .map(|s| {
-                let mut c = s.contours().map(|c| {
-                    crate::slice::simplify_closed(c, SUPPORT_TOLERANCE_MM)
-                });
+                let mut c = s
+                    .contours()
+                    .map(|c| crate::slice::simplify_closed(c, SUPPORT_TOLERANCE_MM));
                 let outer = c.next().unwrap_or_default();
                 Shape::new(outer, c.collect())
             })

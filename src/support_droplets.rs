@@ -232,7 +232,12 @@ pub struct LineGaps<'a> {
 
 impl<'a> LineGaps<'a> {
     /// For lines at `angle_deg`, about `spacing` apart.
-    pub fn new(edges: &'a [(Point, Point)], gap: f64, angle_deg: f64, spacing: f64) -> LineGaps<'a> {
+    pub fn new(
+        edges: &'a [(Point, Point)],
+        gap: f64,
+        angle_deg: f64,
+        spacing: f64,
+    ) -> LineGaps<'a> {
         let (sin, cos) = crate::geom::sin_cos_deg(angle_deg);
         let across = |p: Point| -sin * p.x + cos * p.y;
         let band = spacing.max(gap).max(1e-3);
