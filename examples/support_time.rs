@@ -1,6 +1,7 @@
 //! Times the support computation's stages on a model (docs/performance.md, "Support"):
 //! `cargo run --release --example support_time -- MODEL.stl`; `AREAS=1` also prints the
-//! overhang and support areas of some layers.
+//! overhang and support areas of some layers; `REGIONS_ONLY=1` stops after the support
+//! regions (for a profiler).
 use dropslice::geom::{Shapes, region_area};
 use dropslice::support::{self, overhang, par_map};
 use dropslice::{Job, Settings};
@@ -38,6 +39,9 @@ fn main() {
         t.elapsed().as_secs_f64(),
         layers.iter().map(|l| points(&l.region)).sum::<usize>()
     );
+    if std::env::var_os("REGIONS_ONLY").is_some() {
+        return;
+    }
     if std::env::var_os("AREAS").is_some() {
         for (i, l) in layers.iter().enumerate() {
             if i % 10 == 0 || l.unsupported_area > 5.0 {
@@ -52,7 +56,7 @@ fn main() {
         }
     }
     let t = Instant::now();
-    let _p: Vec<usize> = par_map(n, &|i| {
+    let hatch: Vec<Vec<dropslice::plan::Move>> = par_map(n, &|i| {
         dropslice::plan::support_moves(
             &layers[i].region,
             &regions[i],
@@ -61,14 +65,29 @@ fn main() {
             &s,
             Default::default(),
         )
-        .len()
     });
     println!("support hatch   {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let _p: Vec<usize> = par_map(n, &|i| {
-        dropslice::plan::plan_layer(&regions[i], i, &s).moves.len()
-    });
+    let parts: Vec<dropslice::plan::LayerPlan> =
+        par_map(n, &|i| dropslice::plan::plan_layer(&regions[i], i, &s));
     println!("part plans      {:.3} s", t.elapsed().as_secs_f64());
+    let t = Instant::now();
+    let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+    let (_extra, pass) = dropslice::support_droplets::complete(
+        &|i, out: &mut Vec<dropslice::support_droplets::Droplet>| {
+            dropslice::support_droplets::droplets_of(&parts[i].moves, b, b1, out);
+            dropslice::support_droplets::droplets_of(&hatch[i], b, b1, out);
+        },
+        &regions,
+        &s,
+        |n, f| par_map(n, f),
+    );
+    println!(
+        "droplet pass    {:.3} s ({} droplets added)",
+        t.elapsed().as_secs_f64(),
+        pass.added
+    );
+    drop((hatch, parts));
     // The job's own pass: sections, support regions, all plans and the droplet pass.
     let t = Instant::now();
     let pass = job.supported_pass();

@@ -440,51 +440,49 @@ impl Job {
             let s = &self.settings;
             let sections = support::par_map(n, &|i| self.section(i));
             let regions: Vec<geom::Shapes> = sections.iter().map(|x| x.region.clone()).collect();
-            let layers = support::support_layers(&regions, s, |n, f| support::par_map(n, f));
-            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
-            let droplets = |moves: &[plan::Move], out: &mut Vec<support_droplets::Droplet>| {
-                let mut at = geom::Point::ZERO;
-                for m in moves {
-                    let w = if m.unit == 1 { b1 } else { b };
-                    match m.kind {
-                        plan::MoveKind::Droplet => out.push((m.to, w)),
-                        plan::MoveKind::Line => {
-                            out.extend(geom::line_droplets(at, m.to, w).map(|p| (p, w)))
-                        }
-                        plan::MoveKind::Travel => {}
-                    }
-                    at = m.to;
-                }
-            };
-            // Each layer's part plan, unit 1's hatch moves and all their droplets.
-            type Planned = (
-                LayerPlan,
-                geom::Shapes,
-                Vec<plan::Move>,
-                Vec<support_droplets::Droplet>,
+            // The support regions (their top-down union is sequential) beside the parts' own
+            // plans, which do not depend on them.
+            let (layers, parts) = both(
+                || support::support_layers(&regions, s, |n, f| support::par_map(n, f)),
+                || support::par_map(n, &|i| self.plan_parts(i, &sections[i])),
             );
-            let planned: Vec<Planned> = support::par_map(n, &|i| {
-                let section = &sections[i];
-                let (mut p, own) = self.plan_parts(i, section);
-                p.unsupported_area = layers[i].unsupported_area;
-                let start = plan::unit1_start(&p, s);
-                let moves =
-                    plan::support_moves(&layers[i].region, &section.region, &[], i, s, start);
-                let mut all = Vec::new();
-                droplets(&p.moves, &mut all);
-                droplets(&moves, &mut all);
-                (p, own, moves, all)
-            });
+            drop(sections);
+            // Each layer's part plan and unit 1's hatch moves.
+            let parts: Vec<std::sync::Mutex<Option<(LayerPlan, geom::Shapes)>>> = parts
+                .into_iter()
+                .map(|p| std::sync::Mutex::new(Some(p)))
+                .collect();
+            let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> =
+                support::par_map(n, &|i| {
+                    let (mut p, own) = parts[i]
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .take()
+                        .expect("each layer is taken once");
+                    p.unsupported_area = layers[i].unsupported_area;
+                    let start = plan::unit1_start(&p, s);
+                    let moves =
+                        plan::support_moves(&layers[i].region, &regions[i], &[], i, s, start);
+                    (p, own, moves)
+                });
+            drop(parts);
             drop(layers);
-            let (extra, figures) = {
-                let all: Vec<&[support_droplets::Droplet]> =
-                    planned.iter().map(|p| &p.3[..]).collect();
-                support_droplets::complete(&all, &regions, s, |n, f| support::par_map(n, f))
-            };
+            // The droplet-level pass reads each layer's droplets from its moves when it needs
+            // them (no list of all droplets is kept).
+            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+            let (extra, figures) = support_droplets::complete(
+                &|i, out: &mut Vec<support_droplets::Droplet>| {
+                    support_droplets::droplets_of(&planned[i].0.moves, b, b1, out);
+                    support_droplets::droplets_of(&planned[i].2, b, b1, out);
+                },
+                &regions,
+                s,
+                |n, f| support::par_map(n, f),
+            );
             let plans = planned
                 .into_iter()
                 .enumerate()
-                .map(|(i, (mut p, region, mut moves, _))| {
+                .map(|(i, (mut p, region, mut moves))| {
                     if !extra[i].is_empty() {
                         let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
                         let none = geom::Shapes::new();
@@ -1106,8 +1104,15 @@ where
                     if stop.load(Ordering::Relaxed) {
                         break;
                     }
-                    let section =
-                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| job.section(i)));
+                    // With support on, the plan comes from the supported pass, which sliced
+                    // every layer already: no section here.
+                    let section = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        if needs_below {
+                            job.section(i)
+                        } else {
+                            Section::default()
+                        }
+                    }));
                     if needs_below {
                         let mine = section
                             .as_ref()

@@ -431,25 +431,25 @@ pub fn support_moves(
             Some((b1, 0.0, 0.0)),
         );
         let edges = crate::support_droplets::edges_of(part);
-        let clear = crate::support_droplets::Clearance::new(
+        let gaps = crate::support_droplets::LineGaps::new(
             &edges,
             s.support_gap_xy * s.droplet_width(),
-            b1,
+            hatch_angle(s, index),
+            b1 / s1.fill_density,
         );
         let mut runs = Vec::with_capacity(lines.len());
+        let mut near = Vec::new();
         for l in lines {
             let mut run: Option<(Point, Point)> = None;
-            // Droplets within `free` of the last one checked keep the gap too.
-            let mut free = f64::NEG_INFINITY;
-            let mut from = l.a;
-            for p in line_droplets(l.a, l.b, b1) {
-                let ok = if dist(p, from) < free {
-                    true
-                } else {
-                    from = p;
-                    free = clear.slack(p, 8.0 * b1);
-                    free > 0.0
-                };
+            // Where along the line the part is within the gap (sorted intervals).
+            gaps.intervals(l.a, l.b, &mut near);
+            let mut k = 0;
+            for (j, p) in line_droplets(l.a, l.b, b1).enumerate() {
+                let t = j as f64 * b1;
+                while k < near.len() && near[k].1 < t {
+                    k += 1;
+                }
+                let ok = !(k < near.len() && near[k].0 <= t);
                 if ok {
                     run = Some(run.map_or((p, p), |(a, _)| (a, p)));
                 } else if let Some((a, b)) = run.take() {

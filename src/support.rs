@@ -303,6 +303,21 @@ pub fn support_layers(
     let grown: Vec<Shapes> = par_map(n, &|i| {
         grow_within(&overhangs[i], reach, SUPPORT_TOLERANCE_MM)
     });
+    // The part as it clips the need, outlines simplified within the support's tolerance
+    // (fewer points for the sequential union below; the gap to the true part is kept droplet
+    // by droplet when the support is planned).
+    let clips = par_map(n, &|i| {
+        regions[i]
+            .iter()
+            .map(|s| {
+                let mut c = s
+                    .contours()
+                    .map(|c| crate::slice::simplify_closed(c, SUPPORT_TOLERANCE_MM));
+                let outer = c.next().unwrap_or_default();
+                Shape::new(outer, c.collect())
+            })
+            .collect()
+    });
     // Top-down: what the layers above still need carried (the part below carries what it
     // covers).
     let mut needs = vec![Shapes::new(); n];
@@ -311,7 +326,7 @@ pub fn support_layers(
         if need.is_empty() && grown[i + 1].is_empty() {
             continue;
         }
-        need = carried(&need, &grown[i + 1], &regions[i]);
+        need = carried(&need, &grown[i + 1], &clips[i]);
         needs[i] = need.clone();
     }
     // The gap to the part in the layer is kept droplet by droplet when the region is planned

@@ -10,6 +10,7 @@
 
 use crate::geom::{DVec2, Point, Shapes, all_contours, dist, round_output, segment_distance2};
 use crate::grid::EdgeIndex;
+use crate::plan::{Move, MoveKind};
 use crate::settings::Settings;
 use std::collections::HashMap;
 
@@ -79,8 +80,8 @@ impl Grid {
 
     fn key(&self, p: Point) -> (i64, i64) {
         (
-            ((p.x - self.min.x) / self.cell).floor() as i64,
-            ((p.y - self.min.y) / self.cell).floor() as i64,
+            floor((p.x - self.min.x) / self.cell),
+            floor((p.y - self.min.y) / self.cell),
         )
     }
 
@@ -105,6 +106,27 @@ impl Grid {
             }
         }
         None
+    }
+}
+
+/// ⌊x⌋ for |x| < 2⁶³ (without a call into the maths library: this runs per droplet).
+fn floor(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x { t - 1 } else { t }
+}
+
+/// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
+/// order they are set.
+pub fn droplets_of(moves: &[Move], b: f64, b1: f64, out: &mut Vec<Droplet>) {
+    let mut at = Point::ZERO;
+    for m in moves {
+        let w = if m.unit == 1 { b1 } else { b };
+        match m.kind {
+            MoveKind::Droplet => out.push((m.to, w)),
+            MoveKind::Line => out.extend(crate::geom::line_droplets(at, m.to, w).map(|p| (p, w))),
+            MoveKind::Travel => {}
+        }
+        at = m.to;
     }
 }
 
@@ -180,21 +202,6 @@ impl<'a> Clearance<'a> {
         }
     }
 
-    /// How far `p` may move and still keep the gap (≤ 0: it does not keep it now), at most
-    /// `most`.
-    pub fn slack(&self, p: Point, most: f64) -> f64 {
-        let r = self.gap + most;
-        let far = !self.index.any_near(p, r, |e| {
-            let (a, b) = self.edges[e];
-            segment_distance2(p, a, b) < r * r
-        });
-        if far {
-            most
-        } else {
-            self.index.distance(p, 0.0) - self.gap
-        }
-    }
-
     /// No edge closer than the gap to `p`.
     pub fn keeps(&self, p: Point) -> bool {
         let g2 = self.gap * self.gap;
@@ -203,6 +210,168 @@ impl<'a> Clearance<'a> {
                 let (a, b) = self.edges[e];
                 segment_distance2(p, a, b) < g2
             })
+    }
+}
+
+/// The parts of parallel lines (a layer's support hatch) closer than a gap to a region's
+/// boundary, as intervals along each line: each boundary edge's capsule (the points within the
+/// gap of it) cuts a line in one interval. Edges are sorted into bands across the lines, so a
+/// line meets only the edges of its band.
+pub struct LineGaps<'a> {
+    edges: &'a [(Point, Point)],
+    /// Across the lines: y = −sin·x + cos·y of the hatch direction.
+    sin: f64,
+    cos: f64,
+    band: f64,
+    first: i64,
+    /// Band k's edges: `order[starts[k]..starts[k + 1]]`.
+    starts: Vec<u32>,
+    order: Vec<u32>,
+    gap: f64,
+}
+
+impl<'a> LineGaps<'a> {
+    /// For lines at `angle_deg`, about `spacing` apart.
+    pub fn new(
+        edges: &'a [(Point, Point)],
+        gap: f64,
+        angle_deg: f64,
+        spacing: f64,
+    ) -> LineGaps<'a> {
+        let (sin, cos) = crate::geom::sin_cos_deg(angle_deg);
+        let across = |p: Point| -sin * p.x + cos * p.y;
+        let band = spacing.max(gap).max(1e-3);
+        let range = |e: &(Point, Point)| {
+            let (y0, y1) = (across(e.0), across(e.1));
+            (
+                floor((y0.min(y1) - gap) / band),
+                floor((y0.max(y1) + gap) / band),
+            )
+        };
+        let (mut first, mut last) = (i64::MAX, i64::MIN);
+        for e in edges {
+            let (a, b) = range(e);
+            first = first.min(a);
+            last = last.max(b);
+        }
+        let bands = if edges.is_empty() || gap <= 0.0 {
+            0
+        } else {
+            (last - first + 1) as usize
+        };
+        let mut starts = vec![0u32; bands + 1];
+        if bands > 0 {
+            for e in edges {
+                let (a, b) = range(e);
+                for k in a..=b {
+                    starts[(k - first) as usize + 1] += 1;
+                }
+            }
+        }
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
+        }
+        let mut order = vec![0u32; starts.last().map_or(0, |&t| t as usize)];
+        let mut fill = starts.clone();
+        if bands > 0 {
+            for (i, e) in edges.iter().enumerate() {
+                let (a, b) = range(e);
+                for k in a..=b {
+                    let slot = &mut fill[(k - first) as usize];
+                    order[*slot as usize] = i as u32;
+                    *slot += 1;
+                }
+            }
+        }
+        LineGaps {
+            edges,
+            sin,
+            cos,
+            band,
+            first,
+            starts,
+            order,
+            gap,
+        }
+    }
+
+    /// The parameters t (distance from `a` along the line a → b) of the points within the gap
+    /// of the boundary, as sorted, merged closed intervals, appended to `out` (cleared first).
+    pub fn intervals(&self, a: Point, b: Point, out: &mut Vec<(f64, f64)>) {
+        out.clear();
+        let len = dist(a, b);
+        if self.starts.len() < 2 {
+            return;
+        }
+        // A line of one droplet: along the hatch direction.
+        let u = if len > 0.0 {
+            (b - a) / len
+        } else {
+            DVec2::new(self.cos, self.sin)
+        };
+        let k = floor((-self.sin * a.x + self.cos * a.y) / self.band) - self.first;
+        if k < 0 || k as usize + 1 >= self.starts.len() {
+            return;
+        }
+        let k = k as usize;
+        let g2 = self.gap * self.gap;
+        for &e in &self.order[self.starts[k] as usize..self.starts[k + 1] as usize] {
+            let (p, q) = self.edges[e as usize];
+            let mut lo = f64::INFINITY;
+            let mut hi = f64::NEG_INFINITY;
+            // The discs at both ends.
+            for c in [p, q] {
+                let w = c - a;
+                let along = w.dot(u);
+                let off = w.perp_dot(u);
+                let h2 = g2 - off * off;
+                if h2 >= 0.0 {
+                    let h = h2.sqrt();
+                    lo = lo.min(along - h);
+                    hi = hi.max(along + h);
+                }
+            }
+            // The band beside the edge: 0 ≤ (x − p)·v ≤ |pq| and |v × (x − p)| ≤ gap, both
+            // linear in t for x = a + t·u.
+            let el = dist(p, q);
+            if el > 0.0 {
+                let v = (q - p) / el;
+                let w = a - p;
+                let (mut t0, mut t1) = (f64::NEG_INFINITY, f64::INFINITY);
+                for (base, slope, min, max) in [
+                    (w.dot(v), u.dot(v), 0.0, el),
+                    (v.perp_dot(w), v.perp_dot(u), -self.gap, self.gap),
+                ] {
+                    if slope.abs() < 1e-12 {
+                        if base < min || base > max {
+                            t0 = f64::INFINITY;
+                        }
+                    } else {
+                        let (x0, x1) = ((min - base) / slope, (max - base) / slope);
+                        t0 = t0.max(x0.min(x1));
+                        t1 = t1.min(x0.max(x1));
+                    }
+                }
+                if t0 <= t1 {
+                    lo = lo.min(t0);
+                    hi = hi.max(t1);
+                }
+            }
+            if lo <= hi && hi >= 0.0 && lo <= len {
+                out.push((lo, hi));
+            }
+        }
+        out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        let mut merged = 0;
+        for j in 0..out.len() {
+            if merged > 0 && out[j].0 <= out[merged - 1].1 {
+                out[merged - 1].1 = out[merged - 1].1.max(out[j].1);
+            } else {
+                out[merged] = out[j];
+                merged += 1;
+            }
+        }
+        out.truncate(merged);
     }
 }
 
@@ -229,18 +398,19 @@ pub struct PassFigures {
 }
 
 /// The unit-1 droplets to add to each layer so that every droplet above the first layer is
-/// supported: `droplets[i]` are layer i's planned droplets (both units), `regions[i]` its
-/// part's region. Works top-down; an added droplet needs support from the layer below as any
-/// other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with no
-/// such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
+/// supported: `droplets(i, out)` appends layer i's planned droplets (both units) to `out`
+/// (called about twice per layer, so that no layer's droplets need be kept), `regions[i]` is
+/// its part's region. Works top-down; an added droplet needs support from the layer below as
+/// any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
+/// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
 /// support deliberately stops below overhangs, and the pass adds nothing.
 pub fn complete(
-    droplets: &[&[Droplet]],
+    droplets: &(dyn Fn(usize, &mut Vec<Droplet>) + Sync),
     regions: &[Shapes],
     s: &Settings,
     par_map: impl Fn(usize, &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>>,
 ) -> (Vec<Vec<Point>>, PassFigures) {
-    let n = droplets.len();
+    let n = regions.len();
     let mut extra: Vec<Vec<Point>> = vec![Vec::new(); n];
     let mut figures = PassFigures::default();
     if n < 2 || s.support_gap_z > 0 {
@@ -256,42 +426,72 @@ pub fn complete(
         if i == 0 {
             return Vec::new();
         }
-        let below = Grid::new(cell, droplets[i - 1]);
+        let mut buf = Vec::new();
+        droplets(i - 1, &mut buf);
+        let below = Grid::new(cell, &buf);
+        buf.clear();
+        droplets(i, &mut buf);
         // Consecutive droplets are neighbours: the droplet below that supported the last one
         // most often supports the next.
         let mut last: Option<Droplet> = None;
-        droplets[i]
-            .iter()
-            .copied()
-            .filter(|&(p, _)| {
-                if let Some((q, w)) = last {
-                    let r = reach(w);
-                    if (p - q).length_squared() <= r * r {
-                        return false;
-                    }
+        buf.retain(|&(p, _)| {
+            if let Some((q, w)) = last {
+                let r = reach(w);
+                if (p - q).length_squared() <= r * r {
+                    return false;
                 }
-                match below.find_within(p, reach) {
-                    Some(d) => {
-                        last = Some(d);
-                        false
-                    }
-                    None => true,
+            }
+            match below.find_within(p, reach) {
+                Some(d) => {
+                    last = Some(d);
+                    false
                 }
-            })
-            .collect()
+                None => true,
+            }
+        });
+        buf.shrink_to_fit();
+        buf
     });
     let gap = s.support_gap_xy * b;
     let place = reach(b1) - MARGIN_MM;
+    let mut buf = Vec::new();
     // Top-down: layer i's unsupported droplets (planned or added) get droplets in layer i − 1.
     for i in (1..n).rev() {
         let mut todo: Vec<Droplet> = open[i].clone();
         if !extra[i].is_empty() {
-            let below = Grid::new(cell, droplets[i - 1]);
+            // The droplets added to layer i against layer i − 1's planned droplets: few, so
+            // the layer's droplets are scanned once (a grid only for many).
+            buf.clear();
+            droplets(i - 1, &mut buf);
+            let adds: Vec<Droplet> = extra[i].iter().map(|&p| (p, b1)).collect();
+            let mut held = vec![false; adds.len()];
+            if adds.len() > 16 {
+                let below = Grid::new(cell, &buf);
+                for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                    *h = below.any_within(p, reach);
+                }
+            } else {
+                let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+                for (p, _) in &adds {
+                    lo = lo.min(*p);
+                    hi = hi.max(*p);
+                }
+                let (lo, hi) = (lo - DVec2::splat(cell), hi + DVec2::splat(cell));
+                for &(q, w) in &buf {
+                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
+                        continue;
+                    }
+                    let r = reach(w);
+                    for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                        *h = *h || (p - q).length_squared() <= r * r;
+                    }
+                }
+            }
             todo.extend(
-                extra[i]
-                    .iter()
-                    .map(|&p| (p, b1))
-                    .filter(|&(p, _)| !below.any_within(p, reach)),
+                adds.iter()
+                    .zip(&held)
+                    .filter(|(_, h)| !**h)
+                    .map(|(d, _)| *d),
             );
         }
         if todo.is_empty() {
@@ -345,8 +545,13 @@ mod tests {
         regions: &[Shapes],
         s: &Settings,
     ) -> (Vec<Vec<Point>>, PassFigures) {
-        let refs: Vec<&[Droplet]> = droplets.iter().map(|v| &v[..]).collect();
-        complete(&refs, regions, s, serial)
+        assert_eq!(droplets.len(), regions.len());
+        complete(
+            &|i, out: &mut Vec<Droplet>| out.extend_from_slice(&droplets[i]),
+            regions,
+            s,
+            serial,
+        )
     }
 
     fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
@@ -386,6 +591,52 @@ mod tests {
         let p = extra[0][0];
         assert!(p.x >= 2.0 + gap - 1e-9, "{p}");
         assert!(dist(p, c) <= b1_reach(&s), "{p}");
+    }
+
+    #[test]
+    fn line_gaps_agree_with_the_distance_to_every_edge() {
+        // A square with a square hole, lines at several angles and offsets (and of one
+        // point): a point of a line lies in an interval iff some edge is within the gap.
+        let outer = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]].map(DVec2::from);
+        let hole = [[1.0, 1.0], [1.0, 2.0], [2.5, 2.0], [2.5, 1.0]].map(DVec2::from);
+        let region = vec![Shape::new(outer.into(), vec![hole.into()])];
+        let edges = edges_of(&region);
+        let gap = 0.15;
+        let mut near = Vec::new();
+        let (mut inside_hits, mut outside_hits) = (0, 0);
+        for angle in [0.0, 30.0, 45.0, 90.0, 137.0] {
+            let gaps = LineGaps::new(&edges, gap, angle, 0.2);
+            let (sn, cs) = crate::geom::sin_cos_deg(angle);
+            let u = DVec2::new(cs, sn);
+            let across = DVec2::new(-sn, cs);
+            for k in -40..60 {
+                let c = DVec2::new(2.0, 1.5) + (k as f64 * 0.0731) * across;
+                for len in [0.0, 9.0] {
+                    let a = c - 0.5 * len * u;
+                    gaps.intervals(a, a + len * u, &mut near);
+                    for j in 0..=(len / 0.01) as usize {
+                        let t = j as f64 * 0.01;
+                        let p = a + t * u;
+                        let d = edges
+                            .iter()
+                            .map(|&(e0, e1)| segment_distance2(p, e0, e1))
+                            .fold(f64::INFINITY, f64::min)
+                            .sqrt();
+                        if (d - gap).abs() < 1e-9 {
+                            continue;
+                        }
+                        let within = near.iter().any(|&(lo, hi)| lo <= t && t <= hi);
+                        assert_eq!(within, d <= gap, "angle {angle} line {k} t {t} d {d}");
+                        if within {
+                            inside_hits += 1;
+                        } else {
+                            outside_hits += 1;
+                        }
+                    }
+                }
+            }
+        }
+        assert!(inside_hits > 1000 && outside_hits > 1000);
     }
 
     fn b1_reach(s: &Settings) -> f64 {
