@@ -18,7 +18,7 @@ use crate::geom::{DVec2, Shapes, region_area, segment_distance2, signed_area};
 use crate::grid::EdgeIndex;
 use crate::offset::{CHORD_TOLERANCE_MM, Corners, raw_offset};
 use crate::settings::Settings;
-use crate::support::overhang;
+use crate::support::{bounds_of, overhang};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::float::single::SingleFloatOverlay;
@@ -45,16 +45,7 @@ pub fn overhang_area(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> f
 
 /// R ∩ F in one pass, or `None` when a mitred corner was wrong.
 fn one_pass(region: &Shapes, below: &Shapes, d: f64) -> Option<f64> {
-    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for p in region
-        .iter()
-        .chain(below)
-        .flat_map(|s| s.contours())
-        .flatten()
-    {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
+    let (lo, hi) = bounds_of(region, below);
     // A frame around both layers (positive winding), and every loop of the layer below
     // reversed and moved by d to its left: outward from the material.
     let (lo, hi) = (lo - DVec2::splat(d + 1.0), hi + DVec2::splat(d + 1.0));

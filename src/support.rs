@@ -145,6 +145,21 @@ fn carried(a: &Shapes, b: &Shapes, c: &Shapes) -> Shapes {
     cleaned(subject.overlay(&nested(c), OverlayRule::Difference, FillRule::NonZero))
 }
 
+/// The bounding box of two regions' contours (infinite when both are empty).
+pub(crate) fn bounds_of(region: &Shapes, below: &Shapes) -> (DVec2, DVec2) {
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for p in region
+        .iter()
+        .chain(below)
+        .flat_map(|s| s.contours())
+        .flatten()
+    {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    (lo, hi)
+}
+
 /// [`overhang`] as it was computed before (kept for `tests/support.rs`, which compares the
 /// two): the region less i_overlay's outward outline of the layer below, chords within
 /// [`SUPPORT_TOLERANCE_MM`] (inside the arcs: it overstates the area by up to ~2·10⁻³ mm² a
@@ -188,16 +203,7 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
             region.clone()
         };
     }
-    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for p in region
-        .iter()
-        .chain(below)
-        .flat_map(|s| s.contours())
-        .flatten()
-    {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
+    let (lo, hi) = bounds_of(region, below);
     let m = d + 1.0;
     let (lo, hi) = (lo - DVec2::splat(m), hi + DVec2::splat(m));
     let frame: crate::geom::Contour = vec![lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
