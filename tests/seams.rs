@@ -152,8 +152,20 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
                 // Where a pair is too close, is there a placement at all? (see
                 // seams::infeasible_loop and seams::infeasible_in)
                 let path = &lp[l.path];
-                let proven = (n <= 50
-                    && seams::infeasible_loop(path, n, (lower, B), 2.0 / 3.0 * B, 1e-3))
+                // Whole loops up to 160 droplets on cells of an eighth of the room a gap has
+                // (B/n: B/8n, at most 1 µm).
+                let proven = [8, 32]
+                    .into_iter()
+                    .filter(|&r| n <= if r == 8 { 160 } else { 40 })
+                    .any(|r| {
+                        seams::infeasible_loop(
+                            path,
+                            n,
+                            (lower, B),
+                            2.0 / 3.0 * B,
+                            (B / (r * n) as f64).min(1e-3),
+                        )
+                    })
                     || (0..n)
                         .filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL)
                         .any(|j| {
