@@ -154,9 +154,9 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
                 let path = &lp[l.path];
                 // Whole loops up to 160 droplets on cells of an eighth of the room a gap has
                 // (B/n: B/8n, at most 1 µm).
-                let proven = [8, 32]
+                let proven = [8, 16, 32]
                     .into_iter()
-                    .filter(|&r| n <= if r == 8 { 160 } else { 40 })
+                    .filter(|&r| n <= if r == 8 { 3000 } else { 160 })
                     .any(|r| {
                         seams::infeasible_loop(
                             path,

@@ -516,45 +516,90 @@ pub fn infeasible_loop(
             ((length - left * lower + cell) / cell).floor() as i64,
         )
     };
+    // Cells from which every step's chord may reach min_chord ("free": away from bends), and
+    // how many are not free before each.
+    let mut not_free = vec![0usize; all.len() + 1];
+    for g in 0..all.len() {
+        let free = (smin..=smax).all(|s| {
+            let h = g + s as usize;
+            h < all.len() && d(all[g], all[h]) + cell >= min_chord
+        });
+        not_free[g + 1] = not_free[g] + usize::from(!free);
+    }
+    let is_free = |g: usize| not_free[g + 1] == not_free[g];
     for x0 in 0..starts {
         let mid = &all[x0 as usize..];
-        // Droplet i's reachable cells first .. first + reach.len().
-        let (mut first, mut reach) = (0i64, vec![true]);
+        let g0 = x0 as usize;
+        // Droplet i's reachable cells: first ..= last, all of them or those marked.
+        let (mut first, mut last, mut marks): (i64, i64, Option<Vec<bool>>) = (0, 0, None);
+        let mut empty = false;
         for i in 1..n {
             let (wa, wb) = window(i);
             let a = (first + smin).max(wa);
-            let b = (first + reach.len() as i64 - 1 + smax)
-                .min(wb)
-                .min(cells - 1);
+            let b = (last + smax).min(wb).min(cells - 1);
             if b < a {
-                reach.clear();
+                empty = true;
                 break;
             }
-            let mut next = vec![false; (b - a + 1) as usize];
-            for (r, _) in reach.iter().enumerate().filter(|e| *e.1) {
-                let k = first + r as i64;
-                for j in (k + smin).max(a)..=(k + smax).min(b) {
-                    let x = (j - a) as usize;
-                    if !next[x] && d(mid[k as usize], mid[j as usize]) + cell >= min_chord {
-                        next[x] = true;
+            let all_free = not_free[g0 + last as usize + 1] == not_free[g0 + first as usize];
+            if marks.is_none() && all_free {
+                (first, last) = (a, b);
+                continue;
+            }
+            // Steps from free cells as ranges (a difference array), the others cell by cell.
+            let w = (b - a + 1) as usize;
+            let mut diff = vec![0i32; w + 1];
+            let mut next = vec![false; w];
+            for k in first..=last {
+                if marks.as_ref().is_some_and(|m| !m[(k - first) as usize]) {
+                    continue;
+                }
+                let (ja, jb) = ((k + smin).max(a), (k + smax).min(b));
+                if ja > jb {
+                    continue;
+                }
+                if is_free(g0 + k as usize) {
+                    diff[(ja - a) as usize] += 1;
+                    diff[(jb - a) as usize + 1] -= 1;
+                } else {
+                    for j in ja..=jb {
+                        let x = (j - a) as usize;
+                        if !next[x] && d(mid[k as usize], mid[j as usize]) + cell >= min_chord {
+                            next[x] = true;
+                        }
                     }
                 }
             }
+            let mut run = 0;
+            for x in 0..w {
+                run += diff[x];
+                next[x] |= run > 0;
+            }
             let (Some(s), Some(e)) = (next.iter().position(|&x| x), next.iter().rposition(|&x| x))
             else {
-                reach.clear();
+                empty = true;
                 break;
             };
             first = a + s as i64;
-            reach = next[s..=e].to_vec();
+            last = a + e as i64;
+            let m = &next[s..=e];
+            marks = if m.iter().all(|&x| x) {
+                None
+            } else {
+                Some(m.to_vec())
+            };
         }
-        let closes = reach.iter().enumerate().filter(|e| *e.1).any(|(r, _)| {
-            let k = first + r as i64;
-            let gap = length - k as f64 * cell;
-            gap + cell >= lower
-                && gap - cell <= upper
-                && d(mid[k as usize], mid[0]) + cell >= min_chord
-        });
+        if empty {
+            continue;
+        }
+        let closes = (first..=last)
+            .filter(|&k| marks.as_ref().is_none_or(|m| m[(k - first) as usize]))
+            .any(|k| {
+                let gap = length - k as f64 * cell;
+                gap + cell >= lower
+                    && gap - cell <= upper
+                    && d(mid[k as usize], mid[0]) + cell >= min_chord
+            });
         if closes {
             return false;
         }
