@@ -156,7 +156,7 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
                 // (B/n: B/8n, at most 1 µm).
                 let proven = [8, 16, 32]
                     .into_iter()
-                    .filter(|&r| n <= if r == 8 { 3000 } else { 160 })
+                    .filter(|&r| n <= if r == 8 { 3000 } else { 400 })
                     .any(|r| {
                         seams::infeasible_loop(
                             path,
