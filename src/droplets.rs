@@ -23,9 +23,14 @@
 //! anchors. Failing that, loops of at most 64 droplets are searched on a grid of arc
 //! positions (exhaustively, from every first position), and failing that the whole loop is
 //! turned (a droplet onto a corner tip) and droplets
-//! near the worst pair are anchored one by one where they help. Where nothing helps (two sharp
-//! bends closer than the spacing allows) the best placement found is kept: rare (0–1 % of the
-//! loops of the shared models, docs/quality.md). Only loops that need it pay for the search.
+//! near the worst pair are anchored one by one where they help. Last, for each pair still short
+//! the droplets of a window round it (9 … 1001 droplets, then the whole loop from 64 positions
+//! of one droplet over a spacing) are placed afresh between the window's two end droplets on a
+//! fine grid of arc (B/(r·n), r = 4096/window in 4 … 32): every grid position each droplet can
+//! reach with both bounds met, and one chain traced back. Where nothing helps (two sharp bends
+//! closer than the spacing allows: tests/seams.rs proves it for every such loop of the shared
+//! models) the best placement found is kept: rare (0–1 % of the loops of the shared models,
+//! docs/quality.md). Only loops that need it pay for the search.
 //! Loops shorter than 3 B ([`EVEN_MIN_LENGTH_B`]) are printed as `exact`.
 
 use crate::geom::{DVec2, Point, dist};
