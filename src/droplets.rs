@@ -24,8 +24,8 @@
 //! positions (exhaustively, from every first position), and failing that the whole loop is
 //! turned (a droplet onto a corner tip) and droplets
 //! near the worst pair are anchored one by one where they help. Last, for each pair still short
-//! the droplets of a window round it (9 … 1001 droplets, then the whole loop from 64 positions
-//! of one droplet over a spacing) are placed afresh between the window's two end droplets on a
+//! the droplets of a window round it (9, 25, 65 droplets, then for loops of at most 160
+//! droplets the whole loop from 64 positions of one droplet over a spacing) are placed afresh between the window's two end droplets on a
 //! fine grid of arc (B/(r·n), r = 4096/window in 4 … 32): every grid position each droplet can
 //! reach with both bounds met, and one chain traced back. Where nothing helps (two sharp bends
 //! closer than the spacing allows: tests/seams.rs proves it for every such loop of the shared
@@ -72,6 +72,9 @@ pub const EVEN_MIN_LENGTH_B: f64 = 3.0;
 
 /// The longest loop (droplets) searched exhaustively where the faster placements fail.
 const GRID_MAX_N: usize = 64;
+
+/// The longest loop (droplets) placed afresh as a whole by the last stage.
+const WINDOW_LOOP_MAX_N: usize = 160;
 
 /// The least straight-line distance of two consecutive droplets of an `even` loop, in B.
 pub const EVEN_MIN_CHORD_B: f64 = 2.0 / 3.0;
@@ -299,7 +302,11 @@ impl<'a> EvenSpacing<'a> {
                 return;
             };
             let mut fixed = false;
-            for w in [8usize, 24, 64, 160, 400, 1000] {
+            // The whole loop only up to WINDOW_LOOP_MAX_N droplets (its cost grows as n²).
+            for w in [8usize, 24, 64, n] {
+                if w >= n.saturating_sub(2) && n > WINDOW_LOOP_MAX_N {
+                    break;
+                }
                 let w = w.min(n);
                 budget = budget.saturating_sub(1);
                 // Droplets k − w/2 … k + 1 + w/2 round the loop; the whole loop from the
