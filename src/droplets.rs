@@ -23,9 +23,14 @@
 //! anchors. Failing that, loops of at most 64 droplets are searched on a grid of arc
 //! positions (exhaustively, from every first position), and failing that the whole loop is
 //! turned (a droplet onto a corner tip) and droplets
-//! near the worst pair are anchored one by one where they help. Where nothing helps (two sharp
-//! bends closer than the spacing allows) the best placement found is kept: rare (0–1 % of the
-//! loops of the shared models, docs/quality.md). Only loops that need it pay for the search.
+//! near the worst pair are anchored one by one where they help. Last, for each pair still short
+//! the droplets of a window round it (9, 25, 65 droplets, then for loops of at most 160
+//! droplets the whole loop from 64 positions of one droplet over a spacing) are placed afresh between the window's two end droplets on a
+//! fine grid of arc (B/(r·n), r = 4096/window in 4 … 32): every grid position each droplet can
+//! reach with both bounds met, and one chain traced back. Where nothing helps (two sharp bends
+//! closer than the spacing allows: tests/seams.rs proves it for every such loop of the shared
+//! models) the best placement found is kept: rare (0–1 % of the loops of the shared models,
+//! docs/quality.md). Only loops that need it pay for the search.
 //! Loops shorter than 3 B ([`EVEN_MIN_LENGTH_B`]) are printed as `exact`.
 
 use crate::geom::{DVec2, Point, dist};
@@ -67,6 +72,9 @@ pub const EVEN_MIN_LENGTH_B: f64 = 3.0;
 
 /// The longest loop (droplets) searched exhaustively where the faster placements fail.
 const GRID_MAX_N: usize = 64;
+
+/// The longest loop (droplets) placed afresh as a whole by the last stage.
+const WINDOW_LOOP_MAX_N: usize = 160;
 
 /// The least straight-line distance of two consecutive droplets of an `even` loop, in B.
 pub const EVEN_MIN_CHORD_B: f64 = 2.0 / 3.0;
@@ -278,6 +286,151 @@ impl<'a> EvenSpacing<'a> {
                 stuck[k] = true;
             }
         }
+        self.repair_windows();
+    }
+
+    /// Last stage: for each pair still short, the droplets of a window round it (growing, up
+    /// to the whole loop) are placed afresh on a fine grid of arc positions between the
+    /// window's two end droplets, kept where they are: a search over every grid position
+    /// each droplet can reach with gaps in [B·(1 − 1/n), B] and chords of at least 2/3 B.
+    fn repair_windows(&mut self) {
+        let n = self.n;
+        // Bounded: a few windows per short pair.
+        let mut budget = 64usize;
+        while budget > 0 {
+            let Some(k) = (0..n).find(|&i| self.short(i) > 0.0) else {
+                return;
+            };
+            let mut fixed = false;
+            // The whole loop only up to WINDOW_LOOP_MAX_N droplets (its cost grows as n²).
+            for w in [8usize, 24, 64, n] {
+                if w >= n.saturating_sub(2) && n > WINDOW_LOOP_MAX_N {
+                    break;
+                }
+                let w = w.min(n);
+                budget = budget.saturating_sub(1);
+                // Droplets k − w/2 … k + 1 + w/2 round the loop; the whole loop from the
+                // droplet opposite the pair back to itself.
+                let (p, len) = if w >= n.saturating_sub(2) {
+                    ((k + n / 2) % n, n)
+                } else {
+                    ((k + n - w / 2) % n, w + 1)
+                };
+                let ok = if len == n {
+                    // Droplet p itself moved too: a sample of offsets over one spacing.
+                    (0..64).any(|o| self.window_search(p, len, o as f64 / 64.0 * self.step))
+                } else {
+                    self.window_search(p, len, 0.0)
+                };
+                if ok {
+                    fixed = true;
+                    break;
+                }
+                if len == n || budget == 0 {
+                    break;
+                }
+            }
+            if !fixed {
+                return;
+            }
+        }
+    }
+
+    /// Places droplets p + 1 … p + len − 1 (round the loop) afresh, droplets p and p + len
+    /// kept: on a grid of arc positions from droplet p, fine enough (δ ≤ B/16n) that gaps in
+    /// [B·(1 − 1/n), B] have room to differ, every reachable grid position of each droplet is
+    /// found with its predecessor, and one chain to droplet p + len traced back. True if found
+    /// (then every pair of the window meets the bounds).
+    fn window_search(&mut self, p: usize, len: usize, offset: f64) -> bool {
+        let n = self.n;
+        let (lo, hi) = (self.step - self.shrink, self.step + self.grow);
+        if len < 2 || len > n || hi - lo <= 0.0 {
+            return false;
+        }
+        // Cost ≈ len · (cells a droplet) · (cells a gap): (r · len/2) · r.
+        let r = (4096.0 / len as f64).clamp(4.0, 32.0);
+        let delta = (hi - lo) / r;
+        let q = p + len;
+        let pos = |i: usize| i as f64 * self.step + self.dev[i % n];
+        let t0 = pos(p) + offset;
+        let p_pt = if offset == 0.0 {
+            self.pts[p]
+        } else {
+            self.arc.point(t0)
+        };
+        // Droplet q's arc position, droplet q mod n's deviation, counted on past p.
+        let (t_end, end_pt) = if len == n {
+            (t0 + self.arc.length(), p_pt)
+        } else {
+            (q as f64 * self.step + self.dev[q % n], self.pts[q % n])
+        };
+        let total = t_end - t0;
+        let range = |j: usize| {
+            let a = (j as f64 * lo).max(total - (len - j) as f64 * hi);
+            let b = (j as f64 * hi).min(total - (len - j) as f64 * lo);
+            ((a / delta).ceil() as i64, (b / delta).floor() as i64)
+        };
+        // rows[j]: (first k, predecessor of each k or −1, points).
+        let mut rows: Vec<(i64, Vec<i64>, Vec<Point>)> = vec![(0, vec![0], vec![p_pt])];
+        for j in 1..len {
+            let (a, b) = range(j);
+            if b < a || b - a > 1_000_000 {
+                return false;
+            }
+            let pts: Vec<Point> = (a..=b)
+                .map(|k| self.arc.point(t0 + k as f64 * delta))
+                .collect();
+            let mut pred = vec![-1i64; pts.len()];
+            let (pa, ppred, ppts) = &rows[j - 1];
+            let mut any = false;
+            for (r, k) in (a..=b).enumerate() {
+                // Predecessors k' with (k − k')·δ in [lo, hi].
+                let from = (k - (hi / delta).floor() as i64).max(*pa);
+                let to = (k - (lo / delta).ceil() as i64).min(pa + ppred.len() as i64 - 1);
+                for kp in from..=to {
+                    let x = (kp - pa) as usize;
+                    let gap = (k - kp) as f64 * delta;
+                    if ppred[x] >= 0
+                        && gap >= lo
+                        && gap <= hi
+                        && dist(ppts[x], pts[r]) >= self.min_chord
+                    {
+                        pred[r] = kp;
+                        any = true;
+                        break;
+                    }
+                }
+            }
+            if !any {
+                return false;
+            }
+            rows.push((a, pred, pts));
+        }
+        // The last droplet of the window to droplet q.
+        let (a, pred, pts) = &rows[len - 1];
+        let last = (0..pred.len()).find(|&x| {
+            let gap = total - (a + x as i64) as f64 * delta;
+            pred[x] >= 0 && gap >= lo && gap <= hi && dist(pts[x], end_pt) >= self.min_chord
+        });
+        let Some(x) = last else { return false };
+        let mut k = a + x as i64;
+        for j in (1..len).rev() {
+            let (a, pred, pts) = &rows[j];
+            let x = (k - a) as usize;
+            let i = (p + j) % n;
+            let t = t0 + k as f64 * delta;
+            self.dev[i] =
+                t - i as f64 * self.step - if p + j >= n { self.arc.length() } else { 0.0 };
+            self.pts[i] = pts[x];
+            k = pred[x];
+        }
+        if len == n {
+            self.dev[p] = t0 - p as f64 * self.step;
+            self.pts[p] = p_pt;
+        }
+        self.dev[n] = self.dev[0];
+        self.pts[n] = self.pts[0];
+        true
     }
 
     /// The arc intervals a droplet must not start a pair in: s where the chord from s to

@@ -152,8 +152,20 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
                 // Where a pair is too close, is there a placement at all? (see
                 // seams::infeasible_loop and seams::infeasible_in)
                 let path = &lp[l.path];
-                let proven = (n <= 50
-                    && seams::infeasible_loop(path, n, (lower, B), 2.0 / 3.0 * B, 1e-3))
+                // The whole loop (up to 3000 droplets) on cells of an eighth of the room a gap
+                // has (B/n: B/8n, at most 1 µm), finer up to 400 droplets.
+                let proven = [8, 16, 32]
+                    .into_iter()
+                    .filter(|&r| n <= if r == 8 { 3000 } else { 400 })
+                    .any(|r| {
+                        seams::infeasible_loop(
+                            path,
+                            n,
+                            (lower, B),
+                            2.0 / 3.0 * B,
+                            (B / (r * n) as f64).min(1e-3),
+                        )
+                    })
                     || (0..n)
                         .filter(|&j| l.chord[j] < 2.0 / 3.0 * B - TOL)
                         .any(|j| {
@@ -253,7 +265,7 @@ fn even_spacing_on_shared_models() {
         assert_eq!(f.seams_below_quarter_b, 0, "{model}: even seams < B/4");
         // Loops with no placement at all (two sharp bends closer than the spacing allows, proven
         // by seams::infeasible_loop or seams::infeasible_in) keep the best placement found: at
-        // most 1 % of the loops (0.1 % of 3DBenchy's, 0.5 % of the bunny's, on its noisy lower
+        // most 1 % of the loops (0.1 % of 3DBenchy's, 0.9 % of the bunny's, on its noisy lower
         // layers).
         if f.infeasible.len() * 100 > f.loops {
             failures.push(format!(
@@ -262,12 +274,10 @@ fn even_spacing_on_shared_models() {
                 f.loops
             ));
         }
-        // Loops the placement does not meet the bounds on and for which no proof was found
-        // either (sharp bends close together on the bunny's noisy lower layers): the search
-        // or the proof falls short, a known weakness (docs/quality.md); at most 0.5 %.
-        if f.bad.len() * 200 > f.loops {
+        // Every other loop meets the bounds: no loop breaks them without a proof.
+        if !f.bad.is_empty() {
             failures.push(format!(
-                "{model}: {} of {} loops break the even bounds, e.g.\n{}",
+                "{model}: {} of {} loops break the even bounds with no proof that they must, e.g.\n{}",
                 f.bad.len(),
                 f.loops,
                 f.bad[..f.bad.len().min(12)].join("\n")

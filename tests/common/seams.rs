@@ -483,10 +483,11 @@ pub fn infeasible_in(
 /// gaps in [`lower`, `upper`], the seam's included, and every straight-line gap at least
 /// `min_chord`. Some droplet lies in any arc interval as long as `upper`, so the first is put
 /// in each cell of `cell` mm of [0, upper); the others in cells of the same grid from it,
-/// droplet by droplet (the set of cells each can reach), a pair of cells allowed where some
-/// points in them could meet the gap bounds and their centres' chord plus `cell` reaches
-/// `min_chord` (each point is within cell/2 of its cell's centre). True when no cell of the
-/// last droplet reaches back to the first: then no placement exists.
+/// droplet by droplet (the cells each can reach, only those from which the n − i gaps left
+/// can still close the loop), a pair of cells allowed where some points in them could meet
+/// the gap bounds and their centres' chord plus `cell` reaches `min_chord` (each point is
+/// within cell/2 of its cell's centre). True when no cell of the last droplet reaches back to
+/// the first: then no placement exists.
 pub fn infeasible_loop(
     path: &LoopPath,
     n: usize,
@@ -496,40 +497,112 @@ pub fn infeasible_loop(
 ) -> bool {
     let length = path.length;
     let cells = (length / cell).ceil() as i64 + 2;
+    let starts = (upper / cell).ceil() as i64;
+    // Cell centres from 0: the grid of a first droplet in cell x0 is this one from x0.
+    let all: Vec<P> = (0..cells + starts)
+        .map(|k| path.point((k as f64 + 0.5) * cell))
+        .collect();
     // Cell steps k' − k whose gaps could lie in [lower, upper].
     let (smin, smax) = (
-        ((lower - cell) / cell).ceil() as i64,
+        ((lower - cell) / cell).ceil().max(1.0) as i64,
         ((upper + cell) / cell).floor() as i64,
     );
-    let mut x0 = 0.0;
-    while x0 < upper {
-        let mid: Vec<P> = (0..cells)
-            .map(|k| path.point(x0 + (k as f64 + 0.5) * cell))
-            .collect();
-        let mut reach = vec![false; cells as usize];
-        reach[0] = true;
-        for _ in 1..n {
-            let mut next = vec![false; cells as usize];
-            for k in (0..cells).filter(|&k| reach[k as usize]) {
-                for s in smin..=smax {
-                    let j = k + s;
-                    if j < cells && d(mid[k as usize], mid[j as usize]) + cell >= min_chord {
-                        next[j as usize] = true;
+    // Cells of droplet i from which n − i gaps can still end at the first droplet + length
+    // (a droplet in cell k lies within cell of k·cell from the first).
+    let window = |i: usize| {
+        let left = (n - i) as f64;
+        (
+            ((length - left * upper - cell) / cell).ceil() as i64,
+            ((length - left * lower + cell) / cell).floor() as i64,
+        )
+    };
+    // Cells from which every step's chord may reach min_chord ("free": away from bends), and
+    // how many are not free before each.
+    let mut not_free = vec![0usize; all.len() + 1];
+    for g in 0..all.len() {
+        let free = (smin..=smax).all(|s| {
+            let h = g + s as usize;
+            h < all.len() && d(all[g], all[h]) + cell >= min_chord
+        });
+        not_free[g + 1] = not_free[g] + usize::from(!free);
+    }
+    let is_free = |g: usize| not_free[g + 1] == not_free[g];
+    for x0 in 0..starts {
+        let mid = &all[x0 as usize..];
+        let g0 = x0 as usize;
+        // Droplet i's reachable cells: first ..= last, all of them or those marked.
+        let (mut first, mut last, mut marks): (i64, i64, Option<Vec<bool>>) = (0, 0, None);
+        let mut empty = false;
+        for i in 1..n {
+            let (wa, wb) = window(i);
+            let a = (first + smin).max(wa);
+            let b = (last + smax).min(wb).min(cells - 1);
+            if b < a {
+                empty = true;
+                break;
+            }
+            let all_free = not_free[g0 + last as usize + 1] == not_free[g0 + first as usize];
+            if marks.is_none() && all_free {
+                (first, last) = (a, b);
+                continue;
+            }
+            // Steps from free cells as ranges (a difference array), the others cell by cell.
+            let w = (b - a + 1) as usize;
+            let mut diff = vec![0i32; w + 1];
+            let mut next = vec![false; w];
+            for k in first..=last {
+                if marks.as_ref().is_some_and(|m| !m[(k - first) as usize]) {
+                    continue;
+                }
+                let (ja, jb) = ((k + smin).max(a), (k + smax).min(b));
+                if ja > jb {
+                    continue;
+                }
+                if is_free(g0 + k as usize) {
+                    diff[(ja - a) as usize] += 1;
+                    diff[(jb - a) as usize + 1] -= 1;
+                } else {
+                    for j in ja..=jb {
+                        let x = (j - a) as usize;
+                        if !next[x] && d(mid[k as usize], mid[j as usize]) + cell >= min_chord {
+                            next[x] = true;
+                        }
                     }
                 }
             }
-            reach = next;
+            let mut run = 0;
+            for x in 0..w {
+                run += diff[x];
+                next[x] |= run > 0;
+            }
+            let (Some(s), Some(e)) = (next.iter().position(|&x| x), next.iter().rposition(|&x| x))
+            else {
+                empty = true;
+                break;
+            };
+            first = a + s as i64;
+            last = a + e as i64;
+            let m = &next[s..=e];
+            marks = if m.iter().all(|&x| x) {
+                None
+            } else {
+                Some(m.to_vec())
+            };
         }
-        let closes = (0..cells).filter(|&k| reach[k as usize]).any(|k| {
-            let gap = length - k as f64 * cell;
-            gap + cell >= lower
-                && gap - cell <= upper
-                && d(mid[k as usize], mid[0]) + cell >= min_chord
-        });
+        if empty {
+            continue;
+        }
+        let closes = (first..=last)
+            .filter(|&k| marks.as_ref().is_none_or(|m| m[(k - first) as usize]))
+            .any(|k| {
+                let gap = length - k as f64 * cell;
+                gap + cell >= lower
+                    && gap - cell <= upper
+                    && d(mid[k as usize], mid[0]) + cell >= min_chord
+            });
         if closes {
             return false;
         }
-        x0 += cell;
     }
     true
 }
