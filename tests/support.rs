@@ -11,38 +11,11 @@
 
 mod common;
 
-use common::{Gcode, Layer, TempDir, deep_inside, model, parse_gcode, run_cli, slice_cli};
+use common::{Gcode, TempDir, deep_inside, model, parse_gcode, run_cli, slice_cli, unit_droplets};
 use std::collections::HashMap;
 use std::time::Duration;
 
 type P = [f64; 2];
-
-/// Droplet centres of a layer with their unit: G26 one, G25 one every B of its unit from the
-/// current position (`at`: the position before the layer's first command).
-fn droplets(layer: &Layer, at: &mut P, b: [f64; 2]) -> Vec<(P, u8)> {
-    let mut out = Vec::new();
-    for c in &layer.cmds {
-        let to = c.p();
-        match c.code.as_str() {
-            "G26" => out.push((to, c.unit)),
-            "G25" => {
-                let w = b[c.unit as usize];
-                let l = ((to[0] - at[0]).powi(2) + (to[1] - at[1]).powi(2)).sqrt();
-                let n = (l / w + 1e-9).floor() as usize + 1;
-                for j in 0..n {
-                    let t = if l > 0.0 { j as f64 * w / l } else { 0.0 };
-                    out.push((
-                        [at[0] + t * (to[0] - at[0]), at[1] + t * (to[1] - at[1])],
-                        c.unit,
-                    ));
-                }
-            }
-            _ => {}
-        }
-        *at = to;
-    }
-    out
-}
 
 /// Every layer's droplets (B and B₁ from the header).
 fn all_droplets(g: &Gcode) -> Vec<Vec<(P, u8)>> {
@@ -56,7 +29,7 @@ fn all_droplets(g: &Gcode) -> Vec<Vec<(P, u8)>> {
     let mut at = [0.0, 0.0];
     g.layers
         .iter()
-        .map(|l| droplets(l, &mut at, [h * a, h * a1]))
+        .map(|l| unit_droplets(l, &mut at, [h * a, h * a1]))
         .collect()
 }
 

@@ -13,7 +13,7 @@
 mod common;
 
 use common::{
-    Gcode, Layer, TempDir, cut, deep_inside, model_bytes, on_plate, parse_gcode, run_cli,
+    Gcode, TempDir, cut, deep_inside, model_bytes, on_plate, parse_gcode, run_cli, unit_droplets,
 };
 use serde_json::{Value, json};
 use std::collections::HashMap;
@@ -21,33 +21,6 @@ use std::time::Duration;
 
 type P = [f64; 2];
 type Tri = [[f64; 3]; 3];
-
-/// Droplet centres of a layer with their unit: G26 one, G25 one every B of its unit from the
-/// current position.
-fn droplets(layer: &Layer, at: &mut P, b: [f64; 2]) -> Vec<(P, u8)> {
-    let mut out = Vec::new();
-    for c in &layer.cmds {
-        let to = c.p();
-        match c.code.as_str() {
-            "G26" => out.push((to, c.unit)),
-            "G25" => {
-                let w = b[c.unit as usize];
-                let l = ((to[0] - at[0]).powi(2) + (to[1] - at[1]).powi(2)).sqrt();
-                let n = (l / w + 1e-9).floor() as usize + 1;
-                for j in 0..n {
-                    let t = if l > 0.0 { j as f64 * w / l } else { 0.0 };
-                    out.push((
-                        [at[0] + t * (to[0] - at[0]), at[1] + t * (to[1] - at[1])],
-                        c.unit,
-                    ));
-                }
-            }
-            _ => {}
-        }
-        *at = to;
-    }
-    out
-}
 
 /// H, B and B₁ from the header.
 fn widths(g: &Gcode) -> (f64, [f64; 2]) {
@@ -204,7 +177,11 @@ fn each_unit_prints_its_own_part_and_covers_it() {
     assert!(!g.unit_lines.is_empty());
     assert!(g.get("unit1_material_density").is_some());
     let mut at = [0.0, 0.0];
-    let layers: Vec<Vec<(P, u8)>> = g.layers.iter().map(|l| droplets(l, &mut at, b)).collect();
+    let layers: Vec<Vec<(P, u8)>> = g
+        .layers
+        .iter()
+        .map(|l| unit_droplets(l, &mut at, b))
+        .collect();
     // The header's unit-1 count is the droplets of unit 1 read here.
     let ones = layers.iter().flatten().filter(|d| d.1 == 1).count();
     let header: usize = g
@@ -336,7 +313,11 @@ fn box_job(boxes: &[([f64; 4], u8)], h_box: f64) -> (String, Gcode, Vec<Vec<(P, 
     let (text, g) = slice_job(&dir, &job);
     let (_, b) = widths(&g);
     let mut at = [0.0, 0.0];
-    let layers = g.layers.iter().map(|l| droplets(l, &mut at, b)).collect();
+    let layers = g
+        .layers
+        .iter()
+        .map(|l| unit_droplets(l, &mut at, b))
+        .collect();
     (text, g, layers)
 }
 

@@ -193,6 +193,34 @@ impl Cmd {
     }
 }
 
+/// Droplet centres of a layer with their unit: `G26` one, `G25` one every B of its unit
+/// (`b[unit]`) from the current position (`at`: the position before the layer's first
+/// command, left at the layer's last).
+pub fn unit_droplets(layer: &Layer, at: &mut Point, b: [f64; 2]) -> Vec<(Point, u8)> {
+    let mut out = Vec::new();
+    for c in &layer.cmds {
+        let to = c.p();
+        match c.code.as_str() {
+            "G26" => out.push((to, c.unit)),
+            "G25" => {
+                let w = b[c.unit as usize];
+                let l = ((to[0] - at[0]).powi(2) + (to[1] - at[1]).powi(2)).sqrt();
+                let n = (l / w + 1e-9).floor() as usize + 1;
+                for j in 0..n {
+                    let t = if l > 0.0 { j as f64 * w / l } else { 0.0 };
+                    out.push((
+                        [at[0] + t * (to[0] - at[0]), at[1] + t * (to[1] - at[1])],
+                        c.unit,
+                    ));
+                }
+            }
+            _ => {}
+        }
+        *at = to;
+    }
+    out
+}
+
 /// The commands of one layer (consecutive commands with the same Z).
 #[derive(Clone, Debug)]
 pub struct Layer {
