@@ -564,18 +564,7 @@ fn a_job_of_three_parts_slices_as_the_oracle_says() {
         .map(|t| t.map(|p| p.map(|c| c as f32)))
         .collect();
     std::fs::write(&stl, stl_bytes(&tris)).unwrap();
-    let out = std::process::Command::new("python3")
-        .arg(common::shared_dir().join("tools/oracle_sections.py"))
-        .arg(&stl)
-        .arg("0.2")
-        .output()
-        .expect("python3 runs the oracle");
-    assert!(
-        out.status.success(),
-        "oracle: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let oracle: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let oracle = common::oracle_sections(&stl, 0.2);
     let layers = oracle["layers"].as_array().unwrap();
     assert_eq!(j.layer_count(), layers.len(), "layer count");
     let mut bad = Vec::new();

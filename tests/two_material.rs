@@ -101,18 +101,7 @@ fn placed(file: &str, at: P) -> Vec<Tri> {
 /// The oracle's nonzero area of every layer of an STL (None: a layer with faces in its
 /// plane, ambiguous).
 fn oracle_areas(stl: &std::path::Path, h: f64) -> Vec<Option<f64>> {
-    let out = std::process::Command::new("python3")
-        .arg(common::shared_dir().join("tools/oracle_sections.py"))
-        .arg(stl)
-        .arg(h.to_string())
-        .output()
-        .expect("python3 runs the oracle");
-    assert!(
-        out.status.success(),
-        "oracle: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let oracle: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let oracle = common::oracle_sections(stl, h);
     oracle["layers"]
         .as_array()
         .unwrap()

@@ -221,6 +221,23 @@ pub fn unit_droplets(layer: &Layer, at: &mut Point, b: [f64; 2]) -> Vec<(Point, 
     out
 }
 
+/// The independent oracle's cross-sections (`../shared/tools/oracle_sections.py`) of an STL
+/// at layer height `h`, as its JSON.
+pub fn oracle_sections(stl: &Path, h: f64) -> serde_json::Value {
+    let out = Command::new("python3")
+        .arg(shared_dir().join("tools/oracle_sections.py"))
+        .arg(stl)
+        .arg(h.to_string())
+        .output()
+        .expect("python3 runs the oracle");
+    assert!(
+        out.status.success(),
+        "oracle: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("the oracle writes JSON")
+}
+
 /// The commands of one layer (consecutive commands with the same Z).
 #[derive(Clone, Debug)]
 pub struct Layer {
