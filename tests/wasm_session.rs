@@ -64,6 +64,11 @@ fn json(v: JsValue) -> serde_json::Value {
     serde_wasm_bindgen::from_value(v).unwrap()
 }
 
+/// A session made as another worker makes it: from `s`'s prepared mesh, `info` and settings.
+fn prepared_copy(s: &Session, info: JsValue, settings: JsValue) -> Result<Session, JsValue> {
+    Session::from_prepared(&s.vertices().to_vec(), &s.facets().to_vec(), info, settings)
+}
+
 fn defaults() -> JsValue {
     js(serde_json::json!({}))
 }
@@ -277,13 +282,7 @@ fn a_session_from_the_prepared_mesh_slices_the_same() {
     let settings = serde_json::json!({"layer_height": 0.25, "rotate_z": 30});
     let first = Session::new(stl.as_bytes(), "two.stl", js(settings.clone())).unwrap();
     let info = first.info().unwrap();
-    let other = Session::from_prepared(
-        &first.vertices().to_vec(),
-        &first.facets().to_vec(),
-        info,
-        js(settings.clone()),
-    )
-    .unwrap();
+    let other = prepared_copy(&first, info, js(settings.clone())).unwrap();
     assert_eq!(other.layer_count(), first.layer_count());
     assert_eq!(json(other.info().unwrap()), json(first.info().unwrap()));
     assert_eq!(
@@ -314,9 +313,8 @@ fn a_session_from_the_prepared_mesh_slices_the_same() {
     assert_eq!(merged["counts"], sa["counts"]);
     // other settings than the prepared mesh was made with are refused
     let e = thrown(
-        Session::from_prepared(
-            &first.vertices().to_vec(),
-            &first.facets().to_vec(),
+        prepared_copy(
+            &first,
             first.info().unwrap(),
             js(serde_json::json!({"layer_height": 0.1})),
         )
@@ -496,13 +494,7 @@ fn models_give_infos_layouts_and_a_merged_session() {
     assert_eq!(info["instances"].as_array().unwrap().len(), 3);
     assert_eq!(info["layers"], 15);
     assert_eq!(info["bounds"], layout["bounds"]);
-    let other = Session::from_prepared(
-        &s.vertices().to_vec(),
-        &s.facets().to_vec(),
-        s.info().unwrap(),
-        js(job["settings"].clone()),
-    )
-    .unwrap();
+    let other = prepared_copy(&s, s.info().unwrap(), js(job["settings"].clone())).unwrap();
     for i in [0, 7, 14] {
         assert_eq!(
             s.slice_layer(i).unwrap().gcode().to_vec(),
@@ -572,13 +564,7 @@ fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
         ]
     });
     let s = Session::from_models(&models, js(job.clone())).unwrap();
-    let other = Session::from_prepared(
-        &s.vertices().to_vec(),
-        &s.facets().to_vec(),
-        s.info().unwrap(),
-        js(job["settings"].clone()),
-    )
-    .unwrap();
+    let other = prepared_copy(&s, s.info().unwrap(), js(job["settings"].clone())).unwrap();
     assert_eq!(json(other.info().unwrap()), json(s.info().unwrap()));
     assert_eq!(
         other.header(JsValue::NULL).unwrap(),
