@@ -72,10 +72,11 @@ fn main() {
         par_map(n, &|i| dropslice::plan::plan_layer(&regions[i], i, &s));
     println!("part plans      {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
+    let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
     let (_extra, pass) = dropslice::support_droplets::complete(
-        &|i, f: &mut dyn FnMut(&[dropslice::plan::Move])| {
-            f(&parts[i].moves);
-            f(&hatch[i]);
+        &|i, out: &mut Vec<dropslice::support_droplets::Droplet>| {
+            dropslice::support_droplets::droplets_of(&parts[i].moves, b, b1, out);
+            dropslice::support_droplets::droplets_of(&hatch[i], b, b1, out);
         },
         &regions,
         &s,

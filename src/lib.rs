@@ -469,10 +469,11 @@ impl Job {
             drop(layers);
             // The droplet-level pass reads each layer's droplets from its moves when it needs
             // them (no list of all droplets is kept).
+            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
             let (extra, figures) = support_droplets::complete(
-                &|i, f: &mut dyn FnMut(&[plan::Move])| {
-                    f(&planned[i].0.moves);
-                    f(&planned[i].2);
+                &|i, out: &mut Vec<support_droplets::Droplet>| {
+                    support_droplets::droplets_of(&planned[i].0.moves, b, b1, out);
+                    support_droplets::droplets_of(&planned[i].2, b, b1, out);
                 },
                 &regions,
                 s,

@@ -6,15 +6,9 @@
 //! The region form ([`crate::support`]) leaves a few droplets unsupported: where a support
 //! region is a sliver, or where a part droplet lies beyond the edge of the part below by less
 //! than the limit but the droplets below sit B/2 inside that edge. The pass works on droplet
-//! centres only, so it is cheap: a layer below is read as its `G25` lines, kept whole and
-//! sorted across the layer's hatch direction ([`Below`]), and its other droplets in a grid; the
-//! droplets of a line above are mostly settled at once by a sound certificate (the strips
-//! beside the lines below, [`Below::certified`]), and only the rest are searched droplet by
-//! droplet.
+//! centres only (hash grids of the layers' droplets), so it is cheap.
 
-use crate::geom::{
-    DVec2, Point, Shapes, all_contours, dist, line_droplet_count, round_output, segment_distance2,
-};
+use crate::geom::{DVec2, Point, Shapes, all_contours, dist, round_output, segment_distance2};
 use crate::grid::EdgeIndex;
 use crate::plan::{Move, MoveKind};
 use crate::settings::Settings;
@@ -91,6 +85,11 @@ impl Grid {
         )
     }
 
+    /// Whether some droplet d lies within `reach(d's width)` of `p` (reach ≤ the cell).
+    fn any_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> bool {
+        self.find_within(p, reach).is_some()
+    }
+
     /// A droplet d within `reach(d's width)` of `p` (reach ≤ the cell), if any.
     fn find_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> Option<Droplet> {
         let (cx, cy) = self.key(p);
@@ -129,406 +128,6 @@ pub fn droplets_of(moves: &[Move], b: f64, b1: f64, out: &mut Vec<Droplet>) {
         }
         at = m.to;
     }
-}
-
-/// The `j`-th droplet of the `G25` line `from` → `to` of length `len` = dist(from, to) and
-/// pitch `w`: exactly the point [`crate::geom::line_droplets`] sets.
-fn line_droplet(from: Point, to: Point, len: f64, w: f64, j: u64) -> Point {
-    let t = if len > 0.0 { j as f64 * w / len } else { 0.0 };
-    DVec2::new(
-        from[0] + t * (to[0] - from[0]),
-        from[1] + t * (to[1] - from[1]),
-    )
-}
-
-/// A `G25` line of the layer below, kept whole.
-#[derive(Clone, Copy, Debug)]
-struct Line {
-    from: Point,
-    to: Point,
-    len: f64,
-    /// Unit vector from → to.
-    u: DVec2,
-    /// Droplet width (the pitch along the line).
-    w: f64,
-    /// Its droplets (at least 2).
-    n: u64,
-    /// The box of its ends in the frame of the layer's common direction (along, across).
-    lo: DVec2,
-    hi: DVec2,
-    /// Half-width of the strip beside it whose points are certainly supported (< 0: none).
-    h: f64,
-}
-
-/// A piece of a line in a row of [`Below`]: its span along the common direction (at most the
-/// row's chunk long) and the line.
-#[derive(Clone, Copy, Debug, Default)]
-struct Entry {
-    lo: f64,
-    hi: f64,
-    line: u32,
-}
-
-/// Slack for rounding in the search windows, mm (coordinates are below 10⁴ mm).
-const PAD_MM: f64 = 1e-6;
-
-/// Clips the parameter range [s0, s1] to where `base + s·slope` lies in [min, max].
-fn clip(base: f64, slope: f64, min: f64, max: f64, s: &mut (f64, f64)) {
-    if slope.abs() < 1e-12 {
-        // Over any line of a layer (< 10⁴ mm) the value moves by < 10⁻⁸ mm, far inside the
-        // margin the strips keep.
-        if base < min || base > max {
-            *s = (f64::INFINITY, f64::NEG_INFINITY);
-        }
-    } else {
-        let (x0, x1) = ((min - base) / slope, (max - base) / slope);
-        s.0 = s.0.max(x0.min(x1));
-        s.1 = s.1.min(x0.max(x1));
-    }
-}
-
-/// A layer's droplets for the question "does a droplet of this layer lie within the rule of
-/// p": its `G25` lines whole, in cells of a grid in the frame of the layer's hatch direction
-/// (every hatch line of a layer, the part's fill and the support's, runs at the layer's hatch
-/// angle; a line that does not is read as droplets), and its other droplets in a [`Grid`].
-struct Below {
-    lines: Vec<Line>,
-    /// Unit vectors along and across the common direction.
-    along: DVec2,
-    across: DVec2,
-    /// The lines in rows across the common direction: row y covers across ∈ c0 + [y, y + 1)·row;
-    /// its entries (sorted by their start along) are `entries[offsets[y]..offsets[y + 1]]`.
-    c0: f64,
-    row: f64,
-    chunk: f64,
-    offsets: Vec<u32>,
-    entries: Vec<Entry>,
-    /// The largest strip half-width.
-    h_max: f64,
-    singles: Grid,
-    /// The rule's reach of a droplet of width w below is w/2 + limit.
-    limit: f64,
-    /// The largest reach.
-    reach_max: f64,
-}
-
-/// ⌈x⌉ for |x| < 2⁶³.
-fn ceil(x: f64) -> i64 {
-    -floor(-x)
-}
-
-impl Below {
-    /// Reads a layer's moves (`layer` hands each of its move lists; every list starts at the
-    /// origin as in [`droplets_of`]): unit 0's droplets are `b` wide, unit 1's `b1`.
-    fn new(layer: &mut dyn FnMut(&mut dyn FnMut(&[Move])), b: f64, b1: f64, limit: f64) -> Below {
-        let mut raw: Vec<(Point, Point, f64)> = Vec::new();
-        let mut singles: Vec<Droplet> = Vec::new();
-        layer(&mut |moves: &[Move]| {
-            let mut at = Point::ZERO;
-            for m in moves {
-                let w = if m.unit == 1 { b1 } else { b };
-                match m.kind {
-                    MoveKind::Droplet => singles.push((m.to, w)),
-                    MoveKind::Line => raw.push((at, m.to, w)),
-                    MoveKind::Travel => {}
-                }
-                at = m.to;
-            }
-        });
-        // The common direction: the longest line's.
-        let longest = raw
-            .iter()
-            .max_by(|x, y| dist(x.0, x.1).total_cmp(&dist(y.0, y.1)));
-        let along = longest.map_or(DVec2::X, |&(a, b, _)| {
-            let l = dist(a, b);
-            if l > 0.0 { (b - a) / l } else { DVec2::X }
-        });
-        let across = DVec2::new(-along.y, along.x);
-        let frame = |p: Point| DVec2::new(along.dot(p), across.dot(p));
-        let strip = |w: f64| {
-            let r = w / 2.0 + limit - MARGIN_MM;
-            if r > w / 2.0 {
-                (r * r - w * w / 4.0).sqrt()
-            } else {
-                -1.0
-            }
-        };
-        let reach_max = b.max(b1) / 2.0 + limit;
-        let mut lines = Vec::with_capacity(raw.len());
-        let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-        for (from, to, w) in raw {
-            let len = dist(from, to);
-            let n = line_droplet_count(len, w);
-            let (fa, fb) = (frame(from), frame(to));
-            // Lines across the common direction, and lines of one droplet, as droplets.
-            if n < 2 || len <= 0.0 || (fa.y - fb.y).abs() > reach_max {
-                singles.extend(crate::geom::line_droplets(from, to, w).map(|p| (p, w)));
-                continue;
-            }
-            let (a, z) = (fa.min(fb), fa.max(fb));
-            lo = lo.min(a);
-            hi = hi.max(z);
-            lines.push(Line {
-                from,
-                to,
-                len,
-                u: (to - from) / len,
-                w,
-                n,
-                lo: a,
-                hi: z,
-                h: strip(w),
-            });
-        }
-        if lines.is_empty() {
-            (lo, hi) = (DVec2::ZERO, DVec2::ZERO);
-        }
-        // Rows of a few reaches (no more than about one per line).
-        let row = (2.0 * reach_max)
-            .max((hi.y - lo.y) / (lines.len() + 1) as f64)
-            .max(1e-3);
-        let rows = floor((hi.y - lo.y) / row) as usize + 1;
-        let span = |l: &Line| {
-            (
-                floor((l.lo.y - lo.y) / row) as usize,
-                floor((l.hi.y - lo.y) / row) as usize,
-            )
-        };
-        // Entries of at most `chunk` along, so a search by start can stop `chunk` back.
-        let chunk = 8.0 * reach_max;
-        let pieces = |l: &Line| ceil((l.hi.x - l.lo.x) / chunk).max(1) as usize;
-        let mut offsets = vec![0u32; rows + 1];
-        for l in &lines {
-            let (y0, y1) = span(l);
-            for y in y0..=y1 {
-                offsets[y + 1] += pieces(l) as u32;
-            }
-        }
-        for k in 1..offsets.len() {
-            offsets[k] += offsets[k - 1];
-        }
-        let mut entries = vec![Entry::default(); *offsets.last().unwrap_or(&0) as usize];
-        let mut fill = offsets.clone();
-        for (i, l) in lines.iter().enumerate() {
-            let (y0, y1) = span(l);
-            let k = pieces(l);
-            for y in y0..=y1 {
-                for j in 0..k {
-                    let lo = l.lo.x + j as f64 * chunk;
-                    let hi = if j + 1 == k { l.hi.x } else { lo + chunk };
-                    entries[fill[y] as usize] = Entry {
-                        lo,
-                        hi,
-                        line: i as u32,
-                    };
-                    fill[y] += 1;
-                }
-            }
-        }
-        for y in 0..rows {
-            entries[offsets[y] as usize..offsets[y + 1] as usize]
-                .sort_unstable_by(|x, y| x.lo.total_cmp(&y.lo));
-        }
-        let h_max = lines.iter().map(|l| l.h).fold(-1.0, f64::max);
-        Below {
-            lines,
-            along,
-            across,
-            c0: lo.y,
-            row,
-            chunk,
-            offsets,
-            entries,
-            h_max,
-            singles: Grid::new(reach_max, &singles),
-            limit,
-            reach_max,
-        }
-    }
-
-    /// The rows over across ∈ [c_lo, c_hi].
-    fn rows(&self, c_lo: f64, c_hi: f64) -> std::ops::RangeInclusive<i64> {
-        let last = self.offsets.len() as i64 - 2;
-        floor((c_lo - self.c0) / self.row).max(0)..=floor((c_hi - self.c0) / self.row).min(last)
-    }
-
-    /// Row y's lines whose span along meets [t_lo, t_hi] (a line may come more than once).
-    fn in_row(&self, y: i64, t_lo: f64, t_hi: f64) -> impl Iterator<Item = &Line> {
-        let e =
-            &self.entries[self.offsets[y as usize] as usize..self.offsets[y as usize + 1] as usize];
-        let k = e.partition_point(|x| x.lo <= t_hi);
-        e[..k]
-            .iter()
-            .rev()
-            .take_while(move |x| x.lo >= t_lo - self.chunk)
-            .filter(move |x| x.hi >= t_lo)
-            .map(|x| &self.lines[x.line as usize])
-    }
-
-    fn frame(&self, p: Point) -> DVec2 {
-        DVec2::new(self.along.dot(p), self.across.dot(p))
-    }
-
-    /// A droplet of the layer within the rule's reach of `p` (w/2 + limit for a droplet of
-    /// width w), if any: the same answer as a search over every droplet of the layer.
-    fn find(&self, p: Point) -> Option<Droplet> {
-        let limit = self.limit;
-        if let Some(d) = self.singles.find_within(p, |w| w / 2.0 + limit) {
-            return Some(d);
-        }
-        let f = self.frame(p);
-        // A droplet within reach lies in the box f ± r, and so does some point of its line.
-        let r = self.reach_max + PAD_MM;
-        for l in self
-            .rows(f.y - r, f.y + r)
-            .flat_map(|y| self.in_row(y, f.x - r, f.x + r))
-        {
-            let r = l.w / 2.0 + limit;
-            let last = (l.n - 1) as f64;
-            let jf = (p - l.from).dot(l.u) / l.w;
-            if jf < -r / l.w - 1.0 || jf > last + r / l.w + 1.0 {
-                continue;
-            }
-            // The nearest droplet along the line and its neighbours: any droplet of the line
-            // within r is no farther than they are.
-            let j0 = (floor(jf) - 1).clamp(0, l.n as i64 - 1) as u64;
-            let j1 = (ceil(jf) + 1).clamp(0, l.n as i64 - 1) as u64;
-            for j in j0..=j1 {
-                let q = line_droplet(l.from, l.to, l.len, l.w, j);
-                if (p - q).length_squared() <= r * r {
-                    return Some((q, l.w));
-                }
-            }
-        }
-        None
-    }
-
-    /// The droplets k of the line `a` → `b` above (length `len` = dist(a, b), pitch `w`, `n`
-    /// droplets) that are certainly supported, as sorted, merged ranges (k0, k1) in `out`
-    /// (cleared first). A droplet p is certain when it lies in the strip beside a line below
-    /// (width w′, droplets w′ apart along it from its first to its last): along it no farther
-    /// than w′/2 beyond its first or last droplet, across it no farther than h with
-    /// h² + (w′/2)² = (w′/2 + limit − MARGIN_MM)². A droplet of that line then lies within
-    /// √(h² + (w′/2)²), inside the rule's reach by the margin, which covers every rounding.
-    fn certified(&self, a: Point, b: Point, len: f64, w: f64, n: u64, out: &mut Vec<(u64, u64)>) {
-        out.clear();
-        if self.h_max < 0.0 || len <= 0.0 || n < 2 || self.lines.is_empty() {
-            return;
-        }
-        let u = (b - a) / len;
-        let last = (n - 1) as f64;
-        // Row by row (in the order the line crosses them), the lines below whose strips the
-        // line may cross.
-        let (fa, fu) = (
-            self.frame(a),
-            DVec2::new(self.along.dot(u), self.across.dot(u)),
-        );
-        let fz = fa + last * w * fu;
-        let grow = self.h_max + PAD_MM;
-        let mut ys = self.rows(fa.y.min(fz.y) - grow, fa.y.max(fz.y) + grow);
-        let backwards = fu.y < 0.0;
-        let along_grow = self.reach_max + PAD_MM;
-        while let Some(y) = if backwards { ys.next_back() } else { ys.next() } {
-            // Where the line is within the row's band, grown by the widest strip.
-            let band = self.c0 + y as f64 * self.row;
-            let mut s = (0.0, last * w);
-            clip(fa.y, fu.y, band - grow, band + self.row + grow, &mut s);
-            if s.0 > s.1 {
-                continue;
-            }
-            let (t0, t1) = (fa.x + s.0 * fu.x, fa.x + s.1 * fu.x);
-            for l in self.in_row(y, t0.min(t1) - along_grow, t0.max(t1) + along_grow) {
-                if l.h < 0.0 {
-                    continue;
-                }
-                let d = a - l.from;
-                let mut s = (0.0, last * w);
-                clip(
-                    d.dot(l.u),
-                    u.dot(l.u),
-                    -l.w / 2.0,
-                    (l.n - 1) as f64 * l.w + l.w / 2.0,
-                    &mut s,
-                );
-                clip(l.u.perp_dot(d), l.u.perp_dot(u), -l.h, l.h, &mut s);
-                if s.0 > s.1 {
-                    continue;
-                }
-                let (k0, k1) = (ceil(s.0 / w).max(0), floor(s.1 / w).min(n as i64 - 1));
-                if k0 <= k1 {
-                    out.push((k0 as u64, k1 as u64));
-                }
-            }
-        }
-        out.sort_unstable();
-        let mut merged = 0;
-        for j in 0..out.len() {
-            if merged > 0 && out[j].0 <= out[merged - 1].1 + 1 {
-                out[merged - 1].1 = out[merged - 1].1.max(out[j].1);
-            } else {
-                out[merged] = out[j];
-                merged += 1;
-            }
-        }
-        out.truncate(merged);
-    }
-}
-
-/// The droplets of a layer (`layer` hands its move lists, each starting at the origin as in
-/// [`droplets_of`]) that no droplet of the layer below (`below`) supports by the rule: none
-/// within w/2 + `overhang_limit`·B of it for a droplet of width w below. In the order
-/// [`droplets_of`] gives them.
-pub fn unsupported(
-    below: &mut dyn FnMut(&mut dyn FnMut(&[Move])),
-    layer: &mut dyn FnMut(&mut dyn FnMut(&[Move])),
-    s: &Settings,
-) -> Vec<Droplet> {
-    let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
-    let limit = s.overhang_limit * b;
-    let below = Below::new(below, b, b1, limit);
-    let reach = |w: f64| w / 2.0 + limit;
-    let mut open = Vec::new();
-    // Consecutive droplets are neighbours: the droplet below that supported the last one
-    // most often supports the next.
-    let mut last: Option<Droplet> = None;
-    let mut check = |p: Point, w: f64| {
-        if let Some((q, wq)) = last {
-            let r = reach(wq);
-            if (p - q).length_squared() <= r * r {
-                return;
-            }
-        }
-        match below.find(p) {
-            Some(d) => last = Some(d),
-            None => open.push((p, w)),
-        }
-    };
-    let mut sure = Vec::new();
-    layer(&mut |moves: &[Move]| {
-        let mut at = Point::ZERO;
-        for m in moves {
-            let w = if m.unit == 1 { b1 } else { b };
-            match m.kind {
-                MoveKind::Droplet => check(m.to, w),
-                MoveKind::Line => {
-                    let len = dist(at, m.to);
-                    let n = line_droplet_count(len, w);
-                    below.certified(at, m.to, len, w, n, &mut sure);
-                    // The droplets between the certain ranges, one by one.
-                    let mut k = 0;
-                    for &(k0, k1) in sure.iter().chain([(n, n)].iter()) {
-                        for j in k..k0.min(n) {
-                            check(line_droplet(at, m.to, len, w, j), w);
-                        }
-                        k = k1 + 1;
-                    }
-                }
-                MoveKind::Travel => {}
-            }
-            at = m.to;
-        }
-    });
-    open
 }
 
 /// Droplets added to a layer, in a hash grid (few).
@@ -799,15 +398,14 @@ pub struct PassFigures {
 }
 
 /// The unit-1 droplets to add to each layer so that every droplet above the first layer is
-/// supported: `layer(i, f)` hands layer i's planned move lists (both units; each starts at the
-/// origin as in [`droplets_of`]) to `f` (called about twice per layer, so that no layer's
-/// droplets need be kept), `regions[i]` is its part's region. Works top-down; an added droplet
-/// needs support from the layer below as any other. Support droplets keep `support_gap_xy`·B
-/// from the part's region; a droplet with no such place within the rule stays unsupported
-/// (counted). With `support_gap_z` > 0 the support deliberately stops below overhangs, and the
-/// pass adds nothing.
+/// supported: `droplets(i, out)` appends layer i's planned droplets (both units) to `out`
+/// (called about twice per layer, so that no layer's droplets need be kept), `regions[i]` is
+/// its part's region. Works top-down; an added droplet needs support from the layer below as
+/// any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
+/// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
+/// support deliberately stops below overhangs, and the pass adds nothing.
 pub fn complete(
-    layer: &(dyn Fn(usize, &mut dyn FnMut(&[Move])) + Sync),
+    droplets: &(dyn Fn(usize, &mut Vec<Droplet>) + Sync),
     regions: &[Shapes],
     s: &Settings,
     par_map: impl Fn(usize, &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>>,
@@ -828,23 +426,72 @@ pub fn complete(
         if i == 0 {
             return Vec::new();
         }
-        let mut open = unsupported(&mut |f| layer(i - 1, f), &mut |f| layer(i, f), s);
-        open.shrink_to_fit();
-        open
+        let mut buf = Vec::new();
+        droplets(i - 1, &mut buf);
+        let below = Grid::new(cell, &buf);
+        buf.clear();
+        droplets(i, &mut buf);
+        // Consecutive droplets are neighbours: the droplet below that supported the last one
+        // most often supports the next.
+        let mut last: Option<Droplet> = None;
+        buf.retain(|&(p, _)| {
+            if let Some((q, w)) = last {
+                let r = reach(w);
+                if (p - q).length_squared() <= r * r {
+                    return false;
+                }
+            }
+            match below.find_within(p, reach) {
+                Some(d) => {
+                    last = Some(d);
+                    false
+                }
+                None => true,
+            }
+        });
+        buf.shrink_to_fit();
+        buf
     });
     let gap = s.support_gap_xy * b;
     let place = reach(b1) - MARGIN_MM;
+    let mut buf = Vec::new();
     // Top-down: layer i's unsupported droplets (planned or added) get droplets in layer i − 1.
     for i in (1..n).rev() {
         let mut todo: Vec<Droplet> = open[i].clone();
         if !extra[i].is_empty() {
-            // The droplets added to layer i against layer i − 1's planned droplets.
-            let below = Below::new(&mut |f| layer(i - 1, f), b, b1, limit);
+            // The droplets added to layer i against layer i − 1's planned droplets: few, so
+            // the layer's droplets are scanned once (a grid only for many).
+            buf.clear();
+            droplets(i - 1, &mut buf);
+            let adds: Vec<Droplet> = extra[i].iter().map(|&p| (p, b1)).collect();
+            let mut held = vec![false; adds.len()];
+            if adds.len() > 16 {
+                let below = Grid::new(cell, &buf);
+                for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                    *h = below.any_within(p, reach);
+                }
+            } else {
+                let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+                for (p, _) in &adds {
+                    lo = lo.min(*p);
+                    hi = hi.max(*p);
+                }
+                let (lo, hi) = (lo - DVec2::splat(cell), hi + DVec2::splat(cell));
+                for &(q, w) in &buf {
+                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
+                        continue;
+                    }
+                    let r = reach(w);
+                    for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                        *h = *h || (p - q).length_squared() <= r * r;
+                    }
+                }
+            }
             todo.extend(
-                extra[i]
-                    .iter()
-                    .filter(|&&p| below.find(p).is_none())
-                    .map(|&p| (p, b1)),
+                adds.iter()
+                    .zip(&held)
+                    .filter(|(_, h)| !**h)
+                    .map(|(d, _)| *d),
             );
         }
         if todo.is_empty() {
@@ -899,26 +546,12 @@ mod tests {
         s: &Settings,
     ) -> (Vec<Vec<Point>>, PassFigures) {
         assert_eq!(droplets.len(), regions.len());
-        // Single droplets (G26) of unit 0 when B wide, else of unit 1.
-        let b = s.droplet_width();
-        let moves: Vec<Vec<Move>> = droplets
-            .iter()
-            .map(|l| {
-                l.iter()
-                    .map(|&(p, w)| single(p, u8::from(w != b)))
-                    .collect()
-            })
-            .collect();
-        complete(&|i, f| f(&moves[i]), regions, s, serial)
-    }
-
-    fn single(p: Point, unit: u8) -> Move {
-        Move {
-            kind: MoveKind::Droplet,
-            role: crate::plan::Role::Support,
-            to: p,
-            unit,
-        }
+        complete(
+            &|i, out: &mut Vec<Droplet>| out.extend_from_slice(&droplets[i]),
+            regions,
+            s,
+            serial,
+        )
     }
 
     fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
