@@ -91,16 +91,30 @@ impl Grid {
     }
 
     /// A droplet d within `reach(d's width)` of `p` (reach ≤ the cell), if any.
+    /// The cells are searched from p's own outwards (the question is whether there is one).
     fn find_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> Option<Droplet> {
         let (cx, cy) = self.key(p);
-        for y in (cy - 1).max(0)..=(cy + 1).min(self.ny - 1) {
-            for x in (cx - 1).max(0)..=(cx + 1).min(self.nx - 1) {
-                let c = (y * self.nx + x) as usize;
-                let cell = &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize];
-                if let Some(&d) = cell.iter().find(|&&(q, w)| {
+        let search = |x: i64, y: i64| {
+            let c = (y * self.nx + x) as usize;
+            let cell = &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize];
+            cell.iter()
+                .find(|&&(q, w)| {
                     let r = reach(w);
                     (p - q).length_squared() <= r * r
-                }) {
+                })
+                .copied()
+        };
+        // p's own cell lies in the grid (the grid covers every droplet, p may lie outside).
+        let own = (0..self.nx).contains(&cx) && (0..self.ny).contains(&cy);
+        if own && let Some(d) = search(cx, cy) {
+            return Some(d);
+        }
+        for y in (cy - 1).max(0)..=(cy + 1).min(self.ny - 1) {
+            for x in (cx - 1).max(0)..=(cx + 1).min(self.nx - 1) {
+                if own && x == cx && y == cy {
+                    continue;
+                }
+                if let Some(d) = search(x, y) {
                     return Some(d);
                 }
             }
