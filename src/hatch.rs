@@ -157,6 +157,16 @@ impl EndGrid {
             let mut any_cell = false;
             for (x, y) in ring_cells(cx, cy, r, self.nx, self.ny) {
                 any_cell = true;
+                // A cell whose box lies farther than the best end so far holds no nearer end
+                // nor an equally near one (the slack keeps rounding on the safe side).
+                if let Some((bd, _)) = best {
+                    let lo = self.min + DVec2::new(x as f64, y as f64) * self.cell;
+                    let hi = lo + DVec2::splat(self.cell);
+                    let d = (lo - p).max(p - hi).max(DVec2::ZERO);
+                    if d.length_squared() > bd * bd * (1.0 + 1e-9) + 1e-18 {
+                        continue;
+                    }
+                }
                 let cell = &mut self.cells[(y * self.nx + x) as usize];
                 let alive = &self.alive;
                 cell.retain(|&e| alive[e as usize]);
@@ -170,7 +180,7 @@ impl EndGrid {
             // Every end outside rings 0..=r is at least max(r·cell, how far p lies outside the
             // grid) away; stop once the best is at most that.
             let bound = (r as f64 * self.cell).max(self.outside_distance(p));
-            if !any_cell || best.is_some_and(|(bd, _)| bd <= bound) {
+            if !any_cell || best.is_some_and(|(bd, _)| bd < bound) {
                 break;
             }
         }
@@ -207,6 +217,69 @@ mod tests {
         assert_eq!(lines.len(), 10);
         for l in &lines {
             assert!((dist(l.a, l.b) - 10.0).abs() < 1e-12);
+        }
+    }
+
+    /// A small deterministic generator (xorshift), for random inputs.
+    fn random(seed: &mut u64) -> f64 {
+        *seed ^= *seed << 13;
+        *seed ^= *seed >> 7;
+        *seed ^= *seed << 17;
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn greedy_takes_the_nearest_end_as_a_scan_of_every_end_does() {
+        // Random segments in clusters (far jumps between them) and on a lattice (equal
+        // distances, where the lower end id wins): each next segment is the one a scan of
+        // every remaining end picks.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        for case in 0..40 {
+            let mut lines = Vec::new();
+            // (A single line is kept as it is.)
+            let n = 2 + case * 7;
+            for k in 0..n {
+                let c = if k % 3 == 0 { 50.0 } else { 0.0 };
+                let p = |s: &mut u64| {
+                    if case % 2 == 0 {
+                        DVec2::new(c + random(s) * 10.0, random(s) * 5.0)
+                    } else {
+                        DVec2::new((random(s) * 8.0).floor() * 0.25, (random(s) * 8.0).floor())
+                    }
+                };
+                lines.push(HatchLine {
+                    a: p(&mut seed),
+                    b: p(&mut seed),
+                });
+            }
+            let from = DVec2::new(random(&mut seed) * 60.0, -3.0);
+            let ordered = order_greedy(lines.clone(), from);
+            // The scan: the least (distance, end id) over the ends of the lines left.
+            let mut left: Vec<Option<HatchLine>> = lines.iter().copied().map(Some).collect();
+            let mut at = from;
+            for got in ordered {
+                let mut best: Option<(f64, usize)> = None;
+                for (i, l) in left.iter().enumerate() {
+                    if let Some(l) = l {
+                        for (e, q) in [(2 * i, l.a), (2 * i + 1, l.b)] {
+                            let d = dist(at, q);
+                            if best.is_none_or(|(bd, be)| d < bd || (d == bd && e < be)) {
+                                best = Some((d, e));
+                            }
+                        }
+                    }
+                }
+                let (_, e) = best.expect("a line is left");
+                let l = left[e / 2].take().expect("alive");
+                let want = if e % 2 == 0 {
+                    l
+                } else {
+                    HatchLine { a: l.b, b: l.a }
+                };
+                assert_eq!(got, want, "case {case}");
+                at = want.b;
+            }
+            assert!(left.iter().all(Option::is_none));
         }
     }
 

@@ -91,16 +91,30 @@ impl Grid {
     }
 
     /// A droplet d within `reach(d's width)` of `p` (reach ≤ the cell), if any.
+    /// The cells are searched from p's own outwards (the question is whether there is one).
     fn find_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> Option<Droplet> {
         let (cx, cy) = self.key(p);
-        for y in (cy - 1).max(0)..=(cy + 1).min(self.ny - 1) {
-            for x in (cx - 1).max(0)..=(cx + 1).min(self.nx - 1) {
-                let c = (y * self.nx + x) as usize;
-                let cell = &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize];
-                if let Some(&d) = cell.iter().find(|&&(q, w)| {
+        let search = |x: i64, y: i64| {
+            let c = (y * self.nx + x) as usize;
+            let cell = &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize];
+            cell.iter()
+                .find(|&&(q, w)| {
                     let r = reach(w);
                     (p - q).length_squared() <= r * r
-                }) {
+                })
+                .copied()
+        };
+        // p's own cell lies in the grid (the grid covers every droplet, p may lie outside).
+        let own = (0..self.nx).contains(&cx) && (0..self.ny).contains(&cy);
+        if own && let Some(d) = search(cx, cy) {
+            return Some(d);
+        }
+        for y in (cy - 1).max(0)..=(cy + 1).min(self.ny - 1) {
+            for x in (cx - 1).max(0)..=(cx + 1).min(self.nx - 1) {
+                if own && x == cx && y == cy {
+                    continue;
+                }
+                if let Some(d) = search(x, y) {
                     return Some(d);
                 }
             }
@@ -556,6 +570,58 @@ mod tests {
 
     fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
         (0..n).map(f).collect()
+    }
+
+    #[test]
+    fn the_grid_finds_a_droplet_within_reach_as_a_scan_of_every_droplet_does() {
+        // Droplets of two widths in clusters and a sparse spread, queries inside and outside
+        // the grid and right at the reach: the grid answers "is there one" as a full scan.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut random = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (b, b1, limit) = (0.208, 0.15, 0.104);
+        let reach = |w: f64| w / 2.0 + limit;
+        let (mut found, mut missed) = (0, 0);
+        for case in 0..30 {
+            let spread = if case % 2 == 0 { 3.0 } else { 40.0 };
+            let droplets: Vec<Droplet> = (0..(case * 37 % 400))
+                .map(|k| {
+                    let w = if k % 3 == 0 { b1 } else { b };
+                    (DVec2::new(random() * spread, random() * spread / 2.0), w)
+                })
+                .collect();
+            let grid = Grid::new(reach(b), &droplets);
+            for k in 0..300 {
+                let p = if k % 4 == 0 && !droplets.is_empty() {
+                    // At the reach of a droplet, in a random direction.
+                    let (q, w) = droplets[k % droplets.len()];
+                    let a = random() * std::f64::consts::TAU;
+                    q + reach(w) * DVec2::new(a.cos(), a.sin())
+                } else {
+                    DVec2::new(
+                        random() * 1.2 * spread - 0.1 * spread,
+                        random() * spread - 1.0,
+                    )
+                };
+                let scan = droplets.iter().any(|&(q, w)| {
+                    let r = reach(w);
+                    (p - q).length_squared() <= r * r
+                });
+                let got = grid.find_within(p, reach);
+                assert_eq!(got.is_some(), scan, "case {case} query {k} at {p}");
+                if let Some((q, w)) = got {
+                    assert!((p - q).length_squared() <= reach(w) * reach(w));
+                    found += 1;
+                } else {
+                    missed += 1;
+                }
+            }
+        }
+        assert!(found > 1000 && missed > 1000, "{found} {missed}");
     }
 
     #[test]
