@@ -12,7 +12,9 @@
 //! than allowed, so a vertex of the result inside that area is closer than allowed too: the
 //! result's vertices are checked (few: most layers have no overhang) and a layer that fails
 //! is computed by [`crate::support::overhang`]. `tests/overhang.rs` compares every layer's
-//! area with [`crate::support::overhang`] on shared models.
+//! area with [`crate::support::overhang`] on shared models. The support pass takes the
+//! region itself from the same pass ([`overhang_region`]), so with support on each layer's
+//! figure is the very figure of support off.
 
 use crate::geom::{DVec2, Shape, Shapes, region_area, segment_distance2, signed_area};
 use crate::grid::EdgeIndex;

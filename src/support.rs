@@ -16,7 +16,10 @@
 //! need(n) = (need(n + 1) ∪ grow(overhang(n + 1), [`support_reach`])) − region(n) (the part
 //! below carries what it covers), support(n) = need(n) − the grown overhangs of the
 //! `support_gap_z` layers directly above. The overhang is grown by B₁/2 before it is carried
-//! down so that the support reaches under the overhang's edge. Unit 1 hatches a support
+//! down so that the support reaches under the overhang's edge. The overhangs come from the one
+//! pass of [`crate::overhang::overhang_region`], their growth from the fast offset
+//! ([`grow_fast`]); only the union is sequential, and it hands the boolean engine only the
+//! shapes whose boxes meet ([`carried`]). Unit 1 hatches a support
 //! region directly ([`crate::plan::support_moves`]), leaving out the droplets within
 //! `support_gap_xy`·B of the part (no offset of the part); the droplet-level pass
 //! ([`crate::support_droplets`]) then adds droplets wherever the rule still fails.
