@@ -589,6 +589,70 @@ mod tests {
     }
 
     #[test]
+    fn grow_fast_agrees_with_the_exact_offset_and_the_outline() {
+        // A 10 mm square with a 4 mm square hole, grown by 1 mm: the outer boundary gains
+        // a 1 mm band with quarter circles at the corners, the hole shrinks to 2 × 2 mm.
+        let hole: crate::geom::Contour = [[3.0, 3.0], [3.0, 7.0], [7.0, 7.0], [7.0, 3.0]]
+            .map(DVec2::from)
+            .into();
+        let framed = vec![Shape::new(
+            square(0.0, 0.0, 10.0)[0].outer.clone(),
+            vec![hole],
+        )];
+        let want = 100.0 + 40.0 + std::f64::consts::PI - 4.0;
+        let got = region_area(&grow_fast(&framed, 1.0, SUPPORT_TOLERANCE_MM));
+        // Chords within 5 µm of the arcs (2π mm of them).
+        assert!((got - want).abs() < 0.04, "{got} against {want}");
+        // A U with a 0.3 mm slot: grown by 0.104 mm the slot stays open in its middle, by
+        // 0.5 mm it fills. i_overlay's outline (chords within 1 µm) gives the same area
+        // within the chords' error.
+        let u: Shapes = vec![Shape::new(
+            [
+                [0.0, 0.0],
+                [3.0, 0.0],
+                [3.0, 5.0],
+                [1.65, 5.0],
+                [1.65, 1.0],
+                [1.35, 1.0],
+                [1.35, 5.0],
+                [0.0, 5.0],
+            ]
+            .map(DVec2::from)
+            .into(),
+            vec![],
+        )];
+        for d in [0.104, 0.5] {
+            let fast = grow_fast(&u, d, SUPPORT_TOLERANCE_MM);
+            let outline = grow_within(&u, d, 0.001);
+            let (a, b) = (region_area(&fast), region_area(&outline));
+            assert!((a - b).abs() < 0.02, "d {d}: {a} against {b}");
+            assert_eq!(fast.len(), 1);
+            assert!(fast[0].holes.is_empty());
+            let middle = region_area(&intersection(&fast, &square(1.49, 3.0, 0.02)));
+            let want = if d < 0.15 { 0.0 } else { 0.0004 };
+            assert!((middle - want).abs() < 1e-9, "d {d}: {middle}");
+        }
+    }
+
+    #[test]
+    fn simplify_loop_keeps_the_points_of_simplify_closed() {
+        // A wobbly loop of 2,000 points (radius 5 mm, wobbles of a few µm and of 0.1 mm):
+        // the cheaper arithmetic keeps the very points of the slicer's Douglas–Peucker.
+        let c: crate::geom::Contour = (0..2000)
+            .map(|k| {
+                let t = k as f64 / 2000.0 * std::f64::consts::TAU;
+                let r = 5.0 + 0.004 * (37.0 * t).sin() + 0.1 * (5.0 * t).sin();
+                DVec2::new(r * t.cos(), r * t.sin())
+            })
+            .collect();
+        for tol in [0.001, SUPPORT_TOLERANCE_MM, 0.02] {
+            let fast = simplify_loop(&c, tol);
+            assert_eq!(fast, crate::slice::simplify_closed(&c, tol), "tol {tol}");
+            assert!(fast.len() > 20 && fast.len() < c.len(), "{}", fast.len());
+        }
+    }
+
+    #[test]
     fn support_fills_under_a_floating_slab_down_to_the_plate() {
         // A post (layers 0..5) and a slab beside it on layers 5..8.
         let s = Settings::default();
