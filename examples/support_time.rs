@@ -3,7 +3,8 @@
 //! overhang and support areas of some layers; `REGIONS_ONLY=1` stops after the support
 //! regions (for a profiler).
 use dropslice::geom::{Shapes, region_area};
-use dropslice::support::{self, overhang, par_map};
+use dropslice::overhang::overhang_region;
+use dropslice::support::{self, par_map};
 use dropslice::{Job, Settings};
 use std::time::Instant;
 
@@ -29,7 +30,7 @@ fn main() {
     println!("sections        {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
     let _o: Vec<Shapes> = par_map(n, &|i| {
-        overhang(&regions[i], i.checked_sub(1).map(|j| &regions[j]), &s)
+        overhang_region(&regions[i], i.checked_sub(1).map(|j| &regions[j]), &s)
     });
     println!("overhangs       {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();

@@ -12,9 +12,11 @@
 //! than allowed, so a vertex of the result inside that area is closer than allowed too: the
 //! result's vertices are checked (few: most layers have no overhang) and a layer that fails
 //! is computed by [`crate::support::overhang`]. `tests/overhang.rs` compares every layer's
-//! area with [`crate::support::overhang`] on shared models.
+//! area with [`crate::support::overhang`] on shared models. The support pass takes the
+//! region itself from the same pass ([`overhang_region`]), so with support on each layer's
+//! figure is the very figure of support off.
 
-use crate::geom::{DVec2, Shapes, region_area, segment_distance2, signed_area};
+use crate::geom::{DVec2, Shape, Shapes, region_area, segment_distance2, signed_area};
 use crate::grid::EdgeIndex;
 use crate::offset::{CHORD_TOLERANCE_MM, Corners, raw_offset};
 use crate::settings::Settings;
@@ -40,11 +42,34 @@ pub fn overhang_area(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> f
     if below.is_empty() || !d.is_finite() || d <= 2.0 * CHORD_TOLERANCE_MM {
         return region_area(&overhang(region, Some(below), s));
     }
-    one_pass(region, below, d).unwrap_or_else(|| region_area(&overhang(region, Some(below), s)))
+    match one_pass(region, below, d) {
+        // (+0.0 for none, as the sum of the loops' areas always gave.)
+        Some(shapes) if shapes.is_empty() => 0.0,
+        Some(shapes) => region_area(&shapes),
+        None => region_area(&overhang(region, Some(below), s)),
+    }
 }
 
-/// R ∩ F in one pass, or `None` when a mitred corner was wrong.
-fn one_pass(region: &Shapes, below: &Shapes, d: f64) -> Option<f64> {
+/// The overhang of a layer as [`crate::support::overhang`] gives it, up to rounding, by the one
+/// pass of [`overhang_area`] (whose figure is this region's area): what the support pass
+/// carries down.
+pub fn overhang_region(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
+    let Some(below) = below else {
+        return Shapes::new();
+    };
+    if region.is_empty() {
+        return Shapes::new();
+    }
+    let d = s.overhang_limit * s.droplet_width();
+    if below.is_empty() || !d.is_finite() || d <= 2.0 * CHORD_TOLERANCE_MM {
+        return overhang(region, Some(below), s);
+    }
+    one_pass(region, below, d).unwrap_or_else(|| overhang(region, Some(below), s))
+}
+
+/// R ∩ F in one pass (loops of less than [`MIN_AREA_MM2`] left out), or `None` when a mitred
+/// corner was wrong.
+fn one_pass(region: &Shapes, below: &Shapes, d: f64) -> Option<Shapes> {
     let (lo, hi) = bounds_of(region, below);
     // A frame around both layers (positive winding), and every loop of the layer below
     // reversed and moved by d to its left: outward from the material.
@@ -72,25 +97,22 @@ fn one_pass(region: &Shapes, below: &Shapes, d: f64) -> Option<f64> {
     // Outer loops run counter-clockwise and holes clockwise, so the layer's region is its
     // positive winding too.
     let out = layer.overlay(&far, OverlayRule::Intersect, FillRule::Positive);
-    let shapes = crate::geom::shapes_from_overlay(out);
-    let mut area = 0.0;
     let mut points = Vec::new();
-    for s in &shapes {
-        let outer = signed_area(&s.outer);
-        if outer.abs() < MIN_AREA_MM2 {
-            continue;
-        }
-        area += outer;
-        for h in &s.holes {
-            let a = signed_area(h);
-            if a.abs() >= MIN_AREA_MM2 {
-                area += a;
-            }
-        }
-        points.extend(s.contours().flatten().copied());
-    }
+    let shapes: Shapes = crate::geom::shapes_from_overlay(out)
+        .into_iter()
+        .filter(|s| signed_area(&s.outer).abs() >= MIN_AREA_MM2)
+        .map(|s| {
+            points.extend(s.contours().flatten().copied());
+            let holes = s
+                .holes
+                .into_iter()
+                .filter(|h| signed_area(h).abs() >= MIN_AREA_MM2)
+                .collect();
+            Shape::new(s.outer, holes)
+        })
+        .collect();
     if points.is_empty() {
-        return Some(area);
+        return Some(shapes);
     }
     // Every vertex of the overhang lies at least d from the layer below (less the chords'
     // tolerance and rounding), as `offset::inset_within` checks its mitres.
@@ -115,5 +137,5 @@ fn one_pass(region: &Shapes, below: &Shapes, d: f64) -> Option<f64> {
     if points.iter().any(|&p| near(p, index.as_ref())) {
         return None;
     }
-    Some(area)
+    Some(shapes)
 }
