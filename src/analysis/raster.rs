@@ -138,7 +138,21 @@ pub fn analyse_layer_with_mask(
     s: &Settings,
     mask_cell: f64,
 ) -> (LayerAnalysis, CoverageMask) {
-    let r = Raster::new(plan, region, s);
+    analyse_layer_with_mask_in(&mut Raster::empty(), plan, region, s, mask_cell)
+}
+
+/// [`analyse_layer_with_mask`] in `r`'s memory: a worker analysing layer after layer keeps
+/// one raster, so its bitmaps and the labelling's buffers are allocated (and first touched)
+/// once, not per layer. The same figures and mask.
+pub fn analyse_layer_with_mask_in(
+    r: &mut Raster,
+    plan: &LayerPlan,
+    region: &Shapes,
+    s: &Settings,
+    mask_cell: f64,
+) -> (LayerAnalysis, CoverageMask) {
+    let b = s.droplet_width();
+    r.rebuild(plan.index, plan.z, &droplet_centres(plan, b), region, s);
     let a = LayerAnalysis {
         unsupported_area: plan.unsupported_area,
         ..r.analysis()
