@@ -43,6 +43,11 @@ fn main() {
         t[i] += now - *from;
         *from = now;
     };
+    // One raster rebuilt layer after layer (as the workers do); FRESH=1: a new one per layer.
+    let fresh = std::env::var("FRESH").is_ok();
+    // FAST_ONLY=1: not the reference paths (for perf).
+    let fast_only = std::env::var("FAST_ONLY").is_ok();
+    let mut r = Raster::empty();
     for i in 0..job.layer_count() {
         let mut at = cpu();
         let sec = job.section(i);
@@ -50,16 +55,31 @@ fn main() {
         std::hint::black_box(dropslice::gcode::layer_text(&plan));
         lap(0, &mut at);
         let c = droplet_centres(&plan, b);
-        let r = Raster::from_centres(i, plan.z, &c, &sec.region, &s);
+        if fresh {
+            r = Raster::empty();
+        }
+        r.rebuild(i, plan.z, &c, &sec.region, &s);
         lap(1, &mut at);
-        let la = r.analysis();
-        nvoids += la.voids;
-        lap(2, &mut at);
-        std::hint::black_box(r.analysis_reference());
-        lap(3, &mut at);
+        if std::env::var("REF_FIRST").is_ok() {
+            std::hint::black_box(r.analysis_reference());
+            lap(3, &mut at);
+            let la = r.analysis();
+            nvoids += la.voids;
+            lap(2, &mut at);
+        } else {
+            let la = r.analysis();
+            nvoids += la.voids;
+            lap(2, &mut at);
+            if !fast_only {
+                std::hint::black_box(r.analysis_reference());
+            }
+            lap(3, &mut at);
+        }
         std::hint::black_box(r.mask(b / 4.0));
         lap(4, &mut at);
-        std::hint::black_box(r.mask_reference(b / 4.0));
+        if !fast_only {
+            std::hint::black_box(r.mask_reference(b / 4.0));
+        }
         lap(5, &mut at);
         let m = HeightMap::new(&c, &grid, footprint_diameter(&s));
         lap(6, &mut at);

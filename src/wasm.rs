@@ -480,7 +480,7 @@ impl Session {
         self.check_layer(i)?;
         let (plan, region, text) = self.planned(i);
         let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
-        let (a, mask) = analysis::analyse_layer_with_mask_in(
+        let (a, mask) = analysis::analyse_layer_for_page(
             &mut self.raster.borrow_mut(),
             &plan,
             &region,

@@ -70,6 +70,6 @@ pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
 pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
-    Void, analyse_layer, analyse_layer_with_mask, analyse_layer_with_mask_in,
+    Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,
 };
 pub use report::{AnalysedLayer, JobAnalysis, LayerStage, Model, PartAnalysis, Report};
