@@ -2,7 +2,10 @@
 //! `cargo run --release --example analysis_profile -- MODEL.stl [--set stagger=true]`.
 //! Times are seconds the thread ran on a CPU (Linux: /proc/thread-self/schedstat), so waiting
 //! for a core on a busy machine is not counted; elsewhere wall time. "before" is the path
-//! the fast one replaced (`analysis_reference`, `mask_reference`), on the same raster.
+//! the fast one replaced (`analysis_reference`, `mask_reference`), on the same raster. One
+//! raster is rebuilt layer after layer, as the workers do; environment: FRESH=1 a new raster
+//! per layer, REF_FIRST=1 the reference labelling before the fast one (the first after
+//! rasterising pays for the raster's memory), FAST_ONLY=1 no reference paths (for perf).
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
 use std::sync::OnceLock;

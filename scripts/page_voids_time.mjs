@@ -26,12 +26,6 @@ try {
         return st.state !== "slicing" && (!voids || st.analysed === st.layers);
       }, voids, { timeout: 600_000, polling: 50 });
       const s = await page.evaluate(() => window.dropslice.status());
-      if (process.env.WORKER_TIMES) {
-        for (const w of page.workers()) {
-          const t = await w.evaluate(() => globalThis.__dsTimes ?? null).catch(() => null);
-          if (t) console.log("  worker", JSON.stringify(t));
-        }
-      }
       if (s.state !== "done") throw new Error(`${f}: page state ${s.state}`);
       if (i > 0) times.push(s.seconds);
       console.log(`${f.split("/").pop()} run ${i}${i ? "" : " (warm-up)"}: ${s.seconds.toFixed(2)} s, ${s.analysed}/${s.layers} layers analysed, ${s.workers} worker(s)`);
