@@ -1064,9 +1064,9 @@ impl Raster {
     fn count_by_nibbles<const N: usize>(
         &self,
         rows: usize,
-        out: &[MaskTile],
+        out: &mut [MaskTile],
         groups: &[(usize, std::ops::Range<usize>)],
-        counts: &mut [Vec<[u32; 3]>],
+        table: &[u8],
     ) {
         debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
         let tiles = &self.tiles;
@@ -1084,25 +1084,27 @@ impl Raster {
             let x = x - ((x >> 1) & 0x5555_5555_5555_5555);
             (x & 0x3333_3333_3333_3333) + ((x >> 2) & 0x3333_3333_3333_3333)
         };
-        // The cells of mask row `my` (tiles `range`) from `acc`, then `acc` cleared: each
-        // tile's 4-bit groups read in order along its words, `rows` of them per cell.
+        // The cells of mask row `my` (tiles `range`, their words `spans`) from `acc`, their
+        // shares (`table`: per count) into the tiles, then `acc` cleared: each tile's 4-bit
+        // groups read in order along its words, `rows` of them per cell.
         let flush = |my: usize,
                      range: std::ops::Range<usize>,
                      acc: &mut [[u64; N]],
                      at: &[usize],
-                     counts: &mut [Vec<[u32; 3]>]| {
-            for (t, &base_at) in range.zip(at) {
-                let tile = &out[t];
-                let (w0, w1) = words(tile);
+                     spans: &[(usize, usize)],
+                     out: &mut [MaskTile]| {
+            for ((t, &base_at), &(w0, w1)) in range.zip(at).zip(spans) {
+                let tile = &mut out[t];
                 let mine = &acc[base_at..base_at + (w1 - w0)];
                 let base = (my - tile.row) * tile.width;
                 // The tile's first group is (col·rows) mod 16 of its first word.
                 let (mut w, mut sh) = (0, 4 * ((tile.col * rows) & 15));
                 let mut a = mine.first().copied().unwrap_or([0; N]);
-                for slot in &mut counts[t][base..base + tile.width] {
+                for i in base..base + tile.width {
+                    let mut sum = [0usize; N];
                     for _ in 0..rows {
                         for c in 0..N {
-                            slot[c] += ((a[c] >> sh) & 15) as u32;
+                            sum[c] += ((a[c] >> sh) & 15) as usize;
                         }
                         sh += 4;
                         if sh == 64 {
@@ -1110,6 +1112,11 @@ impl Raster {
                             w += 1;
                             a = mine.get(w).copied().unwrap_or([0; N]);
                         }
+                    }
+                    tile.void[i] = table[sum[0]];
+                    tile.overfill[i] = table[sum[1]];
+                    if N == 3 {
+                        tile.covered[i] = table[sum[N - 1]];
                     }
                 }
             }
@@ -1130,7 +1137,7 @@ impl Raster {
                 let my = k / rows;
                 if current.as_ref().is_none_or(|c| c.0 != my) {
                     if let Some((c, range)) = current.take() {
-                        flush(c, range, &mut acc, &at, counts);
+                        flush(c, range, &mut acc, &at, &spans, out);
                     }
                     while groups[group].0 < my / MASK_BAND_ROWS {
                         group += 1;
@@ -1190,7 +1197,7 @@ impl Raster {
             }
         }
         if let Some((c, range)) = current {
-            flush(c, range, &mut acc, &at, counts);
+            flush(c, range, &mut acc, &at, &spans, out);
         }
     }
 
@@ -1237,19 +1244,6 @@ impl Raster {
             }
             groups.push((mb, first..out.len()));
         }
-        let mut counts: Vec<Vec<[u32; 3]>> = out
-            .iter()
-            .map(|t| vec![[0; 3]; t.width * t.height])
-            .collect();
-        if !reference && rows <= NIBBLE_ROWS {
-            if covered {
-                self.count_by_nibbles::<3>(rows, &out, &groups, &mut counts);
-            } else {
-                self.count_by_nibbles::<2>(rows, &out, &groups, &mut counts);
-            }
-        } else {
-            self.count_by_windows(rows, reference, &out, &groups, &mut counts);
-        }
         let full = (rows * cols) as f64;
         let share_of = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
         // The shares of every count a cell can hold, when there are not too many.
@@ -1258,15 +1252,37 @@ impl Raster {
         } else {
             (0..=(rows * cols) as u32).map(share_of).collect()
         };
-        let share = |n: u32| match table.get(n as usize) {
-            Some(&v) => v,
-            None => share_of(n),
-        };
-        for (tile, counts) in out.iter_mut().zip(&counts) {
-            tile.void = counts.iter().map(|c| share(c[0])).collect();
-            tile.overfill = counts.iter().map(|c| share(c[1])).collect();
+        if !reference && rows <= NIBBLE_ROWS {
+            // The shares written as each mask row is summed (every cell is, once).
+            for t in &mut out {
+                let n = t.width * t.height;
+                t.void = vec![0; n];
+                t.overfill = vec![0; n];
+                if covered {
+                    t.covered = vec![0; n];
+                }
+            }
             if covered {
-                tile.covered = counts.iter().map(|c| share(c[2])).collect();
+                self.count_by_nibbles::<3>(rows, &mut out, &groups, &table);
+            } else {
+                self.count_by_nibbles::<2>(rows, &mut out, &groups, &table);
+            }
+        } else {
+            let mut counts: Vec<Vec<[u32; 3]>> = out
+                .iter()
+                .map(|t| vec![[0; 3]; t.width * t.height])
+                .collect();
+            self.count_by_windows(rows, reference, &out, &groups, &mut counts);
+            let share = |n: u32| match table.get(n as usize) {
+                Some(&v) => v,
+                None => share_of(n),
+            };
+            for (tile, counts) in out.iter_mut().zip(&counts) {
+                tile.void = counts.iter().map(|c| share(c[0])).collect();
+                tile.overfill = counts.iter().map(|c| share(c[1])).collect();
+                if covered {
+                    tile.covered = counts.iter().map(|c| share(c[2])).collect();
+                }
             }
         }
         CoverageMask {
