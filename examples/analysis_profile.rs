@@ -2,7 +2,10 @@
 //! `cargo run --release --example analysis_profile -- MODEL.stl [--set stagger=true]`.
 //! Times are seconds the thread ran on a CPU (Linux: /proc/thread-self/schedstat), so waiting
 //! for a core on a busy machine is not counted; elsewhere wall time. "before" is the path
-//! the fast one replaced (`analysis_reference`, `mask_reference`), on the same raster.
+//! the fast one replaced (`analysis_reference`, `mask_reference`), on the same raster. One
+//! raster is rebuilt layer after layer, as the workers do; environment: FRESH=1 a new raster
+//! per layer, REF_FIRST=1 the reference labelling before the fast one (the first after
+//! rasterising pays for the raster's memory), FAST_ONLY=1 no reference paths (for perf).
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
 use std::sync::OnceLock;
@@ -43,6 +46,11 @@ fn main() {
         t[i] += now - *from;
         *from = now;
     };
+    // One raster rebuilt layer after layer (as the workers do); FRESH=1: a new one per layer.
+    let fresh = std::env::var("FRESH").is_ok();
+    // FAST_ONLY=1: not the reference paths (for perf).
+    let fast_only = std::env::var("FAST_ONLY").is_ok();
+    let mut r = Raster::empty();
     for i in 0..job.layer_count() {
         let mut at = cpu();
         let sec = job.section(i);
@@ -50,16 +58,31 @@ fn main() {
         std::hint::black_box(dropslice::gcode::layer_text(&plan));
         lap(0, &mut at);
         let c = droplet_centres(&plan, b);
-        let r = Raster::from_centres(i, plan.z, &c, &sec.region, &s);
+        if fresh {
+            r = Raster::empty();
+        }
+        r.rebuild(i, plan.z, &c, &sec.region, &s);
         lap(1, &mut at);
-        let la = r.analysis();
-        nvoids += la.voids;
-        lap(2, &mut at);
-        std::hint::black_box(r.analysis_reference());
-        lap(3, &mut at);
+        if std::env::var("REF_FIRST").is_ok() {
+            std::hint::black_box(r.analysis_reference());
+            lap(3, &mut at);
+            let la = r.analysis();
+            nvoids += la.voids;
+            lap(2, &mut at);
+        } else {
+            let la = r.analysis();
+            nvoids += la.voids;
+            lap(2, &mut at);
+            if !fast_only {
+                std::hint::black_box(r.analysis_reference());
+            }
+            lap(3, &mut at);
+        }
         std::hint::black_box(r.mask(b / 4.0));
         lap(4, &mut at);
-        std::hint::black_box(r.mask_reference(b / 4.0));
+        if !fast_only {
+            std::hint::black_box(r.mask_reference(b / 4.0));
+        }
         lap(5, &mut at);
         let m = HeightMap::new(&c, &grid, footprint_diameter(&s));
         lap(6, &mut at);

@@ -6,6 +6,8 @@ import { start, openPage, waitSettled, benchy } from "../tests/e2e/helpers.mjs";
 
 const runs = Number(process.argv[2] ?? 5);
 const files = process.argv.length > 3 ? process.argv.slice(3) : [benchy];
+// VOIDS=0: the overlay off (the slicing alone, for comparison).
+const voids = process.env.VOIDS !== "0";
 const env = await start();
 try {
   for (const f of files) {
@@ -13,14 +15,16 @@ try {
     for (let i = 0; i <= runs; i++) {
       const { page, context } = await openPage(env.browser, env.url);
       await waitSettled(page); // the sample part of the first visit
-      await page.check("#opt-voids");
-      await waitSettled(page); // the sample part analysed
+      if (voids) {
+        await page.check("#opt-voids");
+        await waitSettled(page); // the sample part analysed
+      }
       await page.setInputFiles("#file-input", f);
       await page.waitForFunction(() => document.body.dataset.state === "slicing", null, { timeout: 120_000 }).catch(() => {});
-      await page.waitForFunction(() => {
+      await page.waitForFunction((voids) => {
         const st = window.dropslice.status();
-        return st.state !== "slicing" && st.analysed === st.layers;
-      }, null, { timeout: 600_000, polling: 50 });
+        return st.state !== "slicing" && (!voids || st.analysed === st.layers);
+      }, voids, { timeout: 600_000, polling: 50 });
       const s = await page.evaluate(() => window.dropslice.status());
       if (s.state !== "done") throw new Error(`${f}: page state ${s.state}`);
       if (i > 0) times.push(s.seconds);

@@ -332,6 +332,7 @@ impl Session {
             settings,
             unit_after: std::cell::Cell::new(None),
             last_section: std::cell::RefCell::new(None),
+            raster: std::cell::RefCell::new(analysis::Raster::empty()),
         }
     }
 
@@ -383,6 +384,8 @@ pub struct Session {
     /// The last layer planned with support off and its section's region (the overhang figure
     /// of the next layer needs it).
     last_section: std::cell::RefCell<Option<(usize, crate::geom::Shapes)>>,
+    /// The raster every analysed layer is rebuilt into (its memory kept between layers).
+    raster: std::cell::RefCell<analysis::Raster>,
 }
 
 #[wasm_bindgen]
@@ -477,7 +480,13 @@ impl Session {
         self.check_layer(i)?;
         let (plan, region, text) = self.planned(i);
         let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
-        let (a, mask) = analysis::analyse_layer_with_mask(&plan, &region, &self.settings, cell);
+        let (a, mask) = analysis::analyse_layer_for_page(
+            &mut self.raster.borrow_mut(),
+            &plan,
+            &region,
+            &self.settings,
+            cell,
+        );
         let mut r = LayerResult::new(&plan, &self.settings, text);
         r.analysis = Some(a);
         r.mask = Some(mask);
@@ -708,13 +717,33 @@ impl LayerResult {
     pub fn overfill_mask(&self) -> Uint8Array {
         self.shares(|t| &t.overfill)
     }
+    /// Per tile of the mask, 1 when any of its cells has overfill, else 0 (most tiles have
+    /// none: the page then reads no overfill share of them); empty without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn mask_overfilled(&self) -> Uint8Array {
+        let tiles = self.mask.as_ref().map_or(&[][..], |m| &m.tiles[..]);
+        let flags: Vec<u8> = tiles
+            .iter()
+            .map(|t| u8::from(t.overfill.iter().any(|&v| v != 0)))
+            .collect();
+        Uint8Array::from(&flags[..])
+    }
 }
 
 impl LayerResult {
-    /// One share of every tile of the mask, one tile after the other.
+    /// One share of every tile of the mask, one tile after the other (copied once, tile by
+    /// tile, into the JS array).
     fn shares(&self, of: impl Fn(&MaskTile) -> &Vec<u8>) -> Uint8Array {
         let tiles = self.mask.as_ref().map_or(&[][..], |m| &m.tiles[..]);
-        let bytes: Vec<u8> = tiles.iter().flat_map(|t| of(t).iter().copied()).collect();
-        Uint8Array::from(&bytes[..])
+        let total: usize = tiles.iter().map(|t| of(t).len()).sum();
+        let out = Uint8Array::new_with_length(total as u32);
+        let mut at = 0u32;
+        for t in tiles {
+            let v = of(t);
+            let end = at + v.len() as u32;
+            out.subarray(at, end).copy_from(v);
+            at = end;
+        }
+        out
     }
 }

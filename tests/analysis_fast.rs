@@ -2,11 +2,14 @@
 //! page's coverage mask cell for cell (the 4-bit-group counts for cells of B/4, the window
 //! counts for larger cells) against the masks counted range by range, and the layer figures
 //! of the one-pass labelling against the run-per-node labelling, equal (the 0.1 % the
-//! analysis may differ by is not needed).
+//! analysis may differ by is not needed); the page's mask (no covered shares) and one raster
+//! reused from layer to layer against new ones.
 
 mod common;
 
-use dropslice::analysis::Raster;
+use dropslice::analysis::{
+    CoverageMask, MaskTile, Raster, analyse_layer_for_page, analyse_layer_with_mask,
+};
 use dropslice::{Job, Settings};
 
 const MODELS: [&str; 4] = [
@@ -56,14 +59,67 @@ fn masks_are_those_counted_range_by_range() {
                     &[b / 4.0, b / 6.0, b, 7.3 * b]
                 };
                 for &cell in cells {
+                    let want = r.mask_reference(cell);
                     assert_eq!(
                         r.mask(cell),
-                        r.mask_reference(cell),
+                        want,
                         "{model}, stagger {stagger}, cell {cell}"
+                    );
+                    // The page's: the same without the covered shares.
+                    assert_eq!(
+                        r.page_mask(cell),
+                        without_covered(want),
+                        "page mask: {model}, stagger {stagger}, cell {cell}"
                     );
                 }
             }
         }
+    }
+}
+
+fn without_covered(m: CoverageMask) -> CoverageMask {
+    CoverageMask {
+        tiles: m
+            .tiles
+            .into_iter()
+            .map(|t| MaskTile {
+                covered: Vec::new(),
+                ..t
+            })
+            .collect(),
+        ..m
+    }
+}
+
+/// The page's worker rasterises every layer into one raster (`analyse_layer_for_page`): the
+/// figures and masks are those of a new raster per layer, whatever layer came before
+/// (larger, smaller, empty).
+#[test]
+fn one_raster_reused_gives_the_figures_of_new_ones() {
+    let s = Settings::default();
+    let b = s.droplet_width();
+    let model = "3DBenchy.stl";
+    let path = common::model(model);
+    let job = Job::new(
+        &common::model_bytes(model),
+        path.to_str().unwrap(),
+        s.clone(),
+    )
+    .unwrap();
+    let n = job.layer_count();
+    let mut r = Raster::empty();
+    // Up and down the part, every 7th layer, then the first layers in order.
+    let order = (0..n)
+        .step_by(7)
+        .chain((0..n).rev().step_by(11))
+        .chain(0..4);
+    for i in order {
+        let region = &job.section(i).region;
+        let plan = dropslice::plan::plan_layer(region, i, &s);
+        let (a, mask) = analyse_layer_with_mask(&plan, region, &s, b / 4.0);
+        let (pa, pmask) = analyse_layer_for_page(&mut r, &plan, region, &s, b / 4.0);
+        assert_eq!(pa, a, "layer {i}");
+        assert_eq!(pmask, without_covered(mask), "layer {i}");
     }
 }
 

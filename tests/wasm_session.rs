@@ -389,6 +389,20 @@ fn analysed_layers_have_sane_void_figures() {
         let mask = l.void_mask().to_vec();
         assert_eq!(mask.len(), cells);
         assert_eq!(l.overfill_mask().length() as usize, cells);
+        // per tile, whether any of its cells has overfill (the page reads only those)
+        let (overfill, flags) = (l.overfill_mask().to_vec(), l.mask_overfilled().to_vec());
+        assert_eq!(flags.len(), tiles.len() / 4);
+        let mut at = 0;
+        for (t, &flag) in tiles.chunks(4).zip(&flags) {
+            let end = at + t[2] as usize * t[3] as usize;
+            let any = overfill[at..end].iter().any(|&v| v != 0);
+            assert_eq!(flag, u8::from(any), "tile {t:?}");
+            at = end;
+        }
+        assert!(
+            flags.contains(&1),
+            "droplets past the box's edge overfill: {flags:?}"
+        );
         let masked: f64 = mask.iter().map(|&v| v as f64 / 255.0).sum::<f64>() * cell * cell;
         assert!(
             (masked - void).abs() < 0.05 * void,

@@ -162,28 +162,31 @@ export interface MaskTile {
 
 /** The mask from the core's flat arrays (src/wasm.rs: `mask_cell`, `mask_tiles` = origin x,
  *  origin y, width, height per tile, `void_mask` and `overfill_mask` = the tiles' shares one
- *  after the other); each tile gets its own buffers. */
+ *  after the other, `mask_overfilled` = per tile whether it has overfill). The tiles' void
+ *  shares are views of one buffer (one copy out of the core per layer); overfill shares are
+ *  copied only for the tiles that have some. */
 export function coverageMaskOf(r: {
   mask_cell: number;
   mask_tiles: Float64Array;
   void_mask: Uint8Array;
   overfill_mask: Uint8Array;
+  mask_overfilled: Uint8Array;
 }): CoverageMask {
   const frames = r.mask_tiles;
   const voids = r.void_mask;
-  const overfill = r.overfill_mask;
+  const overfilled = r.mask_overfilled;
+  const overfill = overfilled.includes(1) ? r.overfill_mask : null;
   const tiles: MaskTile[] = [];
   let at = 0;
-  for (let i = 0; i + 3 < frames.length; i += 4) {
+  for (let i = 0, t = 0; i + 3 < frames.length; i += 4, t++) {
     const [x, y, width, height] = [frames[i], frames[i + 1], frames[i + 2], frames[i + 3]];
     const end = at + width * height;
-    const over = overfill.subarray(at, end);
     tiles.push({
       origin: [x, y],
       width,
       height,
-      void: voids.slice(at, end),
-      overfill: over.some((v) => v !== 0) ? over.slice() : new Uint8Array(0),
+      void: voids.subarray(at, end),
+      overfill: overfill && overfilled[t] ? overfill.slice(at, end) : new Uint8Array(0),
     });
     at = end;
   }
@@ -409,6 +412,9 @@ export function isErrorValue(e: unknown): e is ErrorValue {
 
 export function transferablesOf(layer: LayerData): Transferable[] {
   const out = [layer.droplets.buffer, layer.roles.buffer, layer.units.buffer, layer.travel.buffer] as Transferable[];
-  for (const t of layer.mask?.tiles ?? []) out.push(t.void.buffer, t.overfill.buffer);
+  // the tiles' shares may be views of one buffer: each buffer once
+  const buffers = new Set<ArrayBufferLike>();
+  for (const t of layer.mask?.tiles ?? []) buffers.add(t.void.buffer).add(t.overfill.buffer);
+  for (const b of buffers) out.push(b as Transferable);
   return out;
 }

@@ -146,6 +146,26 @@ pub fn analyse_layer_with_mask(
     (a, r.mask(mask_cell))
 }
 
+/// What the page's worker needs of a layer: [`analyse_layer_with_mask`]'s figures and its mask
+/// without the covered shares ([`Raster::page_mask`]), rasterised into `r`: a worker keeps one
+/// raster from layer to layer, so its bitmaps and the labelling's buffers are allocated (and
+/// first touched) once, not per layer.
+pub fn analyse_layer_for_page(
+    r: &mut Raster,
+    plan: &LayerPlan,
+    region: &Shapes,
+    s: &Settings,
+    mask_cell: f64,
+) -> (LayerAnalysis, CoverageMask) {
+    let b = s.droplet_width();
+    r.rebuild(plan.index, plan.z, &droplet_centres(plan, b), region, s);
+    let a = LayerAnalysis {
+        unsupported_area: plan.unsupported_area,
+        ..r.analysis()
+    };
+    (a, r.page_mask(mask_cell))
+}
+
 /// Rows of the 2D grid per band of the sparse raster, and words (of 64 columns) per tile: tiles
 /// of 64 × 256 cells, 1.33 mm square with the default B.
 const BAND_ROWS: usize = 64;
@@ -937,14 +957,20 @@ impl Raster {
 
     /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
     pub fn mask(&self, cell: f64) -> CoverageMask {
-        self.mask_with(cell, false)
+        self.mask_with(cell, false, true)
+    }
+
+    /// [`mask`](Self::mask) with only the void and overfill shares, what the page draws: its
+    /// tiles' `covered` are empty (a third less to count).
+    pub fn page_mask(&self, cell: f64) -> CoverageMask {
+        self.mask_with(cell, false, false)
     }
 
     /// [`mask`](Self::mask) counting each cell's bits range by range, as before the window
     /// counts (for tests comparing both).
     #[doc(hidden)]
     pub fn mask_reference(&self, cell: f64) -> CoverageMask {
-        self.mask_with(cell, true)
+        self.mask_with(cell, true, true)
     }
 
     /// Adds each mask cell's counts [void, overfill, covered] to `counts` (per tile of `out`,
@@ -1032,12 +1058,15 @@ impl Raster {
     /// group. Each grid row adds the bit counts of its 4-bit groups (SWAR, a word at a time)
     /// into the mask row's words, at most 4·`rows` ≤ 15 per group; when the mask row is
     /// done, each cell sums its `rows` groups. Counts identical, per cell once a mask row.
-    fn count_by_nibbles(
+    ///
+    /// `N` = 3 counts void, overfill and covered; `N` = 2 only void and overfill (the page's
+    /// mask, [`page_mask`](Self::page_mask)).
+    fn count_by_nibbles<const N: usize>(
         &self,
         rows: usize,
-        out: &[MaskTile],
+        out: &mut [MaskTile],
         groups: &[(usize, std::ops::Range<usize>)],
-        counts: &mut [Vec<[u32; 3]>],
+        table: &[u8],
     ) {
         debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
         let tiles = &self.tiles;
@@ -1047,35 +1076,51 @@ impl Raster {
         // Per grid word under the current mask band's tiles (tile by tile, `at[t]` where tile
         // t's words start), the 4-bit counts of void, overfill, covered: memory for the
         // tiles, not for the grid's width.
-        let mut acc: Vec<[u64; 3]> = Vec::new();
+        let mut acc: Vec<[u64; N]> = Vec::new();
         let mut at: Vec<usize> = Vec::new();
+        // The current band's tiles' words [first, end).
+        let mut spans: Vec<(usize, usize)> = Vec::new();
         let nibbles = |x: u64| {
             let x = x - ((x >> 1) & 0x5555_5555_5555_5555);
             (x & 0x3333_3333_3333_3333) + ((x >> 2) & 0x3333_3333_3333_3333)
         };
-        // The cells of mask row `my` (tiles `range`) from `acc`, then `acc` cleared.
+        // The cells of mask row `my` (tiles `range`, their words `spans`) from `acc`, their
+        // shares (`table`: per count) into the tiles, then `acc` cleared: each tile's 4-bit
+        // groups read in order along its words, `rows` of them per cell.
         let flush = |my: usize,
                      range: std::ops::Range<usize>,
-                     acc: &mut [[u64; 3]],
+                     acc: &mut [[u64; N]],
                      at: &[usize],
-                     counts: &mut [Vec<[u32; 3]>]| {
-            for (t, &base_at) in range.zip(at) {
-                let tile = &out[t];
-                let w0 = words(tile).0;
+                     spans: &[(usize, usize)],
+                     out: &mut [MaskTile]| {
+            for ((t, &base_at), &(w0, w1)) in range.zip(at).zip(spans) {
+                let tile = &mut out[t];
+                let mine = &acc[base_at..base_at + (w1 - w0)];
                 let base = (my - tile.row) * tile.width;
-                for (i, slot) in counts[t][base..base + tile.width].iter_mut().enumerate() {
-                    // The cell's 4-bit groups.
-                    let n0 = (tile.col + i) * rows;
-                    for n in n0..n0 + rows {
-                        let (w, sh) = (base_at + (n >> 4) - w0, 4 * (n & 15));
-                        let a = &acc[w];
-                        slot[0] += ((a[0] >> sh) & 15) as u32;
-                        slot[1] += ((a[1] >> sh) & 15) as u32;
-                        slot[2] += ((a[2] >> sh) & 15) as u32;
+                // The tile's first group is (col·rows) mod 16 of its first word.
+                let (mut w, mut sh) = (0, 4 * ((tile.col * rows) & 15));
+                let mut a = mine.first().copied().unwrap_or([0; N]);
+                for i in base..base + tile.width {
+                    let mut sum = [0usize; N];
+                    for _ in 0..rows {
+                        for c in 0..N {
+                            sum[c] += ((a[c] >> sh) & 15) as usize;
+                        }
+                        sh += 4;
+                        if sh == 64 {
+                            sh = 0;
+                            w += 1;
+                            a = mine.get(w).copied().unwrap_or([0; N]);
+                        }
+                    }
+                    tile.void[i] = table[sum[0]];
+                    tile.overfill[i] = table[sum[1]];
+                    if N == 3 {
+                        tile.covered[i] = table[sum[N - 1]];
                     }
                 }
             }
-            acc.fill([0; 3]);
+            acc.fill([0; N]);
         };
         // The mask row being summed and its band's tiles.
         let mut current: Option<(usize, std::ops::Range<usize>)> = None;
@@ -1092,7 +1137,7 @@ impl Raster {
                 let my = k / rows;
                 if current.as_ref().is_none_or(|c| c.0 != my) {
                     if let Some((c, range)) = current.take() {
-                        flush(c, range, &mut acc, &at, counts);
+                        flush(c, range, &mut acc, &at, &spans, out);
                     }
                     while groups[group].0 < my / MASK_BAND_ROWS {
                         group += 1;
@@ -1100,14 +1145,16 @@ impl Raster {
                     let range = groups[group].1.clone();
                     if laid.as_ref() != Some(&range) {
                         at.clear();
+                        spans.clear();
                         let mut n = 0;
                         for t in &out[range.clone()] {
                             at.push(n);
                             let (w0, w1) = words(t);
+                            spans.push((w0, w1));
                             n += w1 - w0;
                         }
                         acc.clear();
-                        acc.resize(n, [0; 3]);
+                        acc.resize(n, [0; N]);
                         laid = Some(range.clone());
                     }
                     current = Some((my, range));
@@ -1125,15 +1172,20 @@ impl Raster {
                             continue;
                         }
                         let gw = w + shift;
-                        while t < range.end && words(&out[t]).1 <= gw {
+                        while t < range.end && spans[t - range.start].1 <= gw {
                             t += 1;
                         }
-                        let add = [nibbles(rw & !dw), nibbles(dw & !rw), nibbles(rw & dw)];
+                        let add: [u64; N] = std::array::from_fn(|c| match c {
+                            0 => nibbles(rw & !dw),
+                            1 => nibbles(dw & !rw),
+                            _ => nibbles(rw & dw),
+                        });
                         // Every tile whose words hold word gw (two when they are closer
                         // than a word); a set bit always lies under a tile.
                         let mut u = t;
-                        while u < range.end && words(&out[u]).0 <= gw {
-                            let x = &mut acc[at[u - range.start] + gw - words(&out[u]).0];
+                        while u < range.end && spans[u - range.start].0 <= gw {
+                            let i = u - range.start;
+                            let x = &mut acc[at[i] + gw - spans[i].0];
                             for (x, a) in x.iter_mut().zip(add) {
                                 *x += a;
                             }
@@ -1145,11 +1197,11 @@ impl Raster {
             }
         }
         if let Some((c, range)) = current {
-            flush(c, range, &mut acc, &at, counts);
+            flush(c, range, &mut acc, &at, &spans, out);
         }
     }
 
-    fn mask_with(&self, cell: f64, reference: bool) -> CoverageMask {
+    fn mask_with(&self, cell: f64, reference: bool, covered: bool) -> CoverageMask {
         let g = self.grid;
         let tiles = &self.tiles;
         let rows = ((cell / g.gy).round() as usize).max(1);
@@ -1192,15 +1244,6 @@ impl Raster {
             }
             groups.push((mb, first..out.len()));
         }
-        let mut counts: Vec<Vec<[u32; 3]>> = out
-            .iter()
-            .map(|t| vec![[0; 3]; t.width * t.height])
-            .collect();
-        if !reference && rows <= NIBBLE_ROWS {
-            self.count_by_nibbles(rows, &out, &groups, &mut counts);
-        } else {
-            self.count_by_windows(rows, reference, &out, &groups, &mut counts);
-        }
         let full = (rows * cols) as f64;
         let share_of = |n: u32| ((n as f64 / full) * 255.0).round().min(255.0) as u8;
         // The shares of every count a cell can hold, when there are not too many.
@@ -1209,14 +1252,38 @@ impl Raster {
         } else {
             (0..=(rows * cols) as u32).map(share_of).collect()
         };
-        let share = |n: u32| match table.get(n as usize) {
-            Some(&v) => v,
-            None => share_of(n),
-        };
-        for (tile, counts) in out.iter_mut().zip(&counts) {
-            tile.void = counts.iter().map(|c| share(c[0])).collect();
-            tile.overfill = counts.iter().map(|c| share(c[1])).collect();
-            tile.covered = counts.iter().map(|c| share(c[2])).collect();
+        if !reference && rows <= NIBBLE_ROWS {
+            // The shares written as each mask row is summed (every cell is, once).
+            for t in &mut out {
+                let n = t.width * t.height;
+                t.void = vec![0; n];
+                t.overfill = vec![0; n];
+                if covered {
+                    t.covered = vec![0; n];
+                }
+            }
+            if covered {
+                self.count_by_nibbles::<3>(rows, &mut out, &groups, &table);
+            } else {
+                self.count_by_nibbles::<2>(rows, &mut out, &groups, &table);
+            }
+        } else {
+            let mut counts: Vec<Vec<[u32; 3]>> = out
+                .iter()
+                .map(|t| vec![[0; 3]; t.width * t.height])
+                .collect();
+            self.count_by_windows(rows, reference, &out, &groups, &mut counts);
+            let share = |n: u32| match table.get(n as usize) {
+                Some(&v) => v,
+                None => share_of(n),
+            };
+            for (tile, counts) in out.iter_mut().zip(&counts) {
+                tile.void = counts.iter().map(|c| share(c[0])).collect();
+                tile.overfill = counts.iter().map(|c| share(c[1])).collect();
+                if covered {
+                    tile.covered = counts.iter().map(|c| share(c[2])).collect();
+                }
+            }
         }
         CoverageMask {
             origin: DVec2::new(g.x0, g.y0),
