@@ -324,10 +324,13 @@ pub fn slab_voids(
                 for (((v, &t), &b), &a) in col[..n].iter_mut().zip(t).zip(b).zip(a) {
                     *v = fill.column(t, b, a);
                 }
-                // In the reference's order (an empty column adds +0, which changes nothing).
+                // In the reference's order (an empty column adds +0, which changes nothing),
+                // the running sum in a register.
+                let mut sum = filled;
                 for &v in &col[..n] {
-                    filled += v;
+                    sum += v;
                 }
+                filled = sum;
                 ix += n as i64;
             }
             from = to + 1;
