@@ -29,7 +29,11 @@ fn main() {
     while let Some(a) = it.next() {
         match a.as_str() {
             "--set" => {
-                let (k, v) = it.next().expect("--set key=value").split_once('=').expect("=");
+                let (k, v) = it
+                    .next()
+                    .expect("--set key=value")
+                    .split_once('=')
+                    .expect("=");
                 s.set(k, v).expect("setting");
             }
             "--runs" => runs = it.next().expect("--runs N").parse().expect("N"),

@@ -74,7 +74,11 @@ impl<'a> MapRow<'a> {
 #[inline]
 fn floor_i64(t: f64) -> i64 {
     let i = t as i64;
-    if (i as f64) > t { i.saturating_sub(1) } else { i }
+    if (i as f64) > t {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
 }
 
 /// ⌈t⌉ as an integer, as `t.ceil() as i64` gives it (for the finite values used here).

@@ -270,7 +270,8 @@ impl Slabs {
                 continue;
             };
             self.claimed[j] = true;
-            let map = |k: Option<usize>| k.filter(|&k| k < self.n).and_then(|k| self.maps[k].clone());
+            let map =
+                |k: Option<usize>| k.filter(|&k| k < self.n).and_then(|k| self.maps[k].clone());
             claims.push((
                 j,
                 region,
@@ -380,10 +381,14 @@ impl JobAnalysis {
     /// The 3D estimate of the current layer, with `above` (the next layer's map, if any).
     fn close(&mut self, above: Option<&HeightMap>) {
         let Some(cur) = &self.current else { return };
-        let Some((region, map)) = &cur.own else { return };
-        let (exact, void) =
-            self.stage
-                .slab(&cur.analysis, region, [self.below.as_ref(), Some(map), above]);
+        let Some((region, map)) = &cur.own else {
+            return;
+        };
+        let (exact, void) = self.stage.slab(
+            &cur.analysis,
+            region,
+            [self.below.as_ref(), Some(map), above],
+        );
         self.part.add(&cur.analysis, exact, void);
         self.layers.push(cur.analysis.clone());
     }
@@ -426,7 +431,10 @@ impl crate::LayerSink for JobAnalysis {
             let figures = stage.slab(&analysis, &region, maps);
             lock(slabs).complete(j, figures);
         }
-        AnalysedLayer { analysis, own: None }
+        AnalysedLayer {
+            analysis,
+            own: None,
+        }
     }
 
     fn ordered(&mut self, _: usize, layer: AnalysedLayer) {
