@@ -58,18 +58,16 @@ fn main() {
     let cells: usize = layers.iter().map(|l| l.1.len()).sum();
     // Best times: maps fast, maps reference, slabs fast, slabs reference.
     let mut best = [f64::INFINITY; 4];
-    let mut fast_maps: Vec<HeightMap> = Vec::new();
-    let mut ref_maps: Vec<ReferenceMap> = Vec::new();
     let mut figures = (Vec::new(), Vec::new());
     for _ in 0..runs {
         let t = cpu();
-        fast_maps = layers
+        let fast_maps: Vec<HeightMap> = layers
             .iter()
             .map(|(_, c)| HeightMap::new(c, &grid, d))
             .collect();
         best[0] = best[0].min(cpu() - t);
         let t = cpu();
-        ref_maps = layers
+        let ref_maps: Vec<ReferenceMap> = layers
             .iter()
             .map(|(_, c)| ReferenceMap::new(c, &grid, d))
             .collect();

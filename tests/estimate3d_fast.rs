@@ -148,17 +148,14 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
                         [x0, y0 + h].into(),
                     ]
                 };
-                let mut region: Shapes = vec![Shape::new(rect(x0, y0, w, h).into(), vec![])];
+                let mut region: Shapes = vec![Shape::new(rect(x0, y0, w, h), vec![])];
                 match case % 3 {
                     1 => {
                         let mut hole = rect(x0 + w / 4.0, y0 + h / 4.0, w / 2.0, h / 2.0);
                         hole.reverse();
-                        region[0] = Shape::new(rect(x0, y0, w, h).into(), vec![hole.into()]);
+                        region[0] = Shape::new(rect(x0, y0, w, h), vec![hole]);
                     }
-                    2 => region.push(Shape::new(
-                        rect(x0 + 40.0, y0 - 30.0, 1.0, 1.0).into(),
-                        vec![],
-                    )),
+                    2 => region.push(Shape::new(rect(x0 + 40.0, y0 - 30.0, 1.0, 1.0), vec![])),
                     _ => {}
                 }
                 let mut pts: Vec<Point> = Vec::new();

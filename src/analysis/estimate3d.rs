@@ -149,8 +149,9 @@ impl HeightMap {
                 let d = v - p[0];
                 d * d
             }));
-            for k in y(ay)..=y(by) {
-                let d = cy[k] - p[1];
+            let k0 = y(ay);
+            for (k, &yc) in (k0..).zip(&cy[k0..=y(by)]) {
+                let d = yc - p[1];
                 let yy = d * d;
                 if yy * inv >= 1.0 {
                     // No cell of this row is inside (q ≤ 0 never raises a cell).
@@ -202,7 +203,7 @@ static ZEROS: [f32; CHUNK] = [0.0; CHUNK];
 /// `n` cells of a row's piece ([`MapRow::piece`]) from grid index `ix` (q = 0 where nothing
 /// is stored).
 #[inline]
-fn cut<'a>((x0, row): (i64, &'a [f32]), ix: i64, n: usize) -> &'a [f32] {
+fn cut((x0, row): (i64, &[f32]), ix: i64, n: usize) -> &[f32] {
     if row.is_empty() {
         &ZEROS[..n]
     } else {
