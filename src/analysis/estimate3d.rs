@@ -318,7 +318,12 @@ pub fn slab_voids(
             let (xa, ra, ea) = above.piece(from);
             let to = c1.min(et).min(eb).min(ea);
             cells += (to - from + 1) as u64;
-            let mut ix = from;
+            // No droplet reaches this stretch: its columns are empty (they would add +0).
+            let mut ix = if rt.is_empty() && rb.is_empty() && ra.is_empty() {
+                to + 1
+            } else {
+                from
+            };
             while ix <= to {
                 let n = ((to - ix + 1) as usize).min(CHUNK);
                 let (t, b, a) = (
