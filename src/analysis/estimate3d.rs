@@ -7,6 +7,9 @@ use crate::geom::{Point, Shapes, all_contours};
 use crate::grid::{Segment, Spot, Tiles};
 use crate::settings::Settings;
 
+mod reference;
+pub use reference::{ReferenceMap, slab_voids_reference};
+
 /// The 3D estimate samples the part every B / this.
 pub const GRID3_PER_B: f64 = 3.0;
 
@@ -65,18 +68,32 @@ impl<'a> MapRow<'a> {
     }
 }
 
+/// ⌊t⌋ as an integer, as `t.floor() as i64` gives it (saturating; 0 for NaN) but without a
+/// call to libm's `floor` (the baseline x86-64 target has no rounding instruction): this was
+/// a fifth of the height maps' time.
+#[inline]
+fn floor_i64(t: f64) -> i64 {
+    let i = t as i64;
+    if (i as f64) > t {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
+}
+
+/// ⌈t⌉ as an integer, as `t.ceil() as i64` gives it (for the finite values used here).
+#[inline]
+fn ceil_i64(t: f64) -> i64 {
+    floor_i64(-t).saturating_neg()
+}
+
 impl HeightMap {
+    /// The map of droplets at `centres` of footprint diameter `d`. Every stored value is the
+    /// one [`ReferenceMap::new`] stores (the same expressions, in the same order); the work
+    /// saved is around them: each droplet's cells found once, the cells' centres taken from
+    /// a table per column and per row, ⌊·⌋ without libm.
     pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
         let r = d / 2.0;
-        let mut min = [i64::MAX; 2];
-        let mut max = [i64::MIN; 2];
-        let idx = |v: f64, k: usize| ((v - grid.origin[k]) / grid.cell - 0.5).floor() as i64;
-        for p in centres {
-            for k in 0..2 {
-                min[k] = min[k].min(idx(p[k] - r, k));
-                max[k] = max[k].max(idx(p[k] + r, k) + 1);
-            }
-        }
         let mut tiles = Tiles::default();
         if centres.is_empty() {
             return HeightMap {
@@ -86,55 +103,69 @@ impl HeightMap {
                 q: Vec::new(),
             };
         }
+        let idx = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / grid.cell - 0.5);
+        // A droplet's cells [ax, bx] × [ay, by], and the map's bounds.
+        let mut min = [i64::MAX; 2];
+        let mut max = [i64::MIN; 2];
+        let cells: Vec<[i64; 4]> = centres
+            .iter()
+            .map(|p| {
+                let c = [
+                    idx(p[0] - r, 0),
+                    idx(p[0] + r, 0) + 1,
+                    idx(p[1] - r, 1),
+                    idx(p[1] + r, 1) + 1,
+                ];
+                min = [min[0].min(c[0]), min[1].min(c[2])];
+                max = [max[0].max(c[1]), max[1].max(c[3])];
+                c
+            })
+            .collect();
         let (w, h) = (
             (max[0] - min[0] + 1) as usize,
             (max[1] - min[1] + 1) as usize,
         );
-        // A droplet's cells [ax, bx] × [ay, by].
-        let cells = |p: &Point| {
-            (
-                (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1),
-                (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1),
-            )
-        };
-        let cells: Vec<_> = centres.iter().map(cells).collect();
         tiles.reset(h, w, MAP_BAND_ROWS, MAP_TILE_COLS);
-        for &((ax, bx), (ay, by)) in &cells {
-            let (x, y) = (
-                |v: i64| (v - min[0]) as usize,
-                |v: i64| (v - min[1]) as usize,
-            );
+        let (x, y) = (
+            |v: i64| (v - min[0]) as usize,
+            |v: i64| (v - min[1]) as usize,
+        );
+        for &[ax, bx, ay, by] in &cells {
             tiles.mark(y(ay), y(by), x(ax), x(bx));
         }
         let mut q = vec![0f32; tiles.build()];
+        // Cell centres, computed as the reference computes them for each droplet.
+        let centre = |i: i64, k: usize| grid.origin[k] + (i as f64 + 0.5) * grid.cell;
+        let cx: Vec<f64> = (min[0]..=max[0]).map(|i| centre(i, 0)).collect();
+        let cy: Vec<f64> = (min[1]..=max[1]).map(|i| centre(i, 1)).collect();
         let inv = 1.0 / (r * r);
         let mut xx = Vec::new();
         // Where the last droplet row's cells were stored (mostly the next one's too).
         let mut spot: Option<Spot> = None;
-        for (p, &((ax, bx), (ay, by))) in centres.iter().zip(&cells) {
+        for (p, &[ax, bx, ay, by]) in centres.iter().zip(&cells) {
+            let c = x(ax);
             xx.clear();
-            xx.extend((ax..=bx).map(|ix| {
-                let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
-                x * x
+            xx.extend(cx[c..=x(bx)].iter().map(|&v| {
+                let d = v - p[0];
+                d * d
             }));
-            for iy in ay..=by {
-                let y = grid.origin[1] + (iy as f64 + 0.5) * grid.cell - p[1];
-                let yy = y * y;
+            let k0 = y(ay);
+            for (k, &yc) in (k0..).zip(&cy[k0..=y(by)]) {
+                let d = yc - p[1];
+                let yy = d * d;
                 if yy * inv >= 1.0 {
                     // No cell of this row is inside (q ≤ 0 never raises a cell).
                     continue;
                 }
-                let (k, c) = ((iy - min[1]) as usize, (ax - min[0]) as usize);
                 let Some(sp) = tiles.spot_cached(&mut spot, k, c, c + xx.len() - 1) else {
                     debug_assert!(false, "droplet outside the map's tiles");
                     continue;
                 };
                 let at = sp.index(k) + c - sp.shift;
+                // The larger of the two, stored either way (no branch per cell).
                 for (slot, &x2) in q[at..at + xx.len()].iter_mut().zip(&xx) {
                     let v = (1.0 - (x2 + yy) * inv) as f32;
-                    if v > *slot {
-                        *slot = v;
-                    }
+                    *slot = if v > *slot { v } else { *slot };
                 }
             }
         }
@@ -164,8 +195,79 @@ impl HeightMap {
     }
 }
 
+/// Cells a [`slab_voids`] stretch handles at a time.
+const CHUNK: usize = 64;
+/// q = 0 for a stretch where a map stores nothing.
+static ZEROS: [f32; CHUNK] = [0.0; CHUNK];
+
+/// `n` cells of a row's piece ([`MapRow::piece`]) from grid index `ix` (q = 0 where nothing
+/// is stored).
+#[inline]
+fn cut((x0, row): (i64, &[f32]), ix: i64, n: usize) -> &[f32] {
+    if row.is_empty() {
+        &ZEROS[..n]
+    } else {
+        &row[(ix - x0) as usize..][..n]
+    }
+}
+
+/// The constants of a slab's column fill.
+#[derive(Clone, Copy)]
+struct Fill {
+    /// Layer height H, its half, the spheroid's half-height c.
+    h: f64,
+    half: f64,
+    c: f64,
+    /// Above this q a neighbour's droplet reaches into the slab.
+    q_reach: f32,
+}
+
+impl Fill {
+    /// The filled length of a cell's column (of height H) given the q of its own layer's map
+    /// (`t`) and of the layers below (`b`) and above (`a`): the union of [0, lo] from below,
+    /// [H/2 − a, H/2 + a] from its own droplet and [H − hi, H] from above, computed with the
+    /// reference's operations in its order (so to the same bits) but without branches, so
+    /// that a stretch of cells is computed a few at a time. `x.max(y)` and `x.min(y)` are
+    /// written as comparisons: no operand here is NaN or a negative zero, where they could
+    /// differ.
+    #[inline(always)]
+    fn column(&self, t: f32, b: f32, a: f32) -> f64 {
+        let (h, half, c) = (self.h, self.half, self.c);
+        let max = |x: f64, y: f64| if x > y { x } else { y };
+        let min = |x: f64, y: f64| if x < y { x } else { y };
+        // The reference: a = 0 for q = 0, which c·√0 gives too.
+        let own = min(c * (t as f64).sqrt(), half);
+        let ext = |q: f32| {
+            let e = max(c * (q as f64).sqrt() - half, 0.0);
+            if q > self.q_reach { e } else { 0.0 }
+        };
+        let lo = min(ext(b), h);
+        let hi = min(ext(a), h);
+        // [0, lo]: lo ≥ 0, so the union so far is exactly [0, lo].
+        let (len, end) = (lo, lo);
+        // [m0, m1], when it reaches past the end so far (never when m1 ≤ m0).
+        let (m0, m1) = (half - own, half + own);
+        let s0 = max(m0, end);
+        let take = m1 > s0;
+        let (len, end) = if take {
+            (len + (m1 - s0), m1)
+        } else {
+            (len, end)
+        };
+        // [H − hi, H], likewise.
+        let s0 = max(h - hi, end);
+        let len = if h > s0 { len + (h - s0) } else { len };
+        // The own droplet fills the whole column.
+        if own >= half { h } else { len }
+    }
+}
+
 /// The 3D estimate for layer i's slab: (volume, void volume) in mm³ of its region × H, filled
-/// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`).
+/// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`). The figures are those of
+/// [`slab_voids_reference`] to the bit: the same cells, each column's fill computed with the
+/// same operations ([`Fill::column`]) and summed in the same order; the stretches of a row's
+/// span are computed a chunk at a time without branches, and the maps' rows found once per
+/// stretch instead of per cell.
 pub fn slab_voids(
     region: &Shapes,
     grid: &Grid3,
@@ -186,30 +288,25 @@ pub fn slab_voids(
     if !ymin.is_finite() {
         return (0.0, 0.0);
     }
-    let k0 = ((ymin - grid.origin[1]) / grid.cell - 0.5).floor() as i64;
+    let k0 = floor_i64((ymin - grid.origin[1]) / grid.cell - 0.5);
     let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
     let y0 = grid.origin[1] + k0 as f64 * grid.cell;
     let (mut cells, mut filled) = (0u64, 0.0f64);
-    // A neighbour's droplet reaches into this slab where c·√q > H/2.
-    let q_reach = ((half / c) * (half / c)) as f32;
-    let ext = |q: f32| -> f64 {
-        if q > q_reach {
-            (c * (q as f64).sqrt() - half).max(0.0)
-        } else {
-            0.0
-        }
+    let fill = Fill {
+        h,
+        half,
+        c,
+        // A neighbour's droplet reaches into this slab where c·√q > H/2.
+        q_reach: ((half / c) * (half / c)) as f32,
     };
-    let at = |(x0, row): (i64, &[f32]), ix: i64| -> f32 {
-        usize::try_from(ix - x0)
-            .ok()
-            .and_then(|x| row.get(x))
-            .copied()
-            .unwrap_or(0.0)
-    };
+    let mut col = [0f64; CHUNK];
     region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
         let iy = k0 + k as i64;
-        let c0 = ((xa - grid.origin[0]) / grid.cell - 0.5).ceil() as i64;
-        let c1 = ((xb - grid.origin[0]) / grid.cell - 0.5).floor() as i64;
+        let c0 = ceil_i64((xa - grid.origin[0]) / grid.cell - 0.5);
+        let c1 = floor_i64((xb - grid.origin[0]) / grid.cell - 0.5);
+        if c0 > c1 {
+            return;
+        }
         let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
         let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
         let this = this.row(iy);
@@ -220,39 +317,31 @@ pub fn slab_voids(
             let (xb, rb, eb) = below.piece(from);
             let (xa, ra, ea) = above.piece(from);
             let to = c1.min(et).min(eb).min(ea);
-            let (rt, rb, ra) = ((xt, rt), (xb, rb), (xa, ra));
-            for ix in from..=to {
-                cells += 1;
-                // Local z from the slab's bottom: [0, lo] from below, the own droplet around
-                // h/2, [h − hi, h] from above.
-                let q = at(rt, ix);
-                let a = if q > 0.0 {
-                    (c * (q as f64).sqrt()).min(half)
-                } else {
-                    0.0
-                };
-                if a >= half {
-                    // The own droplet fills the whole column.
-                    filled += h;
-                    continue;
+            cells += (to - from + 1) as u64;
+            // No droplet reaches this stretch: its columns are empty (they would add +0).
+            let mut ix = if rt.is_empty() && rb.is_empty() && ra.is_empty() {
+                to + 1
+            } else {
+                from
+            };
+            while ix <= to {
+                let n = ((to - ix + 1) as usize).min(CHUNK);
+                let (t, b, a) = (
+                    cut((xt, rt), ix, n),
+                    cut((xb, rb), ix, n),
+                    cut((xa, ra), ix, n),
+                );
+                for (((v, &t), &b), &a) in col[..n].iter_mut().zip(t).zip(b).zip(a) {
+                    *v = fill.column(t, b, a);
                 }
-                let lo = ext(at(rb, ix)).min(h);
-                let hi = ext(at(ra, ix)).min(h);
-                let (m0, m1) = (half - a, half + a);
-                // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
-                let mut len = 0.0;
-                let mut end = 0.0f64;
-                for (s0, s1) in [(0.0, lo), (m0, m1), (h - hi, h)] {
-                    if s1 <= s0 {
-                        continue;
-                    }
-                    let s0 = s0.max(end);
-                    if s1 > s0 {
-                        len += s1 - s0;
-                        end = s1;
-                    }
+                // In the reference's order (an empty column adds +0, which changes nothing),
+                // the running sum in a register.
+                let mut sum = filled;
+                for &v in &col[..n] {
+                    sum += v;
                 }
-                filled += len;
+                filled = sum;
+                ix += n as i64;
             }
             from = to + 1;
         }

@@ -8,6 +8,8 @@ use crate::geom::{DVec2, Shapes};
 use crate::plan::LayerPlan;
 use crate::settings::Settings;
 use serde::Serialize;
+use std::collections::{BTreeMap, VecDeque};
+use std::sync::{Arc, Mutex, MutexGuard};
 
 /// Part-level figures. Areas in mm² summed over layers; volumes in mm³.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
@@ -133,11 +135,11 @@ pub struct LayerStage {
     grid: Grid3,
 }
 
-/// One layer analysed by a [`LayerStage`], waiting for its neighbours' spheroid maps.
+/// One layer analysed by a [`LayerStage`]: its 2D figures, and its region and spheroid map
+/// waiting for its neighbours' maps (none when the workers compute the slabs, [`Slabs`]).
 pub struct AnalysedLayer {
     analysis: LayerAnalysis,
-    region: Shapes,
-    map: HeightMap,
+    own: Option<(Shapes, HeightMap)>,
 }
 
 /// The 3D grid of a job's analysis (fixed to the part's bounds).
@@ -162,22 +164,144 @@ impl LayerStage {
     /// Analyses layer `plan.index` against its `region`, in `raster`'s memory (one raster per
     /// worker, reused from layer to layer).
     pub fn analyse(&self, raster: &mut Raster, region: &Shapes, plan: &LayerPlan) -> AnalysedLayer {
+        let (analysis, map) = self.analyse_2d(raster, region, plan);
+        AnalysedLayer {
+            analysis,
+            own: Some((region.clone(), map)),
+        }
+    }
+
+    /// The layer's 2D figures and its spheroid map.
+    fn analyse_2d(
+        &self,
+        raster: &mut Raster,
+        region: &Shapes,
+        plan: &LayerPlan,
+    ) -> (LayerAnalysis, HeightMap) {
         let s = &self.settings;
         let centres = droplet_centres(plan, s.droplet_width());
         raster.rebuild(plan.index, plan.z, &centres, region, s);
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
-        AnalysedLayer {
-            analysis,
-            region: region.clone(),
-            map: HeightMap::new(&centres, &self.grid, footprint_diameter(s)),
+        let map = HeightMap::new(&centres, &self.grid, footprint_diameter(s));
+        (analysis, map)
+    }
+
+    /// Slab `i`'s 3D estimate: (its exact volume, its void volume), the void share sampled on
+    /// the grid.
+    fn slab(
+        &self,
+        analysis: &LayerAnalysis,
+        region: &Shapes,
+        maps: [Option<&HeightMap>; 3],
+    ) -> (f64, f64) {
+        let s = &self.settings;
+        let Some(this) = maps[1] else {
+            return (analysis.region_area * s.layer_height, 0.0);
+        };
+        let (vol, void) = slab_voids(region, &self.grid, maps[0], this, maps[2], s);
+        let exact = analysis.region_area * s.layer_height;
+        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
+        (exact, void)
+    }
+}
+
+/// The slabs' 3D estimate in the slicing workers (natively, with [`crate::write_gcode_with`]):
+/// each worker publishes its layer's region and spheroid map here, and the worker that
+/// publishes the last of the three maps a slab needs (layers i − 1, i, i + 1) computes it,
+/// so the writing thread only adds the figures up. A map is dropped once its three slabs are
+/// done; the workers run at most a window of layers ahead of the writing thread, so only
+/// that many maps are held.
+#[derive(Default)]
+pub struct Slabs {
+    n: usize,
+    maps: Vec<Option<Arc<HeightMap>>>,
+    /// Each layer's region and 2D figures, until its slab is done.
+    layers: Vec<Option<(Shapes, LayerAnalysis)>>,
+    claimed: Vec<bool>,
+    /// Slabs not yet done that use each map.
+    uses: Vec<u8>,
+    /// Slabs done and not yet taken: layer → (volume, void volume).
+    done: BTreeMap<usize, (f64, f64)>,
+}
+
+/// What a worker claims: a slab, its layer's region and figures and the three maps.
+type Claim = (usize, Shapes, LayerAnalysis, [Option<Arc<HeightMap>>; 3]);
+
+impl Slabs {
+    fn new(n: usize) -> Slabs {
+        Slabs {
+            n,
+            maps: (0..n).map(|_| None).collect(),
+            layers: (0..n).map(|_| None).collect(),
+            claimed: vec![false; n],
+            uses: (0..n)
+                .map(|k| (k.saturating_sub(1)..(k + 2).min(n)).len() as u8)
+                .collect(),
+            done: BTreeMap::new(),
+        }
+    }
+
+    /// The layers of slab `j` (those in the job).
+    fn around(&self, j: usize) -> std::ops::Range<usize> {
+        j.saturating_sub(1)..(j + 2).min(self.n)
+    }
+
+    /// Publishes layer `i`; returns the slabs it completes, claimed for the caller.
+    fn publish(
+        &mut self,
+        i: usize,
+        region: Shapes,
+        analysis: LayerAnalysis,
+        map: HeightMap,
+    ) -> Vec<Claim> {
+        if i >= self.n {
+            return Vec::new();
+        }
+        self.maps[i] = Some(Arc::new(map));
+        self.layers[i] = Some((region, analysis));
+        let mut claims = Vec::new();
+        for j in self.around(i) {
+            let ready = !self.claimed[j] && self.around(j).all(|k| self.maps[k].is_some());
+            if !ready {
+                continue;
+            }
+            let Some((region, analysis)) = self.layers[j].take() else {
+                continue;
+            };
+            self.claimed[j] = true;
+            let map =
+                |k: Option<usize>| k.filter(|&k| k < self.n).and_then(|k| self.maps[k].clone());
+            claims.push((
+                j,
+                region,
+                analysis,
+                [map(j.checked_sub(1)), map(Some(j)), map(Some(j + 1))],
+            ));
+        }
+        claims
+    }
+
+    /// Slab `j` is done: keeps its figures, drops the maps no slab needs any more.
+    fn complete(&mut self, j: usize, figures: (f64, f64)) {
+        self.done.insert(j, figures);
+        for k in self.around(j) {
+            self.uses[k] = self.uses[k].saturating_sub(1);
+            if self.uses[k] == 0 {
+                self.maps[k] = None;
+            }
         }
     }
 }
 
+fn lock(m: &Mutex<Slabs>) -> MutexGuard<'_, Slabs> {
+    m.lock().unwrap_or_else(|p| p.into_inner())
+}
+
 /// The ordered half of the job analysis: takes every layer's [`AnalysedLayer`] in ascending
-/// order, computes each slab's 3D estimate once its neighbours are in, and gives the
-/// [`Report`]. Keeps two layers' maps at a time.
+/// order, adds each slab's 3D estimate once its neighbours are in (computing it here, or
+/// taking it from the workers, [`Slabs`]), and gives the [`Report`]. Keeps two layers' maps
+/// at a time when it computes the slabs itself.
 pub struct JobAnalysis {
     stage: LayerStage,
     file_name: String,
@@ -185,6 +309,9 @@ pub struct JobAnalysis {
     layers: Vec<LayerAnalysis>,
     below: Option<HeightMap>,
     current: Option<AnalysedLayer>,
+    /// The slabs the workers compute, and the layers waiting for theirs, in order.
+    slabs: Arc<Mutex<Slabs>>,
+    waiting: VecDeque<LayerAnalysis>,
 }
 
 impl JobAnalysis {
@@ -196,6 +323,8 @@ impl JobAnalysis {
             layers: Vec::with_capacity(job.layer_count()),
             below: None,
             current: None,
+            slabs: Arc::new(Mutex::new(Slabs::new(job.layer_count()))),
+            waiting: VecDeque::new(),
         }
     }
 
@@ -206,26 +335,60 @@ impl JobAnalysis {
 
     /// The next layer (layers must come in ascending order, from 0).
     pub fn push(&mut self, layer: AnalysedLayer) {
-        self.close(Some(&layer.map));
-        self.below = self.current.take().map(|c| c.map);
-        self.current = Some(layer);
+        match &layer.own {
+            Some((_, map)) => {
+                self.close(Some(map));
+                self.below = self.current.take().and_then(|c| c.own.map(|o| o.1));
+                self.current = Some(layer);
+            }
+            // Its slab comes from the workers.
+            None => {
+                self.waiting.push_back(layer.analysis);
+                self.take_slabs(false);
+            }
+        }
+    }
+
+    /// Adds the waiting layers whose slabs the workers have done, in order; with `all`, every
+    /// waiting layer (after the last one: a slab no worker did, which only a failed layer
+    /// leaves, is computed here from the maps there are).
+    fn take_slabs(&mut self, all: bool) {
+        let slabs = self.slabs.clone();
+        let mut board = lock(&slabs);
+        while let Some(analysis) = self.waiting.front() {
+            let j = self.layers.len();
+            let figures = match board.done.remove(&j) {
+                Some(f) => f,
+                None if all => {
+                    let map = |k: usize| board.maps.get(k).cloned().flatten();
+                    let maps = [j.checked_sub(1).and_then(map), map(j), map(j + 1)];
+                    let region = board.layers.get_mut(j).and_then(Option::take);
+                    let region = region.map(|r| r.0).unwrap_or_default();
+                    self.stage.slab(
+                        analysis,
+                        &region,
+                        [maps[0].as_deref(), maps[1].as_deref(), maps[2].as_deref()],
+                    )
+                }
+                None => break,
+            };
+            let analysis = self.waiting.pop_front().expect("a waiting layer");
+            self.part.add(&analysis, figures.0, figures.1);
+            self.layers.push(analysis);
+        }
     }
 
     /// The 3D estimate of the current layer, with `above` (the next layer's map, if any).
     fn close(&mut self, above: Option<&HeightMap>) {
         let Some(cur) = &self.current else { return };
-        let s = &self.stage.settings;
-        let (vol, void) = slab_voids(
-            &cur.region,
-            &self.stage.grid,
-            self.below.as_ref(),
-            &cur.map,
-            above,
-            s,
+        let Some((region, map)) = &cur.own else {
+            return;
+        };
+        let (exact, void) = self.stage.slab(
+            &cur.analysis,
+            region,
+            [self.below.as_ref(), Some(map), above],
         );
-        // The slab's exact volume, with the void share sampled on the grid.
-        let exact = cur.analysis.region_area * s.layer_height;
-        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
         self.part.add(&cur.analysis, exact, void);
         self.layers.push(cur.analysis.clone());
     }
@@ -233,6 +396,7 @@ impl JobAnalysis {
     /// The report, after the last layer.
     pub fn finish(mut self) -> Report {
         self.close(None);
+        self.take_slabs(true);
         Report {
             file_name: self.file_name,
             model: Model::new(&self.stage.settings),
@@ -244,22 +408,33 @@ impl JobAnalysis {
 }
 
 /// The job analysis as a stage of [`crate::write_gcode_with`]: each worker analyses the layers
-/// it plans in its own [`Raster`], and the layers are pushed in order.
+/// it plans in its own [`Raster`] and computes the slabs its layer completes ([`Slabs`]); the
+/// layers are pushed in order.
 impl crate::LayerSink for JobAnalysis {
-    type State = (Raster, LayerStage);
+    type State = (Raster, LayerStage, Arc<Mutex<Slabs>>);
     type Out = AnalysedLayer;
 
     fn init(&self) -> Self::State {
-        (Raster::empty(), self.stage())
+        (Raster::empty(), self.stage(), self.slabs.clone())
     }
 
     fn per_layer(
-        (raster, stage): &mut Self::State,
-        _: usize,
+        (raster, stage, slabs): &mut Self::State,
+        i: usize,
         region: &Shapes,
         plan: &LayerPlan,
     ) -> AnalysedLayer {
-        stage.analyse(raster, region, plan)
+        let (analysis, map) = stage.analyse_2d(raster, region, plan);
+        let claims = lock(slabs).publish(i, region.clone(), analysis.clone(), map);
+        for (j, region, analysis, maps) in claims {
+            let maps = [maps[0].as_deref(), maps[1].as_deref(), maps[2].as_deref()];
+            let figures = stage.slab(&analysis, &region, maps);
+            lock(slabs).complete(j, figures);
+        }
+        AnalysedLayer {
+            analysis,
+            own: None,
+        }
     }
 
     fn ordered(&mut self, _: usize, layer: AnalysedLayer) {

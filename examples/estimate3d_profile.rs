@@ -1,0 +1,107 @@
+//! Times the 3D estimate alone on one model, single-threaded, the fast path against the
+//! reference it replaced, and checks that they agree bit for bit:
+//! `cargo run --release --example estimate3d_profile -- MODEL.stl [--set name=value]... [--runs N]`.
+//! Every layer's region and droplet centres are made first (not timed); then each stage runs
+//! over all layers N times (default 5), alternating fast and reference, and the best run is
+//! printed. Times are seconds the thread ran on a CPU (Linux: /proc/thread-self/schedstat).
+use dropslice::analysis::*;
+use dropslice::{Job, Settings};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+fn cpu() -> f64 {
+    static START: OnceLock<Instant> = OnceLock::new();
+    let on_cpu = std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
+    on_cpu.map_or_else(
+        || START.get_or_init(Instant::now).elapsed().as_secs_f64(),
+        |ns| ns * 1e-9,
+    )
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let path = args.get(1).expect("model path");
+    let mut s = Settings::default();
+    let mut runs = 5;
+    let mut it = args[2..].iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--set" => {
+                let (k, v) = it
+                    .next()
+                    .expect("--set key=value")
+                    .split_once('=')
+                    .expect("=");
+                s.set(k, v).expect("setting");
+            }
+            "--runs" => runs = it.next().expect("--runs N").parse().expect("N"),
+            _ => panic!("unknown argument {a}"),
+        }
+    }
+    let bytes = std::fs::read(path).expect("read");
+    let job = Job::new(&bytes, path, s.clone()).expect("job");
+    let b = s.droplet_width();
+    let d = footprint_diameter(&s);
+    let bounds = job.info().bounds;
+    let grid = Grid3 {
+        origin: [bounds.min[0] - d, bounds.min[1] - d].into(),
+        cell: b / GRID3_PER_B,
+    };
+    let layers: Vec<_> = (0..job.layer_count())
+        .map(|i| {
+            let (plan, region) = job.plan_layer_and_region(i);
+            (region, droplet_centres(&plan, b))
+        })
+        .collect();
+    let cells: usize = layers.iter().map(|l| l.1.len()).sum();
+    // Best times: maps fast, maps reference, slabs fast, slabs reference.
+    let mut best = [f64::INFINITY; 4];
+    let mut figures = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let t = cpu();
+        let fast_maps: Vec<HeightMap> = layers
+            .iter()
+            .map(|(_, c)| HeightMap::new(c, &grid, d))
+            .collect();
+        best[0] = best[0].min(cpu() - t);
+        let t = cpu();
+        let ref_maps: Vec<ReferenceMap> = layers
+            .iter()
+            .map(|(_, c)| ReferenceMap::new(c, &grid, d))
+            .collect();
+        best[1] = best[1].min(cpu() - t);
+        let t = cpu();
+        figures.0 = (0..layers.len())
+            .map(|i| {
+                let m = &fast_maps;
+                let (lo, hi) = (i.checked_sub(1).map(|j| &m[j]), m.get(i + 1));
+                slab_voids(&layers[i].0, &grid, lo, &m[i], hi, &s)
+            })
+            .collect::<Vec<_>>();
+        best[2] = best[2].min(cpu() - t);
+        let t = cpu();
+        figures.1 = (0..layers.len())
+            .map(|i| {
+                let m = &ref_maps;
+                let (lo, hi) = (i.checked_sub(1).map(|j| &m[j]), m.get(i + 1));
+                slab_voids_reference(&layers[i].0, &grid, lo, &m[i], hi, &s)
+            })
+            .collect::<Vec<_>>();
+        best[3] = best[3].min(cpu() - t);
+    }
+    let same_figures = figures
+        .0
+        .iter()
+        .zip(&figures.1)
+        .all(|(a, b)| a.0.to_bits() == b.0.to_bits() && a.1.to_bits() == b.1.to_bits());
+    println!(
+        "{} layers, {cells} droplets, best of {runs}: 3D height maps {:.3} (reference {:.3}) | 3D slabs {:.3} (reference {:.3}) | slab figures equal: {same_figures}",
+        layers.len(),
+        best[0],
+        best[1],
+        best[2],
+        best[3]
+    );
+}

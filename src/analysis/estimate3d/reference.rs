@@ -1,0 +1,254 @@
+//! The 3D estimate as it was before its fast path (third round of issue 14), unchanged, kept
+//! as the reference the fast path ([`super`]) is tested against
+//! (tests/estimate3d_fast.rs) and timed against (examples/estimate3d_profile.rs).
+
+use super::super::droplet::spheroid_half_height;
+use super::super::raster::region_spans;
+use super::Grid3;
+use crate::geom::{Point, Shapes, all_contours};
+use crate::grid::{Segment, Spot, Tiles};
+use crate::settings::Settings;
+
+/// Rows per band and cells per tile of a [`ReferenceMap`]: tiles of 32 × 32 cells.
+const MAP_BAND_ROWS: usize = 32;
+const MAP_TILE_COLS: usize = 32;
+
+/// The droplet spheroids of one layer on the 3D grid: per cell, the largest
+/// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
+/// droplets fill the cell's column within c·√q of the layer's mid-height. Stored only in the
+/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere.
+pub struct ReferenceMap {
+    /// Grid indices of the map's cell (0, 0).
+    x0: i64,
+    y0: i64,
+    tiles: Tiles,
+    q: Vec<f32>,
+}
+
+/// One row of a [`ReferenceMap`]: its segments' cells in `data`.
+#[derive(Clone, Copy)]
+struct MapRow<'a> {
+    x0: i64,
+    segs: &'a [Segment],
+    data: &'a [f32],
+}
+
+impl<'a> MapRow<'a> {
+    const EMPTY: MapRow<'static> = MapRow {
+        x0: 0,
+        segs: &[],
+        data: &[],
+    };
+
+    /// The stretch of the row from grid index `ix` on: (grid index of `cells[0]`, cells, grid
+    /// index of its last cell); no cells where nothing is stored.
+    fn piece(&self, ix: i64) -> (i64, &'a [f32], i64) {
+        for s in self.segs {
+            let (a, b) = (self.x0 + s.c0 as i64, self.x0 + s.c1 as i64);
+            if ix < a {
+                return (ix, &[], a - 1);
+            }
+            if ix < b {
+                return (a, &self.data[s.at..s.end()], b - 1);
+            }
+        }
+        (ix, &[], i64::MAX)
+    }
+}
+
+impl ReferenceMap {
+    pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> ReferenceMap {
+        let r = d / 2.0;
+        let mut min = [i64::MAX; 2];
+        let mut max = [i64::MIN; 2];
+        let idx = |v: f64, k: usize| ((v - grid.origin[k]) / grid.cell - 0.5).floor() as i64;
+        for p in centres {
+            for k in 0..2 {
+                min[k] = min[k].min(idx(p[k] - r, k));
+                max[k] = max[k].max(idx(p[k] + r, k) + 1);
+            }
+        }
+        let mut tiles = Tiles::default();
+        if centres.is_empty() {
+            return ReferenceMap {
+                x0: 0,
+                y0: 0,
+                tiles,
+                q: Vec::new(),
+            };
+        }
+        let (w, h) = (
+            (max[0] - min[0] + 1) as usize,
+            (max[1] - min[1] + 1) as usize,
+        );
+        // A droplet's cells [ax, bx] × [ay, by].
+        let cells = |p: &Point| {
+            (
+                (idx(p[0] - r, 0), idx(p[0] + r, 0) + 1),
+                (idx(p[1] - r, 1), idx(p[1] + r, 1) + 1),
+            )
+        };
+        let cells: Vec<_> = centres.iter().map(cells).collect();
+        tiles.reset(h, w, MAP_BAND_ROWS, MAP_TILE_COLS);
+        for &((ax, bx), (ay, by)) in &cells {
+            let (x, y) = (
+                |v: i64| (v - min[0]) as usize,
+                |v: i64| (v - min[1]) as usize,
+            );
+            tiles.mark(y(ay), y(by), x(ax), x(bx));
+        }
+        let mut q = vec![0f32; tiles.build()];
+        let inv = 1.0 / (r * r);
+        let mut xx = Vec::new();
+        // Where the last droplet row's cells were stored (mostly the next one's too).
+        let mut spot: Option<Spot> = None;
+        for (p, &((ax, bx), (ay, by))) in centres.iter().zip(&cells) {
+            xx.clear();
+            xx.extend((ax..=bx).map(|ix| {
+                let x = grid.origin[0] + (ix as f64 + 0.5) * grid.cell - p[0];
+                x * x
+            }));
+            for iy in ay..=by {
+                let y = grid.origin[1] + (iy as f64 + 0.5) * grid.cell - p[1];
+                let yy = y * y;
+                if yy * inv >= 1.0 {
+                    // No cell of this row is inside (q ≤ 0 never raises a cell).
+                    continue;
+                }
+                let (k, c) = ((iy - min[1]) as usize, (ax - min[0]) as usize);
+                let Some(sp) = tiles.spot_cached(&mut spot, k, c, c + xx.len() - 1) else {
+                    debug_assert!(false, "droplet outside the map's tiles");
+                    continue;
+                };
+                let at = sp.index(k) + c - sp.shift;
+                for (slot, &x2) in q[at..at + xx.len()].iter_mut().zip(&xx) {
+                    let v = (1.0 - (x2 + yy) * inv) as f32;
+                    if v > *slot {
+                        *slot = v;
+                    }
+                }
+            }
+        }
+        ReferenceMap {
+            x0: min[0],
+            y0: min[1],
+            tiles,
+            q,
+        }
+    }
+
+    /// Row `iy` (a grid index); empty outside the map.
+    fn row(&self, iy: i64) -> MapRow<'_> {
+        usize::try_from(iy - self.y0)
+            .ok()
+            .and_then(|y| self.tiles.row(y))
+            .map_or(MapRow::EMPTY, |row| MapRow {
+                x0: self.x0,
+                segs: row.segs,
+                data: &self.q[row.range()],
+            })
+    }
+
+    /// Cells stored (for tests of the memory it takes).
+    pub fn stored_cells(&self) -> usize {
+        self.q.len()
+    }
+}
+
+/// The 3D estimate for layer i's slab: (volume, void volume) in mm³ of its region × H, filled
+/// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`).
+pub fn slab_voids_reference(
+    region: &Shapes,
+    grid: &Grid3,
+    below: Option<&ReferenceMap>,
+    this: &ReferenceMap,
+    above: Option<&ReferenceMap>,
+    s: &Settings,
+) -> (f64, f64) {
+    let h = s.layer_height;
+    let c = spheroid_half_height(s);
+    let half = h / 2.0;
+    let mut ymin = f64::INFINITY;
+    let mut ymax = f64::NEG_INFINITY;
+    for p in all_contours(region).flatten() {
+        ymin = ymin.min(p[1]);
+        ymax = ymax.max(p[1]);
+    }
+    if !ymin.is_finite() {
+        return (0.0, 0.0);
+    }
+    let k0 = ((ymin - grid.origin[1]) / grid.cell - 0.5).floor() as i64;
+    let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
+    let y0 = grid.origin[1] + k0 as f64 * grid.cell;
+    let (mut cells, mut filled) = (0u64, 0.0f64);
+    // A neighbour's droplet reaches into this slab where c·√q > H/2.
+    let q_reach = ((half / c) * (half / c)) as f32;
+    let ext = |q: f32| -> f64 {
+        if q > q_reach {
+            (c * (q as f64).sqrt() - half).max(0.0)
+        } else {
+            0.0
+        }
+    };
+    let at = |(x0, row): (i64, &[f32]), ix: i64| -> f32 {
+        usize::try_from(ix - x0)
+            .ok()
+            .and_then(|x| row.get(x))
+            .copied()
+            .unwrap_or(0.0)
+    };
+    region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
+        let iy = k0 + k as i64;
+        let c0 = ((xa - grid.origin[0]) / grid.cell - 0.5).ceil() as i64;
+        let c1 = ((xb - grid.origin[0]) / grid.cell - 0.5).floor() as i64;
+        let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
+        let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
+        let this = this.row(iy);
+        // Stretches of the span over which each map is one slice (or nothing).
+        let mut from = c0;
+        while from <= c1 {
+            let (xt, rt, et) = this.piece(from);
+            let (xb, rb, eb) = below.piece(from);
+            let (xa, ra, ea) = above.piece(from);
+            let to = c1.min(et).min(eb).min(ea);
+            let (rt, rb, ra) = ((xt, rt), (xb, rb), (xa, ra));
+            for ix in from..=to {
+                cells += 1;
+                // Local z from the slab's bottom: [0, lo] from below, the own droplet around
+                // h/2, [h − hi, h] from above.
+                let q = at(rt, ix);
+                let a = if q > 0.0 {
+                    (c * (q as f64).sqrt()).min(half)
+                } else {
+                    0.0
+                };
+                if a >= half {
+                    // The own droplet fills the whole column.
+                    filled += h;
+                    continue;
+                }
+                let lo = ext(at(rb, ix)).min(h);
+                let hi = ext(at(ra, ix)).min(h);
+                let (m0, m1) = (half - a, half + a);
+                // Union of [0, lo], [m0, m1] (if a > 0), [h − hi, h].
+                let mut len = 0.0;
+                let mut end = 0.0f64;
+                for (s0, s1) in [(0.0, lo), (m0, m1), (h - hi, h)] {
+                    if s1 <= s0 {
+                        continue;
+                    }
+                    let s0 = s0.max(end);
+                    if s1 > s0 {
+                        len += s1 - s0;
+                        end = s1;
+                    }
+                }
+                filled += len;
+            }
+            from = to + 1;
+        }
+    });
+    let area = grid.cell * grid.cell;
+    let volume = cells as f64 * area * h;
+    (volume, (volume - filled * area).max(0.0))
+}

@@ -1,0 +1,270 @@
+//! The 3D estimate's fast path (`HeightMap::new`, `slab_voids`) against the code it replaced,
+//! kept unchanged as `ReferenceMap` and `slab_voids_reference`: every slab's (volume, void
+//! volume) equal to the bit, on real models (each layer between its real neighbours, stagger
+//! off and on, both footprints) and on random droplets and regions (droplets on cell centres
+//! and edges, far apart, missing neighbours). And the slabs the slicing workers compute give
+//! the report the writing thread gave when it computed them in order.
+
+mod common;
+
+use dropslice::analysis::{
+    GRID3_PER_B, Grid3, HeightMap, JobAnalysis, ReferenceMap, droplet_centres, footprint_diameter,
+    slab_voids, slab_voids_reference,
+};
+use dropslice::geom::{Point, Shape, Shapes};
+use dropslice::{Job, Settings};
+
+fn bits(f: (f64, f64)) -> (u64, u64) {
+    (f.0.to_bits(), f.1.to_bits())
+}
+
+/// Every slab of `layers` (region, droplet centres), fast and reference, equal to the bit.
+fn assert_slabs_equal(what: &str, layers: &[(Shapes, Vec<Point>)], grid: &Grid3, s: &Settings) {
+    let d = footprint_diameter(s);
+    let fast: Vec<HeightMap> = layers
+        .iter()
+        .map(|l| HeightMap::new(&l.1, grid, d))
+        .collect();
+    let slow: Vec<ReferenceMap> = layers
+        .iter()
+        .map(|l| ReferenceMap::new(&l.1, grid, d))
+        .collect();
+    let mut nonzero = 0;
+    for i in 0..layers.len() {
+        let (lo, hi) = (i.checked_sub(1), i + 1);
+        let a = slab_voids(
+            &layers[i].0,
+            grid,
+            lo.map(|j| &fast[j]),
+            &fast[i],
+            fast.get(hi),
+            s,
+        );
+        let b = slab_voids_reference(
+            &layers[i].0,
+            grid,
+            lo.map(|j| &slow[j]),
+            &slow[i],
+            slow.get(hi),
+            s,
+        );
+        assert_eq!(bits(a), bits(b), "{what}, slab {i}: {a:?} against {b:?}");
+        // Without neighbours, too.
+        let a = slab_voids(&layers[i].0, grid, None, &fast[i], None, s);
+        let b = slab_voids_reference(&layers[i].0, grid, None, &slow[i], None, s);
+        assert_eq!(
+            bits(a),
+            bits(b),
+            "{what}, slab {i} alone: {a:?} against {b:?}"
+        );
+        nonzero += usize::from(a.1 > 0.0 && a.1 < a.0);
+    }
+    // The comparison saw partly filled slabs, not only empty or full ones.
+    assert!(nonzero > 0, "{what}: no slab partly filled");
+}
+
+fn model_layers(model: &str, s: &Settings, step: usize) -> (Vec<(Shapes, Vec<Point>)>, Grid3) {
+    let path = common::model(model);
+    let job = Job::new(
+        &common::model_bytes(model),
+        path.to_str().unwrap(),
+        s.clone(),
+    )
+    .unwrap();
+    let b = s.droplet_width();
+    let d = footprint_diameter(s);
+    let bounds = job.info().bounds;
+    let grid = Grid3 {
+        origin: [bounds.min[0] - d, bounds.min[1] - d].into(),
+        cell: b / GRID3_PER_B,
+    };
+    // Runs of three adjacent layers every `step` layers: each middle one between its real
+    // neighbours.
+    let mut layers = Vec::new();
+    for i in (0..job.layer_count()).step_by(step) {
+        for k in i..(i + 3).min(job.layer_count()) {
+            let (plan, region) = job.plan_layer_and_region(k);
+            layers.push((region, droplet_centres(&plan, b)));
+        }
+    }
+    (layers, grid)
+}
+
+#[test]
+fn slabs_of_real_models_are_the_reference_slabs() {
+    for model in ["3DBenchy.stl", "extruder_idler.stl", "esca_nonmanifold.stl"] {
+        for (stagger, footprint) in [(false, "disc"), (true, "disc"), (false, "spread")] {
+            let mut s = Settings {
+                stagger,
+                ..Settings::default()
+            };
+            s.set("footprint", footprint).unwrap();
+            let (layers, grid) = model_layers(model, &s, 17);
+            assert_slabs_equal(
+                &format!("{model}, stagger {stagger}, footprint {footprint}"),
+                &layers,
+                &grid,
+                &s,
+            );
+        }
+    }
+}
+
+/// A small deterministic generator (xorshift).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn slabs_of_random_droplets_are_the_reference_slabs() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    for footprint in ["disc", "spread"] {
+        let mut s = Settings::default();
+        s.set("footprint", footprint).unwrap();
+        let b = s.droplet_width();
+        let grid = Grid3 {
+            origin: [-1.3, -0.7].into(),
+            cell: b / GRID3_PER_B,
+        };
+        for case in 0..40 {
+            let mut layers = Vec::new();
+            for _ in 0..3 {
+                // A region of one or two boxes (the second sometimes a hole, sometimes far
+                // away), droplets scattered over and around it, some exactly on cell centres
+                // or cell edges, some in a lattice.
+                let (x0, y0) = (rng.next() * 2.0, rng.next() * 2.0);
+                let (w, h) = (0.2 + rng.next() * 3.0, 0.2 + rng.next() * 3.0);
+                let rect = |x0: f64, y0: f64, w: f64, h: f64| -> Vec<Point> {
+                    vec![
+                        [x0, y0].into(),
+                        [x0 + w, y0].into(),
+                        [x0 + w, y0 + h].into(),
+                        [x0, y0 + h].into(),
+                    ]
+                };
+                let mut region: Shapes = vec![Shape::new(rect(x0, y0, w, h), vec![])];
+                match case % 3 {
+                    1 => {
+                        let mut hole = rect(x0 + w / 4.0, y0 + h / 4.0, w / 2.0, h / 2.0);
+                        hole.reverse();
+                        region[0] = Shape::new(rect(x0, y0, w, h), vec![hole]);
+                    }
+                    2 => region.push(Shape::new(rect(x0 + 40.0, y0 - 30.0, 1.0, 1.0), vec![])),
+                    _ => {}
+                }
+                let mut pts: Vec<Point> = Vec::new();
+                let n = (rng.next() * 400.0) as usize;
+                for k in 0..n {
+                    let (u, v) = (
+                        x0 - 0.3 + rng.next() * (w + 0.6),
+                        y0 - 0.3 + rng.next() * (h + 0.6),
+                    );
+                    let p = match k % 4 {
+                        // On a cell centre, or on a cell edge.
+                        0 => {
+                            let snap = |t: f64, o: f64, half: f64| {
+                                o + (((t - o) / grid.cell).floor() + half) * grid.cell
+                            };
+                            [snap(u, grid.origin[0], 0.5), snap(v, grid.origin[1], 0.0)]
+                        }
+                        // A lattice of pitch B at a random phase.
+                        1 => {
+                            let j = k as f64;
+                            [x0 + (j % 13.0) * b, y0 + (j / 13.0).floor() * b]
+                        }
+                        _ => [u, v],
+                    };
+                    pts.push(p.into());
+                }
+                if case % 7 == 3 {
+                    pts.clear();
+                }
+                if case % 3 == 2 {
+                    pts.push([x0 + 40.5, y0 - 29.5].into());
+                }
+                layers.push((region, pts));
+            }
+            for stagger in [false, true] {
+                let s = Settings {
+                    stagger,
+                    ..s.clone()
+                };
+                let d = footprint_diameter(&s);
+                let fast: Vec<HeightMap> = layers
+                    .iter()
+                    .map(|l| HeightMap::new(&l.1, &grid, d))
+                    .collect();
+                let slow: Vec<ReferenceMap> = layers
+                    .iter()
+                    .map(|l| ReferenceMap::new(&l.1, &grid, d))
+                    .collect();
+                for (lo, hi) in [(Some(0), Some(2)), (None, Some(2)), (Some(0), None)] {
+                    let a = slab_voids(
+                        &layers[1].0,
+                        &grid,
+                        lo.map(|j| &fast[j]),
+                        &fast[1],
+                        hi.map(|j| &fast[j]),
+                        &s,
+                    );
+                    let r = slab_voids_reference(
+                        &layers[1].0,
+                        &grid,
+                        lo.map(|j| &slow[j]),
+                        &slow[1],
+                        hi.map(|j| &slow[j]),
+                        &s,
+                    );
+                    assert_eq!(
+                        bits(a),
+                        bits(r),
+                        "case {case}, {footprint}, stagger {stagger}, {lo:?} {hi:?}: {a:?} against {r:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The report when the writing thread computes every slab in order (the layers analysed and
+/// pushed one by one, as before the workers computed them).
+fn report_in_order(job: &Job) -> dropslice::analysis::Report {
+    let mut analysis = JobAnalysis::new(job);
+    let stage = analysis.stage();
+    let mut raster = dropslice::analysis::Raster::empty();
+    for i in 0..job.layer_count() {
+        let (plan, region) = job.plan_layer_and_region(i);
+        analysis.push(stage.analyse(&mut raster, &region, &plan));
+    }
+    analysis.finish()
+}
+
+#[test]
+fn slabs_from_the_workers_give_the_report_of_the_ordered_slabs() {
+    for (model, stagger) in [("3DBenchy.stl", false), ("esca_nonmanifold.stl", true)] {
+        let s = Settings {
+            stagger,
+            ..Settings::default()
+        };
+        let job = Job::new(&common::model_bytes(model), model, s).unwrap();
+        let mut analysis = JobAnalysis::new(&job);
+        dropslice::write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis).unwrap();
+        let workers = analysis.finish();
+        let ordered = report_in_order(&job);
+        assert_eq!(workers.part, ordered.part, "{model}");
+        assert_eq!(workers.layers, ordered.layers, "{model}");
+        // Every slab counted: the part's volume is every layer's area times H, in order.
+        let mut volume = 0.0;
+        for l in &ordered.layers {
+            volume += l.region_area * job.settings().layer_height;
+        }
+        assert_eq!(workers.part.volume.to_bits(), volume.to_bits(), "{model}");
+        assert!(workers.part.void_volume > 0.0 && workers.part.void_fraction < 0.5);
+    }
+}
