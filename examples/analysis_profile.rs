@@ -8,19 +8,10 @@
 //! rasterising pays for the raster's memory), FAST_ONLY=1 no reference paths (for perf).
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
-use std::sync::OnceLock;
-use std::time::Instant;
 
-fn cpu() -> f64 {
-    static START: OnceLock<Instant> = OnceLock::new();
-    let on_cpu = std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
-    on_cpu.map_or_else(
-        || START.get_or_init(Instant::now).elapsed().as_secs_f64(),
-        |ns| ns * 1e-9,
-    )
-}
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

@@ -6,19 +6,10 @@
 //! printed. Times are seconds the thread ran on a CPU (Linux: /proc/thread-self/schedstat).
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
-use std::sync::OnceLock;
-use std::time::Instant;
 
-fn cpu() -> f64 {
-    static START: OnceLock<Instant> = OnceLock::new();
-    let on_cpu = std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok());
-    on_cpu.map_or_else(
-        || START.get_or_init(Instant::now).elapsed().as_secs_f64(),
-        |ns| ns * 1e-9,
-    )
-}
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -67,9 +58,9 @@ fn main() {
             .collect();
         best[0] = best[0].min(cpu() - t);
         let t = cpu();
-        let ref_maps: Vec<ReferenceMap> = layers
+        let ref_maps: Vec<HeightMap> = layers
             .iter()
-            .map(|(_, c)| ReferenceMap::new(c, &grid, d))
+            .map(|(_, c)| HeightMap::reference(c, &grid, d))
             .collect();
         best[1] = best[1].min(cpu() - t);
         let t = cpu();

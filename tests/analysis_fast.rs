@@ -29,13 +29,7 @@ fn rasters(model: &str, stagger: bool, step: usize) -> Vec<Raster> {
 }
 
 fn rasters_with(model: &str, s: Settings, step: usize) -> Vec<Raster> {
-    let path = common::model(model);
-    let job = Job::new(
-        &common::model_bytes(model),
-        path.to_str().unwrap(),
-        s.clone(),
-    )
-    .unwrap();
+    let job = Job::new(&common::model_bytes(model), model, s.clone()).unwrap();
     (0..job.layer_count())
         .step_by(step)
         .map(|i| {
@@ -99,13 +93,7 @@ fn one_raster_reused_gives_the_figures_of_new_ones() {
     let s = Settings::default();
     let b = s.droplet_width();
     let model = "3DBenchy.stl";
-    let path = common::model(model);
-    let job = Job::new(
-        &common::model_bytes(model),
-        path.to_str().unwrap(),
-        s.clone(),
-    )
-    .unwrap();
+    let job = Job::new(&common::model_bytes(model), model, s.clone()).unwrap();
     let n = job.layer_count();
     let mut r = Raster::empty();
     // Up and down the part, every 7th layer, then the first layers in order.

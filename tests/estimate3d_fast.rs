@@ -1,5 +1,5 @@
 //! The 3D estimate's fast path (`HeightMap::new`, `slab_voids`) against the code it replaced,
-//! kept unchanged as `ReferenceMap` and `slab_voids_reference`: every slab's (volume, void
+//! kept unchanged as `HeightMap::reference` and `slab_voids_reference`: every slab's (volume, void
 //! volume) equal to the bit, on real models (each layer between its real neighbours, stagger
 //! off and on, both footprints) and on random droplets and regions (droplets on cell centres
 //! and edges, far apart, missing neighbours). And the slabs the slicing workers compute give
@@ -8,8 +8,8 @@
 mod common;
 
 use dropslice::analysis::{
-    GRID3_PER_B, Grid3, HeightMap, JobAnalysis, ReferenceMap, droplet_centres, footprint_diameter,
-    slab_voids, slab_voids_reference,
+    GRID3_PER_B, Grid3, HeightMap, JobAnalysis, droplet_centres, footprint_diameter, slab_voids,
+    slab_voids_reference,
 };
 use dropslice::geom::{Point, Shape, Shapes};
 use dropslice::{Job, Settings};
@@ -25,9 +25,9 @@ fn assert_slabs_equal(what: &str, layers: &[(Shapes, Vec<Point>)], grid: &Grid3,
         .iter()
         .map(|l| HeightMap::new(&l.1, grid, d))
         .collect();
-    let slow: Vec<ReferenceMap> = layers
+    let slow: Vec<HeightMap> = layers
         .iter()
-        .map(|l| ReferenceMap::new(&l.1, grid, d))
+        .map(|l| HeightMap::reference(&l.1, grid, d))
         .collect();
     let mut nonzero = 0;
     for i in 0..layers.len() {
@@ -64,13 +64,7 @@ fn assert_slabs_equal(what: &str, layers: &[(Shapes, Vec<Point>)], grid: &Grid3,
 }
 
 fn model_layers(model: &str, s: &Settings, step: usize) -> (Vec<(Shapes, Vec<Point>)>, Grid3) {
-    let path = common::model(model);
-    let job = Job::new(
-        &common::model_bytes(model),
-        path.to_str().unwrap(),
-        s.clone(),
-    )
-    .unwrap();
+    let job = Job::new(&common::model_bytes(model), model, s.clone()).unwrap();
     let b = s.droplet_width();
     let d = footprint_diameter(s);
     let bounds = job.info().bounds;
@@ -200,9 +194,9 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
                     .iter()
                     .map(|l| HeightMap::new(&l.1, &grid, d))
                     .collect();
-                let slow: Vec<ReferenceMap> = layers
+                let slow: Vec<HeightMap> = layers
                     .iter()
-                    .map(|l| ReferenceMap::new(&l.1, &grid, d))
+                    .map(|l| HeightMap::reference(&l.1, &grid, d))
                     .collect();
                 for (lo, hi) in [(Some(0), Some(2)), (None, Some(2)), (Some(0), None)] {
                     let a = slab_voids(

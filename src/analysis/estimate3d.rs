@@ -8,7 +8,7 @@ use crate::grid::{Segment, Spot, Tiles};
 use crate::settings::Settings;
 
 mod reference;
-pub use reference::{ReferenceMap, slab_voids_reference};
+pub use reference::slab_voids_reference;
 
 /// The 3D estimate samples the part every B / this.
 pub const GRID3_PER_B: f64 = 3.0;
@@ -89,7 +89,7 @@ fn ceil_i64(t: f64) -> i64 {
 
 impl HeightMap {
     /// The map of droplets at `centres` of footprint diameter `d`. Every stored value is the
-    /// one [`ReferenceMap::new`] stores (the same expressions, in the same order); the work
+    /// one [`HeightMap::reference`] stores (the same expressions, in the same order); the work
     /// saved is around them: each droplet's cells found once, the cells' centres taken from
     /// a table per column and per row, ⌊·⌋ without libm.
     pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {

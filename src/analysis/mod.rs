@@ -69,9 +69,7 @@ mod report;
 
 pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_voids};
 pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
-pub use estimate3d::{
-    GRID3_PER_B, Grid3, HeightMap, ReferenceMap, slab_voids, slab_voids_reference,
-};
+pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids, slab_voids_reference};
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,

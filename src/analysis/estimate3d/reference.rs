@@ -4,60 +4,14 @@
 
 use super::super::droplet::spheroid_half_height;
 use super::super::raster::region_spans;
-use super::Grid3;
+use super::{Grid3, HeightMap, MAP_BAND_ROWS, MAP_TILE_COLS, MapRow};
 use crate::geom::{Point, Shapes, all_contours};
-use crate::grid::{Segment, Spot, Tiles};
+use crate::grid::{Spot, Tiles};
 use crate::settings::Settings;
 
-/// Rows per band and cells per tile of a [`ReferenceMap`]: tiles of 32 × 32 cells.
-const MAP_BAND_ROWS: usize = 32;
-const MAP_TILE_COLS: usize = 32;
-
-/// The droplet spheroids of one layer on the 3D grid: per cell, the largest
-/// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
-/// droplets fill the cell's column within c·√q of the layer's mid-height. Stored only in the
-/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere.
-pub struct ReferenceMap {
-    /// Grid indices of the map's cell (0, 0).
-    x0: i64,
-    y0: i64,
-    tiles: Tiles,
-    q: Vec<f32>,
-}
-
-/// One row of a [`ReferenceMap`]: its segments' cells in `data`.
-#[derive(Clone, Copy)]
-struct MapRow<'a> {
-    x0: i64,
-    segs: &'a [Segment],
-    data: &'a [f32],
-}
-
-impl<'a> MapRow<'a> {
-    const EMPTY: MapRow<'static> = MapRow {
-        x0: 0,
-        segs: &[],
-        data: &[],
-    };
-
-    /// The stretch of the row from grid index `ix` on: (grid index of `cells[0]`, cells, grid
-    /// index of its last cell); no cells where nothing is stored.
-    fn piece(&self, ix: i64) -> (i64, &'a [f32], i64) {
-        for s in self.segs {
-            let (a, b) = (self.x0 + s.c0 as i64, self.x0 + s.c1 as i64);
-            if ix < a {
-                return (ix, &[], a - 1);
-            }
-            if ix < b {
-                return (a, &self.data[s.at..s.end()], b - 1);
-            }
-        }
-        (ix, &[], i64::MAX)
-    }
-}
-
-impl ReferenceMap {
-    pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> ReferenceMap {
+impl HeightMap {
+    /// The height map as it was built before the fast path ([`HeightMap::new`]).
+    pub fn reference(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
         let r = d / 2.0;
         let mut min = [i64::MAX; 2];
         let mut max = [i64::MIN; 2];
@@ -70,7 +24,7 @@ impl ReferenceMap {
         }
         let mut tiles = Tiles::default();
         if centres.is_empty() {
-            return ReferenceMap {
+            return HeightMap {
                 x0: 0,
                 y0: 0,
                 tiles,
@@ -129,29 +83,12 @@ impl ReferenceMap {
                 }
             }
         }
-        ReferenceMap {
+        HeightMap {
             x0: min[0],
             y0: min[1],
             tiles,
             q,
         }
-    }
-
-    /// Row `iy` (a grid index); empty outside the map.
-    fn row(&self, iy: i64) -> MapRow<'_> {
-        usize::try_from(iy - self.y0)
-            .ok()
-            .and_then(|y| self.tiles.row(y))
-            .map_or(MapRow::EMPTY, |row| MapRow {
-                x0: self.x0,
-                segs: row.segs,
-                data: &self.q[row.range()],
-            })
-    }
-
-    /// Cells stored (for tests of the memory it takes).
-    pub fn stored_cells(&self) -> usize {
-        self.q.len()
     }
 }
 
@@ -160,9 +97,9 @@ impl ReferenceMap {
 pub fn slab_voids_reference(
     region: &Shapes,
     grid: &Grid3,
-    below: Option<&ReferenceMap>,
-    this: &ReferenceMap,
-    above: Option<&ReferenceMap>,
+    below: Option<&HeightMap>,
+    this: &HeightMap,
+    above: Option<&HeightMap>,
     s: &Settings,
 ) -> (f64, f64) {
     let h = s.layer_height;
