@@ -447,25 +447,20 @@ impl Job {
                 || support::par_map(n, &|i| self.plan_parts(i, &sections[i])),
             );
             drop(sections);
-            // Each layer's part plan and unit 1's hatch moves.
-            let parts: Vec<std::sync::Mutex<Option<(LayerPlan, geom::Shapes)>>> = parts
+            // Unit 1's hatch moves of each layer, after its part plan.
+            let hatches = support::par_map(n, &|i| {
+                let start = plan::unit1_start(&parts[i].0, s);
+                plan::support_moves(&layers[i].region, &regions[i], &[], i, s, start)
+            });
+            let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> = parts
                 .into_iter()
-                .map(|p| std::sync::Mutex::new(Some(p)))
-                .collect();
-            let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> =
-                support::par_map(n, &|i| {
-                    let (mut p, own) = parts[i]
-                        .lock()
-                        .unwrap_or_else(|e| e.into_inner())
-                        .take()
-                        .expect("each layer is taken once");
-                    p.unsupported_area = layers[i].unsupported_area;
-                    let start = plan::unit1_start(&p, s);
-                    let moves =
-                        plan::support_moves(&layers[i].region, &regions[i], &[], i, s, start);
+                .zip(hatches)
+                .zip(&layers)
+                .map(|(((mut p, own), moves), layer)| {
+                    p.unsupported_area = layer.unsupported_area;
                     (p, own, moves)
-                });
-            drop(parts);
+                })
+                .collect();
             drop(layers);
             // The droplet-level pass reads each layer's droplets from its moves when it needs
             // them (no list of all droplets is kept).
