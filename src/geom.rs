@@ -230,6 +230,15 @@ pub fn scanline_spans(
     }
 }
 
+/// The square [x0, x0 + a] × [y0, y0 + a], counter-clockwise (for the crate's unit tests).
+#[cfg(test)]
+pub(crate) fn square(x0: f64, y0: f64, a: f64) -> Shapes {
+    let outer = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
+        .map(DVec2::from)
+        .into();
+    vec![Shape::new(outer, vec![])]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -203,17 +203,11 @@ impl EndGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn square(a: f64) -> Shapes {
-        let outer = [[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]]
-            .map(Point::from)
-            .into();
-        vec![crate::geom::Shape::new(outer, vec![])]
-    }
+    use crate::geom::square;
 
     #[test]
     fn horizontal_hatch_of_a_square() {
-        let lines = hatch(&square(10.0), 0.0, 1.0);
+        let lines = hatch(&square(0.0, 0.0, 10.0), 0.0, 1.0);
         assert_eq!(lines.len(), 10);
         for l in &lines {
             assert!((dist(l.a, l.b) - 10.0).abs() < 1e-12);
@@ -285,7 +279,7 @@ mod tests {
 
     #[test]
     fn greedy_is_a_boustrophedon_on_a_square() {
-        let lines = hatch(&square(10.0), 45.0, 0.5);
+        let lines = hatch(&square(0.0, 0.0, 10.0), 45.0, 0.5);
         let total: f64 = lines.iter().map(|l| dist(l.a, l.b)).sum();
         // Area / spacing.
         assert!((total - 200.0).abs() < 1.0, "{total}");

@@ -552,13 +552,7 @@ pub fn par_map<R: Send>(n: usize, f: &(dyn Fn(usize) -> R + Sync)) -> Vec<R> {
 mod tests {
     use super::*;
     use crate::geom::DVec2;
-
-    fn square(x0: f64, y0: f64, a: f64) -> Shapes {
-        let outer = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
-            .map(DVec2::from)
-            .into();
-        vec![Shape::new(outer, vec![])]
-    }
+    use crate::geom::square;
 
     #[test]
     fn a_wider_layer_overhangs_by_its_band_beyond_the_limit() {

@@ -546,13 +546,7 @@ pub fn complete(
 mod tests {
     use super::*;
     use crate::geom::Shape;
-
-    fn square(x0: f64, y0: f64, a: f64) -> Shapes {
-        let outer = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
-            .map(DVec2::from)
-            .into();
-        vec![Shape::new(outer, vec![])]
-    }
+    use crate::geom::square;
 
     fn run(
         droplets: &[Vec<Droplet>],

@@ -199,15 +199,8 @@ pub fn slab_section_voids(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::{DVec2, Shape};
-
-    fn square(x0: f64, y0: f64, a: f64) -> Shapes {
-        let p = |x, y| DVec2::new(x, y);
-        vec![Shape::new(
-            vec![p(x0, y0), p(x0 + a, y0), p(x0 + a, y0 + a), p(x0, y0 + a)],
-            vec![],
-        )]
-    }
+    use crate::geom::DVec2;
+    use crate::geom::square;
 
     #[test]
     fn a_line_through_a_square_with_a_hole() {
