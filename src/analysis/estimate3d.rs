@@ -262,6 +262,23 @@ impl Fill {
     }
 }
 
+/// The grid rows a slab's region spans: (grid index of the first, how many, its lower edge
+/// in mm); `None` for an empty region.
+fn slab_rows(region: &Shapes, grid: &Grid3) -> Option<(i64, usize, f64)> {
+    let mut ymin = f64::INFINITY;
+    let mut ymax = f64::NEG_INFINITY;
+    for p in all_contours(region).flatten() {
+        ymin = ymin.min(p[1]);
+        ymax = ymax.max(p[1]);
+    }
+    if !ymin.is_finite() {
+        return None;
+    }
+    let k0 = floor_i64((ymin - grid.origin[1]) / grid.cell - 0.5);
+    let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
+    Some((k0, ny, grid.origin[1] + k0 as f64 * grid.cell))
+}
+
 /// The 3D estimate for layer i's slab: (volume, void volume) in mm³ of its region × H, filled
 /// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`). The figures are those of
 /// [`slab_voids_reference`] to the bit: the same cells, each column's fill computed with the
@@ -279,18 +296,9 @@ pub fn slab_voids(
     let h = s.layer_height;
     let c = spheroid_half_height(s);
     let half = h / 2.0;
-    let mut ymin = f64::INFINITY;
-    let mut ymax = f64::NEG_INFINITY;
-    for p in all_contours(region).flatten() {
-        ymin = ymin.min(p[1]);
-        ymax = ymax.max(p[1]);
-    }
-    if !ymin.is_finite() {
+    let Some((k0, ny, y0)) = slab_rows(region, grid) else {
         return (0.0, 0.0);
-    }
-    let k0 = floor_i64((ymin - grid.origin[1]) / grid.cell - 0.5);
-    let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
-    let y0 = grid.origin[1] + k0 as f64 * grid.cell;
+    };
     let (mut cells, mut filled) = (0u64, 0.0f64);
     let fill = Fill {
         h,

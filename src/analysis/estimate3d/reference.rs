@@ -5,7 +5,7 @@
 use super::super::droplet::spheroid_half_height;
 use super::super::raster::region_spans;
 use super::{Grid3, HeightMap, MAP_BAND_ROWS, MAP_TILE_COLS, MapRow};
-use crate::geom::{Point, Shapes, all_contours};
+use crate::geom::{Point, Shapes};
 use crate::grid::{Spot, Tiles};
 use crate::settings::Settings;
 
@@ -105,18 +105,9 @@ pub fn slab_voids_reference(
     let h = s.layer_height;
     let c = spheroid_half_height(s);
     let half = h / 2.0;
-    let mut ymin = f64::INFINITY;
-    let mut ymax = f64::NEG_INFINITY;
-    for p in all_contours(region).flatten() {
-        ymin = ymin.min(p[1]);
-        ymax = ymax.max(p[1]);
-    }
-    if !ymin.is_finite() {
+    let Some((k0, ny, y0)) = super::slab_rows(region, grid) else {
         return (0.0, 0.0);
-    }
-    let k0 = ((ymin - grid.origin[1]) / grid.cell - 0.5).floor() as i64;
-    let ny = ((ymax - ymin) / grid.cell).ceil() as usize + 2;
-    let y0 = grid.origin[1] + k0 as f64 * grid.cell;
+    };
     let (mut cells, mut filled) = (0u64, 0.0f64);
     // A neighbour's droplet reaches into this slab where c·√q > H/2.
     let q_reach = ((half / c) * (half / c)) as f32;
