@@ -6,25 +6,19 @@
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { execFileSync } from "node:child_process";
-import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { openPage, pick, repo, shared, start, status, waitDone } from "./helpers.mjs";
+import { pick, repo, shared, startWithPage, status, stop, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-calib-"));
 const cli = join(repo, "target/release/dropslice");
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-});
+before(async () => ({ env, main } = await startWithPage()));
 
-after(async () => {
-  await env?.close();
-  rmSync(tmp, { recursive: true, force: true });
-});
+after(() => stop(env, tmp));
 
 /** SPEC.md's figures for N droplets of a code with layer height h and aspect a, mass m (g)
  *  and density rho (g/cm³). */

@@ -2,19 +2,14 @@
 // 3D estimate's voids from the core. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { openPage, start, status, waitSettled } from "./helpers.mjs";
+import { openPage, startWithPage, status, stop, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-});
+before(async () => ({ env, main } = await startWithPage()));
 
-after(async () => {
-  await env?.close();
-});
+after(() => stop(env));
 
 const cutStatus = (page) => page.evaluate(() => window.dropslice.cut().status());
 

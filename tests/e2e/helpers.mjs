@@ -3,7 +3,7 @@
 // download, the pixels of the layer canvas and of the 3D view, test meshes, and a G-code parser
 // for comparisons.
 import assert from "node:assert/strict";
-import { existsSync, readFileSync } from "node:fs";
+import { existsSync, readFileSync, rmSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
@@ -29,6 +29,21 @@ export async function start() {
       await new Promise((ok) => server.close(ok));
     },
   };
+}
+
+/** start() and the page most of a test file's tests share; with `settle`, once its sample
+ *  part is sliced. For `before(async () => ({ env, main } = await startWithPage()))`. */
+export async function startWithPage({ settle = false } = {}) {
+  const env = await start();
+  const main = await openPage(env.browser, env.url);
+  if (settle) await waitSettled(main.page, 60_000);
+  return { env, main };
+}
+
+/** Closes what start() opened (if it got that far) and removes temporary directories. */
+export async function stop(env, ...dirs) {
+  await env?.close();
+  for (const d of dirs) rmSync(d, { recursive: true, force: true });
 }
 
 /** Debian's Chromium, headless. */

@@ -4,10 +4,10 @@
 // (every droplet inside an instance's box) and against the page's own earlier output.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { mkdtempSync, readFileSync, rmSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { boxStl, clientPoint3d, downloadText, open3d, openPage, parseGcode, pick, pixels3d, shareLink, shared, start, torusStl, view3dReady, waitDone, waitSettled } from "./helpers.mjs";
+import { boxStl, clientPoint3d, downloadText, open3d, openPage, parseGcode, pick, pixels3d, shared, shareLink, startWithPage, stop, torusStl, view3dReady, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
@@ -17,16 +17,9 @@ const cube = model("cube_20mm_ascii.stl");
 const idler = model("extruder_idler_quads.obj");
 const benchy = model("3DBenchy.stl");
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-  await waitSettled(main.page, 60_000);
-});
+before(async () => ({ env, main } = await startWithPage({ settle: true })));
 
-after(async () => {
-  await env?.close();
-  rmSync(tmp, { recursive: true, force: true });
-});
+after(() => stop(env, tmp));
 
 const job = (page) => page.evaluate(() => window.dropslice.job());
 

@@ -3,20 +3,14 @@
 // scales it by 25.4 and slices again. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { boxStl, openPage, pick, start, status, waitSettled } from "./helpers.mjs";
+import { boxStl, pick, startWithPage, status, stop, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-  await waitSettled(main.page, 60_000);
-});
+before(async () => ({ env, main } = await startWithPage({ settle: true })));
 
-after(async () => {
-  await env?.close();
-});
+after(() => stop(env));
 
 /** Opens one STL (a buffer) and waits for its slice; returns the page's status. */
 async function open(page, name, buffer) {

@@ -3,25 +3,19 @@
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { execFileSync } from "node:child_process";
-import { existsSync, mkdtempSync, readFileSync, rmSync } from "node:fs";
+import { existsSync, mkdtempSync, readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, canvasPixels, countPixels, openPage, parseGcode, pick, repo, shareLink, start, status, torusStl, waitDone, waitSettled } from "./helpers.mjs";
+import { benchy, canvasPixels, countPixels, openPage, parseGcode, pick, repo, shareLink, startWithPage, status, stop, torusStl, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main; // the page most tests share
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-e2e-"));
 const cli = join(repo, "target/release/dropslice");
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-});
+before(async () => ({ env, main } = await startWithPage()));
 
-after(async () => {
-  await env?.close();
-  rmSync(tmp, { recursive: true, force: true });
-});
+after(() => stop(env, tmp));
 
 /** Coloured (non-background, non-grid) pixels of the canvas. */
 function inkPixels(page) {

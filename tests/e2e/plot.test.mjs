@@ -2,19 +2,14 @@
 // under it, and its label gives the running print time of the core's layer times.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { openPage, start, status, waitSettled } from "./helpers.mjs";
+import { startWithPage, status, stop, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-});
+before(async () => ({ env, main } = await startWithPage()));
 
-after(async () => {
-  await env?.close();
-});
+after(() => stop(env));
 
 /** Pixels of the plot's canvas that are not transparent / that are the running-time line's
  *  orange (#d9480f), counted in the page. */

@@ -4,24 +4,18 @@
 // download), the 3D view's overhang tint, and a two-material job. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { copyFileSync, mkdtempSync, rmSync } from "node:fs";
+import { copyFileSync, mkdtempSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, countPixels, downloadText, open3d, openPage, pick, pixels3d, start, status, waitDone, waitSettled } from "./helpers.mjs";
+import { benchy, countPixels, downloadText, open3d, pick, pixels3d, startWithPage, status, stop, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-support-"));
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-});
+before(async () => ({ env, main } = await startWithPage()));
 
-after(async () => {
-  await env?.close();
-  rmSync(tmp, { recursive: true, force: true });
-});
+after(() => stop(env, tmp));
 
 /** The colours of render.ts (SUPPORT_COLOR, UNIT1_COLOR, OVERHANG_COLOR) as pixel tests. */
 const SUPPORT = "r === 0x10 && g === 0x98 && b === 0xad";

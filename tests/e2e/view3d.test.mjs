@@ -3,14 +3,13 @@
 // pixels3d): the part's steel blue, the selected part's accent blue, the cut's orange.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { benchy, clientPoint3d, open3d, openPage, pick, pixels3d, start, waitDone } from "./helpers.mjs";
+import { benchy, clientPoint3d, open3d, pick, pixels3d, startWithPage, stop, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
 
 before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
+  ({ env, main } = await startWithPage());
   // CSP violations (three.js must need no eval) are counted from the first page load on
   await main.page.evaluate(() => {
     window.__csp = [];
@@ -18,9 +17,7 @@ before(async () => {
   });
 });
 
-after(async () => {
-  await env?.close();
-});
+after(() => stop(env));
 
 test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbited by a drag", async () => {
   const { page, errors } = main;

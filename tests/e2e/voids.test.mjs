@@ -2,19 +2,14 @@
 // canvas, "Go to worst layer". Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { canvasPixels, openPage, start, status, waitSettled, countPixels } from "./helpers.mjs";
+import { canvasPixels, countPixels, startWithPage, status, stop, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
 
-before(async () => {
-  env = await start();
-  main = await openPage(env.browser, env.url);
-});
+before(async () => ({ env, main } = await startWithPage()));
 
-after(async () => {
-  await env?.close();
-});
+after(() => stop(env));
 
 /** Canvas pixels in the overlay's magenta (void) colour. */
 function voidPixels(page) {
