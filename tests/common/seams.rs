@@ -126,16 +126,11 @@ impl LoopPath {
         let m = self.points.len();
         for i in 0..m {
             let (a, c) = (self.points[i], self.points[(i + 1) % m]);
-            let (dx, dy) = (c[0] - a[0], c[1] - a[1]);
-            let l2 = dx * dx + dy * dy;
-            let t = if l2 > 0.0 {
-                (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let q = [a[0] + t * dx, a[1] + t * dy];
+            let (t, q) = project(p, a, c);
             if d(p, q) <= tol {
-                out.push((self.at[i] + t * l2.sqrt()).rem_euclid(self.length));
+                let (dx, dy) = (c[0] - a[0], c[1] - a[1]);
+                let length = (dx * dx + dy * dy).sqrt();
+                out.push((self.at[i] + t * length).rem_euclid(self.length));
             }
         }
         out
@@ -214,6 +209,11 @@ pub fn check_paths(
 }
 
 fn seg_dist(p: P, a: P, c: P) -> f64 {
+    d(p, project(p, a, c).1)
+}
+
+/// The point of segment a–c nearest to p, and where it lies along the segment (0 … 1).
+fn project(p: P, a: P, c: P) -> (f64, P) {
     let (dx, dy) = (c[0] - a[0], c[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = if l2 > 0.0 {
@@ -221,7 +221,7 @@ fn seg_dist(p: P, a: P, c: P) -> f64 {
     } else {
         0.0
     };
-    d(p, [a[0] + t * dx, a[1] + t * dy])
+    (t, [a[0] + t * dx, a[1] + t * dy])
 }
 
 /// One loop's droplets as written, with where they lie on its path.
