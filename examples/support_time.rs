@@ -34,12 +34,21 @@ fn main() {
     });
     println!("overhangs       {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let layers = support::support_layers(&regions, &s, |n, f| par_map(n, f));
+    let layers = support::support_layers(&regions, &s);
     println!(
-        "support_layers  {:.3} s (overhangs included; {} points in the support regions)",
+        "support_layers  {:.3} s (overhangs included; {} support hatch segments)",
         t.elapsed().as_secs_f64(),
-        layers.iter().map(|l| points(&l.region)).sum::<usize>()
+        layers.iter().map(|l| l.lines.len()).sum::<usize>()
     );
+    if std::env::var_os("REGION_FORM").is_some() {
+        let t = Instant::now();
+        let r = support::support_regions(&regions, &s);
+        println!(
+            "support_regions {:.3} s (the region form; {} points in the support regions)",
+            t.elapsed().as_secs_f64(),
+            r.iter().map(|(_, r)| points(r)).sum::<usize>()
+        );
+    }
     if std::env::var_os("REGIONS_ONLY").is_some() {
         return;
     }
@@ -47,10 +56,10 @@ fn main() {
         for (i, l) in layers.iter().enumerate() {
             if i % 10 == 0 || l.unsupported_area > 5.0 {
                 println!(
-                    "layer {}: overhang {:.2} mm², support {:.2} mm², part {:.2} mm²",
+                    "layer {}: overhang {:.2} mm², support {} segments, part {:.2} mm²",
                     i + 1,
                     l.unsupported_area,
-                    region_area(&l.region),
+                    l.lines.len(),
                     region_area(&regions[i])
                 );
             }
@@ -59,7 +68,7 @@ fn main() {
     let t = Instant::now();
     let hatch: Vec<Vec<dropslice::plan::Move>> = par_map(n, &|i| {
         dropslice::plan::support_moves(
-            &layers[i].region,
+            &layers[i].lines,
             &regions[i],
             &[],
             i,

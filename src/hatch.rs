@@ -59,14 +59,19 @@ pub fn hatch_at(
                 let (lo, hi) = ((x0 / pitch - along).floor(), (x1 / pitch - along).ceil());
                 let mut s0 = (lo + along) * pitch;
                 let mut s1 = (hi + along) * pitch;
+                // Whether a lattice point is left is decided on the whole numbers: one point
+                // reached from both sides may differ in its last bit.
+                let (mut k0, mut k1) = (lo, hi);
                 if x0 - s0 > reach {
                     s0 += pitch;
+                    k0 += 1.0;
                 }
                 if s1 - x1 > reach {
                     s1 -= pitch;
+                    k1 -= 1.0;
                 }
-                if s1 >= s0 {
-                    (x0, x1) = (s0, s1);
+                if k1 >= k0 {
+                    (x0, x1) = (s0, if k1 == k0 { s0 } else { s1 });
                 }
             }
             lines.push(HatchLine {
@@ -204,6 +209,35 @@ impl EndGrid {
 mod tests {
     use super::*;
     use crate::geom::square;
+
+    #[test]
+    fn a_span_with_one_lattice_point_gives_that_point() {
+        // Spans holding exactly one lattice point k·pitch, for k where that point reached from
+        // below ((k − 1)·pitch + pitch) and from above ((k + 1)·pitch − pitch) differ in the
+        // last bit: one droplet on the lattice point, not the span's own ends.
+        let pitch = 0.208;
+        let ks: Vec<f64> = (1..2000)
+            .map(|k| k as f64)
+            .filter(|&k| (k - 1.0) * pitch + pitch != (k + 1.0) * pitch - pitch)
+            .take(20)
+            .collect();
+        assert!(ks.len() >= 5, "{}", ks.len());
+        for k in ks {
+            let (x0, x1) = ((k - 0.45) * pitch, (k + 0.4) * pitch);
+            let region = vec![crate::geom::Shape::new(
+                [[x0, 0.0], [x1, 0.0], [x1, 1.0], [x0, 1.0]]
+                    .map(DVec2::from)
+                    .into(),
+                vec![],
+            )];
+            let lines = hatch_at(&region, 0.0, 0.5, 0.5, Some((pitch, 0.0, 0.0)));
+            assert_eq!(lines.len(), 2, "k {k}");
+            for l in lines {
+                assert_eq!(l.a, l.b, "k {k}");
+                assert!((l.a.x - k * pitch).abs() < 1e-12, "k {k}: {}", l.a.x);
+            }
+        }
+    }
 
     #[test]
     fn horizontal_hatch_of_a_square() {

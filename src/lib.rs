@@ -37,6 +37,7 @@ pub mod stl;
 pub mod summary;
 pub mod support;
 pub mod support_droplets;
+pub mod support_lattice;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 #[cfg(target_arch = "wasm32")]
@@ -443,14 +444,14 @@ impl Job {
             // The support regions (their top-down union is sequential) beside the parts' own
             // plans, which do not depend on them.
             let (layers, parts) = both(
-                || support::support_layers(&regions, s, |n, f| support::par_map(n, f)),
+                || support::support_layers(&regions, s),
                 || support::par_map(n, &|i| self.plan_parts(i, &sections[i])),
             );
             drop(sections);
             // Unit 1's hatch moves of each layer, after its part plan.
             let hatches = support::par_map(n, &|i| {
                 let start = plan::unit1_start(&parts[i].0, s);
-                plan::support_moves(&layers[i].region, &regions[i], &[], i, s, start)
+                plan::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
             });
             let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> = parts
                 .into_iter()
@@ -481,7 +482,7 @@ impl Job {
                     if !extra[i].is_empty() {
                         let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
                         let none = geom::Shapes::new();
-                        moves.extend(plan::support_moves(&none, &none, &extra[i], i, s, start));
+                        moves.extend(plan::support_moves(&[], &none, &extra[i], i, s, start));
                     }
                     plan::add_unit1(&mut p, moves, s);
                     (p, region)

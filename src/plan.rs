@@ -404,14 +404,14 @@ pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
 }
 
 /// Unit 1's moves for a support region (SPEC.md: "printed by unit 1 as hatch fill at
-/// `support_density`"), from `start`: the region hatched directly at the layer's hatch angle,
-/// lines B₁ / `support_density` apart, every line's droplets on a lattice of pitch B₁ along it
-/// (ends moved inward to lattice points, so no droplet centre leaves the region), without the
-/// droplets closer than `support_gap_xy`·B to the part's region `part` (a line is split
-/// there); then single droplets at `extra` (the droplet-level pass,
-/// [`crate::support_droplets`]), nearest first. No offsets. Positions are rounded as written.
+/// `support_density`"), from `start`: the region's hatch segments `lines` (lines
+/// B₁ / `support_density` apart at the layer's hatch angle, every line's droplets on a
+/// lattice of pitch B₁ along it, [`crate::support::support_layers`]), without the droplets
+/// closer than `support_gap_xy`·B to the part's region `part` (a line is split there); then
+/// single droplets at `extra` (the droplet-level pass, [`crate::support_droplets`]), nearest
+/// first. No offsets. Positions are rounded as written.
 pub fn support_moves(
-    region: &Shapes,
+    lines: &[crate::hatch::HatchLine],
     part: &Shapes,
     extra: &[Point],
     index: usize,
@@ -422,14 +422,7 @@ pub fn support_moves(
     let b1 = s1.droplet_width();
     let mut moves = Vec::new();
     let mut at = start;
-    if s1.fill_density > 0.0 && !region.is_empty() {
-        let lines = hatch_at(
-            region,
-            hatch_angle(s, index),
-            b1 / s1.fill_density,
-            0.5,
-            Some((b1, 0.0, 0.0)),
-        );
+    if s1.fill_density > 0.0 && !lines.is_empty() {
         let edges = crate::support_droplets::edges_of(part);
         let gaps = crate::support_droplets::LineGaps::new(
             &edges,
@@ -439,7 +432,7 @@ pub fn support_moves(
         );
         let mut runs = Vec::with_capacity(lines.len());
         let mut near = Vec::new();
-        for l in lines {
+        for &l in lines {
             let mut run: Option<(Point, Point)> = None;
             // Where along the line the part is within the gap (sorted intervals).
             gaps.intervals(l.a, l.b, &mut near);

@@ -29,8 +29,10 @@ use crate::geom::{
     DVec2, Shape, Shapes, region_area, segment_distance2, shapes_from_overlay, signed_area,
 };
 use crate::grid::EdgeIndex;
+use crate::hatch::{HatchLine, hatch_at};
 use crate::offset::{CHORD_TOLERANCE_MM, Corners, raw_offset};
 use crate::settings::Settings;
+use crate::support_lattice::{Bits, Lattices, Runs};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
 use i_overlay::core::solver::Solver;
@@ -448,23 +450,117 @@ pub fn overhang_face_normal_z(s: &Settings) -> f64 {
     t / (1.0 + t * t).sqrt()
 }
 
-/// One layer's overhang area and the support region unit 1 prints in it.
+/// One layer's overhang area and the support unit 1 prints in it.
 #[derive(Clone, Debug, Default)]
 pub struct LayerSupport {
     /// Area of the layer's overhang, mm².
     pub unsupported_area: f64,
-    /// Where unit 1 prints support (empty with `support = off`), up to the part: droplets
-    /// within `support_gap_xy`·B of the part are left out when it is planned.
-    pub region: Shapes,
+    /// The support region's hatch segments (empty with `support = off`): lines
+    /// B₁ / `support_density` apart at the layer's hatch angle, their ends on the lattice
+    /// points k·B₁ along them, up to the part: droplets within `support_gap_xy`·B of the part
+    /// are left out when they are planned ([`crate::plan::support_moves`]).
+    pub lines: Vec<HatchLine>,
 }
 
-/// Every layer's overhang and support region from all layers' regions (bottom first).
-/// `par_map(n, f)` evaluates `f(0..n)` (on several threads natively; in order in a worker).
-pub fn support_layers(
-    regions: &[Shapes],
-    s: &Settings,
-    par_map: impl Fn(usize, &(dyn Fn(usize) -> Shapes + Sync)) -> Vec<Shapes>,
-) -> Vec<LayerSupport> {
+/// Every layer's overhang and support from all layers' regions (bottom first): the need
+/// carried on unit 1's lattices ([`crate::support_lattice`]), or, for more hatch directions
+/// than it carries, as regions ([`support_regions`]).
+pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
+    let s1 = crate::plan::support_settings(s);
+    let b1 = s1.droplet_width();
+    if s1.fill_density.is_nan() || s1.fill_density <= 0.0 {
+        // No support hatch: the overhang areas only.
+        return par_map(regions.len(), &|i| LayerSupport {
+            unsupported_area: region_area(&crate::overhang::overhang_region(
+                &regions[i],
+                i.checked_sub(1).map(|j| &regions[j]),
+                s,
+            )),
+            lines: Vec::new(),
+        });
+    }
+    let spacing = b1 / s1.fill_density;
+    let reach = support_reach(s) + SUPPORT_TOLERANCE_MM;
+    match Lattices::new(regions, s, spacing, b1, reach) {
+        Some(lattices) => lattice_layers(regions, s, &lattices),
+        None => {
+            let areas_regions = support_regions(regions, s);
+            par_map(regions.len(), &|i| LayerSupport {
+                unsupported_area: areas_regions[i].0,
+                lines: hatch_at(
+                    &areas_regions[i].1,
+                    crate::plan::hatch_angle(s, i),
+                    spacing,
+                    0.5,
+                    Some((b1, 0.0, 0.0)),
+                ),
+            })
+        }
+    }
+}
+
+/// [`support_layers`] on lattices, top-down in blocks of layers: each block's overhangs are
+/// found, grown and crossed with every lattice on all cores, then the need is carried through
+/// the block by word operations. need(n) = (need(n + 1) ∪ grown overhang(n + 1)) − region(n);
+/// the support of layer n is its need less the grown overhangs of the `support_gap_z` layers
+/// directly above, on the layer's own lattice.
+fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<LayerSupport> {
+    /// Layers whose crossings are held at once (memory stays that of a block).
+    const BLOCK: usize = 32;
+    let n = regions.len();
+    let reach = support_reach(s);
+    let gap_z = s.support_gap_z as usize;
+    let mut out: Vec<LayerSupport> = (0..n).map(|_| LayerSupport::default()).collect();
+    let mut needs: Vec<Bits> = lat.lattices.iter().map(Bits::new).collect();
+    // The grown overhangs of the layers directly above, nearest first, on every lattice.
+    let mut above: std::collections::VecDeque<Vec<Runs>> = Default::default();
+    let mut top = n;
+    while top > 0 {
+        let bottom = top.saturating_sub(BLOCK);
+        let block = par_map(top - bottom, &|k| {
+            let i = bottom + k;
+            let o = crate::overhang::overhang_region(
+                &regions[i],
+                i.checked_sub(1).map(|j| &regions[j]),
+                s,
+            );
+            let grown = grow_fast(&o, reach, SUPPORT_TOLERANCE_MM);
+            let on = |r: &Shapes| -> Vec<Runs> { lat.lattices.iter().map(|l| l.runs(r)).collect() };
+            (region_area(&o), on(&grown), on(&regions[i]))
+        });
+        for (k, (area, grown, part)) in block.into_iter().enumerate().rev() {
+            let i = bottom + k;
+            out[i].unsupported_area = area;
+            if let Some(g) = above.front() {
+                for (bits, runs) in needs.iter_mut().zip(g) {
+                    bits.set(runs);
+                }
+            }
+            for (bits, runs) in needs.iter_mut().zip(&part) {
+                bits.clear(runs);
+            }
+            let x = lat.of[i];
+            out[i].lines = if gap_z == 0 {
+                needs[x].lines(&lat.lattices[x])
+            } else {
+                let mut bits = needs[x].clone();
+                for g in above.iter().take(gap_z) {
+                    bits.clear(&g[x]);
+                }
+                bits.lines(&lat.lattices[x])
+            };
+            above.push_front(grown);
+            above.truncate(gap_z.max(1));
+        }
+        top = bottom;
+    }
+    out
+}
+
+/// The region form of the support (for hatch directions the lattices do not carry): every
+/// layer's overhang area and support region, the need carried top-down by a sequential union
+/// of outlines.
+pub fn support_regions(regions: &[Shapes], s: &Settings) -> Vec<(f64, Shapes)> {
     let n = regions.len();
     let overhangs = par_map(n, &|i| {
         crate::overhang::overhang_region(&regions[i], i.checked_sub(1).map(|j| &regions[j]), s)
@@ -485,8 +581,6 @@ pub fn support_layers(
     for i in (0..n.saturating_sub(1)).rev() {
         needs[i] = carried(&needs[i + 1], &grown[i + 1], &clips[i]);
     }
-    // The gap to the part in the layer is kept droplet by droplet when the region is planned
-    // (`plan::support_moves`): no offset of the part here.
     let gap_z = s.support_gap_z as usize;
     let supports = if gap_z == 0 {
         needs
@@ -499,14 +593,7 @@ pub fn support_layers(
             region
         })
     };
-    overhangs
-        .iter()
-        .zip(supports)
-        .map(|(o, region)| LayerSupport {
-            unsupported_area: region_area(o),
-            region,
-        })
-        .collect()
+    overhangs.iter().map(region_area).zip(supports).collect()
 }
 
 /// `f(0..n)` on all cores (natively), in index order of the result.
@@ -648,31 +735,52 @@ mod tests {
 
     #[test]
     fn support_fills_under_a_floating_slab_down_to_the_plate() {
-        // A post (layers 0..5) and a slab beside it on layers 5..8.
-        let s = Settings::default();
-        let mut regions = vec![square(0.0, 0.0, 2.0); 5];
-        regions.extend(vec![
-            union(&square(0.0, 0.0, 2.0), &square(2.0, 0.0, 4.0));
-            3
-        ]);
-        let serial = |n: usize, f: &(dyn Fn(usize) -> Shapes + Sync)| (0..n).map(f).collect();
-        let layers = support_layers(&regions, &s, serial);
-        assert!(
-            layers[5].unsupported_area > 7.0,
-            "{}",
-            layers[5].unsupported_area
-        );
-        assert_eq!(layers[6].unsupported_area, 0.0);
-        for (i, l) in layers.iter().enumerate() {
-            // Under the slab on layers 0..5, nothing from layer 5 up.
-            assert_eq!(l.region.is_empty(), i >= 5, "layer {i}");
-            if i < 5 {
-                // The slab's area beyond the post, plus the reach around it.
-                let a = region_area(&l.region);
-                assert!(a > 4.0 * 4.0 - 1e-6 && a < 30.0, "{a}");
-                // Outside the post (the gap is kept when it is planned).
-                let inside = intersection(&l.region, &square(0.0, 0.0, 2.0));
-                assert!(region_area(&inside) < 1e-6);
+        // A post (layers 0..5) and a slab beside it on layers 5..8; every hatch direction
+        // carried on lattices (the default) and as regions (a step of 30°: six directions).
+        for step in [90.0, 30.0] {
+            let s = Settings {
+                hatch_angle_step: step,
+                ..Settings::default()
+            };
+            let b1 = s.unit1_droplet_width();
+            let mut regions = vec![square(0.0, 0.0, 2.0); 5];
+            regions.extend(vec![
+                union(&square(0.0, 0.0, 2.0), &square(2.0, 0.0, 4.0));
+                3
+            ]);
+            let layers = support_layers(&regions, &s);
+            assert!(
+                layers[5].unsupported_area > 7.0,
+                "{}",
+                layers[5].unsupported_area
+            );
+            assert_eq!(layers[6].unsupported_area, 0.0);
+            let grown = grow(&square(2.0, 0.0, 4.0), support_reach(&s));
+            for (i, l) in layers.iter().enumerate() {
+                // Under the slab on layers 0..5, nothing from layer 5 up.
+                assert_eq!(l.lines.is_empty(), i >= 5, "layer {i}");
+                let droplets: Vec<DVec2> = l
+                    .lines
+                    .iter()
+                    .flat_map(|h| crate::geom::line_droplets(h.a, h.b, b1))
+                    .collect();
+                for p in &droplets {
+                    // Outside the post (the gap is kept when it is planned), within the
+                    // slab and the reach around it.
+                    assert!(!(p.x > -1e-9 && p.x < 2.0 + 1e-9 && p.y > -1e-9 && p.y < 2.0 + 1e-9));
+                    assert!(
+                        !intersection(&grown, &square(p.x - 1e-3, p.y - 1e-3, 2e-3)).is_empty(),
+                        "{p}"
+                    );
+                }
+                if i < 5 {
+                    // One droplet per B₁² of the slab's area beyond the post (and its reach).
+                    let cells = droplets.len() as f64 * b1 * b1;
+                    assert!(
+                        cells > 16.0 - 1.0 && cells < 30.0,
+                        "step {step} layer {i}: {cells}"
+                    );
+                }
             }
         }
     }

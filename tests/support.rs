@@ -353,3 +353,86 @@ fn the_overhang_figure_agrees_with_the_outline_construction() {
         assert!(support::overhang(&regions[0], None, s).is_empty());
     }
 }
+
+#[test]
+fn the_lattice_need_agrees_with_the_region_form() {
+    // The support carried as bits on unit 1's lattices (`support_layers`) against the need
+    // carried as outlines by the boolean engine (`support_regions`, the form for unusual hatch
+    // steps) and hatched by `hatch_at`: layer by layer, the support droplets of the two differ
+    // only within the region form's tolerances of its boundary (its outlines are simplified
+    // within 5 µm, the clip and the carried need again on every layer).
+    use dropslice::geom::{DVec2, all_contours, line_droplets, segment_distance};
+    use dropslice::hatch::hatch_at;
+    use dropslice::plan::{hatch_angle, support_settings};
+    use dropslice::support;
+    for name in ["3DBenchy.stl", "U_overhang.obj", "bridge.obj"] {
+        let bytes = common::model_bytes(name);
+        let s = dropslice::Settings {
+            support: dropslice::settings::Support::Unit1,
+            ..dropslice::Settings::default()
+        };
+        let job = dropslice::Job::new(&bytes, name, s.clone()).unwrap();
+        let b1 = support_settings(&s).droplet_width();
+        let regions: Vec<_> = (0..job.layer_count())
+            .map(|i| job.section(i).region)
+            .collect();
+        let lattice = support::support_layers(&regions, &s);
+        let outlines = support::support_regions(&regions, &s);
+        let key = |p: &DVec2| ((p.x * 1e7).round() as i64, (p.y * 1e7).round() as i64);
+        let (mut total, mut differ, mut worst) = (0usize, 0usize, 0.0f64);
+        for i in 0..regions.len() {
+            assert_eq!(
+                lattice[i].unsupported_area, outlines[i].0,
+                "{name} layer {i}"
+            );
+            let droplets = |lines: &[dropslice::hatch::HatchLine]| {
+                let mut v: Vec<(i64, i64)> = lines
+                    .iter()
+                    .flat_map(|h| line_droplets(h.a, h.b, b1))
+                    .map(|p| key(&p))
+                    .collect();
+                v.sort_unstable();
+                v
+            };
+            let a = droplets(&lattice[i].lines);
+            let region = &outlines[i].1;
+            let b = droplets(&hatch_at(
+                region,
+                hatch_angle(&s, i),
+                b1,
+                0.5,
+                Some((b1, 0.0, 0.0)),
+            ));
+            total += a.len();
+            // The same lattice point computed along two different lines: keys of 0.1 µm,
+            // the neighbouring keys too (a coordinate near a key's edge rounds either way).
+            let has = |y: &[(i64, i64)], p: &(i64, i64)| {
+                (-1..=1).any(|dx| (-1..=1).any(|dy| y.binary_search(&(p.0 + dx, p.1 + dy)).is_ok()))
+            };
+            let only = |x: &[(i64, i64)], y: &[(i64, i64)]| -> Vec<(i64, i64)> {
+                x.iter().filter(|p| !has(y, p)).copied().collect()
+            };
+            for p in only(&a, &b).into_iter().chain(only(&b, &a)) {
+                differ += 1;
+                let p = DVec2::new(p.0 as f64 * 1e-7, p.1 as f64 * 1e-7);
+                let d = all_contours(region)
+                    .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
+                    .map(|(u, v)| segment_distance(p, u, v))
+                    .fold(f64::INFINITY, f64::min);
+                worst = worst.max(if d.is_finite() { d } else { 0.0 });
+                assert!(
+                    d < 0.02,
+                    "{name} layer {i}: droplet {p} is {d} mm inside or outside"
+                );
+            }
+        }
+        eprintln!(
+            "{name}: {total} support droplets on the lattices, {differ} differ from the region form, at most {worst:.4} mm from its boundary"
+        );
+        assert!(total > 0, "{name}");
+        assert!(
+            (differ as f64) < 0.01 * total as f64,
+            "{name}: {differ} of {total}"
+        );
+    }
+}
