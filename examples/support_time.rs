@@ -90,7 +90,6 @@ fn main() {
         },
         &regions,
         &s,
-        |n, f| par_map(n, f),
     );
     println!(
         "droplet pass    {:.3} s ({} droplets added)",

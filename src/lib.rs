@@ -473,7 +473,6 @@ impl Job {
                 },
                 &regions,
                 s,
-                |n, f| support::par_map(n, f),
             );
             let plans = planned
                 .into_iter()

@@ -3,7 +3,7 @@
 
 use crate::contours::{Loop, contours};
 use crate::droplets::loop_droplets_spaced;
-use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, line_droplets, round_output};
+use crate::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
 use crate::hatch::{hatch_at, order_greedy};
 use crate::settings::{ContourOrder, PrintOrder, Settings};
 use serde::{Deserialize, Serialize};
@@ -432,25 +432,60 @@ pub fn support_moves(
         );
         let mut runs = Vec::with_capacity(lines.len());
         let mut near = Vec::new();
-        for &l in lines {
-            let mut run: Option<(Point, Point)> = None;
-            // Where along the line the part is within the gap (sorted intervals).
-            gaps.intervals(l.a, l.b, &mut near);
-            let mut k = 0;
-            for (j, p) in line_droplets(l.a, l.b, b1).enumerate() {
-                let t = j as f64 * b1;
-                while k < near.len() && near[k].1 < t {
-                    k += 1;
-                }
-                let ok = !(k < near.len() && near[k].0 <= t);
-                if ok {
-                    run = Some(run.map_or((p, p), |(a, _)| (a, p)));
-                } else if let Some((a, b)) = run.take() {
-                    runs.push(crate::hatch::HatchLine { a, b });
-                }
+        // Droplet j of a line lies at t = j·B₁ along it (as `line_droplets` sets them); the
+        // first j at or after t, the last at or before t (exact in the products).
+        let first_at = |t: f64| {
+            let mut j = (t / b1).ceil().max(0.0);
+            while j > 0.0 && (j - 1.0) * b1 >= t {
+                j -= 1.0;
             }
-            if let Some((a, b)) = run {
-                runs.push(crate::hatch::HatchLine { a, b });
+            while j * b1 < t {
+                j += 1.0;
+            }
+            j
+        };
+        let last_at = |t: f64| {
+            let mut j = (t / b1).floor();
+            while (j + 1.0) * b1 <= t {
+                j += 1.0;
+            }
+            while j >= 0.0 && j * b1 > t {
+                j -= 1.0;
+            }
+            j
+        };
+        for &l in lines {
+            // Where along the line the part is within the gap (sorted intervals): the
+            // droplets there are left out, the runs between them kept.
+            gaps.intervals(l.a, l.b, &mut near);
+            let len = dist(l.a, l.b);
+            let count = line_droplet_count(len, b1) as f64;
+            let at_j = |j: f64| {
+                let t = if len > 0.0 { j * b1 / len } else { 0.0 };
+                DVec2::new(
+                    l.a[0] + t * (l.b[0] - l.a[0]),
+                    l.a[1] + t * (l.b[1] - l.a[1]),
+                )
+            };
+            let mut next = 0.0;
+            for &(t0, t1) in &near {
+                let (d0, d1) = (first_at(t0), last_at(t1).min(count - 1.0));
+                if d0 > d1 {
+                    continue;
+                }
+                if d0 > next {
+                    runs.push(crate::hatch::HatchLine {
+                        a: at_j(next),
+                        b: at_j(d0 - 1.0),
+                    });
+                }
+                next = next.max(d1 + 1.0);
+            }
+            if next < count {
+                runs.push(crate::hatch::HatchLine {
+                    a: at_j(next),
+                    b: at_j(count - 1.0),
+                });
             }
         }
         for l in order_greedy(runs, at) {

@@ -30,10 +30,27 @@ struct Grid {
     ny: i64,
     offsets: Vec<u32>,
     items: Vec<Droplet>,
+    /// Each droplet's cell while the grid is filled (kept for the next fill).
+    keys: Vec<u32>,
 }
 
 impl Grid {
     fn new(cell: f64, droplets: &[Droplet]) -> Grid {
+        let mut g = Grid {
+            cell,
+            min: DVec2::ZERO,
+            nx: 0,
+            ny: 0,
+            offsets: Vec::new(),
+            items: Vec::new(),
+            keys: Vec::new(),
+        };
+        g.fill(cell, droplets);
+        g
+    }
+
+    /// The grid of `droplets` in place of this one's (its buffers reused).
+    fn fill(&mut self, cell: f64, droplets: &[Droplet]) {
         let mut min = DVec2::INFINITY;
         let mut max = DVec2::NEG_INFINITY;
         for (p, _) in droplets {
@@ -46,36 +63,39 @@ impl Grid {
         // About one cell per droplet at most, however large the layer: memory stays
         // proportional to the droplets (larger cells still hold every droplet within reach).
         let spread = ((max.x - min.x) * (max.y - min.y) / droplets.len().max(1) as f64).sqrt();
-        let cell = cell.max(spread);
-        let nx = ((max.x - min.x) / cell).floor() as i64 + 1;
-        let ny = ((max.y - min.y) / cell).floor() as i64 + 1;
-        let mut g = Grid {
-            cell,
-            min,
-            nx,
-            ny,
-            offsets: vec![0; (nx * ny) as usize + 1],
-            items: vec![(DVec2::ZERO, 0.0); droplets.len()],
-        };
-        let keys: Vec<usize> = droplets
-            .iter()
-            .map(|(p, _)| {
-                let (x, y) = g.key(*p);
-                (y * nx + x) as usize
-            })
-            .collect();
+        self.cell = cell.max(spread);
+        self.min = min;
+        self.nx = ((max.x - min.x) / self.cell).floor() as i64 + 1;
+        self.ny = ((max.y - min.y) / self.cell).floor() as i64 + 1;
+        let nx = self.nx;
+        self.offsets.clear();
+        self.offsets.resize((nx * self.ny) as usize + 1, 0);
+        self.items.clear();
+        self.items.resize(droplets.len(), (DVec2::ZERO, 0.0));
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.clear();
+        keys.extend(droplets.iter().map(|(p, _)| {
+            let (x, y) = self.key(*p);
+            (y * nx + x) as u32
+        }));
         for &k in &keys {
-            g.offsets[k + 1] += 1;
+            self.offsets[k as usize + 1] += 1;
         }
-        for i in 1..g.offsets.len() {
-            g.offsets[i] += g.offsets[i - 1];
+        for i in 1..self.offsets.len() {
+            self.offsets[i] += self.offsets[i - 1];
         }
-        let mut fill = g.offsets.clone();
+        // Each cell's droplets in their order, filled from the cell's start (moved along as
+        // they are placed, then moved back).
         for (d, &k) in droplets.iter().zip(&keys) {
-            g.items[fill[k] as usize] = *d;
-            fill[k] += 1;
+            let slot = &mut self.offsets[k as usize];
+            self.items[*slot as usize] = *d;
+            *slot += 1;
         }
-        g
+        for i in (1..self.offsets.len()).rev() {
+            self.offsets[i] = self.offsets[i - 1];
+        }
+        self.offsets[0] = 0;
+        self.keys = keys;
     }
 
     fn key(&self, p: Point) -> (i64, i64) {
@@ -413,8 +433,8 @@ pub struct PassFigures {
 
 /// The unit-1 droplets to add to each layer so that every droplet above the first layer is
 /// supported: `droplets(i, out)` appends layer i's planned droplets (both units) to `out`
-/// (called about twice per layer, so that no layer's droplets need be kept), `regions[i]` is
-/// its part's region. Works top-down; an added droplet needs support from the layer below as
+/// (about once per layer, in runs of layers on all cores; again for a layer under added
+/// droplets), so that no layer's droplets need be kept; `regions[i]` is its part's region. Works top-down; an added droplet needs support from the layer below as
 /// any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
 /// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
 /// support deliberately stops below overhangs, and the pass adds nothing.
@@ -422,7 +442,6 @@ pub fn complete(
     droplets: &(dyn Fn(usize, &mut Vec<Droplet>) + Sync),
     regions: &[Shapes],
     s: &Settings,
-    par_map: impl Fn(usize, &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>>,
 ) -> (Vec<Vec<Point>>, PassFigures) {
     let n = regions.len();
     let mut extra: Vec<Vec<Point>> = vec![Vec::new(); n];
@@ -435,37 +454,45 @@ pub fn complete(
     let limit = s.overhang_limit * b;
     let reach = |w: f64| w / 2.0 + limit;
     let cell = reach(b.max(b1));
-    // Layer i's droplets that layer i − 1's planned droplets leave unsupported (in parallel).
-    let open = par_map(n, &|i| {
-        if i == 0 {
-            return Vec::new();
-        }
+    // Layer i's droplets that layer i − 1's planned droplets leave unsupported: runs of
+    // consecutive layers on all cores, each layer's droplets listed and put in a grid once
+    // within a run (the grid of layer i then checks layer i + 1).
+    const RUN: usize = 8;
+    let runs = crate::support::par_map((n - 1).div_ceil(RUN), &|r| {
+        let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
         let mut buf = Vec::new();
-        droplets(i - 1, &mut buf);
-        let below = Grid::new(cell, &buf);
-        buf.clear();
-        droplets(i, &mut buf);
-        // Consecutive droplets are neighbours: the droplet below that supported the last one
-        // most often supports the next.
-        let mut last: Option<Droplet> = None;
-        buf.retain(|&(p, _)| {
-            if let Some((q, w)) = last {
-                let r = reach(w);
-                if (p - q).length_squared() <= r * r {
-                    return false;
+        droplets(first - 1, &mut buf);
+        let mut below = Grid::new(cell, &buf);
+        let mut out = Vec::with_capacity(end - first);
+        for i in first..end {
+            buf.clear();
+            droplets(i, &mut buf);
+            // Consecutive droplets are neighbours: the droplet below that supported the last
+            // one most often supports the next.
+            let mut last: Option<Droplet> = None;
+            let mut open = Vec::new();
+            for &(p, w) in &buf {
+                if let Some((q, wq)) = last {
+                    let r = reach(wq);
+                    if (p - q).length_squared() <= r * r {
+                        continue;
+                    }
+                }
+                match below.find_within(p, reach) {
+                    Some(d) => last = Some(d),
+                    None => open.push((p, w)),
                 }
             }
-            match below.find_within(p, reach) {
-                Some(d) => {
-                    last = Some(d);
-                    false
-                }
-                None => true,
+            out.push(open);
+            if i + 1 < end {
+                below.fill(cell, &buf);
             }
-        });
-        buf.shrink_to_fit();
-        buf
+        }
+        out
     });
+    let open: Vec<Vec<Droplet>> = std::iter::once(Vec::new())
+        .chain(runs.into_iter().flatten())
+        .collect();
     let gap = s.support_gap_xy * b;
     let place = reach(b1) - MARGIN_MM;
     let mut buf = Vec::new();
@@ -558,12 +585,7 @@ mod tests {
             &|i, out: &mut Vec<Droplet>| out.extend_from_slice(&droplets[i]),
             regions,
             s,
-            serial,
         )
-    }
-
-    fn serial(n: usize, f: &(dyn Fn(usize) -> Vec<Droplet> + Sync)) -> Vec<Vec<Droplet>> {
-        (0..n).map(f).collect()
     }
 
     #[test]
