@@ -2,24 +2,26 @@
 
 use crate::geom::{Point, segment_distance2};
 
-/// The cells (x, y) at Chebyshev distance exactly `r` from (cx, cy) that lie inside an
+/// Calls `f(x, y)` for the cells at Chebyshev distance exactly `r` from (cx, cy) that lie inside an
 /// `nx` × `ny` grid: the ring searched in step `r` of a nearest-neighbour search.
-pub fn ring_cells(cx: i64, cy: i64, r: i64, nx: i64, ny: i64) -> impl Iterator<Item = (i64, i64)> {
-    ((cy - r)..=(cy + r))
-        .filter(move |y| (0..ny).contains(y))
-        .flat_map(move |y| {
-            // Full rows at the ring's top and bottom, only the two ends in between.
-            let step = if y == cy - r || y == cy + r {
-                1
-            } else {
-                (2 * r).max(1)
-            };
-            (0..)
-                .map(move |k| cx - r + k * step)
-                .take_while(move |&x| x <= cx + r)
-                .filter(move |x| (0..nx).contains(x))
-                .map(move |x| (x, y))
-        })
+pub fn each_ring_cell(cx: i64, cy: i64, r: i64, nx: i64, ny: i64, mut f: impl FnMut(i64, i64)) {
+    // Full rows at the ring's top and bottom, only the two ends of the rows between (plain
+    // loops: this runs for every nearest-end query of the hatch order).
+    let inside_x = |x: i64| (0..nx).contains(&x);
+    for y in (cy - r).max(0)..=(cy + r).min(ny - 1) {
+        if y == cy - r || y == cy + r {
+            for x in (cx - r).max(0)..=(cx + r).min(nx - 1) {
+                f(x, y);
+            }
+        } else {
+            if inside_x(cx - r) {
+                f(cx - r, y);
+            }
+            if inside_x(cx + r) {
+                f(cx + r, y);
+            }
+        }
+    }
 }
 
 /// Region edges in a uniform grid, for the distance from a point to the boundary.
@@ -103,13 +105,13 @@ impl<'a> EdgeIndex<'a> {
         let mut best = f64::INFINITY;
         let max_r = self.nx.max(self.ny) + cx.abs().max(cy.abs());
         for r in 0..=max_r {
-            for (x, y) in ring_cells(cx, cy, r, self.nx, self.ny) {
+            each_ring_cell(cx, cy, r, self.nx, self.ny, |x, y| {
                 let c = (y * self.nx + x) as usize;
                 for &e in &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
                     let (a, b) = self.edges[e as usize];
                     best = best.min(segment_distance2(p, a, b));
                 }
-            }
+            });
             // Edges outside rings 0..=r are at least r·cell away.
             let bound = r as f64 * self.cell;
             if best <= bound * bound || best <= enough * enough {
@@ -546,10 +548,20 @@ mod tests {
         let (nx, ny) = (7, 5);
         let mut seen = vec![0; (nx * ny) as usize];
         for r in 0..10 {
-            for (x, y) in ring_cells(2, 3, r, nx, ny) {
+            each_ring_cell(2, 3, r, nx, ny, |x, y| {
                 assert_eq!((x - 2).abs().max((y - 3).abs()), r);
                 seen[(y * nx + x) as usize] += 1;
-            }
+            });
+        }
+        assert!(seen.iter().all(|&n| n == 1));
+        // Centres outside the grid (the edge index's queries): only cells inside, once.
+        let mut seen = vec![0; (nx * ny) as usize];
+        for r in 0..20 {
+            each_ring_cell(-4, 9, r, nx, ny, |x, y| {
+                assert!((0..nx).contains(&x) && (0..ny).contains(&y));
+                assert_eq!((x + 4).abs().max((y - 9).abs()), r);
+                seen[(y * nx + x) as usize] += 1;
+            });
         }
         assert!(seen.iter().all(|&n| n == 1));
     }

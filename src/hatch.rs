@@ -6,7 +6,7 @@
 //! so two layers with the same angle have their lines in the same places; with `stagger`, some
 //! layers use (j + 0)·spacing instead (see [`crate::plan::hatch_shifted`]).
 
-use crate::grid::ring_cells;
+use crate::grid::each_ring_cell;
 
 use crate::geom::{DVec2, Point, Shapes, dist, scanline_spans, sin_cos_deg};
 
@@ -155,33 +155,15 @@ impl EndGrid {
     /// Removes the segment with the end nearest to `p` and returns that end's id.
     fn take_nearest(&mut self, p: Point) -> Option<usize> {
         let (cx, cy) = self.cell_of(p);
-        // Distance from p to the grid's cell (cx, cy) box, to bound rings when p is outside.
         let mut best: Option<(f64, usize)> = None;
         let max_r = self.nx.max(self.ny);
         for r in 0..=max_r {
             let mut any_cell = false;
-            for (x, y) in ring_cells(cx, cy, r, self.nx, self.ny) {
+            let (nx, ny) = (self.nx, self.ny);
+            each_ring_cell(cx, cy, r, nx, ny, |x, y| {
                 any_cell = true;
-                // A cell whose box lies farther than the best end so far holds no nearer end
-                // nor an equally near one (the slack keeps rounding on the safe side).
-                if let Some((bd, _)) = best {
-                    let lo = self.min + DVec2::new(x as f64, y as f64) * self.cell;
-                    let hi = lo + DVec2::splat(self.cell);
-                    let d = (lo - p).max(p - hi).max(DVec2::ZERO);
-                    if d.length_squared() > bd * bd * (1.0 + 1e-9) + 1e-18 {
-                        continue;
-                    }
-                }
-                let cell = &mut self.cells[(y * self.nx + x) as usize];
-                let alive = &self.alive;
-                cell.retain(|&e| alive[e as usize]);
-                for &e in cell.iter() {
-                    let d = dist(p, self.ends[e as usize]);
-                    if best.is_none_or(|(bd, be)| d < bd || (d == bd && (e as usize) < be)) {
-                        best = Some((d, e as usize));
-                    }
-                }
-            }
+                self.scan(x, y, p, &mut best);
+            });
             // Every end outside rings 0..=r is at least max(r·cell, how far p lies outside the
             // grid) away; stop once the best is at most that.
             let bound = (r as f64 * self.cell).max(self.outside_distance(p));
@@ -193,6 +175,33 @@ impl EndGrid {
         self.alive[e] = false;
         self.alive[e ^ 1] = false;
         Some(e)
+    }
+
+    /// Looks at the live ends of cell (x, y) for one nearer to `p` than `best` (or as near with
+    /// a smaller id).
+    fn scan(&mut self, x: i64, y: i64, p: Point, best: &mut Option<(f64, usize)>) {
+        // A cell whose box lies farther than the best end so far holds no nearer end nor an
+        // equally near one (the slack keeps rounding on the safe side).
+        if let Some((bd, _)) = *best {
+            let lo = self.min + DVec2::new(x as f64, y as f64) * self.cell;
+            let hi = lo + DVec2::splat(self.cell);
+            let d = (lo - p).max(p - hi).max(DVec2::ZERO);
+            if d.length_squared() > bd * bd * (1.0 + 1e-9) + 1e-18 {
+                return;
+            }
+        }
+        let cell = &mut self.cells[(y * self.nx + x) as usize];
+        if cell.is_empty() {
+            return;
+        }
+        let alive = &self.alive;
+        cell.retain(|&e| alive[e as usize]);
+        for &e in cell.iter() {
+            let d = dist(p, self.ends[e as usize]);
+            if best.is_none_or(|(bd, be)| d < bd || (d == bd && (e as usize) < be)) {
+                *best = Some((d, e as usize));
+            }
+        }
     }
 
     /// How far `p` lies outside the grid's box (0 inside).

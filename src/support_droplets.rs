@@ -143,10 +143,14 @@ impl Grid {
     }
 }
 
-/// ⌊x⌋ for |x| < 2⁶³ (without a call into the maths library: this runs per droplet).
+/// ⌊x⌋ for |x| < 2⁵¹ (a grid's cells; this runs per droplet): without a call into the maths
+/// library, nor the range checks of a float-to-integer cast. Adding 1.5·2⁵² rounds x to the
+/// nearest integer, which the sum's low bits then hold.
 fn floor(x: f64) -> i64 {
-    let t = x as i64;
-    if (t as f64) > x { t - 1 } else { t }
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    let y = x + SHIFT;
+    let t = (y.to_bits() as i64).wrapping_sub(SHIFT.to_bits() as i64);
+    if y - SHIFT > x { t - 1 } else { t }
 }
 
 /// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
@@ -351,6 +355,12 @@ impl<'a> LineGaps<'a> {
         let g2 = self.gap * self.gap;
         for &e in &self.order[self.starts[k] as usize..self.starts[k + 1] as usize] {
             let (p, q) = self.edges[e as usize];
+            // The edge's capsule lies within its ends' span along the line widened by the gap:
+            // wholly before the line's start or beyond its end, it gives no interval.
+            let (sp, sq) = ((p - a).dot(u), (q - a).dot(u));
+            if sp.max(sq) + self.gap < -1e-9 || sp.min(sq) - self.gap > len + 1e-9 {
+                continue;
+            }
             let mut lo = f64::INFINITY;
             let mut hi = f64::NEG_INFINITY;
             // The discs at both ends.
@@ -586,6 +596,42 @@ mod tests {
             regions,
             s,
         )
+    }
+
+    #[test]
+    fn floor_is_the_floor() {
+        for x in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.999_999_999,
+            -1e-300,
+            1e-300,
+            123_456.789,
+            -123_456.789,
+            2_251_799_813_685_247.0,
+            -2_251_799_813_685_247.5,
+            f64::EPSILON,
+            1.0 - f64::EPSILON / 2.0,
+            -(1.0 - f64::EPSILON / 2.0),
+        ] {
+            assert_eq!(floor(x), x.floor() as i64, "{x}");
+        }
+        let mut v = 0x9e37_79b9_7f4a_7c15_u64;
+        for _ in 0..100_000 {
+            v ^= v << 13;
+            v ^= v >> 7;
+            v ^= v << 17;
+            let x = ((v >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e6;
+            assert_eq!(floor(x), x.floor() as i64, "{x}");
+        }
     }
 
     #[test]
