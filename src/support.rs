@@ -177,78 +177,18 @@ pub fn union(a: &Shapes, b: &Shapes) -> Shapes {
     cleaned(nested(a).overlay(&nested(b), OverlayRule::Union, FillRule::NonZero))
 }
 
-/// A region with every loop simplified within [`SUPPORT_TOLERANCE_MM`] ([`simplify_loop`]).
+/// A region with every loop simplified within [`SUPPORT_TOLERANCE_MM`] (the slicer's
+/// Douglas–Peucker, [`crate::slice::simplify_closed`]).
 fn simplified(r: &Shapes) -> Shapes {
     r.iter()
         .map(|s| {
-            let mut c = s.contours().map(|c| simplify_loop(c, SUPPORT_TOLERANCE_MM));
+            let mut c = s
+                .contours()
+                .map(|c| crate::slice::simplify_closed(c, SUPPORT_TOLERANCE_MM));
             let outer = c.next().unwrap_or_default();
             Shape::new(outer, c.collect())
         })
         .collect()
-}
-
-/// Douglas–Peucker on a closed loop, anchored at point 0 and the point farthest from it: the
-/// construction of [`crate::slice::simplify_closed`] with squared distances and without a
-/// division per point (the same points kept, but for ties of rounding). The sequential union
-/// of [`support_layers`] simplifies the whole carried need on every layer.
-fn simplify_loop(c: &[DVec2], tol: f64) -> crate::geom::Contour {
-    let n = c.len();
-    if n < 4 {
-        return c.to_vec();
-    }
-    let mut far = 1;
-    let mut far_d = -1.0;
-    for (i, &p) in c.iter().enumerate().skip(1) {
-        let d = (p - c[0]).length_squared();
-        if d >= far_d {
-            (far, far_d) = (i, d);
-        }
-    }
-    let mut keep = vec![false; n + 1];
-    keep[0] = true;
-    keep[far] = true;
-    keep[n] = true;
-    // Index n stands for point 0 again (closing the loop).
-    let at = |i: usize| c[if i == n { 0 } else { i }];
-    let tol2 = tol * tol;
-    let mut stack = vec![(0usize, far), (far, n)];
-    while let Some((a, b)) = stack.pop() {
-        if b <= a + 1 {
-            continue;
-        }
-        let (p, q) = (at(a), at(b));
-        let d = q - p;
-        let len2 = d.length_squared();
-        let (mut worst, mut wd) = (0, -1.0);
-        if len2 > 0.0 {
-            // |cross| is the distance to the line times the chord's length.
-            for i in a + 1..b {
-                let r = at(i) - p;
-                let e = (r.x * d.y - r.y * d.x).abs();
-                if e > wd {
-                    (worst, wd) = (i, e);
-                }
-            }
-            if wd * wd <= tol2 * len2 {
-                continue;
-            }
-        } else {
-            for i in a + 1..b {
-                let e = (at(i) - p).length_squared();
-                if e > wd {
-                    (worst, wd) = (i, e);
-                }
-            }
-            if wd <= tol2 {
-                continue;
-            }
-        }
-        keep[worst] = true;
-        stack.push((a, worst));
-        stack.push((worst, b));
-    }
-    (0..n).filter(|&i| keep[i]).map(|i| c[i]).collect()
 }
 
 /// The bounding box of a shape (of its outer loop).
@@ -712,24 +652,6 @@ mod tests {
             let middle = region_area(&intersection(&fast, &square(1.49, 3.0, 0.02)));
             let want = if d < 0.15 { 0.0 } else { 0.0004 };
             assert!((middle - want).abs() < 1e-9, "d {d}: {middle}");
-        }
-    }
-
-    #[test]
-    fn simplify_loop_keeps_the_points_of_simplify_closed() {
-        // A wobbly loop of 2,000 points (radius 5 mm, wobbles of a few µm and of 0.1 mm):
-        // the cheaper arithmetic keeps the very points of the slicer's Douglas–Peucker.
-        let c: crate::geom::Contour = (0..2000)
-            .map(|k| {
-                let t = k as f64 / 2000.0 * std::f64::consts::TAU;
-                let r = 5.0 + 0.004 * (37.0 * t).sin() + 0.1 * (5.0 * t).sin();
-                DVec2::new(r * t.cos(), r * t.sin())
-            })
-            .collect();
-        for tol in [0.001, SUPPORT_TOLERANCE_MM, 0.02] {
-            let fast = simplify_loop(&c, tol);
-            assert_eq!(fast, crate::slice::simplify_closed(&c, tol), "tol {tol}");
-            assert!(fast.len() > 20 && fast.len() < c.len(), "{}", fast.len());
         }
     }
 
