@@ -32,21 +32,12 @@ const MIN_AREA_MM2: f64 = 1e-6;
 /// The overhang area of a layer, mm²: the area of [`crate::support::overhang`] (`region`: the
 /// layer's region; `below`: the layer below's, `None` on layer 1), up to floating-point noise.
 pub fn overhang_area(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> f64 {
-    let Some(below) = below else {
-        return 0.0;
-    };
-    if region.is_empty() {
-        return 0.0;
-    }
-    let d = s.overhang_limit * s.droplet_width();
-    if below.is_empty() || !d.is_finite() || d <= 2.0 * CHORD_TOLERANCE_MM {
-        return region_area(&overhang(region, Some(below), s));
-    }
-    match one_pass(region, below, d) {
-        // (+0.0 for none, as the sum of the loops' areas always gave.)
-        Some(shapes) if shapes.is_empty() => 0.0,
-        Some(shapes) => region_area(&shapes),
-        None => region_area(&overhang(region, Some(below), s)),
+    let shapes = overhang_region(region, below, s);
+    // +0.0 for none (a sum of no loops' areas starts at −0.0).
+    if shapes.is_empty() {
+        0.0
+    } else {
+        region_area(&shapes)
     }
 }
 
@@ -54,17 +45,20 @@ pub fn overhang_area(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> f
 /// pass of [`overhang_area`] (whose figure is this region's area): what the support pass
 /// carries down.
 pub fn overhang_region(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
-    let Some(below) = below else {
-        return Shapes::new();
-    };
-    if region.is_empty() {
-        return Shapes::new();
-    }
     let d = s.overhang_limit * s.droplet_width();
-    if below.is_empty() || !d.is_finite() || d <= 2.0 * CHORD_TOLERANCE_MM {
-        return overhang(region, Some(below), s);
+    match below {
+        // The first layer, an empty layer or nothing below, a limit too small for the mitres:
+        // the construction of `support::overhang` (which answers those cases itself).
+        Some(b)
+            if !region.is_empty()
+                && !b.is_empty()
+                && d.is_finite()
+                && d > 2.0 * CHORD_TOLERANCE_MM =>
+        {
+            one_pass(region, b, d).unwrap_or_else(|| overhang(region, below, s))
+        }
+        _ => overhang(region, below, s),
     }
-    one_pass(region, below, d).unwrap_or_else(|| overhang(region, Some(below), s))
 }
 
 /// R ∩ F in one pass (loops of less than [`MIN_AREA_MM2`] left out), or `None` when a mitred
