@@ -978,7 +978,9 @@ impl Raster {
                     let (_, s1, e1, l1) = runs[i];
                     let (_, s2, e2, l2) = runs[j];
                     let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
-                    if joined && l2 != NO_LABEL {
+                    // One branch, taken rarely (`joined &&` would branch on `joined`, which
+                    // is as often true as not).
+                    if joined & (l2 != NO_LABEL) {
                         // A second run above: rare.
                         let (a, b) = (find(parent, l1 as usize), find(parent, l2 as usize));
                         if a != b {
