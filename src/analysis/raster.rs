@@ -213,6 +213,17 @@ struct Scratch {
     down: Vec<u64>,
 }
 
+/// Which labelling [`Raster::analysis_with`] runs.
+#[derive(Clone, Copy)]
+enum Path {
+    /// The labelling before the fast paths, a union-find node per run.
+    Reference,
+    /// The one-pass labelling, natively with the popcount instruction when the CPU has it.
+    Fast,
+    /// The one-pass labelling without it.
+    Portable,
+}
+
 /// A void run's label before the labelling gives it one.
 const NO_LABEL: u32 = u32::MAX;
 
@@ -642,21 +653,27 @@ impl Raster {
 
     /// The figures of the layer.
     pub fn analysis(&self) -> LayerAnalysis {
-        self.analysis_with(false)
+        self.analysis_with(Path::Fast)
     }
 
     /// [`analysis`](Self::analysis) as it was before the fast paths (for tests comparing both).
     #[doc(hidden)]
     pub fn analysis_reference(&self) -> LayerAnalysis {
-        self.analysis_with(true)
+        self.analysis_with(Path::Reference)
     }
 
-    fn analysis_with(&self, reference: bool) -> LayerAnalysis {
-        let g = self.grid;
+    /// [`analysis`](Self::analysis) compiled without the popcount instruction, whichever CPU
+    /// runs it (for tests: natively the fast path takes the instruction when the CPU has it).
+    #[doc(hidden)]
+    pub fn analysis_portable(&self) -> LayerAnalysis {
+        self.analysis_with(Path::Portable)
+    }
+
+    /// Adds the cells of the region, covered region and overfill to `counts`, and the rows
+    /// holding overfill to `over_rows` (the reference's pass; the fast path counts them as it
+    /// labels).
+    fn count_cells(&self, counts: &mut [u64; 3], over_rows: &mut Vec<usize>) {
         let tiles = &self.tiles;
-        let cell = g.gx * g.gy;
-        let (mut n_region, mut n_covered, mut n_over) = (0u64, 0u64, 0u64);
-        let mut over_rows = Vec::new();
         for (bi, band) in tiles.bands().iter().enumerate() {
             for k in band.first_row..band.end_row {
                 let row = tiles.row_in(bi, k);
@@ -665,26 +682,38 @@ impl Raster {
                     continue;
                 }
                 let range = row.offset + lo as usize..row.offset + hi as usize;
-                let before = n_over;
+                let before = counts[2];
                 for (r, d) in self.region_bits[range.clone()]
                     .iter()
                     .zip(&self.drop_bits[range])
                 {
-                    n_region += r.count_ones() as u64;
-                    n_covered += (r & d).count_ones() as u64;
-                    n_over += (d & !r).count_ones() as u64;
+                    counts[0] += r.count_ones() as u64;
+                    counts[1] += (r & d).count_ones() as u64;
+                    counts[2] += (d & !r).count_ones() as u64;
                 }
-                if n_over > before {
+                if counts[2] > before {
                     over_rows.push(k);
                 }
             }
         }
+    }
+
+    fn analysis_with(&self, path: Path) -> LayerAnalysis {
+        let g = self.grid;
+        let tiles = &self.tiles;
+        let cell = g.gx * g.gy;
         let index = EdgeIndex::new(&self.edges, self.b);
-        let v = if reference {
-            self.voids_reference(&index)
-        } else {
-            self.voids_fast(&index)
+        let mut counts = [0u64; 3];
+        let mut over_rows = Vec::new();
+        let v = match path {
+            Path::Reference => {
+                self.count_cells(&mut counts, &mut over_rows);
+                self.voids_reference(&index)
+            }
+            Path::Fast => self.voids_fast(&index, &mut counts, &mut over_rows),
+            Path::Portable => self.voids_fast_with(&index, &mut counts, &mut over_rows),
         };
+        let [n_region, n_covered, n_over] = counts;
         let dev_in = v.dev_in;
         // Outward deviation: overfill runs.
         let mut dev_out = Deviation::default();
@@ -855,7 +884,9 @@ impl Raster {
         bnd: &mut Vec<bool>,
         up_buf: &mut Vec<u64>,
         down_buf: &mut Vec<u64>,
-    ) {
+        counts: &mut [u64; 3],
+    ) -> bool {
+        let mut over = 0u64;
         let (lo, hi) = self.extent[row.slot];
         let range = row.range();
         let (bits, drops) = (&self.region_bits[range.clone()], &self.drop_bits[range]);
@@ -882,8 +913,12 @@ impl Raster {
             // run without its end).
             let mut open = runs.len();
             for w in a..e {
-                let r = bits[w];
-                let v = r & !drops[w];
+                let (r, dr) = (bits[w], drops[w]);
+                counts[0] += r.count_ones() as u64;
+                counts[1] += (r & dr).count_ones() as u64;
+                counts[2] += (dr & !r).count_ones() as u64;
+                over |= dr & !r;
+                let v = r & !dr;
                 if v | carry == 0 {
                     // No run here and none open (so no carry of the addition either).
                     continue;
@@ -921,6 +956,7 @@ impl Raster {
                 bnd[open] = touch;
             }
         }
+        over != 0
     }
 
     /// [`voids_reference`](Self::voids_reference) in one pass over the rows: a run takes the
@@ -929,8 +965,43 @@ impl Raster {
     /// come in, so there are as many union-find nodes as runs that start a void, not as runs.
     /// The largest void's centroid and box are summed afterwards from its runs. Figures
     /// identical.
-    #[inline(never)]
-    fn voids_fast(&self, index: &EdgeIndex) -> Voids {
+    /// Also adds the cells of the region, covered region and overfill to `counts` and the rows
+    /// holding overfill to `over_rows`, as [`count_cells`](Self::count_cells) does, in the
+    /// same pass over the words. Natively on a CPU with a popcount instruction, compiled for
+    /// it (the baseline x86-64 target counts bits by shifts and adds).
+    fn voids_fast(
+        &self,
+        index: &EdgeIndex,
+        counts: &mut [u64; 3],
+        over_rows: &mut Vec<usize>,
+    ) -> Voids {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("popcnt") {
+            // SAFETY: the CPU has the instruction, as the check above found.
+            return unsafe { self.voids_popcnt(index, counts, over_rows) };
+        }
+        self.voids_fast_with(index, counts, over_rows)
+    }
+
+    /// [`voids_fast_with`](Self::voids_fast_with) compiled with the popcount instruction.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "popcnt")]
+    fn voids_popcnt(
+        &self,
+        index: &EdgeIndex,
+        counts: &mut [u64; 3],
+        over_rows: &mut Vec<usize>,
+    ) -> Voids {
+        self.voids_fast_with(index, counts, over_rows)
+    }
+
+    #[inline(always)]
+    fn voids_fast_with(
+        &self,
+        index: &EdgeIndex,
+        counts: &mut [u64; 3],
+        over_rows: &mut Vec<usize>,
+    ) -> Voids {
         // A label's cells, with the boundary flag in the top bit.
         const TOP: u64 = 1 << 63;
         let g = self.grid;
@@ -968,7 +1039,9 @@ impl Raster {
                 next_k = k + 1;
                 let row = tiles.row_in(bi, k);
                 let first = runs.len();
-                self.void_runs(&row, k, runs, bnd, up_buf, down_buf);
+                if self.void_runs(&row, k, runs, bnd, up_buf, down_buf, counts) {
+                    over_rows.push(k);
+                }
                 if runs.len() == first {
                     prev = first..first;
                     continue;
