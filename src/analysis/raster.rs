@@ -209,8 +209,8 @@ struct Scratch {
     parent: Vec<u32>,
     cells: Vec<u64>,
     root: Vec<u32>,
-    up: Vec<u64>,
-    down: Vec<u64>,
+    /// The region rows above and below, when copied from another band.
+    around: (Vec<u64>, Vec<u64>),
 }
 
 /// Which labelling [`Raster::analysis_with`] runs.
@@ -882,8 +882,7 @@ impl Raster {
         k: usize,
         runs: &mut Vec<(u32, u32, u32, u32)>,
         bnd: &mut Vec<bool>,
-        up_buf: &mut Vec<u64>,
-        down_buf: &mut Vec<u64>,
+        (up_buf, down_buf): &mut (Vec<u64>, Vec<u64>),
         counts: &mut [u64; 3],
     ) -> bool {
         let mut over = 0u64;
@@ -1013,8 +1012,7 @@ impl Raster {
             parent,
             cells,
             root,
-            up: up_buf,
-            down: down_buf,
+            around,
         } = &mut *scratch;
         // (row, start, end, label)
         runs.clear();
@@ -1039,7 +1037,7 @@ impl Raster {
                 next_k = k + 1;
                 let row = tiles.row_in(bi, k);
                 let first = runs.len();
-                if self.void_runs(&row, k, runs, bnd, up_buf, down_buf, counts) {
+                if self.void_runs(&row, k, runs, bnd, around, counts) {
                     over_rows.push(k);
                 }
                 if runs.len() == first {
