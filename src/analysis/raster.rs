@@ -540,8 +540,10 @@ impl Raster {
                 let mut at = 64 * sp.index(k0);
                 for (slot, &(n, half)) in (sp.slot(k0)..).zip(rows_of) {
                     if n >= 1 {
-                        // Within the widest row's columns: ≥ w0 ≥ 0.
-                        let c0 = (u - half + 0.5) as usize - shift;
+                        // Within the widest row's columns: ≥ w0 ≥ 0, so the value is above −1
+                        // and `as i64` truncates it as `as usize` would (one instruction on
+                        // baseline x86-64; `as usize` takes a dozen).
+                        let c0 = (u - half + 0.5) as i64 as usize - shift;
                         let c1 = c0 + n as usize - 1;
                         set_range(drop_bits, at + c0, at + c1);
                         mark(slot, c0, c1);
