@@ -939,13 +939,13 @@ impl Raster {
                 let base = (w * 64) as u32 + shift;
                 while starts != 0 {
                     runs.push((k, base + starts.trailing_zeros(), 0, NO_LABEL));
-                    bnd.push(false);
                     starts &= starts - 1;
                 }
                 while ends != 0 {
                     let t = ends.trailing_zeros();
                     runs[open].2 = base + t;
-                    bnd[open] = (touched >> t) & 1 != 0;
+                    // Runs end in order: `bnd` has an entry per run ended.
+                    bnd.push((touched >> t) & 1 != 0);
                     open += 1;
                     ends &= ends - 1;
                 }
@@ -954,7 +954,7 @@ impl Raster {
             // The segment's next word is not stored (zero) or beyond the row's bits.
             if carry != 0 {
                 runs[open].2 = (e * 64) as u32 + shift;
-                bnd[open] = touch;
+                bnd.push(touch);
             }
         }
         over != 0
