@@ -207,13 +207,25 @@ struct Scratch {
     runs: Vec<(u32, u32, u32, u32)>,
     bnd: Vec<bool>,
     parent: Vec<u32>,
-    accs: Vec<Acc>,
-    buf: Vec<(u32, u32)>,
-    edge: Vec<u64>,
-    up: Vec<u64>,
-    down: Vec<u64>,
-    at_boundary: Vec<bool>,
+    cells: Vec<u64>,
+    root: Vec<u32>,
+    /// The region rows above and below, when copied from another band.
+    around: (Vec<u64>, Vec<u64>),
 }
+
+/// Which labelling [`Raster::analysis_with`] runs.
+#[derive(Clone, Copy)]
+enum Path {
+    /// The labelling before the fast paths, a union-find node per run.
+    Reference,
+    /// The one-pass labelling, natively with the popcount instruction when the CPU has it.
+    Fast,
+    /// The one-pass labelling without it.
+    Portable,
+}
+
+/// A void run's label before the labelling gives it one.
+const NO_LABEL: u32 = u32::MAX;
 
 #[derive(Clone, Copy, Debug)]
 struct Grid {
@@ -528,8 +540,10 @@ impl Raster {
                 let mut at = 64 * sp.index(k0);
                 for (slot, &(n, half)) in (sp.slot(k0)..).zip(rows_of) {
                     if n >= 1 {
-                        // Within the widest row's columns: ≥ w0 ≥ 0.
-                        let c0 = (u - half + 0.5) as usize - shift;
+                        // Within the widest row's columns: ≥ w0 ≥ 0, so the value is above −1
+                        // and `as i64` truncates it as `as usize` would (one instruction on
+                        // baseline x86-64; `as usize` takes a dozen).
+                        let c0 = (u - half + 0.5) as i64 as usize - shift;
                         let c1 = c0 + n as usize - 1;
                         set_range(drop_bits, at + c0, at + c1);
                         mark(slot, c0, c1);
@@ -641,21 +655,27 @@ impl Raster {
 
     /// The figures of the layer.
     pub fn analysis(&self) -> LayerAnalysis {
-        self.analysis_with(false)
+        self.analysis_with(Path::Fast)
     }
 
     /// [`analysis`](Self::analysis) as it was before the fast paths (for tests comparing both).
     #[doc(hidden)]
     pub fn analysis_reference(&self) -> LayerAnalysis {
-        self.analysis_with(true)
+        self.analysis_with(Path::Reference)
     }
 
-    fn analysis_with(&self, reference: bool) -> LayerAnalysis {
-        let g = self.grid;
+    /// [`analysis`](Self::analysis) compiled without the popcount instruction, whichever CPU
+    /// runs it (for tests: natively the fast path takes the instruction when the CPU has it).
+    #[doc(hidden)]
+    pub fn analysis_portable(&self) -> LayerAnalysis {
+        self.analysis_with(Path::Portable)
+    }
+
+    /// Adds the cells of the region, covered region and overfill to `counts`, and the rows
+    /// holding overfill to `over_rows` (the reference's pass; the fast path counts them as it
+    /// labels).
+    fn count_cells(&self, counts: &mut [u64; 3], over_rows: &mut Vec<usize>) {
         let tiles = &self.tiles;
-        let cell = g.gx * g.gy;
-        let (mut n_region, mut n_covered, mut n_over) = (0u64, 0u64, 0u64);
-        let mut over_rows = Vec::new();
         for (bi, band) in tiles.bands().iter().enumerate() {
             for k in band.first_row..band.end_row {
                 let row = tiles.row_in(bi, k);
@@ -664,26 +684,38 @@ impl Raster {
                     continue;
                 }
                 let range = row.offset + lo as usize..row.offset + hi as usize;
-                let before = n_over;
+                let before = counts[2];
                 for (r, d) in self.region_bits[range.clone()]
                     .iter()
                     .zip(&self.drop_bits[range])
                 {
-                    n_region += r.count_ones() as u64;
-                    n_covered += (r & d).count_ones() as u64;
-                    n_over += (d & !r).count_ones() as u64;
+                    counts[0] += r.count_ones() as u64;
+                    counts[1] += (r & d).count_ones() as u64;
+                    counts[2] += (d & !r).count_ones() as u64;
                 }
-                if n_over > before {
+                if counts[2] > before {
                     over_rows.push(k);
                 }
             }
         }
+    }
+
+    fn analysis_with(&self, path: Path) -> LayerAnalysis {
+        let g = self.grid;
+        let tiles = &self.tiles;
+        let cell = g.gx * g.gy;
         let index = EdgeIndex::new(&self.edges, self.b);
-        let v = if reference {
-            self.voids_reference(&index)
-        } else {
-            self.voids_fast(&index)
+        let mut counts = [0u64; 3];
+        let mut over_rows = Vec::new();
+        let v = match path {
+            Path::Reference => {
+                self.count_cells(&mut counts, &mut over_rows);
+                self.voids_reference(&index)
+            }
+            Path::Fast => self.voids_fast(&index, &mut counts, &mut over_rows),
+            Path::Portable => self.voids_fast_with(&index, &mut counts, &mut over_rows),
         };
+        let [n_region, n_covered, n_over] = counts;
         let dev_in = v.dev_in;
         // Outward deviation: overfill runs.
         let mut dev_out = Deviation::default();
@@ -837,13 +869,142 @@ impl Raster {
         Voids::of(&g, accs.iter(), dev_in)
     }
 
+    /// The void runs of row `k` (laid out as `row`) appended to `runs` as (row, start, end,
+    /// `NO_LABEL`), and to `bnd` whether each touches a region cell with a neighbour (left,
+    /// right, above, below) outside the region: the runs of [`runs`](Self::runs) with the
+    /// boundary test of [`edge_row`](Self::edge_row), in one pass over the words. A run
+    /// touches the edge when adding its edge cells to the void bits carries out of it: the
+    /// row's void words plus their edge cells, added as one long number, set the bit just
+    /// above each run holding an edge cell (where the run ends) and no other bit outside the
+    /// void.
+    #[inline(always)]
+    fn void_runs(
+        &self,
+        row: &Row,
+        k: usize,
+        runs: &mut Vec<(u32, u32, u32, u32)>,
+        bnd: &mut Vec<bool>,
+        (up_buf, down_buf): &mut (Vec<u64>, Vec<u64>),
+        counts: &mut [u64; 3],
+    ) -> bool {
+        let mut over = 0u64;
+        let (lo, hi) = self.extent[row.slot];
+        let range = row.range();
+        let (bits, drops) = (&self.region_bits[range.clone()], &self.drop_bits[range]);
+        let up = (k + 1 < self.grid.ny)
+            .then(|| self.region_row_as(row, k + 1, up_buf))
+            .flatten();
+        let down = (k > 0)
+            .then(|| self.region_row_as(row, k - 1, down_buf))
+            .flatten();
+        let k = k as u32;
+        for seg in row.segs {
+            let end = seg.end();
+            let (a, e) = (seg.at.max(lo as usize), end.min(hi as usize));
+            if a >= e {
+                continue;
+            }
+            let (bits, drops) = (&bits[..end], &drops[..end]);
+            let (up, down) = (up.map(|x| &x[..end]), down.map(|x| &x[..end]));
+            // Grid column of the slice's column 0 in this segment.
+            let shift = (64 * seg.shift()) as u32;
+            // The last word's top void bit, and the carry of the addition.
+            let (mut carry, mut touch) = (0u64, false);
+            // Starts are pushed as they come, ends fill the runs in order (`open` the first
+            // run without its end).
+            let mut open = runs.len();
+            for w in a..e {
+                let (r, dr) = (bits[w], drops[w]);
+                counts[0] += r.count_ones() as u64;
+                counts[1] += (r & dr).count_ones() as u64;
+                counts[2] += (dr & !r).count_ones() as u64;
+                over |= dr & !r;
+                let v = r & !dr;
+                if v | carry == 0 {
+                    // No run here and none open (so no carry of the addition either).
+                    continue;
+                }
+                let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
+                let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
+                let u = up.map_or(0, |x| x[w]);
+                let d = down.map_or(0, |x| x[w]);
+                let edge = v & !(left & right & u & d);
+                let (sum, c1) = v.overflowing_add(edge);
+                let (sum, c2) = sum.overflowing_add(touch as u64);
+                touch = c1 | c2;
+                let touched = sum & !v;
+                let prev = (v << 1) | carry;
+                let mut starts = v & !prev;
+                let mut ends = !v & prev;
+                let base = (w * 64) as u32 + shift;
+                while starts != 0 {
+                    runs.push((k, base + starts.trailing_zeros(), 0, NO_LABEL));
+                    starts &= starts - 1;
+                }
+                while ends != 0 {
+                    let t = ends.trailing_zeros();
+                    runs[open].2 = base + t;
+                    // Runs end in order: `bnd` has an entry per run ended.
+                    bnd.push((touched >> t) & 1 != 0);
+                    open += 1;
+                    ends &= ends - 1;
+                }
+                carry = v >> 63;
+            }
+            // The segment's next word is not stored (zero) or beyond the row's bits.
+            if carry != 0 {
+                runs[open].2 = (e * 64) as u32 + shift;
+                bnd.push(touch);
+            }
+        }
+        over != 0
+    }
+
     /// [`voids_reference`](Self::voids_reference) in one pass over the rows: a run takes the
     /// label of the first run above it joins (a new label when none), labels are joined by
-    /// union-find, and each label's sums are kept at its root as runs come in, so there are
-    /// as many union-find nodes as runs that start a void, not as runs. Figures identical.
-    #[inline(never)]
-    fn voids_fast(&self, index: &EdgeIndex) -> Voids {
-        const NONE: u32 = u32::MAX;
+    /// union-find, and each label's cell count and boundary flag are kept at its root as runs
+    /// come in, so there are as many union-find nodes as runs that start a void, not as runs.
+    /// The largest void's centroid and box are summed afterwards from its runs. Figures
+    /// identical.
+    /// Also adds the cells of the region, covered region and overfill to `counts` and the rows
+    /// holding overfill to `over_rows`, as [`count_cells`](Self::count_cells) does, in the
+    /// same pass over the words. Natively on a CPU with a popcount instruction, compiled for
+    /// it (the baseline x86-64 target counts bits by shifts and adds).
+    fn voids_fast(
+        &self,
+        index: &EdgeIndex,
+        counts: &mut [u64; 3],
+        over_rows: &mut Vec<usize>,
+    ) -> Voids {
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("popcnt") {
+            // SAFETY: the CPU has the instruction, as the check above found.
+            return unsafe { self.voids_popcnt(index, counts, over_rows) };
+        }
+        self.voids_fast_with(index, counts, over_rows)
+    }
+
+    /// [`voids_fast_with`](Self::voids_fast_with) compiled with the popcount instruction.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "popcnt")]
+    fn voids_popcnt(
+        &self,
+        index: &EdgeIndex,
+        counts: &mut [u64; 3],
+        over_rows: &mut Vec<usize>,
+    ) -> Voids {
+        self.voids_fast_with(index, counts, over_rows)
+    }
+
+    #[inline(always)]
+    fn voids_fast_with(
+        &self,
+        index: &EdgeIndex,
+        counts: &mut [u64; 3],
+        over_rows: &mut Vec<usize>,
+    ) -> Voids {
+        // A label's cells, with the boundary flag in the top bit.
+        const TOP: u64 = 1 << 63;
         let g = self.grid;
         let tiles = &self.tiles;
         let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
@@ -851,25 +1012,25 @@ impl Raster {
             runs,
             bnd,
             parent,
-            accs,
-            buf,
-            edge,
-            up: up_buf,
-            down: down_buf,
-            at_boundary,
+            cells,
+            root,
+            around,
         } = &mut *scratch;
         // (row, start, end, label)
         runs.clear();
-        accs.clear();
-        let mut labels = UnionFind {
-            parent: std::mem::take(parent),
+        bnd.clear();
+        cells.clear();
+        parent.clear();
+        let find = |parent: &mut Vec<u32>, mut i: usize| {
+            while parent[i] as usize != i {
+                let p = parent[i] as usize;
+                parent[i] = parent[p];
+                i = p;
+            }
+            i
         };
-        labels.parent.clear();
         let mut prev = 0..0;
         let mut next_k = 0;
-        let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
-        edge.clear();
-        edge.resize(widest, 0);
         for (bi, band) in tiles.bands().iter().enumerate() {
             for k in band.first_row..band.end_row {
                 if k != next_k {
@@ -877,82 +1038,97 @@ impl Raster {
                 }
                 next_k = k + 1;
                 let row = tiles.row_in(bi, k);
-                buf.clear();
-                self.runs(&row, |r, d| r & !d, buf);
-                if buf.is_empty() {
-                    prev = runs.len()..runs.len();
-                    continue;
-                }
-                self.edge_row(&row, k, edge, up_buf, down_buf);
                 let first = runs.len();
-                bnd.clear();
-                let mut seg = 0;
-                for &(s, e) in buf.iter() {
-                    while row.segs[seg].c1 * 64 <= s as usize {
-                        seg += 1;
-                    }
-                    let shift = 64 * row.segs[seg].shift();
-                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
-                    bnd.push(if c1 - c0 < 64 {
-                        window(edge, c0, c1) != 0
-                    } else {
-                        count_range(edge, c0, c1) > 0
-                    });
-                    runs.push((k as u32, s, e, NONE));
+                if self.void_runs(&row, k, runs, bnd, around, counts) {
+                    over_rows.push(k);
+                }
+                if runs.len() == first {
+                    prev = first..first;
+                    continue;
                 }
                 let (mut i, mut j) = (prev.start, first);
                 while i < prev.end && j < runs.len() {
                     let (_, s1, e1, l1) = runs[i];
                     let (_, s2, e2, l2) = runs[j];
                     let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
-                    if joined && l2 != NONE {
+                    // One branch, taken rarely (`joined &&` would branch on `joined`, which
+                    // is as often true as not).
+                    if joined & (l2 != NO_LABEL) {
                         // A second run above: rare.
-                        let (a, b) = (labels.find(l1 as usize), labels.find(l2 as usize));
+                        let (a, b) = (find(parent, l1 as usize), find(parent, l2 as usize));
                         if a != b {
                             // The earlier label stays the root: roots in order of their
                             // component's first run, as the reference numbers them.
                             let (lo, hi) = (a.min(b), a.max(b));
-                            labels.parent[hi] = lo as u32;
-                            let h = accs[hi];
-                            accs[lo].merge(&h);
+                            parent[hi] = lo as u32;
+                            let h = cells[hi];
+                            cells[lo] = (cells[lo] + (h & !TOP)) | (h & TOP);
                         }
                     }
                     // Without branches on the data: the first run above gives its label.
-                    runs[j].3 = if joined && l2 == NONE { l1 } else { l2 };
+                    runs[j].3 = if joined && l2 == NO_LABEL { l1 } else { l2 };
                     let step = (e1 < e2) as usize;
                     i += step;
                     j += 1 - step;
                 }
-                for (run, &b) in runs[first..].iter_mut().zip(bnd.iter()) {
-                    let l = if run.3 == NONE {
-                        labels.parent.push(accs.len() as u32);
-                        accs.push(Acc::default());
-                        accs.len() - 1
+                for (run, &b) in runs[first..].iter_mut().zip(&bnd[first..]) {
+                    let l = if run.3 == NO_LABEL {
+                        parent.push(cells.len() as u32);
+                        cells.push(0);
+                        cells.len() - 1
                     } else {
-                        labels.find(run.3 as usize)
+                        find(parent, run.3 as usize)
                     };
                     run.3 = l as u32;
-                    accs[l].add(run.0, run.1, run.2, b);
+                    cells[l] = (cells[l] + (run.2 - run.1) as u64) | ((b as u64) << 63);
                 }
                 prev = first..runs.len();
             }
         }
-        // Each label's component: whether it reaches the boundary.
-        at_boundary.clear();
-        for l in 0..accs.len() {
-            let b = accs[labels.find(l)].boundary;
-            at_boundary.push(b);
-        }
-        let mut dev_in = Deviation::default();
-        for &(k, s, e, l) in runs.iter() {
-            if at_boundary[l as usize] {
-                probe(&g, index, &mut dev_in, k as usize, s, e);
+        // Each label's root (a label's parent precedes it), the voids and the largest: the
+        // first of the largest roots, in label order, as `Voids::of` takes them.
+        let cell = g.gx * g.gy;
+        root.clear();
+        let (mut count, mut enclosed) = (0, 0u64);
+        let mut largest: Option<(usize, f64)> = None;
+        for l in 0..cells.len() {
+            let p = parent[l] as usize;
+            if p != l {
+                let r = root[p];
+                root.push(r);
+                continue;
+            }
+            root.push(l as u32);
+            count += 1;
+            let c = cells[l];
+            if c & TOP == 0 {
+                enclosed += c;
+            }
+            let area = (c & !TOP) as f64 * cell;
+            if largest.is_none_or(|(_, a)| area > a) {
+                largest = Some((l, area));
             }
         }
-        let roots = (0..accs.len()).filter(|&l| labels.parent[l] as usize == l);
-        let v = Voids::of(&g, roots.map(|l| &accs[l]), dev_in);
-        *parent = labels.parent;
-        v
+        // Inward deviation (runs of voids that reach the boundary) and the largest's sums.
+        let mut dev_in = Deviation::default();
+        let mut acc = Acc::default();
+        let big = largest.map_or(u32::MAX, |(l, _)| l as u32);
+        for &(k, s, e, l) in runs.iter() {
+            let r = root[l as usize];
+            if cells[r as usize] & TOP != 0 {
+                probe(&g, index, &mut dev_in, k as usize, s, e);
+            }
+            if r == big {
+                acc.add(k, s, e, false);
+            }
+        }
+        acc.boundary = largest.is_some_and(|(l, _)| cells[l] & TOP != 0);
+        Voids {
+            count,
+            enclosed,
+            largest: largest.map(|_| acc.void(&g)),
+            dev_in,
+        }
     }
 
     /// A [`CoverageMask`] with square cells of about `cell` mm, in tiles over the raster's.
@@ -1331,13 +1507,25 @@ impl Acc {
         self.boundary |= boundary;
     }
 
-    fn merge(&mut self, o: &Acc) {
-        self.cells += o.cells;
-        self.sx2 += o.sx2;
-        self.sy += o.sy;
-        self.min = [self.min[0].min(o.min[0]), self.min[1].min(o.min[1])];
-        self.max = [self.max[0].max(o.max[0]), self.max[1].max(o.max[1])];
-        self.boundary |= o.boundary;
+    /// The void these sums describe.
+    fn void(&self, g: &Grid) -> Void {
+        let n = self.cells as f64;
+        Void {
+            area: self.cells as f64 * (g.gx * g.gy),
+            centroid: DVec2::new(
+                g.x0 + (self.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
+                g.y0 + (self.sy as f64 / n + 0.5) * g.gy,
+            ),
+            min: DVec2::new(
+                g.x0 + self.min[0] as f64 * g.gx,
+                g.y0 + self.min[1] as f64 * g.gy,
+            ),
+            max: DVec2::new(
+                g.x0 + self.max[0] as f64 * g.gx,
+                g.y0 + self.max[1] as f64 * g.gy,
+            ),
+            at_boundary: self.boundary,
+        }
     }
 }
 
@@ -1362,17 +1550,7 @@ impl Voids {
             }
             let area = a.cells as f64 * cell;
             if largest.is_none_or(|l| area > l.area) {
-                let n = a.cells as f64;
-                largest = Some(Void {
-                    area,
-                    centroid: DVec2::new(
-                        g.x0 + (a.sx2 as f64 / (2.0 * n) + 0.5) * g.gx,
-                        g.y0 + (a.sy as f64 / n + 0.5) * g.gy,
-                    ),
-                    min: DVec2::new(g.x0 + a.min[0] as f64 * g.gx, g.y0 + a.min[1] as f64 * g.gy),
-                    max: DVec2::new(g.x0 + a.max[0] as f64 * g.gx, g.y0 + a.max[1] as f64 * g.gy),
-                    at_boundary: a.boundary,
-                });
+                largest = Some(a.void(g));
             }
         }
         Voids {
