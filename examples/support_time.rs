@@ -84,9 +84,9 @@ fn main() {
     let t = Instant::now();
     let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
     let (_extra, pass) = dropslice::support_droplets::complete(
-        &|i, out: &mut Vec<dropslice::support_droplets::Droplet>| {
-            dropslice::support_droplets::droplets_of(&parts[i].moves, b, b1, out);
-            dropslice::support_droplets::droplets_of(&hatch[i], b, b1, out);
+        &|i, within, out: &mut Vec<dropslice::support_droplets::Droplet>| {
+            dropslice::support_droplets::droplets_of(&parts[i].moves, b, b1, within, out);
+            dropslice::support_droplets::droplets_of(&hatch[i], b, b1, within, out);
         },
         &regions,
         &s,

@@ -467,9 +467,9 @@ impl Job {
             // them (no list of all droplets is kept).
             let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
             let (extra, figures) = support_droplets::complete(
-                &|i, out: &mut Vec<support_droplets::Droplet>| {
-                    support_droplets::droplets_of(&planned[i].0.moves, b, b1, out);
-                    support_droplets::droplets_of(&planned[i].2, b, b1, out);
+                &|i, within, out: &mut Vec<support_droplets::Droplet>| {
+                    support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
+                    support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
                 },
                 &regions,
                 s,

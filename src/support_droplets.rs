@@ -17,6 +17,12 @@ use std::collections::HashMap;
 /// A droplet centre and its width (B or B₁).
 pub type Droplet = (Point, f64);
 
+/// An axis-aligned box: its least and greatest corners.
+pub type Bounds = (Point, Point);
+
+/// `f(i, within, out)` appends layer i's droplets (in the box `within` if given) to `out`.
+pub type LayerDroplets<'a> = &'a (dyn Fn(usize, Option<Bounds>, &mut Vec<Droplet>) + Sync);
+
 /// Centres kept this much inside the rule's distance, so rounding the written positions
 /// cannot break it (positions are rounded to 0.05 µm).
 const MARGIN_MM: f64 = 1e-3;
@@ -154,15 +160,34 @@ fn floor(x: f64) -> i64 {
 }
 
 /// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
-/// order they are set.
-pub fn droplets_of(moves: &[Move], b: f64, b1: f64, out: &mut Vec<Droplet>) {
+/// order they are set; with `within = Some((lo, hi))` only those in that box (a line whose
+/// box misses it is not walked).
+pub fn droplets_of(
+    moves: &[Move],
+    b: f64,
+    b1: f64,
+    within: Option<Bounds>,
+    out: &mut Vec<Droplet>,
+) {
     let mut at = Point::ZERO;
+    let inside = |p: Point| within.is_none_or(|(lo, hi)| p.cmpge(lo).all() && p.cmple(hi).all());
     for m in moves {
         let w = if m.unit == 1 { b1 } else { b };
         match m.kind {
-            MoveKind::Droplet => out.push((m.to, w)),
-            MoveKind::Line => out.extend(crate::geom::line_droplets(at, m.to, w).map(|p| (p, w))),
-            MoveKind::Travel => {}
+            MoveKind::Droplet if inside(m.to) => out.push((m.to, w)),
+            MoveKind::Line => {
+                let meets = within.is_none_or(|(lo, hi)| {
+                    at.min(m.to).cmple(hi).all() && at.max(m.to).cmpge(lo).all()
+                });
+                if meets {
+                    out.extend(
+                        crate::geom::line_droplets(at, m.to, w)
+                            .filter(|&p| inside(p))
+                            .map(|p| (p, w)),
+                    );
+                }
+            }
+            _ => {}
         }
         at = m.to;
     }
@@ -442,14 +467,15 @@ pub struct PassFigures {
 }
 
 /// The unit-1 droplets to add to each layer so that every droplet above the first layer is
-/// supported: `droplets(i, out)` appends layer i's planned droplets (both units) to `out`
+/// supported: `droplets(i, within, out)` appends layer i's planned droplets (both units; in
+/// the box `within` if given, [`droplets_of`]) to `out`
 /// (about once per layer, in runs of layers on all cores; again for a layer under added
 /// droplets), so that no layer's droplets need be kept; `regions[i]` is its part's region. Works top-down; an added droplet needs support from the layer below as
 /// any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
 /// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
 /// support deliberately stops below overhangs, and the pass adds nothing.
 pub fn complete(
-    droplets: &(dyn Fn(usize, &mut Vec<Droplet>) + Sync),
+    droplets: LayerDroplets,
     regions: &[Shapes],
     s: &Settings,
 ) -> (Vec<Vec<Point>>, PassFigures) {
@@ -471,12 +497,12 @@ pub fn complete(
     let runs = crate::support::par_map((n - 1).div_ceil(RUN), &|r| {
         let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
         let mut buf = Vec::new();
-        droplets(first - 1, &mut buf);
+        droplets(first - 1, None, &mut buf);
         let mut below = Grid::new(cell, &buf);
         let mut out = Vec::with_capacity(end - first);
         for i in first..end {
             buf.clear();
-            droplets(i, &mut buf);
+            droplets(i, None, &mut buf);
             // Consecutive droplets are neighbours: the droplet below that supported the last
             // one most often supports the next.
             let mut last: Option<Droplet> = None;
@@ -511,10 +537,17 @@ pub fn complete(
         let mut todo: Vec<Droplet> = open[i].clone();
         if !extra[i].is_empty() {
             // The droplets added to layer i against layer i − 1's planned droplets: few, so
-            // the layer's droplets are scanned once (a grid only for many).
-            buf.clear();
-            droplets(i - 1, &mut buf);
+            // only that layer's droplets within reach of their box are listed, and scanned
+            // once (a grid only for many).
             let adds: Vec<Droplet> = extra[i].iter().map(|&p| (p, b1)).collect();
+            let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+            for (p, _) in &adds {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+            let (lo, hi) = (lo - DVec2::splat(cell), hi + DVec2::splat(cell));
+            buf.clear();
+            droplets(i - 1, Some((lo, hi)), &mut buf);
             let mut held = vec![false; adds.len()];
             if adds.len() > 16 {
                 let below = Grid::new(cell, &buf);
@@ -522,16 +555,7 @@ pub fn complete(
                     *h = below.any_within(p, reach);
                 }
             } else {
-                let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-                for (p, _) in &adds {
-                    lo = lo.min(*p);
-                    hi = hi.max(*p);
-                }
-                let (lo, hi) = (lo - DVec2::splat(cell), hi + DVec2::splat(cell));
                 for &(q, w) in &buf {
-                    if q.x < lo.x || q.y < lo.y || q.x > hi.x || q.y > hi.y {
-                        continue;
-                    }
                     let r = reach(w);
                     for (h, &(p, _)) in held.iter_mut().zip(&adds) {
                         *h = *h || (p - q).length_squared() <= r * r;
@@ -549,7 +573,17 @@ pub fn complete(
             continue;
         }
         let region = &regions[i - 1];
-        let edges = edges_of(region);
+        // The gap is kept from the part's edges near the candidates only (within the rule's
+        // reach and the gap of the droplets to support).
+        let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+        for (p, _) in &todo {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let margin = DVec2::splat(place + gap.max(0.0) + MARGIN_MM);
+        let (lo, hi) = (lo - margin, hi + margin);
+        let mut edges = edges_of(region);
+        edges.retain(|&(a, e)| a.min(e).cmple(hi).all() && a.max(e).cmpge(lo).all());
         let clear = Clearance::new(&edges, gap, b);
         let mut added = Added {
             cell,
@@ -592,7 +626,11 @@ mod tests {
     ) -> (Vec<Vec<Point>>, PassFigures) {
         assert_eq!(droplets.len(), regions.len());
         complete(
-            &|i, out: &mut Vec<Droplet>| out.extend_from_slice(&droplets[i]),
+            &|i, within: Option<Bounds>, out: &mut Vec<Droplet>| {
+                out.extend(droplets[i].iter().filter(|(p, _)| {
+                    within.is_none_or(|(lo, hi)| p.cmpge(lo).all() && p.cmple(hi).all())
+                }))
+            },
             regions,
             s,
         )
