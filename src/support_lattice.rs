@@ -428,22 +428,8 @@ mod tests {
             col0: 0,
             cols: 130,
         };
-        let mut bits = Bits::new(&l);
-        bits.set(&vec![
-            (3, 0, 129),
-            (5, 63, 64),
-            (7, 127, 128),
-            (9, 129, 129),
-            (10, 0, 0),
-            (10, 2, 61),
-            (10, 64, 64),
-        ]);
-        let got: Vec<(i64, i64, i64)> = bits
-            .lines(&l)
-            .iter()
-            .map(|h| (h.a.y as i64, h.a.x as i64, h.b.x as i64))
-            .collect();
-        let want = vec![
+        // Runs at word edges, across them, to the box's last column, and three in one row.
+        let runs: Runs = vec![
             (3, 0, 129),
             (5, 63, 64),
             (7, 127, 128),
@@ -452,6 +438,18 @@ mod tests {
             (10, 2, 61),
             (10, 64, 64),
         ];
+        let mut bits = Bits::new(&l);
+        bits.set(&runs);
+        // Each comes back as one segment (the frame is the identity: y = row + ½, x = column).
+        let got: Vec<(i64, i64, i64)> = bits
+            .lines(&l)
+            .iter()
+            .map(|h| (h.a.y as i64, h.a.x as i64, h.b.x as i64))
+            .collect();
+        let want: Vec<(i64, i64, i64)> = runs
+            .iter()
+            .map(|&(r, k0, k1)| (r as i64, k0 as i64, k1 as i64))
+            .collect();
         assert_eq!(got, want);
         // Clearing part of a run splits it.
         bits.clear(&vec![(3, 60, 70)]);

@@ -157,14 +157,7 @@ fn random_layers_give_the_reference_figures() {
         seed ^= seed << 17;
         (seed >> 11) as f64 / (1u64 << 53) as f64
     };
-    let rect = |x: f64, y: f64, w: f64, h: f64| -> Vec<Point> {
-        vec![
-            [x, y].into(),
-            [x + w, y].into(),
-            [x + w, y + h].into(),
-            [x, y + h].into(),
-        ]
-    };
+    let rect = common::rect_loop;
     for case in 0..400 {
         let mut region: Shapes = Vec::new();
         let mut x = 0.0;

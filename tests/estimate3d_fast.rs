@@ -134,14 +134,7 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
                 // or cell edges, some in a lattice.
                 let (x0, y0) = (rng.next() * 2.0, rng.next() * 2.0);
                 let (w, h) = (0.2 + rng.next() * 3.0, 0.2 + rng.next() * 3.0);
-                let rect = |x0: f64, y0: f64, w: f64, h: f64| -> Vec<Point> {
-                    vec![
-                        [x0, y0].into(),
-                        [x0 + w, y0].into(),
-                        [x0 + w, y0 + h].into(),
-                        [x0, y0 + h].into(),
-                    ]
-                };
+                let rect = common::rect_loop;
                 let mut region: Shapes = vec![Shape::new(rect(x0, y0, w, h), vec![])];
                 match case % 3 {
                     1 => {

@@ -341,6 +341,24 @@ fn half_width_table(r: f64, gy: f64) -> (usize, Vec<f64>) {
     (rows, table)
 }
 
+/// The cells of word `w` of a row's region words `bits` (its segment starting at word `at`,
+/// ending before `end`) whose four neighbours (left, right, above in `up`, below in `down`)
+/// all lie in the region: a region cell not among them is an edge cell.
+#[inline(always)]
+fn interior(
+    bits: &[u64],
+    w: usize,
+    at: usize,
+    end: usize,
+    up: Option<&[u64]>,
+    down: Option<&[u64]>,
+) -> u64 {
+    let r = bits[w];
+    let left = (r << 1) | if w > at { bits[w - 1] >> 63 } else { 0 };
+    let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
+    left & right & up.map_or(0, |x| x[w]) & down.map_or(0, |x| x[w])
+}
+
 impl Raster {
     /// Rasterises a layer's region and droplets.
     pub fn new(plan: &LayerPlan, region: &Shapes, s: &Settings) -> Raster {
@@ -626,6 +644,24 @@ impl Raster {
         }
     }
 
+    /// The region words of the rows above and below row `k`, laid out as `row`'s slice
+    /// ([`region_row_as`](Self::region_row_as); `None` where there is no such row or it holds
+    /// nothing).
+    fn neighbour_rows<'a>(
+        &'a self,
+        row: &Row,
+        k: usize,
+        (up_buf, down_buf): (&'a mut Vec<u64>, &'a mut Vec<u64>),
+    ) -> (Option<&'a [u64]>, Option<&'a [u64]>) {
+        let up = (k + 1 < self.grid.ny)
+            .then(|| self.region_row_as(row, k + 1, up_buf))
+            .flatten();
+        let down = (k > 0)
+            .then(|| self.region_row_as(row, k - 1, down_buf))
+            .flatten();
+        (up, down)
+    }
+
     /// The region words of row `k` laid out as `row`'s slice (its own slice when both are in
     /// the same band, else copied into `buf`); `None` when row `k` holds nothing.
     fn region_row_as<'a>(
@@ -771,21 +807,11 @@ impl Raster {
     ) {
         let (lo, hi) = self.extent[row.slot];
         let bits = &self.region_bits[row.range()];
-        let up = (k + 1 < self.grid.ny)
-            .then(|| self.region_row_as(row, k + 1, up_buf))
-            .flatten();
-        let down = (k > 0)
-            .then(|| self.region_row_as(row, k - 1, down_buf))
-            .flatten();
+        let (up, down) = self.neighbour_rows(row, k, (up_buf, down_buf));
         for seg in row.segs {
             let end = seg.end();
             for w in seg.at.max(lo as usize)..end.min(hi as usize) {
-                let r = bits[w];
-                let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
-                let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
-                let u = up.map_or(0, |x| x[w]);
-                let d = down.map_or(0, |x| x[w]);
-                edge[w] = r & !(left & right & u & d);
+                edge[w] = bits[w] & !interior(bits, w, seg.at, end, up, down);
             }
         }
     }
@@ -891,12 +917,7 @@ impl Raster {
         let (lo, hi) = self.extent[row.slot];
         let range = row.range();
         let (bits, drops) = (&self.region_bits[range.clone()], &self.drop_bits[range]);
-        let up = (k + 1 < self.grid.ny)
-            .then(|| self.region_row_as(row, k + 1, up_buf))
-            .flatten();
-        let down = (k > 0)
-            .then(|| self.region_row_as(row, k - 1, down_buf))
-            .flatten();
+        let (up, down) = self.neighbour_rows(row, k, (up_buf, down_buf));
         let k = k as u32;
         for seg in row.segs {
             let end = seg.end();
@@ -924,11 +945,7 @@ impl Raster {
                     // No run here and none open (so no carry of the addition either).
                     continue;
                 }
-                let left = (r << 1) | if w > seg.at { bits[w - 1] >> 63 } else { 0 };
-                let right = (r >> 1) | if w + 1 < end { bits[w + 1] << 63 } else { 0 };
-                let u = up.map_or(0, |x| x[w]);
-                let d = down.map_or(0, |x| x[w]);
-                let edge = v & !(left & right & u & d);
+                let edge = v & !interior(bits, w, seg.at, end, up, down);
                 let (sum, c1) = v.overflowing_add(edge);
                 let (sum, c2) = sum.overflowing_add(touch as u64);
                 touch = c1 | c2;

@@ -685,3 +685,13 @@ pub fn deep_inside(segs: &[(Point, Point)], p: Point, d: f64) -> bool {
     }
     crossings % 2 == 1
 }
+
+/// The loop of the box [x, x + w] × [y, y + h], counter-clockwise.
+pub fn rect_loop(x: f64, y: f64, w: f64, h: f64) -> Vec<dropslice::geom::Point> {
+    vec![
+        [x, y].into(),
+        [x + w, y].into(),
+        [x + w, y + h].into(),
+        [x, y + h].into(),
+    ]
+}
