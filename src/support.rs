@@ -18,11 +18,14 @@
 //! `support_gap_z` layers directly above. The overhang is grown by B₁/2 before it is carried
 //! down so that the support reaches under the overhang's edge. The overhangs come from the one
 //! pass of [`crate::overhang::overhang_region`], their growth from the fast offset
-//! ([`grow_fast`]); only the union is sequential, and it hands the boolean engine only the
-//! shapes whose boxes meet ([`carried`]). Unit 1 hatches a support
-//! region directly ([`crate::plan::support_moves`]), leaving out the droplets within
-//! `support_gap_xy`·B of the part (no offset of the part); the droplet-level pass
-//! ([`crate::support_droplets`]) then adds droplets wherever the rule still fails.
+//! ([`grow_fast`]). The need is carried as bits on the lattices unit 1 hatches on
+//! ([`crate::support_lattice`]: union and clip by word operations, exact at every point a
+//! support droplet can take); for unusual hatch steps as outlines by a sequential union
+//! ([`support_regions`], which hands the boolean engine only the shapes whose boxes meet,
+//! [`carried`]). Unit 1 prints each layer's support hatch segments
+//! ([`crate::plan::support_moves`]), leaving out the droplets within `support_gap_xy`·B of the
+//! part (no offset of the part); the droplet-level pass ([`crate::support_droplets`]) then
+//! adds droplets wherever the rule still fails.
 //! `tests/support.rs` checks the rule on the printed droplets.
 
 use crate::geom::{
