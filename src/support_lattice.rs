@@ -290,9 +290,9 @@ impl Bits {
 
     /// Whether no point is set.
     pub fn is_empty(&self) -> bool {
-        self.data[self.lo.min(self.data.len())..]
-            .iter()
-            .all(|&w| w == 0)
+        // Rows before `lo` hold nothing.
+        let first = self.lo.saturating_mul(self.words).min(self.data.len());
+        self.data[first..].iter().all(|&w| w == 0)
     }
 }
 
