@@ -11,6 +11,16 @@ use dropslice::{Job, Settings};
 mod cpu;
 use cpu::cpu;
 
+/// [`slab_voids`] or [`slab_voids_reference`].
+type SlabFn = fn(
+    &dropslice::geom::Shapes,
+    &Grid3,
+    Option<&HeightMap>,
+    &HeightMap,
+    Option<&HeightMap>,
+    &Settings,
+) -> (f64, f64);
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let path = args.get(1).expect("model path");
@@ -63,23 +73,20 @@ fn main() {
             .map(|(_, c)| HeightMap::reference(c, &grid, d))
             .collect();
         best[1] = best[1].min(cpu() - t);
+        // Every layer's slab between its real neighbours, by `slab` on `maps`.
+        let slabs = |maps: &[HeightMap], slab: SlabFn| -> Vec<(f64, f64)> {
+            (0..layers.len())
+                .map(|i| {
+                    let (lo, hi) = (i.checked_sub(1).map(|j| &maps[j]), maps.get(i + 1));
+                    slab(&layers[i].0, &grid, lo, &maps[i], hi, &s)
+                })
+                .collect()
+        };
         let t = cpu();
-        figures.0 = (0..layers.len())
-            .map(|i| {
-                let m = &fast_maps;
-                let (lo, hi) = (i.checked_sub(1).map(|j| &m[j]), m.get(i + 1));
-                slab_voids(&layers[i].0, &grid, lo, &m[i], hi, &s)
-            })
-            .collect::<Vec<_>>();
+        figures.0 = slabs(&fast_maps, slab_voids);
         best[2] = best[2].min(cpu() - t);
         let t = cpu();
-        figures.1 = (0..layers.len())
-            .map(|i| {
-                let m = &ref_maps;
-                let (lo, hi) = (i.checked_sub(1).map(|j| &m[j]), m.get(i + 1));
-                slab_voids_reference(&layers[i].0, &grid, lo, &m[i], hi, &s)
-            })
-            .collect::<Vec<_>>();
+        figures.1 = slabs(&ref_maps, slab_voids_reference);
         best[3] = best[3].min(cpu() - t);
     }
     let same_figures = figures

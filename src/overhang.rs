@@ -32,12 +32,16 @@ const MIN_AREA_MM2: f64 = 1e-6;
 /// The overhang area of a layer, mm²: the area of [`crate::support::overhang`] (`region`: the
 /// layer's region; `below`: the layer below's, `None` on layer 1), up to floating-point noise.
 pub fn overhang_area(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> f64 {
-    let shapes = overhang_region(region, below, s);
-    // +0.0 for none (a sum of no loops' areas starts at −0.0).
+    overhang_figure(&overhang_region(region, below, s))
+}
+
+/// The overhang area of a layer's overhang shapes ([`overhang_region`]), mm²: +0.0 for none
+/// (a sum of no loops' areas starts at −0.0). The support pass reports the same figure.
+pub fn overhang_figure(shapes: &Shapes) -> f64 {
     if shapes.is_empty() {
         0.0
     } else {
-        region_area(&shapes)
+        region_area(shapes)
     }
 }
 

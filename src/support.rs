@@ -34,6 +34,7 @@ use crate::geom::{
 use crate::grid::EdgeIndex;
 use crate::hatch::{HatchLine, hatch_at};
 use crate::offset::{CHORD_TOLERANCE_MM, Corners, raw_offset};
+use crate::overhang::overhang_figure;
 use crate::settings::Settings;
 use crate::support_lattice::{Bits, Lattices, Runs};
 use i_overlay::core::fill_rule::FillRule;
@@ -414,11 +415,11 @@ pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
     if s1.fill_density.is_nan() || s1.fill_density <= 0.0 {
         // No support hatch: the overhang areas only.
         return par_map(regions.len(), &|i| LayerSupport {
-            unsupported_area: region_area(&crate::overhang::overhang_region(
+            unsupported_area: crate::overhang::overhang_area(
                 &regions[i],
                 i.checked_sub(1).map(|j| &regions[j]),
                 s,
-            )),
+            ),
             lines: Vec::new(),
         });
     }
@@ -469,7 +470,7 @@ fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<Layer
             );
             let grown = grow_fast(&o, reach, SUPPORT_TOLERANCE_MM);
             let on = |r: &Shapes| -> Vec<Runs> { lat.lattices.iter().map(|l| l.runs(r)).collect() };
-            (region_area(&o), on(&grown), on(&regions[i]))
+            (overhang_figure(&o), on(&grown), on(&regions[i]))
         });
         for (k, (area, grown, part)) in block.into_iter().enumerate().rev() {
             let i = bottom + k;
@@ -536,7 +537,11 @@ pub fn support_regions(regions: &[Shapes], s: &Settings) -> Vec<(f64, Shapes)> {
             region
         })
     };
-    overhangs.iter().map(region_area).zip(supports).collect()
+    overhangs
+        .iter()
+        .map(overhang_figure)
+        .zip(supports)
+        .collect()
 }
 
 /// `f(0..n)` on all cores (natively), in index order of the result.

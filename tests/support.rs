@@ -208,23 +208,24 @@ fn support_stays_out_of_the_part() {
     }
 }
 
-/// The report's unsupported areas of a model (per layer, total).
-fn report_areas(name: &str) -> (Vec<f64>, f64) {
+/// The report's unsupported areas of a model (per layer, total), with settings `sets`.
+fn report_areas_with(name: &str, sets: &[&str]) -> (Vec<f64>, f64) {
     let dir = TempDir::new("support-report");
     let out = dir.join("out.gco");
     let rep = dir.join("report.json");
-    let r = run_cli(
-        &[
-            model(name).display().to_string(),
-            "-q".into(),
-            "-o".into(),
-            out.display().to_string(),
-            "--report".into(),
-            rep.display().to_string(),
-        ],
-        dir.path(),
-        Duration::from_secs(300),
-    );
+    let mut args = vec![
+        model(name).display().to_string(),
+        "-q".into(),
+        "-o".into(),
+        out.display().to_string(),
+        "--report".into(),
+        rep.display().to_string(),
+    ];
+    for set in sets {
+        args.push("--set".into());
+        args.push(set.to_string());
+    }
+    let r = run_cli(&args, dir.path(), Duration::from_secs(300));
     assert_eq!(r.code, Some(0), "{r:?}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
@@ -235,6 +236,33 @@ fn report_areas(name: &str) -> (Vec<f64>, f64) {
         .map(|l| l["unsupported_area"].as_f64().unwrap())
         .collect();
     (per_layer, v["part"]["unsupported_area"].as_f64().unwrap())
+}
+
+fn report_areas(name: &str) -> (Vec<f64>, f64) {
+    report_areas_with(name, &[])
+}
+
+#[test]
+fn the_report_gives_the_same_unsupported_area_with_support_on_and_off() {
+    // SPEC.md: the unsupported area is reported whether or not support is on; a layer
+    // without overhang reports 0 either way (not −0).
+    for name in ["U_overhang.obj", "bridge.obj"] {
+        let (off, off_total) = report_areas(name);
+        let (on, on_total) = report_areas_with(name, &["support=unit1"]);
+        assert_eq!(off.len(), on.len(), "{name}");
+        for (i, (a, b)) in off.iter().zip(&on).enumerate() {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "{name} layer {i}: {a} off, {b} on"
+            );
+        }
+        assert!(
+            off.iter().any(|&a| a == 0.0) && off.iter().any(|&a| a > 1.0),
+            "{name}"
+        );
+        assert_eq!(off_total.to_bits(), on_total.to_bits(), "{name}");
+    }
 }
 
 #[test]
