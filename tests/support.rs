@@ -257,10 +257,7 @@ fn the_report_gives_the_same_unsupported_area_with_support_on_and_off() {
                 "{name} layer {i}: {a} off, {b} on"
             );
         }
-        assert!(
-            off.iter().any(|&a| a == 0.0) && off.iter().any(|&a| a > 1.0),
-            "{name}"
-        );
+        assert!(off.contains(&0.0) && off.iter().any(|&a| a > 1.0), "{name}");
         assert_eq!(off_total.to_bits(), on_total.to_bits(), "{name}");
     }
 }
