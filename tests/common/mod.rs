@@ -221,15 +221,29 @@ pub fn unit_droplets(layer: &Layer, at: &mut Point, b: [f64; 2]) -> Vec<(Point, 
     out
 }
 
+/// The Python that runs the oracle: `ORACLE_PYTHON`, else the project's virtual environment
+/// with numpy and shapely (`target/pyenv`, made by `scripts/setup.sh`), else `python3`.
+pub fn oracle_python() -> PathBuf {
+    if let Some(p) = std::env::var_os("ORACLE_PYTHON") {
+        return PathBuf::from(p);
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/pyenv/bin/python3");
+    if venv.exists() {
+        return venv;
+    }
+    PathBuf::from("python3")
+}
+
 /// The independent oracle's cross-sections (`../shared/tools/oracle_sections.py`) of an STL
 /// at layer height `h`, as its JSON.
 pub fn oracle_sections(stl: &Path, h: f64) -> serde_json::Value {
-    let out = Command::new("python3")
+    let python = oracle_python();
+    let out = Command::new(&python)
         .arg(shared_dir().join("tools/oracle_sections.py"))
         .arg(stl)
         .arg(h.to_string())
         .output()
-        .expect("python3 runs the oracle");
+        .unwrap_or_else(|e| panic!("{} runs the oracle: {e}", python.display()));
     assert!(
         out.status.success(),
         "oracle: {}",
