@@ -3,6 +3,9 @@
 //! `cargo run --release --example analysis_agreement -- STEP MODEL.stl... [--stagger]`.
 //! Prints a Markdown table: coverage, void share, enclosed void share (of the region area),
 //! largest void and boundary deviation, fast / reference, and the largest difference.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::analysis::{LayerAnalysis, Raster};
 use dropslice::{Job, Settings};
 

@@ -7,6 +7,9 @@
 //! per layer, REF_FIRST=1 the reference labelling before the fast one (the first after
 //! rasterising pays for the raster's memory), FAST_ONLY=1 no reference paths (for perf),
 //! REPEAT=n the fast analysis n times per layer, the fastest (wall time) of each layer counted.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
 

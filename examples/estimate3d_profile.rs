@@ -4,6 +4,9 @@
 //! Every layer's region and droplet centres are made first (not timed); then each stage runs
 //! over all layers N times (default 5), alternating fast and reference, and the best run is
 //! printed. Times are seconds the thread ran on a CPU (Linux: /proc/thread-self/schedstat).
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::analysis::*;
 use dropslice::{Job, Settings};
 

@@ -1,5 +1,8 @@
 //! Finds offset loop vertices closer to the section boundary than the loop's offset:
 //! `cargo run --release --example offset_debug -- MODEL.stl LAYER`.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::geom::segment_distance as seg_dist;
 
 fn main() {

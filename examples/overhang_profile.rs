@@ -2,6 +2,9 @@
 //! construction (`support::overhang_reference`: outline of the layer below, two differences)
 //! and its parts, the fast one (`support::overhang`), and their largest per-layer difference
 //! at the same chord tolerance. `cargo run --release --example overhang_profile MODEL`.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::{Job, Settings, geom, support};
 use std::time::Instant;
 fn best(mut f: impl FnMut() -> f64) -> (f64, f64) {

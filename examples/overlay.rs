@@ -4,6 +4,9 @@
 //! whole layer; pixels of B/10, each drawn N × N; `--below` marks the droplet centres of the
 //! layer below with dark dots).
 //! The PNG is written with stored (uncompressed) deflate blocks: no dependency needed.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::analysis::analyse_layer_with_mask;
 use dropslice::{Job, Settings};
 

@@ -1,5 +1,8 @@
 //! Time of `Job::new` (import, shells, checks, repair, facet index) on a model, median of 7.
 //! Usage: cargo run --release --example prepare_time -- MODEL.stl
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::{Job, Settings};
 use std::time::Instant;
 

@@ -1,5 +1,8 @@
 //! Coverage and void figures with stagger off and on, and the analysis time against slicing:
 //! `cargo run --release --example quality -- MODEL.stl...` (the figures of docs/quality.md).
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::analysis::JobAnalysis;
 use dropslice::{Job, Settings, write_gcode, write_gcode_with};
 use std::time::Instant;

@@ -4,6 +4,9 @@
 //! (tests/common/seams.rs: `exact` loops end at their repeated first droplet, `even` loops are
 //! found on the layer's contour paths and their arc gaps measured along them); the void
 //! fraction is `--report`'s.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 #[path = "../tests/common/seams.rs"]
 mod seams;
 

@@ -1,4 +1,7 @@
 //! Prints the section statistics of chosen layers: `cargo run --release --example section_debug -- MODEL.stl 18 19`.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let bytes = std::fs::read(&args[0]).expect("read model");

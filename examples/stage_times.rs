@@ -1,4 +1,7 @@
 //! Prints how long each stage takes on a model: `cargo run --release --example stage_times -- MODEL.stl`.
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use std::time::Instant;
 fn main() {
     let path = std::env::args().nth(1).expect("model path");

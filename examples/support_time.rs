@@ -2,6 +2,9 @@
 //! `cargo run --release --example support_time -- MODEL.stl`; `AREAS=1` also prints the
 //! overhang and support areas of some layers; `REGIONS_ONLY=1` stops after the support
 //! regions (for a profiler).
+// Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
+#![cfg_attr(target_arch = "wasm32", no_main)]
+#![cfg(not(target_arch = "wasm32"))]
 use dropslice::geom::{Shapes, region_area};
 use dropslice::overhang::overhang_region;
 use dropslice::support::{self, par_map};

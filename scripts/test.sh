@@ -7,6 +7,10 @@ step() { echo; echo "=== $* ($(date +%T))" >&2; }
 
 step setup
 bash scripts/setup.sh
+export PATH="$HOME/.cargo/bin:$PATH"
+
+step "every tool and package the tests call is present"
+bash scripts/check_tools.sh
 
 step "cargo fmt --check"
 cargo fmt --check
@@ -18,9 +22,8 @@ cargo clippy --target wasm32-unknown-unknown --lib --test wasm_session -- -D war
 step "cargo test --release (native)"
 cargo test --release
 
-step "wasm facade tests (Node, wasm-bindgen-test-runner)"
-CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner \
-  cargo test --release --target wasm32-unknown-unknown --test wasm_session
+step "wasm facade tests (wasm-pack test --node --release)"
+wasm-pack test --node --release
 
 step "build the page"
 bash scripts/build.sh

@@ -528,6 +528,13 @@ mod tests {
         let mut cache = None;
         assert_eq!(t.spot_cached(&mut cache, 20, 5, 9).unwrap().shift, 4);
         assert!(cache.is_some() && t.spot_cached(&mut cache, 20, 5, 20).is_none());
+    }
+
+    /// Grids wider than 2³² cells: natively only (usize has 64 bits there).
+    #[cfg(target_pointer_width = "64")]
+    #[test]
+    fn wide_grids() {
+        let mut t = Tiles::default();
         // Nothing marked, nothing stored.
         t.reset(1 << 40, 1 << 40, 64, 256);
         assert_eq!(t.build(), 0);

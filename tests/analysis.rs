@@ -1,5 +1,6 @@
 //! The coverage analysis against exact cases (disc area, square lattice, scallops along an
 //! edge, overfill across an edge) and the staggering of loops and hatch lines.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

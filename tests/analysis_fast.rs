@@ -4,6 +4,7 @@
 //! of the one-pass labelling against the run-per-node labelling, equal (the 0.1 % the
 //! analysis may differ by is not needed); the page's mask (no covered shares) and one raster
 //! reused from layer to layer against new ones.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -2,6 +2,7 @@
 //! two 1 mm cubes 1 m apart once took 4.5 GB (its raster spanned the layer's bounding box) and
 //! 3 m apart it could not allocate at all; the page's coverage mask was a dense grid over the
 //! same box. Now rasters, spheroid maps and masks are stored in tiles near the parts only.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -3,6 +3,7 @@
 //! `dropslice: ` line on stderr naming the problem (warnings aside), and leave no output file
 //! behind — an existing output file stays untouched. `Job::new` must return `Err` on each bad
 //! file, never panic.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

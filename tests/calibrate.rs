@@ -2,6 +2,7 @@
 //! of known droplet count and a mass chosen for a known droplet volume give back exactly that
 //! volume, its filling degree and the aspect whose B²H cell holds it; every refusal exits 2
 //! with a message that says what to check.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -5,6 +5,7 @@
 //! existing `OUT.partial` link is never followed, and a directory given as the output is
 //! refused before slicing. Each case runs with the unnamed temporary file (the default) and
 //! with the named one (`DROPSLICE_NAMED_TEMP=1`).
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

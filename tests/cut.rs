@@ -1,6 +1,7 @@
 //! The vertical cut's voids (src/analysis/cut.rs) against an independent computation: points
 //! sampled along the line at each band's height, tested against every spheroid in 3D and the
 //! region by a winding number of their own.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! Real-world damage: copies of closed shared models with facets removed, flipped or
 //! duplicated, vertices jittered, or the whole mesh turned inside out still slice into
 //! closed sections whose areas stay within 2 % of the undamaged part's.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 use dropslice::{Job, Settings};
 use std::path::PathBuf;

@@ -4,6 +4,7 @@
 //! off and on, both footprints) and on random droplets and regions (droplets on cell centres
 //! and edges, far apart, missing neighbours). And the slabs the slicing workers compute give
 //! the report the writing thread gave when it computed them in order.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -9,6 +9,7 @@
 //! (`DROPSLICE_FUZZ_SECONDS`, default 25): on a slow machine it does fewer cases, never more
 //! time. The case count is printed. A failing case is written to the temp folder with its
 //! seed and settings so it can be replayed.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

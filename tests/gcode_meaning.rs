@@ -3,6 +3,7 @@
 //! droplet totals equal to the commands' count, every droplet inside the part, loop droplets
 //! exactly B apart and closed, loops at (outer_offset + k)·B from the boundary — and that
 //! settings take effect.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

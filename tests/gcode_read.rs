@@ -1,5 +1,6 @@
 //! The `.gco` reader on files the slicer wrote: the same droplets, in the same order, as the
 //! plan (and its preview), layer by layer, and the same counts.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

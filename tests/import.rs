@@ -2,6 +2,7 @@
 //! with expectations computed independently (Python: the OBJ lines and the 3MF XML read
 //! with zipfile + ElementTree, numpy for bounds and volumes — see the constants), the 3MF
 //! Consortium's conformance files, and crafted hostile files (bombs, cycles, deep nesting).
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

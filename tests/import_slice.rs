@@ -3,6 +3,7 @@
 //! 10 × 20 × 30 mm box, so every section is exactly 200 mm²; the quad OBJ of the extruder idler
 //! has the bounds of its STL twin; cube_gears.3mf's build measures 167.996 × 125.102 × 33.601 mm
 //! (read from its XML with Python's zipfile and ElementTree).
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

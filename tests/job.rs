@@ -1,6 +1,7 @@
 //! Build jobs (src/job.rs, `Job::from_models`): the job file, the arrangement, the instance
 //! transforms against the independent oracle (`../shared/tools/oracle_sections.py`), lay_flat,
 //! the display mesh and the CLI.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -5,6 +5,7 @@
 //! Tolerance: 0.5 % or 0.05 mm², whichever is larger. Counts: the union's, except on layers
 //! with pinch points (see `compare`). Layers whose plane contains horizontal
 //! faces are ambiguous (the oracle flags them, `near_plane_faces`) and skipped.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 use dropslice::{Job, Settings};
 use serde_json::Value;

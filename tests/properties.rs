@@ -2,6 +2,7 @@
 //! the result. Rotating a part about z (`rotate_z`), or shuffling its facets (and cycling each
 //! facet's corners, which keeps its orientation), leaves every layer's region area unchanged
 //! (±0.1 %) and the droplet count nearly so (±1 %).
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

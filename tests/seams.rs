@@ -5,6 +5,7 @@
 //! `exact` (the default) a share of seams is closer than B/4, as SPEC.md measured. Fill is the
 //! same in both, and so are the part's coverage and void fraction (within a small tolerance)
 //! and the section areas against the oracle. Loops are found as tests/common/seams.rs says.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 #[path = "common/seams.rs"]

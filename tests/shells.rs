@@ -4,6 +4,7 @@
 //! the independent oracle's areas of a shared model (tests/fixtures/oracle), never
 //! dropslice's own output. Also the droplet limit, which shells of opposite orientation must
 //! not be able to cancel.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! One summary, however it is assembled: per-unit summaries merged in any order give the same
 //! figures as one summary over all layers, and the CLI prints the library's figures.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

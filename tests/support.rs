@@ -8,6 +8,7 @@
 //! * the part's own (unit-0) commands are exactly those of the slice without support;
 //! * `T` lines only where the unit changes; none, and no unit-1 settings, with support off;
 //! * the report's unsupported area: large on 3DBenchy's cabin roof, none on a cube.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

@@ -9,6 +9,7 @@
 //!   boxes in a row, units 0, 1, 0: the regions are known exactly);
 //! * `T` lines only where the unit changes, unit 0 first within a layer, the unit-1 settings
 //!   in the header.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 
