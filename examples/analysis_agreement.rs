@@ -59,7 +59,7 @@ fn main() {
         let mut n = 0;
         for i in (0..job.layer_count()).step_by(step) {
             let region = &job.section(i).region;
-            let plan = dropslice::plan::plan_layer(region, i, &s);
+            let plan = dropslice::slicing::plan::plan_layer(region, i, &s);
             let r = Raster::new(&plan, region, &s);
             fast.add(&r.analysis());
             reference.add(&r.analysis_reference());

@@ -51,8 +51,8 @@ fn main() {
     for i in 0..job.layer_count() {
         let mut at = cpu();
         let sec = job.section(i);
-        let plan = dropslice::plan::plan_layer(&sec.region, i, &s);
-        std::hint::black_box(dropslice::gcode::layer_text(&plan));
+        let plan = dropslice::slicing::plan::plan_layer(&sec.region, i, &s);
+        std::hint::black_box(dropslice::output::gcode::layer_text(&plan));
         lap(0, &mut at);
         let c = droplet_centres(&plan, b);
         if fresh {

@@ -16,7 +16,7 @@ use cpu::cpu;
 
 /// [`slab_voids`] or [`slab_voids_reference`].
 type SlabFn = fn(
-    &dropslice::geom::Shapes,
+    &dropslice::base::geom::Shapes,
     &Grid3,
     Option<&HeightMap>,
     &HeightMap,

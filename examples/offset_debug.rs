@@ -3,7 +3,7 @@
 // Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
 #![cfg_attr(target_arch = "wasm32", no_main)]
 #![cfg(not(target_arch = "wasm32"))]
-use dropslice::geom::segment_distance as seg_dist;
+use dropslice::base::geom::segment_distance as seg_dist;
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
@@ -19,11 +19,11 @@ fn main() {
     let mut bad = 0;
     for i in layers {
         let region = job.section(i).region;
-        let c = dropslice::contours::contours(&region, &s);
+        let c = dropslice::slicing::contours::contours(&region, &s);
         for l in &c.loops {
             let want = (0.5 + l.k as f64) * b;
             for (j, p) in l.points.iter().enumerate() {
-                let d = dropslice::geom::all_contours(&region)
+                let d = dropslice::base::geom::all_contours(&region)
                     .flat_map(|c| (0..c.len()).map(move |k| (c[k], c[(k + 1) % c.len()])))
                     .map(|(x, y)| seg_dist(*p, x, y))
                     .fold(f64::INFINITY, f64::min);

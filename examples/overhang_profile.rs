@@ -5,7 +5,7 @@
 // Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
 #![cfg_attr(target_arch = "wasm32", no_main)]
 #![cfg(not(target_arch = "wasm32"))]
-use dropslice::{Job, Settings, geom, support};
+use dropslice::{Job, Settings, base::geom, support};
 use std::time::Instant;
 fn best(mut f: impl FnMut() -> f64) -> (f64, f64) {
     let mut b = f64::INFINITY;
@@ -59,7 +59,7 @@ fn main() {
             let g = support::grow_within(
                 &regions[i - 1],
                 s.overhang_limit * s.droplet_width(),
-                dropslice::offset::CHORD_TOLERANCE_MM,
+                dropslice::slicing::offset::CHORD_TOLERANCE_MM,
             );
             let a = geom::region_area(&support::difference(&regions[i], &g));
             let b = geom::region_area(&support::overhang(&regions[i], Some(&regions[i - 1]), &s));

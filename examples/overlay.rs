@@ -36,7 +36,7 @@ fn main() {
     let job = Job::new(&bytes, &pos[0], s.clone()).expect("job");
     let i = layer - 1;
     let region = job.section(i).region;
-    let plan = dropslice::plan::plan_layer(&region, i, &s);
+    let plan = dropslice::slicing::plan::plan_layer(&region, i, &s);
     let b = s.droplet_width();
     let (a, m) = analyse_layer_with_mask(&plan, &region, &s, b / 10.0);
     eprintln!("{}", serde_json::to_string(&a).unwrap());
@@ -64,7 +64,7 @@ fn main() {
     let mut dots = std::collections::HashSet::new();
     if below && i > 0 {
         let region = job.section(i - 1).region;
-        let plan = dropslice::plan::plan_layer(&region, i - 1, &s);
+        let plan = dropslice::slicing::plan::plan_layer(&region, i - 1, &s);
         for p in dropslice::analysis::droplet_centres(&plan, b) {
             let c = ((p[0] - m.origin[0]) / m.cell) as i64;
             let r = ((p[1] - m.origin[1]) / m.cell) as i64;

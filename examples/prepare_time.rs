@@ -20,7 +20,10 @@ fn main() {
         })
         .collect();
     times.sort_by(f64::total_cmp);
-    let mut mesh = dropslice::mesh::Mesh::weld(&dropslice::stl::parse(&bytes).unwrap().0).0;
+    let mut mesh = dropslice::model::mesh::Mesh::weld(
+        &dropslice::model::import::stl::parse(&bytes).unwrap().0,
+    )
+    .0;
     let t = Instant::now();
     let shells = mesh.orient_shells();
     let orient = t.elapsed().as_secs_f64() * 1000.0;
@@ -32,7 +35,7 @@ fn main() {
         .map(|i| b.min[2] + (i as f64 + 0.5) * 0.2)
         .collect();
     let t = Instant::now();
-    let buckets = dropslice::slice::FacetBuckets::new(&mesh, &zs);
+    let buckets = dropslice::slicing::slice::FacetBuckets::new(&mesh, &zs);
     let bt = t.elapsed().as_secs_f64() * 1000.0;
     std::hint::black_box((stats, buckets.layer(0).len()));
     println!("stats {st:.1} ms, facet index {bt:.1} ms");

@@ -69,7 +69,7 @@ fn main() {
                         &drops,
                         &lp[i],
                         b,
-                        dropslice::droplets::EVEN_MIN_LENGTH_B * b,
+                        dropslice::slicing::droplets::EVEN_MIN_LENGTH_B * b,
                     )
                     .expect("loops");
                     for m in ms {

@@ -12,7 +12,7 @@ fn main() {
         println!(
             "layer {i} z={} area={:.3} shapes={} holes={} closed={} reoriented={} open={} gap={:.3}",
             s.z,
-            dropslice::geom::region_area(&s.region),
+            dropslice::base::geom::region_area(&s.region),
             s.region.len(),
             s.region.iter().map(|x| x.holes.len()).sum::<usize>(),
             s.closed_loops,
@@ -22,7 +22,7 @@ fn main() {
         );
         if std::env::var_os("LOOPS").is_some() {
             for c in job.section_loops(i) {
-                let a = dropslice::geom::signed_area(&c);
+                let a = dropslice::base::geom::signed_area(&c);
                 println!("  loop n={} signed_area={a:.3} first={:?}", c.len(), c[0]);
             }
         }

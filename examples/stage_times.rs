@@ -9,10 +9,10 @@ fn main() {
     let bytes = std::fs::read(&path).expect("read");
     let read = t.elapsed();
     let t = Instant::now();
-    let (tris, _) = dropslice::stl::parse(&bytes).expect("parse");
+    let (tris, _) = dropslice::model::import::stl::parse(&bytes).expect("parse");
     let parse = t.elapsed();
     let t = Instant::now();
-    let _ = dropslice::mesh::Mesh::weld(&tris);
+    let _ = dropslice::model::mesh::Mesh::weld(&tris);
     let weld = t.elapsed();
     let t = Instant::now();
     let job = dropslice::Job::new(&bytes, &path, dropslice::Settings::default()).expect("job");

@@ -5,8 +5,8 @@
 // Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
 #![cfg_attr(target_arch = "wasm32", no_main)]
 #![cfg(not(target_arch = "wasm32"))]
-use dropslice::geom::{Shapes, region_area};
-use dropslice::overhang::overhang_region;
+use dropslice::base::geom::{Shapes, region_area};
+use dropslice::support::overhang::overhang_region;
 use dropslice::support::{self, par_map};
 use dropslice::{Job, Settings};
 use std::time::Instant;
@@ -23,7 +23,7 @@ fn main() {
         .expect("usage: support_time MODEL.stl");
     let bytes = std::fs::read(&path).expect("read the model");
     let s = Settings {
-        support: dropslice::settings::Support::Unit1,
+        support: dropslice::base::settings::Support::Unit1,
         ..Settings::default()
     };
     let job = Job::new(&bytes, &path, s.clone()).expect("job");
@@ -69,8 +69,8 @@ fn main() {
         }
     }
     let t = Instant::now();
-    let hatch: Vec<Vec<dropslice::plan::Move>> = par_map(n, &|i| {
-        dropslice::plan::support_moves(
+    let hatch: Vec<Vec<dropslice::slicing::plan::Move>> = par_map(n, &|i| {
+        dropslice::slicing::plan::support_moves(
             &layers[i].lines,
             &regions[i],
             &[],
@@ -81,15 +81,16 @@ fn main() {
     });
     println!("support hatch   {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let parts: Vec<dropslice::plan::LayerPlan> =
-        par_map(n, &|i| dropslice::plan::plan_layer(&regions[i], i, &s));
+    let parts: Vec<dropslice::slicing::plan::LayerPlan> = par_map(n, &|i| {
+        dropslice::slicing::plan::plan_layer(&regions[i], i, &s)
+    });
     println!("part plans      {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
     let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
-    let (_extra, pass) = dropslice::support_droplets::complete(
-        &|i, within, out: &mut Vec<dropslice::support_droplets::Droplet>| {
-            dropslice::support_droplets::droplets_of(&parts[i].moves, b, b1, within, out);
-            dropslice::support_droplets::droplets_of(&hatch[i], b, b1, within, out);
+    let (_extra, pass) = dropslice::support::droplets::complete(
+        &|i, within, out: &mut Vec<dropslice::support::droplets::Droplet>| {
+            dropslice::support::droplets::droplets_of(&parts[i].moves, b, b1, within, out);
+            dropslice::support::droplets::droplets_of(&hatch[i], b, b1, within, out);
         },
         &regions,
         &s,

@@ -15,43 +15,27 @@
 //! time, so memory stays bounded however tall the part is.
 
 pub mod analysis;
-pub mod calibrate;
-pub mod contours;
-pub mod droplets;
-pub mod error;
-pub mod gcode;
-pub mod gcode_read;
-pub mod geom;
-pub mod grid;
-pub mod hatch;
-pub mod import;
-pub mod job;
-pub mod mesh;
-pub mod offset;
-pub mod overhang;
-pub mod plan;
-pub mod preview;
-pub mod settings;
-pub mod slice;
-pub mod stl;
-pub mod summary;
+pub mod base;
+pub mod model;
+pub mod output;
+pub mod slicing;
 pub mod support;
-pub mod support_droplets;
-pub mod support_lattice;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
-#[cfg(target_arch = "wasm32")]
-mod wasm_cut;
-#[cfg(target_arch = "wasm32")]
-pub mod wasm_gcode;
 
-pub use error::Error;
-pub use settings::Settings;
-pub use summary::{Figures, Summary};
+pub use base::error::Error;
+pub use base::settings::Settings;
+pub use output::summary::{Figures, Summary};
 
-use mesh::{Bounds, Mesh, MeshStats};
-use plan::LayerPlan;
-use slice::{FacetBuckets, Section};
+use base::{geom, settings};
+use model::mesh::{Bounds, Mesh, MeshStats};
+use model::{import, import::stl, mesh, spec as job};
+use output::gcode;
+use slicing::plan::LayerPlan;
+use slicing::slice::{FacetBuckets, Section};
+use slicing::{plan, slice};
+use support::droplets as support_droplets;
+use support::overhang;
 
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 

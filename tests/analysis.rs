@@ -6,8 +6,8 @@ mod common;
 
 use dropslice::Settings;
 use dropslice::analysis::{analyse_layer, analyse_layer_with_mask};
-use dropslice::geom::{Shape, Shapes};
-use dropslice::plan::{LayerPlan, Move, Role};
+use dropslice::base::geom::{Shape, Shapes};
+use dropslice::slicing::plan::{LayerPlan, Move, Role};
 
 /// Points as plain arrays in these tests.
 type Point = [f64; 2];
@@ -146,7 +146,7 @@ fn an_enclosed_void_is_found_with_its_position() {
 
 #[test]
 fn stagger_start_step_is_an_odd_multiple_of_half_a_droplet() {
-    use dropslice::plan::loop_start_step;
+    use dropslice::slicing::plan::loop_start_step;
     let mut s = Settings::default();
     let b = s.droplet_width();
     assert_eq!(loop_start_step(&s), 0.07);
@@ -162,7 +162,7 @@ fn stagger_start_step_is_an_odd_multiple_of_half_a_droplet() {
 
 #[test]
 fn stagger_shifts_hatch_lattices_only_where_directions_repeat() {
-    use dropslice::plan::hatch_shifted;
+    use dropslice::slicing::plan::hatch_shifted;
     let mut s = Settings {
         stagger: true,
         ..Settings::default()
@@ -206,7 +206,7 @@ fn staggered_fill_droplets_lie_on_the_lattice_and_interleave() {
             moves: fill,
             ..LayerPlan::default()
         };
-        let angle = dropslice::plan::hatch_angle(&s, i).to_radians();
+        let angle = dropslice::slicing::plan::hatch_angle(&s, i).to_radians();
         let (sn, c) = angle.sin_cos();
         for p in droplet_centres(&fill_plan, b) {
             // Hatch frame: along = x', across = y'.

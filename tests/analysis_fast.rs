@@ -35,7 +35,7 @@ fn rasters_with(model: &str, s: Settings, step: usize) -> Vec<Raster> {
         .step_by(step)
         .map(|i| {
             let region = &job.section(i).region;
-            let plan = dropslice::plan::plan_layer(region, i, &s);
+            let plan = dropslice::slicing::plan::plan_layer(region, i, &s);
             Raster::new(&plan, region, &s)
         })
         .collect()
@@ -104,7 +104,7 @@ fn one_raster_reused_gives_the_figures_of_new_ones() {
         .chain(0..4);
     for i in order {
         let region = &job.section(i).region;
-        let plan = dropslice::plan::plan_layer(region, i, &s);
+        let plan = dropslice::slicing::plan::plan_layer(region, i, &s);
         let (a, mask) = analyse_layer_with_mask(&plan, region, &s, b / 4.0);
         let (pa, pmask) = analyse_layer_for_page(&mut r, &plan, region, &s, b / 4.0);
         assert_eq!(pa, a, "layer {i}");
@@ -148,7 +148,7 @@ fn figures_and_masks_with_evenly_spaced_loops() {
 /// reference's.
 #[test]
 fn random_layers_give_the_reference_figures() {
-    use dropslice::geom::{Point, Shape, Shapes};
+    use dropslice::base::geom::{Point, Shape, Shapes};
     let s = Settings::default();
     let b = s.droplet_width();
     let mut seed = 0x9e37_79b9_7f4a_7c15u64;

@@ -11,13 +11,13 @@ use dropslice::analysis::{
     Grid3, HeightMap, Raster, analyse_layer, analyse_layer_with_mask, footprint_diameter,
     slab_voids,
 };
-use dropslice::geom::{Point, Shapes};
+use dropslice::base::geom::{Point, Shapes};
 
 /// A `side` mm square at (x, y) filled with droplets on a square lattice of pitch B (their
 /// gaps are voids).
 fn square(x: f64, y: f64, side: f64, b: f64) -> (Shapes, Vec<Point>) {
     let outer = [[x, y], [x + side, y], [x + side, y + side], [x, y + side]];
-    let region = vec![dropslice::geom::Shape::new(
+    let region = vec![dropslice::base::geom::Shape::new(
         outer.map(Into::into).into(),
         vec![],
     )];

@@ -8,7 +8,7 @@
 mod common;
 
 use common::{Rng, TempDir, ascii_stl, binary_stl};
-use dropslice::settings::{Kind, schema};
+use dropslice::base::settings::{Kind, schema};
 use dropslice::{Job, Settings};
 use std::time::Duration;
 

@@ -7,7 +7,7 @@
 mod common;
 
 use common::{B, H, TempDir};
-use dropslice::calibrate::{CountSource, calibrate_gcode};
+use dropslice::output::calibrate::{CountSource, calibrate_gcode};
 use std::path::Path;
 use std::time::Duration;
 

@@ -10,7 +10,7 @@ use dropslice::Settings;
 use dropslice::analysis::{
     CUT_BANDS, CutLine, Near, footprint_diameter, slab_section_voids, spheroid_half_height,
 };
-use dropslice::geom::{DVec2, Shape, Shapes};
+use dropslice::base::geom::{DVec2, Shape, Shapes};
 
 /// Winding number of `p` around the closed polygon `c` (non-zero = inside).
 fn winding(c: &[DVec2], p: DVec2) -> i32 {
@@ -76,9 +76,9 @@ fn cut_voids_match_points_sampled_in_3d() {
     for case in 0..12 {
         let s = Settings {
             footprint: if case % 2 == 0 {
-                dropslice::settings::Footprint::Disc
+                dropslice::base::settings::Footprint::Disc
             } else {
-                dropslice::settings::Footprint::Spread
+                dropslice::base::settings::Footprint::Spread
             },
             ..Settings::default()
         };
@@ -169,7 +169,7 @@ fn a_dense_lattice_fills_the_middle_of_the_slab() {
     // the spheroid's radius is above 0.53 B: the middle bands are filled wherever the line
     // goes; at the bottom band's middle (5H/12 below) the radius is 0.47 B: gaps.
     let s = Settings {
-        footprint: dropslice::settings::Footprint::Spread,
+        footprint: dropslice::base::settings::Footprint::Spread,
         ..Settings::default()
     };
     let b = s.droplet_width();

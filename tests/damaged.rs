@@ -16,11 +16,11 @@ fn shared() -> PathBuf {
 
 fn load(model: &str) -> Vec<Tri> {
     let bytes = std::fs::read(shared().join("models").join(format!("{model}.stl"))).unwrap();
-    dropslice::stl::parse(&bytes).unwrap().0
+    dropslice::model::import::stl::parse(&bytes).unwrap().0
 }
 
 fn binary(tris: &[Tri]) -> Vec<u8> {
-    dropslice::stl::write_binary(b"damaged copy", tris)
+    dropslice::model::import::stl::write_binary(b"damaged copy", tris)
 }
 
 /// A small deterministic generator (xorshift64*), so failures reproduce.
@@ -40,7 +40,7 @@ impl Rng {
 fn areas(tris: &[Tri]) -> Vec<f64> {
     let job = Job::new(&binary(tris), "damaged", Settings::default()).unwrap();
     (0..job.layer_count())
-        .map(|i| dropslice::geom::region_area(&job.section(i).region))
+        .map(|i| dropslice::base::geom::region_area(&job.section(i).region))
         .collect()
 }
 

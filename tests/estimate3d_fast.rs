@@ -12,7 +12,7 @@ use dropslice::analysis::{
     GRID3_PER_B, Grid3, HeightMap, JobAnalysis, droplet_centres, footprint_diameter, slab_voids,
     slab_voids_reference,
 };
-use dropslice::geom::{Point, Shape, Shapes};
+use dropslice::base::geom::{Point, Shape, Shapes};
 use dropslice::{Job, Settings};
 
 fn bits(f: (f64, f64)) -> (u64, u64) {

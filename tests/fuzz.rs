@@ -14,7 +14,7 @@
 mod common;
 
 use common::Rng;
-use dropslice::settings::{Kind, schema};
+use dropslice::base::settings::{Kind, schema};
 use dropslice::{Error, Job, Settings};
 use std::time::{Duration, Instant};
 

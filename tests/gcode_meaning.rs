@@ -196,9 +196,9 @@ fn check_loop(model: &str, z: f64, lp: &[Point]) {
 /// the header reproduces the settings.
 fn check_header(model: &str, g: &Gcode, used: &Settings) {
     let mut rebuilt = Settings::default();
-    let unit1_used = used.support != dropslice::settings::Support::Off;
-    for name in dropslice::settings::names() {
-        if !unit1_used && dropslice::settings::is_unit1_setting(name) {
+    let unit1_used = used.support != dropslice::base::settings::Support::Off;
+    for name in dropslice::base::settings::names() {
+        if !unit1_used && dropslice::base::settings::is_unit1_setting(name) {
             // SPEC.md: unit 1's settings are listed only when unit 1 is used.
             assert!(
                 g.get(name).is_none(),
@@ -220,7 +220,7 @@ fn check_header(model: &str, g: &Gcode, used: &Settings) {
     let input = g.get("input").unwrap_or("");
     assert_eq!(input, model, "{model}: header names the input file");
     // The header comes before any command (parse_gcode only reads it there).
-    assert!(g.header.len() >= dropslice::settings::names().len());
+    assert!(g.header.len() >= dropslice::base::settings::names().len());
 }
 
 #[test]

@@ -4,8 +4,8 @@
 
 mod common;
 
-use dropslice::gcode_read::read_gcode;
-use dropslice::preview::PreviewLayer;
+use dropslice::output::gcode_read::read_gcode;
+use dropslice::output::preview::PreviewLayer;
 use dropslice::{Job, Settings};
 
 fn check(model: &str, s: Settings) {

@@ -9,8 +9,8 @@ mod common;
 use std::time::{Duration, Instant};
 
 use dropslice::Error;
-use dropslice::import::{self, IDENTITY, Part};
-use dropslice::stl::Format;
+use dropslice::model::import::stl::Format;
+use dropslice::model::import::{self, IDENTITY, Part};
 
 type Tri = [[f32; 3]; 3];
 type P3 = [f64; 3];
@@ -115,7 +115,8 @@ fn obj_quads_match_the_stl() {
         .unwrap()
         .remove(0)
         .triangles;
-    let (stl, _) = dropslice::stl::parse(&common::model_bytes("extruder_idler.stl")).unwrap();
+    let (stl, _) =
+        dropslice::model::import::stl::parse(&common::model_bytes("extruder_idler.stl")).unwrap();
     assert_eq!(bounds(&obj), bounds(&stl));
     let (vo, vs) = (volume(&obj), volume(&stl));
     assert!((vs - 5431.4657).abs() < 1e-3, "{vs}");

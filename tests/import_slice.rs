@@ -19,7 +19,7 @@ fn a_3mf_box_slices_to_its_exact_section() {
     let j = job("box.3mf");
     assert_eq!(j.layer_count(), 150);
     for i in 0..j.layer_count() {
-        let a = dropslice::geom::region_area(&j.section(i).region);
+        let a = dropslice::base::geom::region_area(&j.section(i).region);
         assert!((a - 200.0).abs() < 1e-6, "layer {i}: {a}");
     }
 }

@@ -6,7 +6,7 @@
 mod common;
 
 use common::{Rng, TempDir, model, model_bytes, on_plate, run_cli};
-use dropslice::job::{self, JobSpec, Model, Rect, arrange};
+use dropslice::model::spec::{self as job, JobSpec, Model, Rect, arrange};
 use dropslice::{Error, Job, Settings};
 use serde_json::{Value, json};
 use std::time::Duration;
@@ -478,7 +478,7 @@ fn placed(tris: &[Tri], rot: [f64; 3], scale: [f64; 3], at: [f64; 2]) -> Vec<[[f
 
 fn all_triangles(file: &str) -> Vec<Tri> {
     let bytes = model_bytes(file);
-    dropslice::import::read_parts(&bytes, file)
+    dropslice::model::import::read_parts(&bytes, file)
         .unwrap()
         .into_iter()
         .flat_map(|p| p.triangles)
@@ -576,7 +576,7 @@ fn a_job_of_three_parts_slices_as_the_oracle_says() {
         }
         compared += 1;
         let want = l["nonzero"]["area"].as_f64().unwrap();
-        let got = dropslice::geom::region_area(&j.section(i).region);
+        let got = dropslice::base::geom::region_area(&j.section(i).region);
         if (got - want).abs() > (want * 0.005).max(0.05) {
             bad.push(format!("layer {i}: {got:.4} vs oracle {want:.4}"));
         }
@@ -675,7 +675,7 @@ fn matrices_map_the_model_onto_the_sliced_mesh() {
     for inst in &j.info().instances {
         let tris = m.triangles(inst.item).unwrap();
         let mx = inst.matrix;
-        let (welded, _) = dropslice::mesh::Mesh::weld(&tris);
+        let (welded, _) = dropslice::model::mesh::Mesh::weld(&tris);
         for (k, v) in welded.vertices.iter().enumerate() {
             let p =
                 [0, 1, 2].map(|r| mx[r] * v[0] + mx[4 + r] * v[1] + mx[8 + r] * v[2] + mx[12 + r]);

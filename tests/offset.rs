@@ -6,8 +6,10 @@
 mod common;
 
 use common::{B, IndexedRegion, model_bytes, nested};
-use dropslice::geom::{Shape, Shapes, all_contours, region_area, shapes_from_overlay, signed_area};
-use dropslice::offset::{CHORD_TOLERANCE_MM, inset};
+use dropslice::base::geom::{
+    Shape, Shapes, all_contours, region_area, shapes_from_overlay, signed_area,
+};
+use dropslice::slicing::offset::{CHORD_TOLERANCE_MM, inset};
 use dropslice::{Job, Settings};
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
@@ -49,10 +51,11 @@ fn layers_of(name: &str) -> Vec<Shapes> {
         .collect()
 }
 
-fn square(x0: f64, y0: f64, a: f64, ccw: bool) -> dropslice::geom::Contour {
-    let mut c: dropslice::geom::Contour = [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
-        .map(Into::into)
-        .into();
+fn square(x0: f64, y0: f64, a: f64, ccw: bool) -> dropslice::base::geom::Contour {
+    let mut c: dropslice::base::geom::Contour =
+        [[x0, y0], [x0 + a, y0], [x0 + a, y0 + a], [x0, y0 + a]]
+            .map(Into::into)
+            .into();
     if !ccw {
         c.reverse();
     }
@@ -168,7 +171,7 @@ fn every_vertex_keeps_its_distance_from_the_boundary() {
             let index = IndexedRegion::new(&nested(region));
             for f in [0.5, 1.5, 2.0] {
                 let d = f * B;
-                for p in dropslice::geom::all_contours(&inset(region, d, d)).flatten() {
+                for p in dropslice::base::geom::all_contours(&inset(region, d, d)).flatten() {
                     let dist = index.boundary_distance(p.to_array());
                     assert!(
                         index.contains(p.to_array(), 0.0) && dist >= d - 2.0 * CHORD_TOLERANCE_MM,
@@ -192,7 +195,7 @@ fn loops_far_inside_match_direct_offsets() {
         let job = Job::new(&model_bytes(name), name, s.clone()).expect("job");
         for i in (0..job.layer_count()).step_by(10) {
             let region = job.section(i).region;
-            let c = dropslice::contours::contours(&region, &s);
+            let c = dropslice::slicing::contours::contours(&region, &s);
             for k in 0..12u32 {
                 let d = (0.5 + k as f64) * b;
                 let direct = inset(&region, d, d);

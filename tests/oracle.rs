@@ -51,7 +51,7 @@ fn compare(model: &str, fixture: &str, counts: bool) -> (Vec<Mismatch>, usize) {
         let nz = &l["nonzero"];
         let want = nz["area"].as_f64().unwrap();
         let section = job.section(i);
-        let got = dropslice::geom::region_area(&section.region);
+        let got = dropslice::base::geom::region_area(&section.region);
         let tol = (want * 0.005).max(0.05);
         if (got - want).abs() > tol {
             bad.push(Mismatch {

@@ -8,9 +8,9 @@
 
 mod common;
 
-use dropslice::geom::{DVec2, Shape, Shapes, region_area, signed_area};
-use dropslice::offset::CHORD_TOLERANCE_MM;
-use dropslice::overhang::overhang_area;
+use dropslice::base::geom::{DVec2, Shape, Shapes, region_area, signed_area};
+use dropslice::slicing::offset::CHORD_TOLERANCE_MM;
+use dropslice::support::overhang::overhang_area;
 use dropslice::{Settings, support};
 
 /// The largest difference per layer from `support::overhang` and from the outline

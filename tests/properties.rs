@@ -6,7 +6,7 @@
 
 mod common;
 
-use dropslice::geom::region_area;
+use dropslice::base::geom::region_area;
 use dropslice::{Job, Settings};
 use proptest::prelude::*;
 use std::collections::HashMap;
@@ -101,7 +101,7 @@ fn compare(what: &str, base: &Measure, got: &Measure) -> Result<(), TestCaseErro
 
 /// A tiny permutation generator (Fisher–Yates with the tests' xorshift).
 fn shuffled_stl(bytes: &[u8], seed: u64) -> Vec<u8> {
-    let (mut tris, _) = dropslice::stl::parse(bytes).expect("model parses");
+    let (mut tris, _) = dropslice::model::import::stl::parse(bytes).expect("model parses");
     let mut rng = common::Rng::new(seed);
     for i in (1..tris.len()).rev() {
         let j = rng.below(i as u64 + 1) as usize;

@@ -104,7 +104,7 @@ fn check_even(model: &str, even: &str) -> EvenFigures {
         min_chord: f64::INFINITY,
         ..EvenFigures::default()
     };
-    let min_length = dropslice::droplets::EVEN_MIN_LENGTH_B * B;
+    let min_length = dropslice::slicing::droplets::EVEN_MIN_LENGTH_B * B;
     for (i, (drops, lp)) in layers.iter().zip(&paths).enumerate() {
         let loops = seams::even_loops(drops, lp, B, min_length)
             .unwrap_or_else(|e| panic!("{model} layer {}: {e}", i + 1));

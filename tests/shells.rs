@@ -46,7 +46,7 @@ fn inverted(mut t: Vec<Tri>) -> Vec<Tri> {
 }
 
 fn job(tris: &[Tri]) -> Result<Job, Error> {
-    let bytes = dropslice::stl::write_binary(b"constructed", tris);
+    let bytes = dropslice::model::import::stl::write_binary(b"constructed", tris);
     Job::new(&bytes, "constructed.stl", Settings::default())
 }
 
@@ -56,7 +56,7 @@ fn areas(job: &Job) -> Vec<(f64, f64)> {
         .map(|i| {
             (
                 job.plane_z(i),
-                dropslice::geom::region_area(&job.section(i).region),
+                dropslice::base::geom::region_area(&job.section(i).region),
             )
         })
         .collect()
@@ -193,7 +193,9 @@ fn a_whole_inverted_part_with_a_cavity_and_a_core() {
 }
 
 fn shared_model(name: &str) -> Vec<Tri> {
-    dropslice::stl::parse(&common::model_bytes(name)).unwrap().0
+    dropslice::model::import::stl::parse(&common::model_bytes(name))
+        .unwrap()
+        .0
 }
 
 /// The facets of the connected piece (by shared vertices) that holds facet 0.
@@ -248,7 +250,7 @@ fn a_shared_model_with_one_shell_inside_out_matches_the_oracle() {
             continue;
         }
         let want = l["nonzero"]["area"].as_f64().unwrap();
-        let got = dropslice::geom::region_area(&j.section(i).region);
+        let got = dropslice::base::geom::region_area(&j.section(i).region);
         if (got - want).abs() > (want * 0.005).max(0.05) {
             bad.push(format!("layer {i}: {got:.3} vs oracle {want:.3}"));
         }
@@ -298,7 +300,11 @@ fn the_cli_refuses_the_inverted_box_file_before_writing() {
         [2100.0, 1000.0, 1000.0 - 1e-2],
     )));
     let input = dir.path().join("boxes.stl");
-    std::fs::write(&input, dropslice::stl::write_binary(b"two boxes", &t)).unwrap();
+    std::fs::write(
+        &input,
+        dropslice::model::import::stl::write_binary(b"two boxes", &t),
+    )
+    .unwrap();
     let out = dir.path().join("boxes.gco");
     let r = std::process::Command::new(common::bin())
         .arg(&input)

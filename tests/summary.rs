@@ -5,7 +5,7 @@
 mod common;
 
 use dropslice::analysis::analyse_layer;
-use dropslice::summary::layer_seconds;
+use dropslice::output::summary::layer_seconds;
 use dropslice::{Figures, Job, Settings, Summary};
 use std::process::Command;
 

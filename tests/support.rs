@@ -168,7 +168,7 @@ fn support_makes_every_droplet_supported_on_3dbenchy() {
 }
 
 /// The mesh cut by the plane z: segments, without chaining them into loops.
-fn cut_mesh(mesh: &dropslice::mesh::Mesh, z: f64) -> Vec<(P, P)> {
+fn cut_mesh(mesh: &dropslice::model::mesh::Mesh, z: f64) -> Vec<(P, P)> {
     let tris: Vec<[[f64; 3]; 3]> = mesh
         .facets
         .iter()
@@ -299,12 +299,13 @@ fn the_overlay_marks_the_droplets_the_gcode_breaks_the_rule_with() {
             let (k, v) = kv.split_once('=').unwrap();
             json.insert(k.into(), v.into());
         }
-        let settings = dropslice::settings::Settings::from_value(json.into()).unwrap();
+        let settings = dropslice::base::settings::Settings::from_value(json.into()).unwrap();
         let (b, b1) = (settings.droplet_width(), settings.unit1_droplet_width());
         let limit = settings.overhang_limit * b;
         let job = dropslice::Job::new(&common::model_bytes(name), name, settings).unwrap();
         assert_eq!(job.layer_count(), want.len(), "{name}");
-        let preview = |i: usize| dropslice::preview::PreviewLayer::from_plan(&job.plan_layer(i), b);
+        let preview =
+            |i: usize| dropslice::output::preview::PreviewLayer::from_plan(&job.plan_layer(i), b);
         // 3DBenchy: the layers where the G-code reading finds droplets, and a few others.
         let layers: Vec<usize> = if name == "3DBenchy.stl" {
             let mut l: Vec<usize> = (0..want.len()).filter(|&i| want[i] > 0).collect();
@@ -351,7 +352,7 @@ fn the_overhang_figure_agrees_with_the_outline_construction() {
     // outline of the layer below (`overhang_reference`, chords within 5 µm, inside the arcs)
     // and the same outline with chords within 1 µm, layer by layer on 3DBenchy and the
     // overhang models.
-    use dropslice::{geom::region_area, offset::CHORD_TOLERANCE_MM, support};
+    use dropslice::{base::geom::region_area, slicing::offset::CHORD_TOLERANCE_MM, support};
     for name in ["3DBenchy.stl", "U_overhang.obj", "extruder_idler.stl"] {
         let bytes = common::model_bytes(name);
         let job = dropslice::Job::new(&bytes, name, dropslice::Settings::default()).unwrap();
@@ -387,14 +388,14 @@ fn the_lattice_need_agrees_with_the_region_form() {
     // steps) and hatched by `hatch_at`: layer by layer, the support droplets of the two differ
     // only within the region form's tolerances of its boundary (its outlines are simplified
     // within 5 µm, the clip and the carried need again on every layer).
-    use dropslice::geom::{DVec2, all_contours, line_droplets, segment_distance};
-    use dropslice::hatch::hatch_at;
-    use dropslice::plan::{hatch_angle, support_settings};
+    use dropslice::base::geom::{DVec2, all_contours, line_droplets, segment_distance};
+    use dropslice::slicing::hatch::hatch_at;
+    use dropslice::slicing::plan::{hatch_angle, support_settings};
     use dropslice::support;
     for name in ["3DBenchy.stl", "U_overhang.obj", "bridge.obj"] {
         let bytes = common::model_bytes(name);
         let s = dropslice::Settings {
-            support: dropslice::settings::Support::Unit1,
+            support: dropslice::base::settings::Support::Unit1,
             ..dropslice::Settings::default()
         };
         let job = dropslice::Job::new(&bytes, name, s.clone()).unwrap();
@@ -411,7 +412,7 @@ fn the_lattice_need_agrees_with_the_region_form() {
                 lattice[i].unsupported_area, outlines[i].0,
                 "{name} layer {i}"
             );
-            let droplets = |lines: &[dropslice::hatch::HatchLine]| {
+            let droplets = |lines: &[dropslice::slicing::hatch::HatchLine]| {
                 let mut v: Vec<(i64, i64)> = lines
                     .iter()
                     .flat_map(|h| line_droplets(h.a, h.b, b1))

@@ -90,7 +90,7 @@ fn box_tris(x0: f64, y0: f64, x1: f64, y1: f64, h: f64) -> Vec<Tri> {
 /// A model's triangles moved so that their box minimum is at (at, 0) (no rotation, no scale).
 fn placed(file: &str, at: P) -> Vec<Tri> {
     let bytes = model_bytes(file);
-    let tris = dropslice::import::read_parts(&bytes, file)
+    let tris = dropslice::model::import::read_parts(&bytes, file)
         .unwrap()
         .into_iter()
         .flat_map(|p| p.triangles)

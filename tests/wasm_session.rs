@@ -2,10 +2,10 @@
 //! `cargo test --target wasm32-unknown-unknown --test wasm_session` is given it as the runner.
 #![cfg(target_arch = "wasm32")]
 
+use dropslice::wasm::reader::{GcodeStream, calibrate};
 use dropslice::wasm::{
     Models, Session, Tally, default_settings, merge_summaries, settings_schema, version,
 };
-use dropslice::wasm_gcode::{GcodeStream, calibrate};
 use serde::Serialize;
 use wasm_bindgen::{JsCast, JsValue};
 use wasm_bindgen_test::wasm_bindgen_test;

@@ -8,9 +8,9 @@
 //! bands' middles), not on a grid: the section is a set of intervals per band.
 
 use super::droplet::{footprint_diameter, spheroid_half_height};
-use crate::error::Error;
-use crate::geom::{Point, Shapes, scanline_spans};
-use crate::settings::Settings;
+use crate::base::error::Error;
+use crate::base::geom::{Point, Shapes, scanline_spans};
+use crate::base::settings::Settings;
 
 /// Heights sampled per slab: the void intervals of band k (of H / CUT_BANDS) are those at its
 /// middle.
@@ -199,8 +199,8 @@ pub fn slab_section_voids(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::DVec2;
-    use crate::geom::square;
+    use crate::base::geom::DVec2;
+    use crate::base::geom::square;
 
     #[test]
     fn a_line_through_a_square_with_a_hole() {

@@ -1,9 +1,9 @@
 //! The droplet model: a droplet's footprint in its layer's plane and its spheroid in 3D, and
 //! where a layer's droplets are.
 
-use crate::geom::{Point, line_droplets};
-use crate::plan::{LayerPlan, MoveKind};
-use crate::settings::{Footprint, Settings};
+use crate::base::geom::{Point, line_droplets};
+use crate::base::settings::{Footprint, Settings};
+use crate::slicing::plan::{LayerPlan, MoveKind};
 use std::f64::consts::PI;
 
 /// Footprint diameter D of a droplet, in mm.

@@ -3,9 +3,9 @@
 
 use super::droplet::spheroid_half_height;
 use super::raster::region_spans;
-use crate::geom::{Point, Shapes, all_contours};
-use crate::grid::{Segment, Spot, Tiles};
-use crate::settings::Settings;
+use crate::base::geom::{Point, Shapes, all_contours};
+use crate::base::settings::Settings;
+use crate::base::spatial::{Segment, Spot, Tiles};
 
 mod reference;
 pub use reference::slab_voids_reference;

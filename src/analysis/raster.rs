@@ -2,10 +2,10 @@
 //! overfill, boundary deviation) and the coverage mask for the page's overlay.
 
 use super::droplet::{droplet_centres, footprint_diameter};
-use crate::geom::{DVec2, Point, Shapes, all_contours, dist, region_area, scanline_spans};
-use crate::grid::{EdgeIndex, Row, Spot, Tiles};
-use crate::plan::LayerPlan;
-use crate::settings::Settings;
+use crate::base::geom::{DVec2, Point, Shapes, all_contours, dist, region_area, scanline_spans};
+use crate::base::settings::Settings;
+use crate::base::spatial::{EdgeIndex, Row, Spot, Tiles};
+use crate::slicing::plan::LayerPlan;
 use serde::Serialize;
 
 /// Grid rows per droplet width B.

@@ -4,9 +4,9 @@
 use super::droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
 use super::estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
-use crate::geom::{DVec2, Shapes};
-use crate::plan::LayerPlan;
-use crate::settings::Settings;
+use crate::base::geom::{DVec2, Shapes};
+use crate::base::settings::Settings;
+use crate::slicing::plan::LayerPlan;
 use serde::Serialize;
 use std::collections::{BTreeMap, VecDeque};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -97,7 +97,7 @@ pub struct Report {
 /// The analysis model as used, for the report.
 #[derive(Clone, Debug, Serialize)]
 pub struct Model {
-    pub footprint: crate::settings::Footprint,
+    pub footprint: crate::base::settings::Footprint,
     /// Droplet width B, footprint diameter D, spheroid height, mm.
     pub droplet_width: f64,
     pub footprint_diameter: f64,

@@ -15,7 +15,7 @@ fn main() {}
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
     use dropslice::analysis::JobAnalysis;
-    use dropslice::job::{self, JobSpec, Model, PartSpec};
+    use dropslice::model::spec::{self as job, JobSpec, Model, PartSpec};
     use dropslice::{Error, Job, Settings, write_gcode_with};
     use staged::Staged;
     use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
@@ -241,14 +241,14 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         let file = file.ok_or_else(|| format!("no .gco file given\n\n{CAL_USAGE}"))?;
         let mass = mass.ok_or_else(|| format!("--mass GRAMS is needed\n\n{CAL_USAGE}"))?;
         let reader = read_counting(&file)?;
-        let c = dropslice::calibrate::calibrate_read(&reader, mass, density)
+        let c = dropslice::output::calibrate::calibrate_read(&reader, mass, density)
             .map_err(|e| format!("{}: {e}", file.display()))?;
         Ok(format!(
             "{}\n  droplets          {} ({})\n  droplet volume    {:.5} mm³ (m / (N ρ), ρ = {} g/cm³)\n  cell B²H          {:.5} mm³ (H = {} mm, droplet_aspect = {})\n  filling degree    {:.3}\n  droplet_aspect    {:.3} suggested (now {})",
             c.explanation,
             c.droplets,
             match c.count_source {
-                dropslice::calibrate::CountSource::Header => "from the header",
+                dropslice::output::calibrate::CountSource::Header => "from the header",
                 _ => "counted from the commands",
             },
             c.droplet_volume_mm3,
@@ -263,11 +263,11 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
     }
 
     /// Reads a `.gco` file through the core's reader (counting only), in pieces of whole lines.
-    fn read_counting(path: &Path) -> Result<dropslice::gcode_read::GcodeReader, String> {
+    fn read_counting(path: &Path) -> Result<dropslice::output::gcode_read::GcodeReader, String> {
         use std::io::Read;
         let shown = path.display();
         let mut f = std::fs::File::open(path).map_err(|e| format!("cannot open {shown}: {e}"))?;
-        let mut r = dropslice::gcode_read::GcodeReader::counting();
+        let mut r = dropslice::output::gcode_read::GcodeReader::counting();
         let mut buf: Vec<u8> = Vec::new();
         let mut chunk = vec![0u8; 1 << 20];
         loop {
@@ -279,10 +279,10 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             }
             buf.extend_from_slice(&chunk[..n]);
             let Some(nl) = buf.iter().rposition(|&c| c == b'\n') else {
-                if buf.len() > 4 * dropslice::gcode_read::MAX_LINE_CHARS {
+                if buf.len() > 4 * dropslice::output::gcode_read::MAX_LINE_CHARS {
                     return Err(format!(
                         "{shown}: a line is longer than {} characters: not a G-code file",
-                        dropslice::gcode_read::MAX_LINE_CHARS
+                        dropslice::output::gcode_read::MAX_LINE_CHARS
                     ));
                 }
                 continue;
@@ -303,7 +303,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
 
     fn list_settings() -> String {
         let mut out = String::new();
-        for s in dropslice::settings::schema() {
+        for s in dropslice::base::settings::schema() {
             let range = match (s.min, s.max) {
                 (Some(lo), Some(hi)) => {
                     format!(" [{}{lo} … {hi}]", if s.min_exclusive { ">" } else { "" })
@@ -452,7 +452,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         }
         if !args.quiet {
             for p in &job.info().instances {
-                eprintln!("dropslice: {}", dropslice::gcode::part_line(p));
+                eprintln!("dropslice: {}", dropslice::output::gcode::part_line(p));
             }
         }
         // Written to a temporary file beside the target (`out`), put in place only at the end:

@@ -444,7 +444,7 @@ pub fn split_loops(run: &[Point], b: f64, b_tol: f64) -> Vec<Vec<Point>> {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Geometry on a section (dropslice::geom::Shapes: shapes of contours)
+// Geometry on a section (dropslice::base::geom::Shapes: shapes of contours)
 
 pub type Shapes = Vec<Vec<Vec<Point>>>;
 
@@ -474,11 +474,11 @@ pub fn contour_winding(c: &[Point], p: Point) -> i32 {
 }
 
 fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
-    dropslice::geom::segment_distance(p.into(), a.into(), b.into())
+    dropslice::base::geom::segment_distance(p.into(), a.into(), b.into())
 }
 
 /// A section's region as plain arrays (outer boundary first, then the holes).
-pub fn nested(region: &dropslice::geom::Shapes) -> Shapes {
+pub fn nested(region: &dropslice::base::geom::Shapes) -> Shapes {
     region
         .iter()
         .map(|s| {
@@ -568,7 +568,7 @@ impl IndexedRegion {
 
 /// A binary STL of the given triangles (zero normals).
 pub fn binary_stl(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
-    dropslice::stl::write_binary(header, tris)
+    dropslice::model::import::stl::write_binary(header, tris)
 }
 
 /// An ASCII STL of the given triangles, coordinates written with `{}`.
@@ -622,10 +622,10 @@ impl Rng {
 }
 
 /// A layer plan of single droplets (`G26`, fill) at the given points, for analysis tests.
-pub fn droplet_plan<P: Copy + Into<dropslice::geom::Point>>(
+pub fn droplet_plan<P: Copy + Into<dropslice::base::geom::Point>>(
     points: &[P],
-) -> dropslice::plan::LayerPlan {
-    use dropslice::plan::{LayerPlan, Move, MoveKind, Role};
+) -> dropslice::slicing::plan::LayerPlan {
+    use dropslice::slicing::plan::{LayerPlan, Move, MoveKind, Role};
     LayerPlan {
         moves: points
             .iter()
@@ -701,7 +701,7 @@ pub fn deep_inside(segs: &[(Point, Point)], p: Point, d: f64) -> bool {
 }
 
 /// The loop of the box [x, x + w] × [y, y + h], counter-clockwise.
-pub fn rect_loop(x: f64, y: f64, w: f64, h: f64) -> Vec<dropslice::geom::Point> {
+pub fn rect_loop(x: f64, y: f64, w: f64, h: f64) -> Vec<dropslice::base::geom::Point> {
     vec![
         [x, y].into(),
         [x + w, y].into(),

@@ -3,7 +3,7 @@
 //!
 //! The droplets are the `G26` lines of each layer, in file order, as written (4 decimals). The
 //! loops they lie on are the layer's contour loops: the path every loop's droplets are placed
-//! along. They come from the library's contour function (`dropslice::contours::contours` on
+//! along. They come from the library's contour function (`dropslice::slicing::contours::contours` on
 //! the layer's section): an offset by (f + k)·B of a section with round joins, chained for the
 //! inner loops, is what `even` spaces along, and a polygon offset written again here would
 //! have to reproduce its joins and chord tolerance to the µm for arc lengths to agree. So the
@@ -152,7 +152,7 @@ pub fn loop_paths(job: &dropslice::Job) -> Vec<Vec<LoopPath>> {
     (0..job.layer_count())
         .map(|i| {
             let region = job.section(i).region;
-            dropslice::contours::contours(&region, job.settings())
+            dropslice::slicing::contours::contours(&region, job.settings())
                 .loops
                 .into_iter()
                 .map(|l| LoopPath::new(l.points.iter().map(|p| p.to_array()).collect(), l.k))

@@ -5,9 +5,9 @@
 use super::super::droplet::spheroid_half_height;
 use super::super::raster::region_spans;
 use super::{Grid3, HeightMap, MAP_BAND_ROWS, MAP_TILE_COLS, MapRow};
-use crate::geom::{Point, Shapes};
-use crate::grid::{Spot, Tiles};
-use crate::settings::Settings;
+use crate::base::geom::{Point, Shapes};
+use crate::base::settings::Settings;
+use crate::base::spatial::{Spot, Tiles};
 
 impl HeightMap {
     /// The height map as it was built before the fast path ([`HeightMap::new`]).

@@ -1,0 +1,626 @@
+//! Import, stage 1b: triangle soup → [`Mesh`] (welded vertex list + facet list), its
+//! transforms (SPEC.md: rotate, scale, bounding box minimum to the origin, placement) and its
+//! diagnostics (open and non-manifold edges).
+
+use crate::base::geom::{DMat3, DVec3, sin_cos_deg};
+use crate::base::settings::Settings;
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
+
+/// A welded triangle mesh in millimetres.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub vertices: Vec<[f64; 3]>,
+    /// Vertex indices in the file's order (which gives the orientation).
+    pub facets: Vec<[u32; 3]>,
+}
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Bounds {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl Bounds {
+    pub fn size(&self) -> [f64; 3] {
+        [0, 1, 2].map(|k| self.max[k] - self.min[k])
+    }
+}
+
+/// What the import found in the mesh.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeshStats {
+    pub facets_in_file: usize,
+    pub facets: usize,
+    pub vertices: usize,
+    /// Facets dropped because two of their corners are the same vertex.
+    pub degenerate_facets: usize,
+    /// Edges used by only one facet (holes in the surface).
+    pub open_edges: usize,
+    /// Edges used by more than two facets.
+    pub nonmanifold_edges: usize,
+    /// Edges whose two facets run along them in the same direction (a flipped facet).
+    pub misoriented_edges: usize,
+    /// Signed volume from the facets' orientation (negative: the mesh is inside out).
+    pub signed_volume: f64,
+    /// Connected pieces of the surface.
+    pub bodies: usize,
+    /// Vertices merged by the tolerance weld (0 when exact welding closed the surface).
+    pub tolerance_welded: usize,
+    /// Facets dropped because they repeat another facet.
+    pub duplicate_facets: usize,
+    /// Closed shells that were inside out (negative volume) and not inside another shell:
+    /// turned outward (see [`Mesh::orient_shells`]).
+    pub flipped_shells: usize,
+    /// Closed inside-out shells inside another closed shell: kept as cavities.
+    pub cavity_shells: usize,
+    /// Inside-out shells left as they were because checking them would have taken too long.
+    pub unchecked_shells: usize,
+}
+
+/// What [`Mesh::orient_shells`] found and did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShellOrientation {
+    /// Closed shells: every edge shared by exactly two facets running along it in opposite
+    /// directions.
+    pub closed: usize,
+    /// The other shells (open, non-manifold or with flipped facets): left to the slicer's
+    /// majority rule.
+    pub open: usize,
+    /// Inside-out closed shells outside every other closed shell, turned outward.
+    pub flipped: usize,
+    /// Inside-out closed shells inside another closed shell, kept as cavities.
+    pub cavities: usize,
+    /// Inside-out closed shells not checked (over [`ENCLOSURE_BUDGET`]), left as they were.
+    pub unchecked: usize,
+    /// Sum of every closed shell's |volume| (mm³) after orientation: an upper bound of the
+    /// solid they enclose (overlaps count twice, cavities are not subtracted).
+    pub closed_volume: f64,
+}
+
+/// Most facet evaluations spent on deciding which inside-out shells lie inside other shells
+/// (about half a second): a file with very many inverted shells inside big ones keeps the
+/// rest as they are instead of stalling.
+pub const ENCLOSURE_BUDGET: u64 = 60_000_000;
+
+impl Mesh {
+    /// Welds corners whose float32 coordinates are bit-identical (−0 = +0) and drops facets
+    /// that collapse to a line or a point.
+    pub fn weld(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
+        let mut index: HashMap<[u32; 3], u32> =
+            HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
+        let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
+        let mut facets = Vec::with_capacity(tris.len());
+        let mut degenerate = 0;
+        for t in tris {
+            let ids = t.map(|p| {
+                let key = p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() });
+                *index.entry(key).or_insert_with(|| {
+                    vertices.push(p.map(f64::from));
+                    (vertices.len() - 1) as u32
+                })
+            });
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                degenerate += 1;
+            } else {
+                facets.push(ids);
+            }
+        }
+        (Mesh { vertices, facets }, degenerate)
+    }
+
+    pub fn bounds(&self) -> Bounds {
+        let mut min = [f64::INFINITY; 3];
+        let mut max = [f64::NEG_INFINITY; 3];
+        for v in &self.vertices {
+            for k in 0..3 {
+                min[k] = min[k].min(v[k]);
+                max[k] = max[k].max(v[k]);
+            }
+        }
+        Bounds { min, max }
+    }
+
+    /// Applies SPEC.md's transforms: rotate about x, y, z (in that order), scale, move the
+    /// bounding box minimum to the origin, then rotate by `place_angle` about the z axis
+    /// through the origin and move by (`place_x`, `place_y`).
+    pub fn transform(&mut self, s: &Settings) {
+        self.place(&Placement::of_settings(s));
+    }
+
+    /// [`Mesh::transform`] with the values of a [`Placement`] (a build job's part).
+    pub fn place(&mut self, p: &Placement) {
+        let r = rotation(p.rotate);
+        let scale = DVec3::from(p.scale);
+        for v in &mut self.vertices {
+            *v = (r * DVec3::from(*v) * scale).to_array();
+        }
+        let b = self.bounds();
+        let place = rot(2, p.place_angle);
+        let min = DVec3::from(b.min);
+        for v in &mut self.vertices {
+            let q = place * (DVec3::from(*v) - min);
+            *v = [q.x + p.place[0], q.y + p.place[1], q.z];
+        }
+    }
+
+    /// Drops facets that repeat another facet with the same orientation (the same three
+    /// vertices in the same cyclic order). Two copies of opposite orientation are kept: they are
+    /// the shared face of two touching bodies, and each closes its own body's surface.
+    /// Returns how many were dropped.
+    pub fn remove_duplicate_facets(&mut self) -> usize {
+        let before = self.facets.len();
+        self.remove_duplicate_facets_kept();
+        before - self.facets.len()
+    }
+
+    /// [`remove_duplicate_facets`](Self::remove_duplicate_facets), returning which of the
+    /// facets before were kept (the others keep their order).
+    pub fn remove_duplicate_facets_kept(&mut self) -> Vec<bool> {
+        let before = self.facets.len();
+        let mut seen = HashSet::with_capacity_and_hasher(before, Default::default());
+        let kept: Vec<bool> = self
+            .facets
+            .iter()
+            .map(|f| {
+                // The cyclic rotation starting at the smallest vertex id.
+                let k = f
+                    .iter()
+                    .enumerate()
+                    .min_by_key(|(_, v)| **v)
+                    .map_or(0, |(k, _)| k);
+                seen.insert([f[k], f[(k + 1) % 3], f[(k + 2) % 3]])
+            })
+            .collect();
+        let mut it = kept.iter();
+        self.facets.retain(|_| *it.next().unwrap_or(&true));
+        kept
+    }
+
+    /// Merges vertices closer than `tol` (mm) to an earlier vertex (cracks left by exporters
+    /// that write near-coincident corners), drops facets that collapse, and returns how many
+    /// vertices were merged. Used only as a fallback when the exact weld leaves open edges.
+    pub fn weld_tolerance(&mut self, tol: f64) -> usize {
+        self.weld_tolerance_kept(tol).0
+    }
+
+    /// [`weld_tolerance`](Self::weld_tolerance), also returning which of the facets before
+    /// were kept (the others keep their order).
+    pub fn weld_tolerance_kept(&mut self, tol: f64) -> (usize, Vec<bool>) {
+        let cell = |p: &[f64; 3]| p.map(|c| (c / tol).floor() as i64);
+        let mut grid: HashMap<[i64; 3], Vec<u32>> =
+            HashMap::with_capacity_and_hasher(self.vertices.len(), Default::default());
+        let mut remap: Vec<u32> = Vec::with_capacity(self.vertices.len());
+        let mut kept: Vec<[f64; 3]> = Vec::with_capacity(self.vertices.len());
+        let mut merged = 0;
+        for v in &self.vertices {
+            let c = cell(v);
+            let mut found = None;
+            'search: for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(ids) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                            for &id in ids {
+                                let w = kept[id as usize];
+                                let d2 = (0..3).map(|k| (w[k] - v[k]).powi(2)).sum::<f64>();
+                                if d2 <= tol * tol {
+                                    found = Some(id);
+                                    break 'search;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            let id = found.unwrap_or_else(|| {
+                kept.push(*v);
+                let id = (kept.len() - 1) as u32;
+                grid.entry(c).or_default().push(id);
+                id
+            });
+            if found.is_some() {
+                merged += 1;
+            }
+            remap.push(id);
+        }
+        self.vertices = kept;
+        let facets: Vec<[u32; 3]> = self
+            .facets
+            .iter()
+            .map(|f| f.map(|i| remap[i as usize]))
+            .collect();
+        let alive: Vec<bool> = facets
+            .iter()
+            .map(|f| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+            .collect();
+        self.facets = facets
+            .into_iter()
+            .zip(&alive)
+            .filter_map(|(f, &a)| a.then_some(f))
+            .collect();
+        (merged, alive)
+    }
+
+    /// Number of connected bodies (facets sharing a vertex belong to one body).
+    pub fn bodies(&self) -> usize {
+        let root = self.vertex_components();
+        let mut used = vec![false; self.vertices.len()];
+        for f in &self.facets {
+            used[root[f[0] as usize] as usize] = true;
+        }
+        used.iter().filter(|&&u| u).count()
+    }
+
+    /// Volume enclosed by the facets, signed by their orientation (negative: inside out).
+    pub fn signed_volume(&self) -> f64 {
+        self.facets
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| self.vertices[i as usize]);
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum()
+    }
+
+    /// Orients every closed shell by its signed volume, as the part's author meant it: a
+    /// closed shell that is inside out (negative volume) and lies inside no other closed shell
+    /// is turned outward (its facets reversed); one that lies inside another closed shell is a
+    /// cavity and stays as it is. Shells that are not closed keep their facets (the slicer
+    /// orients their loops by the majority of their facets).
+    ///
+    /// Shells are the connected pieces of the surface (facets sharing a vertex). "Inside" is
+    /// decided by the winding number of the other shell around a point of this one (the sum
+    /// of the solid angles of its facets), which needs no ray and no tolerance.
+    pub fn orient_shells(&mut self) -> ShellOrientation {
+        let mut out = ShellOrientation::default();
+        if self.facets.is_empty() {
+            return out;
+        }
+        let (facet_shell, closed) = self.edge_shells();
+        let shells = closed.len();
+        // Volumes (about a point near the mesh, for precision) and bounding boxes per shell.
+        let b = self.bounds();
+        let o = [0, 1, 2].map(|k| 0.5 * (b.min[k] + b.max[k]));
+        let mut volume = vec![0.0f64; shells];
+        let mut bmin = vec![[f64::INFINITY; 3]; shells];
+        let mut bmax = vec![[f64::NEG_INFINITY; 3]; shells];
+        let mut first_facet = vec![usize::MAX; shells];
+        let mut facet_count = vec![0u64; shells];
+        for (fi, f) in self.facets.iter().enumerate() {
+            let s = facet_shell[fi] as usize;
+            let [p, q, r] = f.map(|i| {
+                let v = self.vertices[i as usize];
+                [v[0] - o[0], v[1] - o[1], v[2] - o[2]]
+            });
+            volume[s] += dot(p, cross(q, r)) / 6.0;
+            for v in f.map(|i| self.vertices[i as usize]) {
+                for k in 0..3 {
+                    bmin[s][k] = bmin[s][k].min(v[k]);
+                    bmax[s][k] = bmax[s][k].max(v[k]);
+                }
+            }
+            if first_facet[s] == usize::MAX {
+                first_facet[s] = fi;
+            }
+            facet_count[s] += 1;
+        }
+        out.closed = closed.iter().filter(|&&c| c).count();
+        out.open = shells - out.closed;
+        // Each inverted closed shell: inside another closed shell?
+        let mut flip = vec![false; shells];
+        let mut budget = ENCLOSURE_BUDGET;
+        let candidates: Vec<usize> = (0..shells).filter(|&s| closed[s]).collect();
+        let inverted = (0..shells).any(|s| closed[s] && volume[s] < 0.0);
+        // The facets of each shell, grouped (counting sort), when any shell needs checking.
+        let mut start = vec![0usize; shells + 1];
+        let mut grouped: Vec<u32> = Vec::new();
+        if inverted {
+            for &sh in &facet_shell {
+                start[sh as usize + 1] += 1;
+            }
+            for k in 0..shells {
+                start[k + 1] += start[k];
+            }
+            let mut next = start.clone();
+            grouped = vec![0; self.facets.len()];
+            for (fi, &sh) in facet_shell.iter().enumerate() {
+                grouped[next[sh as usize]] = fi as u32;
+                next[sh as usize] += 1;
+            }
+        }
+        for s in (0..shells).filter(|&s| closed[s] && volume[s] < 0.0) {
+            let f = self.facets[first_facet[s]].map(|i| self.vertices[i as usize]);
+            let p = [0, 1, 2].map(|k| (f[0][k] + f[1][k] + f[2][k]) / 3.0);
+            let around: Vec<usize> = candidates
+                .iter()
+                .copied()
+                .filter(|&t| t != s && (0..3).all(|k| bmin[t][k] <= p[k] && p[k] <= bmax[t][k]))
+                .collect();
+            let cost: u64 = around.iter().map(|&t| facet_count[t]).sum();
+            if cost > budget {
+                out.unchecked += 1;
+                continue;
+            }
+            budget -= cost;
+            let inside = around.iter().any(|&t| {
+                self.winding_number(&grouped[start[t]..start[t + 1]], p)
+                    .abs()
+                    > 0.5
+            });
+            if inside {
+                out.cavities += 1;
+            } else {
+                flip[s] = true;
+                out.flipped += 1;
+            }
+        }
+        if out.flipped > 0 {
+            for (fi, f) in self.facets.iter_mut().enumerate() {
+                if flip[facet_shell[fi] as usize] {
+                    f.swap(1, 2);
+                }
+            }
+        }
+        out.closed_volume = (0..shells)
+            .filter(|&s| closed[s])
+            .map(|s| volume[s].abs())
+            .sum();
+        out
+    }
+
+    /// The shells: pieces of the surface connected through edges shared by exactly two facets
+    /// (two bodies touching at a vertex or along a non-manifold edge stay apart). Returns the
+    /// shell of every facet and, per shell, whether it is closed: each of its edges shared by
+    /// exactly two facets running along it in opposite directions.
+    fn edge_shells(&self) -> (Vec<u32>, Vec<bool>) {
+        let nf = self.facets.len();
+        // Facets around each vertex (compressed rows).
+        let mut start = vec![0u32; self.vertices.len() + 1];
+        for f in &self.facets {
+            for &v in f {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for k in 0..self.vertices.len() {
+            start[k + 1] += start[k];
+        }
+        let mut next = start.clone();
+        let mut around = vec![0u32; 3 * nf];
+        for (fi, f) in self.facets.iter().enumerate() {
+            for &v in f {
+                around[next[v as usize] as usize] = fi as u32;
+                next[v as usize] += 1;
+            }
+        }
+        drop(next);
+        let mut parent: Vec<u32> = (0..nf as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        let mut bad: Vec<u32> = Vec::new();
+        for (fi, f) in self.facets.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                // The other facets with the edge a–b, and whether they run b→a.
+                let (mut others, mut opposite, mut other) = (0, true, 0u32);
+                for &g in &around[start[a as usize] as usize..start[a as usize + 1] as usize] {
+                    if g as usize == fi {
+                        continue;
+                    }
+                    let h = self.facets[g as usize];
+                    if let Some(j) = h.iter().position(|&v| v == b) {
+                        others += 1;
+                        other = g;
+                        opposite &= h[(j + 1) % 3] == a;
+                    }
+                }
+                if others == 1 && opposite {
+                    let (x, y) = (find(&mut parent, fi as u32), find(&mut parent, other));
+                    if x != y {
+                        parent[y as usize] = x;
+                    }
+                } else {
+                    bad.push(fi as u32);
+                }
+            }
+        }
+        drop(around);
+        let mut id = vec![u32::MAX; nf];
+        let mut shells = 0u32;
+        let facet_shell: Vec<u32> = (0..nf as u32)
+            .map(|fi| {
+                let r = find(&mut parent, fi) as usize;
+                if id[r] == u32::MAX {
+                    id[r] = shells;
+                    shells += 1;
+                }
+                id[r]
+            })
+            .collect();
+        let mut closed = vec![true; shells as usize];
+        for f in bad {
+            closed[facet_shell[f as usize] as usize] = false;
+        }
+        (facet_shell, closed)
+    }
+
+    /// The winding number of the closed surface made of `facets` around `p`: ±1 inside, 0
+    /// outside (the sum of the facets' signed solid angles over 4π, Van Oosterom & Strackee).
+    fn winding_number(&self, facets: &[u32], p: [f64; 3]) -> f64 {
+        let mut sum = 0.0;
+        for &fi in facets {
+            let [a, b, c] = self.facets[fi as usize].map(|i| {
+                let v = self.vertices[i as usize];
+                [v[0] - p[0], v[1] - p[1], v[2] - p[2]]
+            });
+            let (la, lb, lc) = (norm(a), norm(b), norm(c));
+            let num = dot(a, cross(b, c));
+            let den = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la;
+            sum += 2.0 * num.atan2(den);
+        }
+        sum / (4.0 * std::f64::consts::PI)
+    }
+
+    /// The connected piece (a root vertex id) of every vertex; facets sharing a vertex are in
+    /// one piece.
+    fn vertex_components(&self) -> Vec<u32> {
+        let mut parent: Vec<u32> = (0..self.vertices.len() as u32).collect();
+        fn find(p: &mut [u32], mut x: u32) -> u32 {
+            while p[x as usize] != x {
+                p[x as usize] = p[p[x as usize] as usize];
+                x = p[x as usize];
+            }
+            x
+        }
+        for f in &self.facets {
+            let a = find(&mut parent, f[0]);
+            for &v in &f[1..] {
+                let b = find(&mut parent, v);
+                if a != b {
+                    parent[b as usize] = a;
+                }
+            }
+        }
+        for v in 0..parent.len() as u32 {
+            let r = find(&mut parent, v);
+            parent[v as usize] = r;
+        }
+        parent
+    }
+
+    /// Edge statistics and signed volume.
+    pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
+        // Directed edges, sorted by their undirected key.
+        // Directed edges as (undirected key << 1 | direction), sorted: 8 bytes an edge, which
+        // matters at millions of facets. Vertex ids stay below 2^31 (at most 3 per facet, and
+        // files over 20 million facets are refused), so the shift loses nothing.
+        let mut edges: Vec<u64> = Vec::with_capacity(self.facets.len() * 3);
+        for f in &self.facets {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                edges.push(edge_key(a, b) << 1 | u64::from(a < b));
+            }
+        }
+        edges.sort_unstable();
+        let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
+        for group in edges.chunk_by(|x, y| x >> 1 == y >> 1) {
+            match group.len() {
+                1 => open += 1,
+                2 => {
+                    if group[0] & 1 == group[1] & 1 {
+                        misoriented += 1
+                    }
+                }
+                _ => nonmanifold += 1,
+            }
+        }
+        let signed_volume = self.signed_volume();
+        MeshStats {
+            facets_in_file,
+            facets: self.facets.len(),
+            vertices: self.vertices.len(),
+            degenerate_facets: degenerate,
+            open_edges: open,
+            nonmanifold_edges: nonmanifold,
+            misoriented_edges: misoriented,
+            signed_volume,
+            bodies: self.bodies(),
+            tolerance_welded: 0,
+            duplicate_facets: 0,
+            flipped_shells: 0,
+            cavity_shells: 0,
+            unchecked_shells: 0,
+        }
+    }
+}
+
+/// Undirected edge key of two vertex ids.
+pub fn edge_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Rotation about axis `axis` (0 x, 1 y, 2 z) by `deg` degrees; exact for multiples of 90°.
+/// A part's transform (SPEC.md): rotate about x, y, z (degrees, in that order), scale, bounding
+/// box minimum to the origin, rotate by `place_angle` (degrees) about z, move by `place`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    pub rotate: [f64; 3],
+    pub scale: [f64; 3],
+    pub place_angle: f64,
+    pub place: [f64; 2],
+}
+
+impl Placement {
+    /// The settings' `rotate_*`, `scale_*`, `place_*`.
+    pub fn of_settings(s: &Settings) -> Placement {
+        Placement {
+            rotate: [s.rotate_x, s.rotate_y, s.rotate_z],
+            scale: [s.scale_x, s.scale_y, s.scale_z],
+            place_angle: s.place_angle,
+            place: [s.place_x, s.place_y],
+        }
+    }
+}
+
+/// The rotation of [`Mesh::place`]: about x, then y, then z (degrees).
+pub fn rotation(rotate: [f64; 3]) -> DMat3 {
+    rot(2, rotate[2]) * (rot(1, rotate[1]) * rot(0, rotate[0]))
+}
+
+/// The rotation about one axis (0 = x, 1 = y, 2 = z) by `deg` degrees (exact at right angles).
+pub fn rot(axis: usize, deg: f64) -> DMat3 {
+    let (s, c) = sin_cos_deg(deg);
+    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    // Rows, then transposed into glam's columns.
+    let mut m = [[0.0; 3]; 3];
+    m[axis][axis] = 1.0;
+    m[i][i] = c;
+    m[j][j] = c;
+    m[i][j] = -s;
+    m[j][i] = s;
+    DMat3::from_cols_array_2d(&m).transpose()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_is_exact_at_right_angles() {
+        let mut m = Mesh {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 2.0, 3.0]],
+            facets: vec![],
+        };
+        let s = Settings {
+            rotate_x: 90.0,
+            ..Settings::default()
+        };
+        m.transform(&s);
+        // (1,2,3) about x by 90°: (1,-3,2); then min (0,-3,0) moves to the origin.
+        assert_eq!(m.vertices[1], [1.0, 0.0, 2.0]);
+        assert_eq!(m.vertices[0], [0.0, 3.0, 0.0]);
+    }
+}

@@ -1,0 +1,246 @@
+//! Write code, stage 6 (SPEC.md 4.5, 5.3.6): the header and each [`LayerPlan`] as `.gco` text.
+//! Coordinates have exactly 4 decimals; `G01` travel, `G25` a line of droplets, `G26` one
+//! droplet. The header lists every setting, the input file, the version and a summary; it is
+//! written before any layer, with fixed-width placeholders for the droplet counts that
+//! [`header`] fills in once the slice is done (same length, so a file can be patched in place).
+
+use crate::base::geom::{OUTPUT_DECIMALS, OUTPUT_SCALE, OUTPUT_SCALE_INT};
+use crate::base::settings::Settings;
+pub use crate::output::summary::Summary;
+use crate::slicing::plan::{LayerPlan, MoveKind};
+use std::fmt::Write;
+
+/// What the header says about the input.
+#[derive(Clone, Debug)]
+pub struct HeaderInput<'a> {
+    pub file_name: &'a str,
+    pub facets: usize,
+    pub layers: usize,
+    /// Bounding box of the placed part (min, max).
+    pub bounds: ([f64; 3], [f64; 3]),
+    pub warnings: &'a [String],
+    /// Every copy of every part (one line each).
+    pub instances: &'a [crate::model::spec::Instance],
+    /// Whether discharge unit 1 prints anything (its settings are listed only then).
+    pub unit1_used: bool,
+}
+
+/// Width of the droplet count fields in the header.
+const COUNT_WIDTH: usize = 12;
+
+/// `x` with [`OUTPUT_DECIMALS`] (4) decimals, never `-0.0000`.
+pub fn coord(x: f64) -> String {
+    let mut s = String::with_capacity(12);
+    push_coord(&mut s, x);
+    s
+}
+
+/// Appends `x` rounded to [`OUTPUT_DECIMALS`] (4) decimals (half away from zero), never
+/// `-0.0000`. Much faster than `format!("{x:.4}")`, which matters for files with millions of
+/// droplets.
+pub fn push_coord(out: &mut String, x: f64) {
+    const _: () = assert!(OUTPUT_DECIMALS == 4, "push_coord writes 4 digits");
+    let v = (x * OUTPUT_SCALE).round();
+    if !v.is_finite() || v.abs() >= 1e15 {
+        let _ = write!(out, "{x:.OUTPUT_DECIMALS$}");
+        return;
+    }
+    let v = v as i64;
+    if v < 0 {
+        out.push('-');
+    }
+    let v = v.unsigned_abs();
+    let (int, frac) = (v / OUTPUT_SCALE_INT, v % OUTPUT_SCALE_INT);
+    let _ = write!(out, "{int}.");
+    let digits = [frac / 1000, frac / 100 % 10, frac / 10 % 10, frac % 10];
+    for d in digits {
+        out.push((b'0' + d as u8) as char);
+    }
+}
+
+/// The header comment block. With `summary = None` the droplet counts are placeholders of
+/// the same width, so the final header has exactly the same length.
+pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> String {
+    let mut h = String::new();
+    let field = |v: Option<u64>| match v {
+        Some(v) => format!("{v:>COUNT_WIDTH$}"),
+        None => format!("{:>COUNT_WIDTH$}", "pending"),
+    };
+    let c = summary.map(|s| s.counts);
+    let b = s.droplet_width();
+    let _ = writeln!(
+        h,
+        "; dropslice {} — droplet machine code (G01 travel, G25 droplet line, G26 droplet)",
+        crate::VERSION
+    );
+    let _ = writeln!(
+        h,
+        "; input = {}",
+        input.file_name.replace(['\n', '\r'], " ")
+    );
+    let _ = writeln!(h, "; facets = {}", input.facets);
+    let (lo, hi) = input.bounds;
+    let _ = writeln!(
+        h,
+        "; bounding box = X{}..{} Y{}..{} Z{}..{} mm",
+        coord(lo[0]),
+        coord(hi[0]),
+        coord(lo[1]),
+        coord(hi[1]),
+        coord(lo[2]),
+        coord(hi[2])
+    );
+    let _ = writeln!(h, "; layers = {}", input.layers);
+    let _ = writeln!(
+        h,
+        "; droplet width B = {} mm, height H = {} mm",
+        coord(b),
+        coord(s.layer_height)
+    );
+    let _ = writeln!(h, "; droplets outer loops = {}", field(c.map(|c| c.outer)));
+    let _ = writeln!(h, "; droplets inner loops = {}", field(c.map(|c| c.inner)));
+    let _ = writeln!(h, "; droplets fill        = {}", field(c.map(|c| c.fill)));
+    if input.unit1_used {
+        let _ = writeln!(
+            h,
+            "; droplets support     = {}",
+            field(c.map(|c| c.support))
+        );
+        let _ = writeln!(h, "; droplets of unit 1   = {}", field(c.map(|c| c.unit1)));
+    }
+    let _ = writeln!(
+        h,
+        "; droplets total       = {}",
+        field(c.map(|c| c.total()))
+    );
+    for p in input.instances {
+        let _ = writeln!(h, "; {}", part_line(p));
+    }
+    for w in input.warnings {
+        let _ = writeln!(h, "; warning: {}", w.replace(['\n', '\r'], " "));
+    }
+    let _ = writeln!(h, "; settings:");
+    for (name, value, unit) in s.entries_with(input.unit1_used) {
+        if unit.is_empty() {
+            let _ = writeln!(h, "; {name} = {value}");
+        } else {
+            let _ = writeln!(h, "; {name} = {value} ({unit})");
+        }
+    }
+    let _ = writeln!(h, "; end of header");
+    h
+}
+
+/// An instance as the header lists it: `part 1 = gear.3mf (object 3), rotate 0/0/90 deg,
+/// scale 1/1/1, at X30.0000 Y5.0000, angle 0 deg, copy 1 of 2, unit 0`.
+pub fn part_line(p: &crate::model::spec::Instance) -> String {
+    let clean = |s: &str| crate::model::spec::clean_name(s);
+    let what = match (&p.object, p.item) {
+        (Some(o), _) => format!(" (object {})", clean(o)),
+        (None, Some(i)) => format!(" (item {i})"),
+        (None, None) => String::new(),
+    };
+    let name = if crate::model::import::stem(&p.file) == p.name {
+        String::new()
+    } else {
+        format!(" \"{}\"", clean(&p.name))
+    };
+    let [rx, ry, rz] = p.rotate;
+    let [sx, sy, sz] = p.scale;
+    format!(
+        "part {} = {}{what}{name}, rotate {rx}/{ry}/{rz} deg, scale {sx}/{sy}/{sz}, at X{} Y{}{}, angle {} deg, copy {} of {}, unit {}",
+        p.part + 1,
+        clean(&p.file),
+        coord(p.at[0]),
+        coord(p.at[1]),
+        if p.placed { "" } else { " (arranged)" },
+        p.place_angle,
+        p.copy + 1,
+        p.copies,
+        p.unit
+    )
+}
+
+/// One layer's commands, with a `T` line wherever the unit changes within the layer (none
+/// before its first move: see [`layer_text_after`]).
+pub fn layer_text(plan: &LayerPlan) -> String {
+    layer_text_after(plan, plan.first_unit().unwrap_or(0))
+}
+
+/// One layer's commands after a layer that left unit `before` selected: a `T` line (right
+/// after the layer's comment line) wherever the unit of the next move differs from the one
+/// selected, and nowhere else (SPEC.md "Two discharge units").
+pub fn layer_text_after(plan: &LayerPlan, before: u8) -> String {
+    let mut t = String::with_capacity(plan.moves.len() * 34 + 40);
+    let z = coord(plan.z);
+    let _ = writeln!(t, "; layer {} z = {}", plan.index + 1, z);
+    let mut unit = before;
+    for m in &plan.moves {
+        if m.unit != unit {
+            unit = m.unit;
+            let _ = writeln!(t, "T{unit}");
+        }
+        t.push_str(match m.kind {
+            MoveKind::Travel => "G01 X",
+            MoveKind::Droplet => "G26 X",
+            MoveKind::Line => "G25 X",
+        });
+        push_coord(&mut t, m.to[0]);
+        t.push_str(" Y");
+        push_coord(&mut t, m.to[1]);
+        t.push_str(" Z");
+        t.push_str(&z);
+        t.push('\n');
+    }
+    t
+}
+
+/// Puts a `T{unit}` line after the first line (the layer's comment) of a layer's text made by
+/// [`layer_text`], for a layer that follows one which left another unit selected.
+pub fn insert_unit_line(text: &mut String, unit: u8) {
+    let at = text.find('\n').map_or(text.len(), |i| i + 1);
+    text.insert_str(at, &format!("T{unit}\n"));
+}
+
+/// Closing comments: the totals and what slicing repaired.
+pub fn footer(summary: &Summary) -> String {
+    let mut f = format!(
+        "; end of code: {} layers, {} droplets ({} outer loops, {} inner loops, {} fill)\n",
+        summary.layers,
+        summary.counts.total(),
+        summary.counts.outer,
+        summary.counts.inner,
+        summary.counts.fill
+    );
+    if summary.counts.unit1 > 0 {
+        let _ = writeln!(
+            f,
+            "; unit 1: {} droplets ({} of them support)",
+            summary.counts.unit1, summary.counts.support
+        );
+    }
+    for r in summary.repairs() {
+        let _ = writeln!(f, "; repaired: {r}");
+    }
+    f
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coordinates_have_four_decimals() {
+        for (x, s) in [
+            (0.0, "0.0000"),
+            (-0.00001, "0.0000"),
+            (0.312, "0.3120"),
+            (-1.23456, "-1.2346"),
+            (19.99999, "20.0000"),
+            (123456.7, "123456.7000"),
+            (-0.5, "-0.5000"),
+        ] {
+            assert_eq!(coord(x), s, "{x}");
+        }
+    }
+}

@@ -1,0 +1,603 @@
+//! Reading `.gco` back: machine code → layers of droplet centres, roles and travel moves (the
+//! page's viewer of existing files; later `dropslice calibrate PART.gco`).
+//!
+//! `G01` travels, `G25` sets droplets every B on the line from the current position (the first
+//! at the current position: [`crate::base::geom::line_droplets`], as the plan counts them), `G26`
+//! travels and sets one droplet. B = `layer_height` × `droplet_aspect`, read from the header's
+//! `; name = value` lines before the first command. G-code does not say which loop a droplet
+//! belongs to: every `G26` droplet counts as a loop droplet (role 0), every `G25` droplet as
+//! fill (role 2). A new layer starts where Z changes by more than 1e-6 mm. `T0`/`T1` select
+//! the discharge unit of the commands that follow (a file starts with unit 0); every droplet
+//! is tagged with its unit ([`ReadLayer::units`]), and unit 1's `G25` lines set droplets every
+//! B₁ = `layer_height` × `unit1_droplet_aspect` (default 1.04).
+//!
+//! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
+//! filling its memory, and every refusal names the line and the reason.
+
+use crate::base::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
+use crate::output::preview::PreviewLayer;
+use crate::slicing::plan::Counts;
+use std::collections::VecDeque;
+
+/// Coordinates beyond ±100 m are refused (no printer is that big; far beyond, the view and
+/// the float32 droplet arrays lose all precision).
+pub const MAX_COORD_MM: f64 = 1e5;
+/// Droplets expanded from one file (G25 lines and G26): 50 million, about 450 MB in the page.
+/// Checked before a line is expanded.
+pub const MAX_DROPLETS: u64 = 50_000_000;
+/// A line longer than this (1 MB) is refused rather than gathered in memory.
+pub const MAX_LINE_CHARS: usize = 1 << 20;
+/// Travel moves (G01) kept for drawing: 20 million, about 320 MB.
+pub const MAX_TRAVEL_MOVES: u64 = 20_000_000;
+/// Layers (distinct heights): 100,000, e.g. 1 m at 0.01 mm.
+pub const MAX_LAYERS: usize = 100_000;
+
+crate::base::error::message_error! {
+    /// Why a file was refused.
+    GcodeError
+}
+
+/// One layer read from a file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReadLayer {
+    /// Layer number from 0, in file order.
+    pub index: usize,
+    pub z: f64,
+    pub counts: Counts,
+    /// Length of the moves without material (G01, and G26's way to its droplet), mm.
+    pub travel_mm: f64,
+    /// Droplet centres, roles and travel moves, as the slicer's preview gives them.
+    pub preview: PreviewLayer,
+    /// The discharge unit of each droplet (0 or 1), in the order of `preview.roles`.
+    pub units: Vec<u8>,
+}
+
+/// Streaming reader: feed text or lines, take finished layers.
+#[derive(Debug, Default)]
+pub struct GcodeReader {
+    /// The header's `name = value` lines before the first command, in file order.
+    pub header: Vec<(String, String)>,
+    width: f64,
+    /// B₁, unit 1's droplet width.
+    width1: f64,
+    /// The selected discharge unit.
+    unit: u8,
+    at: DVec2,
+    z: f64,
+    layer: Option<ReadLayer>,
+    index: usize,
+    line_no: usize,
+    commands: u64,
+    droplets: u64,
+    travels: u64,
+    rest: String,
+    done: VecDeque<ReadLayer>,
+    /// The header's `; droplets total = N`, if it has one (not the placeholder `pending`).
+    header_droplets: Option<u64>,
+    /// Count only: no droplet positions, roles or travel kept (`dropslice calibrate`).
+    counts_only: bool,
+}
+
+/// The header's droplet size must lie within the settings' ranges (greater than 0, at most
+/// this).
+fn header_max(name: &str) -> Option<(f64, &'static str)> {
+    let spec = crate::base::settings::schema().into_iter().find(|s| {
+        s.name == name
+            && matches!(
+                name,
+                "layer_height" | "droplet_aspect" | "unit1_droplet_aspect"
+            )
+    })?;
+    Some((spec.max?, spec.unit))
+}
+
+fn shown(word: &str) -> String {
+    if word.chars().count() > 40 {
+        format!("{}…", word.chars().take(40).collect::<String>())
+    } else {
+        word.to_string()
+    }
+}
+
+/// `n` with thousands separators.
+fn grouped(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// A count for a message: "96 million", "1.2e+300", "12,345".
+fn count(n: f64) -> String {
+    if !n.is_finite() {
+        return "countless".into();
+    }
+    if n >= 1e15 {
+        return js_exponent(format!("{n:.1e}"));
+    }
+    if n >= 1e7 {
+        return format!("{} million", grouped((n / 1e6).round() as u64));
+    }
+    grouped(n as u64)
+}
+
+/// Rust's `1e-7` / `1e21` as JavaScript writes them (`1e-7`, `1e+21`).
+fn js_exponent(s: String) -> String {
+    match s.split_once('e') {
+        Some((m, e)) if !e.starts_with('-') => format!("{m}e+{e}"),
+        _ => s,
+    }
+}
+
+/// `v` to `digits` significant digits, written as JavaScript writes a number.
+fn precise(v: f64, digits: usize) -> String {
+    let r: f64 = format!("{:.*e}", digits - 1, v).parse().unwrap_or(v);
+    if r != 0.0 && (r.abs() < 1e-6 || r.abs() >= 1e21) {
+        js_exponent(format!("{r:e}"))
+    } else {
+        format!("{r}")
+    }
+}
+
+impl GcodeReader {
+    pub fn new() -> GcodeReader {
+        GcodeReader {
+            width: f64::NAN,
+            width1: f64::NAN,
+            ..GcodeReader::default()
+        }
+    }
+
+    /// A reader that only counts: layers come without droplet positions, roles and travel.
+    pub fn counting() -> GcodeReader {
+        GcodeReader {
+            counts_only: true,
+            ..GcodeReader::new()
+        }
+    }
+
+    /// Droplets the commands set so far (G26 one each, G25 as [`crate::base::geom::line_droplets`]).
+    pub fn droplets(&self) -> u64 {
+        self.droplets
+    }
+
+    /// The header's droplet total (`; droplets total = N`), if it gives one.
+    pub fn header_droplets(&self) -> Option<u64> {
+        self.header_droplets
+    }
+
+    /// Droplet width B from the header (NaN before it is known).
+    pub fn droplet_width(&self) -> f64 {
+        self.width
+    }
+
+    /// Layers finished so far.
+    pub fn layers(&self) -> usize {
+        self.index
+    }
+
+    /// Lines read so far.
+    pub fn line_number(&self) -> usize {
+        self.line_no
+    }
+
+    /// The header's value of `name`.
+    pub fn header_value(&self, name: &str) -> Option<&str> {
+        self.header
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_str())
+    }
+
+    /// The next finished layer, if any.
+    pub fn take_layer(&mut self) -> Option<ReadLayer> {
+        self.done.pop_front()
+    }
+
+    /// Reads a piece of the file (any split, lines ending in `\n`).
+    pub fn feed(&mut self, text: &str) -> Result<(), GcodeError> {
+        let mut text = text;
+        while let Some(nl) = text.find('\n') {
+            if self.rest.is_empty() {
+                self.line(&text[..nl])?;
+            } else {
+                let mut line = std::mem::take(&mut self.rest);
+                line.push_str(&text[..nl]);
+                self.line(&line)?;
+            }
+            text = &text[nl + 1..];
+        }
+        self.rest.push_str(text);
+        if self.rest.len() > MAX_LINE_CHARS && self.rest.chars().count() > MAX_LINE_CHARS {
+            return Err(GcodeError(format!(
+                "line {} is longer than {} characters; this is not a G-code file this viewer reads",
+                self.line_no + 1,
+                grouped(MAX_LINE_CHARS as u64)
+            )));
+        }
+        Ok(())
+    }
+
+    /// Reads one line.
+    pub fn line(&mut self, raw: &str) -> Result<(), GcodeError> {
+        self.line_no += 1;
+        let no = self.line_no;
+        let line = raw.trim();
+        if line.is_empty() {
+            return Ok(());
+        }
+        if let Some(c) = line.strip_prefix(';') {
+            return self.comment(c.trim());
+        }
+        if let Some(n) = line.strip_prefix(['T', 't']) {
+            let n = n.split(';').next().unwrap_or("").trim();
+            self.unit = match n {
+                "0" => 0,
+                "1" => 1,
+                _ => {
+                    return Err(GcodeError(format!(
+                        "line {no}: \"{}\" selects a discharge unit this slicer does not have: only T0 and T1 are known",
+                        shown(line)
+                    )));
+                }
+            };
+            return Ok(());
+        }
+        let code = line.get(..3).map(str::to_ascii_uppercase);
+        let code = match code.as_deref() {
+            Some(c @ ("G01" | "G25" | "G26")) => c.to_string(),
+            _ => {
+                return Err(GcodeError(format!(
+                    "line {no}: \"{}\" is not a G01, G25 or G26 command",
+                    line.chars().take(40).collect::<String>()
+                )));
+            }
+        };
+        if self.width.is_nan() || self.width <= 0.0 {
+            return Err(GcodeError(
+                "the header does not give the droplet size (lines '; layer_height = …' and '; droplet_aspect = …' are needed before the first command)".into(),
+            ));
+        }
+        let (mut x, mut y, mut z) = (self.at.x, self.at.y, self.z);
+        for word in line[3..].split_whitespace() {
+            if word.starts_with(';') {
+                break;
+            }
+            let mut chars = word.chars();
+            let letter = chars.next().unwrap_or(' ');
+            let number = chars.as_str();
+            let v = if number.is_empty() {
+                f64::NAN
+            } else {
+                number.parse::<f64>().unwrap_or(f64::NAN)
+            };
+            if !v.is_finite() {
+                return Err(GcodeError(format!(
+                    "line {no}: bad number in \"{}\"",
+                    shown(word)
+                )));
+            }
+            if v.abs() > MAX_COORD_MM {
+                return Err(GcodeError(format!(
+                    "line {no}: the coordinate \"{}\" is too far out: this viewer reads coordinates up to ±{} mm",
+                    shown(word),
+                    grouped(MAX_COORD_MM as u64)
+                )));
+            }
+            match letter.to_ascii_uppercase() {
+                'X' => x = v,
+                'Y' => y = v,
+                'Z' => z = v,
+                _ => {
+                    return Err(GcodeError(format!(
+                        "line {no}: unknown word \"{}\"",
+                        shown(word)
+                    )));
+                }
+            }
+        }
+        let to = DVec2::new(x, y);
+        // What this line adds, checked before anything is stored.
+        let len = dist(self.at, to);
+        let width = if self.unit == 1 {
+            self.width1
+        } else {
+            self.width
+        };
+        let too_many = || {
+            GcodeError(format!(
+                "line {no}: the file holds more than {} droplets, the most this viewer expands; it was not opened",
+                count(MAX_DROPLETS as f64)
+            ))
+        };
+        let n: u64 = match code.as_str() {
+            "G25" => {
+                let n = line_droplet_count_f64(len, width);
+                if n.is_nan() || self.droplets as f64 + n > MAX_DROPLETS as f64 {
+                    return Err(if n > MAX_DROPLETS as f64 / 10.0 || !n.is_finite() {
+                        GcodeError(format!(
+                            "line {no}: a G25 of {} mm would expand to {} droplets (one every {} mm); this viewer expands at most {} droplets per file",
+                            precise(len, 6),
+                            count(n),
+                            precise(width, 4),
+                            count(MAX_DROPLETS as f64)
+                        ))
+                    } else {
+                        too_many()
+                    });
+                }
+                n as u64
+            }
+            "G26" => {
+                if self.droplets + 1 > MAX_DROPLETS {
+                    return Err(too_many());
+                }
+                1
+            }
+            _ => {
+                self.travels += 1;
+                if self.travels > MAX_TRAVEL_MOVES {
+                    return Err(GcodeError(format!(
+                        "line {no}: the file holds more than {} travel moves (G01), the most this viewer shows; it was not opened",
+                        count(MAX_TRAVEL_MOVES as f64)
+                    )));
+                }
+                0
+            }
+        };
+        self.droplets += n;
+        self.commands += 1;
+        if self.layer.as_ref().is_none_or(|l| (z - l.z).abs() > 1e-6) {
+            if self.index + 1 >= MAX_LAYERS && self.layer.is_some() {
+                return Err(GcodeError(format!(
+                    "line {no}: the file has more than {} layers (heights), the most this viewer shows; it was not opened",
+                    grouped(MAX_LAYERS as u64)
+                )));
+            }
+            self.flush();
+            self.layer = Some(ReadLayer {
+                z,
+                ..ReadLayer::default()
+            });
+        }
+        let from = self.at;
+        let keep = !self.counts_only;
+        let l = self.layer.as_mut().expect("a layer is open");
+        let p = &mut l.preview;
+        match code.as_str() {
+            "G01" => {
+                if keep {
+                    p.travel.extend([from.x, from.y, x, y].map(|v| v as f32));
+                }
+                l.travel_mm += len;
+            }
+            "G26" => {
+                if to != from {
+                    l.travel_mm += len;
+                }
+                if keep {
+                    p.droplets.extend([x as f32, y as f32]);
+                    p.roles.push(0);
+                }
+                l.counts.outer += 1;
+                l.units.push(self.unit);
+            }
+            _ => {
+                if keep {
+                    for d in line_droplets(from, to, width) {
+                        p.droplets.extend([d.x as f32, d.y as f32]);
+                        p.roles.push(2);
+                    }
+                }
+                l.counts.fill += n;
+                l.units.extend(std::iter::repeat_n(self.unit, n as usize));
+            }
+        }
+        if self.unit == 1 {
+            l.counts.unit1 += n;
+        }
+        (self.at, self.z) = (to, z);
+        Ok(())
+    }
+
+    fn comment(&mut self, text: &str) -> Result<(), GcodeError> {
+        if self.commands > 0 {
+            return Ok(());
+        }
+        // The header's droplet total (`pending` in a header that was never filled in).
+        if let Some(rest) = text.strip_prefix("droplets total") {
+            let value = rest.trim_start().strip_prefix('=').map(str::trim);
+            self.header_droplets = value.and_then(|v| v.parse::<u64>().ok());
+            return Ok(());
+        }
+        // `name = value`: a lower-case name, then the value's first word.
+        let name_len = text
+            .bytes()
+            .enumerate()
+            .take_while(|(i, b)| {
+                b.is_ascii_lowercase() || *b == b'_' || (*i > 0 && b.is_ascii_digit())
+            })
+            .count();
+        if name_len == 0 {
+            return Ok(());
+        }
+        let (name, after) = text.split_at(name_len);
+        let Some(after) = after.trim_start().strip_prefix('=') else {
+            return Ok(());
+        };
+        let Some(value) = after.split_whitespace().next() else {
+            return Ok(());
+        };
+        if let Some((max, unit)) = header_max(name) {
+            // The droplet size decides how many droplets a G25 line holds: only the core's range.
+            let v: f64 = value.parse().unwrap_or(f64::NAN);
+            if v.is_nan() || v <= 0.0 || v > max {
+                let unit = if unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" {unit}")
+                };
+                return Err(GcodeError(format!(
+                    "line {}: the header's {name} = {} is out of range: it must be greater than 0 and at most {max}{unit}",
+                    self.line_no,
+                    shown(value)
+                )));
+            }
+        }
+        match self.header.iter_mut().find(|(n, _)| n == name) {
+            Some(entry) => entry.1 = value.to_string(),
+            None => self.header.push((name.to_string(), value.to_string())),
+        }
+        let num = |n: &str| {
+            self.header_value(n)
+                .map(|v| v.parse::<f64>().unwrap_or(f64::NAN))
+        };
+        let h = num("layer_height").unwrap_or(f64::NAN);
+        let a = num("droplet_aspect").unwrap_or(1.04);
+        let a1 = num("unit1_droplet_aspect").unwrap_or(1.04);
+        if h > 0.0 && a > 0.0 {
+            self.width = h * a;
+        }
+        if h > 0.0 && a1 > 0.0 {
+            self.width1 = h * a1;
+        }
+        Ok(())
+    }
+
+    /// Closes the current layer (it becomes available from [`take_layer`](Self::take_layer)).
+    pub fn flush(&mut self) {
+        if let Some(mut l) = self.layer.take() {
+            l.index = self.index;
+            self.index += 1;
+            self.done.push_back(l);
+        }
+    }
+
+    /// After the last piece: reads an unterminated last line and closes the last layer.
+    pub fn finish(&mut self) -> Result<(), GcodeError> {
+        if !self.rest.is_empty() {
+            let rest = std::mem::take(&mut self.rest);
+            self.line(&rest)?;
+        }
+        self.flush();
+        if self.commands == 0 {
+            return Err(GcodeError("the file holds no G01/G25/G26 commands".into()));
+        }
+        Ok(())
+    }
+}
+
+/// Reads a whole file: its layers and its reader (header, droplet width).
+pub fn read_gcode(text: &str) -> Result<(Vec<ReadLayer>, GcodeReader), GcodeError> {
+    let mut r = GcodeReader::new();
+    r.feed(text)?;
+    r.finish()?;
+    let layers = std::iter::from_fn(|| r.take_layer()).collect();
+    Ok((layers, r))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str =
+        "; dropslice test\n; layer_height = 0.2 (mm)\n; droplet_aspect = 1.04\n; end of header\n";
+
+    #[test]
+    fn lines_expand_every_b_and_layers_split_on_z() {
+        let b = 0.2 * 1.04;
+        let text = format!(
+            "{HEADER}G26 X1.0000 Y1.0000 Z0.2000\nG26 X1.2080 Y1.0000 Z0.2000\nG01 X0.0000 Y0.0000 Z0.2000\nG25 X{:.4} Y0.0000 Z0.2000\nG26 X5.0000 Y5.0000 Z0.4000",
+            10.0 * b
+        );
+        let (layers, r) = read_gcode(&text).unwrap();
+        assert_eq!(r.droplet_width(), b);
+        assert_eq!(layers.len(), 2);
+        assert_eq!(
+            layers[0].counts,
+            Counts {
+                outer: 2,
+                inner: 0,
+                fill: 11,
+                ..Counts::default()
+            }
+        );
+        assert_eq!(layers[0].preview.roles.len(), 13);
+        assert!((layers[0].preview.droplets[2 * 12] as f64 - 10.0 * b).abs() < 1e-4);
+        assert_eq!(layers[0].preview.travel.len(), 4);
+        assert_eq!(layers[1].z, 0.4);
+        assert_eq!(layers[1].index, 1);
+    }
+
+    #[test]
+    fn refusals_name_the_line_and_the_reason() {
+        let err = |t: &str| read_gcode(t).unwrap_err().0;
+        assert!(err("G26 X1 Y1 Z0.2\n").contains("droplet size"));
+        assert!(err(&format!("{HEADER}M104 S200\n")).contains("not a G01, G25 or G26"));
+        assert!(err(&format!("{HEADER}G26 X1 Yabc Z0.2\n")).contains("bad number"));
+        assert!(err(&format!("{HEADER}G26 X1 Q2 Z0.2\n")).contains("unknown word"));
+        assert!(err(HEADER).contains("no G01/G25/G26"));
+        assert_eq!(
+            err(&format!("{HEADER}G01 X0 Y0 Z0.2\nG25 X20000000\n")),
+            "line 6: the coordinate \"X20000000\" is too far out: this viewer reads coordinates up to ±100,000 mm"
+        );
+        let tiny = err(
+            "; layer_height = 0.0001\n; droplet_aspect = 0.001\nG01 X0 Y0 Z0.2\nG25 X100000 Y100000\n",
+        );
+        assert!(
+            tiny.starts_with("line 4: a G25 of 141421 mm would expand to ")
+                && tiny.contains(" million droplets (one every 1e-7 mm)"),
+            "{tiny}"
+        );
+        let many = format!(
+            "{HEADER}G01 X-100000 Y0 Z0.2\n{}",
+            "G25 X100000 Y0\nG25 X-100000 Y0\n".repeat(30)
+        );
+        assert!(
+            err(&many).contains("the file holds more than 50 million droplets"),
+            "{}",
+            err(&many)
+        );
+        let long = format!("{HEADER}; {}", "x".repeat(2 << 20));
+        assert!(err(&long).contains("is longer than 1,048,576 characters"));
+        assert_eq!(
+            err("; layer_height = 7\n"),
+            "line 1: the header's layer_height = 7 is out of range: it must be greater than 0 and at most 5 mm"
+        );
+    }
+
+    #[test]
+    fn t_lines_tag_droplets_with_their_unit() {
+        let head = "; layer_height = 0.2\n; droplet_aspect = 1.0\n; unit1_droplet_aspect = 2.0\n";
+        let text = format!(
+            "{head}G26 X0.0000 Y0.0000 Z0.2000\nT1\nG01 X0.0000 Y0.0000 Z0.2000\nG25 X1.2000 Y0.0000 Z0.2000\nT0\nG25 X2.0000 Y0.0000 Z0.2000\n"
+        );
+        let (layers, _) = read_gcode(&text).unwrap();
+        // Unit 1's line: droplets every 0.4 mm (4); unit 0's: every 0.2 mm (5).
+        assert_eq!(layers[0].units, vec![0, 1, 1, 1, 1, 0, 0, 0, 0, 0]);
+        assert_eq!(layers[0].counts.unit1, 4);
+        assert_eq!(layers[0].counts.total(), 10);
+        let err = read_gcode(&format!("{head}T2\nG26 X0 Y0 Z0.2\n"))
+            .unwrap_err()
+            .0;
+        assert_eq!(
+            err,
+            "line 4: \"T2\" selects a discharge unit this slicer does not have: only T0 and T1 are known"
+        );
+    }
+
+    #[test]
+    fn numbers_as_javascript_writes_them() {
+        assert_eq!(precise(141421.356, 6), "141421");
+        assert_eq!(precise(1e-7, 4), "1e-7");
+        assert_eq!(precise(0.208, 4), "0.208");
+        assert_eq!(count(1.2e300), "1.2e+300");
+        assert_eq!(count(96_400_000.0), "96 million");
+        assert_eq!(count(12_345.0), "12,345");
+    }
+}

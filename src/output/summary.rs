@@ -1,0 +1,327 @@
+//! Every figure about a slice, computed once, here: the CLI prints them and the page shows
+//! them (it computes none of its own).
+//!
+//! A [`Summary`] is built per unit of work (a layer, a run of layers, a worker's share) and
+//! merged with [`Summary::merge`]; units may arrive in any order and from several workers, and
+//! merging them gives the same figures as one summary over all layers. [`Summary::figures`]
+//! turns it into what is shown: droplets by role, material volume and mass, print time, part
+//! coverage, void area, the worst layer and what slicing repaired. [`Summary::printable`] is
+//! the one "nothing to print" check of the CLI and the page.
+
+use crate::analysis::{LayerAnalysis, PartAnalysis};
+use crate::base::error::Error;
+use crate::base::settings::Settings;
+use crate::slicing::plan::{Counts, LayerPlan};
+use serde::{Deserialize, Serialize};
+
+/// Totals of some layers of a slice (all of them once every unit is merged).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Layers planned (added with [`Summary::add`]).
+    pub layers: usize,
+    pub counts: Counts,
+    /// Length of all moves without material, in mm.
+    pub travel_mm: f64,
+    /// Layers whose section had open chains that were joined across gaps.
+    pub layers_with_open_chains: usize,
+    /// Loops chained against the direction of some of their facets (flipped facets).
+    pub reoriented_loops: usize,
+    /// The void analysis of the layers analysed (added with [`Summary::add_analysis`];
+    /// `analysis.layers` of them), in 2D (no slab volumes).
+    #[serde(default)]
+    pub analysis: PartAnalysis,
+    /// Overhang area summed over the layers, mm² (support on or off).
+    #[serde(default)]
+    pub unsupported_area: f64,
+    /// The layer with the largest overhang area (none without overhangs).
+    #[serde(default)]
+    pub worst_overhang: Option<WorstLayer>,
+}
+
+/// The worst layer by some area: the largest connected void, or the largest overhang.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WorstLayer {
+    /// Layer number from 0.
+    pub index: usize,
+    /// Its area (of the largest void, or of the overhang), mm².
+    pub area: f64,
+}
+
+/// The estimated print time, s: unit 0's droplets / droplet_rate + unit 1's droplets /
+/// unit1_droplet_rate + travel / travel_speed. The one estimate of the job's figures
+/// ([`Figures::print_seconds`]) and of each layer ([`layer_seconds`]), so the layers' times
+/// add up to the job's.
+pub fn print_seconds(counts: &Counts, travel_mm: f64, settings: &Settings) -> f64 {
+    let (t0, t1) = unit_seconds(counts, settings);
+    t0 + t1 + travel_mm / settings.travel_speed
+}
+
+/// The droplet time of each discharge unit, s.
+pub fn unit_seconds(counts: &Counts, settings: &Settings) -> (f64, f64) {
+    (
+        counts.unit0() as f64 / settings.droplet_rate,
+        counts.unit1 as f64 / settings.unit1_droplet_rate,
+    )
+}
+
+/// The estimated print time of one planned layer, s (the page's per-layer plot).
+pub fn layer_seconds(plan: &LayerPlan, settings: &Settings) -> f64 {
+    print_seconds(&plan.counts, plan.travel_mm, settings)
+}
+
+impl WorstLayer {
+    /// The worse of two (larger area; of equal areas the lower layer, so merges commute).
+    fn worse(a: Option<WorstLayer>, b: Option<WorstLayer>) -> Option<WorstLayer> {
+        match (a, b) {
+            (Some(x), Some(y)) => Some(
+                if y.area > x.area || (y.area == x.area && y.index < x.index) {
+                    y
+                } else {
+                    x
+                },
+            ),
+            (x, None) => x,
+            (None, y) => y,
+        }
+    }
+}
+
+/// What the CLI prints and the page shows about a slice.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Figures {
+    pub layers: usize,
+    pub counts: Counts,
+    pub droplets: u64,
+    /// Unit 0's droplets × B²H, mm³ (the parts of unit 0).
+    pub volume_mm3: f64,
+    /// volume × material_density, g.
+    pub mass_g: f64,
+    /// Droplets printed by unit 1 (its parts and the support).
+    pub unit1_droplets: u64,
+    /// Unit 1's droplets × B₁²H, mm³.
+    pub unit1_volume_mm3: f64,
+    /// unit-1 volume × unit1_material_density, g.
+    pub unit1_mass_g: f64,
+    /// unit-0 droplets / droplet_rate + unit-1 droplets / unit1_droplet_rate
+    /// + travel / travel_speed, s ([`print_seconds`]).
+    pub print_seconds: f64,
+    /// Unit 0's droplets / droplet_rate, s.
+    pub unit0_seconds: f64,
+    /// Unit 1's droplets / unit1_droplet_rate, s.
+    pub unit1_seconds: f64,
+    /// Overhang area summed over the layers, mm² (support on or off: what would be printed
+    /// in the air without support).
+    pub unsupported_area: f64,
+    /// The layer with the largest overhang area.
+    pub worst_overhang: Option<WorstLayer>,
+    pub travel_mm: f64,
+    /// Layers with a void analysis.
+    pub analysed_layers: usize,
+    /// Area-weighted coverage of the analysed layers (0 … 1); `None` without analysis.
+    pub coverage: Option<f64>,
+    /// Uncovered area summed over the analysed layers, mm².
+    pub void_area: Option<f64>,
+    pub worst_layer: Option<WorstLayer>,
+    /// What slicing repaired, in plain language.
+    pub repairs: Vec<String>,
+}
+
+impl Summary {
+    /// Adds one planned layer.
+    pub fn add(&mut self, plan: &LayerPlan) {
+        self.layers += 1;
+        self.counts.add(&plan.counts);
+        self.travel_mm += plan.travel_mm;
+        self.layers_with_open_chains += usize::from(plan.open_chains > 0);
+        self.reoriented_loops += plan.reoriented_loops;
+        self.unsupported_area += plan.unsupported_area;
+        if plan.unsupported_area > 0.0 {
+            self.worst_overhang = WorstLayer::worse(
+                self.worst_overhang,
+                Some(WorstLayer {
+                    index: plan.index,
+                    area: plan.unsupported_area,
+                }),
+            );
+        }
+    }
+
+    /// A summary of one planned layer.
+    pub fn of_layer(plan: &LayerPlan) -> Summary {
+        let mut s = Summary::default();
+        s.add(plan);
+        s
+    }
+
+    /// Adds one layer's void analysis (a layer may be analysed without being counted again,
+    /// e.g. when the analysis is made after the slice).
+    pub fn add_analysis(&mut self, layer: &LayerAnalysis) {
+        self.analysis.add(layer, 0.0, 0.0);
+    }
+
+    /// Adds the layers of another summary (disjoint from this one's).
+    pub fn merge(&mut self, other: &Summary) {
+        self.layers += other.layers;
+        self.counts.add(&other.counts);
+        self.travel_mm += other.travel_mm;
+        self.layers_with_open_chains += other.layers_with_open_chains;
+        self.reoriented_loops += other.reoriented_loops;
+        self.analysis.merge(&other.analysis);
+        self.unsupported_area += other.unsupported_area;
+        self.worst_overhang = WorstLayer::worse(self.worst_overhang, other.worst_overhang);
+    }
+
+    /// The merge of `parts`.
+    pub fn merged<'a>(parts: impl IntoIterator<Item = &'a Summary>) -> Summary {
+        let mut s = Summary::default();
+        for p in parts {
+            s.merge(p);
+        }
+        s
+    }
+
+    /// Plain-language notes on what slicing repaired.
+    pub fn repairs(&self) -> Vec<String> {
+        let mut r = Vec::new();
+        if self.layers_with_open_chains > 0 {
+            r.push(format!(
+                "{} layers had open sections (holes in the mesh), closed by joining their ends",
+                self.layers_with_open_chains
+            ));
+        }
+        if self.reoriented_loops > 0 {
+            r.push(format!(
+                "{} loops crossed flipped facets and were oriented by the majority",
+                self.reoriented_loops
+            ));
+        }
+        r
+    }
+
+    /// The figures shown to the user, with the estimates of `settings`.
+    pub fn figures(&self, settings: &Settings) -> Figures {
+        let droplets = self.counts.total();
+        let (d0, d1) = (self.counts.unit0(), self.counts.unit1);
+        let b = settings.droplet_width();
+        let b1 = settings.unit1_droplet_width();
+        let h = settings.layer_height;
+        let volume = d0 as f64 * b * b * h;
+        let volume1 = d1 as f64 * b1 * b1 * h;
+        let (t0, t1) = (
+            d0 as f64 / settings.droplet_rate,
+            d1 as f64 / settings.unit1_droplet_rate,
+        );
+        let a = &self.analysis;
+        let analysed = a.layers > 0;
+        Figures {
+            layers: self.layers,
+            counts: self.counts,
+            droplets,
+            volume_mm3: volume,
+            mass_g: volume / 1000.0 * settings.material_density,
+            unit1_droplets: d1,
+            unit1_volume_mm3: volume1,
+            unit1_mass_g: volume1 / 1000.0 * settings.unit1_material_density,
+            print_seconds: print_seconds(&self.counts, self.travel_mm, settings),
+            unit0_seconds: t0,
+            unit1_seconds: t1,
+            unsupported_area: self.unsupported_area,
+            worst_overhang: self.worst_overhang,
+            travel_mm: self.travel_mm,
+            analysed_layers: a.layers,
+            coverage: analysed.then_some(a.coverage),
+            void_area: analysed.then_some(a.void_area),
+            worst_layer: match (a.largest_void, a.largest_void_layer) {
+                (Some(v), Some(index)) => Some(WorstLayer {
+                    index,
+                    area: v.area,
+                }),
+                _ => None,
+            },
+            repairs: self.repairs(),
+        }
+    }
+
+    /// "Nothing to print": a finished slice without a single droplet (every wall thinner than
+    /// a droplet). The CLI writes no file and the page offers no download.
+    pub fn printable(&self, settings: &Settings) -> Result<(), Error> {
+        if self.counts.total() > 0 {
+            return Ok(());
+        }
+        Err(Error::NothingToPrint(format!(
+            "no droplet fits in the part: every wall is thinner than the droplet width B = {:.3} mm; scale the part up or use smaller droplets (layer_height, droplet_aspect)",
+            settings.droplet_width()
+        )))
+    }
+}
+
+impl PartAnalysis {
+    /// Adds the layers of another part analysis (disjoint layers), as if each of its layers
+    /// had been [`add`](PartAnalysis::add)ed here. Of equal largest voids (or deviations) the
+    /// lower layer wins, so the order of the merges does not matter.
+    pub fn merge(&mut self, o: &PartAnalysis) {
+        if o.layers == 0 {
+            return;
+        }
+        let covered = self.coverage * self.region_area + o.coverage * o.region_area;
+        self.layers += o.layers;
+        self.droplets += o.droplets;
+        self.region_area += o.region_area;
+        self.coverage = if self.region_area > 0.0 {
+            covered / self.region_area
+        } else {
+            0.0
+        };
+        self.void_area += o.void_area;
+        self.enclosed_void_area += o.enclosed_void_area;
+        self.overfill_area += o.overfill_area;
+        let better = |a: f64, ai: Option<usize>, b: f64, bi: Option<usize>| {
+            a > b || (a == b && ai.unwrap_or(usize::MAX) < bi.unwrap_or(usize::MAX))
+        };
+        if let Some(v) = o.largest_void
+            && self.largest_void.is_none_or(|mine| {
+                better(
+                    v.area,
+                    o.largest_void_layer,
+                    mine.area,
+                    self.largest_void_layer,
+                )
+            })
+        {
+            self.largest_void = Some(v);
+            self.largest_void_layer = o.largest_void_layer;
+        }
+        if o.max_deviation_layer.is_some()
+            && (self.max_deviation_layer.is_none()
+                || better(
+                    o.max_boundary_deviation,
+                    o.max_deviation_layer,
+                    self.max_boundary_deviation,
+                    self.max_deviation_layer,
+                ))
+        {
+            self.max_boundary_deviation = o.max_boundary_deviation;
+            self.max_deviation_layer = o.max_deviation_layer;
+        }
+        self.unsupported_area += o.unsupported_area;
+        if o.max_unsupported_area_layer.is_some()
+            && (self.max_unsupported_area_layer.is_none()
+                || better(
+                    o.max_unsupported_area,
+                    o.max_unsupported_area_layer,
+                    self.max_unsupported_area,
+                    self.max_unsupported_area_layer,
+                ))
+        {
+            self.max_unsupported_area = o.max_unsupported_area;
+            self.max_unsupported_area_layer = o.max_unsupported_area_layer;
+        }
+        self.volume += o.volume;
+        self.void_volume += o.void_volume;
+        self.void_fraction = if self.volume > 0.0 {
+            self.void_volume / self.volume
+        } else {
+            0.0
+        };
+    }
+}

@@ -1,0 +1,563 @@
+//! Plan, stage 5b: a layer's region → its [`LayerPlan`], every move in print order
+//! (SPEC.md `contour_order`, `print_order`).
+
+use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::base::settings::{ContourOrder, PrintOrder, Settings};
+use crate::slicing::contours::{Loop, contours};
+use crate::slicing::droplets::loop_droplets_spaced;
+use crate::slicing::hatch::{hatch_at, order_greedy};
+use serde::{Deserialize, Serialize};
+
+/// What a move does (the machine command it becomes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MoveKind {
+    /// `G01`: travel, no material.
+    Travel,
+    /// `G26`: travel, then one droplet at the point.
+    Droplet,
+    /// `G25`: droplets every B on the line from the current position to the point.
+    Line,
+}
+
+/// What a droplet belongs to (for the preview's colours and the statistics).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[repr(u8)]
+pub enum Role {
+    /// The outermost loop along a boundary (k = 0).
+    Outer = 0,
+    /// The other contour loops.
+    Inner = 1,
+    /// Hatch fill.
+    Fill = 2,
+    /// Support under overhangs (discharge unit 1, see [`crate::support`]).
+    Support = 3,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Move {
+    pub kind: MoveKind,
+    pub role: Role,
+    pub to: Point,
+    /// The discharge unit that prints it (0 or 1; SPEC.md "Two discharge units"). A travel
+    /// belongs to the unit whose droplets follow it.
+    pub unit: u8,
+}
+
+/// Droplet counts by role (the roles partition the droplets), and how many of them discharge
+/// unit 1 prints.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Counts {
+    pub outer: u64,
+    pub inner: u64,
+    pub fill: u64,
+    /// Support droplets (all printed by unit 1).
+    #[serde(default)]
+    pub support: u64,
+    /// Droplets of any role printed by unit 1 (its parts' and the support).
+    #[serde(default)]
+    pub unit1: u64,
+}
+
+impl Counts {
+    pub fn total(&self) -> u64 {
+        self.outer + self.inner + self.fill + self.support
+    }
+
+    /// Droplets printed by unit 0.
+    pub fn unit0(&self) -> u64 {
+        self.total() - self.unit1
+    }
+
+    pub fn add(&mut self, o: &Counts) {
+        self.outer += o.outer;
+        self.inner += o.inner;
+        self.fill += o.fill;
+        self.support += o.support;
+        self.unit1 += o.unit1;
+    }
+}
+
+/// Every move of one layer, in print order.
+#[derive(Clone, Debug, Default)]
+pub struct LayerPlan {
+    /// Layer number from 0.
+    pub index: usize,
+    /// Z written in the code: the layer's top, (index + 1)·H.
+    pub z: f64,
+    pub moves: Vec<Move>,
+    pub counts: Counts,
+    /// Length of all moves without material (G01 and the travel part of G26), in mm.
+    pub travel_mm: f64,
+    /// Repairs the section needed: open chains joined across gaps, loops chained against
+    /// the direction of some of their facets.
+    pub open_chains: usize,
+    pub reoriented_loops: usize,
+    /// The layer's overhang area, mm² (its region farther than `overhang_limit`·B from the
+    /// region below, [`crate::support::overhang`]).
+    pub unsupported_area: f64,
+    /// Droplet width B₁ of the unit-1 moves (0 when there are none).
+    pub unit1_width: f64,
+}
+
+impl LayerPlan {
+    /// The droplet width of a move's unit.
+    pub fn width_of(&self, m: &Move, b: f64) -> f64 {
+        if m.unit == 1 { self.unit1_width } else { b }
+    }
+
+    /// The unit of the first move, if any.
+    pub fn first_unit(&self) -> Option<u8> {
+        self.moves.first().map(|m| m.unit)
+    }
+
+    /// The unit selected after this layer, given the one selected before it.
+    pub fn unit_after(&self, before: u8) -> u8 {
+        self.moves.last().map_or(before, |m| m.unit)
+    }
+}
+
+/// Hatch angle of a layer (from 0): α_s + index·α_v.
+pub fn hatch_angle(s: &Settings, index: usize) -> f64 {
+    (s.hatch_angle + index as f64 * s.hatch_angle_step).rem_euclid(360.0)
+}
+
+/// How far each layer's loops start after the layer below's, in mm (arc length).
+///
+/// Without `stagger`: `start_jitter`. With it: `start_jitter` rounded to the nearest odd
+/// multiple of B/2 (at least B/2), so the seam still moves every layer and every layer's
+/// droplets lie half a droplet along the loop from the layer below's, over its gaps
+/// (0.07 mm → 0.104 mm with the defaults). Adding B/2 on alternate layers to the unrounded
+/// jitter instead would undo the stagger: 0.07 ± 0.104 mm is 0.034 mm from a whole B.
+pub fn loop_start_step(s: &Settings) -> f64 {
+    if !s.stagger {
+        return s.start_jitter;
+    }
+    let b = s.droplet_width();
+    ((s.start_jitter / b - 0.5).round().max(0.0) + 0.5) * b
+}
+
+/// Whether layer `index`'s hatch lattice is shifted by half a spacing across and half a
+/// droplet along (`stagger`). With `stagger` every hatch line's droplets are set on a lattice
+/// fixed to the origin: lines at (j + ½)·spacing across, droplets at k·B along (line ends
+/// moved outward to lattice points, see [`crate::slicing::hatch::hatch_at`]), or (j + 0), (k + ½) when
+/// shifted.
+///
+/// With a 90° step (the default), the next layer's lattice is this one turned by 90° about the
+/// origin, and with spacing B its points are exactly the centres of this layer's lattice cells:
+/// every layer already lies over the gaps of the layer below, and layer i + 2 over layer i's
+/// droplets, with layer i + 1's droplets in between, so nothing is shifted (shifting layer
+/// i + 2 by half a spacing, as for repeating angles, measured worse: docs/quality.md).
+/// Otherwise layers whose lines run in the same direction (angle mod 180°) alternate between
+/// shifted and not (a 0° step: every other layer); a step whose direction never repeats within
+/// 360 layers shifts nothing.
+pub fn hatch_shifted(s: &Settings, index: usize) -> bool {
+    if !s.stagger {
+        return false;
+    }
+    let quarter = (s.hatch_angle_step.rem_euclid(180.0) - 90.0).abs() < 1e-6;
+    if quarter {
+        return false;
+    }
+    let period = (1..=360usize).find(|&p| {
+        let r = (p as f64 * s.hatch_angle_step).rem_euclid(180.0);
+        r < 1e-6 || 180.0 - r < 1e-6
+    });
+    period.is_some_and(|p| (index / p) % 2 == 1)
+}
+
+/// The least distance between the fill region and the part's boundary (outer or hole), mm:
+/// hatch ends may move out this far without a droplet centre leaving the part.
+fn fill_margin(s: &Settings) -> f64 {
+    let last = s.contours as f64 - 1.0;
+    let extra = 1.0 - s.fill_overlap;
+    let f = s.outer_offset.min(s.inner_offset);
+    ((f + last + extra) * s.droplet_width()).max(0.0)
+}
+
+/// Plans one layer from its region (unit 0, starting at the origin).
+pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
+    plan_layer_from(region, index, s, Point::ZERO)
+}
+
+/// Plans one layer's region with the droplet width of `s`, starting at `start`; every move is
+/// unit 0's (see [`plan_unit1_layer`]).
+pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point) -> LayerPlan {
+    let b = s.droplet_width();
+    let layer = contours(region, s);
+    let mut plan = LayerPlan {
+        index,
+        z: (index + 1) as f64 * s.layer_height,
+        ..LayerPlan::default()
+    };
+    let mut at = start;
+    let add_contours = |plan: &mut LayerPlan, at: &mut Point| {
+        let mut loops: Vec<&Loop> = layer.loops.iter().collect();
+        loops.sort_by_key(|l| match s.contour_order {
+            ContourOrder::InsideOut => u32::MAX - l.k,
+            ContourOrder::OutsideIn => l.k,
+        });
+        let shift = index as f64 * loop_start_step(s);
+        // Within one ring (same k), the loop whose start is nearest goes next.
+        for ring in loops.chunk_by(|a, b| a.k == b.k) {
+            let mut pending: Vec<(Vec<Point>, Role)> = ring
+                .iter()
+                .map(|l| {
+                    let role = if l.k == 0 { Role::Outer } else { Role::Inner };
+                    (
+                        loop_droplets_spaced(&l.points, b, shift, s.close_loops, s.loop_spacing),
+                        role,
+                    )
+                })
+                .filter(|(d, _)| !d.is_empty())
+                .collect();
+            while !pending.is_empty() {
+                let next = (0..pending.len())
+                    .min_by(|&i, &j| {
+                        dist(*at, pending[i].0[0]).total_cmp(&dist(*at, pending[j].0[0]))
+                    })
+                    .expect("non-empty");
+                let (drops, role) = pending.swap_remove(next);
+                for p in drops {
+                    plan.travel_mm += dist(*at, p);
+                    plan.moves.push(Move {
+                        kind: MoveKind::Droplet,
+                        role,
+                        to: p,
+                        unit: 0,
+                    });
+                    *at = p;
+                }
+            }
+        }
+    };
+    let add_fill = |plan: &mut LayerPlan, at: &mut Point| {
+        if s.fill_density <= 0.0 {
+            return;
+        }
+        let lines = hatch_at(
+            &layer.fill_region,
+            hatch_angle(s, index),
+            b / s.fill_density,
+            if hatch_shifted(s, index) { 0.0 } else { 0.5 },
+            s.stagger.then(|| {
+                let along = if hatch_shifted(s, index) { 0.5 } else { 0.0 };
+                (b, along, fill_margin(s))
+            }),
+        );
+        for l in order_greedy(lines, *at) {
+            plan.travel_mm += dist(*at, l.a);
+            plan.moves.push(Move {
+                kind: MoveKind::Travel,
+                role: Role::Fill,
+                to: l.a,
+                unit: 0,
+            });
+            plan.moves.push(Move {
+                kind: MoveKind::Line,
+                role: Role::Fill,
+                to: l.b,
+                unit: 0,
+            });
+            *at = l.b;
+        }
+    };
+    match s.print_order {
+        PrintOrder::ContoursFirst => {
+            add_contours(&mut plan, &mut at);
+            add_fill(&mut plan, &mut at);
+        }
+        PrintOrder::FillFirst => {
+            add_fill(&mut plan, &mut at);
+            add_contours(&mut plan, &mut at);
+        }
+    }
+    // Positions as written, so counts, previews and the code agree exactly.
+    for m in &mut plan.moves {
+        m.to = round_output(m.to);
+    }
+    plan.counts = count(&plan.moves, b);
+    plan
+}
+
+/// Droplet counts of a move list of one droplet width.
+pub fn count(moves: &[Move], b: f64) -> Counts {
+    count_units(moves, b, b)
+}
+
+/// Droplet counts of a move list: unit 0's droplets `b` apart on `G25` lines, unit 1's `b1`.
+pub fn count_units(moves: &[Move], b: f64, b1: f64) -> Counts {
+    let mut c = Counts::default();
+    let mut at = DVec2::ZERO;
+    for m in moves {
+        let w = if m.unit == 1 { b1 } else { b };
+        let n = match m.kind {
+            MoveKind::Travel => 0,
+            MoveKind::Droplet => 1,
+            MoveKind::Line => line_droplet_count(dist(at, m.to), w),
+        };
+        match m.role {
+            Role::Outer => c.outer += n,
+            Role::Inner => c.inner += n,
+            Role::Fill => c.fill += n,
+            Role::Support => c.support += n,
+        }
+        if m.unit == 1 {
+            c.unit1 += n;
+        }
+        at = m.to;
+    }
+    c
+}
+
+/// The settings unit 1 prints a support region with: droplet width B₁
+/// (`unit1_droplet_aspect`), one contour loop by the same rules as unit 0's, and hatch fill
+/// at `support_density`.
+pub fn support_settings(s: &Settings) -> Settings {
+    Settings {
+        droplet_aspect: s.unit1_droplet_aspect,
+        fill_density: s.support_density,
+        contours: 1,
+        ..s.clone()
+    }
+}
+
+/// The settings unit 1 prints its parts with (SPEC.md "Two discharge units"): the same
+/// contour and fill rules as unit 0, with unit 1's droplet width B₁ (`unit1_droplet_aspect`).
+pub fn unit1_part_settings(s: &Settings) -> Settings {
+    Settings {
+        droplet_aspect: s.unit1_droplet_aspect,
+        ..s.clone()
+    }
+}
+
+/// Adds unit 1's moves to a planned layer, in the order `unit_order` gives: first the region
+/// of its parts (`parts`, contours and fill as unit 0's with B₁, roles outer/inner/fill),
+/// then `support` (one loop and hatch at `support_density`, [`support_settings`], as
+/// `support_role`). Unit 0's droplets stay exactly as planned; only the travel between the
+/// two units' moves changes.
+pub fn plan_unit1_layer(
+    plan: &mut LayerPlan,
+    parts: &Shapes,
+    support: &Shapes,
+    support_role: Role,
+    s: &Settings,
+) {
+    if parts.is_empty() && support.is_empty() {
+        return;
+    }
+    let b1 = s.unit1_droplet_width();
+    let unit0_first = s.unit_order == crate::base::settings::UnitOrder::Unit0First;
+    let start = if unit0_first {
+        plan.moves.last().map_or(Point::ZERO, |m| m.to)
+    } else {
+        Point::ZERO
+    };
+    let mut moves: Vec<Move> = Vec::new();
+    let mut travel = 0.0;
+    let mut at = start;
+    for (region, role, s1) in [
+        (parts, None, unit1_part_settings(s)),
+        (support, Some(support_role), support_settings(s)),
+    ] {
+        if region.is_empty() {
+            continue;
+        }
+        let p1 = plan_layer_from(region, plan.index, &s1, at);
+        travel += p1.travel_mm;
+        for mut m in p1.moves {
+            m.unit = 1;
+            if let Some(r) = role {
+                m.role = r;
+            }
+            moves.push(m);
+        }
+        at = moves.last().map_or(at, |m| m.to);
+    }
+    if moves.is_empty() {
+        return;
+    }
+    let c1 = count_units(&moves, b1, b1);
+    plan.counts.add(&c1);
+    plan.unit1_width = b1;
+    plan.travel_mm += travel;
+    if unit0_first {
+        plan.moves.extend(moves);
+    } else {
+        // Unit 0 was planned from the origin; it now starts where unit 1 ends.
+        let end = moves.last().map_or(Point::ZERO, |m| m.to);
+        if let Some(first) = plan.moves.first() {
+            plan.travel_mm += dist(end, first.to) - dist(Point::ZERO, first.to);
+        }
+        moves.append(&mut plan.moves);
+        plan.moves = moves;
+    }
+}
+
+/// Where unit 1 starts in a layer whose unit-0 moves are planned: after them, or at the origin
+/// with `unit_order = unit1_first`.
+pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
+    if s.unit_order == crate::base::settings::UnitOrder::Unit0First {
+        plan.moves.last().map_or(Point::ZERO, |m| m.to)
+    } else {
+        Point::ZERO
+    }
+}
+
+/// Unit 1's moves for a support region (SPEC.md: "printed by unit 1 as hatch fill at
+/// `support_density`"), from `start`: the region's hatch segments `lines` (lines
+/// B₁ / `support_density` apart at the layer's hatch angle, every line's droplets on a
+/// lattice of pitch B₁ along it, [`crate::support::support_layers`]), without the droplets
+/// closer than `support_gap_xy`·B to the part's region `part` (a line is split there); then
+/// single droplets at `extra` (the droplet-level pass, [`crate::support::droplets`]), nearest
+/// first. No offsets. Positions are rounded as written.
+pub fn support_moves(
+    lines: &[crate::slicing::hatch::HatchLine],
+    part: &Shapes,
+    extra: &[Point],
+    index: usize,
+    s: &Settings,
+    start: Point,
+) -> Vec<Move> {
+    let s1 = support_settings(s);
+    let b1 = s1.droplet_width();
+    let mut moves = Vec::new();
+    let mut at = start;
+    if s1.fill_density > 0.0 && !lines.is_empty() {
+        let edges = crate::support::droplets::edges_of(part);
+        let gaps = crate::support::droplets::LineGaps::new(
+            &edges,
+            s.support_gap_xy * s.droplet_width(),
+            hatch_angle(s, index),
+            b1 / s1.fill_density,
+        );
+        let mut runs = Vec::with_capacity(lines.len());
+        let mut near = Vec::new();
+        // Droplet j of a line lies at t = j·B₁ along it (as `line_droplets` sets them); the
+        // first j at or after t, the last at or before t (exact in the products).
+        let first_at = |t: f64| {
+            let mut j = (t / b1).ceil().max(0.0);
+            while j > 0.0 && (j - 1.0) * b1 >= t {
+                j -= 1.0;
+            }
+            while j * b1 < t {
+                j += 1.0;
+            }
+            j
+        };
+        let last_at = |t: f64| {
+            let mut j = (t / b1).floor();
+            while (j + 1.0) * b1 <= t {
+                j += 1.0;
+            }
+            while j >= 0.0 && j * b1 > t {
+                j -= 1.0;
+            }
+            j
+        };
+        for &l in lines {
+            // Where along the line the part is within the gap (sorted intervals): the
+            // droplets there are left out, the runs between them kept.
+            gaps.intervals(l.a, l.b, &mut near);
+            let len = dist(l.a, l.b);
+            let count = line_droplet_count(len, b1) as f64;
+            let at_j = |j: f64| {
+                let t = if len > 0.0 { j * b1 / len } else { 0.0 };
+                DVec2::new(
+                    l.a[0] + t * (l.b[0] - l.a[0]),
+                    l.a[1] + t * (l.b[1] - l.a[1]),
+                )
+            };
+            let mut next = 0.0;
+            for &(t0, t1) in &near {
+                let (d0, d1) = (first_at(t0), last_at(t1).min(count - 1.0));
+                if d0 > d1 {
+                    continue;
+                }
+                if d0 > next {
+                    runs.push(crate::slicing::hatch::HatchLine {
+                        a: at_j(next),
+                        b: at_j(d0 - 1.0),
+                    });
+                }
+                next = next.max(d1 + 1.0);
+            }
+            if next < count {
+                runs.push(crate::slicing::hatch::HatchLine {
+                    a: at_j(next),
+                    b: at_j(count - 1.0),
+                });
+            }
+        }
+        for l in order_greedy(runs, at) {
+            if dist(l.a, l.b) < 0.5 * b1 {
+                moves.push(Move {
+                    kind: MoveKind::Droplet,
+                    role: Role::Support,
+                    to: round_output(l.a),
+                    unit: 1,
+                });
+            } else {
+                moves.push(Move {
+                    kind: MoveKind::Travel,
+                    role: Role::Support,
+                    to: round_output(l.a),
+                    unit: 1,
+                });
+                moves.push(Move {
+                    kind: MoveKind::Line,
+                    role: Role::Support,
+                    to: round_output(l.b),
+                    unit: 1,
+                });
+            }
+            at = l.b;
+        }
+    }
+    let mut left: Vec<Point> = extra.to_vec();
+    while !left.is_empty() {
+        let next = (0..left.len())
+            .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
+            .expect("non-empty");
+        let p = left.swap_remove(next);
+        moves.push(Move {
+            kind: MoveKind::Droplet,
+            role: Role::Support,
+            to: round_output(p),
+            unit: 1,
+        });
+        at = p;
+    }
+    moves
+}
+
+/// Adds unit-1 moves (planned from [`unit1_start`]) to a layer planned for unit 0, in the
+/// order `unit_order` gives: the counts, B₁ and the travel follow. Unit 0's moves stay
+/// exactly as planned; only the travel between the two units' moves changes.
+pub fn add_unit1(plan: &mut LayerPlan, mut moves: Vec<Move>, s: &Settings) {
+    if moves.is_empty() {
+        return;
+    }
+    let b1 = support_settings(s).droplet_width();
+    let unit0_first = s.unit_order == crate::base::settings::UnitOrder::Unit0First;
+    let mut at = unit1_start(plan, s);
+    for m in &mut moves {
+        m.unit = 1;
+        if m.kind != MoveKind::Line {
+            plan.travel_mm += dist(at, m.to);
+        }
+        at = m.to;
+    }
+    let c1 = count_units(&moves, b1, b1);
+    plan.counts.add(&c1);
+    plan.unit1_width = b1;
+    if unit0_first {
+        plan.moves.extend(moves);
+    } else {
+        // Unit 0 was planned from the origin; it now starts where unit 1 ends.
+        if let Some(first) = plan.moves.first() {
+            plan.travel_mm += dist(at, first.to) - dist(Point::ZERO, first.to);
+        }
+        moves.append(&mut plan.moves);
+        plan.moves = moves;
+    }
+}

@@ -1,0 +1,752 @@
+//! The thin WebAssembly facade used by the page's web workers (`www/worker.ts`).
+//!
+//! One [`Session`] per worker owns one prepared [`Job`]; the worker asks it for layers by index
+//! and gets flat typed arrays (droplet centres, roles, travel moves) and the layer's G-code text,
+//! never a JS object per point. Everything else crosses as typed values through
+//! serde-wasm-bindgen (plain JS objects, never JSON text): settings go in as an object; info,
+//! summaries, figures, layer analyses, the schema and the defaults come out as objects. An
+//! error is thrown as a plain object `{kind, message, setting?}` ([`ErrorReport`]: `kind` from
+//! [`Error::kind`], `setting` the setting's name), so the page can tell the user's mistakes
+//! from bugs; a value that cannot be converted is an internal error, never a silent default.
+//! A panic is reported to `globalThis.dropslicePanic` (if the worker defined it) and to the
+//! console, and the worker turns the trap that follows into an error message.
+//!
+//! The model comes in as a `File` read in the worker ([`Session::from_file`], `FileReaderSync`),
+//! so the page's thread never copies its bytes; one worker prepares the job and hands the
+//! prepared mesh ([`Session::vertices`], [`Session::facets`], [`Session::info`]) to the others
+//! ([`Session::from_prepared`]), which skip the import.
+//!
+//! The core knows nothing of wasm; this file only converts.
+
+mod cut;
+pub mod reader;
+
+use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
+use crate::base::error::{Error, ErrorReport};
+use crate::base::settings::{self, Settings};
+use crate::model::mesh::Mesh;
+use crate::model::spec::{self as job, JobSpec, Model};
+use crate::output::gcode;
+use crate::output::preview::PreviewLayer;
+use crate::output::summary::{self, Figures, Summary};
+use crate::slicing::plan::{Counts, LayerPlan};
+use crate::{Job, JobInfo};
+use js_sys::{Float32Array, Float64Array, Uint8Array, Uint32Array};
+use serde::Serialize;
+use wasm_bindgen::prelude::*;
+
+/// Cells of the void overlay's mask per droplet width B (cells of B/4: ~0.05 mm by default).
+pub const MASK_CELLS_PER_B: f64 = 4.0;
+
+/// The error as thrown to JS: a plain object `{kind, message, setting?}`.
+pub fn js_error(e: Error) -> JsValue {
+    let report = e.report();
+    report
+        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .unwrap_or_else(|_| {
+            // Cannot happen for this plain struct; still an error, never a silent value.
+            let o = js_sys::Object::new();
+            let _ = js_sys::Reflect::set(&o, &"kind".into(), &report.kind.into());
+            let _ = js_sys::Reflect::set(&o, &"message".into(), &report.message.into());
+            o.into()
+        })
+}
+
+/// A value for JS (plain objects and arrays, `null` for `None`); a failure is an internal error.
+pub(crate) fn to_js<T: Serialize + ?Sized>(value: &T, what: &str) -> Result<JsValue, JsValue> {
+    value
+        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
+        .map_err(|e| {
+            js_error(Error::Internal(format!(
+                "cannot pass {what} to the page: {e}"
+            )))
+        })
+}
+
+/// A value from JS; a failure is an internal error (the page sent what the core did not make).
+fn from_js<T: serde::de::DeserializeOwned>(value: JsValue, what: &str) -> Result<T, JsValue> {
+    serde_wasm_bindgen::from_value(value)
+        .map_err(|e| js_error(Error::Internal(format!("bad {what} from the page: {e}"))))
+}
+
+/// Settings from a JS object `{name: value, ...}` (missing names: defaults), validated.
+fn settings_of(value: JsValue) -> Result<Settings, JsValue> {
+    let value: serde_json::Value = serde_wasm_bindgen::from_value(value).map_err(|e| {
+        js_error(Error::Setting {
+            name: String::new(),
+            message: format!("the settings are not a plain object of values: {e}"),
+        })
+    })?;
+    Settings::from_value(value).map_err(js_error)
+}
+
+fn report_panic(info: &std::panic::PanicHookInfo<'_>) {
+    console_error_panic_hook::hook(info);
+    let global = js_sys::global();
+    if let Ok(f) = js_sys::Reflect::get(&global, &JsValue::from_str("dropslicePanic"))
+        && let Some(f) = f.dyn_ref::<js_sys::Function>()
+    {
+        let _ = f.call1(&JsValue::NULL, &JsValue::from_str(&info.to_string()));
+    }
+}
+
+/// Runs once when the module is instantiated.
+#[wasm_bindgen(start)]
+pub fn start() {
+    std::panic::set_hook(Box::new(report_panic));
+}
+
+/// The core's version (`dropslice::VERSION`).
+#[wasm_bindgen]
+pub fn version() -> String {
+    crate::VERSION.to_string()
+}
+
+/// The settings table: `[{name, kind, unit, min, max, min_exclusive, choices, group,
+/// description, default}]`.
+#[wasm_bindgen]
+pub fn settings_schema() -> Result<JsValue, JsValue> {
+    to_js(&settings::schema(), "the settings schema")
+}
+
+/// The default settings: `{name: value, ...}`.
+#[wasm_bindgen]
+pub fn default_settings() -> Result<JsValue, JsValue> {
+    to_js(&Settings::default(), "the default settings")
+}
+
+/// Panics on purpose: lets the page's tests check that a crash becomes an error message.
+#[doc(hidden)]
+#[wasm_bindgen]
+pub fn crash_for_test() {
+    panic!("crash_for_test was called");
+}
+
+/// Checks settings; returns the validated settings (all names) or throws `{kind: "setting",
+/// message, setting}`.
+#[wasm_bindgen]
+pub fn check_settings(settings: JsValue) -> Result<JsValue, JsValue> {
+    let s = settings_of(settings)?;
+    to_js(&s, "the settings")
+}
+
+/// Merges the summaries of the units of a slice (any order) into one.
+#[wasm_bindgen]
+pub fn merge_summaries(parts: JsValue) -> Result<JsValue, JsValue> {
+    let parts: Vec<Summary> = from_js(parts, "summaries")?;
+    to_js(&Summary::merged(&parts), "a summary")
+}
+
+/// The overhang overlay (docs/support.md "The rule", [`crate::support::unsupported_droplets`]):
+/// per droplet of a layer (`droplets` x,y pairs, `units` its discharge units) 1 if no droplet
+/// of the layer below (`below`, `below_units`) lies within B_d/2 + `limit_mm`, else 0; B_d is
+/// `widths[u]` for unit u (`[B, B₁]`), `limit_mm` = `overhang_limit`·B. `on_plate`: the layer is
+/// the first (every droplet supported). Throws `{kind: "internal"}` on arrays that do not pair
+/// up, a unit other than 0 or 1, or a width or coordinate that is not a finite number.
+#[wasm_bindgen]
+pub fn unsupported_droplets(
+    droplets: &[f32],
+    units: &[u8],
+    below: &[f32],
+    below_units: &[u8],
+    widths: &[f64],
+    limit_mm: f64,
+    on_plate: bool,
+) -> Result<Uint8Array, JsValue> {
+    let bad = |m: &str| js_error(Error::Internal(format!("overhang overlay: {m}")));
+    if droplets.len() != 2 * units.len() || below.len() != 2 * below_units.len() {
+        return Err(bad("the droplets and their units do not pair up"));
+    }
+    let [b, b1] = widths else {
+        return Err(bad("two droplet widths are needed, B and B₁"));
+    };
+    let (b, b1) = (*b, *b1);
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    if !(positive(b) && positive(b1) && limit_mm.is_finite() && limit_mm >= 0.0) {
+        return Err(bad(
+            "the droplet widths must be positive and the limit at least 0",
+        ));
+    }
+    if units.iter().chain(below_units).any(|&u| u > 1) {
+        return Err(bad("a droplet's unit is neither 0 nor 1"));
+    }
+    if !droplets.iter().chain(below).all(|v| v.is_finite()) {
+        return Err(bad("a droplet centre is not a number"));
+    }
+    let layer: Vec<[f64; 2]> = droplets
+        .chunks_exact(2)
+        .map(|c| [c[0] as f64, c[1] as f64])
+        .collect();
+    let under: Vec<([f64; 2], f64)> = below
+        .chunks_exact(2)
+        .zip(below_units)
+        .map(|(c, &u)| ([c[0] as f64, c[1] as f64], if u == 1 { b1 } else { b }))
+        .collect();
+    let mask =
+        crate::support::unsupported_droplets(&layer, (!on_plate).then_some(&under[..]), limit_mm);
+    let bytes: Vec<u8> = mask.into_iter().map(u8::from).collect();
+    Ok(Uint8Array::from(&bytes[..]))
+}
+
+/// The 3D view's overhang tint for `settings`: a face whose unit normal (plate coordinates, z
+/// up) has z below minus this overhangs ([`crate::support::overhang_face_normal_z`]).
+#[wasm_bindgen]
+pub fn overhang_face_normal_z(settings: JsValue) -> Result<f64, JsValue> {
+    let s = settings_of(settings)?;
+    Ok(crate::support::overhang_face_normal_z(&s))
+}
+
+/// A job (`{settings, parts}`, the job file's JSON) from a JS object.
+fn job_of(value: JsValue) -> Result<JobSpec, JsValue> {
+    let value: serde_json::Value = serde_wasm_bindgen::from_value(value).map_err(|e| {
+        js_error(Error::Job(format!(
+            "the job is not a plain object {{settings, parts}}: {e}"
+        )))
+    })?;
+    JobSpec::from_value(value).map_err(js_error)
+}
+
+/// Reads a `File` in the worker (`FileReaderSync`).
+fn read_file(file: &web_sys::File) -> Result<Vec<u8>, JsValue> {
+    let name = file.name();
+    let unreadable = |e: JsValue| {
+        js_error(Error::Import(format!(
+            "the browser could not read {name}: {}",
+            e.as_string()
+                .or_else(|| e.dyn_ref::<js_sys::Error>().map(|e| e.message().into()))
+                .unwrap_or_else(|| format!("{e:?}"))
+        )))
+    };
+    let reader = web_sys::FileReaderSync::new().map_err(unreadable)?;
+    let buffer = reader.read_as_array_buffer(file).map_err(unreadable)?;
+    Ok(Uint8Array::new(&buffer).to_vec())
+}
+
+/// The imported files of a build job, kept in one worker: the page adds and removes files,
+/// asks for their display meshes, the job's layout and lay-flat angles, and builds the merged
+/// job with [`Session::from_models`].
+#[wasm_bindgen]
+#[derive(Default)]
+pub struct Models {
+    models: Vec<Model>,
+}
+
+#[wasm_bindgen]
+impl Models {
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> Models {
+        Models::default()
+    }
+
+    /// Reads and imports a `File` under `name` (the job's key for it; a file of the same name
+    /// is replaced). Returns `ModelInfo {name, format, triangles, bounds {min, max}, items:
+    /// [{name, triangles, bounds}], warnings, suggested_scale}`.
+    pub fn add(&mut self, file: web_sys::File, name: &str) -> Result<JsValue, JsValue> {
+        let bytes = read_file(&file)?;
+        self.add_bytes(&bytes, name)
+    }
+
+    /// [`Models::add`] from bytes.
+    pub fn add_bytes(&mut self, bytes: &[u8], name: &str) -> Result<JsValue, JsValue> {
+        let model = Model::read(bytes, name).map_err(js_error)?;
+        let info = model.info();
+        self.models.retain(|m| m.name != name);
+        self.models.push(model);
+        to_js(&info, "the model info")
+    }
+
+    /// Forgets a file; whether it was there.
+    pub fn remove(&mut self, name: &str) -> bool {
+        let before = self.models.len();
+        self.models.retain(|m| m.name != name);
+        self.models.len() != before
+    }
+
+    /// The files' names, in the order they were added.
+    pub fn names(&self) -> Result<JsValue, JsValue> {
+        let names: Vec<&str> = self.models.iter().map(|m| m.name.as_str()).collect();
+        to_js(&names, "the file names")
+    }
+
+    /// A decimated copy of a file's triangles (one build item, or all) for the 3D view, at
+    /// most `max_triangles`: 9 floats per triangle, model coordinates in mm. Never sliced.
+    pub fn display_mesh(
+        &self,
+        name: &str,
+        item: Option<usize>,
+        max_triangles: u32,
+    ) -> Result<Float32Array, JsValue> {
+        let tris = self.model(name)?.triangles(item).map_err(js_error)?;
+        Ok(Float32Array::from(
+            &job::display_mesh(&tris, max_triangles as usize)[..],
+        ))
+    }
+
+    /// Where every copy of every part goes: `Layout {instances: [{part, copy, copies, name,
+    /// file, item, object, rotate, scale, place_angle, placed, at, unit, matrix, min, max}],
+    /// bounds, warnings}` (`matrix`: column-major 4×4, model → plate coordinates, exactly
+    /// the transform sliced). `job`: `{settings, parts}` as in a job file. Throws
+    /// `{kind: "job" | "setting", message, setting?}`.
+    pub fn layout(&self, job: JsValue) -> Result<JsValue, JsValue> {
+        let spec = job_of(job)?;
+        let layout = job::layout(&self.models, &spec).map_err(js_error)?;
+        to_js(&layout, "the layout")
+    }
+
+    /// `{rotate_x, rotate_y}` (degrees) that put a file's (or item's) largest flat face down.
+    pub fn lay_flat(&self, name: &str, item: Option<usize>) -> Result<JsValue, JsValue> {
+        let tris = self.model(name)?.triangles(item).map_err(js_error)?;
+        let (rotate_x, rotate_y) = job::lay_flat(&tris);
+        #[derive(Serialize)]
+        struct Angles {
+            rotate_x: f64,
+            rotate_y: f64,
+        }
+        to_js(&Angles { rotate_x, rotate_y }, "the angles")
+    }
+}
+
+impl Models {
+    fn model(&self, name: &str) -> Result<&Model, JsValue> {
+        self.models.iter().find(|m| m.name == name).ok_or_else(|| {
+            js_error(Error::Job(format!(
+                "no file named '{}' was added",
+                job::clean_name(name)
+            )))
+        })
+    }
+}
+
+impl Session {
+    fn check_layer(&self, i: usize) -> Result<(), JsValue> {
+        if i >= self.job.layer_count() {
+            return Err(js_error(Error::Internal(format!(
+                "layer {i} asked for, but the part has {} layers",
+                self.job.layer_count()
+            ))));
+        }
+        Ok(())
+    }
+
+    fn with(job: Job) -> Session {
+        let settings = job.settings().clone();
+        Session {
+            job,
+            settings,
+            unit_after: std::cell::Cell::new(None),
+            last_section: std::cell::RefCell::new(None),
+            raster: std::cell::RefCell::new(analysis::Raster::empty()),
+        }
+    }
+
+    /// Plans layer `i` and writes its text after the unit the layers below leave selected: the
+    /// unit after the layer this session planned last if that was layer i − 1 (the layers of a
+    /// unit of work come in order), else [`Job::unit_before`] (which plans the layers below
+    /// again, only when the job uses unit 1).
+    fn planned(&self, i: usize) -> (LayerPlan, crate::base::geom::Shapes, String) {
+        let (plan, region) = if self.job.needs_below() {
+            // The overhang figure needs the layer below's section: the one this session sliced
+            // last when that was layer i − 1 (a unit of work's layers come in order), else
+            // `plan_layer_with` slices it (once per unit of work).
+            let section = self.job.section(i);
+            let mine = section.region.clone();
+            let mut last = self.last_section.borrow_mut();
+            let below = last.take().filter(|(j, _)| j + 1 == i).map(|(_, r)| r);
+            let planned = self.job.plan_layer_with(i, section, below.as_ref());
+            *last = Some((i, mine));
+            planned
+        } else {
+            self.job.plan_layer_and_region(i)
+        };
+        let before = match self.unit_after.get() {
+            Some((j, u)) if j + 1 == i => u,
+            _ => self.job.unit_before(i),
+        };
+        self.unit_after.set(Some((i, plan.unit_after(before))));
+        let text = gcode::layer_text_after(&plan, before);
+        (plan, region, text)
+    }
+}
+
+/// The figures of a slice as the page shows them: the merged summary (to keep instead of its
+/// parts), its figures, and "nothing to print" once every layer is in.
+#[derive(Serialize)]
+struct SliceFigures {
+    summary: Summary,
+    figures: Figures,
+    nothing_to_print: Option<ErrorReport>,
+}
+
+/// One prepared slicing job: the parsed, transformed mesh and its settings.
+#[wasm_bindgen]
+pub struct Session {
+    pub(crate) job: Job,
+    pub(crate) settings: Settings,
+    /// The last layer planned and the unit selected after it.
+    unit_after: std::cell::Cell<Option<(usize, u8)>>,
+    /// The last layer planned with support off and its section's region (the overhang figure
+    /// of the next layer needs it).
+    last_section: std::cell::RefCell<Option<(usize, crate::base::geom::Shapes)>>,
+    /// The raster every analysed layer is rebuilt into (its memory kept between layers).
+    raster: std::cell::RefCell<analysis::Raster>,
+}
+
+#[wasm_bindgen]
+impl Session {
+    /// Parses the STL bytes and prepares the job (tests and Node; the page uses
+    /// [`Session::from_file`]). Throws `{kind, message, setting?}`.
+    #[wasm_bindgen(constructor)]
+    pub fn new(stl: &[u8], file_name: &str, settings: JsValue) -> Result<Session, JsValue> {
+        let settings = settings_of(settings)?;
+        let job = Job::new(stl, file_name, settings).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// Reads the model from a `File` (in a worker: `FileReaderSync`, so the page's thread
+    /// never copies it) and prepares the job.
+    pub fn from_file(file: web_sys::File, settings: JsValue) -> Result<Session, JsValue> {
+        let settings = settings_of(settings)?;
+        let bytes = read_file(&file)?;
+        let job = Job::new(&bytes, &file.name(), settings).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// The build job `job` (`{settings, parts}`, as in a job file) of the files in `models`:
+    /// every instance placed as [`Models::layout`] says and merged into one mesh; its settings
+    /// are `job.settings`. Other workers get it through `vertices()`, `facets()`, `info()` and
+    /// [`Session::from_prepared`] (with the same settings) as for one file.
+    pub fn from_models(models: &Models, job: JsValue) -> Result<Session, JsValue> {
+        let spec = job_of(job)?;
+        let job = Job::from_models(&models.models, &spec).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// A session from the prepared mesh of another worker's session (its `vertices`, `facets`
+    /// and `info`, made with the same settings): no import, only the facet index.
+    pub fn from_prepared(
+        vertices: &[f64],
+        facets: &[u32],
+        info: JsValue,
+        settings: JsValue,
+    ) -> Result<Session, JsValue> {
+        let settings = settings_of(settings)?;
+        let info: JobInfo = from_js(info, "job info")?;
+        if !vertices.len().is_multiple_of(3) || !facets.len().is_multiple_of(3) {
+            return Err(js_error(Error::Internal(
+                "prepared mesh: arrays are not triples".into(),
+            )));
+        }
+        let mesh = Mesh {
+            vertices: vertices
+                .chunks_exact(3)
+                .map(|v| [v[0], v[1], v[2]])
+                .collect(),
+            facets: facets.chunks_exact(3).map(|f| [f[0], f[1], f[2]]).collect(),
+        };
+        let job = Job::from_prepared(mesh, info, settings).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
+    /// The prepared mesh's vertices, x,y,z per vertex, mm (a copy; transfer its buffer).
+    pub fn vertices(&self) -> Float64Array {
+        let v: &[[f64; 3]] = &self.job.mesh().vertices;
+        Float64Array::from(v.as_flattened())
+    }
+
+    /// The prepared mesh's facets, three vertex indices each (a copy; transfer its buffer).
+    pub fn facets(&self) -> Uint32Array {
+        let f: &[[u32; 3]] = &self.job.mesh().facets;
+        Uint32Array::from(f.as_flattened())
+    }
+
+    /// Number of layers.
+    pub fn layer_count(&self) -> usize {
+        self.job.layer_count()
+    }
+
+    /// Facets, bounds, layers, droplet width and mesh warnings (`JobInfo`).
+    pub fn info(&self) -> Result<JsValue, JsValue> {
+        to_js(self.job.info(), "the job info")
+    }
+
+    /// Plans layer `i`: its G-code text, droplet counts and preview arrays.
+    pub fn slice_layer(&self, i: usize) -> Result<LayerResult, JsValue> {
+        self.check_layer(i)?;
+        let (plan, _, text) = self.planned(i);
+        Ok(LayerResult::new(&plan, &self.settings, text))
+    }
+
+    /// [`Session::slice_layer`] plus the void analysis of the same plan (no second planning):
+    /// `analysis` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]). About 2–3
+    /// times the work of planning the layer.
+    pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsValue> {
+        self.check_layer(i)?;
+        let (plan, region, text) = self.planned(i);
+        let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
+        let (a, mask) = analysis::analyse_layer_for_page(
+            &mut self.raster.borrow_mut(),
+            &plan,
+            &region,
+            &self.settings,
+            cell,
+        );
+        let mut r = LayerResult::new(&plan, &self.settings, text);
+        r.analysis = Some(a);
+        r.mask = Some(mask);
+        Ok(r)
+    }
+
+    /// The header comment block for a finished slice (`summary`: every unit's summary
+    /// merged); `null` gives the same-width placeholder header.
+    pub fn header(&self, summary: JsValue) -> Result<String, JsValue> {
+        if summary.is_null() || summary.is_undefined() {
+            return Ok(self.job.header(None));
+        }
+        let summary: Summary = from_js(summary, "summary")?;
+        Ok(self.job.header(Some(&summary)))
+    }
+
+    /// The closing comment block.
+    pub fn footer(&self, summary: JsValue) -> Result<String, JsValue> {
+        let summary: Summary = from_js(summary, "summary")?;
+        Ok(gcode::footer(&summary))
+    }
+
+    /// Merges `parts` (summaries of units, in any order) and computes the figures with this
+    /// session's settings: `{summary, figures, nothing_to_print}` (`nothing_to_print` is the
+    /// error `{kind, message}` when every layer is in and not one droplet fits, else `null`).
+    pub fn figures(&self, parts: JsValue) -> Result<JsValue, JsValue> {
+        let parts: Vec<Summary> = from_js(parts, "summaries")?;
+        let summary = Summary::merged(&parts);
+        let complete = summary.layers == self.job.layer_count();
+        let out = SliceFigures {
+            figures: summary.figures(&self.settings),
+            nothing_to_print: if complete {
+                summary.printable(&self.settings).err().map(|e| e.report())
+            } else {
+                None
+            },
+            summary,
+        };
+        to_js(&out, "the figures")
+    }
+}
+
+/// A unit's summary, built layer by layer in the worker.
+#[wasm_bindgen]
+#[derive(Default)]
+pub struct Tally {
+    summary: Summary,
+}
+
+#[wasm_bindgen]
+impl Tally {
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> Tally {
+        Tally::default()
+    }
+
+    /// Adds a sliced layer (its counts, travel and repairs, and its analysis if it has one).
+    pub fn add_layer(&mut self, layer: &LayerResult) {
+        self.summary.merge(&layer.summary);
+        if let Some(a) = &layer.analysis {
+            self.summary.add_analysis(a);
+        }
+    }
+
+    /// Adds only a layer's analysis (a layer analysed after the slice that counted it).
+    pub fn add_analysis(&mut self, layer: &LayerResult) {
+        if let Some(a) = &layer.analysis {
+            self.summary.add_analysis(a);
+        }
+    }
+
+    /// The summary so far (`Summary`).
+    pub fn summary(&self) -> Result<JsValue, JsValue> {
+        to_js(&self.summary, "a summary")
+    }
+}
+
+/// One planned layer, ready to be posted to the page.
+#[wasm_bindgen]
+pub struct LayerResult {
+    index: usize,
+    z: f64,
+    counts: Counts,
+    travel_mm: f64,
+    seconds: f64,
+    unsupported_area: f64,
+    summary: Summary,
+    gcode: String,
+    preview: PreviewLayer,
+    analysis: Option<LayerAnalysis>,
+    mask: Option<CoverageMask>,
+}
+
+impl LayerResult {
+    fn new(plan: &LayerPlan, settings: &Settings, gcode: String) -> LayerResult {
+        LayerResult {
+            index: plan.index,
+            z: plan.z,
+            counts: plan.counts,
+            travel_mm: plan.travel_mm,
+            seconds: summary::layer_seconds(plan, settings),
+            unsupported_area: plan.unsupported_area,
+            summary: Summary::of_layer(plan),
+            gcode,
+            preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
+            analysis: None,
+            mask: None,
+        }
+    }
+}
+
+#[wasm_bindgen]
+impl LayerResult {
+    #[wasm_bindgen(getter)]
+    pub fn index(&self) -> usize {
+        self.index
+    }
+    #[wasm_bindgen(getter)]
+    pub fn z(&self) -> f64 {
+        self.z
+    }
+    /// Droplets of the outermost loops.
+    #[wasm_bindgen(getter)]
+    pub fn outer(&self) -> f64 {
+        self.counts.outer as f64
+    }
+    /// Droplets of the inner loops.
+    #[wasm_bindgen(getter)]
+    pub fn inner(&self) -> f64 {
+        self.counts.inner as f64
+    }
+    /// Fill droplets.
+    #[wasm_bindgen(getter)]
+    pub fn fill(&self) -> f64 {
+        self.counts.fill as f64
+    }
+    /// Total length of the layer's travel moves in mm.
+    #[wasm_bindgen(getter)]
+    pub fn travel_mm(&self) -> f64 {
+        self.travel_mm
+    }
+    /// The layer's estimated print time, s (`summary::layer_seconds`: the layers' times add up
+    /// to the job's `print_seconds`).
+    #[wasm_bindgen(getter)]
+    pub fn seconds(&self) -> f64 {
+        self.seconds
+    }
+    /// The layer's G-code lines as UTF-8 bytes (a copy; the worker collects a run of layers
+    /// into one Blob: a Blob per layer costs far more than the bytes).
+    #[wasm_bindgen(getter)]
+    pub fn gcode(&self) -> Uint8Array {
+        Uint8Array::from(self.gcode.as_bytes())
+    }
+    /// Droplet centres, x,y pairs in mm (a copy; its buffer can be transferred).
+    #[wasm_bindgen(getter)]
+    pub fn droplets(&self) -> Float32Array {
+        Float32Array::from(&self.preview.droplets[..])
+    }
+    /// Role per droplet: 0 outermost loop, 1 inner loops, 2 fill, 3 support (unit 1).
+    #[wasm_bindgen(getter)]
+    pub fn roles(&self) -> Uint8Array {
+        Uint8Array::from(&self.preview.roles[..])
+    }
+    /// Discharge unit per droplet (0 or 1), in the order of `roles`.
+    #[wasm_bindgen(getter)]
+    pub fn units(&self) -> Uint8Array {
+        Uint8Array::from(&self.preview.units[..])
+    }
+    /// Travel moves, x0,y0,x1,y1 per move, in mm.
+    #[wasm_bindgen(getter)]
+    pub fn travel(&self) -> Float32Array {
+        Float32Array::from(&self.preview.travel[..])
+    }
+    /// The layer's overhang area, mm² (its region farther than `overhang_limit`·B from the
+    /// region below; 0 on the first layer).
+    #[wasm_bindgen(getter)]
+    pub fn unsupported_area(&self) -> f64 {
+        self.unsupported_area
+    }
+    /// Support droplets (unit 1).
+    #[wasm_bindgen(getter)]
+    pub fn support(&self) -> f64 {
+        self.counts.support as f64
+    }
+    /// Droplets printed by unit 1 (support and unit-1 parts).
+    #[wasm_bindgen(getter)]
+    pub fn unit1(&self) -> f64 {
+        self.counts.unit1 as f64
+    }
+    /// The layer's void analysis (`analysis::LayerAnalysis`: coverage, void_area,
+    /// largest_void {area, centroid, min, max, at_boundary}, overfill_area,
+    /// boundary_deviation, ...); `null` unless made by `slice_layer_analysed`.
+    pub fn analysis(&self) -> Result<JsValue, JsValue> {
+        match &self.analysis {
+            Some(a) => to_js(a, "a layer analysis"),
+            None => Ok(JsValue::NULL),
+        }
+    }
+    /// The coverage mask's cell, mm; 0 without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn mask_cell(&self) -> f64 {
+        self.mask.as_ref().map_or(0.0, |m| m.cell)
+    }
+    /// The coverage mask's tiles (only where the layer's region and droplets are): per tile
+    /// origin x, origin y (mm), width, height (cells); cell (col, row) of a tile starts at its
+    /// origin + (col, row)·cell. Empty without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn mask_tiles(&self) -> Float64Array {
+        let frames: Vec<f64> = self.mask.as_ref().map_or_else(Vec::new, |m| {
+            m.tiles
+                .iter()
+                .flat_map(|t| {
+                    let o = m.tile_origin(t);
+                    [o[0], o[1], t.width as f64, t.height as f64]
+                })
+                .collect()
+        });
+        Float64Array::from(&frames[..])
+    }
+    /// Void share (region not covered) per mask cell, 0..255: the tiles one after the other,
+    /// each row-major from its lowest row; empty without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn void_mask(&self) -> Uint8Array {
+        self.shares(|t| &t.void)
+    }
+    /// Overfill share (covered outside the region) per mask cell, laid out as `void_mask`.
+    #[wasm_bindgen(getter)]
+    pub fn overfill_mask(&self) -> Uint8Array {
+        self.shares(|t| &t.overfill)
+    }
+    /// Per tile of the mask, 1 when any of its cells has overfill, else 0 (most tiles have
+    /// none: the page then reads no overfill share of them); empty without analysis.
+    #[wasm_bindgen(getter)]
+    pub fn mask_overfilled(&self) -> Uint8Array {
+        let tiles = self.mask.as_ref().map_or(&[][..], |m| &m.tiles[..]);
+        let flags: Vec<u8> = tiles
+            .iter()
+            .map(|t| u8::from(t.overfill.iter().any(|&v| v != 0)))
+            .collect();
+        Uint8Array::from(&flags[..])
+    }
+}
+
+impl LayerResult {
+    /// One share of every tile of the mask, one tile after the other (copied once, tile by
+    /// tile, into the JS array).
+    fn shares(&self, of: impl Fn(&MaskTile) -> &Vec<u8>) -> Uint8Array {
+        let tiles = self.mask.as_ref().map_or(&[][..], |m| &m.tiles[..]);
+        let total: usize = tiles.iter().map(|t| of(t).len()).sum();
+        let out = Uint8Array::new_with_length(total as u32);
+        let mut at = 0u32;
+        for t in tiles {
+            let v = of(t);
+            let end = at + v.len() as u32;
+            out.subarray(at, end).copy_from(v);
+            at = end;
+        }
+        out
+    }
+}
