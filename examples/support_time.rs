@@ -70,7 +70,7 @@ fn main() {
     }
     let t = Instant::now();
     let hatch: Vec<Vec<dropslice::slicing::plan::Move>> = par_map(n, &|i| {
-        dropslice::slicing::plan::support_moves(
+        dropslice::support::moves::support_moves(
             &layers[i].lines,
             &regions[i],
             &[],

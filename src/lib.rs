@@ -410,7 +410,7 @@ impl Job {
 
     /// Every layer's plan with support on (`support = unit1`), computed once per job on first
     /// use: each layer's part planned as without support, its support region hatched by unit 1
-    /// ([`plan::support_moves`]), then the droplet-level pass over all layers
+    /// ([`moves::support_moves`]), then the droplet-level pass over all layers
     /// ([`support_droplets::complete`]) adds unit-1 droplets under every droplet the layer
     /// below leaves unsupported. Natively the layers are planned in parallel; in the page each
     /// worker's job plans them all once (docs/support.md).
@@ -435,7 +435,7 @@ impl Job {
             // Unit 1's hatch moves of each layer, after its part plan.
             let hatches = support::par_map(n, &|i| {
                 let start = plan::unit1_start(&parts[i].0, s);
-                plan::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
+                support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
             });
             let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> = parts
                 .into_iter()
@@ -465,7 +465,14 @@ impl Job {
                     if !extra[i].is_empty() {
                         let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
                         let none = geom::Shapes::new();
-                        moves.extend(plan::support_moves(&[], &none, &extra[i], i, s, start));
+                        moves.extend(support::moves::support_moves(
+                            &[],
+                            &none,
+                            &extra[i],
+                            i,
+                            s,
+                            start,
+                        ));
                     }
                     plan::add_unit1(&mut p, moves, s);
                     (p, region)

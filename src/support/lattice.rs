@@ -2,7 +2,7 @@
 //! docs/support.md *Support regions*).
 //!
 //! Unit 1 prints a support region as hatch lines (j + ½)·spacing across the layer's hatch
-//! direction, every line's droplets at k·B₁ along it ([`crate::slicing::plan::support_moves`]): a
+//! direction, every line's droplets at k·B₁ along it ([`crate::support::moves::support_moves`]): a
 //! droplet is set at exactly the lattice points inside the region. So the region matters only
 //! at those points, and the top-down need
 //! need(n) = (need(n + 1) ∪ grow(overhang(n + 1))) − region(n)
@@ -346,7 +346,7 @@ mod tests {
         out
     }
 
-    /// The droplets unit 1 sets on `lines` (as `plan::support_moves` does).
+    /// The droplets unit 1 sets on `lines` (as `moves::support_moves` does).
     fn points(l: &Lattice, lines: &[HatchLine]) -> Vec<Point> {
         let mut out = Vec::new();
         for h in lines {

@@ -23,13 +23,14 @@
 //! support droplet can take); for unusual hatch steps as outlines by a sequential union
 //! ([`support_regions`], which hands the boolean engine only the shapes whose boxes meet,
 //! [`carried`]). Unit 1 prints each layer's support hatch segments
-//! ([`crate::slicing::plan::support_moves`]), leaving out the droplets within `support_gap_xy`·B of the
+//! ([`crate::support::moves::support_moves`]), leaving out the droplets within `support_gap_xy`·B of the
 //! part (no offset of the part); the droplet-level pass ([`crate::support::droplets`]) then
 //! adds droplets wherever the rule still fails.
 //! `tests/support.rs` checks the rule on the printed droplets.
 
 pub mod droplets;
 pub mod lattice;
+pub mod moves;
 pub mod overhang;
 
 use crate::base::geom::{
@@ -411,7 +412,7 @@ pub struct LayerSupport {
     /// The support region's hatch segments (empty with `support = off`): lines
     /// B₁ / `support_density` apart at the layer's hatch angle, their ends on the lattice
     /// points k·B₁ along them, up to the part: droplets within `support_gap_xy`·B of the part
-    /// are left out when they are planned ([`crate::slicing::plan::support_moves`]).
+    /// are left out when they are planned ([`crate::support::moves::support_moves`]).
     pub lines: Vec<HatchLine>,
 }
 
