@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the page into dist/: the core for wasm32 (release), its wasm-bindgen glue, a type
-# check of www/, the esbuild bundles (page + worker), the manifest and icons, and the service
-# worker (offline use) with the build's id.
+# check of www/, the esbuild bundles (the page, www/main.ts; the worker, www/worker/worker.ts),
+# the manifest and icons, and the service worker (offline use, www/pwa/sw.ts) with the build's id.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -24,7 +24,7 @@ mkdir -p dist
 # bundled alone, unsplit: one file.
 node_modules/.bin/esbuild www/main.ts --bundle --splitting --format=esm --target=es2022 \
   --minify --sourcemap --outdir=dist --log-level=warning
-node_modules/.bin/esbuild www/worker.ts --bundle --format=esm --target=es2022 \
+node_modules/.bin/esbuild www/worker/worker.ts --bundle --format=esm --target=es2022 \
   --minify --sourcemap --outdir=dist --log-level=warning
 cp www/index.html www/style.css dist/
 # No wasm-opt: Debian's binaryen 108 produced a module whose function table Chromium rejects
@@ -44,7 +44,7 @@ for f in index.html main.js worker.js dropslice_bg.wasm; do
   [[ " ${shell[*]} " == *" $f "* ]] || { echo "build: dist/$f is missing from the shell" >&2; exit 1; }
 done
 build_id=$(cd dist && cat "${shell[@]}" | sha256sum | cut -c1-16)
-node_modules/.bin/esbuild www/sw.ts --bundle --format=iife --target=es2022 --minify \
+node_modules/.bin/esbuild www/pwa/sw.ts --bundle --format=iife --target=es2022 --minify \
   "--define:BUILD_ID=\"$build_id\"" "--define:SHELL=$shell_json" --outfile=dist/sw.js --log-level=warning
 echo "== build id $build_id" >&2
 echo "== built dist/ ($(du -sh dist | cut -f1))" >&2

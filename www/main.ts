@@ -1,30 +1,35 @@
-// Page wiring only: events -> worker pool (client.ts) -> store (store.ts) -> views (views/).
-// The runs of the workers are in flows.ts, opening files and links in open.ts, the figures
-// of a slice in figures.ts.
+// Page wiring only: the page's one instance (core/ store and worker pool, views/ canvases and
+// panels), the actions the views ask for wired to their flows (flows/), the page's own events
+// (buttons, drag and drop) to flows, the service worker (pwa/), and the tests' hooks.
 
-import { Cancelled, MAX_WORKERS, Pool } from "./client";
-import { showError } from "./errors";
-import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows";
-import { SettingsForm } from "./form";
-import { PART_KEYS } from "./job";
-import { addParts, relayout } from "./jobflows";
-import { openFiles, openLink, openSample } from "./open";
-import type { Page } from "./page";
-import { Renderer, type View } from "./render";
-import { cacheBudgetBytes, Store } from "./store";
+import { Cancelled, MAX_WORKERS, Pool } from "./core/client";
+import { checkLine } from "./core/cutline";
+import { PART_KEYS } from "./core/job";
+import { cacheBudgetBytes, Store } from "./core/store";
+import type { View } from "./core/view";
+import { cutStatus, setCutLine, updateCut } from "./flows/cut";
+import { showError } from "./flows/errors";
+import { addParts, arrangeAll, duplicatePart, editParts, layFlat, movePart, relayout, removePart, saveJob, selectPart } from "./flows/job";
+import { fit, setShowOverhangs, show } from "./flows/layer";
+import { openFiles, openLink, openSample } from "./flows/open";
+import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows/slice";
+import { registerOffline } from "./pwa/offline";
 import { hideBanner } from "./views/banner";
-import { updateButtons } from "./views/controls";
-import { $ } from "./views/dom";
 import { wireCalibrate } from "./views/calibrate";
-import { wireCut } from "./views/cut";
-import { setShowOverhangs, show, wireLayerView } from "./views/layer";
-import { wirePlot } from "./views/plot";
-import { registerOffline } from "./offline";
-import { share } from "./views/share";
-import { setState } from "./views/status";
+import { CutRenderer } from "./views/canvas/cutrender";
+import { Renderer } from "./views/canvas/render";
+import { updateButtons } from "./views/controls";
+import { setLine, wireCut } from "./views/cut";
+import { $ } from "./views/dom";
+import { SettingsForm } from "./views/form";
+import { wireLayerView } from "./views/layer";
+import type { Actions, Page, PartsView } from "./views/page";
 import { wirePartDrag } from "./views/partdrag";
 import { PartsPanel } from "./views/parts";
-import { View3DPanel, wireView3D } from "./views/view3d";
+import { wirePlot } from "./views/plot";
+import { share } from "./views/share";
+import { setState } from "./views/status";
+import { View3DPanel, wireView3D } from "./views/view3d/panel";
 
 /** Tuning through the query string (used by the tests): `?workers=3&cache=2` (MB). */
 const query = new URLSearchParams(location.search);
@@ -41,19 +46,37 @@ function workersAsked(): number | null {
 }
 
 const asked = workersAsked();
+/** What the views ask for, each a flow of the page. */
+const actions: Actions = {
+  show: (i) => show(page, i),
+  fit: () => fit(page),
+  error: (e) => showError(page, e),
+  selectPart: (id) => selectPart(page, id),
+  editParts: (edits) => editParts(page, edits),
+  movePart: (id, copy, dx, dy) => movePart(page, id, copy, dx, dy),
+  layFlat: (id) => void layFlat(page, id),
+  duplicatePart: (id) => duplicatePart(page, id),
+  removePart: (id) => removePart(page, id),
+  arrangeAll: () => arrangeAll(page),
+  saveJob: () => saveJob(page),
+  unitFix: (factor) => fixUnits(page, factor),
+  calibrate: (request) => page.pool.calibrate(request),
+  overhangFace: (settings) => page.pool.overhangFace(settings),
+  setCutLine: (line, refit) => setCutLine(page, line, refit),
+  updateCut: () => updateCut(page),
+};
 const page: Page = {
   store: new Store(cacheBudgetBytes(query)),
   pool: asked === null ? new Pool() : new Pool(asked),
   renderer: new Renderer($<HTMLCanvasElement>("view")),
+  cut: new CutRenderer($<HTMLCanvasElement>("cut-view")),
   view3d: new View3DPanel($("view3d")),
-  parts: null as unknown as PartsPanel,
-  onUnitFix: (factor) => fixUnits(page, factor),
+  parts: null as unknown as PartsView,
+  actions,
 };
-(page as { parts: PartsPanel }).parts = new PartsPanel(page);
+(page as { parts: PartsView }).parts = new PartsPanel(page);
 const { store, pool, renderer } = page;
-const error = (e: unknown) => showError(page, e);
-
-let cutHooks: ReturnType<typeof wireCut> | null = null;
+const error = actions.error;
 
 function wire(): void {
   $("btn-sample").addEventListener("click", () => void openSample(page));
@@ -87,9 +110,9 @@ function wire(): void {
 
   wireLayerView(page);
   wireView3D(page);
-  cutHooks = wireCut(page);
+  wireCut(page);
   wirePartDrag(page);
-  wirePlot(page, (i) => show(page, i));
+  wirePlot(page, actions.show);
   wireCalibrate(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;
@@ -195,8 +218,23 @@ window.dropslice = {
   /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
    *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
   view3d: () => page.view3d.testState(),
-  /** The vertical cut (views/cut.ts): set(line), status(), setView(v), redraw(). */
-  cut: () => cutHooks,
+  /** The vertical cut (views/cut.ts, flows/cut.ts): set(line), status(), setView(v), redraw(). */
+  cut: () => ({
+    /** Sets the cut line `{a: [x, y], b: [x, y]}` (mm); false if it is refused. */
+    set: (l: unknown): boolean => {
+      const line = checkLine(l);
+      if (line) setLine(page, line);
+      return line !== null;
+    },
+    /** The cut's state: the line, layers with droplets, droplets, layers resolved by the
+     *  core, voids, runs still out. */
+    status: () => cutStatus(page),
+    setView: (v: { scale: number; ct: number; cz: number }) => {
+      page.cut.setView(v);
+      page.cut.request();
+    },
+    redraw: () => page.cut.draw(),
+  }),
   /** The build job: its parts (specs), the core's layout and the selected part's id. */
   job: () => {
     const job = store.job;

@@ -1,7 +1,8 @@
-// Build jobs in the page (www/job.ts, jobflows.ts, views/parts.ts, views/view3d.ts, open.ts,
-// share.ts): several files become one job, the core lays it out, the 3D view draws and moves
-// its parts, job files and preview links carry it. G-code is checked against the core's layout
-// (every droplet inside an instance's box) and against the page's own earlier output.
+// Build jobs in the page (www/core/job.ts, flows/job.ts, views/parts.ts, views/view3d/,
+// flows/open.ts, core/share.ts): several files become one job, the core lays it out, the 3D
+// view draws and moves its parts, job files and preview links carry it. G-code is checked
+// against the core's layout (every droplet inside an instance's box) and against the page's
+// own earlier output.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";

@@ -1,4 +1,4 @@
-// Offline use (www/sw.ts, www/offline.ts): the manifest is linked and parses; after a first
+// Offline use (www/pwa/sw.ts, www/pwa/offline.ts): the manifest is linked and parses; after a first
 // visit the page loads and slices with the server gone and the browser offline, and gives the
 // same G-code as online; a new build served on the same origin installs beside the old one,
 // the page offers it, and Reload brings the new build with only its cache left.

@@ -1,5 +1,5 @@
 // Unit tests of the page's pure modules (G-code reader, preview links, settings parsing,
-// sample part), bundled from www/*.ts with esbuild and run in Node.
+// sample part), bundled from www/core and www/worker with esbuild and run in Node.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync } from "node:fs";
@@ -13,7 +13,7 @@ const out = mkdtempSync(join(tmpdir(), "dropslice-units-"));
 let gcode, share, form, sample;
 
 before(async () => {
-  const names = ["gcode", "share", "form", "sample"];
+  const names = ["worker/gcode", "core/share", "core/settings", "core/sample"];
   await build({
     entryPoints: names.map((n) => join(repo, "www", `${n}.ts`)),
     bundle: true,

@@ -1,4 +1,4 @@
-// The 3D tab (www/view3d.ts, www/views/view3d.ts) in headless Chromium: WebGL2 renders in
+// The 3D tab (www/views/view3d/view3d.ts, panel.ts) in headless Chromium: WebGL2 renders in
 // software here. The canvas' pixels are read back and classified by colour (helpers.mjs
 // pixels3d): the part's steel blue, the selected part's accent blue, the cut's orange.
 import { after, before, test } from "node:test";

@@ -1,6 +1,6 @@
 // Messages: the banner (errors, notices) and the note about a preview link.
 
-import { SliceError } from "../client";
+import { SliceError } from "../core/client";
 import { $ } from "./dom";
 
 export const TITLES: Record<string, string> = {

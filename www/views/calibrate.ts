@@ -3,14 +3,14 @@
 // the slice shown (its droplet total, H and droplet_aspect as sliced) or of the opened .gco
 // file (its header's total, else its commands'; its header's H and aspect), give the core's
 // effective droplet volume, cell B²H, filling degree and suggested droplet_aspect. Every figure
-// is the core's (src/calibrate.rs, called in a worker: www/calibration.ts); the page only checks
+// is the core's (src/calibrate.rs, called in a worker: www/worker/calibration.ts); the page only checks
 // that the inputs are positive numbers before asking and shows the answer or the core's refusal
 // next to the inputs. "Use droplet_aspect = X" puts the suggestion into the settings form.
 
-import { Cancelled, SliceError } from "../client";
-import type { Page } from "../page";
-import type { CalibrateRequest, Calibration } from "../protocol";
-import type { Slice } from "../store";
+import { Cancelled, SliceError } from "../core/client";
+import type { Page } from "./page";
+import type { CalibrateRequest, Calibration } from "../core/protocol";
+import type { Slice } from "../core/store";
 import { updateButtons } from "./controls";
 import { $, nf, setText } from "./dom";
 
@@ -149,7 +149,7 @@ async function run(page: Page): Promise<void> {
   }
   message("Calculating…");
   try {
-    const c = await page.pool.calibrate(src.request(mass.value, density.value));
+    const c = await page.actions.calibrate(src.request(mass.value, density.value));
     if (seq !== state.seq || state.source !== src) return;
     message("");
     showResult(c);

@@ -1,7 +1,7 @@
 // The buttons Download, Copy preview link and Slice, and the settings' status line.
 
-import { jobSettings } from "../job";
-import type { Page } from "../page";
+import { jobSettings } from "../core/job";
+import type { Page } from "./page";
 import { $ } from "./dom";
 
 export function updateButtons(page: Page): void {

@@ -4,8 +4,7 @@
 // lays the job out again). Elsewhere, or with no part selected, a drag pans as before. The
 // droplets drawn stay the slice's until the job is sliced again (the Slice button says so).
 
-import { movePart } from "../jobflows";
-import type { Page } from "../page";
+import type { Page } from "./page";
 import { $ } from "./dom";
 
 interface Drag {
@@ -98,7 +97,7 @@ export function wirePartDrag(page: Page): void {
     drag = null;
     canvas.classList.remove("dragging");
     if (ev.type === "pointerup" && Math.hypot(d.dx, d.dy) > 1e-6) {
-      void movePart(page, d.part, d.copy, d.dx, d.dy).then(() => renderer.request());
+      void page.actions.movePart(d.part, d.copy, d.dx, d.dy).then(() => renderer.request());
     } else renderer.request();
   };
   canvas.addEventListener("pointerup", end, { capture: true });

@@ -1,12 +1,11 @@
 // The parts panel (left column, above the settings): the job's parts (name, triangles, size on
 // the plate, copies), the selected part's editor (rotation, scale with a uniform lock, place or
 // "auto", place angle, copies, lay flat, duplicate, remove) and the job's buttons (add part,
-// arrange, save job). Every change goes to jobflows.ts, which has the core lay the job out
+// arrange, save job). Every change is an action (flows/job.ts), which has the core lay the job out
 // again; what is shown comes from the job and the core's layout only.
 
-import { PART_LIMITS, partName, type Part } from "../job";
-import { arrangeAll, duplicatePart, editParts, layFlat, removePart, saveJob, selectPart, type Changes } from "../jobflows";
-import type { Page } from "../page";
+import { PART_LIMITS, partName, type Changes, type Part } from "../core/job";
+import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
 
 const NUMBER_FIELDS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "copies"] as const;
@@ -31,12 +30,12 @@ function parseField(k: NumberField, raw: string): { value?: number; error?: stri
   return { value: x };
 }
 
-export class PartsPanel {
+export class PartsPanel implements PartsView {
   constructor(private readonly page: Page) {}
 
   /** Wires the panel's inputs and buttons (once). */
   wire(): void {
-    const page = this.page;
+    const { actions } = this.page;
     for (const k of NUMBER_FIELDS) {
       const input = $<HTMLInputElement>(`part-${k}`);
       input.addEventListener("change", () => this.changed(k, input));
@@ -62,11 +61,11 @@ export class PartsPanel {
       const unit = Number((ev.target as HTMLSelectElement).value);
       if (p && (unit === 0 || unit === 1) && unit !== p.spec.unit) void this.edit(p, { unit }).then((ok) => ok || this.renderEditor());
     });
-    $("part-lay-flat").addEventListener("click", () => this.part() && void layFlat(page, this.part()!.id));
-    $("part-duplicate").addEventListener("click", () => this.part() && duplicatePart(page, this.part()!.id));
-    $("part-remove").addEventListener("click", () => this.part() && removePart(page, this.part()!.id));
-    $("btn-arrange").addEventListener("click", () => arrangeAll(page));
-    $("btn-save-job").addEventListener("click", () => saveJob(page));
+    $("part-lay-flat").addEventListener("click", () => this.part() && actions.layFlat(this.part()!.id));
+    $("part-duplicate").addEventListener("click", () => this.part() && actions.duplicatePart(this.part()!.id));
+    $("part-remove").addEventListener("click", () => this.part() && actions.removePart(this.part()!.id));
+    $("btn-arrange").addEventListener("click", () => actions.arrangeAll());
+    $("btn-save-job").addEventListener("click", () => actions.saveJob());
   }
 
   /** The part the editor edits: the selected one, or the only one. */
@@ -84,7 +83,7 @@ export class PartsPanel {
   }
 
   private edit(p: Part, changes: Changes): Promise<boolean> {
-    return editParts(this.page, [{ id: p.id, changes }]);
+    return this.page.actions.editParts([{ id: p.id, changes }]);
   }
 
   private changed(k: NumberField, input: HTMLInputElement): void {
@@ -145,7 +144,7 @@ export class PartsPanel {
       right.className = "part-tags";
       right.append(unit, copies);
       li.append(name, right, meta);
-      const pick = () => selectPart(this.page, p.id);
+      const pick = () => this.page.actions.selectPart(p.id);
       li.addEventListener("click", pick);
       li.addEventListener("keydown", (ev) => {
         if (ev.key === "Enter" || ev.key === " ") {

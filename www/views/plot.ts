@@ -7,9 +7,9 @@
 // draw costs O(layers + width) whatever the count; while the workers run it is redrawn at most
 // every [[BUSY_REDRAW_MS]].
 
-import { sizeCanvas, watchCanvas } from "../hidpi";
-import type { Page } from "../page";
-import type { Slice } from "../store";
+import { sizeCanvas, watchCanvas } from "./canvas/hidpi";
+import type { Page } from "./page";
+import type { Slice } from "../core/store";
 import { $, duration, nf } from "./dom";
 
 const BUSY_REDRAW_MS = 150;

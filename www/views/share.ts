@@ -1,9 +1,9 @@
 // The share dialog: makes the preview link of the slice shown, copies it, and shows it.
 
-import type { Value } from "../form";
-import type { Page } from "../page";
-import { fullSpec, PART_KEYS, specOut } from "../job";
-import { makeLink } from "../share";
+import type { Value } from "../core/settings";
+import type { Page } from "./page";
+import { fullSpec, PART_KEYS, specOut } from "../core/job";
+import { makeLink } from "../core/share";
 import { $ } from "./dom";
 
 export async function share(page: Page): Promise<void> {

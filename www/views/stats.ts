@@ -1,8 +1,8 @@
 // The statistics panel: the model, droplets by role, the estimates, this layer, the mesh
 // warnings and the unit fix. The figures are the core's (figures.ts); nothing is computed here.
 
-import type { Page } from "../page";
-import type { Slice } from "../store";
+import type { Page } from "./page";
+import type { Slice } from "../core/store";
 import { writeCalibration } from "./calibrate";
 import { $, duration, nf, setText } from "./dom";
 import { requestPlot } from "./plot";
@@ -133,7 +133,7 @@ function writeUnitFix(page: Page, s: Slice): void {
   if (typeof factor !== "number" || btn.hidden) return;
   btn.textContent = factor > 1 ? `Scale ×${factor} (inches → mm)` : `Scale ×${factor} (µm → mm)`;
   btn.title = "Scale x, y and z by this factor and slice again";
-  btn.onclick = () => page.onUnitFix(factor);
+  btn.onclick = () => page.actions.unitFix(factor);
 }
 
 /** The slice's parts as the core placed them: "gear.stl × 2, box.stl" (one line per part). */

@@ -1,6 +1,6 @@
 // The "Voids" block of the statistics: this layer, the part, the worst layer (and its button).
 
-import type { Slice } from "../store";
+import type { Slice } from "../core/store";
 import { $, nf, setText } from "./dom";
 
 const pct = (x: number) => `${(x * 100).toFixed(1)} %`;

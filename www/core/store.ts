@@ -3,11 +3,11 @@
 // that was replaced. No DOM here.
 
 import type { JobFileRef } from "./client";
-import type { Value } from "./form";
+import type { Value } from "./settings";
 import { Figures } from "./figures";
 import type { Job } from "./job";
 import type { Counts, JobFile, JobInfo, LayerAnalysis, LayerData, SliceUnit } from "./protocol";
-import type { Bounds } from "./render";
+import type { Bounds } from "./view";
 import type { ShareState } from "./share";
 
 /** Layer previews kept in the page (`?cache=MB`, 384 MB unless asked): beyond this, layers far
@@ -189,7 +189,7 @@ export class Store {
   fileChosenAt: number | null = null;
   /** Layers being fetched from a worker (evicted, or wanted with their mask). */
   readonly previewRequests = new Set<number>();
-  /** The redraw waiting while the workers run (flows.ts whileBusy). */
+  /** The redraw waiting while the workers run (flows/slice.ts whileBusy). */
   busyRedraw: { gen: number; update: () => void } | null = null;
 
   constructor(readonly cacheBudget: number) {}

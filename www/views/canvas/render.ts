@@ -5,8 +5,10 @@
 // pixels wide, over 60,000 droplets), droplets are written straight into a pixel buffer as
 // small squares: ~330,000 droplets then take ~10 ms instead of ~100 ms of path filling.
 
-import { sizeCanvas, watchCanvas } from "./hidpi";
-import type { CoverageMask, LayerData } from "./protocol";
+import type { CoverageMask, LayerData } from "../../core/protocol";
+import type { Bounds } from "../../core/view";
+import type { LayerCanvas } from "../page";
+import { PanZoomCanvas } from "./panzoom";
 
 export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
 export const ROLE_NAMES = ["Outer loop", "Inner loops", "Fill"] as const;
@@ -43,53 +45,31 @@ export const OVERFILL_RGB = [12, 166, 120] as const;
 const VOID_ALPHA = 0.9;
 const VOID_MARK = "#a61e4d";
 
-export interface View {
-  /** CSS pixels per mm. */
-  scale: number;
-  /** mm at the canvas centre. */
-  cx: number;
-  cy: number;
-}
-
-/** The renderer's zoom limits (CSS pixels per mm) and the farthest the view's centre may be
- *  from the plate's origin (mm): a view outside them is brought inside, whatever set it (a
- *  link, a .gco file's bounds, the wheel or a drag), so no drawing loop can run away. */
-export const MIN_SCALE = 0.05;
-export const MAX_SCALE = 5000;
-export const MAX_CENTRE_MM = 1e5;
 /** At most this many grid lines per direction are drawn, whatever the view. */
 const MAX_GRID_LINES = 2000;
 
-const clamp = (x: number, lo: number, hi: number) => Math.min(hi, Math.max(lo, x));
-
-/** `v` brought within the limits; a number that is not finite is replaced by `fallback`'s. */
-export function clampView(v: View, fallback: View = { scale: 10, cx: 0, cy: 0 }): View {
-  const scale = Number.isFinite(v.scale) && v.scale > 0 ? v.scale : fallback.scale;
-  const cx = Number.isFinite(v.cx) ? v.cx : fallback.cx;
-  const cy = Number.isFinite(v.cy) ? v.cy : fallback.cy;
-  return {
-    scale: clamp(scale, MIN_SCALE, MAX_SCALE),
-    cx: clamp(cx, -MAX_CENTRE_MM, MAX_CENTRE_MM),
-    cy: clamp(cy, -MAX_CENTRE_MM, MAX_CENTRE_MM),
-  };
+/** A label on a white rounded box (device px): `place` puts the box of width `tw` and height
+ *  `th` (its top-left corner). */
+export function drawTag(
+  ctx: CanvasRenderingContext2D,
+  label: string,
+  style: { size: number; pad: number; height: number; radius: number; color: string },
+  place: (tw: number, th: number) => [number, number],
+): void {
+  ctx.font = `600 ${style.size}px system-ui, sans-serif`;
+  const tw = ctx.measureText(label).width + 2 * style.pad;
+  const th = style.height;
+  const [lx, ly] = place(tw, th);
+  ctx.fillStyle = "rgba(255, 255, 255, 0.92)";
+  ctx.beginPath();
+  ctx.roundRect(lx, ly, tw, th, style.radius);
+  ctx.fill();
+  ctx.fillStyle = style.color;
+  ctx.textBaseline = "middle";
+  ctx.fillText(label, lx + style.pad, ly + th / 2);
 }
 
-export interface Bounds {
-  minX: number;
-  minY: number;
-  maxX: number;
-  maxY: number;
-}
-
-export class Renderer {
-  private _view: View = { scale: 10, cx: 0, cy: 0 };
-  /** The view, always within the limits (see [[clampView]]): set it as a whole. */
-  get view(): View {
-    return this._view;
-  }
-  set view(v: View) {
-    this._view = clampView(v, this._view);
-  }
+export class Renderer extends PanZoomCanvas implements LayerCanvas {
   current: LayerData | null = null;
   below: LayerData | null = null;
   dropletWidth = 0.208;
@@ -104,28 +84,10 @@ export class Renderer {
   showOverhangs = false;
   /** Called after every draw (for the zoom read-out). */
   onDraw: (() => void) | null = null;
-  private frame = 0;
-  private cssW = 1;
-  private cssH = 1;
-  private dpr = 1;
 
-  constructor(readonly canvas: HTMLCanvasElement) {
-    watchCanvas(canvas, () => this.resize());
+  constructor(canvas: HTMLCanvasElement) {
+    super(canvas);
     this.resize();
-  }
-
-  private resize(): void {
-    ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
-    this.draw();
-  }
-
-  /** Schedules a redraw on the next animation frame. */
-  request(): void {
-    if (this.frame) return;
-    this.frame = requestAnimationFrame(() => {
-      this.frame = 0;
-      this.draw();
-    });
   }
 
   fit(b: Bounds | null): void {
@@ -136,32 +98,6 @@ export class Renderer {
     // the setter keeps the zoom and the centre within the limits (a .gco's bounds may be huge)
     this.view = { scale: Math.min(sx, sy), cx: b.minX / 2 + b.maxX / 2, cy: b.minY / 2 + b.maxY / 2 };
     this.request();
-  }
-
-  /** Zooms by `factor` keeping the mm under the CSS pixel (px, py) in place. */
-  zoomAt(px: number, py: number, factor: number): void {
-    const [mx, my] = this.toMm(px, py);
-    const scale = clamp(this.view.scale * factor, MIN_SCALE, MAX_SCALE);
-    if (!Number.isFinite(scale)) return;
-    this.view = { scale, cx: mx - (px - this.cssW / 2) / scale, cy: my + (py - this.cssH / 2) / scale };
-    this.request();
-  }
-
-  panBy(dxPx: number, dyPx: number): void {
-    const v = this.view;
-    this.view = { scale: v.scale, cx: v.cx - dxPx / v.scale, cy: v.cy + dyPx / v.scale };
-    this.request();
-  }
-
-  toMm(px: number, py: number): [number, number] {
-    const v = this.view;
-    return [v.cx + (px - this.cssW / 2) / v.scale, v.cy - (py - this.cssH / 2) / v.scale];
-  }
-
-  /** CSS pixels of the point (x, y) in mm (the inverse of [[toMm]]). */
-  toPx(x: number, y: number): [number, number] {
-    const v = this.view;
-    return [(x - v.cx) * v.scale + this.cssW / 2, -(y - v.cy) * v.scale + this.cssH / 2];
   }
 
   draw(): void {
@@ -371,18 +307,10 @@ export class Renderer {
     ctx.strokeRect(x0, y0, x1 - x0, y1 - y0);
     ctx.setLineDash([]);
     const label = `Largest void ${v.area < 0.1 ? v.area.toFixed(3) : v.area.toFixed(2)} mm²`;
-    ctx.font = `600 ${12 * dpr}px system-ui, sans-serif`;
-    const tw = ctx.measureText(label).width + 12 * dpr;
-    const th = 20 * dpr;
-    const lx = Math.min(Math.max(x0, 4 * dpr), W - tw - 4 * dpr);
-    const ly = y0 - th - 4 * dpr >= 4 * dpr ? y0 - th - 4 * dpr : y1 + 4 * dpr;
-    ctx.fillStyle = "rgba(255, 255, 255, 0.92)";
-    ctx.beginPath();
-    ctx.roundRect(lx, ly, tw, th, 4 * dpr);
-    ctx.fill();
-    ctx.fillStyle = VOID_MARK;
-    ctx.textBaseline = "middle";
-    ctx.fillText(label, lx + 6 * dpr, ly + th / 2);
+    drawTag(ctx, label, { size: 12 * dpr, pad: 6 * dpr, height: 20 * dpr, radius: 4 * dpr, color: VOID_MARK }, (tw, th) => [
+      Math.min(Math.max(x0, 4 * dpr), W - tw - 4 * dpr),
+      y0 - th - 4 * dpr >= 4 * dpr ? y0 - th - 4 * dpr : y1 + 4 * dpr,
+    ]);
   }
 
   private drawTravel(ctx: CanvasRenderingContext2D, layer: LayerData, k: number): void {

@@ -2,20 +2,21 @@
 // a slice, the analysis pass over a finished slice, reading a .gco file, cancel, and the
 // G-code's assembly for download. Opening files and links: open.ts.
 
-import { Cancelled, SliceError } from "./client";
-import type { GcodeParseResult } from "./protocol";
-import type { View } from "./render";
+import { Cancelled, SliceError } from "../core/client";
+import type { GcodeParseResult } from "../core/protocol";
+import type { View } from "../core/view";
 import { restoreModel, showError } from "./errors";
-import type { Page } from "./page";
-import { jobSettings } from "./job";
-import { editParts } from "./jobflows";
-import type { Slice, SlicedJob } from "./store";
-import { errorBanner, hideBanner, showBanner, TITLES } from "./views/banner";
-import { updateButtons } from "./views/controls";
-import { saveGcode } from "./views/download";
-import { clampLayer, layerLabel, setLayers, show } from "./views/layer";
-import { showModel, writeStats } from "./views/stats";
-import { progress, setState } from "./views/status";
+import type { Page } from "../views/page";
+import { jobSettings } from "../core/job";
+import { editParts } from "./job";
+import type { Slice, SlicedJob } from "../core/store";
+import { errorBanner, hideBanner, showBanner, TITLES } from "../views/banner";
+import { updateButtons } from "../views/controls";
+import { saveGcode } from "../views/download";
+import { layerLabel, setLayers } from "../views/layer";
+import { clampLayer, show } from "./layer";
+import { showModel, writeStats } from "../views/stats";
+import { progress, setState } from "../views/status";
 
 export interface Target {
   layer?: number;

@@ -1,13 +1,14 @@
-// Draws the vertical cut (views/cut.ts): distance along the cut line (mm, to the right) × z
-// (mm, up), one true scale for both. Per layer: the part's section along the line (light), the
-// droplets the plane crosses, each as the chord of its footprint disc at the plane (width
-// 2·√(R² − d²) for a droplet at distance d from the plane, R = D/2 of the analysis' footprint)
-// over the layer's height H, coloured by role; the 3D estimate's voids (the core's intervals,
-// at 6 heights per slab) over them; the current layer outlined. Only layers and droplets in
-// view are drawn, batched into one Path2D per colour.
+// Draws the vertical cut (views/cut.ts, flows/cut.ts): distance along the cut line (mm, to
+// the right) × z (mm, up), one true scale for both. Per layer: the part's section along the
+// line (light), the droplets the plane crosses, each as the chord of its footprint disc at the
+// plane (width 2·√(R² − d²) for a droplet at distance d from the plane, R = D/2 of the
+// analysis' footprint) over the layer's height H, coloured by role; the 3D estimate's voids
+// (the core's intervals, at 6 heights per slab) over them; the current layer outlined. Only
+// layers and droplets in view are drawn, batched into one Path2D per colour.
 
-import { sizeCanvas, watchCanvas } from "./hidpi";
-import { CLASS_COLORS, dropletClass, VOID_RGB, clampView, MAX_SCALE, MIN_SCALE } from "./render";
+import type { CutCanvas } from "../page";
+import { PanZoomCanvas } from "./panzoom";
+import { CLASS_COLORS, drawTag, dropletClass, VOID_RGB } from "./render";
 
 /** One layer of the cut: what the page or the core found along the line. */
 export interface CutLayer {
@@ -39,8 +40,7 @@ export interface CutView {
   cz: number;
 }
 
-export class CutRenderer {
-  view: CutView = { scale: 10, ct: 0, cz: 0 };
+export class CutRenderer extends PanZoomCanvas implements CutCanvas {
   layers = new Map<number, CutLayer>();
   /** Top z of each layer (mm), as the slice gives them. */
   z: number[] = [];
@@ -50,42 +50,31 @@ export class CutRenderer {
   length = 0;
   current = -1;
   showVoids = true;
-  private frame = 0;
-  private cssW = 1;
-  private cssH = 1;
-  private dpr = 1;
 
-  constructor(readonly canvas: HTMLCanvasElement) {
-    watchCanvas(canvas, () => this.resize());
+  constructor(canvas: HTMLCanvasElement) {
+    super(canvas);
     this.resize();
   }
 
-  private resize(): void {
-    ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
+  /** A resize keeps the view the user zoomed or panned to, else it fits the cut again. */
+  protected resized(): void {
     if (!this.touched) this.fit();
-    this.draw();
   }
 
-  /** The user zoomed or panned: a resize keeps the view (else it fits the cut again). */
-  touched = false;
-
-  request(): void {
-    if (this.frame) return;
-    this.frame = requestAnimationFrame(() => {
-      this.frame = 0;
-      this.draw();
-    });
+  /** The view as mm along the line (`ct`) and z (`cz`) at the plot's centre. */
+  cutView(): CutView {
+    const v = this.view;
+    return { scale: v.scale, ct: v.cx, cz: v.cy };
   }
 
   /** Sets the view, brought within the layer view's limits. */
   setView(v: CutView): void {
     this.touched = true;
-    const c = clampView({ scale: v.scale, cx: v.ct, cy: v.cz }, { scale: this.view.scale, cx: this.view.ct, cy: this.view.cz });
-    this.view = { scale: c.scale, ct: c.cx, cz: c.cy };
+    this.view = { scale: v.scale, cx: v.ct, cy: v.cz };
   }
 
   /** The plot area's centre in CSS px (the axes take the left and bottom margins). */
-  private centre(): [number, number] {
+  protected centre(): [number, number] {
     return [MARGIN_LEFT + (this.cssW - MARGIN_LEFT) / 2, (this.cssH - MARGIN_BOTTOM) / 2];
   }
 
@@ -100,28 +89,6 @@ export class CutRenderer {
     this.request();
   }
 
-  zoomAt(px: number, py: number, factor: number): void {
-    this.touched = true;
-    const [t, z] = this.toMm(px, py);
-    const scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, this.view.scale * factor));
-    const [ox, oy] = this.centre();
-    this.setView({ scale, ct: t - (px - ox) / scale, cz: z + (py - oy) / scale });
-    this.request();
-  }
-
-  panBy(dx: number, dy: number): void {
-    this.touched = true;
-    const v = this.view;
-    this.setView({ scale: v.scale, ct: v.ct - dx / v.scale, cz: v.cz + dy / v.scale });
-    this.request();
-  }
-
-  toMm(px: number, py: number): [number, number] {
-    const [ox, oy] = this.centre();
-    const v = this.view;
-    return [v.ct + (px - ox) / v.scale, v.cz - (py - oy) / v.scale];
-  }
-
   draw(): void {
     const ctx = this.canvas.getContext("2d", { alpha: false });
     if (!ctx) return;
@@ -133,13 +100,13 @@ export class CutRenderer {
     ctx.fillRect(0, 0, W, H);
     const k = this.view.scale * dpr; // device px per mm
     const [ox, oy] = this.centre();
-    const X = ox * dpr - this.view.ct * k; // device x of t = 0
-    const Y = oy * dpr + this.view.cz * k; // device y of z = 0
+    const X = ox * dpr - this.view.cx * k; // device x of t = 0
+    const Y = oy * dpr + this.view.cy * k; // device y of z = 0
     // visible ranges (mm)
-    const t0 = this.view.ct - (ox - MARGIN_LEFT) / this.view.scale - this.radius;
-    const t1 = this.view.ct + (this.cssW - ox) / this.view.scale + this.radius;
-    const zLo = this.view.cz - (this.cssH - oy) / this.view.scale;
-    const zHi = this.view.cz + oy / this.view.scale;
+    const t0 = this.view.cx - (ox - MARGIN_LEFT) / this.view.scale - this.radius;
+    const t1 = this.view.cx + (this.cssW - ox) / this.view.scale + this.radius;
+    const zLo = this.view.cy - (this.cssH - oy) / this.view.scale;
+    const zHi = this.view.cy + oy / this.view.scale;
     const h = this.layerHeight;
     const plotLeft = MARGIN_LEFT * dpr;
     const plotBottom = H - MARGIN_BOTTOM * dpr;
@@ -295,18 +262,10 @@ export class CutRenderer {
       const y = Y - (cur - this.layerHeight / 2) * k;
       if (y > 0 && y < bottom) {
         const label = `Layer ${this.current + 1}`;
-        ctx.font = `600 ${11.5 * dpr}px system-ui, sans-serif`;
-        const tw = ctx.measureText(label).width + 10 * dpr;
-        const th = 18 * dpr;
-        const lx = W - tw - 8 * dpr;
-        const ly = Math.min(Math.max(y - th - 4 * dpr, 4 * dpr), bottom - th - 4 * dpr);
-        ctx.fillStyle = "rgba(255, 255, 255, 0.92)";
-        ctx.beginPath();
-        ctx.roundRect(lx, ly, tw, th, 4 * dpr);
-        ctx.fill();
-        ctx.fillStyle = CURRENT_COLOR;
-        ctx.textBaseline = "middle";
-        ctx.fillText(label, lx + 5 * dpr, ly + th / 2);
+        drawTag(ctx, label, { size: 11.5 * dpr, pad: 5 * dpr, height: 18 * dpr, radius: 4 * dpr, color: CURRENT_COLOR }, (tw, th) => [
+          W - tw - 8 * dpr,
+          Math.min(Math.max(y - th - 4 * dpr, 4 * dpr), bottom - th - 4 * dpr),
+        ]);
       }
     }
   }

@@ -1,19 +1,18 @@
-// The stage's 3D tab: the plate and every instance of the build job (../view3d.ts), from the
+// The stage's 3D tab: the plate and every instance of the build job (view3d.ts), from the
 // parts' display meshes and the core's layout matrices (one View3DPart per instance, id
 // `${part id}:${copy}`); after a slice of the job as it is, cut at the layer the slider shows.
 // A click selects the part in the parts panel; dragging an instance moves its part (re-laid
 // out by the core on release). The toggle "Layer | 3D" switches the stage between the layer
 // canvas and this view; the View3D (a WebGL context) is made the first time the tab is opened,
-// and its code (../view3d.ts with three.js, most of the page's script) is loaded then: a chunk
+// and its code (view3d.ts with three.js, most of the page's script) is loaded then: a chunk
 // of its own (dynamic import; scripts/build.sh splits the bundle), precached by the service
 // worker like the rest of the page.
 
-import { jobSettings } from "../job";
-import { movePart, selectPart } from "../jobflows";
-import type { Page } from "../page";
-import type { View3D, View3DPart, View3DSlice } from "../view3d";
-import { errorBanner } from "./banner";
-import { $ } from "./dom";
+import { jobSettings } from "../../core/job";
+import { errorBanner } from "../banner";
+import { $ } from "../dom";
+import type { Page, View3DView } from "../page";
+import type { View3D, View3DPart, View3DSlice } from "./view3d";
 
 /** The 3D view's id of an instance, and back. */
 export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
@@ -22,7 +21,7 @@ export function parseInstanceId(id: string): { part: number; copy: number } | nu
   return m ? { part: Number(m[1]), copy: Number(m[2]) } : null;
 }
 
-export class View3DPanel {
+export class View3DPanel implements View3DView {
   private view: View3D | null = null;
   /** Whether the view's code was asked for (it loads once; the view is made when it is in). */
   private loading = false;
@@ -88,7 +87,7 @@ export class View3DPanel {
     if (key === this.overhangFor) return;
     this.overhangFor = key;
     this.overhang = null;
-    page.pool
+    page.actions
       .overhangFace(settings)
       .then((z) => {
         if (this.overhangFor !== key) return;
@@ -99,11 +98,6 @@ export class View3DPanel {
         // a refused setting is shown by the form; the tint stays off
         if (this.overhangFor === key) this.overhangFor = "";
       });
-  }
-
-  /** The selection of the page's job (the part's first copy is tinted). */
-  select(page: Page): void {
-    this.sync(page);
   }
 
   private apply(): void {
@@ -132,7 +126,7 @@ export class View3DPanel {
     this.container.hidden = !on;
     if (on && !this.loading) {
       this.loading = true;
-      import("../view3d").then(
+      import("./view3d").then(
         ({ View3D }) => this.create(View3D),
         (e: unknown) => {
           this.loading = false; // asked again the next time the tab is opened
@@ -152,17 +146,17 @@ export class View3DPanel {
       if (!page) return;
       this.selected = id;
       const at = id === null ? null : parseInstanceId(id);
-      selectPart(page, at ? at.part : null);
+      page.actions.selectPart(at ? at.part : null);
     });
     view.onDrag((id, dx, dy, done) => {
       const page = this.page;
       const at = parseInstanceId(id);
       if (!done || !page || !at) return;
       this.selected = id;
-      selectPart(page, at.part);
+      page.actions.selectPart(at.part);
       if (Math.hypot(dx, dy) < 1e-6) return;
       // refused (off the plate is allowed; a value out of range is not): back where it was
-      void movePart(page, at.part, at.copy, dx, dy).then((ok) => ok || this.sync(page));
+      void page.actions.movePart(at.part, at.copy, dx, dy).then((ok) => ok || this.sync(page));
     });
     this.apply();
   }

@@ -1,9 +1,9 @@
 // An error shown in the page; after a crash the new workers get the finished slice's model back.
 
-import { SliceError } from "./client";
-import type { Page } from "./page";
-import { errorBanner } from "./views/banner";
-import { setState } from "./views/status";
+import { SliceError } from "../core/client";
+import type { Page } from "../views/page";
+import { errorBanner } from "../views/banner";
+import { setState } from "../views/status";
 
 /** After the workers were replaced (cancel, crash), lets them hold the finished slice's model
  *  again, so its evicted layers and its download keep working. */

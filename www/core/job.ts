@@ -47,6 +47,9 @@ export interface Part {
 
 export type Spec = Part["spec"];
 
+/** Changes of parts' specs: `place: null` clears a placement (the part is arranged). */
+export type Changes = Partial<Omit<Spec, "file">> & { place?: null };
+
 /** A spec with every default filled in (the core's defaults, docs/jobs.md). */
 export function fullSpec(p: PartSpec): Spec {
   const s: Spec = {

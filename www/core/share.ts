@@ -12,7 +12,7 @@
 
 import { PART_LIMITS } from "./job";
 import type { PartSpec } from "./protocol";
-import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./render";
+import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./view";
 
 export const EMBED_LIMIT = 256 * 1024;
 

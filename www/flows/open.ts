@@ -2,23 +2,23 @@
 // viewed; a job file opens its job and asks for its models), the sample part, or the preview
 // link in the URL (its job and, when they fit, its models). A job waiting for its models (a
 // job file, a link too big for them) takes the files dropped next: by name for a job file, by
-// SHA-256 for a link. Each ends in a flow of flows.ts.
+// SHA-256 for a link. Each ends in a flow of slice.ts.
 
-import type { Value } from "./form";
-import { openGcode, startSlice, type Target } from "./flows";
-import { PART_KEYS, PART_LIMITS } from "./job";
-import { adoptJob, newJob, type NewFile } from "./jobflows";
-import type { Page } from "./page";
-import type { JobFile, PartSpec } from "./protocol";
-import { sampleStl } from "./sample";
-import { LinkError, readLink, type ShareState, type SharedLink } from "./share";
-import type { PendingJob } from "./store";
-import { note, showBanner, TITLES } from "./views/banner";
-import { updateButtons } from "./views/controls";
-import { nf } from "./views/dom";
-import { setShowTravel } from "./views/layer";
-import { showModel } from "./views/stats";
-import { setState } from "./views/status";
+import type { Value } from "../core/settings";
+import { openGcode, startSlice, type Target } from "./slice";
+import { PART_KEYS, PART_LIMITS } from "../core/job";
+import { adoptJob, newJob, type NewFile } from "./job";
+import type { Page } from "../views/page";
+import type { JobFile, PartSpec } from "../core/protocol";
+import { sampleStl } from "../core/sample";
+import { LinkError, readLink, type ShareState, type SharedLink } from "../core/share";
+import type { PendingJob } from "../core/store";
+import { note, showBanner, TITLES } from "../views/banner";
+import { updateButtons } from "../views/controls";
+import { nf } from "../views/dom";
+import { setShowTravel } from "../views/layer";
+import { showModel } from "../views/stats";
+import { setState } from "../views/status";
 
 /** A job file is read on the page's thread: at most this many bytes. */
 export const JOB_FILE_MAX_BYTES = 1024 * 1024;

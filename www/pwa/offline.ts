@@ -2,7 +2,7 @@
 // one is ready. Only on secure contexts (https, and http://127.0.0.1 or localhost), where
 // browsers allow service workers. See sw.ts for what is cached and when it updates.
 
-import { $ } from "./views/dom";
+import { $ } from "../views/dom";
 
 /** How often an open page asks whether a new build is served (browsers also check on every
  *  navigation). */

@@ -4,8 +4,8 @@
 // header) and the bounds a file from anyone must keep (coordinates, droplets, travel moves,
 // layers, line length), with the messages that name the line and the reason.
 
-import init, { GcodeStream } from "./pkg/dropslice.js";
-import type { Calibration, LayerData } from "./protocol";
+import init, { GcodeStream } from "../pkg/dropslice.js";
+import type { Calibration, LayerData } from "../core/protocol";
 
 export class GcodeError extends Error {}
 

@@ -1,15 +1,16 @@
 // The build job's runs: a new job of files, adding parts, every edit of a part (re-laid out by
 // the core at once; refused edits leave the job as it was), selection, lay flat, duplicate,
 // remove, arrange, the display meshes of the 3D view, and saving the job file. The slice of a
-// job: flows.ts startSlice.
+// job: flows/slice.ts startSlice.
 
-import type { Page } from "./page";
-import { DISPLAY_BUDGET, Job, jobSettings, specOut, uniqueName, type JobModel, type Part, type Spec } from "./job";
-import type { PartSpec } from "./protocol";
-import { errorBanner, hideBanner } from "./views/banner";
-import { updateButtons } from "./views/controls";
-import { saveFile } from "./views/download";
-import { SliceError } from "./client";
+import type { Page } from "../views/page";
+import { DISPLAY_BUDGET, Job, jobSettings, specOut, uniqueName, type Changes, type JobModel, type Part, type Spec } from "../core/job";
+import type { PartSpec } from "../core/protocol";
+import { errorBanner, hideBanner } from "../views/banner";
+import { updateButtons } from "../views/controls";
+import { saveFile } from "../views/download";
+import { SliceError } from "../core/client";
+import { grouped } from "../core/grouped";
 import { showError } from "./errors";
 
 /** A file to add to a job: the File and, from a job file or a link, the name it has there. */
@@ -130,9 +131,6 @@ export function relayout(page: Page): Promise<boolean> {
   return applyParts(page, job.parts);
 }
 
-/** Changes of parts' specs: `place: null` clears a placement (the part is arranged). */
-export type Changes = Partial<Omit<Spec, "file">> & { place?: null };
-
 export function editParts(page: Page, edits: { id: number; changes: Changes }[]): Promise<boolean> {
   const job = page.store.job;
   if (!job) return Promise.resolve(false);
@@ -156,7 +154,7 @@ export function selectPart(page: Page, id: number | null): void {
   if (!job || (id !== null && !job.part(id))) return;
   job.selected = id;
   page.parts.render();
-  page.view3d.select(page);
+  page.view3d.sync(page);
   page.renderer.request();
 }
 
@@ -238,11 +236,7 @@ export async function ensureMeshes(page: Page): Promise<void> {
   const budget = Math.max(2000, Math.floor(DISPLAY_BUDGET / Math.max(1, job.instances)));
   const want = job.parts.filter((p) => !p.mesh || p.mesh.budget > 2 * budget || (p.mesh.budget < budget / 2 && p.mesh.positions.length / 9 >= p.mesh.budget * 0.8));
   // parts of the same file and item share one mesh
-  const byKey = new Map<string, Part[]>();
-  for (const p of want) {
-    const k = `${p.spec.file}\u0000${p.spec.item ?? ""}`;
-    byKey.set(k, [...(byKey.get(k) ?? []), p]);
-  }
+  const byKey = grouped(want, (p) => `${p.spec.file}\u0000${p.spec.item ?? ""}`);
   for (const parts of byKey.values()) {
     const p = parts[0];
     try {

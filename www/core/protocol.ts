@@ -1,4 +1,4 @@
-// Messages between the page (client.ts) and a worker (worker.ts).
+// Messages between the page (client.ts) and a worker (worker/worker.ts).
 // Every request is {id, kind, data}; the worker answers with any number of
 // "progress" replies and then exactly one "result" or "error" reply with the same id.
 
@@ -333,7 +333,7 @@ export interface Calls {
   unsupported: { data: UnsupportedRequest; result: Uint8Array };
   /** The 3D view's overhang tint: faces with normal z below minus this overhang. */
   overhang_face: { data: { settings: Settings }; result: number };
-  /** The vertical cut of layers [from, to) (views/cut.ts, src/wasm_cut.rs `Session.cut`). */
+  /** The vertical cut of layers [from, to) (flows/cut.ts, src/wasm_cut.rs `Session.cut`). */
   cut: { data: CutRequest; result: CutReply };
   /** The droplet size from a printed part's mass (views/calibrate.ts, src/calibrate.rs). */
   calibrate: { data: CalibrateRequest; result: Calibration };

@@ -5,9 +5,9 @@
 // Refusals become errors of kind "calibration" with the core's message, a file that cannot be
 // read one of kind "import"; a crash of the core stays what it is.
 
-import { calibrate } from "./pkg/dropslice.js";
+import { calibrate } from "../pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
-import { isErrorValue, type CalibrateRequest, type Calibration, type ErrorValue } from "./protocol";
+import { isErrorValue, type CalibrateRequest, type Calibration, type ErrorValue } from "../core/protocol";
 
 function refused(e: unknown): unknown {
   if (e instanceof GcodeError) return { kind: "import", message: `cannot read the G-code file: ${e.message}` } satisfies ErrorValue;

@@ -1,12 +1,12 @@
 // One worker = one wasm instance = at most one Session (one prepared slicing job), and in the
 // job worker (the pool's first) the job's `Models` (its imported files). Answers the requests
-// of protocol.ts; streams layers as "progress" replies with their buffers transferred. The
+// of core/protocol.ts; streams layers as "progress" replies with their buffers transferred. The
 // model files arrive as Files and are read here (by the core, with FileReaderSync), never on
 // the page's thread; the worker that prepares a job hands the prepared mesh to the others
 // ("adopt"). Everything from the core is a typed value; its
 // errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, { Models, Session, Tally, crash_for_test, default_settings, overhang_face_normal_z, settings_schema, unsupported_droplets, version, type InitOutput } from "./pkg/dropslice.js";
+import init, { Models, Session, Tally, crash_for_test, default_settings, overhang_face_normal_z, settings_schema, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
@@ -28,7 +28,7 @@ import {
   type ModelInfo,
   type Summary,
   type LayerData,
-} from "./protocol";
+} from "../core/protocol";
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
 

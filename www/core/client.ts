@@ -403,7 +403,7 @@ export class Pool {
     });
   }
 
-  /** The vertical cut of a run of layers of the current model (views/cut.ts). */
+  /** The vertical cut of a run of layers of the current model (flows/cut.ts). */
   cut(data: RequestData<"cut">): Promise<ResultOf<"cut">> {
     return this.guarded(async () => (await this.pick()).call("cut", data, undefined, [data.sent.buffer, data.centres.buffer]));
   }

@@ -1,6 +1,6 @@
 // HiDPI 2D canvases: one backing-store pixel per device pixel. The layer canvas (render.ts),
 // the vertical cut (cutrender.ts) and the per-layer plot (views/plot.ts) size their canvas
-// here and are told here when to size it again (the WebGL view, view3d.ts, has three.js for
+// here and are told here when to size it again (the WebGL view, view3d/view3d.ts, has three.js for
 // this).
 //
 //   sizeCanvas(canvas)          the backing store to the CSS box × devicePixelRatio; returns

@@ -1,0 +1,26 @@
+// The vertical cut's line on the plate (mm): its checks, its length.
+
+export type Pt = [number, number];
+export interface Line {
+  a: Pt;
+  b: Pt;
+}
+
+/** The longest line accepted (mm), as the core's `MAX_CUT_LENGTH`. */
+const MAX_LENGTH = 10_000;
+
+/** A line within bounds, or null (ends not finite, no length, too long or too far away). */
+export function checkLine(l: unknown): Line | null {
+  const o = l as { a?: unknown; b?: unknown } | null;
+  const pt = (p: unknown): Pt | null =>
+    Array.isArray(p) && p.length === 2 && p.every((v) => typeof v === "number" && Number.isFinite(v) && Math.abs(v) < 1e5) ? [p[0], p[1]] : null;
+  const a = pt(o?.a);
+  const b = pt(o?.b);
+  if (!a || !b) return null;
+  const len = Math.hypot(b[0] - a[0], b[1] - a[1]);
+  return len > 1e-3 && len <= MAX_LENGTH ? { a, b } : null;
+}
+
+export function lineLength(l: Line): number {
+  return Math.hypot(l.b[0] - l.a[0], l.b[1] - l.a[1]);
+}

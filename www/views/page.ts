@@ -1,0 +1,134 @@
+// What the flows and views share: the store, the worker pool, the views (as interfaces: the
+// flows depend on these, not on the classes that draw), the settings form once the core's
+// schema has arrived, and the actions (what the user can ask for: main.ts wires them to the
+// flows, so that a view never imports a flow). main.ts makes the one instance.
+
+import type { Pool } from "../core/client";
+import type { Changes } from "../core/job";
+import type { CalibrateRequest, Calibration, InitResult, LayerData, Settings } from "../core/protocol";
+import type { Value } from "../core/settings";
+import type { Store } from "../core/store";
+import type { Bounds, View } from "../core/view";
+import type { Line } from "../core/cutline";
+import type { CutLayer, CutView } from "./canvas/cutrender";
+import type { PanZoom } from "./canvas/panzoom";
+import type { View3D } from "./view3d/view3d";
+
+export interface Page {
+  readonly store: Store;
+  readonly pool: Pool;
+  /** The layer canvas. */
+  readonly renderer: LayerCanvas;
+  /** The vertical cut's canvas. */
+  readonly cut: CutCanvas;
+  /** The stage's 3D tab. */
+  readonly view3d: View3DView;
+  /** The parts panel (left column). */
+  readonly parts: PartsView;
+  /** What the views ask for. */
+  readonly actions: Actions;
+  /** The settings form, once init has answered. */
+  form?: SettingsView;
+  /** The core's version, settings schema and defaults, once init has answered. */
+  init?: InitResult;
+}
+
+/** What a view asks for when the user acts (main.ts wires each to its flow). */
+export interface Actions {
+  /** Goes to layer `i` (clamped to the slice). */
+  show(i: number): void;
+  /** The part fills the layer canvas (or the 3D view frames the plate, when it is shown). */
+  fit(): void;
+  /** Shows an error in the page. */
+  error(e: unknown): void;
+  selectPart(id: number | null): void;
+  editParts(edits: { id: number; changes: Changes }[]): Promise<boolean>;
+  /** A dragged instance dropped `dx`, `dy` mm away: its part placed there. */
+  movePart(id: number, copy: number, dx: number, dy: number): Promise<boolean>;
+  layFlat(id: number): void;
+  duplicatePart(id: number): void;
+  removePart(id: number): void;
+  arrangeAll(): void;
+  saveJob(): void;
+  /** The unit fix: the parts scaled by `factor` and the job sliced again. */
+  unitFix(factor: number): void;
+  /** The droplet calibration for a mass and a density (a worker computes it). */
+  calibrate(request: CalibrateRequest): Promise<Calibration>;
+  /** The 3D tint's threshold (the face normal's z) for `settings`. */
+  overhangFace(settings: Settings): Promise<number>;
+  /** The cut line set (null: no cut); `refit` fits the cut's canvas to it. */
+  setCutLine(line: Line | null, refit: boolean): void;
+  /** Keeps the cut in step with the page (a new slice, layers that arrived, the layer shown). */
+  updateCut(): void;
+}
+
+/** The layer canvas (views/canvas/render.ts). */
+export interface LayerCanvas extends PanZoom {
+  /** The view, kept within the limits (set it as a whole). */
+  view: View;
+  current: LayerData | null;
+  below: LayerData | null;
+  dropletWidth: number;
+  showTravel: boolean;
+  showBelow: boolean;
+  showVoids: boolean;
+  /** Per droplet of `current`, 1 when it breaks the overhang rule; null while unknown or off. */
+  overhangs: Uint8Array | null;
+  showOverhangs: boolean;
+  /** Called after every draw. */
+  onDraw: (() => void) | null;
+  fit(b: Bounds | null): void;
+  request(): void;
+  draw(): void;
+  toMm(px: number, py: number): [number, number];
+  toPx(x: number, y: number): [number, number];
+}
+
+/** The vertical cut's canvas (views/canvas/cutrender.ts). */
+export interface CutCanvas extends PanZoom {
+  layers: Map<number, CutLayer>;
+  z: number[];
+  layerHeight: number;
+  radius: number;
+  length: number;
+  current: number;
+  showVoids: boolean;
+  /** The user zoomed or panned (a resize keeps the view). */
+  touched: boolean;
+  fit(): void;
+  request(): void;
+  draw(): void;
+  cutView(): CutView;
+  setView(v: CutView): void;
+}
+
+/** The stage's 3D tab (views/view3d/panel.ts). */
+export interface View3DView {
+  /** Whether the 3D tab is shown (else the layer canvas). */
+  readonly active: boolean;
+  setActive(on: boolean): void;
+  /** Shows the page's job, its selection and the slice's layer. */
+  sync(page: Page): void;
+  fit(): void;
+  /** For the tests: the view's state after a synchronous draw (null before it was made). */
+  testState(): ReturnType<View3D["state"]> | null;
+}
+
+/** The parts panel (views/parts.ts). */
+export interface PartsView {
+  /** Wires the panel's inputs and buttons (once). */
+  wire(): void;
+  /** Redraws the list and the editor from the job. */
+  render(): void;
+}
+
+/** The settings form (views/form.ts). */
+export interface SettingsView {
+  values(): Record<string, Value>;
+  get(name: string): Value | undefined;
+  /** Sets the values given; returns the names it did not know. */
+  set(values: Record<string, Value>): string[];
+  reset(): void;
+  errors(): { name: string; message: string }[];
+  focusFirstError(): void;
+}
