@@ -1,5 +1,5 @@
 //! Times the per-layer overhang figure (support off) on a model: the sections, the reference
-//! construction (`support::overhang_reference`: outline of the layer below, two differences)
+//! construction (`support::overhang::overhang_reference`: outline of the layer below, two differences)
 //! and its parts, the fast one (`support::overhang`), and their largest per-layer difference
 //! at the same chord tolerance. `cargo run --release --example overhang_profile MODEL`.
 // Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
@@ -28,7 +28,7 @@ fn main() {
     let (ta, va) = best(|| {
         (1..n)
             .map(|i| {
-                geom::region_area(&support::overhang_reference(
+                geom::region_area(&support::overhang::overhang_reference(
                     &regions[i],
                     Some(&regions[i - 1]),
                     &s,
@@ -40,13 +40,20 @@ fn main() {
     let (tg, _) = best(|| {
         (1..n)
             .map(|i| {
-                support::grow_within(&regions[i - 1], d, support::SUPPORT_TOLERANCE_MM).len() as f64
+                dropslice::base::boolean::grow_within(
+                    &regions[i - 1],
+                    d,
+                    support::SUPPORT_TOLERANCE_MM,
+                )
+                .len() as f64
             })
             .sum()
     });
     let (tf, _) = best(|| {
         (1..n)
-            .map(|i| support::difference(&regions[i], &regions[i - 1]).len() as f64)
+            .map(|i| {
+                dropslice::base::boolean::difference(&regions[i], &regions[i - 1]).len() as f64
+            })
             .sum()
     });
     let (tb, vb) = best(|| {
@@ -56,12 +63,12 @@ fn main() {
     });
     let worst = (1..n)
         .map(|i| {
-            let g = support::grow_within(
+            let g = dropslice::base::boolean::grow_within(
                 &regions[i - 1],
                 s.overhang_limit * s.droplet_width(),
                 dropslice::slicing::offset::CHORD_TOLERANCE_MM,
             );
-            let a = geom::region_area(&support::difference(&regions[i], &g));
+            let a = geom::region_area(&dropslice::base::boolean::difference(&regions[i], &g));
             let b = geom::region_area(&support::overhang(&regions[i], Some(&regions[i - 1]), &s));
             ((a - b).abs(), i)
         })

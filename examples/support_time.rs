@@ -6,8 +6,9 @@
 #![cfg_attr(target_arch = "wasm32", no_main)]
 #![cfg(not(target_arch = "wasm32"))]
 use dropslice::base::geom::{Shapes, region_area};
+use dropslice::base::parallel::par_map;
+use dropslice::support;
 use dropslice::support::overhang::overhang_region;
-use dropslice::support::{self, par_map};
 use dropslice::{Job, Settings};
 use std::time::Instant;
 

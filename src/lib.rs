@@ -423,17 +423,17 @@ impl Job {
         self.supported.get_or_init(|| {
             let n = self.layer_count();
             let s = &self.settings;
-            let sections = support::par_map(n, &|i| self.section(i));
+            let sections = base::parallel::par_map(n, &|i| self.section(i));
             let regions: Vec<geom::Shapes> = sections.iter().map(|x| x.region.clone()).collect();
             // The support regions (their top-down union is sequential) beside the parts' own
             // plans, which do not depend on them.
             let (layers, parts) = both(
                 || support::support_layers(&regions, s),
-                || support::par_map(n, &|i| self.plan_parts(i, &sections[i])),
+                || base::parallel::par_map(n, &|i| self.plan_parts(i, &sections[i])),
             );
             drop(sections);
             // Unit 1's hatch moves of each layer, after its part plan.
-            let hatches = support::par_map(n, &|i| {
+            let hatches = base::parallel::par_map(n, &|i| {
                 let start = plan::unit1_start(&parts[i].0, s);
                 support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
             });
@@ -628,12 +628,12 @@ impl Job {
                 continue;
             }
             let section = slice::slice_layer(&self.mesh, &mine, self.zs[i]).region;
-            let own = support::difference(&section, &covered);
+            let own = base::boolean::difference(&section, &covered);
             if k + 1 < self.groups.len() {
-                covered = support::union(&covered, &section);
+                covered = base::boolean::union(&covered, &section);
             }
             let r = &mut regions[usize::from(*unit).min(1)];
-            *r = support::union(r, &own);
+            *r = base::boolean::union(r, &own);
         }
         regions
     }

@@ -2,7 +2,7 @@
 //! engine) against two independent constructions, layer by layer: the region of
 //! `support::overhang` (the layer below's complement moved inward by the fast offset, then an
 //! intersection: the figure before) and i_overlay's own outward outline of the layer below
-//! (`support::grow_within`, chords within 1 µm) taken from the layer by a difference. Also
+//! (`dropslice::base::boolean::grow_within`, chords within 1 µm) taken from the layer by a difference. Also
 //! on random star-shaped layers, whose sharp corners make mitres fail.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
@@ -23,8 +23,8 @@ fn compare(regions: &[Shapes], s: &Settings) -> (f64, f64, f64) {
         let (r, below) = (&regions[i], &regions[i - 1]);
         let got = overhang_area(r, Some(below), s);
         let before = region_area(&support::overhang(r, Some(below), s));
-        let grown = support::grow_within(below, d, CHORD_TOLERANCE_MM);
-        let outline = region_area(&support::difference(r, &grown));
+        let grown = dropslice::base::boolean::grow_within(below, d, CHORD_TOLERANCE_MM);
+        let outline = region_area(&dropslice::base::boolean::difference(r, &grown));
         worst = worst.max((got - before).abs());
         worst_outline = worst_outline.max((got - outline).abs());
         total += got;

@@ -365,9 +365,9 @@ fn the_overhang_figure_agrees_with_the_outline_construction() {
         for i in 1..regions.len() {
             let (r, below) = (&regions[i], &regions[i - 1]);
             let got = region_area(&support::overhang(r, Some(below), s));
-            let fine = support::grow_within(below, d, CHORD_TOLERANCE_MM);
-            let want = region_area(&support::difference(r, &fine));
-            let reference = region_area(&support::overhang_reference(r, Some(below), s));
+            let fine = dropslice::base::boolean::grow_within(below, d, CHORD_TOLERANCE_MM);
+            let want = region_area(&dropslice::base::boolean::difference(r, &fine));
+            let reference = region_area(&support::overhang::overhang_reference(r, Some(below), s));
             worst = worst.max((got - want).abs());
             worst_ref = worst_ref.max((got - reference).abs());
             total += got;

@@ -1,6 +1,9 @@
-//! What every stage shares: geometry types, the spatial index, settings and errors.
+//! What every stage shares: geometry types, the boolean engine's operations, the spatial
+//! index, work on all cores, settings and errors.
 
+pub mod boolean;
 pub mod error;
 pub mod geom;
+pub mod parallel;
 pub mod settings;
 pub mod spatial;

@@ -496,7 +496,7 @@ pub fn complete(
     // consecutive layers on all cores, each layer's droplets listed and put in a grid once
     // within a run (the grid of layer i then checks layer i + 1).
     const RUN: usize = 8;
-    let runs = crate::support::par_map((n - 1).div_ceil(RUN), &|r| {
+    let runs = crate::base::parallel::par_map((n - 1).div_ceil(RUN), &|r| {
         let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
         let mut buf = Vec::new();
         droplets(first - 1, None, &mut buf);
