@@ -281,25 +281,27 @@ impl Job {
         let bounds = mesh.bounds();
         let size = bounds.size();
         check_height(&size, &settings)?;
-        // Repeated facets first (they would make a shell's edges look non-manifold), then every
-        // closed shell as its author meant it (inside-out shells turned outward, cavities kept),
-        // so the volume below counts what will be printed: shells of opposite orientation can
-        // no longer cancel.
+        // Repeated facets first (they would make a shell's edges look non-manifold), then
+        // cracks (a tolerance weld, kept if it closes some), then every shell as its author
+        // meant it (inside-out shells turned outward, cavities kept), so the volume below
+        // counts what will be printed: shells of opposite orientation can no longer cancel.
         let mut groups = input.groups;
         let kept = mesh.remove_duplicate_facets_kept();
         let duplicates = kept.iter().filter(|&&k| !k).count();
         keep_groups(&mut groups, &kept);
-        let shells = mesh.orient_shells();
+        let (mesh_shells, weld) = close_cracks(&mut mesh, &mut groups);
+        let shells = mesh.orient(&mesh_shells);
+        drop(mesh_shells);
         check_volume(&mesh, &shells, &size, &settings)?;
         let zs = plane_heights(&size, &settings)?;
         let (mesh, buckets, stats) = repair(
             mesh,
             &zs,
-            shells.clone(),
+            &shells,
+            weld,
             duplicates,
             input.facets_in_file,
             input.degenerate,
-            &mut groups,
         );
         if shells.open > 0 {
             // Open shells enclose no definite volume: estimate what will be printed from the
@@ -794,56 +796,53 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
     Ok(zs)
 }
 
-/// Mesh repair and index: duplicate facets removed, statistics, the facet index per layer,
-/// and a tolerance weld kept if it closes cracks.
+/// Cracks between near-coincident corners: when the exact weld left open edges, a tolerance
+/// weld, kept if it leaves fewer. Returns the shells of the mesh as it is then, and how many
+/// vertices were merged and facets dropped.
+fn close_cracks(mesh: &mut Mesh, groups: &mut [FacetGroup]) -> (mesh::Shells, (usize, usize)) {
+    let shells = mesh.shells();
+    if shells.open_edges == 0 {
+        return (shells, (0, 0));
+    }
+    let mut welded = mesh.clone();
+    let (merged, kept) = welded.weld_tolerance_kept(WELD_TOLERANCE_MM);
+    if merged == 0 {
+        return (shells, (0, 0));
+    }
+    let better = welded.shells();
+    if better.open_edges >= shells.open_edges {
+        return (shells, (0, 0));
+    }
+    let dropped = mesh.facets.len() - welded.facets.len();
+    *mesh = welded;
+    keep_groups(groups, &kept);
+    (better, (merged, dropped))
+}
+
+/// Mesh statistics and index: the facet index per layer and what the repair did.
 fn repair(
-    mut mesh: Mesh,
+    mesh: Mesh,
     zs: &[f64],
-    mut shells: mesh::ShellOrientation,
+    shells: &mesh::ShellOrientation,
+    (welded, dropped): (usize, usize),
     duplicates: usize,
     facets_in_file: usize,
     degenerate: usize,
-    groups: &mut [FacetGroup],
 ) -> (Mesh, FacetBuckets, MeshStats) {
     // The statistics and the facet index are independent: build them side by side.
-    let (stats, mut buckets) = both(
-        || mesh.stats(facets_in_file, degenerate),
+    let (stats, buckets) = both(
+        || mesh.stats(facets_in_file, degenerate + dropped),
         || FacetBuckets::new(&mesh, zs),
     );
-    let mut stats = MeshStats {
+    let stats = MeshStats {
         duplicate_facets: duplicates,
+        tolerance_welded: welded,
+        flipped_shells: shells.flipped,
+        flipped_open_shells: shells.flipped_open,
+        cavity_shells: shells.cavities,
+        unchecked_shells: shells.unchecked,
         ..stats
     };
-    if stats.open_edges > 0 {
-        // Cracks between near-coincident corners: try a tolerance weld, keep it if it helps.
-        let mut welded = mesh.clone();
-        let (merged, kept) = welded.weld_tolerance_kept(WELD_TOLERANCE_MM);
-        let dropped = mesh.facets.len() - welded.facets.len();
-        let better = welded.stats(facets_in_file, degenerate + dropped);
-        if merged > 0 && better.open_edges < stats.open_edges {
-            mesh = welded;
-            keep_groups(groups, &kept);
-            // Shells the weld closed can now be oriented too (the facet index does not depend
-            // on the facets' orientation).
-            let again = mesh.orient_shells();
-            shells.flipped += again.flipped;
-            shells.cavities += again.cavities;
-            shells.unchecked = shells.unchecked.max(again.unchecked);
-            buckets = FacetBuckets::new(&mesh, zs);
-            stats = MeshStats {
-                tolerance_welded: merged,
-                duplicate_facets: duplicates,
-                ..better
-            };
-            if again.flipped > 0 {
-                // `better` was measured before these shells were turned.
-                stats.signed_volume = mesh.signed_volume();
-            }
-        }
-    }
-    stats.flipped_shells = shells.flipped;
-    stats.cavity_shells = shells.cavities;
-    stats.unchecked_shells = shells.unchecked;
     (mesh, buckets, stats)
 }
 
@@ -923,6 +922,13 @@ fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
             if m.flipped_shells == 1 { " was" } else { "s were" }
         ));
     }
+    if m.flipped_open_shells > 0 {
+        w.push(format!(
+            "{} open shell{} inside out (facets facing inward, holes in the surface) and outside every other shell: turned outward and printed as solid",
+            m.flipped_open_shells,
+            if m.flipped_open_shells == 1 { " was" } else { "s were" }
+        ));
+    }
     if m.cavity_shells > 0 {
         w.push(format!(
             "{} inside-out closed shell{} inside another shell: kept as cavities (hollow inside the part)",
@@ -936,7 +942,7 @@ fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
             m.unchecked_shells
         ));
     }
-    if m.signed_volume < 0.0 && m.flipped_shells == 0 {
+    if m.signed_volume < 0.0 && m.flipped_shells + m.flipped_open_shells == 0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
     }
     let largest = size[0].max(size[1]).max(size[2]);

@@ -329,3 +329,350 @@ fn the_cli_refuses_the_inverted_box_file_before_writing() {
         "files left: {left:?}"
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Many shells: the orientation step is near-linear in the number of shells and bounded.
+
+/// The signed volume of facets (outward: positive).
+fn volume(t: &[Tri]) -> f64 {
+    t.iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| v.map(f64::from));
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum()
+}
+
+#[test]
+fn a_million_tiny_inverted_cubes_are_all_turned_outward() {
+    // 100 × 100 × 100 inside-out cubes of 0.5 mm, 1 mm apart, as one mesh: every one is
+    // outside every other, so every one is turned outward (none left unchecked).
+    let n = 100usize;
+    let mut mesh = dropslice::mesh::Mesh::default();
+    for i in 0..n * n * n {
+        let at = [i % n, i / n % n, i / (n * n)].map(|c| c as f64);
+        let base = mesh.vertices.len() as u32;
+        for k in 0..8 {
+            mesh.vertices
+                .push([0, 1, 2].map(|j| at[j] + 0.5 * ((k >> j) & 1) as f64));
+        }
+        // The cube's faces wound inward (clockwise seen from outside).
+        for q in [
+            [0, 1, 3, 2],
+            [4, 6, 7, 5],
+            [0, 4, 5, 1],
+            [2, 3, 7, 6],
+            [0, 2, 6, 4],
+            [1, 5, 7, 3],
+        ] {
+            mesh.facets.push([q[0], q[1], q[2]].map(|v| base + v));
+            mesh.facets.push([q[0], q[2], q[3]].map(|v| base + v));
+        }
+    }
+    assert!(mesh.signed_volume() < 0.0);
+    let t = std::time::Instant::now();
+    let o = mesh.orient_shells();
+    eprintln!(
+        "orientation of {} inverted cubes: {:.2?}",
+        n * n * n,
+        t.elapsed()
+    );
+    assert_eq!(o.closed, n * n * n);
+    assert_eq!((o.flipped, o.cavities, o.unchecked), (n * n * n, 0, 0));
+    for (i, cube) in mesh.facets.chunks(12).enumerate() {
+        let v: f64 = cube
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|i| mesh.vertices[i as usize]);
+                let (b, c) = (
+                    [0, 1, 2].map(|k| b[k] - a[k]),
+                    [0, 1, 2].map(|k| c[k] - a[k]),
+                );
+                // Outward: the normal points away from the cube's centre.
+                let nrm = [
+                    b[1] * c[2] - b[2] * c[1],
+                    b[2] * c[0] - b[0] * c[2],
+                    b[0] * c[1] - b[1] * c[0],
+                ];
+                let centre = [i % n, i / n % n, i / (n * n)].map(|c| c as f64 + 0.25);
+                (0..3).map(|k| nrm[k] * (a[k] - centre[k])).sum::<f64>()
+            })
+            .sum();
+        assert!(v > 0.0, "cube {i} still faces inward");
+    }
+    assert!((mesh.signed_volume() - 0.125 * (n * n * n) as f64).abs() < 1e-3);
+}
+
+#[test]
+fn many_nested_or_overlapping_inverted_shells_stay_within_the_budget() {
+    // 5000 nested inside-out cubes: each is inside all the bigger ones, so deciding them all
+    // would take every bigger cube's facets for every cube (1.5 × 10⁸ evaluations). The
+    // outermost is turned outward; the others are cavities (inside it) or, past the budget,
+    // left as they are.
+    let k = 5000;
+    let mut t = Vec::new();
+    for i in 0..k {
+        let d = i as f32 * 0.005;
+        t.extend(inverted(cuboid([d; 3], [60.0 - d; 3])));
+    }
+    let mut mesh = dropslice::mesh::Mesh::weld(&t).0;
+    let clock = std::time::Instant::now();
+    let o = mesh.orient_shells();
+    eprintln!("{k} nested inverted cubes: {:.2?}, {o:?}", clock.elapsed());
+    assert_eq!(o.flipped, 1);
+    assert_eq!(o.flipped + o.cavities + o.unchecked, k);
+    assert!(o.unchecked > 0, "{o:?}");
+    // 20 000 inside-out cubes shifted by 0.01 µm each: every box overlaps every other, none holds
+    // another. Each is turned outward or, past the budget, left as it is.
+    let k = 20_000;
+    let mut t = Vec::new();
+    for i in 0..k {
+        let d = i as f32 * 1e-5;
+        t.extend(inverted(cuboid([d, 0.0, 0.0], [1.0 + d, 1.0, 1.0])));
+    }
+    let mut mesh = dropslice::mesh::Mesh::weld(&t).0;
+    let clock = std::time::Instant::now();
+    let o = mesh.orient_shells();
+    eprintln!(
+        "{k} overlapping inverted cubes: {:.2?}, {o:?}",
+        clock.elapsed()
+    );
+    assert_eq!(o.closed, k);
+    assert_eq!(o.cavities, 0);
+    assert_eq!(o.flipped + o.unchecked, k);
+}
+
+/// A 3MF package (deflated) with one model part.
+fn three_mf(resources: &str, build: &str) -> Vec<u8> {
+    use std::io::Write;
+    let rels = r#"<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#;
+    let model = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources>{resources}</resources><build>{build}</build></model>"#
+    );
+    let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let opt = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    for (name, text) in [("_rels/.rels", rels), ("3D/3dmodel.model", model.as_str())] {
+        z.start_file(name, opt).unwrap();
+        z.write_all(text.as_bytes()).unwrap();
+    }
+    z.finish().unwrap().into_inner()
+}
+
+/// `<object id>`: an inside-out cube of side 0.5 mm at the origin.
+fn inverted_cube_object(id: u32) -> String {
+    let mut s = format!(r#"<object id="{id}" type="model"><mesh><vertices>"#);
+    for i in 0..8 {
+        let c = |b: usize| if (i >> b) & 1 == 1 { "0.5" } else { "0" };
+        s += &format!(r#"<vertex x="{}" y="{}" z="{}"/>"#, c(0), c(1), c(2));
+    }
+    s += "</vertices><triangles>";
+    for q in [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ] {
+        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            s += &format!(r#"<triangle v1="{}" v2="{}" v3="{}"/>"#, t[0], t[1], t[2]);
+        }
+    }
+    s + "</triangles></mesh></object>"
+}
+
+#[test]
+fn a_small_3mf_fanning_out_inverted_cubes_by_components_is_oriented_quickly() {
+    // Five levels of ten components each: 100 000 inside-out cubes from a file of about a
+    // kilobyte, every one outside the others.
+    let levels = 5;
+    let mut res = inverted_cube_object(1);
+    for l in 0..levels {
+        let pitch = 10f64.powi(l / 3);
+        let comps: String = (0..10)
+            .map(|k| {
+                let mut d = [0.0; 3];
+                d[(l % 3) as usize] = k as f64 * pitch;
+                format!(
+                    r#"<component objectid="{}" transform="1 0 0 0 1 0 0 0 1 {} {} {}"/>"#,
+                    l + 1,
+                    d[0],
+                    d[1],
+                    d[2]
+                )
+            })
+            .collect();
+        res += &format!(
+            r#"<object id="{}" type="model"><components>{comps}</components></object>"#,
+            l + 2
+        );
+    }
+    let bytes = three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
+    assert!(bytes.len() < 2000, "{} bytes", bytes.len());
+    let t = std::time::Instant::now();
+    let j = Job::new(&bytes, "fan.3mf", Settings::default()).unwrap();
+    eprintln!(
+        "3MF with 100 000 inverted cubes: Job::new {:.2?}",
+        t.elapsed()
+    );
+    let m = &j.info().mesh;
+    assert_eq!((m.flipped_shells, m.unchecked_shells), (100_000, 0));
+    assert!(m.signed_volume > 0.0);
+    assert!(
+        j.info()
+            .warnings
+            .iter()
+            .any(|w| w.contains("100000 closed shells were inside out")),
+        "{:?}",
+        j.info().warnings
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Open shells: oriented by their own volume, holes capped.
+
+/// A prism over the convex polygon `ring` (counter-clockwise seen from above) from z = 0 to
+/// `h`, outward: side quads, and fans for the bottom and the top.
+fn prism(ring: &[[f32; 2]], h: f32) -> Vec<Tri> {
+    let n = ring.len();
+    let p = |i: usize, z: f32| [ring[i % n][0], ring[i % n][1], z];
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push([p(i, 0.0), p(i + 1, 0.0), p(i + 1, h)]);
+        t.push([p(i, 0.0), p(i + 1, h), p(i, h)]);
+    }
+    for i in 1..n - 1 {
+        t.push([p(0, 0.0), p(i + 1, 0.0), p(i, 0.0)]);
+        t.push([p(0, h), p(i, h), p(i + 1, h)]);
+    }
+    t
+}
+
+/// A "D": the part of a circle of radius `r` (vertices every 9°, from 2°) with x < `cut`,
+/// closed by the chord at x = `cut`; counter-clockwise.
+fn d_ring(r: f32, cut: f32) -> Vec<[f32; 2]> {
+    let y = (r * r - cut * cut).sqrt();
+    // Angles from 2° in steps of 9° lie in (0, 360°): in order, they run counter-clockwise
+    // from the chord's top end round the left side to its bottom end.
+    let mut ring = vec![[cut, y]];
+    for k in 0..40 {
+        let a = (2.0 + 9.0 * k as f32).to_radians();
+        if r * a.cos() < cut {
+            ring.push([r * a.cos(), r * a.sin()]);
+        }
+    }
+    ring.push([cut, -y]);
+    ring
+}
+
+fn mirrored_x(t: &[Tri]) -> Vec<Tri> {
+    // A mirror reverses the facets' turning sense: the copy is inside out, as exporters that
+    // mirror a half leave it.
+    t.iter().map(|f| f.map(|v| [-v[0], v[1], v[2]])).collect()
+}
+
+fn write_stl(dir: &common::TempDir, name: &str, t: &[Tri]) -> PathBuf {
+    let path = dir.path().join(name);
+    std::fs::write(&path, dropslice::stl::write_binary(b"constructed", t)).unwrap();
+    path
+}
+
+#[test]
+fn mirrored_open_halves_print_as_their_union() {
+    // A cylinder (r = 10 mm, 12 mm tall) made of two "D" halves overlapping by 2 mm; the right
+    // one is the left one mirrored, so inside out. Each has a hole: a side facet missing.
+    let left = prism(&d_ring(10.0, 1.0), 12.0);
+    let right = mirrored_x(&left);
+    assert!(volume(&left) > 0.0 && volume(&right) < 0.0);
+    let mut model = left.clone();
+    model.remove(10); // a side facet of the left half
+    let mut holed_right = right.clone();
+    holed_right.remove(25); // another side facet of the right half
+    model.extend(&holed_right);
+    // The reference: the oracle's union of the two halves as meant (both outward, closed).
+    let dir = common::TempDir::new("shells-halves");
+    let mut meant = left.clone();
+    meant.extend(inverted(right.clone()));
+    let oracle = common::oracle_sections(&write_stl(&dir, "meant.stl", &meant), 0.2);
+    let bytes = dropslice::stl::write_binary(b"halves", &model);
+    let j = Job::new(&bytes, "halves.stl", Settings::default()).unwrap();
+    let m = &j.info().mesh;
+    assert_eq!((m.flipped_open_shells, m.flipped_shells), (1, 0), "{m:?}");
+    assert!(m.open_edges > 0);
+    assert!(
+        j.info()
+            .warnings
+            .iter()
+            .any(|w| w.contains("1 open shell was inside out") && w.contains("turned outward")),
+        "{:?}",
+        j.info().warnings
+    );
+    let layers = oracle["layers"].as_array().unwrap();
+    assert_eq!(j.layer_count(), layers.len());
+    let mut bad = Vec::new();
+    for (i, l) in layers.iter().enumerate() {
+        if l.get("near_plane_faces").is_some() {
+            continue;
+        }
+        let want = l["nonzero"]["area"].as_f64().unwrap();
+        // Two D's of 2 mm overlap: well over a half circle each.
+        assert!(want > 250.0, "layer {i}: oracle {want}");
+        let section = j.section(i);
+        let got = dropslice::geom::region_area(&section.region);
+        if (got - want).abs() > (want * 0.005).max(0.05) || section.region.len() != 1 {
+            bad.push(format!(
+                "layer {i}: {got:.3} in {} pieces vs oracle {want:.3}",
+                section.region.len()
+            ));
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{} layers differ:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn an_open_inside_out_shell_inside_an_open_shell_stays_a_cavity() {
+    // A hollow box: outer walls outward, inner walls facing into the cavity (negative volume),
+    // both with a hole. The inner shell is a cavity, not a part turned inside out.
+    let mut t = cuboid([0.0; 3], [20.0; 3]);
+    t.remove(5);
+    let mut cavity = inverted(cuboid([5.0; 3], [15.0; 3]));
+    cavity.remove(7);
+    t.extend(cavity);
+    let j = job(&t).unwrap();
+    let m = &j.info().mesh;
+    assert_eq!((m.flipped_open_shells, m.flipped_shells), (0, 0), "{m:?}");
+    for (z, a) in areas(&j) {
+        let want = if (5.0..15.0).contains(&z) {
+            300.0
+        } else {
+            400.0
+        };
+        assert!(
+            (a - want).abs() < 1e-6,
+            "z = {z}: area {a} instead of {want}"
+        );
+    }
+}
+
+#[test]
+fn flipped_facets_and_flat_patches_are_not_turned_as_shells() {
+    // A box with one side's two facets flipped: the pair is a flat open shell (no volume),
+    // the rest an open shell facing outward. Nothing is turned; the slicer's majority rule
+    // keeps the box whole.
+    let mut t = cuboid([0.0; 3], [10.0; 3]);
+    t[4].swap(1, 2);
+    t[5].swap(1, 2);
+    let j = job(&t).unwrap();
+    let m = &j.info().mesh;
+    assert_eq!((m.flipped_open_shells, m.flipped_shells), (0, 0), "{m:?}");
+    assert!(m.misoriented_edges > 0);
+    assert_areas(&j, |_| 100.0, "box with a flipped side");
+}
