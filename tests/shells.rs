@@ -350,7 +350,7 @@ fn a_million_tiny_inverted_cubes_are_all_turned_outward() {
     // 100 × 100 × 100 inside-out cubes of 0.5 mm, 1 mm apart, as one mesh: every one is
     // outside every other, so every one is turned outward (none left unchecked).
     let n = 100usize;
-    let mut mesh = dropslice::mesh::Mesh::default();
+    let mut mesh = dropslice::model::mesh::Mesh::default();
     for i in 0..n * n * n {
         let at = [i % n, i / n % n, i / (n * n)].map(|c| c as f64);
         let base = mesh.vertices.len() as u32;
@@ -417,7 +417,7 @@ fn many_nested_or_overlapping_inverted_shells_stay_within_the_budget() {
         let d = i as f32 * 0.005;
         t.extend(inverted(cuboid([d; 3], [60.0 - d; 3])));
     }
-    let mut mesh = dropslice::mesh::Mesh::weld(&t).0;
+    let mut mesh = dropslice::model::mesh::Mesh::weld(&t).0;
     let clock = std::time::Instant::now();
     let o = mesh.orient_shells();
     eprintln!("{k} nested inverted cubes: {:.2?}, {o:?}", clock.elapsed());
@@ -432,7 +432,7 @@ fn many_nested_or_overlapping_inverted_shells_stay_within_the_budget() {
         let d = i as f32 * 1e-5;
         t.extend(inverted(cuboid([d, 0.0, 0.0], [1.0 + d, 1.0, 1.0])));
     }
-    let mut mesh = dropslice::mesh::Mesh::weld(&t).0;
+    let mut mesh = dropslice::model::mesh::Mesh::weld(&t).0;
     let clock = std::time::Instant::now();
     let o = mesh.orient_shells();
     eprintln!(
@@ -576,7 +576,11 @@ fn mirrored_x(t: &[Tri]) -> Vec<Tri> {
 
 fn write_stl(dir: &common::TempDir, name: &str, t: &[Tri]) -> PathBuf {
     let path = dir.path().join(name);
-    std::fs::write(&path, dropslice::stl::write_binary(b"constructed", t)).unwrap();
+    std::fs::write(
+        &path,
+        dropslice::model::import::stl::write_binary(b"constructed", t),
+    )
+    .unwrap();
     path
 }
 
@@ -597,7 +601,7 @@ fn mirrored_open_halves_print_as_their_union() {
     let mut meant = left.clone();
     meant.extend(inverted(right.clone()));
     let oracle = common::oracle_sections(&write_stl(&dir, "meant.stl", &meant), 0.2);
-    let bytes = dropslice::stl::write_binary(b"halves", &model);
+    let bytes = dropslice::model::import::stl::write_binary(b"halves", &model);
     let j = Job::new(&bytes, "halves.stl", Settings::default()).unwrap();
     let m = &j.info().mesh;
     assert_eq!((m.flipped_open_shells, m.flipped_shells), (1, 0), "{m:?}");
@@ -621,7 +625,7 @@ fn mirrored_open_halves_print_as_their_union() {
         // Two D's of 2 mm overlap: well over a half circle each.
         assert!(want > 250.0, "layer {i}: oracle {want}");
         let section = j.section(i);
-        let got = dropslice::geom::region_area(&section.region);
+        let got = dropslice::base::geom::region_area(&section.region);
         if (got - want).abs() > (want * 0.005).max(0.05) || section.region.len() != 1 {
             bad.push(format!(
                 "layer {i}: {got:.3} in {} pieces vs oracle {want:.3}",

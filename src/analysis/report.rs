@@ -1,5 +1,5 @@
 //! The job's report: part figures, the analysis model, and the per-layer stage the slicing
-//! workers run with its ordered half ([`JobAnalysis`], a [`crate::LayerSink`]).
+//! workers run with its ordered half ([`JobAnalysis`], a [`crate::slicing::sink::LayerSink`]).
 
 use super::droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
 use super::estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
@@ -410,7 +410,7 @@ impl JobAnalysis {
 /// The job analysis as a stage of [`crate::write_gcode_with`]: each worker analyses the layers
 /// it plans in its own [`Raster`] and computes the slabs its layer completes ([`Slabs`]); the
 /// layers are pushed in order.
-impl crate::LayerSink for JobAnalysis {
+impl crate::slicing::sink::LayerSink for JobAnalysis {
     type State = (Raster, LayerStage, Arc<Mutex<Slabs>>);
     type Out = AnalysedLayer;
 

@@ -2,4 +2,5 @@
 
 pub mod import;
 pub mod mesh;
+pub mod prepare;
 pub mod spec;

@@ -500,7 +500,7 @@ pub struct ModelInfo {
     /// The 3MF build items (one item for STL and OBJ).
     pub items: Vec<ItemInfo>,
     pub warnings: Vec<String>,
-    /// See [`crate::suggested_scale`].
+    /// See [`crate::model::prepare::suggested_scale`].
     pub suggested_scale: Option<f64>,
 }
 
@@ -552,7 +552,7 @@ impl Model {
             grow(&mut bounds, i.bounds.min, i.bounds.max);
         }
         let size = bounds.size();
-        let suggested_scale = crate::suggested_scale(&size);
+        let suggested_scale = crate::model::prepare::suggested_scale(&size);
         let largest = size[0].max(size[1]).max(size[2]);
         let warnings = match suggested_scale {
             Some(f) if f > 1.0 => vec![format!(

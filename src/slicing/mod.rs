@@ -5,4 +5,5 @@ pub mod droplets;
 pub mod hatch;
 pub mod offset;
 pub mod plan;
+pub mod sink;
 pub mod slice;

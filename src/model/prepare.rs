@@ -1,0 +1,279 @@
+//! Preparing a model for slicing: the import of one file (bytes → welded, placed mesh), the
+//! checks of its size and volume, the repairs (cracks closed, shells oriented, duplicates
+//! dropped) and the plain-language warnings about what was found and done.
+
+use crate::base::error::Error;
+use crate::base::settings::Settings;
+use crate::model::import::{self, stl};
+use crate::model::mesh::{self, Bounds, Mesh, MeshStats, ShellOrientation};
+use crate::model::spec as job;
+
+/// Most layers a job may have (a guard against settings that would run for hours).
+pub const MAX_LAYERS: usize = 200_000;
+/// Largest part extent in x or y, in droplet widths (hatch lines per layer).
+pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
+
+/// What the import found, for the CLI summary, the header and the page.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct JobInfo {
+    pub file_name: String,
+    pub format: stl::Format,
+    pub mesh: MeshStats,
+    /// Bounding box of the placed part, in mm.
+    pub bounds: Bounds,
+    pub layers: usize,
+    /// Droplet width B in mm.
+    pub droplet_width: f64,
+    /// Problems found in the mesh and what was done about them.
+    pub warnings: Vec<String>,
+    /// A scale factor for all three axes when the part's size suggests the file is not in
+    /// millimetres (25.4: inches; 0.001: micrometres); never applied silently.
+    pub suggested_scale: Option<f64>,
+    /// Every copy of every part: its file, transform, placement, matrix and bounds.
+    #[serde(default)]
+    pub instances: Vec<job::Instance>,
+    /// Which discharge unit prints which facets of the prepared mesh: runs of facets in mesh
+    /// order, each the instances of consecutive parts of one unit, in the order the parts are
+    /// listed (the order that decides who keeps an overlap). Empty: every facet is unit 0's
+    /// (every job without unit-1 parts).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groups: Vec<FacetGroup>,
+}
+
+/// A run of facets of the prepared mesh printed by one discharge unit ([`JobInfo::groups`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct FacetGroup {
+    /// How many facets (they follow the run before).
+    pub facets: usize,
+    /// The discharge unit, 0 or 1.
+    pub unit: u8,
+}
+
+/// Drops the facets that were not kept from the runs' counts.
+pub(crate) fn keep_groups(groups: &mut [FacetGroup], kept: &[bool]) {
+    let mut at = 0;
+    for g in groups {
+        let end = (at + g.facets).min(kept.len());
+        let n = kept[at.min(end)..end].iter().filter(|&&k| k).count();
+        at = end;
+        g.facets = n;
+    }
+}
+
+/// Vertices closer than this are merged when exact welding leaves the surface open.
+pub const WELD_TOLERANCE_MM: f64 = 1e-4;
+
+/// The unit rule: a part whose largest extent is under 10 mm is probably in inches; one over
+/// 2 m probably in micrometres.
+pub fn suggested_scale(size: &[f64; 3]) -> Option<f64> {
+    let largest = size[0].max(size[1]).max(size[2]);
+    if largest < 10.0 {
+        Some(25.4)
+    } else if largest > 2000.0 {
+        Some(0.001)
+    } else {
+        None
+    }
+}
+
+/// What [`import`] read.
+pub(crate) struct Imported {
+    pub(crate) mesh: Mesh,
+    pub(crate) format: stl::Format,
+    pub(crate) facets_in_file: usize,
+    pub(crate) degenerate: usize,
+    pub(crate) instance: job::Instance,
+}
+
+/// What [`Job::build`] needs besides the mesh.
+pub(crate) struct Input {
+    pub(crate) file_name: String,
+    pub(crate) format: stl::Format,
+    pub(crate) facets_in_file: usize,
+    pub(crate) degenerate: usize,
+    pub(crate) instances: Vec<job::Instance>,
+    pub(crate) warnings: Vec<String>,
+    /// [`JobInfo::groups`] of the merged mesh (before the repair drops facets).
+    pub(crate) groups: Vec<FacetGroup>,
+}
+
+/// Import: STL bytes → triangles → welded mesh → rotated, scaled, placed.
+pub(crate) fn import(
+    bytes: &[u8],
+    file_name: &str,
+    settings: &Settings,
+) -> Result<Imported, Error> {
+    let (tris, format) = import::read_merged(bytes, file_name)?;
+    let (mut mesh, degenerate) = Mesh::weld(&tris);
+    if mesh.facets.is_empty() {
+        return Err(Error::Import(format!(
+            "all {} triangles are degenerate (their corners coincide): the mesh has no surface",
+            tris.len()
+        )));
+    }
+    let facets_in_file = tris.len();
+    drop(tris);
+    let placement = mesh::Placement::of_settings(settings);
+    let frame = job::Frame::of(mesh.vertices.iter().copied(), &placement)
+        .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
+    let place = placement.place;
+    let name = job::clean_name(&import::stem(file_name));
+    let instance = job::Instance {
+        part: 0,
+        copy: 0,
+        copies: 1,
+        name,
+        file: job::clean_name(file_name),
+        item: None,
+        object: None,
+        rotate: placement.rotate,
+        scale: placement.scale,
+        place_angle: placement.place_angle,
+        placed: true,
+        at: place,
+        unit: 0,
+        matrix: frame.matrix(place),
+        min: [
+            frame.qmin.x + place[0],
+            frame.qmin.y + place[1],
+            frame.qmin.z,
+        ],
+        max: [
+            frame.qmax.x + place[0],
+            frame.qmax.y + place[1],
+            frame.qmax.z,
+        ],
+        shift: place,
+    };
+    mesh.transform(settings);
+    Ok(Imported {
+        mesh,
+        format,
+        facets_in_file,
+        degenerate,
+        instance,
+    })
+}
+
+/// Checks: the part has a height, and not too many layers of it.
+pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), Error> {
+    let h = settings.layer_height;
+    if size[2] <= 0.0 {
+        return Err(Error::NothingToPrint(
+            "the part is flat (0 mm tall after rotation): check rotate_x/rotate_y".into(),
+        ));
+    }
+    let layers_needed = size[2] / h;
+    if layers_needed > MAX_LAYERS as f64 {
+        return Err(Error::Setting {
+            name: "layer_height".into(),
+            message: format!(
+                "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
+                size[2], layers_needed
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Checks that the mesh encloses a volume; returns it, mm³ (its droplets are checked when the
+/// job is built).
+pub(crate) fn check_volume(
+    mesh: &Mesh,
+    shells: &ShellOrientation,
+    size: &[f64; 3],
+) -> Result<f64, Error> {
+    let volume = mesh.signed_volume().abs().max(shells.closed_volume);
+    if size[0] <= 0.0 || size[1] <= 0.0 || volume <= 1e-9 * size[0] * size[1] * size[2] {
+        return Err(Error::NothingToPrint(
+            "the mesh encloses no volume (a surface without thickness): export the part as a solid"
+                .into(),
+        ));
+    }
+    Ok(volume)
+}
+
+/// Cracks between near-coincident corners: when the exact weld left open edges, a tolerance
+/// weld, kept if it leaves fewer. Returns the shells of the mesh as it is then, and how many
+/// vertices were merged and facets dropped.
+pub(crate) fn close_cracks(
+    mesh: &mut Mesh,
+    groups: &mut [FacetGroup],
+) -> (mesh::Shells, (usize, usize)) {
+    let shells = mesh.shells();
+    if shells.open_edges == 0 {
+        return (shells, (0, 0));
+    }
+    let mut welded = mesh.clone();
+    let (merged, kept) = welded.weld_tolerance_kept(WELD_TOLERANCE_MM);
+    if merged == 0 {
+        return (shells, (0, 0));
+    }
+    let better = welded.shells();
+    if better.open_edges >= shells.open_edges {
+        return (shells, (0, 0));
+    }
+    let dropped = mesh.facets.len() - welded.facets.len();
+    *mesh = welded;
+    keep_groups(groups, &kept);
+    (better, (merged, dropped))
+}
+
+/// Plain-language warnings about the mesh.
+pub(crate) fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
+    let counted: [(usize, &str, String); 7] = [
+        (m.open_edges, "the mesh is not closed: ", " open edges (holes in the surface); open sections are closed by joining their ends".into()),
+        (m.nonmanifold_edges, "", " non-manifold edges (shared by more than two facets); overlapping parts are printed as their union".into()),
+        (m.misoriented_edges, "", " edges between facets of opposite orientation (flipped facets); loops are oriented by the majority".into()),
+        (m.duplicate_facets, "", " duplicate facets were ignored".into()),
+        (m.degenerate_facets, "", " degenerate facets (zero area) were ignored".into()),
+        (m.tolerance_welded, "", format!(" near-coincident vertices (closer than {WELD_TOLERANCE_MM} mm) were merged to close cracks in the surface")),
+        (if m.bodies > 1 { m.bodies } else { 0 }, "", " separate bodies; where they overlap they are printed as one".into()),
+    ];
+    let mut w: Vec<String> = counted
+        .into_iter()
+        .filter(|(n, _, _)| *n > 0)
+        .map(|(n, before, after)| format!("{before}{n}{after}"))
+        .collect();
+    if m.flipped_shells > 0 {
+        w.push(format!(
+            "{} closed shell{} inside out (facets facing inward) and outside every other shell: turned outward and printed as solid",
+            m.flipped_shells,
+            if m.flipped_shells == 1 { " was" } else { "s were" }
+        ));
+    }
+    if m.flipped_open_shells > 0 {
+        w.push(format!(
+            "{} open shell{} inside out (facets facing inward, holes in the surface) and outside every other shell: turned outward and printed as solid",
+            m.flipped_open_shells,
+            if m.flipped_open_shells == 1 { " was" } else { "s were" }
+        ));
+    }
+    if m.cavity_shells > 0 {
+        w.push(format!(
+            "{} inside-out closed shell{} inside another shell: kept as cavities (hollow inside the part)",
+            m.cavity_shells,
+            if m.cavity_shells == 1 { " lies" } else { "s lie" }
+        ));
+    }
+    if m.unchecked_shells > 0 {
+        w.push(format!(
+            "{} inside-out shells were not checked (too many to check quickly) and are sliced as they are",
+            m.unchecked_shells
+        ));
+    }
+    if m.signed_volume < 0.0 && m.flipped_shells + m.flipped_open_shells == 0 {
+        w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
+    }
+    let largest = size[0].max(size[1]).max(size[2]);
+    match suggested_scale(size) {
+        Some(f) if f > 1.0 => w.push(format!(
+            "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
+        )),
+        Some(f) => w.push(format!(
+            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
+        )),
+        None => {}
+    }
+    w
+}

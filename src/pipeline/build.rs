@@ -1,0 +1,373 @@
+//! Building a [`Job`]: from one file, from a build job's parts, or from a mesh another job
+//! prepared; the checks that need the plane heights and the facet index (the width in
+//! droplets, the droplet estimate).
+
+use crate::base::error::Error;
+use crate::base::geom;
+use crate::base::parallel::both;
+use crate::base::settings::Settings;
+use crate::model::import;
+use crate::model::mesh::{self, Mesh, MeshStats};
+use crate::model::prepare::{
+    FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_height, check_volume,
+    close_cracks, import, keep_groups, suggested_scale, warnings,
+};
+use crate::model::spec as job;
+use crate::pipeline::Job;
+use crate::slicing::slice::{self, FacetBuckets};
+
+/// Most droplets a job may set (volume / B²H): beyond this the code would not fit on a disk.
+pub const MAX_DROPLETS: f64 = 2e9;
+impl Job {
+    /// Reads the model (STL, OBJ or a 3MF build, see [`import`]), validates the settings and
+    /// places the part: import → checks → mesh repair → facet index. A 3MF build's items keep
+    /// their relative positions and are sliced together.
+    pub fn new(model_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
+        settings.validate()?;
+        let Imported {
+            mesh,
+            format,
+            facets_in_file,
+            degenerate,
+            instance,
+        } = import(model_bytes, file_name, &settings)?;
+        let input = Input {
+            file_name: file_name.to_string(),
+            format,
+            facets_in_file,
+            degenerate,
+            instances: vec![instance],
+            warnings: Vec::new(),
+            groups: Vec::new(),
+        };
+        Job::build(mesh, input, settings)
+    }
+
+    /// A build job (SPEC.md "Build jobs"): reads each file of `files` (name, bytes) once and
+    /// builds the job of `spec` from them (see [`Job::from_models`]).
+    pub fn from_parts(files: &[(&str, &[u8])], spec: &job::JobSpec) -> Result<Job, Error> {
+        let models = files
+            .iter()
+            .map(|(name, bytes)| job::Model::read(bytes, name))
+            .collect::<Result<Vec<_>, _>>()?;
+        Job::from_models(&models, spec)
+    }
+
+    /// A build job from imported files: every part welded once, each instance placed (the
+    /// arrangement of [`job::place_instances`]) with [`Mesh::place`] — the very transform of
+    /// [`Job::new`] — the instances merged into one mesh and prepared as [`Job::new`] does
+    /// (checks, shells, repair, facet index). The job's settings are `spec.settings`.
+    pub fn from_models(models: &[job::Model], spec: &job::JobSpec) -> Result<Job, Error> {
+        spec.validate()?;
+        let settings = spec.settings.clone();
+        let by_part = job::models_of(models, spec)?;
+        // Runs of consecutive parts of one unit (SPEC.md: where parts of different units
+        // overlap, the part listed first keeps the overlap).
+        let mut run_of = Vec::with_capacity(spec.parts.len());
+        for (i, p) in spec.parts.iter().enumerate() {
+            let run = match i.checked_sub(1) {
+                Some(j) if spec.parts[j].unit == p.unit => run_of[j],
+                Some(j) => run_of[j] + 1,
+                None => 0,
+            };
+            run_of.push(run);
+        }
+        let mut welded = Vec::with_capacity(spec.parts.len());
+        let mut frames = Vec::with_capacity(spec.parts.len());
+        let (mut facets_in_file, mut degenerate, mut facets) = (0usize, 0usize, 0usize);
+        for (i, (p, m)) in spec.parts.iter().zip(&by_part).enumerate() {
+            let tris = m.triangles(p.item).map_err(|e| job::at_part(i, e))?;
+            let (mesh, dropped) = Mesh::weld(&tris);
+            let copies = p.copies as usize;
+            facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
+            if facets > import::MAX_TRIANGLES {
+                return Err(Error::Job(format!(
+                    "the job has more than {} triangles in all (parts × copies); print fewer copies or simplify the models",
+                    import::MAX_TRIANGLES
+                )));
+            }
+            let frame = job::Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0]));
+            let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
+                return Err(Error::Import(format!(
+                    "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
+                    job::clean_name(&m.part_name(p.item)),
+                    tris.len()
+                )));
+            };
+            facets_in_file += tris.len() * copies;
+            degenerate += dropped * copies;
+            welded.push(mesh);
+            frames.push(frame);
+        }
+        let layout = job::place_instances(&by_part, spec, &frames)?;
+        let vertices: usize = layout
+            .instances
+            .iter()
+            .map(|x| welded[x.part].vertices.len())
+            .sum();
+        let mut mesh = Mesh {
+            vertices: Vec::with_capacity(vertices),
+            facets: Vec::with_capacity(facets),
+        };
+        // The instances run by run (a job of unit 0 alone: one run, in the layout's order).
+        let mut order: Vec<&job::Instance> = layout.instances.iter().collect();
+        order.sort_by_key(|inst| run_of[inst.part]);
+        let mut groups: Vec<FacetGroup> = Vec::new();
+        for inst in order {
+            let mut m = welded[inst.part].clone();
+            m.place(&spec.parts[inst.part].placement(inst.shift));
+            let base = mesh.vertices.len() as u32;
+            mesh.vertices.extend_from_slice(&m.vertices);
+            mesh.facets
+                .extend(m.facets.iter().map(|f| f.map(|v| v + base)));
+            // Runs are numbered from 0 in order: run r is the (r + 1)-th group.
+            match groups.get_mut(run_of[inst.part]) {
+                Some(g) => g.facets += m.facets.len(),
+                None => groups.push(FacetGroup {
+                    facets: m.facets.len(),
+                    unit: spec.parts[inst.part].unit,
+                }),
+            }
+        }
+        drop(welded);
+        if groups.iter().all(|g| g.unit == 0) {
+            groups.clear();
+        }
+        let mut names: Vec<String> = Vec::new();
+        for p in &spec.parts {
+            let n = job::clean_name(&p.file);
+            if !names.contains(&n) {
+                names.push(n);
+            }
+        }
+        let mut file_name = names.join(", ");
+        if file_name.chars().count() > 4 * job::MAX_NAME_CHARS {
+            file_name = format!(
+                "{}… ({} files)",
+                file_name
+                    .chars()
+                    .take(4 * job::MAX_NAME_CHARS)
+                    .collect::<String>(),
+                names.len()
+            );
+        }
+        let input = Input {
+            file_name,
+            format: by_part[0].format,
+            facets_in_file,
+            degenerate,
+            instances: layout.instances,
+            warnings: layout.warnings,
+            groups,
+        };
+        Job::build(mesh, input, settings)
+    }
+
+    /// The common tail of [`Job::new`] and [`Job::from_models`]: checks → shells → mesh repair
+    /// → facet index.
+    fn build(mut mesh: Mesh, input: Input, settings: Settings) -> Result<Job, Error> {
+        let bounds = mesh.bounds();
+        let size = bounds.size();
+        check_height(&size, &settings)?;
+        // Repeated facets first (they would make a shell's edges look non-manifold), then
+        // cracks (a tolerance weld, kept if it closes some), then every shell as its author
+        // meant it (inside-out shells turned outward, cavities kept), so the volume below
+        // counts what will be printed: shells of opposite orientation can no longer cancel.
+        let mut groups = input.groups;
+        let kept = mesh.remove_duplicate_facets_kept();
+        let duplicates = kept.iter().filter(|&&k| !k).count();
+        keep_groups(&mut groups, &kept);
+        let (mesh_shells, weld) = close_cracks(&mut mesh, &mut groups);
+        let shells = mesh.orient(&mesh_shells);
+        drop(mesh_shells);
+        check_droplets(check_volume(&mesh, &shells, &size)?, &settings)?;
+        let zs = plane_heights(&size, &settings)?;
+        let (mesh, buckets, stats) = repair(
+            mesh,
+            &zs,
+            &shells,
+            weld,
+            duplicates,
+            input.facets_in_file,
+            input.degenerate,
+        );
+        if shells.open > 0 {
+            // Open shells enclose no definite volume: estimate what will be printed from the
+            // sliced area of sampled layers (the slicer closes open sections the same way).
+            let h = settings.layer_height;
+            check_droplets(sampled_volume(&mesh, &buckets, &zs, h), &settings)?;
+        }
+        let mut all_warnings = input.warnings;
+        all_warnings.extend(warnings(&stats, &size));
+        let info = JobInfo {
+            file_name: input.file_name,
+            format: input.format,
+            warnings: all_warnings,
+            suggested_scale: suggested_scale(&size),
+            mesh: stats,
+            bounds,
+            layers: zs.len(),
+            droplet_width: settings.droplet_width(),
+            instances: input.instances,
+            groups,
+        };
+        Ok(Job::assemble(settings, mesh, buckets, zs, info))
+    }
+
+    /// A job from a mesh another [`Job`] prepared (its [`Job::mesh`] and [`Job::info`], with
+    /// the same settings): no import, checks or repair, only the facet index. Slices exactly
+    /// as that job does.
+    pub fn from_prepared(mesh: Mesh, info: JobInfo, settings: Settings) -> Result<Job, Error> {
+        settings.validate()?;
+        let zs = slice::layer_heights(
+            info.bounds.size()[2],
+            settings.layer_height,
+            settings.slice_plane,
+        );
+        let bad = |what: String| Error::Internal(format!("prepared mesh: {what}"));
+        if zs.len() != info.layers {
+            return Err(bad(format!(
+                "{} layers, but the settings give {} (prepared with other settings?)",
+                info.layers,
+                zs.len()
+            )));
+        }
+        if info.mesh.facets != mesh.facets.len() {
+            return Err(bad(format!(
+                "{} facets, but the info says {}",
+                mesh.facets.len(),
+                info.mesh.facets
+            )));
+        }
+        let n = mesh.vertices.len();
+        if mesh.facets.iter().flatten().any(|&v| v as usize >= n) {
+            return Err(bad("a facet refers to a vertex that does not exist".into()));
+        }
+        if !info.groups.is_empty() {
+            let total = info
+                .groups
+                .iter()
+                .try_fold(0usize, |t, g| t.checked_add(g.facets));
+            if total != Some(mesh.facets.len())
+                || info.groups.len() > job::MAX_INSTANCES
+                || info.groups.iter().any(|g| g.unit > 1)
+            {
+                return Err(bad(
+                    "the facet groups do not cover the facets, or name a unit other than 0 or 1"
+                        .into(),
+                ));
+            }
+        }
+        let buckets = FacetBuckets::new(&mesh, &zs);
+        Ok(Job::assemble(settings, mesh, buckets, zs, info))
+    }
+
+    /// The common tail of [`Job::new`] and [`Job::from_prepared`].
+    fn assemble(
+        settings: Settings,
+        mesh: Mesh,
+        buckets: FacetBuckets,
+        zs: Vec<f64>,
+        info: JobInfo,
+    ) -> Job {
+        let mut groups = Vec::with_capacity(info.groups.len());
+        let mut at = 0u32;
+        for g in &info.groups {
+            let end = at + g.facets as u32;
+            groups.push((at..end, g.unit));
+            at = end;
+        }
+        Job {
+            settings,
+            mesh,
+            buckets,
+            zs,
+            info,
+            groups,
+            supported: std::sync::OnceLock::new(),
+        }
+    }
+}
+
+/// Checks the width in droplets; the plane heights of the layers (at least one).
+fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {
+    let b = settings.droplet_width();
+    let h = settings.layer_height;
+    if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
+        return Err(Error::Setting {
+            name: "scale_x".into(),
+            message: format!(
+                "the part is {:.0} mm wide, more than {MAX_WIDTH_IN_DROPLETS} droplets of {b:.4} mm; check the scale (is the file in micrometres?)",
+                size[0].max(size[1])
+            ),
+        });
+    }
+    let zs = slice::layer_heights(size[2], h, settings.slice_plane);
+    if zs.is_empty() {
+        return Err(Error::NothingToPrint(format!(
+            "the part is {:.4} mm tall, less than half a layer ({} mm): scale it up or lower layer_height",
+            size[2],
+            h / 2.0
+        )));
+    }
+    Ok(zs)
+}
+
+/// Mesh statistics and index: the facet index per layer and what the repair did.
+fn repair(
+    mesh: Mesh,
+    zs: &[f64],
+    shells: &mesh::ShellOrientation,
+    (welded, dropped): (usize, usize),
+    duplicates: usize,
+    facets_in_file: usize,
+    degenerate: usize,
+) -> (Mesh, FacetBuckets, MeshStats) {
+    // The statistics and the facet index are independent: build them side by side.
+    let (stats, buckets) = both(
+        || mesh.stats(facets_in_file, degenerate + dropped),
+        || FacetBuckets::new(&mesh, zs),
+    );
+    let stats = MeshStats {
+        duplicate_facets: duplicates,
+        tolerance_welded: welded,
+        flipped_shells: shells.flipped,
+        flipped_open_shells: shells.flipped_open,
+        cavity_shells: shells.cavities,
+        unchecked_shells: shells.unchecked,
+        ..stats
+    };
+    (mesh, buckets, stats)
+}
+
+/// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
+fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
+    let b = settings.droplet_width();
+    let droplets = volume / (b * b * settings.layer_height);
+    if droplets > MAX_DROPLETS || !droplets.is_finite() {
+        return Err(Error::Setting {
+            name: "layer_height".into(),
+            message: format!(
+                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of {b:.4} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height) or check the scale"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Layers sampled by [`sampled_volume`].
+const VOLUME_SAMPLES: usize = 24;
+
+/// The volume the slicer will print, estimated from the sliced area of up to
+/// [`VOLUME_SAMPLES`] evenly spaced layers (their mean area × the part's height).
+fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f64 {
+    let n = zs.len();
+    let samples = n.min(VOLUME_SAMPLES);
+    let total: f64 = (0..samples)
+        .map(|k| {
+            let i = (2 * k + 1) * n / (2 * samples);
+            geom::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
+        })
+        .sum();
+    total / samples as f64 * n as f64 * h
+}

@@ -1,0 +1,210 @@
+//! The slicing job: a prepared mesh, its plane heights and a facet index per layer; any layer
+//! planned on any thread ([`Job::plan_layer`]), with both discharge units and the support.
+
+use crate::base::geom;
+use crate::base::settings::{self, Settings};
+use crate::model::mesh::Mesh;
+use crate::model::prepare::JobInfo;
+use crate::output::gcode;
+use crate::output::summary::Summary;
+use crate::pipeline::SupportedPlans;
+use crate::slicing::plan::{self, LayerPlan};
+use crate::slicing::slice::{self, FacetBuckets, Section};
+use crate::support::overhang;
+
+/// One prepared slicing job: the placed mesh, its plane heights and a facet index per layer.
+pub struct Job {
+    pub(crate) settings: Settings,
+    pub(crate) mesh: Mesh,
+    pub(crate) buckets: FacetBuckets,
+    pub(crate) zs: Vec<f64>,
+    pub(crate) info: JobInfo,
+    /// The facet runs of [`JobInfo::groups`] as ranges of facet numbers (empty: all unit 0).
+    pub(crate) groups: Vec<(std::ops::Range<u32>, u8)>,
+    /// Every layer's plan with support (`support = unit1`), computed on first use: the
+    /// droplet-level pass needs all layers' droplets (see [`Job::supported_plans`]).
+    pub(crate) supported: std::sync::OnceLock<SupportedPlans>,
+}
+
+impl Job {
+    /// Whether discharge unit 1 prints in this job: support is on, or a part is unit 1's.
+    pub fn uses_unit1(&self) -> bool {
+        self.settings.support == settings::Support::Unit1 || self.has_unit1_parts()
+    }
+
+    /// Whether a part of this job is printed by unit 1.
+    pub fn has_unit1_parts(&self) -> bool {
+        self.groups.iter().any(|(_, u)| *u == 1)
+    }
+
+    /// The unit selected when layer `i` starts: the unit of the last move of the nearest
+    /// layer below that has moves (0 at the start of the file). Without unit 1, 0 at once;
+    /// otherwise that layer is planned again (the page's workers ask this once per run of
+    /// layers, [`crate::wasm`]).
+    pub fn unit_before(&self, i: usize) -> u8 {
+        if !self.uses_unit1() {
+            return 0;
+        }
+        for j in (0..i.min(self.layer_count())).rev() {
+            if let Some(m) = self.plan_layer(j).moves.last() {
+                return m.unit;
+            }
+        }
+        0
+    }
+
+    /// The placed, repaired mesh that is sliced (for [`Job::from_prepared`]).
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    pub fn info(&self) -> &JobInfo {
+        &self.info
+    }
+
+    pub fn layer_count(&self) -> usize {
+        self.zs.len()
+    }
+
+    /// Plane height of layer `i` above the part's bottom.
+    pub fn plane_z(&self, i: usize) -> f64 {
+        self.zs[i]
+    }
+
+    /// The cross-section of layer `i`.
+    pub fn section(&self, i: usize) -> Section {
+        slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i])
+    }
+
+    /// The closed loops of layer `i` before their union (for diagnostics).
+    pub fn section_loops(&self, i: usize) -> Vec<geom::Contour> {
+        slice::section_loops(&self.mesh, self.buckets.layer(i), self.zs[i]).0
+    }
+
+    /// Every move of layer `i`.
+    pub fn plan_layer(&self, i: usize) -> LayerPlan {
+        self.plan_layer_and_region(i).0
+    }
+
+    /// [`plan_layer`](Self::plan_layer) and the region unit 0 prints in the layer (its section
+    /// in a job without unit-1 parts), which the analysis needs.
+    pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
+        if self.settings.support == settings::Support::Unit1 {
+            return self.supported_plans()[i].clone();
+        }
+        self.plan_layer_with(i, self.section(i), None)
+    }
+
+    /// Whether planning a layer needs the section of the layer below (for the overhang
+    /// figure: with support off; with support on it comes from [`Job::supported_plans`]).
+    pub fn needs_below(&self) -> bool {
+        self.settings.support != settings::Support::Unit1
+    }
+
+    /// [`plan_layer_and_region`](Self::plan_layer_and_region) given the layer's section and,
+    /// when known, the region of layer i − 1's section (else it is sliced again when
+    /// [`Job::needs_below`]): the native writer hands it from layer to layer.
+    pub fn plan_layer_with(
+        &self,
+        i: usize,
+        section: Section,
+        below: Option<&geom::Shapes>,
+    ) -> (LayerPlan, geom::Shapes) {
+        if self.settings.support == settings::Support::Unit1 {
+            return self.supported_plans()[i].clone();
+        }
+        let (mut plan, region) = self.plan_parts(i, &section);
+        // Layers stay independent: the overhang needs only the section below.
+        let sliced;
+        let below = match (i.checked_sub(1), below) {
+            (None, _) => None,
+            (Some(_), Some(b)) => Some(b),
+            (Some(j), None) => {
+                sliced = self.section(j).region;
+                Some(&sliced)
+            }
+        };
+        plan.unsupported_area = overhang::overhang_area(&section.region, below, &self.settings);
+        (plan, region)
+    }
+
+    /// Layer `i`'s plan without support: unit 0's region, then unit 1's parts (with B₁, in
+    /// the order `unit_order` gives), and the region unit 0 prints.
+    pub(crate) fn plan_parts(&self, i: usize, section: &Section) -> (LayerPlan, geom::Shapes) {
+        let (mut plan, own) = if self.groups.is_empty() {
+            (plan::plan_layer(&section.region, i, &self.settings), None)
+        } else {
+            let [r0, r1] = self.unit_regions(i);
+            (plan::plan_layer(&r0, i, &self.settings), Some((r0, r1)))
+        };
+        plan.open_chains = section.open_chains;
+        plan.reoriented_loops = section.reoriented_loops;
+        match own {
+            None => (plan, section.region.clone()),
+            Some((r0, r1)) => {
+                plan::plan_unit1_layer(
+                    &mut plan,
+                    &r1,
+                    &geom::Shapes::new(),
+                    plan::Role::Support,
+                    &self.settings,
+                );
+                (plan, r0)
+            }
+        }
+    }
+
+    /// The regions units 0 and 1 print in layer `i` (SPEC.md "Two discharge units"): each
+    /// run of consecutive parts of one unit ([`JobInfo::groups`]) is sliced on its own, and
+    /// keeps its section less the sections of the runs listed before it (where parts of
+    /// different units overlap, the part listed first keeps the overlap). A job without
+    /// unit-1 parts: unit 0 prints the whole section.
+    pub fn unit_regions(&self, i: usize) -> [geom::Shapes; 2] {
+        if self.groups.is_empty() {
+            return [self.section(i).region, geom::Shapes::new()];
+        }
+        let facets = self.buckets.layer(i);
+        let mut regions = [geom::Shapes::new(), geom::Shapes::new()];
+        let mut covered = geom::Shapes::new();
+        for (k, (range, unit)) in self.groups.iter().enumerate() {
+            let mine: Vec<u32> = facets
+                .iter()
+                .copied()
+                .filter(|f| range.contains(f))
+                .collect();
+            if mine.is_empty() {
+                continue;
+            }
+            let section = slice::slice_layer(&self.mesh, &mine, self.zs[i]).region;
+            let own = crate::base::boolean::difference(&section, &covered);
+            if k + 1 < self.groups.len() {
+                covered = crate::base::boolean::union(&covered, &section);
+            }
+            let r = &mut regions[usize::from(*unit).min(1)];
+            *r = crate::base::boolean::union(r, &own);
+        }
+        regions
+    }
+
+    /// The header; with `None` the droplet counts are fixed-width placeholders.
+    pub fn header(&self, summary: Option<&Summary>) -> String {
+        let b = &self.info.bounds;
+        gcode::header(
+            &self.settings,
+            &gcode::HeaderInput {
+                file_name: &self.info.file_name,
+                facets: self.info.mesh.facets_in_file,
+                layers: self.zs.len(),
+                bounds: (b.min, b.max),
+                warnings: &self.info.warnings,
+                instances: &self.info.instances,
+                unit1_used: self.uses_unit1(),
+            },
+            summary,
+        )
+    }
+}

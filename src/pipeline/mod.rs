@@ -1,0 +1,14 @@
+//! The job: building it from models, planning its layers (both units, the support), and the
+//! native layer writer.
+
+mod build;
+mod job;
+mod supported;
+#[cfg(not(target_arch = "wasm32"))]
+mod writer;
+
+pub use build::MAX_DROPLETS;
+pub use job::Job;
+pub use supported::SupportedPlans;
+#[cfg(not(target_arch = "wasm32"))]
+pub use writer::{write_gcode, write_gcode_with};

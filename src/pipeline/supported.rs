@@ -1,0 +1,94 @@
+//! The supported pass (`support = unit1`): every layer's plan with unit 1's support, computed
+//! once per job because the droplet-level pass needs all layers' droplets.
+
+use crate::base::geom;
+use crate::base::parallel::{both, par_map};
+use crate::pipeline::Job;
+use crate::slicing::plan::{self, LayerPlan};
+use crate::support::{self, droplets as support_droplets};
+
+/// Every layer's plan and region with support on, and what the droplet-level pass added
+/// ([`Job::supported_pass`]).
+pub struct SupportedPlans {
+    pub layers: Vec<(LayerPlan, geom::Shapes)>,
+    pub figures: support_droplets::PassFigures,
+}
+
+impl Job {
+    /// Every layer's plan with support on (`support = unit1`), computed once per job on first
+    /// use: each layer's part planned as without support, its support region hatched by unit 1
+    /// ([`moves::support_moves`]), then the droplet-level pass over all layers
+    /// ([`support_droplets::complete`]) adds unit-1 droplets under every droplet the layer
+    /// below leaves unsupported. Natively the layers are planned in parallel; in the page each
+    /// worker's job plans them all once (docs/support.md).
+    pub fn supported_plans(&self) -> &[(LayerPlan, geom::Shapes)] {
+        &self.supported_pass().layers
+    }
+
+    /// [`Job::supported_plans`] and what the droplet-level pass added.
+    pub fn supported_pass(&self) -> &SupportedPlans {
+        self.supported.get_or_init(|| {
+            let n = self.layer_count();
+            let s = &self.settings;
+            let sections = par_map(n, &|i| self.section(i));
+            let regions: Vec<geom::Shapes> = sections.iter().map(|x| x.region.clone()).collect();
+            // The support regions (their top-down union is sequential) beside the parts' own
+            // plans, which do not depend on them.
+            let (layers, parts) = both(
+                || support::support_layers(&regions, s),
+                || par_map(n, &|i| self.plan_parts(i, &sections[i])),
+            );
+            drop(sections);
+            // Unit 1's hatch moves of each layer, after its part plan.
+            let hatches = par_map(n, &|i| {
+                let start = plan::unit1_start(&parts[i].0, s);
+                support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
+            });
+            let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> = parts
+                .into_iter()
+                .zip(hatches)
+                .zip(&layers)
+                .map(|(((mut p, own), moves), layer)| {
+                    p.unsupported_area = layer.unsupported_area;
+                    (p, own, moves)
+                })
+                .collect();
+            drop(layers);
+            // The droplet-level pass reads each layer's droplets from its moves when it needs
+            // them (no list of all droplets is kept).
+            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+            let (extra, figures) = support_droplets::complete(
+                &|i, within, out: &mut Vec<support_droplets::Droplet>| {
+                    support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
+                    support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
+                },
+                &regions,
+                s,
+            );
+            let plans = planned
+                .into_iter()
+                .enumerate()
+                .map(|(i, (mut p, region, mut moves))| {
+                    if !extra[i].is_empty() {
+                        let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+                        let none = geom::Shapes::new();
+                        moves.extend(support::moves::support_moves(
+                            &[],
+                            &none,
+                            &extra[i],
+                            i,
+                            s,
+                            start,
+                        ));
+                    }
+                    plan::add_unit1(&mut p, moves, s);
+                    (p, region)
+                })
+                .collect();
+            SupportedPlans {
+                layers: plans,
+                figures,
+            }
+        })
+    }
+}
