@@ -256,13 +256,12 @@ impl JobSpec {
                 text.len()
             )));
         }
-        let value: serde_json::Value = serde_json::from_str(text)
-            .map_err(|e| {
-                Error::Job(format!(
-                    "the job file is not valid JSON: {}",
-                    crate::error::quote(&e.to_string())
-                ))
-            })?;
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+            Error::Job(format!(
+                "the job file is not valid JSON: {}",
+                crate::error::quote(&e.to_string())
+            ))
+        })?;
         JobSpec::from_value(value)
     }
 
@@ -414,13 +413,12 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
     {
         return bad("unit", &format!("{u} is not a discharge unit: 0 or 1"));
     }
-    let part: PartSpec = serde_json::from_value(Value::Object(map))
-        .map_err(|e| {
-            Error::Job(format!(
-                "parts[{i}]: {}",
-                crate::error::quote(&e.to_string())
-            ))
-        })?;
+    let part: PartSpec = serde_json::from_value(Value::Object(map)).map_err(|e| {
+        Error::Job(format!(
+            "parts[{i}]: {}",
+            crate::error::quote(&e.to_string())
+        ))
+    })?;
     part.validate(i)?;
     Ok(part)
 }

@@ -644,7 +644,8 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 .unwrap_or_default()
         };
         let read = |p: &Path| {
-            read_regular(p, dropslice::import::MAX_FILE_BYTES, "a model file").map_err(Error::Import)
+            read_regular(p, dropslice::import::MAX_FILE_BYTES, "a model file")
+                .map_err(Error::Import)
         };
         if let [one] = &args.models[..] {
             if is_job_file(one)? {

@@ -847,8 +847,7 @@ fn parse_model(
                 if let Some(req) = attr(&attrs, "requiredextensions") {
                     for prefix in req.split_ascii_whitespace() {
                         let ns =
-                            x.ns
-                                .resolve_element(quick_xml::name::QName(&format!("{prefix}:x")))
+                            x.ns.resolve_element(quick_xml::name::QName(&format!("{prefix}:x")))
                                 .0;
                         let ns = match ns {
                             ResolveResult::Bound(n) => n.0.to_string(),
