@@ -493,8 +493,9 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
                 _ => {}
             }
         }
-        self.close();
-        self.ns.pop();
+        if self.close() > 0 {
+            self.ns.pop();
+        }
         Ok(())
     }
 
@@ -507,8 +508,9 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
     ) -> Result<Option<XmlEvent>, Error> {
         if self.pending_end {
             self.pending_end = false;
-            self.close();
-            self.ns.pop();
+            if self.close() > 0 {
+                self.ns.pop();
+            }
             return Ok(Some(XmlEvent::End));
         }
         loop {
@@ -517,19 +519,26 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
                 Ok(ev) => ev,
                 Err(e) => return Err(self.read_error(e, part)),
             };
+            // A namespace scope is kept only for elements that declare namespaces.
+            let mut decls = 0;
             if let Event::Start(s) | Event::Empty(s) = &ev {
-                self.ns.push(s).map_err(|e| {
-                    err(format!(
-                        "the 3MF part '/{part}' has a bad namespace declaration ({}); the file is damaged",
-                        quote(&e.to_string())
-                    ))
-                })?;
+                decls = declarations(s, part)?;
+                if decls > 0 {
+                    self.ns.push(s).map_err(|e| {
+                        err(format!(
+                            "the 3MF part '/{part}' has a bad namespace declaration ({}); the file is damaged",
+                            quote(&e.to_string())
+                        ))
+                    })?;
+                }
             }
             let ns = match &ev {
                 Event::Start(s) | Event::Empty(s) => self.ns.resolve_element(s.name()).0,
                 _ => ResolveResult::Unbound,
             };
+            // The core namespace as "" (as unbound names): no text made for most elements.
             let ns: String = match ns {
+                ResolveResult::Bound(n) if n.0 == CORE_NS => String::new(),
                 ResolveResult::Bound(n) => n.0.to_string(),
                 ResolveResult::Unbound => String::new(),
                 ResolveResult::Unknown(p) => {
@@ -545,8 +554,9 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
                 other => {
                     match other {
                         Event::End(_) => {
-                            self.close();
-                            self.ns.pop();
+                            if self.close() > 0 {
+                                self.ns.pop();
+                            }
                             return Ok(Some(XmlEvent::End));
                         }
                         Event::DocType(_) => return Err(doctype(part)),
@@ -569,7 +579,6 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
             if let Some((s, empty)) = start {
                 {
                     let local = s.local_name().as_ref().to_string();
-                    let decls = declarations(&s, part)?;
                     let attrs = if want(&ns, &local) {
                         attributes(&self.ns, &s, &local, part)?
                     } else {
@@ -598,9 +607,10 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
         }
     }
 
-    fn close(&mut self) {
+    /// An element closes: returns its number of namespace declarations.
+    fn close(&mut self) -> usize {
         self.depth = self.depth.saturating_sub(1);
-        self.ns_stack.pop();
+        self.ns_stack.pop().unwrap_or(0)
     }
 }
 
