@@ -23,6 +23,10 @@ enum Input {
     Missing,
     /// A directory given as the model.
     Directory,
+    /// A model file with this name and these bytes.
+    Named(&'static str, Vec<u8>),
+    /// A path given as the model as it is; `{dir}` is replaced by the row's temp directory.
+    Path(&'static str),
 }
 
 struct Row {
@@ -34,7 +38,14 @@ struct Row {
     settings_json: Option<String>,
     /// The error line must contain one of these (case-insensitive).
     keywords: Vec<String>,
+    /// Creates a FIFO `fifo` in the row's directory (nothing ever writes to it).
+    fifo: bool,
 }
+
+/// Most bytes of stderr of any row (messages are bounded: `dropslice::base::error`).
+const MAX_STDERR: usize = 2500;
+/// Most bytes of stderr of the rows about hostile sizes (limits_rows).
+const SHORT_STDERR: usize = 1000;
 
 fn row(name: impl Into<String>, input: Input, keywords: &[&str]) -> Row {
     Row {
@@ -43,6 +54,7 @@ fn row(name: impl Into<String>, input: Input, keywords: &[&str]) -> Row {
         args: Vec::new(),
         settings_json: None,
         keywords: keywords.iter().map(|s| s.to_string()).collect(),
+        fifo: false,
     }
 }
 
@@ -453,14 +465,27 @@ fn not_stl_rows() -> Vec<Row> {
 
 /// Runs one row twice: with no output file, then with an existing one.
 fn check_row(r: &Row) -> Result<(), String> {
+    check_row_within(r, MAX_STDERR)
+}
+
+/// [`check_row`] with at most `max_stderr` bytes on stderr.
+fn check_row_within(r: &Row, max_stderr: usize) -> Result<(), String> {
     for existing in [false, true] {
         let dir = TempDir::new("bad");
         let d = dir.path().display().to_string();
+        if r.fifo {
+            make_fifo(&dir.join("fifo"));
+        }
         let model = match &r.input {
             Input::Bytes(b) => {
                 std::fs::write(dir.join("model.stl"), b).unwrap();
                 dir.join("model.stl")
             }
+            Input::Named(name, b) => {
+                std::fs::write(dir.join(name), b).unwrap();
+                dir.join(name)
+            }
+            Input::Path(p) => std::path::PathBuf::from(p.replace("{dir}", &d)),
             Input::Missing => dir.join("does_not_exist.stl"),
             Input::Directory => {
                 std::fs::create_dir(dir.join("a_folder.stl")).unwrap();
@@ -509,6 +534,13 @@ fn check_row(r: &Row) -> Result<(), String> {
                 "{} error lines on stderr, expected one: {}",
                 errors.len(),
                 ctx()
+            ));
+        }
+        if run.stderr.len() > max_stderr {
+            return Err(format!(
+                "stderr is {} bytes, expected at most {max_stderr}: row '{}'",
+                run.stderr.len(),
+                r.name
             ));
         }
         let msg = errors[0].to_lowercase();
@@ -571,6 +603,157 @@ fn cli_settings_file_rows() {
 #[test]
 fn cli_not_stl_is_named() {
     check_rows(not_stl_rows());
+}
+
+fn make_fifo(path: &std::path::Path) {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(path.as_os_str().as_bytes()).unwrap();
+    assert_eq!(
+        unsafe { libc::mkfifo(c.as_ptr(), 0o600) },
+        0,
+        "mkfifo {path:?}"
+    );
+}
+
+/// A job file `job.json` with this text.
+fn job_row(name: &str, json: &str, keywords: &[&str]) -> Row {
+    row(
+        name,
+        Input::Named("job.json", json.as_bytes().to_vec()),
+        keywords,
+    )
+}
+
+/// Inputs that used to run away (issue 22): files that are not files, sizes past a bound,
+/// numbers and texts quoted without bound. Each must be refused quickly with a short message.
+fn limits_rows() -> Vec<Row> {
+    let not_regular = &["not a regular file"][..];
+    let mut rows = vec![
+        row("model /dev/zero", Input::Path("/dev/zero"), not_regular),
+        row("model /dev/stdin", Input::Path("/dev/stdin"), not_regular),
+        job_row(
+            "job file part /dev/zero",
+            r#"{"parts": [{"file": "/dev/zero"}]}"#,
+            not_regular,
+        ),
+        job_row(
+            "job file part /dev/stdin",
+            r#"{"parts": [{"file": "/dev/stdin"}]}"#,
+            not_regular,
+        ),
+        job_row(
+            "job file part a FIFO",
+            r#"{"parts": [{"file": "fifo"}]}"#,
+            not_regular,
+        ),
+        row(
+            "a FIFO as the job file",
+            Input::Path("{dir}/fifo"),
+            not_regular,
+        ),
+        job_row(
+            "job file part 1e308 scale",
+            r#"{"parts": [{"file": "a.stl", "scale_x": 1e308}]}"#,
+            &["1e308 is out of range"],
+        ),
+        job_row(
+            "job file with a 100 kB unknown key",
+            &format!(r#"{{"parts": [], "{}": 1}}"#, "k".repeat(100_000)),
+            &["unknown key 'kkkk"],
+        ),
+        setting_row(
+            "--set layer_height=1e308",
+            "layer_height=1e308".into(),
+            &["1e308 is out of range"],
+        ),
+        setting_row(
+            "--set with a 100 kB name",
+            format!("{}=1", "n".repeat(100_000)),
+            &["no setting named 'nnnn"],
+        ),
+        setting_row(
+            "--set contour_order=<100 kB>",
+            format!("contour_order={}", "s".repeat(100_000)),
+            &["contour_order"],
+        ),
+        json_row(
+            "--settings with a 100 kB string",
+            &format!(r#"{{"contour_order": "{}"}}"#, "s".repeat(100_000)),
+            &["contour_order"],
+        ),
+        json_row(
+            "--settings over 1 MiB",
+            &format!(r#"{{"layer_height": 0.2{}}}"#, " ".repeat(1 << 20)),
+            &["bytes"],
+        ),
+    ];
+    for (what, path) in [("/dev/zero", "/dev/zero"), ("a FIFO", "{dir}/fifo")] {
+        let mut r = row(
+            format!("--settings {what}"),
+            Input::Bytes(common::model_bytes("cube_20mm_ascii.stl")),
+            not_regular,
+        );
+        r.args = vec!["--settings".into(), path.into()];
+        rows.push(r);
+    }
+    // OBJ corners separated by vertical tabs: 20 million + 1 triangles in one face.
+    let mut obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf".to_vec();
+    for k in 0..dropslice::model::import::stl::MAX_TRIANGLES + 3 {
+        obj.extend([0x0b, b'1' + (k % 3) as u8]);
+    }
+    obj.push(b'\n');
+    rows.push(row(
+        "OBJ face of 20 M triangles split by vertical tabs",
+        Input::Named("tabs.obj", obj),
+        &["20000001 triangles"],
+    ));
+    // A 3MF whose vertex has a 15 MB number.
+    rows.push(row(
+        "3MF vertex with a 15 MB number",
+        Input::Named("huge.3mf", huge_attribute_3mf()),
+        &["not a finite number ('999"],
+    ));
+    // An ASCII STL with a 15 MB word where a number belongs.
+    let stl = format!(
+        "solid s\nfacet normal 0 0 1\nouter loop\nvertex {} 0 0\n",
+        "x".repeat(15_000_000)
+    );
+    rows.push(row(
+        "ASCII STL with a 15 MB word",
+        Input::Bytes(stl.into_bytes()),
+        &["is not a number"],
+    ));
+    for r in &mut rows {
+        r.fifo = true;
+    }
+    rows
+}
+
+/// A 3MF package (deflated) whose one vertex has a 15-million-digit x.
+fn huge_attribute_3mf() -> Vec<u8> {
+    use std::io::Write;
+    let rels = r#"<?xml version="1.0"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#;
+    let model = format!(
+        r#"<?xml version="1.0"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources><object id="1"><mesh><vertices><vertex x="{}" y="0" z="0"/></vertices></mesh></object></resources><build><item objectid="1"/></build></model>"#,
+        "9".repeat(15_000_000)
+    );
+    let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let o = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    z.start_file("_rels/.rels", o).unwrap();
+    z.write_all(rels.as_bytes()).unwrap();
+    z.start_file("3D/3dmodel.model", o).unwrap();
+    z.write_all(model.as_bytes()).unwrap();
+    z.finish().unwrap().into_inner()
+}
+
+#[test]
+fn cli_refuses_runaway_inputs_quickly_and_briefly() {
+    let failures: Vec<String> = limits_rows()
+        .iter()
+        .filter_map(|r| check_row_within(r, SHORT_STDERR).err())
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]

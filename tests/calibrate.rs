@@ -208,3 +208,101 @@ fn refusals_exit_2_with_a_reason() {
         assert!(r.stdout.is_empty(), "{all:?}: {}", r.stdout);
     }
 }
+
+/// A code of more droplets than the viewer expands (50 million): 700 G25 lines of 20 m each,
+/// 67 million droplets in a file of 20 kB. `calibrate` counts them by arithmetic, with the
+/// header's total and without it, and gives the same figures either way.
+#[test]
+fn large_codes_are_counted_not_expanded() {
+    let dir = TempDir::new("calibrate");
+    let lines = 700;
+    let per_line = common::line_droplets(20_000.0, B);
+    let n = lines * per_line;
+    assert!(n > dropslice::output::gcode_read::MAX_DROPLETS, "{n}");
+    let mut body = String::new();
+    for k in 0..lines {
+        let x = if k % 2 == 0 { 20_000 } else { 0 };
+        body += &format!("G25 X{x}.0000 Y0.0000 Z0.2000\n");
+    }
+    let head = "; layer_height = 0.2 (mm)\n; droplet_aspect = 1.04\n";
+    let with_total = format!("{head}; droplets total = {n}\n{body}");
+    let without = format!("{head}{body}");
+    std::fs::write(dir.join("total.gco"), &with_total).unwrap();
+    std::fs::write(dir.join("bare.gco"), &without).unwrap();
+    // The viewer refuses to expand it.
+    let e = dropslice::output::gcode_read::read_gcode(&without).unwrap_err();
+    assert!(e.0.contains("50 million"), "{e}");
+    // A filling of exactly one cell at density 1.04.
+    let mass = n as f64 * 1.04 * B * B * H / 1000.0;
+    for (file, text, source) in [
+        ("total.gco", &with_total, CountSource::Header),
+        ("bare.gco", &without, CountSource::Commands),
+    ] {
+        let c = calibrate_gcode(text, mass, None).unwrap();
+        assert_eq!((c.droplets, c.count_source), (n, source), "{file}");
+        assert!((c.filling_degree - 1.0).abs() < 1e-9, "{file}: {c:?}");
+        let r = cli(
+            &["calibrate", file, "--mass", &format!("{mass}")],
+            dir.path(),
+        );
+        assert_eq!(r.code, Some(0), "{file}: {r:?}");
+        assert!(
+            r.stdout.contains(&format!("droplets          {n} (")),
+            "{file}: {}",
+            r.stdout
+        );
+    }
+}
+
+/// Numbers and files that used to give long messages or hangs: short messages, exit 2.
+#[test]
+fn hostile_arguments_are_refused_briefly() {
+    let dir = TempDir::new("calibrate");
+    let (_, n) = cube_code(&dir);
+    let sane = n as f64 * 1.04 * B * B * H / 1000.0;
+    let fifo = dir.join("fifo.gco");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let long = "7".repeat(100_000);
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["cube.gco".into(), "--mass".into(), "1e308".into()],
+            "(1e308 g over",
+        ),
+        (
+            vec![
+                "cube.gco".into(),
+                "--mass".into(),
+                format!("{sane}"),
+                "--density".into(),
+                "1e300".into(),
+            ],
+            "got 1e300",
+        ),
+        (
+            vec!["cube.gco".into(), "--mass".into(), format!("x{long}")],
+            "not a number",
+        ),
+        (
+            vec!["fifo.gco".into(), "--mass".into(), "1".into()],
+            "not a regular file",
+        ),
+        (
+            vec!["/dev/zero".into(), "--mass".into(), "1".into()],
+            "not a regular file",
+        ),
+    ];
+    for (args, want) in cases {
+        let mut all = vec!["calibrate".to_string()];
+        all.extend(args.iter().cloned());
+        let r = cli(&all, dir.path());
+        assert_eq!(r.code, Some(2), "{all:?}: {r:?}");
+        assert!(r.stderr.contains(want), "{want:?} in {:?}", r.stderr);
+        assert!(
+            r.stderr.len() < 600,
+            "{} bytes: {}",
+            r.stderr.len(),
+            r.stderr
+        );
+    }
+}

@@ -1003,3 +1003,92 @@ fn fake_zip_directories_are_refused_quickly() {
         assert!(t0.elapsed() < Duration::from_secs(2), "{:?}", t0.elapsed());
     }
 }
+
+/// 1.1 GiB of elements dropslice ignores (attributes and all), inflated from a few MB: refused
+/// at the 1 GiB bound after skipping them, in seconds (about 250 MB/s of XML on one core). Nested inside an ignored element (skipped
+/// without resolving names) and flat beside the resources (each element seen, attributes not
+/// read).
+#[test]
+fn ignored_element_bombs_are_refused_quickly() {
+    let head = HEAD.replace("UNIT", "millimeter");
+    let junk = r#"<junk a="1" b="2" c="3"/><x:note xmlns:x="urn:n" x:k="v">t</x:note>"#;
+    let mut blk = junk.repeat((1 << 20) / junk.len()).into_bytes();
+    blk.resize(1 << 20, b' ');
+    for (what, prefix) in [
+        (
+            "nested in <metadata>",
+            format!(r#"{head}<metadata name="a">"#),
+        ),
+        ("flat in <model>", head.clone()),
+    ] {
+        let data = deflate_repeated(prefix.as_bytes(), &blk, 1100);
+        let model = Entry {
+            name: "3D/3dmodel.model".into(),
+            method: 8,
+            data,
+            crc: 0,
+            size: (1100u32 << 20) + prefix.len() as u32,
+            flags: 0,
+        };
+        let b = zip(&[stored("_rels/.rels", RELS), model]);
+        assert!(b.len() < 8 << 20, "{what}: {} bytes", b.len());
+        let t0 = Instant::now();
+        let m = import_err(read(&b));
+        let dt = t0.elapsed();
+        eprintln!("{what}: refused in {dt:?}");
+        assert!(m.contains("more than 1024 MB"), "{what}: {m}");
+        // Before: 52 s on one quiet core. The bound leaves room for a busy machine.
+        assert!(dt < Duration::from_secs(90), "{what}: {dt:?}");
+    }
+}
+
+/// A 15 MB number in an attribute: the message quotes 80 characters of it.
+#[test]
+fn huge_attribute_is_quoted_short() {
+    let big = "9".repeat(15_000_000);
+    for (what, res) in [
+        (
+            "vertex x",
+            format!(
+                r#"<object id="1"><mesh><vertices><vertex x="{big}" y="0" z="0"/></vertices></mesh></object>"#
+            ),
+        ),
+        (
+            "triangle v1",
+            format!(
+                r#"<object id="1"><mesh><vertices><vertex x="0" y="0" z="0"/></vertices><triangles><triangle v1="x{big}" v2="0" v3="0"/></triangles></mesh></object>"#
+            ),
+        ),
+    ] {
+        let b = package("millimeter", &res, r#"<item objectid="1"/>"#, vec![]);
+        let m = import_err(read(&b));
+        assert!(m.chars().count() < 400, "{what}: {} characters", m.len());
+        assert!(m.contains("999…"), "{what}: {m}");
+    }
+    // A unit of 15 MB.
+    let b = package(&big, &cube(1), r#"<item objectid="1"/>"#, vec![]);
+    let m = import_err(read(&b));
+    assert!(m.chars().count() < 400 && m.contains("unit"), "{m}");
+}
+
+/// OBJ corners separated by vertical tabs (white space to tobj, not to ASCII): counted as
+/// tobj builds them, so a face of more than 20 million triangles is refused before it is built.
+#[test]
+fn obj_unicode_whitespace_is_counted_as_tobj_splits() {
+    // A small one is read (a square of two triangles, corners apart by \v and no-break space).
+    let obj = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf\u{b}1\u{b}2\u{a0}3\u{c}4\n";
+    let parts = import::read_parts(obj.as_bytes(), "square.obj").unwrap();
+    assert_eq!(parts[0].triangles.len(), 2);
+    // One face of MAX_TRIANGLES + 1 triangles: 40 MB of text.
+    let n = import::MAX_TRIANGLES + 3;
+    let mut obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf".to_vec();
+    for k in 0..n {
+        obj.push(0x0b);
+        obj.push(b'1' + (k % 3) as u8);
+    }
+    obj.push(b'\n');
+    let t0 = Instant::now();
+    let m = import_err(import::read_parts(&obj, "tabs.obj"));
+    assert!(m.contains("20000001 triangles"), "{m}");
+    eprintln!("refused in {:?}", t0.elapsed());
+}

@@ -61,8 +61,68 @@ impl Error {
     }
 }
 
+/// Most characters of input a message quotes ([`quote`]).
+pub const QUOTE_CHARS: usize = 80;
+
+/// Most characters of a whole message ([`Error`]'s `Display`): a last bound for messages that
+/// hold several quotes or lists, far above any message written for people.
+pub const MAX_MESSAGE_CHARS: usize = 2000;
+
+/// `text` as a message quotes it: at most [`QUOTE_CHARS`] characters (then "…"), control
+/// characters (line breaks, tabs, vertical tabs …) shown as spaces, so that a message stays
+/// one short line whatever the input holds.
+pub fn quote(text: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in text.chars().enumerate() {
+        if i == QUOTE_CHARS {
+            out.push('…');
+            break;
+        }
+        out.push(if c.is_control() { ' ' } else { c });
+    }
+    out
+}
+
+/// A number from the input as a message shows it: as Rust prints it (`0.2`, `45`, `-3.5`)
+/// unless that is long, then in exponent form (`1e308`, not 309 digits; `1e-300`).
+pub fn number(x: f64) -> String {
+    let s = format!("{x}");
+    if s.len() > 24 { format!("{x:e}") } else { s }
+}
+
+/// A message cut to at most [`MAX_MESSAGE_CHARS`] characters.
+pub fn clamp_message(s: &str) -> std::borrow::Cow<'_, str> {
+    clamp(s, MAX_MESSAGE_CHARS)
+}
+
+/// `s` cut to at most `max` characters (then "…").
+fn clamp(s: &str, max: usize) -> std::borrow::Cow<'_, str> {
+    match s.char_indices().nth(max) {
+        Some((at, _)) => format!("{}…", &s[..at]).into(),
+        None => s.into(),
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let whole = self.unbounded();
+        f.write_str(&clamp(&whole, MAX_MESSAGE_CHARS))
+    }
+}
+
+impl Error {
+    /// The message before [`MAX_MESSAGE_CHARS`] is applied.
+    fn unbounded(&self) -> String {
+        struct Whole<'a>(&'a Error);
+        impl fmt::Display for Whole<'_> {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                self.0.write_unbounded(f)
+            }
+        }
+        Whole(self).to_string()
+    }
+
+    fn write_unbounded(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::Import(m) => write!(f, "cannot read the model file: {m}"),
             Error::Setting { name, message } if name.is_empty() => {
@@ -94,7 +154,7 @@ macro_rules! message_error {
 
         impl std::fmt::Display for $name {
             fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-                f.write_str(&self.0)
+                f.write_str(&$crate::base::error::clamp_message(&self.0))
             }
         }
 
@@ -102,3 +162,28 @@ macro_rules! message_error {
     };
 }
 pub(crate) use message_error;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quotes_and_numbers_are_short() {
+        assert_eq!(quote("abc"), "abc");
+        assert_eq!(quote("a\u{b}b\nc"), "a b c");
+        let q = quote(&"9".repeat(15_000_000));
+        assert_eq!(q.chars().count(), QUOTE_CHARS + 1);
+        assert!(q.ends_with('…'));
+        assert_eq!(number(1e308), "1e308");
+        assert_eq!(number(-1e300), "-1e300");
+        assert_eq!(number(1e-300), "1e-300");
+        assert_eq!(number(0.2), "0.2");
+        assert_eq!(number(45.0), "45");
+        assert_eq!(number(0.1 + 0.2), "0.30000000000000004");
+        assert_eq!(number(1000001.0), "1000001");
+        let long = Error::Import("x".repeat(5 * MAX_MESSAGE_CHARS));
+        let shown = long.to_string();
+        assert_eq!(shown.chars().count(), MAX_MESSAGE_CHARS + 1);
+        assert_eq!(long.report().message, shown);
+    }
+}

@@ -594,13 +594,21 @@ pub fn schema_json() -> String {
     serde_json::to_string(&schema()).expect("schema serializes")
 }
 
+/// Largest settings file the command-line tool reads (`--settings FILE.json`), checked before
+/// reading: 1 MiB, as a job file ([`crate::model::spec::MAX_JOB_FILE_BYTES`]); every setting with a
+/// long value takes a few kB.
+pub const MAX_SETTINGS_FILE_BYTES: usize = 1 << 20;
+
 impl Settings {
     /// Parses settings from a JSON object `{"name": value, ...}`; missing names take their
     /// defaults. The result is validated.
     pub fn from_json(text: &str) -> Result<Settings, Error> {
         let value: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::Setting {
             name: String::new(),
-            message: format!("the settings are not valid JSON: {e}"),
+            message: format!(
+                "the settings are not valid JSON: {}",
+                crate::base::error::quote(&e.to_string())
+            ),
         })?;
         Settings::from_value(value)
     }
@@ -649,17 +657,18 @@ impl Settings {
         use serde_json::Value;
         let mut map = serde_json::to_value(&*self).expect("settings serialize");
         let Some(spec) = schema().into_iter().find(|s| s.name == name) else {
+            let name = crate::base::error::quote(name);
             return Err(Error::Setting {
-                name: name.to_string(),
                 message: format!(
                     "there is no setting named '{name}'; known settings: {}",
                     names().join(", ")
                 ),
+                name,
             });
         };
         let shown = match &value {
-            Value::String(s) => s.clone(),
-            other => other.to_string(),
+            Value::String(s) => crate::base::error::quote(s),
+            other => crate::base::error::quote(&other.to_string()),
         };
         let bad = |what: String| Error::Setting {
             name: name.to_string(),
@@ -686,7 +695,8 @@ impl Settings {
             (Kind::Integer | Kind::Number, _) => return Err(bad("a finite number".into())),
         };
         map[name] = value;
-        *self = serde_json::from_value(map).map_err(|e| bad(format!("allowed: {e}")))?;
+        *self = serde_json::from_value(map)
+            .map_err(|e| bad(format!("allowed: {}", crate::base::error::quote(&e.to_string()))))?;
         Ok(())
     }
 
@@ -721,7 +731,8 @@ impl Settings {
                 return Err(Error::Setting {
                     name: spec.name.to_string(),
                     message: format!(
-                        "{x} is out of range: it must be {lower} {min} and at most {max}{} ({})",
+                        "{} is out of range: it must be {lower} {min} and at most {max}{} ({})",
+                        crate::base::error::number(x),
                         if spec.unit.is_empty() {
                             String::new()
                         } else {

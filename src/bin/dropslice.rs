@@ -15,6 +15,7 @@ fn main() {}
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
     use dropslice::analysis::JobAnalysis;
+    use dropslice::base::error::quote;
     use dropslice::model::spec::{self as job, JobSpec, Model, PartSpec};
     use dropslice::{Error, Job, Settings, write_gcode_with};
     use staged::Staged;
@@ -165,21 +166,28 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                     let kv = value(&mut it, a)?;
                     let (k, v) = kv
                         .split_once('=')
-                        .ok_or_else(|| format!("--set expects name=value, got '{kv}'"))?;
+                        .ok_or_else(|| format!("--set expects name=value, got '{}'", quote(&kv)))?;
                     settings.set(k.trim(), v).map_err(|e| e.to_string())?;
                     ops.push(Op::Set(k.trim().to_string(), v.to_string()));
                 }
                 "--settings" => {
                     let path = value(&mut it, a)?;
-                    let text = std::fs::read_to_string(&path)
-                        .map_err(|e| format!("cannot read the settings file {path}: {e}"))?;
+                    let bytes = read_regular(
+                        Path::new(&path),
+                        dropslice::base::settings::MAX_SETTINGS_FILE_BYTES as u64,
+                        "a settings file",
+                    )
+                    .map_err(|e| format!("the settings file: {e}"))?;
+                    let text = String::from_utf8(bytes).map_err(|_| {
+                        format!("the settings file {path} is not text (UTF-8): it is not a JSON settings file")
+                    })?;
                     settings = Settings::from_json(&text).map_err(|e| format!("{path}: {e}"))?;
                     if let Ok(serde_json::Value::Object(map)) = serde_json::from_str(&text) {
                         ops.push(Op::File(path, map));
                     }
                 }
                 s if s.starts_with('-') && s.len() > 1 => {
-                    return Err(format!("unknown option '{s}'\n\n{USAGE}"));
+                    return Err(format!("unknown option '{}'\n\n{USAGE}", quote(s)));
                 }
                 s => {
                     if models.len() >= job::MAX_PARTS {
@@ -221,7 +229,7 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 .parse::<f64>()
                 .ok()
                 .filter(|x| x.is_finite())
-                .ok_or_else(|| format!("{opt} {v}: not a number"))
+                .ok_or_else(|| format!("{opt} {}: not a number", quote(v)))
         };
         while let Some(a) = it.next() {
             match a.as_str() {
@@ -229,11 +237,14 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 "--mass" => mass = Some(number(&mut it, a)?),
                 "--density" => density = Some(number(&mut it, a)?),
                 s if s.starts_with('-') && s.len() > 1 => {
-                    return Err(format!("unknown option '{s}'\n\n{CAL_USAGE}"));
+                    return Err(format!("unknown option '{}'\n\n{CAL_USAGE}", quote(s)));
                 }
                 s => {
                     if file.replace(PathBuf::from(s)).is_some() {
-                        return Err(format!("give one .gco file only ('{s}' is a second one)"));
+                        return Err(format!(
+                            "give one .gco file only ('{}' is a second one)",
+                            quote(s)
+                        ));
                     }
                 }
             }
@@ -262,11 +273,77 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         ))
     }
 
+    /// A path for a message: as given, cut to 240 characters (a job file may name anything).
+    fn shown_path(path: &Path) -> String {
+        let s = path.display().to_string();
+        match s.char_indices().nth(240) {
+            Some((at, _)) => format!("{}…", &s[..at]),
+            None => s,
+        }
+    }
+
+    /// Opens `path` for reading if it is a regular file: a device (`/dev/zero`, `/dev/stdin`),
+    /// a FIFO, a socket or a folder is refused. The file is opened without blocking (a FIFO
+    /// swapped in after a check cannot hang the open) and checked on the open handle. Returns
+    /// the file and its size.
+    fn open_regular(path: &Path) -> Result<(std::fs::File, u64), String> {
+        let shown = shown_path(path);
+        let mut options = std::fs::OpenOptions::new();
+        options.read(true);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::OpenOptionsExt;
+            options.custom_flags(libc::O_NONBLOCK);
+        }
+        let f = options
+            .open(path)
+            .map_err(|e| format!("cannot open {shown}: {e}"))?;
+        let meta = f
+            .metadata()
+            .map_err(|e| format!("cannot open {shown}: {e}"))?;
+        if meta.is_dir() {
+            return Err(format!(
+                "cannot open {shown}: it is a directory, not a file"
+            ));
+        }
+        if !meta.is_file() {
+            return Err(format!(
+                "cannot read {shown}: it is not a regular file (a device, a pipe or a socket); dropslice reads files only — save the data to a file first"
+            ));
+        }
+        Ok((f, meta.len()))
+    }
+
+    /// Reads a regular file ([`open_regular`]) of at most `max` bytes, checked before reading
+    /// (and again while reading, should the file grow); `what` names it in the message
+    /// ("a model file").
+    fn read_regular(path: &Path, max: u64, what: &str) -> Result<Vec<u8>, String> {
+        use std::io::Read;
+        let (f, len) = open_regular(path)?;
+        let too_big = |n: u64| {
+            format!(
+                "cannot read {}: it is {n} bytes, and {what} is read only up to {max} bytes",
+                shown_path(path)
+            )
+        };
+        if len > max {
+            return Err(too_big(len));
+        }
+        let mut bytes = Vec::with_capacity(len as usize);
+        f.take(max + 1)
+            .read_to_end(&mut bytes)
+            .map_err(|e| format!("cannot read {}: {e}", shown_path(path)))?;
+        if bytes.len() as u64 > max {
+            return Err(too_big(bytes.len() as u64));
+        }
+        Ok(bytes)
+    }
+
     /// Reads a `.gco` file through the core's reader (counting only), in pieces of whole lines.
     fn read_counting(path: &Path) -> Result<dropslice::output::gcode_read::GcodeReader, String> {
         use std::io::Read;
         let shown = path.display();
-        let mut f = std::fs::File::open(path).map_err(|e| format!("cannot open {shown}: {e}"))?;
+        let (mut f, _) = open_regular(path)?;
         let mut r = dropslice::output::gcode_read::GcodeReader::counting();
         let mut buf: Vec<u8> = Vec::new();
         let mut chunk = vec![0u8; 1 << 20];
@@ -567,7 +644,8 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
                 .unwrap_or_default()
         };
         let read = |p: &Path| {
-            std::fs::read(p).map_err(|e| Error::Import(format!("cannot open {}: {e}", p.display())))
+            read_regular(p, dropslice::model::import::MAX_FILE_BYTES, "a model file")
+                .map_err(Error::Import)
         };
         if let [one] = &args.models[..] {
             if is_job_file(one)? {
@@ -648,9 +726,10 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         }
         use std::io::Read;
         let mut start = [0u8; 64];
-        let n = std::fs::File::open(path)
-            .and_then(|mut f| f.read(&mut start))
-            .map_err(|e| Error::Import(format!("cannot open {}: {e}", path.display())))?;
+        let (mut f, _) = open_regular(path).map_err(Error::Import)?;
+        let n = f
+            .read(&mut start)
+            .map_err(|e| Error::Import(format!("cannot read {}: {e}", shown_path(path))))?;
         Ok(start[..n]
             .iter()
             .find(|b| !b.is_ascii_whitespace())
@@ -660,15 +739,14 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
     /// Reads a job file (at most [`job::MAX_JOB_FILE_BYTES`]) and its parts' files (relative
     /// to its folder); `ops` override its settings.
     fn job_file(path: &Path, ops: &[Op]) -> Result<Job, Error> {
-        use std::io::Read;
-        let shown = path.display();
-        let mut text = String::new();
-        std::fs::File::open(path)
-            .and_then(|f| {
-                f.take(job::MAX_JOB_FILE_BYTES as u64 + 1)
-                    .read_to_string(&mut text)
-            })
-            .map_err(|e| Error::Job(format!("cannot read the job file {shown}: {e}")))?;
+        let shown = shown_path(path);
+        let bytes = read_regular(path, job::MAX_JOB_FILE_BYTES as u64, "a job file")
+            .map_err(|e| Error::Job(format!("the job file: {e}")))?;
+        let text = String::from_utf8(bytes).map_err(|_| {
+            Error::Job(format!(
+                "the job file {shown} is not text (UTF-8): it is not a JSON job file"
+            ))
+        })?;
         let in_file = |e: Error| match e {
             Error::Job(m) => Error::Job(format!("{shown}: {m}")),
             e => e,
@@ -712,13 +790,10 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             if models.iter().any(|m| m.name == p.file) {
                 continue;
             }
+            // Any path is read, also outside the job file's folder (docs/security.md).
             let file = dir.join(&p.file);
-            let bytes = std::fs::read(&file).map_err(|e| {
-                Error::Import(format!(
-                    "parts[{i}].file: cannot open {} (named in {shown}): {e}",
-                    file.display()
-                ))
-            })?;
+            let bytes = read_regular(&file, dropslice::model::import::MAX_FILE_BYTES, "a model file")
+                .map_err(|e| Error::Import(format!("parts[{i}].file: {e} (named in {shown})")))?;
             models.push(Model::read(&bytes, &p.file).map_err(|e| named(&p.file, e))?);
         }
         Job::from_models(&models, &spec).map_err(in_file)

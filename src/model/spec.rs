@@ -240,7 +240,8 @@ fn check_range(
             "at least"
         };
         return Err(Error::Job(format!(
-            "parts[{i}].{key}: {x} is out of range: it must be a finite number {lower} {lo} and at most {hi}"
+            "parts[{i}].{key}: {} is out of range: it must be a finite number {lower} {lo} and at most {hi}",
+            crate::base::error::number(x)
         )));
     }
     Ok(())
@@ -255,8 +256,12 @@ impl JobSpec {
                 text.len()
             )));
         }
-        let value: serde_json::Value = serde_json::from_str(text)
-            .map_err(|e| Error::Job(format!("the job file is not valid JSON: {e}")))?;
+        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| {
+            Error::Job(format!(
+                "the job file is not valid JSON: {}",
+                crate::base::error::quote(&e.to_string())
+            ))
+        })?;
         JobSpec::from_value(value)
     }
 
@@ -271,7 +276,8 @@ impl JobSpec {
         };
         if let Some(k) = top.keys().find(|k| *k != "settings" && *k != "parts") {
             return Err(Error::Job(format!(
-                "unknown key '{k}': a job has only \"settings\" and \"parts\""
+                "unknown key '{}': a job has only \"settings\" and \"parts\"",
+                crate::base::error::quote(k)
             )));
         }
         let settings = match top.remove("settings") {
@@ -387,7 +393,8 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
             }
             k => {
                 return Err(Error::Job(format!(
-                    "parts[{i}]: unknown key '{k}'; a part has: {}",
+                    "parts[{i}]: unknown key '{}'; a part has: {}",
+                    crate::base::error::quote(k),
                     PART_SPEC_KEYS.join(", ")
                 )));
             }
@@ -406,8 +413,12 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
     {
         return bad("unit", &format!("{u} is not a discharge unit: 0 or 1"));
     }
-    let part: PartSpec = serde_json::from_value(Value::Object(map))
-        .map_err(|e| Error::Job(format!("parts[{i}]: {e}")))?;
+    let part: PartSpec = serde_json::from_value(Value::Object(map)).map_err(|e| {
+        Error::Job(format!(
+            "parts[{i}]: {}",
+            crate::base::error::quote(&e.to_string())
+        ))
+    })?;
     part.validate(i)?;
     Ok(part)
 }
@@ -443,7 +454,7 @@ impl Model {
         };
         let parts = import::read_parts(bytes, name)?;
         if parts.is_empty() {
-            return Err(Error::Import(format!("{name} has no parts")));
+            return Err(Error::Import(format!("{} has no parts", clean_name(name))));
         }
         Ok(Model {
             name: name.to_string(),
@@ -462,7 +473,7 @@ impl Model {
                 .ok_or_else(|| {
                     Error::Job(format!(
                         "{} has {} build item{}; item {i} does not exist (items count from 0)",
-                        self.name,
+                        clean_name(&self.name),
                         self.parts.len(),
                         if self.parts.len() == 1 { "" } else { "s" }
                     ))

@@ -13,8 +13,9 @@
 //! code) and a suggestion outside `droplet_aspect`'s range are refused with a message that says
 //! what to check.
 
-use crate::base::settings::{Settings, schema};
+use crate::base::error::number;
 use crate::output::gcode_read::GcodeReader;
+use crate::base::settings::{Settings, schema};
 use serde::Serialize;
 
 /// Filling degrees outside this range are refused as impossible (a droplet holding a fifth of
@@ -102,25 +103,29 @@ pub fn calibrate(
     }
     if !(mass_g.is_finite() && mass_g > 0.0) {
         return err(format!(
-            "the mass must be a positive number of grams, got {mass_g}"
+            "the mass must be a positive number of grams, got {}",
+            number(mass_g)
         ));
     }
     let (lo, hi) = range("material_density");
     if !(density_g_cm3.is_finite() && density_g_cm3 > lo && density_g_cm3 <= hi) {
         return err(format!(
-            "the density must be greater than {lo} and at most {hi} g/cm³, got {density_g_cm3}"
+            "the density must be greater than {lo} and at most {hi} g/cm³, got {}",
+            number(density_g_cm3)
         ));
     }
     let (h_lo, h_hi) = range("layer_height");
     let (a_lo, a_hi) = range("droplet_aspect");
     if !(layer_height > h_lo && layer_height <= h_hi) {
         return err(format!(
-            "the code's layer_height = {layer_height} mm is out of range ({h_lo} … {h_hi} mm)"
+            "the code's layer_height = {} mm is out of range ({h_lo} … {h_hi} mm)",
+            number(layer_height)
         ));
     }
     if !(droplet_aspect > a_lo && droplet_aspect <= a_hi) {
         return err(format!(
-            "the code's droplet_aspect = {droplet_aspect} is out of range ({a_lo} … {a_hi})"
+            "the code's droplet_aspect = {} is out of range ({a_lo} … {a_hi})",
+            number(droplet_aspect)
         ));
     }
     let h = layer_height;
@@ -131,9 +136,15 @@ pub fn calibrate(
     let suggested = (volume / h).sqrt() / h;
     if !(filling >= FILLING_RANGE.0 && filling <= FILLING_RANGE.1) {
         return err(format!(
-            "impossible: check the mass, the density ({density_g_cm3} g/cm³) and that the file is the printed part's code ({mass_g} g over {} droplets is {:.0} % of a droplet's B²H cell; sane: {:.0} … {:.0} %)",
+            "impossible: check the mass, the density ({} g/cm³) and that the file is the printed part's code ({} g over {} droplets is {} % of a droplet's B²H cell; sane: {:.0} … {:.0} %)",
+            number(density_g_cm3),
+            number(mass_g),
             grouped(droplets),
-            100.0 * filling,
+            if filling < 1e12 {
+                format!("{:.0}", 100.0 * filling)
+            } else {
+                number(100.0 * filling)
+            },
             100.0 * FILLING_RANGE.0,
             100.0 * FILLING_RANGE.1
         ));

@@ -23,11 +23,12 @@ use std::collections::VecDeque;
 /// the float32 droplet arrays lose all precision).
 pub const MAX_COORD_MM: f64 = 1e5;
 /// Droplets expanded from one file (G25 lines and G26): 50 million, about 450 MB in the page.
-/// Checked before a line is expanded.
+/// Checked before a line is expanded. A [counting](GcodeReader::counting) reader expands
+/// nothing and has no such bound (its counts saturate at `u64::MAX`).
 pub const MAX_DROPLETS: u64 = 50_000_000;
 /// A line longer than this (1 MB) is refused rather than gathered in memory.
 pub const MAX_LINE_CHARS: usize = 1 << 20;
-/// Travel moves (G01) kept for drawing: 20 million, about 320 MB.
+/// Travel moves (G01) kept for drawing: 20 million, about 320 MB (not bounded when counting).
 pub const MAX_TRAVEL_MOVES: u64 = 20_000_000;
 /// Layers (distinct heights): 100,000, e.g. 1 m at 0.01 mm.
 pub const MAX_LAYERS: usize = 100_000;
@@ -48,7 +49,8 @@ pub struct ReadLayer {
     pub travel_mm: f64,
     /// Droplet centres, roles and travel moves, as the slicer's preview gives them.
     pub preview: PreviewLayer,
-    /// The discharge unit of each droplet (0 or 1), in the order of `preview.roles`.
+    /// The discharge unit of each droplet (0 or 1), in the order of `preview.roles` (empty
+    /// when [counting](GcodeReader::counting)).
     pub units: Vec<u8>,
 }
 
@@ -316,6 +318,20 @@ impl GcodeReader {
             ))
         };
         let n: u64 = match code.as_str() {
+            "G25" if self.counts_only => {
+                // Counted by arithmetic (as `line_droplets` expands), never expanded.
+                let n = line_droplet_count_f64(len, width);
+                if !n.is_finite() {
+                    return Err(GcodeError(format!(
+                        "line {no}: a G25 of {} mm with droplets every {} mm has no droplet count",
+                        precise(len, 6),
+                        precise(width, 4)
+                    )));
+                }
+                n as u64
+            }
+            "G26" if self.counts_only => 1,
+            "G01" if self.counts_only => 0,
             "G25" => {
                 let n = line_droplet_count_f64(len, width);
                 if n.is_nan() || self.droplets as f64 + n > MAX_DROPLETS as f64 {
@@ -350,7 +366,7 @@ impl GcodeReader {
                 0
             }
         };
-        self.droplets += n;
+        self.droplets = self.droplets.saturating_add(n);
         self.commands += 1;
         if self.layer.as_ref().is_none_or(|l| (z - l.z).abs() > 1e-6) {
             if self.index + 1 >= MAX_LAYERS && self.layer.is_some() {
@@ -385,7 +401,9 @@ impl GcodeReader {
                     p.roles.push(0);
                 }
                 l.counts.outer += 1;
-                l.units.push(self.unit);
+                if keep {
+                    l.units.push(self.unit);
+                }
             }
             _ => {
                 if keep {
@@ -394,12 +412,14 @@ impl GcodeReader {
                         p.roles.push(2);
                     }
                 }
-                l.counts.fill += n;
-                l.units.extend(std::iter::repeat_n(self.unit, n as usize));
+                l.counts.fill = l.counts.fill.saturating_add(n);
+                if keep {
+                    l.units.extend(std::iter::repeat_n(self.unit, n as usize));
+                }
             }
         }
         if self.unit == 1 {
-            l.counts.unit1 += n;
+            l.counts.unit1 = l.counts.unit1.saturating_add(n);
         }
         (self.at, self.z) = (to, z);
         Ok(())

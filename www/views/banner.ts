@@ -16,7 +16,17 @@ export const TITLES: Record<string, string> = {
   linkFiles: "The preview link needs its models.",
 };
 
+/** Most characters of a banner's message: a message quoting a hostile file stays short (the
+ *  core bounds its own messages too; this holds for every source). */
+export const BANNER_MAX_CHARS = 600;
+
+/** `message` cut to [[BANNER_MAX_CHARS]] (then "…"). */
+export function clampMessage(message: string): string {
+  return message.length > BANNER_MAX_CHARS ? `${message.slice(0, BANNER_MAX_CHARS)}…` : message;
+}
+
 export function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error"): void {
+  message = clampMessage(message);
   const b = $("banner");
   b.className = `banner ${tone === "error" ? "" : tone}`;
   $("banner-title").textContent = title;

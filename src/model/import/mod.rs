@@ -26,6 +26,12 @@ use stl::{Format, Triangles};
 /// Most triangles a job may have after import, counting every instance (the STL bound).
 pub const MAX_TRIANGLES: usize = stl::MAX_TRIANGLES;
 
+/// Largest model file the command-line tool reads (bytes), checked before reading: 6 GiB,
+/// the size of an ASCII STL of [`MAX_TRIANGLES`] triangles written with full-precision numbers
+/// (about 300 bytes a facet); a binary STL of that many triangles is 1 GB. A file too large to
+/// hold that many triangles cannot be a model dropslice accepts.
+pub const MAX_FILE_BYTES: u64 = 6 << 30;
+
 /// The identity as a 3×4 affine matrix (see [`Part::transform_applied`]).
 pub const IDENTITY: [[f64; 4]; 3] = [
     [1.0, 0.0, 0.0, 0.0],

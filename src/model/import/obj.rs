@@ -17,11 +17,12 @@ use crate::model::import::stl::{MAX_TRIANGLES, Triangles};
 pub fn looks_like_obj(bytes: &[u8]) -> bool {
     let mut seen = 0;
     for line in bytes.split(|&c| c == b'\n').take(200) {
-        let t = trim(line);
-        if t.is_empty() || t[0] == b'#' {
+        let Some(kw) = words(line).next() else {
+            continue;
+        };
+        if kw[0] == b'#' {
             continue;
         }
-        let kw = t.split(|c| c.is_ascii_whitespace()).next().unwrap_or(&[]);
         let ok = matches!(
             kw,
             b"v" | b"vt"
@@ -54,12 +55,10 @@ pub fn parse(bytes: &[u8]) -> Result<Triangles, Error> {
             "the OBJ file is empty (0 bytes); choose a model file".into(),
         ));
     }
-    // Count the triangles before tobj allocates them.
+    // Count the triangles before tobj allocates them, with tobj's own splitting into words.
     let mut n: u64 = 0;
     for line in bytes.split(|&c| c == b'\n') {
-        let mut toks = trim(line)
-            .split(|c| c.is_ascii_whitespace())
-            .filter(|t| !t.is_empty());
+        let mut toks = words(line);
         if toks.next() == Some(b"f") {
             n += (toks.count() as u64).saturating_sub(2);
         }
@@ -80,6 +79,11 @@ pub fn parse(bytes: &[u8]) -> Result<Triangles, Error> {
         tobj::load_obj_buf(&mut reader, &opts, |_| Err(tobj::LoadError::OpenFileFailed))
             .map_err(|e| Error::Import(describe(bytes, e)))?;
     let n: usize = models.iter().map(|m| m.mesh.indices.len() / 3).sum();
+    if n > MAX_TRIANGLES {
+        return Err(Error::Internal(format!(
+            "OBJ reader: {n} triangles built after {MAX_TRIANGLES} were counted at most"
+        )));
+    }
     let mut tris = Triangles::with_capacity(n);
     for m in &models {
         let p = &m.mesh.positions;
@@ -215,7 +219,7 @@ fn describe(bytes: &[u8], e: tobj::LoadError) -> String {
 fn count_kw(bytes: &[u8], kw: &[u8]) -> u64 {
     let mut n = 0;
     for line in bytes.split(|&c| c == b'\n') {
-        if trim(line).split(|c| c.is_ascii_whitespace()).next() == Some(kw) {
+        if words(line).next() == Some(kw) {
             n += 1;
         }
     }
@@ -227,9 +231,7 @@ fn count_kw(bytes: &[u8], kw: &[u8]) -> u64 {
 fn first_line(bytes: &[u8], bad: impl Fn(&[u8], &[&[u8]], u64) -> bool) -> Option<usize> {
     let mut vs = 0u64;
     for (i, line) in bytes.split(|&c| c == b'\n').enumerate() {
-        let mut toks = trim(line)
-            .split(|c| c.is_ascii_whitespace())
-            .filter(|t| !t.is_empty());
+        let mut toks = words(line);
         let Some(kw) = toks.next() else { continue };
         let rest: Vec<&[u8]> = toks.collect();
         if bad(kw, &rest, vs) {
@@ -242,16 +244,16 @@ fn first_line(bytes: &[u8], bad: impl Fn(&[u8], &[&[u8]], u64) -> bool) -> Optio
     None
 }
 
-fn trim(line: &[u8]) -> &[u8] {
-    let s = line
-        .iter()
-        .position(|c| !c.is_ascii_whitespace())
-        .unwrap_or(line.len());
-    let e = line
-        .iter()
-        .rposition(|c| !c.is_ascii_whitespace())
-        .map_or(s, |e| e + 1);
-    &line[s..e.max(s)]
+/// The words of one line (split at `\n`) as tobj splits them: `str::split_whitespace`, i.e. at
+/// Unicode white space (vertical tab, form feed, no-break space … as well as space and tab),
+/// so that every count here sees the faces tobj builds. tobj refuses a line that is not UTF-8;
+/// its valid beginning is split.
+fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    let text = match std::str::from_utf8(line) {
+        Ok(s) => s,
+        Err(e) => std::str::from_utf8(&line[..e.valid_up_to()]).unwrap_or(""),
+    };
+    text.split_whitespace().map(str::as_bytes)
 }
 
 fn parse_f32(t: &[u8]) -> Option<f32> {

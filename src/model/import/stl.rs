@@ -192,7 +192,7 @@ fn parse_ascii(bytes: &[u8]) -> Result<Triangles, Error> {
                     Error::Import(format!(
                         "line {}: '{}' is not a number",
                         tokens.line(),
-                        String::from_utf8_lossy(t)
+                        crate::base::error::quote(&String::from_utf8_lossy(t))
                     ))
                 })?;
             }

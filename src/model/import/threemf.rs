@@ -24,12 +24,12 @@
 use std::collections::{HashMap, HashSet};
 use std::io::{BufRead, BufReader, Cursor, Read};
 
-use quick_xml::NsReader;
+use quick_xml::Reader;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::name::ResolveResult;
 
 use super::{MAX_TRIANGLES, Part};
-use crate::base::error::Error;
+use crate::base::error::{Error, quote};
 use crate::model::import::stl::Triangles;
 
 /// Most bytes inflated from the package in all (checked while inflating, whatever the ZIP
@@ -156,7 +156,8 @@ pub fn parse(bytes: &[u8], file_stem: &str) -> Result<Vec<Part>, Error> {
     check_entry_count(bytes)?;
     let mut zip = zip::ZipArchive::new(Cursor::new(bytes)).map_err(|e| {
         err(format!(
-            "the 3MF file is not a readable ZIP archive ({e}); it is damaged or truncated — download or export it again"
+            "the 3MF file is not a readable ZIP archive ({}); it is damaged or truncated — download or export it again",
+            quote(&e.to_string())
         ))
     })?;
     if zip.len() > MAX_ENTRIES {
@@ -194,7 +195,8 @@ pub fn parse(bytes: &[u8], file_stem: &str) -> Result<Vec<Part>, Error> {
         }
         let Some(&index) = names.get(&path) else {
             return Err(err(format!(
-                "the 3MF package has no part '/{path}', which {}; the file is damaged or incomplete",
+                "the 3MF package has no part '/{}', which {}; the file is damaged or incomplete",
+                quote(&path),
                 if path == root {
                     "its _rels/.rels names as the 3D model"
                 } else {
@@ -202,7 +204,13 @@ pub fn parse(bytes: &[u8], file_stem: &str) -> Result<Vec<Part>, Error> {
                 }
             )));
         };
-        let model = parse_model(&mut zip, index, &shown[&path], path == root, &mut totals)?;
+        let model = parse_model(
+            &mut zip,
+            index,
+            &quote(&shown[&path]),
+            path == root,
+            &mut totals,
+        )?;
         for o in model.objects.values() {
             if let Content::Components(cs) = &o.content {
                 queue.extend(cs.iter().filter_map(|c| c.path.clone()));
@@ -304,7 +312,8 @@ fn open_entry<'z, 'a>(
             ))
         } else {
             err(format!(
-                "the 3MF part '/{path}' cannot be unpacked ({s}); export the file again (with standard 'deflate' compression)"
+                "the 3MF part '/{path}' cannot be unpacked ({}); export the file again (with standard 'deflate' compression)",
+                quote(&s)
             ))
         }
     })?;
@@ -337,7 +346,7 @@ fn start_part(
     let mut x = Xml::new(r);
     let mut models = Vec::new();
     let mut keystore = false;
-    while let Some(ev) = x.next("_rels/.rels")? {
+    while let Some(ev) = x.next("_rels/.rels", |_, local| local == "Relationship")? {
         if let XmlEvent::Start { local, attrs, .. } = ev
             && local == "Relationship"
         {
@@ -394,9 +403,12 @@ enum XmlEvent {
     End,
 }
 
-/// A bounded, namespace-resolving XML event reader over a ZIP entry.
+/// A bounded, namespace-resolving XML event reader over a ZIP entry. Names are resolved
+/// (and namespace scopes kept) only for the elements [`Xml::next`] gives, not for those
+/// [`Xml::skip`] passes over.
 struct Xml<R: BufRead> {
-    r: NsReader<R>,
+    r: Reader<R>,
+    ns: quick_xml::name::NamespaceResolver,
     buf: Vec<u8>,
     depth: usize,
     /// Namespace declarations per open element.
@@ -407,10 +419,11 @@ struct Xml<R: BufRead> {
 
 impl<R: BufRead> Xml<R> {
     fn new(r: R) -> Self {
-        let mut r = NsReader::from_reader(r);
+        let mut r = Reader::from_reader(r);
         r.config_mut().trim_text(true);
         Xml {
             r,
+            ns: Default::default(),
             buf: Vec::new(),
             depth: 0,
             ns_stack: Vec::new(),
@@ -425,33 +438,113 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
         self.r.get_ref().get_ref().left
     }
 
-    fn next(&mut self, part: &str) -> Result<Option<XmlEvent>, Error> {
+    /// A read error as a message: the inflation bound's own message when it was passed.
+    fn read_error(&self, e: quick_xml::Error, part: &str) -> Error {
+        if let Some(m) = self.r.get_ref().get_ref().exceeded.clone() {
+            return err(m);
+        }
+        let pos = self.r.buffer_position();
+        err(format!(
+            "the 3MF part '/{part}' is not well-formed XML (at byte {pos}: {}); the file is damaged — export it again",
+            quote(&e.to_string())
+        ))
+    }
+
+    /// An element opens, with `decls` namespace declarations: the depth and namespace bounds.
+    fn open(&mut self, decls: usize, part: &str) -> Result<(), Error> {
+        self.depth += 1;
+        self.ns_stack.push(decls);
+        if self.depth > MAX_XML_DEPTH {
+            return Err(too_deep(part));
+        }
+        if decls > 0 && self.ns_stack.iter().sum::<usize>() > MAX_NAMESPACES {
+            return Err(err(format!(
+                "the 3MF part '/{part}' declares more than {MAX_NAMESPACES} XML namespaces at once; it is not a 3MF model"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Skips the content of the element [`next`](Self::next) just gave (a start, not an
+    /// empty element) up to and including its end, for elements nothing is read from: no
+    /// names are resolved, no attributes read and no namespace scopes kept (so the namespace
+    /// bound has nothing to count), but the depth bound, the ban on DOCTYPE and
+    /// well-formedness still hold.
+    fn skip(&mut self, part: &str) -> Result<(), Error> {
+        let mut depth = self.depth;
+        let end = depth - 1;
+        while depth > end {
+            self.buf.clear();
+            let ev = match self.r.read_event_into(&mut self.buf) {
+                Ok(ev) => ev,
+                Err(e) => return Err(self.read_error(e, part)),
+            };
+            match ev {
+                Event::Start(_) => {
+                    depth += 1;
+                    if depth > MAX_XML_DEPTH {
+                        return Err(too_deep(part));
+                    }
+                }
+                Event::Empty(_) if depth + 1 > MAX_XML_DEPTH => return Err(too_deep(part)),
+                Event::End(_) => depth -= 1,
+                Event::DocType(_) => return Err(doctype(part)),
+                Event::Eof => return Err(truncated(part)),
+                _ => {}
+            }
+        }
+        if self.close() > 0 {
+            self.ns.pop();
+        }
+        Ok(())
+    }
+
+    /// The next event; the attributes of a start are read only if `want(namespace, local
+    /// name)`.
+    fn next(
+        &mut self,
+        part: &str,
+        want: impl Fn(&str, &str) -> bool,
+    ) -> Result<Option<XmlEvent>, Error> {
         if self.pending_end {
             self.pending_end = false;
-            self.close();
+            if self.close() > 0 {
+                self.ns.pop();
+            }
             return Ok(Some(XmlEvent::End));
         }
         loop {
             self.buf.clear();
-            let res = self.r.read_resolved_event_into(&mut self.buf);
-            let (ns, ev) = match res {
-                Ok(x) => x,
-                Err(e) => {
-                    if let Some(m) = self.r.get_ref().get_ref().exceeded.clone() {
-                        return Err(err(m));
-                    }
-                    let pos = self.r.buffer_position();
-                    return Err(err(format!(
-                        "the 3MF part '/{part}' is not well-formed XML (at byte {pos}: {e}); the file is damaged — export it again"
-                    )));
-                }
+            let ev = match self.r.read_event_into(&mut self.buf) {
+                Ok(ev) => ev,
+                Err(e) => return Err(self.read_error(e, part)),
             };
+            // A namespace scope is kept only for elements that declare namespaces.
+            let mut decls = 0;
+            if let Event::Start(s) | Event::Empty(s) = &ev {
+                decls = declarations(s, part)?;
+                if decls > 0 {
+                    self.ns.push(s).map_err(|e| {
+                        err(format!(
+                            "the 3MF part '/{part}' has a bad namespace declaration ({}); the file is damaged",
+                            quote(&e.to_string())
+                        ))
+                    })?;
+                }
+            }
+            let ns = match &ev {
+                Event::Start(s) | Event::Empty(s) => self.ns.resolve_element(s.name()).0,
+                _ => ResolveResult::Unbound,
+            };
+            // The core namespace as "" (as unbound names): no text made for most elements.
             let ns: String = match ns {
+                ResolveResult::Bound(n) if n.0 == CORE_NS => String::new(),
                 ResolveResult::Bound(n) => n.0.to_string(),
                 ResolveResult::Unbound => String::new(),
                 ResolveResult::Unknown(p) => {
                     return Err(err(format!(
-                        "the 3MF part '/{part}' uses the XML prefix '{p}' without declaring it; the file is damaged"
+                        "the 3MF part '/{part}' uses the XML prefix '{}' without declaring it; the file is damaged",
+                        quote(&p.to_string())
                     )));
                 }
             };
@@ -461,19 +554,15 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
                 other => {
                     match other {
                         Event::End(_) => {
-                            self.close();
+                            if self.close() > 0 {
+                                self.ns.pop();
+                            }
                             return Ok(Some(XmlEvent::End));
                         }
-                        Event::DocType(_) => {
-                            return Err(err(format!(
-                                "the 3MF part '/{part}' has a document type definition (<!DOCTYPE>), which 3MF forbids; the file is not a valid 3MF model — export it again"
-                            )));
-                        }
+                        Event::DocType(_) => return Err(doctype(part)),
                         Event::Eof => {
                             if self.depth > 0 {
-                                return Err(err(format!(
-                                    "the 3MF part '/{part}' ends in the middle of the XML (unclosed elements); it is truncated — export it again"
-                                )));
+                                return Err(truncated(part));
                             }
                             return Ok(None);
                         }
@@ -489,7 +578,12 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
             };
             if let Some((s, empty)) = start {
                 {
-                    let (local, attrs, decls) = element(self.r.resolver(), &s, part)?;
+                    let local = s.local_name().as_ref().to_string();
+                    let attrs = if want(&ns, &local) {
+                        attributes(&self.ns, &s, &local, part)?
+                    } else {
+                        Vec::new()
+                    };
                     if self.depth == 0 {
                         self.roots += 1;
                         if self.roots > 1 {
@@ -498,18 +592,7 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
                             )));
                         }
                     }
-                    self.depth += 1;
-                    self.ns_stack.push(decls);
-                    if self.depth > MAX_XML_DEPTH {
-                        return Err(err(format!(
-                            "the 3MF part '/{part}' nests XML elements more than {MAX_XML_DEPTH} deep; it is not a 3MF model"
-                        )));
-                    }
-                    if self.ns_stack.iter().sum::<usize>() > MAX_NAMESPACES {
-                        return Err(err(format!(
-                            "the 3MF part '/{part}' declares more than {MAX_NAMESPACES} XML namespaces at once; it is not a 3MF model"
-                        )));
-                    }
+                    self.open(decls, part)?;
                     if empty {
                         self.pending_end = true;
                     }
@@ -524,31 +607,80 @@ impl<R: Read> Xml<BufReader<Limited<R>>> {
         }
     }
 
-    fn close(&mut self) {
+    /// An element closes: returns its number of namespace declarations.
+    fn close(&mut self) -> usize {
         self.depth = self.depth.saturating_sub(1);
-        self.ns_stack.pop();
+        self.ns_stack.pop().unwrap_or(0)
     }
 }
 
-/// The local name, attributes and number of namespace declarations of an element.
-#[allow(clippy::type_complexity)]
-fn element(
-    resolver: &quick_xml::name::NamespaceResolver,
-    s: &BytesStart,
-    part: &str,
-) -> Result<(String, Vec<(String, String, String)>, usize), Error> {
-    let local = s.local_name().as_ref().to_string();
-    let mut attrs = Vec::new();
+fn too_deep(part: &str) -> Error {
+    err(format!(
+        "the 3MF part '/{part}' nests XML elements more than {MAX_XML_DEPTH} deep; it is not a 3MF model"
+    ))
+}
+
+fn doctype(part: &str) -> Error {
+    err(format!(
+        "the 3MF part '/{part}' has a document type definition (<!DOCTYPE>), which 3MF forbids; the file is not a valid 3MF model — export it again"
+    ))
+}
+
+fn truncated(part: &str) -> Error {
+    err(format!(
+        "the 3MF part '/{part}' ends in the middle of the XML (unclosed elements); it is truncated — export it again"
+    ))
+}
+
+fn broken_attribute(local: &str, e: impl std::fmt::Display, part: &str) -> Error {
+    err(format!(
+        "the 3MF part '/{part}' has a broken attribute in <{}> ({}); the file is damaged",
+        quote(local),
+        quote(&e.to_string())
+    ))
+}
+
+/// The number of namespace declarations (`xmlns`, `xmlns:p`) of an element; its attributes
+/// are looked at only when their text holds "xmlns".
+fn declarations(s: &BytesStart, part: &str) -> Result<usize, Error> {
+    let raw: &[u8] = s.attributes_raw().as_bytes();
+    let mut rest = raw;
+    let mut any = false;
+    while let Some(i) = rest.iter().position(|&c| c == b'x') {
+        if rest[i..].starts_with(b"xmlns") {
+            any = true;
+            break;
+        }
+        rest = &rest[i + 1..];
+    }
+    if !any {
+        return Ok(0);
+    }
     let mut decls = 0;
     for a in s.attributes().with_checks(false) {
-        let a = a.map_err(|e| {
-                err(format!(
-                    "the 3MF part '/{part}' has a broken attribute in <{local}> ({e}); the file is damaged"
-                ))
-            })?;
+        let a = a.map_err(|e| broken_attribute(s.local_name().as_ref(), e, part))?;
         let key: &str = a.key.0;
         if key == "xmlns" || key.starts_with("xmlns:") {
             decls += 1;
+        }
+    }
+    Ok(decls)
+}
+
+/// The attributes of an element (namespace, local name, unescaped value), namespace
+/// declarations left out.
+#[allow(clippy::type_complexity)]
+fn attributes(
+    resolver: &quick_xml::name::NamespaceResolver,
+    s: &BytesStart,
+    local: &str,
+    part: &str,
+) -> Result<Vec<(String, String, String)>, Error> {
+    let mut attrs = Vec::new();
+    for a in s.attributes().with_checks(false) {
+        let a = a.map_err(|e| broken_attribute(local, e, part))?;
+        let key: &str = a.key.0;
+        if key == "xmlns" || key.starts_with("xmlns:") {
             continue;
         }
         let (ns, l) = resolver.resolve_attribute(a.key);
@@ -567,7 +699,7 @@ fn element(
             )));
         }
     }
-    Ok((local, attrs, decls))
+    Ok(attrs)
 }
 
 fn unit_scale(u: &str) -> Option<f64> {
@@ -586,11 +718,12 @@ fn number(v: &str, what: &str, part: &str) -> Result<f64, Error> {
     match v.trim().parse::<f64>() {
         Ok(x) if x.is_finite() => Ok(x),
         Ok(_) => Err(err(format!(
-            "the 3MF part '/{part}' has {what} that is not a finite number ('{v}'); the file is damaged — export it again"
+            "the 3MF part '/{part}' has {what} that is not a finite number ('{}'); the file is damaged — export it again",
+            quote(v)
         ))),
         Err(_) => Err(err(format!(
             "the 3MF part '/{part}' has {what} that is not a number ('{}'); the file is damaged",
-            v.chars().take(40).collect::<String>()
+            quote(v)
         ))),
     }
 }
@@ -604,7 +737,7 @@ fn index(v: Option<String>, what: &str, part: &str) -> Result<u32, Error> {
     v.trim().parse::<u32>().map_err(|_| {
         err(format!(
             "the 3MF part '/{part}' has {what} '{}' that is not a whole number ≥ 0; the file is damaged",
-            v.chars().take(40).collect::<String>()
+            quote(&v)
         ))
     })
 }
@@ -641,6 +774,18 @@ fn known_extension(ns: &str) -> bool {
         || ns == CORE_NS
 }
 
+/// The core elements whose children [`parse_model`] reads (everything else is skipped).
+const READ_INSIDE: [&str; 8] = [
+    "model",
+    "resources",
+    "object",
+    "mesh",
+    "vertices",
+    "triangles",
+    "components",
+    "build",
+];
+
 /// Parses one model part.
 fn parse_model(
     zip: &mut Zip,
@@ -661,8 +806,25 @@ fn parse_model(
     let mut saw_model = false;
     let is_core = |ns: &str| ns.is_empty() || ns == CORE_NS;
     let p = part;
-    while let Some(ev) = x.next(part)? {
-        let (ns, local, attrs, _empty) = match ev {
+    loop {
+        // Attributes are read only where they are used.
+        let want = |ns: &str, local: &str| {
+            let parent = path.last().map(String::as_str).unwrap_or("");
+            path.is_empty()
+                || parent == "resources"
+                || (is_core(ns)
+                    && matches!(
+                        (parent, local),
+                        ("vertices", "vertex")
+                            | ("triangles", "triangle")
+                            | ("components", "component")
+                            | ("build", "item")
+                    ))
+        };
+        let Some(ev) = x.next(part, want)? else {
+            break;
+        };
+        let (ns, local, attrs, empty) = match ev {
             XmlEvent::End => {
                 let closed = path.pop().unwrap_or_default();
                 if closed == "object"
@@ -688,14 +850,14 @@ fn parse_model(
                 let unit = attr(&attrs, "unit").unwrap_or_else(|| "millimeter".into());
                 scale = unit_scale(&unit).ok_or_else(|| {
                     err(format!(
-                        "the 3MF model's unit '{unit}' is unknown (micron, millimeter, centimeter, inch, foot and meter are); the file is damaged"
+                        "the 3MF model's unit '{}' is unknown (micron, millimeter, centimeter, inch, foot and meter are); the file is damaged",
+                        quote(&unit)
                     ))
                 })?;
                 if let Some(req) = attr(&attrs, "requiredextensions") {
                     for prefix in req.split_ascii_whitespace() {
                         let ns =
-                            x.r.resolver()
-                                .resolve_element(quick_xml::name::QName(&format!("{prefix}:x")))
+                            x.ns.resolve_element(quick_xml::name::QName(&format!("{prefix}:x")))
                                 .0;
                         let ns = match ns {
                             ResolveResult::Bound(n) => n.0.to_string(),
@@ -708,7 +870,8 @@ fn parse_model(
                         }
                         if !known_extension(&ns) {
                             return Err(err(format!(
-                                "the 3MF file requires the extension '{ns}', which dropslice does not read; export the model as plain 3MF (core), STL or OBJ"
+                                "the 3MF file requires the extension '{}', which dropslice does not read; export the model as plain 3MF (core), STL or OBJ",
+                                quote(&ns)
                             )));
                         }
                     }
@@ -716,7 +879,8 @@ fn parse_model(
             }
             (_, "model") | ("", _) if path.is_empty() => {
                 return Err(err(format!(
-                    "the 3MF part '/{p}' is not a 3D model (its root element is <{local}>, not <model>); the file is damaged"
+                    "the 3MF part '/{p}' is not a 3D model (its root element is <{}>, not <model>); the file is damaged",
+                    quote(&local)
                 )));
             }
             ("model", "resources") | ("model", "build") => {}
@@ -803,7 +967,8 @@ fn parse_model(
                     let c = (number(&s, "a vertex coordinate", p)? * scale) as f32;
                     if !c.is_finite() {
                         return Err(err(format!(
-                            "the 3MF part '/{p}' has a vertex coordinate too large for single precision ('{s}'); the file is damaged"
+                            "the 3MF part '/{p}' has a vertex coordinate too large for single precision ('{}'); the file is damaged",
+                            quote(&s)
                         )));
                     }
                     v[k] = c;
@@ -892,6 +1057,11 @@ fn parse_model(
                 });
             }
             _ => {}
+        }
+        // Nothing inside an element is read unless it is one whose children are: skip the rest.
+        if !empty && !READ_INSIDE.contains(&name.as_str()) {
+            x.skip(p)?;
+            continue;
         }
         path.push(name);
     }
@@ -1010,7 +1180,8 @@ fn lookup<'m>(
         .and_then(|m| m.objects.get(&id))
         .ok_or_else(|| {
             err(format!(
-                "{who} refers to object {id}, which the 3MF part '/{path}' does not define; the file is damaged — export it again"
+                "{who} refers to object {id}, which the 3MF part '/{}' does not define; the file is damaged — export it again",
+                quote(path)
             ))
         })
 }

@@ -1,0 +1,141 @@
+// Hostile model files in the page (issue 22): an OBJ whose face corners are separated by
+// vertical tabs (20 million + 1 triangles in one face: counted as tobj splits words, refused
+// before it is built) and a 3MF whose vertex has a 15-million-digit number (the message quotes
+// 80 characters of it). For each: a short banner within seconds, a page that keeps answering,
+// and a good model opens after. Inputs are made here, at run time.
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { crc32, deflateRawSync } from "node:zlib";
+import { pick, start, status, waitDone } from "./helpers.mjs";
+
+let env;
+
+before(async () => {
+  env = await start();
+});
+
+after(async () => {
+  await env?.close();
+});
+
+/** A ZIP archive of deflated entries ({ name, data }). */
+function zip(entries) {
+  const locals = [];
+  const central = [];
+  let offset = 0;
+  for (const { name, data } of entries) {
+    const packed = deflateRawSync(data);
+    const n = Buffer.from(name);
+    const head = Buffer.alloc(30);
+    head.writeUInt32LE(0x04034b50, 0);
+    head.writeUInt16LE(20, 4);
+    head.writeUInt16LE(8, 8);
+    head.writeUInt32LE(crc32(data), 14);
+    head.writeUInt32LE(packed.length, 18);
+    head.writeUInt32LE(data.length, 22);
+    head.writeUInt16LE(n.length, 26);
+    const dir = Buffer.alloc(46);
+    dir.writeUInt32LE(0x02014b50, 0);
+    dir.writeUInt16LE(20, 4);
+    dir.writeUInt16LE(20, 6);
+    dir.writeUInt16LE(8, 10);
+    dir.writeUInt32LE(crc32(data), 16);
+    dir.writeUInt32LE(packed.length, 20);
+    dir.writeUInt32LE(data.length, 24);
+    dir.writeUInt16LE(n.length, 28);
+    dir.writeUInt32LE(offset, 42);
+    locals.push(head, n, packed);
+    central.push(dir, n);
+    offset += head.length + n.length + packed.length;
+  }
+  const size = central.reduce((s, b) => s + b.length, 0);
+  const end = Buffer.alloc(22);
+  end.writeUInt32LE(0x06054b50, 0);
+  end.writeUInt16LE(entries.length, 8);
+  end.writeUInt16LE(entries.length, 10);
+  end.writeUInt32LE(size, 12);
+  end.writeUInt32LE(offset, 16);
+  return Buffer.concat([...locals, ...central, end]);
+}
+
+function verticalTabObj() {
+  const corners = 20_000_000 + 3;
+  const head = Buffer.from("v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+  const buf = Buffer.alloc(head.length + 2 * corners + 1);
+  head.copy(buf);
+  for (let k = 0; k < corners; k++) {
+    buf[head.length + 2 * k] = 0x0b;
+    buf[head.length + 2 * k + 1] = 0x31 + (k % 3);
+  }
+  buf[buf.length - 1] = 0x0a;
+  return buf;
+}
+
+function hugeAttribute3mf() {
+  const rels = `<?xml version="1.0"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>`;
+  const model = `<?xml version="1.0"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources><object id="1"><mesh><vertices><vertex x="${"9".repeat(15_000_000)}" y="0" z="0"/></vertices></mesh></object></resources><build><item objectid="1"/></build></model>`;
+  return zip([
+    { name: "_rels/.rels", data: Buffer.from(rels) },
+    { name: "3D/3dmodel.model", data: Buffer.from(model) },
+  ]);
+}
+
+/** The page answers page.evaluate within 2 s. */
+async function answers(page) {
+  const answer = await Promise.race([page.evaluate(() => 1), new Promise((ok) => setTimeout(() => ok("timeout"), 2000))]);
+  assert.equal(answer, 1, "the page did not answer within 2 s");
+}
+
+/** Waits, polling that the page answers, until it has settled; returns its status. */
+async function settle(page, timeout = 60_000) {
+  const t0 = Date.now();
+  for (;;) {
+    await answers(page);
+    const s = await status(page);
+    if (["done", "error", "cancelled"].includes(s.state)) return s;
+    if (Date.now() - t0 > timeout) assert.fail(`the page did not settle: ${JSON.stringify(s)}`);
+    await page.waitForTimeout(100);
+  }
+}
+
+const CASES = [
+  ["an OBJ face of 20 M triangles split by vertical tabs", "tabs.obj", verticalTabObj, /20000001 triangles/],
+  ["a 3MF vertex with a 15 MB number", "huge.3mf", hugeAttribute3mf, /not a finite number \('9{20,80}…'\)/],
+];
+
+test("hostile model files: a short banner within seconds, the page keeps answering", async () => {
+  const context = await env.browser.newContext({ viewport: { width: 1280, height: 800 } });
+  const page = await context.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  await page.goto(env.url);
+  await settle(page);
+  for (const [what, name, make, expected] of CASES) {
+    const buffer = make();
+    const t0 = Date.now();
+    await pick(page, { name, mimeType: "application/octet-stream", buffer });
+    // (Handing the page 40 MB through the test's browser connection takes seconds itself.)
+    const t1 = Date.now();
+    const s = await settle(page, 30_000);
+    const seconds = (Date.now() - t1) / 1000;
+    const handing = (t1 - t0) / 1000;
+    assert.equal(s.state, "error", `${what}: ${JSON.stringify(s)}`);
+    const text = await page.locator("#banner-message").innerText();
+    assert.match(text, expected, `${what}: ${text.slice(0, 300)}`);
+    assert.ok(text.length < 600, `${what}: the banner holds ${text.length} characters`);
+    for (let i = 0; i < 3; i++) {
+      await answers(page);
+      await page.waitForTimeout(100);
+    }
+    console.log(`# ${what} (${(buffer.length / 1e6).toFixed(1)} MB, handed over in ${handing.toFixed(1)} s): refused in ${seconds.toFixed(1)} s, banner ${text.length} characters`);
+  }
+  // A good model still opens.
+  await pick(page, {
+    name: "cube.obj",
+    mimeType: "text/plain",
+    buffer: Buffer.from("v 0 0 0\nv 10 0 0\nv 10 10 0\nv 0 10 0\nv 0 0 10\nv 10 0 10\nv 10 10 10\nv 0 10 10\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"),
+  });
+  await waitDone(page, 60_000);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
