@@ -15,6 +15,7 @@
 //! time, so memory stays bounded however tall the part is.
 
 pub mod analysis;
+pub mod budget;
 pub mod calibrate;
 pub mod contours;
 pub mod droplets;
@@ -306,7 +307,13 @@ impl Job {
         let duplicates = kept.iter().filter(|&&k| !k).count();
         keep_groups(&mut groups, &kept);
         let shells = mesh.orient_shells();
-        check_volume(&mesh, &shells, &size, &settings)?;
+        let volume = check_volume(&mesh, &shells, &size)?;
+        // One droplet estimate for the whole job: every unit and the support.
+        let unit1 = budget::Unit1Parts::of(&mesh, &groups);
+        let open = shells.open > 0;
+        let mut estimate =
+            budget::Estimate::new(volume, unit1, open, &size, &input.instances, &settings);
+        estimate.check(&settings)?;
         let zs = plane_heights(&size, &settings)?;
         let (mesh, buckets, stats) = repair(
             mesh,
@@ -321,7 +328,8 @@ impl Job {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
             let h = settings.layer_height;
-            check_droplets(sampled_volume(&mesh, &buckets, &zs, h), &settings)?;
+            estimate.unit0_volume = sampled_volume(&mesh, &buckets, &zs, h);
+            estimate.check(&settings)?;
         }
         let mut all_warnings = input.warnings;
         all_warnings.extend(warnings(&stats, &size));
@@ -762,13 +770,13 @@ fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), Error> {
     Ok(())
 }
 
-/// Checks: the mesh encloses a volume, and not one of too many droplets.
+/// Checks: the mesh encloses a volume; returns it (its droplets are checked by
+/// [`budget::Estimate::check`]).
 fn check_volume(
     mesh: &Mesh,
     shells: &mesh::ShellOrientation,
     size: &[f64; 3],
-    settings: &Settings,
-) -> Result<(), Error> {
+) -> Result<f64, Error> {
     let volume = mesh.signed_volume().abs().max(shells.closed_volume);
     if size[0] <= 0.0 || size[1] <= 0.0 || volume <= 1e-9 * size[0] * size[1] * size[2] {
         return Err(Error::NothingToPrint(
@@ -776,7 +784,7 @@ fn check_volume(
                 .into(),
         ));
     }
-    check_droplets(volume, settings)
+    Ok(volume)
 }
 
 /// Checks the width in droplets; the plane heights of the layers (at least one).
@@ -864,7 +872,8 @@ fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
         return Err(Error::Setting {
             name: "layer_height".into(),
             message: format!(
-                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of {b:.4} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height) or check the scale"
+                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of unit 0's B = {} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height, droplet_aspect) or check the scale",
+                budget::mm(b)
             ),
         });
     }
