@@ -209,9 +209,12 @@ impl Estimate {
             let per_layer = p0 + p1;
             if !(per_layer <= MAX_LAYER_DROPLETS_WITH_SUPPORT) {
                 let (name, what) = if p0 >= p1 {
-                    ("droplet_aspect", format!("B = {} mm", mm(b0)))
+                    ("droplet_aspect", format!("unit 0's B = {} mm", mm(b0)))
                 } else {
-                    ("unit1_droplet_aspect", format!("B₁ = {} mm", mm(b1)))
+                    (
+                        "unit1_droplet_aspect",
+                        format!("unit 1's B₁ = {} mm", mm(b1)),
+                    )
                 };
                 return Err(Error::Setting {
                     name: name.into(),
