@@ -4,7 +4,8 @@
 //! bound of its region, each against [`MAX_DROPLETS`] in all; the width of unit 1's region in
 //! droplets of B₁ against [`MAX_WIDTH_IN_DROPLETS`]; and with support on, the droplets one
 //! layer can hold against [`MAX_LAYER_DROPLETS_WITH_SUPPORT`] (the support's droplet-level
-//! pass lists a layer's droplets at once). docs/security.md *Droplet budget*.
+//! pass lists a layer's droplets at once) and the whole job against
+//! [`MAX_DROPLETS_WITH_SUPPORT`] (the pass checks every droplet). docs/security.md *Droplet budget*.
 
 use crate::job::Instance;
 use crate::mesh::Mesh;
@@ -15,6 +16,11 @@ use crate::{Error, FacetGroup, MAX_DROPLETS, MAX_WIDTH_IN_DROPLETS};
 /// ([`crate::support_droplets::complete`]) lists a layer's droplets and sorts them into a grid,
 /// about 50 bytes each (0.5 GB per worker at this limit).
 pub const MAX_LAYER_DROPLETS_WITH_SUPPORT: f64 = 1e7;
+
+/// Most droplets a job with support on may have (every unit and the support): the support's
+/// droplet-level pass checks every droplet of the job against the layer below (about 10 s per
+/// 10⁸ droplets natively, more in the page, where each worker runs it).
+pub const MAX_DROPLETS_WITH_SUPPORT: f64 = 1e8;
 
 /// The facets unit 1 prints (its parts): their signed volume and bounding box.
 #[derive(Clone, Copy, Debug)]
@@ -44,9 +50,9 @@ impl Unit1Parts {
                         + a[2] * (b[0] * c[1] - b[1] * c[0]))
                         / 6.0;
                     for p in [a, b, c] {
-                        for k in 0..3 {
-                            out.min[k] = out.min[k].min(p[k]);
-                            out.max[k] = out.max[k].max(p[k]);
+                        for ((lo, hi), x) in out.min.iter_mut().zip(&mut out.max).zip(p) {
+                            *lo = lo.min(x);
+                            *hi = hi.max(x);
                         }
                     }
                     any = true;
@@ -163,8 +169,8 @@ impl Estimate {
         };
         let total = d0 + d1 + ds;
         let [x, y, z] = self.size;
-        if !(total <= MAX_DROPLETS) {
-            let (name, message) = if !(d1 <= ds) && self.unit1_volume > 0.0 {
+        if over(total, MAX_DROPLETS) {
+            let (name, message) = if over(d1, ds) && self.unit1_volume > 0.0 {
                 (
                     "unit1_droplet_aspect",
                     format!(
@@ -187,9 +193,33 @@ impl Estimate {
                 message,
             });
         }
+        if support && over(total, MAX_DROPLETS_WITH_SUPPORT) {
+            let (name, what) = if d0 >= d1.max(ds) {
+                (
+                    "droplet_aspect",
+                    format!("{d0:.1e} of unit 0's B = {} mm", mm(b0)),
+                )
+            } else if d1 >= ds {
+                (
+                    "unit1_droplet_aspect",
+                    format!("{d1:.1e} of unit 1's parts, B₁ = {} mm", mm(b1)),
+                )
+            } else {
+                (
+                    "unit1_droplet_aspect",
+                    format!("up to {ds:.1e} of support, B₁ = {} mm", mm(b1)),
+                )
+            };
+            return Err(Error::Setting {
+                name: name.into(),
+                message: format!(
+                    "with support the job could take up to {total:.1e} droplets ({what}), more than the {MAX_DROPLETS_WITH_SUPPORT:.0e} the support's check of every droplet allows; raise {name} (or layer_height), or set support = off"
+                ),
+            });
+        }
         let used = support || self.unit1_volume > 0.0;
         let lines = self.unit1_extent / b1;
-        if used && !(lines <= MAX_WIDTH_IN_DROPLETS) {
+        if used && over(lines, MAX_WIDTH_IN_DROPLETS) {
             return Err(Error::Setting {
                 name: "unit1_droplet_aspect".into(),
                 message: format!(
@@ -207,7 +237,7 @@ impl Estimate {
             let p1 = a * (s.support_density + if self.unit1_volume > 0.0 { 1.0 } else { 0.0 })
                 / (b1 * b1);
             let per_layer = p0 + p1;
-            if !(per_layer <= MAX_LAYER_DROPLETS_WITH_SUPPORT) {
+            if over(per_layer, MAX_LAYER_DROPLETS_WITH_SUPPORT) {
                 let (name, what) = if p0 >= p1 {
                     ("droplet_aspect", format!("unit 0's B = {} mm", mm(b0)))
                 } else {
@@ -228,11 +258,84 @@ impl Estimate {
     }
 }
 
+/// Whether `x` is beyond `limit` (or not a number).
+fn over(x: f64, limit: f64) -> bool {
+    x.is_nan() || x > limit
+}
+
 /// A droplet width for a message: 4 decimals, or 2 significant digits below a micrometre.
 pub fn mm(x: f64) -> String {
     if x >= 1e-3 {
         format!("{x:.4}")
     } else {
         format!("{x:.1e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn setting(r: Result<(), Error>) -> String {
+        match r {
+            Err(Error::Setting { name, .. }) => name,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn each_unit_and_the_support_count_with_their_own_droplets() {
+        let size = [20.0, 20.0, 20.0];
+        let s = Settings::default();
+        // The 20 mm cube by unit 0, with and without support: well within every limit.
+        let e = Estimate::new(8000.0, None, false, &size, &[], &s);
+        assert!(e.check(&s).is_ok());
+        let on = Settings {
+            support: Support::Unit1,
+            ..s.clone()
+        };
+        assert!(
+            Estimate::new(8000.0, None, false, &size, &[], &on)
+                .check(&on)
+                .is_ok()
+        );
+        // A tiny B₁ does not matter without unit 1, and is refused for the support with it.
+        let tiny = Settings {
+            unit1_droplet_aspect: 1e-3,
+            ..s.clone()
+        };
+        assert!(e.check(&tiny).is_ok());
+        let tiny_on = Settings {
+            support: Support::Unit1,
+            ..tiny.clone()
+        };
+        let e = Estimate::new(8000.0, None, false, &size, &[], &tiny_on);
+        assert_eq!(setting(e.check(&tiny_on)), "support");
+        // A unit-1 part of the whole cube: its droplets are of B₁.
+        let cube = Unit1Parts {
+            signed_volume: 8000.0,
+            min: [0.0; 3],
+            max: size,
+        };
+        let e = Estimate::new(8000.0, Some(cube), false, &size, &[], &tiny);
+        assert_eq!(e.unit0_volume, 0.0);
+        assert_eq!(setting(e.check(&tiny)), "unit1_droplet_aspect");
+        assert!(e.check(&s).is_ok());
+        // A small unit-0 B: fine alone, too many for the support's pass.
+        let small = Settings {
+            droplet_aspect: 0.1,
+            ..s.clone()
+        };
+        let small_on = Settings {
+            support: Support::Unit1,
+            ..small.clone()
+        };
+        assert!(
+            Estimate::new(8000.0, None, false, &size, &[], &small)
+                .check(&small)
+                .is_ok()
+        );
+        let e = Estimate::new(8000.0, None, false, &size, &[], &small_on);
+        assert_eq!(setting(e.check(&small_on)), "droplet_aspect");
     }
 }

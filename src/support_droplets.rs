@@ -57,18 +57,25 @@ impl Grid {
 
     /// The grid of `droplets` in place of this one's (its buffers reused).
     fn fill(&mut self, cell: f64, droplets: &[Droplet]) {
+        self.fill_where(cell, droplets, |_| true);
+    }
+
+    /// The grid of the droplets `keep` accepts in place of this one's.
+    fn fill_where(&mut self, cell: f64, droplets: &[Droplet], keep: impl Fn(&Droplet) -> bool) {
         let mut min = DVec2::INFINITY;
         let mut max = DVec2::NEG_INFINITY;
-        for (p, _) in droplets {
-            min = min.min(*p);
-            max = max.max(*p);
+        let mut count = 0usize;
+        for d in droplets.iter().filter(|d| keep(d)) {
+            min = min.min(d.0);
+            max = max.max(d.0);
+            count += 1;
         }
-        if droplets.is_empty() {
+        if count == 0 {
             (min, max) = (DVec2::ZERO, DVec2::ZERO);
         }
         // About one cell per droplet at most, however large the layer: memory stays
         // proportional to the droplets (larger cells still hold every droplet within reach).
-        let spread = ((max.x - min.x) * (max.y - min.y) / droplets.len().max(1) as f64).sqrt();
+        let spread = ((max.x - min.x) * (max.y - min.y) / count.max(1) as f64).sqrt();
         self.cell = cell.max(spread);
         self.min = min;
         self.nx = ((max.x - min.x) / self.cell).floor() as i64 + 1;
@@ -77,10 +84,10 @@ impl Grid {
         self.offsets.clear();
         self.offsets.resize((nx * self.ny) as usize + 1, 0);
         self.items.clear();
-        self.items.resize(droplets.len(), (DVec2::ZERO, 0.0));
+        self.items.resize(count, (DVec2::ZERO, 0.0));
         let mut keys = std::mem::take(&mut self.keys);
         keys.clear();
-        keys.extend(droplets.iter().map(|(p, _)| {
+        keys.extend(droplets.iter().filter(|d| keep(d)).map(|(p, _)| {
             let (x, y) = self.key(*p);
             (y * nx + x) as u32
         }));
@@ -92,7 +99,7 @@ impl Grid {
         }
         // Each cell's droplets in their order, filled from the cell's start (moved along as
         // they are placed, then moved back).
-        for (d, &k) in droplets.iter().zip(&keys) {
+        for (d, &k) in droplets.iter().filter(|d| keep(d)).zip(&keys) {
             let slot = &mut self.offsets[k as usize];
             self.items[*slot as usize] = *d;
             *slot += 1;
@@ -150,8 +157,6 @@ impl Grid {
 /// every query). The answer is the same either way.
 struct Below {
     grids: Vec<Grid>,
-    /// The droplets of width `narrow` (and of `wide`), while filled.
-    parts: [Vec<Droplet>; 2],
     narrow: f64,
     wide: f64,
 }
@@ -167,7 +172,6 @@ impl Below {
         };
         let mut below = Below {
             grids,
-            parts: [Vec::new(), Vec::new()],
             narrow,
             wide,
         };
@@ -181,24 +185,14 @@ impl Below {
             self.grids[0].fill(reach(self.wide), droplets);
             return;
         }
-        let [narrow, wide] = &mut self.parts;
-        narrow.clear();
-        wide.clear();
-        for &d in droplets {
-            // Each grid's cells are at least the reach of every droplet in it.
-            if d.1 <= self.narrow {
-                narrow.push(d);
-            } else {
-                wide.push(d);
-            }
-        }
-        let cells = [
-            reach(self.narrow),
-            wide.iter().fold(reach(self.wide), |c, d| c.max(reach(d.1))),
-        ];
-        for ((g, part), cell) in self.grids.iter_mut().zip(&self.parts).zip(cells) {
-            g.fill(cell, part);
-        }
+        // Each grid's cells are at least the reach of every droplet in it.
+        let narrow = self.narrow;
+        let wide = droplets
+            .iter()
+            .filter(|d| d.1 > narrow)
+            .fold(reach(self.wide), |c, d| c.max(reach(d.1)));
+        self.grids[0].fill_where(reach(narrow), droplets, |d| d.1 <= narrow);
+        self.grids[1].fill_where(wide, droplets, |d| d.1 > narrow);
     }
 
     /// A droplet d within `reach(d's width)` of `p`, if any.
