@@ -27,6 +27,8 @@ enum Input {
     Named(&'static str, Vec<u8>),
     /// A path given as the model as it is; `{dir}` is replaced by the row's temp directory.
     Path(&'static str),
+    /// A job file (`job.json`, this text) beside the 20 mm cube as `cube.stl`.
+    Job(String),
 }
 
 struct Row {
@@ -40,6 +42,8 @@ struct Row {
     keywords: Vec<String>,
     /// Creates a FIFO `fifo` in the row's directory (nothing ever writes to it).
     fifo: bool,
+    /// ... and all of these (case-insensitive).
+    all: Vec<String>,
 }
 
 /// Most bytes of stderr of any row (messages are bounded: `dropslice::base::error`).
@@ -55,6 +59,7 @@ fn row(name: impl Into<String>, input: Input, keywords: &[&str]) -> Row {
         settings_json: None,
         keywords: keywords.iter().map(|s| s.to_string()).collect(),
         fifo: false,
+        all: Vec::new(),
     }
 }
 
@@ -310,6 +315,7 @@ fn rows() -> Vec<Row> {
         Input::Directory,
         &["cannot open", "directory"],
     ));
+    rows.extend(budget_rows());
 
     // Every number setting out of range, NaN, infinite, not a number.
     for spec in schema() {
@@ -428,6 +434,75 @@ fn rows() -> Vec<Row> {
     rows
 }
 
+/// The droplet estimate counts every unit and the support (issue 22): each row would otherwise
+/// run for minutes or exhaust memory. The message names the unit and the setting to change.
+fn budget_rows() -> Vec<Row> {
+    let mut rows = Vec::new();
+    for aspect in ["0.001", "1e-6"] {
+        let mut r = row(
+            format!("a unit-1 part with unit1_droplet_aspect {aspect}"),
+            Input::Job(format!(
+                r#"{{"settings": {{"unit1_droplet_aspect": {aspect}}}, "parts": [{{"file": "cube.stl", "unit": 1}}]}}"#
+            )),
+            &["droplets"],
+        );
+        r.all = vec!["unit 1".into(), "raise unit1_droplet_aspect".into()];
+        rows.push(r);
+        // The same by `--set` on a job that asks for nothing unusual.
+        let mut r = row(
+            format!("a unit-1 part, --set unit1_droplet_aspect={aspect}"),
+            Input::Job(
+                r#"{"parts": [{"file": "cube.stl"}, {"file": "cube.stl", "unit": 1}]}"#.into(),
+            ),
+            &["droplets"],
+        );
+        r.args = vec!["--set".into(), format!("unit1_droplet_aspect={aspect}")];
+        r.all = vec!["unit 1".into(), "raise unit1_droplet_aspect".into()];
+        rows.push(r);
+        // Support is printed by unit 1: with a tiny B₁ its droplets are counted too.
+        let mut r = setting_row(
+            format!("support on, unit1_droplet_aspect={aspect}"),
+            "support=unit1".into(),
+            &["droplets"],
+        );
+        r.args
+            .extend(["--set".into(), format!("unit1_droplet_aspect={aspect}")]);
+        r.all = vec![
+            "bad setting support".into(),
+            "B₁".into(),
+            "raise unit1_droplet_aspect".into(),
+            "support = off".into(),
+        ];
+        rows.push(r);
+    }
+    // A small unit-0 B that is fine without support (1.6e9 droplets at most): with support the
+    // pass would list up to 1.7e7 droplets of a layer at once.
+    let mut r = setting_row(
+        "support on, droplet_aspect=0.025",
+        "support=unit1".into(),
+        &["droplets"],
+    );
+    r.args
+        .extend(["--set".into(), "droplet_aspect=0.025".into()]);
+    r.all = vec![
+        "bad setting droplet_aspect".into(),
+        "unit 0".into(),
+        "support = off".into(),
+    ];
+    rows.push(r);
+    // Far too small a unit-0 B: refused by unit 0's own count, support or not.
+    let mut r = setting_row(
+        "support on, droplet_aspect=0.001",
+        "support=unit1".into(),
+        &["droplets"],
+    );
+    r.args
+        .extend(["--set".into(), "droplet_aspect=0.001".into()]);
+    r.all = vec!["unit 0".into(), "droplet_aspect".into()];
+    rows.push(r);
+    rows
+}
+
 /// Settings-file regressions (fixed in 2e4b1c7): a JSON array was read as the struct's fields
 /// in order (layer_height = 1, droplet_aspect = 2, contours = 3; exit 0), and a negative
 /// `contours` gave serde's "invalid value: integer `-1`, expected u32" without the name.
@@ -491,6 +566,12 @@ fn check_row_within(r: &Row, max_stderr: usize) -> Result<(), String> {
                 std::fs::create_dir(dir.join("a_folder.stl")).unwrap();
                 dir.join("a_folder.stl")
             }
+            Input::Job(text) => {
+                let cube = common::model_bytes("cube_20mm_ascii.stl");
+                std::fs::write(dir.join("cube.stl"), cube).unwrap();
+                std::fs::write(dir.join("job.json"), text).unwrap();
+                dir.join("job.json")
+            }
         };
         if let Some(j) = &r.settings_json {
             std::fs::write(dir.join("settings.json"), j).unwrap();
@@ -544,6 +625,9 @@ fn check_row_within(r: &Row, max_stderr: usize) -> Result<(), String> {
             ));
         }
         let msg = errors[0].to_lowercase();
+        if let Some(k) = r.all.iter().find(|k| !msg.contains(&k.to_lowercase())) {
+            return Err(format!("the message does not say {k:?}: {}", ctx()));
+        }
         if !r.keywords.iter().any(|k| msg.contains(&k.to_lowercase())) {
             return Err(format!(
                 "the message does not name the problem (none of {:?}): {}",

@@ -164,6 +164,15 @@ fn random_settings(rng: &mut Rng) -> Settings {
     s.scale_x = s.scale_x.clamp(0.2, 2.0);
     s.scale_y = s.scale_y.clamp(0.2, 2.0);
     s.scale_z = s.scale_z.clamp(0.2, 2.0);
+    // Droplet bombs of unit 1 and the support (issue 22): a tiny B₁ or B with support on must
+    // be refused by the job's droplet estimate (or stay small), never run for minutes.
+    if rng.pick(10) == 0 {
+        s.support = dropslice::base::settings::Support::Unit1;
+        match rng.pick(2) {
+            0 => s.unit1_droplet_aspect = 1e-6,
+            _ => s.droplet_aspect = 1e-3,
+        }
+    }
     if s.validate().is_err() {
         return Settings::default();
     }

@@ -695,8 +695,12 @@ impl Settings {
             (Kind::Integer | Kind::Number, _) => return Err(bad("a finite number".into())),
         };
         map[name] = value;
-        *self = serde_json::from_value(map)
-            .map_err(|e| bad(format!("allowed: {}", crate::base::error::quote(&e.to_string()))))?;
+        *self = serde_json::from_value(map).map_err(|e| {
+            bad(format!(
+                "allowed: {}",
+                crate::base::error::quote(&e.to_string())
+            ))
+        })?;
         Ok(())
     }
 

@@ -792,8 +792,12 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
             }
             // Any path is read, also outside the job file's folder (docs/security.md).
             let file = dir.join(&p.file);
-            let bytes = read_regular(&file, dropslice::model::import::MAX_FILE_BYTES, "a model file")
-                .map_err(|e| Error::Import(format!("parts[{i}].file: {e} (named in {shown})")))?;
+            let bytes = read_regular(
+                &file,
+                dropslice::model::import::MAX_FILE_BYTES,
+                "a model file",
+            )
+            .map_err(|e| Error::Import(format!("parts[{i}].file: {e} (named in {shown})")))?;
             models.push(Model::read(&bytes, &p.file).map_err(|e| named(&p.file, e))?);
         }
         Job::from_models(&models, &spec).map_err(in_file)

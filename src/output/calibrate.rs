@@ -14,8 +14,8 @@
 //! what to check.
 
 use crate::base::error::number;
-use crate::output::gcode_read::GcodeReader;
 use crate::base::settings::{Settings, schema};
+use crate::output::gcode_read::GcodeReader;
 use serde::Serialize;
 
 /// Filling degrees outside this range are refused as impossible (a droplet holding a fifth of

@@ -13,7 +13,7 @@ use crate::model::prepare::{
     close_cracks, import, keep_groups, suggested_scale, warnings,
 };
 use crate::model::spec as job;
-use crate::pipeline::Job;
+use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
 
 /// Most droplets a job may set (volume / B²H): beyond this the code would not fit on a disk.
@@ -180,7 +180,13 @@ impl Job {
         let (mesh_shells, weld) = close_cracks(&mut mesh, &mut groups);
         let shells = mesh.orient(&mesh_shells);
         drop(mesh_shells);
-        check_droplets(check_volume(&mesh, &shells, &size)?, &settings)?;
+        let volume = check_volume(&mesh, &shells, &size)?;
+        // One droplet estimate for the whole job: every unit and the support.
+        let unit1 = budget::Unit1Parts::of(&mesh, &groups);
+        let open = shells.open > 0;
+        let mut estimate =
+            budget::Estimate::new(volume, unit1, open, &size, &input.instances, &settings);
+        estimate.check(&settings)?;
         let zs = plane_heights(&size, &settings)?;
         let (mesh, buckets, stats) = repair(
             mesh,
@@ -195,7 +201,8 @@ impl Job {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
             let h = settings.layer_height;
-            check_droplets(sampled_volume(&mesh, &buckets, &zs, h), &settings)?;
+            estimate.unit0_volume = sampled_volume(&mesh, &buckets, &zs, h);
+            estimate.check(&settings)?;
         }
         let mut all_warnings = input.warnings;
         all_warnings.extend(warnings(&stats, &size));
@@ -341,14 +348,15 @@ fn repair(
 }
 
 /// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
-fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
+pub(crate) fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
     let b = settings.droplet_width();
     let droplets = volume / (b * b * settings.layer_height);
     if droplets > MAX_DROPLETS || !droplets.is_finite() {
         return Err(Error::Setting {
             name: "layer_height".into(),
             message: format!(
-                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of {b:.4} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height) or check the scale"
+                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of unit 0's B = {} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height, droplet_aspect) or check the scale",
+                budget::mm(b)
             ),
         });
     }

@@ -1,12 +1,14 @@
 //! The job: building it from models, planning its layers (both units, the support), and the
 //! native layer writer.
 
+mod budget;
 mod build;
 mod job;
 mod supported;
 #[cfg(not(target_arch = "wasm32"))]
 mod writer;
 
+pub use budget::{MAX_DROPLETS_WITH_SUPPORT, MAX_LAYER_DROPLETS_WITH_SUPPORT};
 pub use build::MAX_DROPLETS;
 pub use job::Job;
 pub use supported::SupportedPlans;

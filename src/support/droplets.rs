@@ -59,18 +59,25 @@ impl Grid {
 
     /// The grid of `droplets` in place of this one's (its buffers reused).
     fn fill(&mut self, cell: f64, droplets: &[Droplet]) {
+        self.fill_where(cell, droplets, |_| true);
+    }
+
+    /// The grid of the droplets `keep` accepts in place of this one's.
+    fn fill_where(&mut self, cell: f64, droplets: &[Droplet], keep: impl Fn(&Droplet) -> bool) {
         let mut min = DVec2::INFINITY;
         let mut max = DVec2::NEG_INFINITY;
-        for (p, _) in droplets {
-            min = min.min(*p);
-            max = max.max(*p);
+        let mut count = 0usize;
+        for d in droplets.iter().filter(|d| keep(d)) {
+            min = min.min(d.0);
+            max = max.max(d.0);
+            count += 1;
         }
-        if droplets.is_empty() {
+        if count == 0 {
             (min, max) = (DVec2::ZERO, DVec2::ZERO);
         }
         // About one cell per droplet at most, however large the layer: memory stays
         // proportional to the droplets (larger cells still hold every droplet within reach).
-        let spread = ((max.x - min.x) * (max.y - min.y) / droplets.len().max(1) as f64).sqrt();
+        let spread = ((max.x - min.x) * (max.y - min.y) / count.max(1) as f64).sqrt();
         self.cell = cell.max(spread);
         self.min = min;
         self.nx = ((max.x - min.x) / self.cell).floor() as i64 + 1;
@@ -79,10 +86,10 @@ impl Grid {
         self.offsets.clear();
         self.offsets.resize((nx * self.ny) as usize + 1, 0);
         self.items.clear();
-        self.items.resize(droplets.len(), (DVec2::ZERO, 0.0));
+        self.items.resize(count, (DVec2::ZERO, 0.0));
         let mut keys = std::mem::take(&mut self.keys);
         keys.clear();
-        keys.extend(droplets.iter().map(|(p, _)| {
+        keys.extend(droplets.iter().filter(|d| keep(d)).map(|(p, _)| {
             let (x, y) = self.key(*p);
             (y * nx + x) as u32
         }));
@@ -94,7 +101,7 @@ impl Grid {
         }
         // Each cell's droplets in their order, filled from the cell's start (moved along as
         // they are placed, then moved back).
-        for (d, &k) in droplets.iter().zip(&keys) {
+        for (d, &k) in droplets.iter().filter(|d| keep(d)).zip(&keys) {
             let slot = &mut self.offsets[k as usize];
             self.items[*slot as usize] = *d;
             *slot += 1;
@@ -111,11 +118,6 @@ impl Grid {
             floor((p.x - self.min.x) / self.cell),
             floor((p.y - self.min.y) / self.cell),
         )
-    }
-
-    /// Whether some droplet d lies within `reach(d's width)` of `p` (reach ≤ the cell).
-    fn any_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> bool {
-        self.find_within(p, reach).is_some()
     }
 
     /// A droplet d within `reach(d's width)` of `p` (reach ≤ the cell), if any.
@@ -148,6 +150,56 @@ impl Grid {
             }
         }
         None
+    }
+}
+
+/// A layer's droplets for "is there one within reach": one [`Grid`] when B and B₁ differ by at
+/// most twice, else one grid per width, each in cells of its own reach (in one grid with cells
+/// of the wider droplets' reach, each cell would hold (B₁/B)² of the narrow ones, all scanned by
+/// every query). The answer is the same either way.
+struct Below {
+    grids: Vec<Grid>,
+    narrow: f64,
+    wide: f64,
+}
+
+impl Below {
+    fn new(b: f64, b1: f64, reach: impl Fn(f64) -> f64, droplets: &[Droplet]) -> Below {
+        let (narrow, wide) = (b.min(b1), b.max(b1));
+        let split = wide > 2.0 * narrow;
+        let grids = if split {
+            vec![Grid::new(reach(narrow), &[]), Grid::new(reach(wide), &[])]
+        } else {
+            vec![Grid::new(reach(wide), &[])]
+        };
+        let mut below = Below {
+            grids,
+            narrow,
+            wide,
+        };
+        below.fill(&reach, droplets);
+        below
+    }
+
+    /// The index of `droplets` in place of this one's (its buffers reused).
+    fn fill(&mut self, reach: impl Fn(f64) -> f64, droplets: &[Droplet]) {
+        if self.grids.len() == 1 {
+            self.grids[0].fill(reach(self.wide), droplets);
+            return;
+        }
+        // Each grid's cells are at least the reach of every droplet in it.
+        let narrow = self.narrow;
+        let wide = droplets
+            .iter()
+            .filter(|d| d.1 > narrow)
+            .fold(reach(self.wide), |c, d| c.max(reach(d.1)));
+        self.grids[0].fill_where(reach(narrow), droplets, |d| d.1 <= narrow);
+        self.grids[1].fill_where(wide, droplets, |d| d.1 > narrow);
+    }
+
+    /// A droplet d within `reach(d's width)` of `p`, if any.
+    fn find_within(&self, p: Point, reach: impl Fn(f64) -> f64) -> Option<Droplet> {
+        self.grids.iter().find_map(|g| g.find_within(p, &reach))
     }
 }
 
@@ -446,6 +498,112 @@ impl<'a> LineGaps<'a> {
     }
 }
 
+/// `points` in the order of a greedy walk from `from`: each time the nearest point left (by
+/// [`dist`]; of equal ones, the first in a list the walk takes points from by `swap_remove`).
+/// The same order as the plain scan of every point left at every step, found in a grid of
+/// cells around the walk's place (a layer may get hundreds of thousands of added droplets).
+pub fn nearest_first(points: &[Point], from: Point) -> Vec<Point> {
+    let n = points.len();
+    let mut out = Vec::with_capacity(n);
+    if n <= 64 {
+        let mut left = points.to_vec();
+        let mut at = from;
+        while !left.is_empty() {
+            let next = (0..left.len())
+                .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
+                .expect("non-empty");
+            at = left.swap_remove(next);
+            out.push(at);
+        }
+        return out;
+    }
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for p in points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let size = hi - lo;
+    // About two points per cell.
+    let cell = (size.x * size.y * 2.0 / n as f64)
+        .sqrt()
+        .max(size.x.max(size.y) / 4096.0)
+        .max(1e-9);
+    let nx = (size.x / cell).floor() as i64 + 1;
+    let ny = (size.y / cell).floor() as i64 + 1;
+    let key = |p: Point| (floor((p.x - lo.x) / cell), floor((p.y - lo.y) / cell));
+    let mut cells: Vec<Vec<u32>> = vec![Vec::new(); (nx * ny) as usize];
+    for (i, p) in points.iter().enumerate() {
+        let (x, y) = key(*p);
+        cells[(y.clamp(0, ny - 1) * nx + x.clamp(0, nx - 1)) as usize].push(i as u32);
+    }
+    // The list the plain scan would hold: slot → point, point → slot.
+    let mut slots: Vec<u32> = (0..n as u32).collect();
+    let mut slot_of: Vec<u32> = (0..n as u32).collect();
+    let mut at = from;
+    for _ in 0..n {
+        let (cx, cy) = key(at);
+        // Rings of cells around at's cell (which may lie outside the grid), from the first
+        // that meets the grid; a point of ring r + 1 lies at least r cells away.
+        let gap = |c: i64, hi: i64| if c < 0 { -c } else { (c - hi + 1).max(0) };
+        let first = gap(cx, nx).max(gap(cy, ny));
+        let last = (cx.max(nx - 1 - cx)).max(cy.max(ny - 1 - cy)).max(first);
+        let mut best: Option<(f64, u32, u32)> = None;
+        let mut r = first;
+        while r <= last {
+            let mut visit = |x: i64, y: i64| {
+                if x < 0 || y < 0 || x >= nx || y >= ny {
+                    return;
+                }
+                for &i in &cells[(y * nx + x) as usize] {
+                    let d = dist(at, points[i as usize]);
+                    let slot = slot_of[i as usize];
+                    let better = match best {
+                        None => true,
+                        Some((bd, bs, _)) => d.total_cmp(&bd).then(slot.cmp(&bs)).is_lt(),
+                    };
+                    if better {
+                        best = Some((d, slot, i));
+                    }
+                }
+            };
+            if r == 0 {
+                visit(cx, cy);
+            } else {
+                for x in (cx - r).max(-1)..=(cx + r).min(nx) {
+                    visit(x, cy - r);
+                    visit(x, cy + r);
+                }
+                for y in (cy - r + 1).max(-1)..=(cy + r - 1).min(ny) {
+                    visit(cx - r, y);
+                    visit(cx + r, y);
+                }
+            }
+            // Points of the rings beyond lie more than r cells away (less a margin for
+            // rounding): stop when the best is nearer.
+            if let Some((d, _, _)) = best
+                && d < (r as f64 * cell) * (1.0 - 1e-9) - 1e-12
+            {
+                break;
+            }
+            r += 1;
+        }
+        let (_, slot, i) = best.expect("a point is left");
+        // swap_remove of the plain scan's list.
+        let last_point = *slots.last().expect("non-empty");
+        slots.swap_remove(slot as usize);
+        if (slot as usize) < slots.len() {
+            slot_of[last_point as usize] = slot;
+        }
+        let p = points[i as usize];
+        let (x, y) = key(p);
+        let c = &mut cells[(y.clamp(0, ny - 1) * nx + x.clamp(0, nx - 1)) as usize];
+        c.retain(|&j| j != i);
+        out.push(p);
+        at = p;
+    }
+    out
+}
+
 /// Candidate places for a support droplet under `c`: c itself, then rings around it out to
 /// `r` (nearest first).
 fn candidates(c: Point, r: f64) -> impl Iterator<Item = Point> {
@@ -500,7 +658,7 @@ pub fn complete(
         let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
         let mut buf = Vec::new();
         droplets(first - 1, None, &mut buf);
-        let mut below = Grid::new(cell, &buf);
+        let mut below = Below::new(b, b1, reach, &buf);
         let mut out = Vec::with_capacity(end - first);
         for i in first..end {
             buf.clear();
@@ -523,7 +681,7 @@ pub fn complete(
             }
             out.push(open);
             if i + 1 < end {
-                below.fill(cell, &buf);
+                below.fill(reach, &buf);
             }
         }
         out
@@ -552,9 +710,9 @@ pub fn complete(
             droplets(i - 1, Some((lo, hi)), &mut buf);
             let mut held = vec![false; adds.len()];
             if adds.len() > 16 {
-                let below = Grid::new(cell, &buf);
+                let below = Below::new(b, b1, reach, &buf);
                 for (h, &(p, _)) in held.iter_mut().zip(&adds) {
-                    *h = below.any_within(p, reach);
+                    *h = below.find_within(p, reach).is_some();
                 }
             } else {
                 for &(q, w) in &buf {
@@ -724,6 +882,54 @@ mod tests {
             }
         }
         assert!(found > 1000 && missed > 1000, "{found} {missed}");
+    }
+
+    #[test]
+    fn nearest_first_is_the_plain_greedy_walk() {
+        // Clusters, a sparse spread, repeated points and points on a lattice (equal distances:
+        // the tie goes to the first in the walk's list), starts inside and far outside.
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut random = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let plain = |points: &[Point], from: Point| {
+            let mut left = points.to_vec();
+            let mut at = from;
+            let mut out = Vec::new();
+            while !left.is_empty() {
+                let next = (0..left.len())
+                    .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
+                    .unwrap();
+                at = left.swap_remove(next);
+                out.push(at);
+            }
+            out
+        };
+        for case in 0..40 {
+            let n = [0, 1, 5, 64, 65, 300, 2000][case % 7];
+            let points: Vec<Point> = (0..n)
+                .map(|k| match case % 4 {
+                    0 => DVec2::new(random() * 30.0, random() * 3.0),
+                    1 => DVec2::new((k % 17) as f64 * 0.2, (k / 17) as f64 * 0.2),
+                    2 => DVec2::new((random() * 6.0).floor(), (random() * 6.0).floor()),
+                    _ => DVec2::new(random(), random()) * if k % 2 == 0 { 0.01 } else { 50.0 },
+                })
+                .collect();
+            for from in [
+                DVec2::new(0.1, 0.1),
+                DVec2::new(-500.0, 40.0),
+                DVec2::new(7.0, 2.0),
+            ] {
+                assert_eq!(
+                    nearest_first(&points, from),
+                    plain(&points, from),
+                    "case {case}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -117,19 +117,13 @@ pub fn support_moves(
             at = l.b;
         }
     }
-    let mut left: Vec<Point> = extra.to_vec();
-    while !left.is_empty() {
-        let next = (0..left.len())
-            .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
-            .expect("non-empty");
-        let p = left.swap_remove(next);
+    for p in super::droplets::nearest_first(extra, at) {
         moves.push(Move {
             kind: MoveKind::Droplet,
             role: Role::Support,
             to: round_output(p),
             unit: 1,
         });
-        at = p;
     }
     moves
 }
