@@ -12,6 +12,9 @@ export PATH="$HOME/.cargo/bin:$PATH"
 step "every tool and package the tests call is present"
 bash scripts/check_tools.sh
 
+step "import cycles between top-level parts of src/ and www/ (deps.py)"
+python3 ../shared/checks/deps.py
+
 step "cargo fmt --check"
 cargo fmt --check
 
