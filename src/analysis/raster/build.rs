@@ -199,24 +199,12 @@ impl Raster {
         self.extent.resize(tiles.row_slots(), (u32::MAX, 0));
         let (region_bits, drop_bits, extent) =
             (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
-        // Columns c0..=c1 of a row's slice are set.
-        let mut mark = |slot: usize, c0: usize, c1: usize| {
-            let e = &mut extent[slot];
-            e.0 = e.0.min((c0 >> 6) as u32);
-            e.1 = e.1.max((c1 >> 6) as u32 + 1);
-        };
+        let tiles = &*tiles;
         // Where the last span or droplet row was stored (mostly where the next one is).
         let mut spot: Option<Spot> = None;
         for &(k, c0, c1) in self.spans.iter() {
             let (k, c0, c1) = (k as usize, c0 as usize, c1 as usize);
-            let Some(sp) = tiles.spot_cached(&mut spot, k, c0 >> 6, c1 >> 6) else {
-                debug_assert!(false, "region span outside the tiles");
-                continue;
-            };
-            let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
-            let at = 64 * sp.index(k);
-            set_range(region_bits, at + c0, at + c1);
-            mark(sp.slot(k), c0, c1);
+            set_cols(tiles, &mut spot, region_bits, extent, k, c0, c1);
         }
         for &(k0, ph, u) in self.places.iter() {
             let rows_of = &spans[ph * rows..(ph + 1) * rows];
@@ -241,7 +229,7 @@ impl Raster {
                         let c0 = (u - half + 0.5) as i64 as usize - shift;
                         let c1 = c0 + n as usize - 1;
                         set_range(drop_bits, at + c0, at + c1);
-                        mark(slot, c0, c1);
+                        widen(&mut extent[slot], c0, c1);
                     }
                     at += 64 * sp.row_len;
                 }
@@ -257,15 +245,15 @@ impl Raster {
                 if c0 < 0 || c1 >= nx as i64 {
                     continue;
                 }
-                let (c0, c1) = (c0 as usize, c1 as usize);
-                let Some(sp) = tiles.spot_cached(&mut spot, k, c0 >> 6, c1 >> 6) else {
-                    debug_assert!(false, "droplet outside the tiles");
-                    continue;
-                };
-                let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
-                let at = 64 * sp.index(k);
-                set_range(drop_bits, at + c0, at + c1);
-                mark(sp.slot(k), c0, c1);
+                set_cols(
+                    tiles,
+                    &mut spot,
+                    drop_bits,
+                    extent,
+                    k,
+                    c0 as usize,
+                    c1 as usize,
+                );
             }
         }
         self.index = index;
@@ -280,4 +268,33 @@ impl Raster {
     pub fn stored_words(&self) -> usize {
         self.region_bits.len() + self.drop_bits.len()
     }
+}
+
+/// Widens a row's extent (the words of its slice holding any bit) to columns c0..=c1.
+#[inline]
+fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
+    e.0 = e.0.min((c0 >> 6) as u32);
+    e.1 = e.1.max((c1 >> 6) as u32 + 1);
+}
+
+/// Sets grid columns c0..=c1 of row `k` in `bits` (laid out by `tiles`; `spot` where the last
+/// row set was stored) and widens the row's extent.
+#[inline]
+fn set_cols(
+    tiles: &Tiles,
+    spot: &mut Option<Spot>,
+    bits: &mut [u64],
+    extent: &mut [(u32, u32)],
+    k: usize,
+    c0: usize,
+    c1: usize,
+) {
+    let Some(sp) = tiles.spot_cached(spot, k, c0 >> 6, c1 >> 6) else {
+        debug_assert!(false, "bits outside the tiles");
+        return;
+    };
+    let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
+    let at = 64 * sp.index(k);
+    set_range(bits, at + c0, at + c1);
+    widen(&mut extent[sp.slot(k)], c0, c1);
 }

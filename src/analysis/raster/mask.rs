@@ -33,46 +33,37 @@ impl Raster {
         mut count: impl FnMut(&[u64], &[u64], usize, usize) -> [u32; 3],
     ) -> Vec<Vec<[u32; 3]>> {
         let g = self.grid;
-        let tiles = &self.tiles;
         let cols = rows * COLS_PER_ROW as usize;
         let mut counts: Vec<Vec<[u32; 3]>> = out
             .iter()
             .map(|t| vec![[0; 3]; t.width * t.height])
             .collect();
         let mut group = 0;
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                let row = tiles.row_in(bi, k);
-                let (lo, hi) = self.extent[row.slot];
-                if lo >= hi {
+        for (k, row, lo, hi) in self.filled_rows() {
+            let my = k / rows;
+            while groups[group].0 < my / MASK_BAND_ROWS {
+                group += 1;
+            }
+            let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+            let mut t = groups[group].1.start;
+            for seg in row.segs {
+                let (a, e) = (seg.at.max(lo), seg.end().min(hi));
+                if a >= e {
                     continue;
                 }
-                let (lo, hi) = (lo as usize, hi as usize);
-                let my = k / rows;
-                while groups[group].0 < my / MASK_BAND_ROWS {
-                    group += 1;
-                }
-                let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
-                let mut t = groups[group].1.start;
-                for seg in row.segs {
-                    let (a, e) = (seg.at.max(lo), seg.end().min(hi));
-                    if a >= e {
-                        continue;
+                // Grid columns [gc0, gc1] of the segment's bits; column c at c − shift.
+                let shift = 64 * seg.shift();
+                let (gc0, gc1) = (64 * a + shift, (64 * e + shift).min(g.nx) - 1);
+                for cx in gc0 / cols..=gc1 / cols {
+                    let (c0, c1) = ((cx * cols).max(gc0), ((cx + 1) * cols - 1).min(gc1));
+                    while out[t].col + out[t].width <= cx {
+                        t += 1;
                     }
-                    // Grid columns [gc0, gc1] of the segment's bits; column c at c − shift.
-                    let shift = 64 * seg.shift();
-                    let (gc0, gc1) = (64 * a + shift, (64 * e + shift).min(g.nx) - 1);
-                    for cx in gc0 / cols..=gc1 / cols {
-                        let (c0, c1) = ((cx * cols).max(gc0), ((cx + 1) * cols - 1).min(gc1));
-                        while out[t].col + out[t].width <= cx {
-                            t += 1;
-                        }
-                        let tile = &out[t];
-                        let slot = &mut counts[t][(my - tile.row) * tile.width + cx - tile.col];
-                        let add = count(r, d, c0 - shift, c1 - shift);
-                        for (s, a) in slot.iter_mut().zip(add) {
-                            *s += a;
-                        }
+                    let tile = &out[t];
+                    let slot = &mut counts[t][(my - tile.row) * tile.width + cx - tile.col];
+                    let add = count(r, d, c0 - shift, c1 - shift);
+                    for (s, a) in slot.iter_mut().zip(add) {
+                        *s += a;
                     }
                 }
             }
@@ -103,7 +94,6 @@ impl Raster {
         table: &[u8],
     ) {
         debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
-        let tiles = &self.tiles;
         // Grid words [first, end) under tile t's cells: its 4-bit groups are
         // [col·rows, (col + width)·rows).
         let words = |t: &MaskTile| (t.col * rows / 16, ((t.col + t.width) * rows).div_ceil(16));
@@ -161,72 +151,65 @@ impl Raster {
         // The tiles `acc` is laid out for.
         let mut laid: Option<std::ops::Range<usize>> = None;
         let mut group = 0;
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                let row = tiles.row_in(bi, k);
-                let (lo, hi) = self.extent[row.slot];
-                if lo >= hi {
-                    continue;
+        for (k, row, lo, hi) in self.filled_rows() {
+            let my = k / rows;
+            if current.as_ref().is_none_or(|c| c.0 != my) {
+                if let Some((c, range)) = current.take() {
+                    flush(c, range, &mut acc, &at, &spans, out);
                 }
-                let my = k / rows;
-                if current.as_ref().is_none_or(|c| c.0 != my) {
-                    if let Some((c, range)) = current.take() {
-                        flush(c, range, &mut acc, &at, &spans, out);
-                    }
-                    while groups[group].0 < my / MASK_BAND_ROWS {
-                        group += 1;
-                    }
-                    let range = groups[group].1.clone();
-                    if laid.as_ref() != Some(&range) {
-                        at.clear();
-                        spans.clear();
-                        let mut n = 0;
-                        for t in &out[range.clone()] {
-                            at.push(n);
-                            let (w0, w1) = words(t);
-                            spans.push((w0, w1));
-                            n += w1 - w0;
-                        }
-                        acc.clear();
-                        acc.resize(n, [0; N]);
-                        laid = Some(range.clone());
-                    }
-                    current = Some((my, range));
+                while groups[group].0 < my / MASK_BAND_ROWS {
+                    group += 1;
                 }
-                let range = current.as_ref().map_or(0..0, |c| c.1.clone());
-                let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
-                // The tiles' word ranges are in order along the row, as the words are.
-                let mut t = range.start;
-                for seg in row.segs {
-                    let (a, e) = (seg.at.max(lo as usize), seg.end().min(hi as usize));
-                    let shift = seg.shift();
-                    for w in a..e {
-                        let (rw, dw) = (r[w], d[w]);
-                        if rw | dw == 0 {
-                            continue;
-                        }
-                        let gw = w + shift;
-                        while t < range.end && spans[t - range.start].1 <= gw {
-                            t += 1;
-                        }
-                        let add: [u64; N] = std::array::from_fn(|c| match c {
-                            0 => nibbles(rw & !dw),
-                            1 => nibbles(dw & !rw),
-                            _ => nibbles(rw & dw),
-                        });
-                        // Every tile whose words hold word gw (two when they are closer
-                        // than a word); a set bit always lies under a tile.
-                        let mut u = t;
-                        while u < range.end && spans[u - range.start].0 <= gw {
-                            let i = u - range.start;
-                            let x = &mut acc[at[i] + gw - spans[i].0];
-                            for (x, a) in x.iter_mut().zip(add) {
-                                *x += a;
-                            }
-                            u += 1;
-                        }
-                        debug_assert!(u > t, "mask bits outside the mask's tiles");
+                let range = groups[group].1.clone();
+                if laid.as_ref() != Some(&range) {
+                    at.clear();
+                    spans.clear();
+                    let mut n = 0;
+                    for t in &out[range.clone()] {
+                        at.push(n);
+                        let (w0, w1) = words(t);
+                        spans.push((w0, w1));
+                        n += w1 - w0;
                     }
+                    acc.clear();
+                    acc.resize(n, [0; N]);
+                    laid = Some(range.clone());
+                }
+                current = Some((my, range));
+            }
+            let range = current.as_ref().map_or(0..0, |c| c.1.clone());
+            let (r, d) = (&self.region_bits[row.range()], &self.drop_bits[row.range()]);
+            // The tiles' word ranges are in order along the row, as the words are.
+            let mut t = range.start;
+            for seg in row.segs {
+                let (a, e) = (seg.at.max(lo), seg.end().min(hi));
+                let shift = seg.shift();
+                for w in a..e {
+                    let (rw, dw) = (r[w], d[w]);
+                    if rw | dw == 0 {
+                        continue;
+                    }
+                    let gw = w + shift;
+                    while t < range.end && spans[t - range.start].1 <= gw {
+                        t += 1;
+                    }
+                    let add: [u64; N] = std::array::from_fn(|c| match c {
+                        0 => nibbles(rw & !dw),
+                        1 => nibbles(dw & !rw),
+                        _ => nibbles(rw & dw),
+                    });
+                    // Every tile whose words hold word gw (two when they are closer
+                    // than a word); a set bit always lies under a tile.
+                    let mut u = t;
+                    while u < range.end && spans[u - range.start].0 <= gw {
+                        let i = u - range.start;
+                        let x = &mut acc[at[i] + gw - spans[i].0];
+                        for (x, a) in x.iter_mut().zip(add) {
+                            *x += a;
+                        }
+                        u += 1;
+                    }
+                    debug_assert!(u > t, "mask bits outside the mask's tiles");
                 }
             }
         }

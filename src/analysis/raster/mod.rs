@@ -10,7 +10,7 @@
 use super::droplet::droplet_centres;
 use crate::base::geom::{DVec2, Point, Shapes, scanline_spans};
 use crate::base::settings::Settings;
-use crate::base::spatial::Tiles;
+use crate::base::spatial::{Row, Tiles};
 use crate::slicing::plan::LayerPlan;
 use serde::Serialize;
 
@@ -211,6 +211,26 @@ struct Scratch {
     root: Vec<u32>,
     /// The region rows above and below, when copied from another band.
     around: (Vec<u64>, Vec<u64>),
+}
+
+impl Raster {
+    /// The stored rows, in order: (row number, row).
+    fn stored_rows(&self) -> impl Iterator<Item = (usize, Row<'_>)> + '_ {
+        let tiles = &self.tiles;
+        let bands = tiles.bands().iter().enumerate();
+        bands.flat_map(move |(bi, band)| {
+            (band.first_row..band.end_row).map(move |k| (k, tiles.row_in(bi, k)))
+        })
+    }
+
+    /// The stored rows holding any bit, in order: (row number, row, the words [lo, hi) of its
+    /// slice holding any).
+    fn filled_rows(&self) -> impl Iterator<Item = (usize, Row<'_>, usize, usize)> + '_ {
+        self.stored_rows().filter_map(|(k, row)| {
+            let (lo, hi) = self.extent[row.slot];
+            (lo < hi).then_some((k, row, lo as usize, hi as usize))
+        })
+    }
 }
 
 #[derive(Clone, Copy, Debug)]

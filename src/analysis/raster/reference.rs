@@ -23,27 +23,19 @@ impl Raster {
     /// holding overfill to `over_rows` (the reference's pass; the fast path counts them as it
     /// labels).
     fn count_cells(&self, counts: &mut [u64; 3], over_rows: &mut Vec<usize>) {
-        let tiles = &self.tiles;
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                let row = tiles.row_in(bi, k);
-                let (lo, hi) = self.extent[row.slot];
-                if lo >= hi {
-                    continue;
-                }
-                let range = row.offset + lo as usize..row.offset + hi as usize;
-                let before = counts[2];
-                for (r, d) in self.region_bits[range.clone()]
-                    .iter()
-                    .zip(&self.drop_bits[range])
-                {
-                    counts[0] += r.count_ones() as u64;
-                    counts[1] += (r & d).count_ones() as u64;
-                    counts[2] += (d & !r).count_ones() as u64;
-                }
-                if counts[2] > before {
-                    over_rows.push(k);
-                }
+        for (k, row, lo, hi) in self.filled_rows() {
+            let range = row.offset + lo..row.offset + hi;
+            let before = counts[2];
+            for (r, d) in self.region_bits[range.clone()]
+                .iter()
+                .zip(&self.drop_bits[range])
+            {
+                counts[0] += r.count_ones() as u64;
+                counts[1] += (r & d).count_ones() as u64;
+                counts[2] += (d & !r).count_ones() as u64;
+            }
+            if counts[2] > before {
+                over_rows.push(k);
             }
         }
     }
@@ -85,44 +77,41 @@ impl Raster {
         let widest = tiles.bands().iter().map(|b| b.row_len).max().unwrap_or(0);
         let mut edge = vec![0u64; widest];
         let (mut up_buf, mut down_buf) = (Vec::new(), Vec::new());
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                if k != next_k {
-                    prev = runs.len()..runs.len();
-                }
-                next_k = k + 1;
-                let row = tiles.row_in(bi, k);
-                buf.clear();
-                self.runs(&row, |r, d| r & !d, &mut buf);
-                if buf.is_empty() {
-                    prev = runs.len()..runs.len();
-                    continue;
-                }
-                self.edge_row(&row, k, &mut edge, &mut up_buf, &mut down_buf);
-                let first = runs.len();
-                let mut seg = 0;
-                for &(s, e) in &buf {
-                    while row.segs[seg].c1 * 64 <= s as usize {
-                        seg += 1;
-                    }
-                    let shift = 64 * row.segs[seg].shift();
-                    let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
-                    runs.push((k as u32, s, e));
-                    touches.push(count_range(&edge, c0, c1) > 0);
-                    uf.parent.push(uf.parent.len() as u32);
-                }
-                let cur = first..runs.len();
-                let (mut i, mut j) = (prev.start, cur.start);
-                while i < prev.end && j < cur.end {
-                    let (_, s1, e1) = runs[i];
-                    let (_, s2, e2) = runs[j];
-                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
-                        uf.union(i, j);
-                    }
-                    if e1 < e2 { i += 1 } else { j += 1 }
-                }
-                prev = cur;
+        for (k, row) in self.stored_rows() {
+            if k != next_k {
+                prev = runs.len()..runs.len();
             }
+            next_k = k + 1;
+            buf.clear();
+            self.runs(&row, |r, d| r & !d, &mut buf);
+            if buf.is_empty() {
+                prev = runs.len()..runs.len();
+                continue;
+            }
+            self.edge_row(&row, k, &mut edge, &mut up_buf, &mut down_buf);
+            let first = runs.len();
+            let mut seg = 0;
+            for &(s, e) in &buf {
+                while row.segs[seg].c1 * 64 <= s as usize {
+                    seg += 1;
+                }
+                let shift = 64 * row.segs[seg].shift();
+                let (c0, c1) = (s as usize - shift, e as usize - 1 - shift);
+                runs.push((k as u32, s, e));
+                touches.push(count_range(&edge, c0, c1) > 0);
+                uf.parent.push(uf.parent.len() as u32);
+            }
+            let cur = first..runs.len();
+            let (mut i, mut j) = (prev.start, cur.start);
+            while i < prev.end && j < cur.end {
+                let (_, s1, e1) = runs[i];
+                let (_, s2, e2) = runs[j];
+                if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                    uf.union(i, j);
+                }
+                if e1 < e2 { i += 1 } else { j += 1 }
+            }
+            prev = cur;
         }
         // Components, numbered in order of their first run (a root precedes its members).
         let mut comp = vec![0u32; runs.len()];

@@ -317,7 +317,6 @@ impl Raster {
         // A label's cells, with the boundary flag in the top bit.
         const TOP: u64 = 1 << 63;
         let g = self.grid;
-        let tiles = &self.tiles;
         let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
         let Scratch {
             runs,
@@ -334,59 +333,56 @@ impl Raster {
         parent.clear();
         let mut prev = 0..0;
         let mut next_k = 0;
-        for (bi, band) in tiles.bands().iter().enumerate() {
-            for k in band.first_row..band.end_row {
-                if k != next_k {
-                    prev = runs.len()..runs.len();
-                }
-                next_k = k + 1;
-                let row = tiles.row_in(bi, k);
-                let first = runs.len();
-                if self.void_runs(&row, k, runs, bnd, around, counts) {
-                    over_rows.push(k);
-                }
-                if runs.len() == first {
-                    prev = first..first;
-                    continue;
-                }
-                let (mut i, mut j) = (prev.start, first);
-                while i < prev.end && j < runs.len() {
-                    let (_, s1, e1, l1) = runs[i];
-                    let (_, s2, e2, l2) = runs[j];
-                    let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
-                    // One branch, taken rarely (`joined &&` would branch on `joined`, which
-                    // is as often true as not).
-                    if joined & (l2 != NO_LABEL) {
-                        // A second run above: rare.
-                        let (a, b) = (find(parent, l1 as usize), find(parent, l2 as usize));
-                        if a != b {
-                            // The earlier label stays the root: roots in order of their
-                            // component's first run, as the reference numbers them.
-                            let (lo, hi) = (a.min(b), a.max(b));
-                            parent[hi] = lo as u32;
-                            let h = cells[hi];
-                            cells[lo] = (cells[lo] + (h & !TOP)) | (h & TOP);
-                        }
-                    }
-                    // Without branches on the data: the first run above gives its label.
-                    runs[j].3 = if joined && l2 == NO_LABEL { l1 } else { l2 };
-                    let step = (e1 < e2) as usize;
-                    i += step;
-                    j += 1 - step;
-                }
-                for (run, &b) in runs[first..].iter_mut().zip(&bnd[first..]) {
-                    let l = if run.3 == NO_LABEL {
-                        parent.push(cells.len() as u32);
-                        cells.push(0);
-                        cells.len() - 1
-                    } else {
-                        find(parent, run.3 as usize)
-                    };
-                    run.3 = l as u32;
-                    cells[l] = (cells[l] + (run.2 - run.1) as u64) | ((b as u64) << 63);
-                }
-                prev = first..runs.len();
+        for (k, row) in self.stored_rows() {
+            if k != next_k {
+                prev = runs.len()..runs.len();
             }
+            next_k = k + 1;
+            let first = runs.len();
+            if self.void_runs(&row, k, runs, bnd, around, counts) {
+                over_rows.push(k);
+            }
+            if runs.len() == first {
+                prev = first..first;
+                continue;
+            }
+            let (mut i, mut j) = (prev.start, first);
+            while i < prev.end && j < runs.len() {
+                let (_, s1, e1, l1) = runs[i];
+                let (_, s2, e2, l2) = runs[j];
+                let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
+                // One branch, taken rarely (`joined &&` would branch on `joined`, which
+                // is as often true as not).
+                if joined & (l2 != NO_LABEL) {
+                    // A second run above: rare.
+                    let (a, b) = (find(parent, l1 as usize), find(parent, l2 as usize));
+                    if a != b {
+                        // The earlier label stays the root: roots in order of their
+                        // component's first run, as the reference numbers them.
+                        let (lo, hi) = (a.min(b), a.max(b));
+                        parent[hi] = lo as u32;
+                        let h = cells[hi];
+                        cells[lo] = (cells[lo] + (h & !TOP)) | (h & TOP);
+                    }
+                }
+                // Without branches on the data: the first run above gives its label.
+                runs[j].3 = if joined && l2 == NO_LABEL { l1 } else { l2 };
+                let step = (e1 < e2) as usize;
+                i += step;
+                j += 1 - step;
+            }
+            for (run, &b) in runs[first..].iter_mut().zip(&bnd[first..]) {
+                let l = if run.3 == NO_LABEL {
+                    parent.push(cells.len() as u32);
+                    cells.push(0);
+                    cells.len() - 1
+                } else {
+                    find(parent, run.3 as usize)
+                };
+                run.3 = l as u32;
+                cells[l] = (cells[l] + (run.2 - run.1) as u64) | ((b as u64) << 63);
+            }
+            prev = first..runs.len();
         }
         // Each label's root (a label's parent precedes it), the voids and the largest: the
         // first of the largest roots, in label order, as `Voids::of` takes them.
