@@ -31,7 +31,7 @@ fn main() {
             let slicing = t.elapsed().as_secs_f64();
             // As `--report` does it: each layer analysed by the worker that planned it.
             let t = Instant::now();
-            let mut analysis = JobAnalysis::new(&job);
+            let mut analysis = JobAnalysis::new(&job.analysis_grid(), job.settings());
             write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis)
                 .expect("slice and analyse");
             let r = analysis.finish();

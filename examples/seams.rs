@@ -45,7 +45,7 @@ fn main() {
             let b = s.droplet_width();
             let h = s.layer_height;
             let job = Job::new(&bytes, &name, s).expect("job");
-            let mut analysis = JobAnalysis::new(&job);
+            let mut analysis = JobAnalysis::new(&job.analysis_grid(), job.settings());
             let mut code = Vec::new();
             write_gcode_with(&job, &mut code, |_, _| {}, &mut analysis).expect("slice");
             let r = analysis.finish();

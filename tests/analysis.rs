@@ -266,7 +266,7 @@ fn staggered_hatch_ends_stay_inside_the_part_without_contours() {
 /// planned it), and the code written meanwhile.
 fn report_of(job: &dropslice::Job) -> (dropslice::analysis::Report, Vec<u8>) {
     use dropslice::analysis::JobAnalysis;
-    let mut analysis = JobAnalysis::new(job);
+    let mut analysis = JobAnalysis::new(&job.analysis_grid(), job.settings());
     let mut code = Vec::new();
     dropslice::write_gcode_with(job, &mut code, |_, _| {}, &mut analysis).unwrap();
     (analysis.finish(), code)

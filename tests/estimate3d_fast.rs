@@ -223,7 +223,7 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
 /// The report when the writing thread computes every slab in order (the layers analysed and
 /// pushed one by one, as before the workers computed them).
 fn report_in_order(job: &Job) -> dropslice::analysis::Report {
-    let mut analysis = JobAnalysis::new(job);
+    let mut analysis = JobAnalysis::new(&job.analysis_grid(), job.settings());
     let stage = analysis.stage();
     let mut raster = dropslice::analysis::Raster::empty();
     for i in 0..job.layer_count() {
@@ -241,7 +241,7 @@ fn slabs_from_the_workers_give_the_report_of_the_ordered_slabs() {
             ..Settings::default()
         };
         let job = Job::new(&common::model_bytes(model), model, s).unwrap();
-        let mut analysis = JobAnalysis::new(&job);
+        let mut analysis = JobAnalysis::new(&job.analysis_grid(), job.settings());
         dropslice::write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis).unwrap();
         let workers = analysis.finish();
         let ordered = report_in_order(&job);

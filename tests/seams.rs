@@ -291,7 +291,7 @@ fn even_spacing_on_shared_models() {
 /// The void analysis of a whole job (as `--report` makes it).
 fn report(model: &str, s: dropslice::Settings) -> dropslice::analysis::Report {
     let job = dropslice::Job::new(&common::model_bytes(model), model, s).expect("job");
-    let mut analysis = dropslice::analysis::JobAnalysis::new(&job);
+    let mut analysis = dropslice::analysis::JobAnalysis::new(&job.analysis_grid(), job.settings());
     dropslice::write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis)
         .expect("slice");
     analysis.finish()

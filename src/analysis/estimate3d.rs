@@ -7,7 +7,9 @@ use crate::base::geom::{Point, Shapes, all_contours};
 use crate::base::settings::Settings;
 use crate::base::spatial::{Segment, Spot, Tiles};
 
+#[cfg(any(test, feature = "reference"))]
 mod reference;
+#[cfg(any(test, feature = "reference"))]
 pub use reference::slab_voids_reference;
 
 /// The 3D estimate samples the part every B / this.
@@ -89,7 +91,7 @@ fn ceil_i64(t: f64) -> i64 {
 
 impl HeightMap {
     /// The map of droplets at `centres` of footprint diameter `d`. Every stored value is the
-    /// one [`HeightMap::reference`] stores (the same expressions, in the same order); the work
+    /// one `HeightMap::reference` stores (the same expressions, in the same order); the work
     /// saved is around them: each droplet's cells found once, the cells' centres taken from
     /// a table per column and per row, ⌊·⌋ without libm.
     pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
@@ -281,7 +283,7 @@ fn slab_rows(region: &Shapes, grid: &Grid3) -> Option<(i64, usize, f64)> {
 
 /// The 3D estimate for layer i's slab: (volume, void volume) in mm³ of its region × H, filled
 /// by the spheroids of layers i − 1 (`below`), i and i + 1 (`above`). The figures are those of
-/// [`slab_voids_reference`] to the bit: the same cells, each column's fill computed with the
+/// `slab_voids_reference` to the bit: the same cells, each column's fill computed with the
 /// same operations ([`Fill::column`]) and summed in the same order; the stretches of a row's
 /// span are computed a chunk at a time without branches, and the maps' rows found once per
 /// stretch instead of per cell.

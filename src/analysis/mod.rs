@@ -49,9 +49,9 @@
 //! cell's groups once per mask row; a cell's share comes from a table of the counts it can
 //! hold. The page's worker keeps one raster from layer to layer (its memory allocated once)
 //! and counts only the void and overfill shares ([`analyse_layer_for_page`]). The figures and
-//! masks are those of the paths they replaced, kept as
-//! `Raster::analysis_reference` and `Raster::mask_reference` for tests
-//! (tests/analysis_fast.rs). docs/quality.md (*Analysis speed*) has the profile, and why the
+//! masks are those of the paths they replaced, kept as `Raster::analysis_reference` and
+//! `Raster::mask_reference` for tests (tests/analysis_fast.rs; built for tests and with the
+//! `reference` feature only). docs/quality.md (*Analysis speed*) has the profile, and why the
 //! periodic interior of the hatch does not help on this axis-aligned grid.
 //!
 //! # Memory
@@ -69,9 +69,13 @@ mod report;
 
 pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_voids};
 pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
-pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids, slab_voids_reference};
+#[cfg(any(test, feature = "reference"))]
+pub use estimate3d::slab_voids_reference;
+pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,
 };
-pub use report::{AnalysedLayer, JobAnalysis, LayerStage, Model, PartAnalysis, Report};
+pub use report::{
+    AnalysedLayer, AnalysisGrid, JobAnalysis, LayerStage, Model, PartAnalysis, Report,
+};

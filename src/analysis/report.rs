@@ -4,7 +4,7 @@
 use super::droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
 use super::estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
-use crate::base::geom::{DVec2, Shapes};
+use crate::base::geom::{DVec2, Point, Shapes};
 use crate::base::settings::Settings;
 use crate::slicing::plan::LayerPlan;
 use serde::Serialize;
@@ -142,22 +142,32 @@ pub struct AnalysedLayer {
     own: Option<(Shapes, HeightMap)>,
 }
 
-/// The 3D grid of a job's analysis (fixed to the part's bounds).
-fn job_grid(job: &crate::Job) -> Grid3 {
-    let s = job.settings();
-    let d = footprint_diameter(s);
-    let bounds = job.info().bounds;
-    Grid3 {
-        origin: DVec2::new(bounds.min[0] - d, bounds.min[1] - d),
-        cell: s.droplet_width() / GRID3_PER_B,
+/// What a job's analysis needs of the job besides its settings: where the part lies (the 3D
+/// grid is fixed to it), how many layers it has, and the model's name for the report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AnalysisGrid {
+    /// The least x and y of the placed part's bounding box, mm.
+    pub min: Point,
+    pub layers: usize,
+    pub file_name: String,
+}
+
+impl AnalysisGrid {
+    /// The 3D grid of the analysis with settings `s`.
+    fn grid3(&self, s: &Settings) -> Grid3 {
+        let d = footprint_diameter(s);
+        Grid3 {
+            origin: DVec2::new(self.min[0] - d, self.min[1] - d),
+            cell: s.droplet_width() / GRID3_PER_B,
+        }
     }
 }
 
 impl LayerStage {
-    pub fn new(job: &crate::Job) -> LayerStage {
+    pub fn new(grid: &AnalysisGrid, settings: &Settings) -> LayerStage {
         LayerStage {
-            settings: job.settings().clone(),
-            grid: job_grid(job),
+            settings: settings.clone(),
+            grid: grid.grid3(settings),
         }
     }
 
@@ -315,15 +325,16 @@ pub struct JobAnalysis {
 }
 
 impl JobAnalysis {
-    pub fn new(job: &crate::Job) -> JobAnalysis {
+    /// The analysis of a job of `grid.layers` layers, sliced with `settings`.
+    pub fn new(grid: &AnalysisGrid, settings: &Settings) -> JobAnalysis {
         JobAnalysis {
-            stage: LayerStage::new(job),
-            file_name: job.info().file_name.clone(),
+            stage: LayerStage::new(grid, settings),
+            file_name: grid.file_name.clone(),
             part: PartAnalysis::default(),
-            layers: Vec::with_capacity(job.layer_count()),
+            layers: Vec::with_capacity(grid.layers),
             below: None,
             current: None,
-            slabs: Arc::new(Mutex::new(Slabs::new(job.layer_count()))),
+            slabs: Arc::new(Mutex::new(Slabs::new(grid.layers))),
             waiting: VecDeque::new(),
         }
     }

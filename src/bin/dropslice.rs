@@ -545,7 +545,9 @@ Exit codes: 0 done, 2 bad input or settings (the message says what to fix), 1 ot
         let every_ms = if terminal { 250 } else { 2000 };
         let mut shown = false;
         // With --report, each layer is analysed by the worker that planned it.
-        let mut analysis = report.as_ref().map(|_| JobAnalysis::new(&job));
+        let mut analysis = report
+            .as_ref()
+            .map(|_| JobAnalysis::new(&job.analysis_grid(), job.settings()));
         let progress = |done: usize, total: usize| {
             let due = last.elapsed().as_millis() >= every_ms || (done == total && shown);
             if quiet || t0.elapsed().as_secs_f64() < 1.0 || !due {

@@ -70,6 +70,17 @@ impl Job {
         self.zs.len()
     }
 
+    /// What the job's analysis needs of it besides the settings
+    /// ([`crate::analysis::JobAnalysis::new`]).
+    pub fn analysis_grid(&self) -> crate::analysis::AnalysisGrid {
+        let min = self.info.bounds.min;
+        crate::analysis::AnalysisGrid {
+            min: geom::DVec2::new(min[0], min[1]),
+            layers: self.layer_count(),
+            file_name: self.info.file_name.clone(),
+        }
+    }
+
     /// Plane height of layer `i` above the part's bottom.
     pub fn plane_z(&self, i: usize) -> f64 {
         self.zs[i]

@@ -1,6 +1,6 @@
-//! The 3D estimate as it was before its fast path (third round of issue 14), unchanged, kept
-//! as the reference the fast path ([`super`]) is tested against
-//! (tests/estimate3d_fast.rs) and timed against (examples/estimate3d_profile.rs).
+//! The 3D estimate as it was before its fast path, unchanged, kept as the reference the fast
+//! path ([`super`]) is tested against (tests/estimate3d_fast.rs) and timed against
+//! (examples/estimate3d_profile.rs). Built for tests and with the `reference` feature only.
 
 use super::super::droplet::spheroid_half_height;
 use super::super::raster::region_spans;

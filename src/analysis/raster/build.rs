@@ -1,0 +1,300 @@
+//! The rasterisation: a layer's region and droplets as bitmaps on the grid, in the tiles they
+//! touch.
+
+use super::{COLS_PER_ROW, Grid, ROWS_PER_B, Raster, region_spans, set_range};
+use crate::analysis::droplet::{droplet_centres, footprint_diameter};
+use crate::base::geom::{Point, Shapes, all_contours, region_area};
+use crate::base::settings::Settings;
+use crate::base::spatial::{Spot, Tiles};
+use crate::slicing::plan::LayerPlan;
+
+/// Steps of the table of band-averaged half-widths (a droplet's offset within its first row).
+const PHASES: usize = 256;
+/// Rows of the 2D grid per band of the sparse raster, and words (of 64 columns) per tile: tiles
+/// of 64 × 256 cells, 1.33 mm square with the default B.
+const BAND_ROWS: usize = 64;
+const TILE_WORDS: usize = 4;
+
+/// Band-averaged half-widths of a disc of radius `r` on rows of height `gy`: entry
+/// [phase][j] for the j-th row from the one holding the disc's lowest point, when that point
+/// lies `(phase + ½)/PHASES` of a row above the row's bottom.
+fn half_width_table(r: f64, gy: f64) -> (usize, Vec<f64>) {
+    let rows = (2.0 * r / gy).ceil() as usize + 2;
+    let g = |t: f64| {
+        let t = t.clamp(-r, r);
+        0.5 * (t * (r * r - t * t).max(0.0).sqrt() + r * r * (t / r).clamp(-1.0, 1.0).asin())
+    };
+    let mut table = vec![0.0; PHASES * rows];
+    for ph in 0..PHASES {
+        let phi = (ph as f64 + 0.5) / PHASES as f64;
+        for j in 0..rows {
+            // Band j relative to the disc's centre.
+            let lo = (j as f64 - phi) * gy - r;
+            let hi = lo + gy;
+            table[ph * rows + j] = (g(hi) - g(lo)) / gy;
+        }
+    }
+    (rows, table)
+}
+impl Raster {
+    /// Rasterises a layer's region and droplets.
+    pub fn new(plan: &LayerPlan, region: &Shapes, s: &Settings) -> Raster {
+        let b = s.droplet_width();
+        let centres = droplet_centres(plan, b);
+        Raster::from_centres(plan.index, plan.z, &centres, region, s)
+    }
+
+    /// Rasterises droplets at `centres` against `region`.
+    pub fn from_centres(
+        index: usize,
+        z: f64,
+        centres: &[Point],
+        region: &Shapes,
+        s: &Settings,
+    ) -> Raster {
+        let mut r = Raster::empty();
+        r.rebuild(index, z, centres, region, s);
+        r
+    }
+
+    /// A raster of nothing, to [`rebuild`](Self::rebuild) (reusing its memory).
+    pub fn empty() -> Raster {
+        Raster {
+            index: 0,
+            z: 0.0,
+            droplets: 0,
+            region_area: 0.0,
+            b: 1.0,
+            grid: Grid {
+                x0: 0.0,
+                y0: 0.0,
+                gx: 1.0,
+                gy: 1.0,
+                nx: 0,
+                ny: 0,
+            },
+            tiles: Tiles::default(),
+            region_bits: Vec::new(),
+            drop_bits: Vec::new(),
+            extent: Vec::new(),
+            edges: Vec::new(),
+            spans: Vec::new(),
+            places: Vec::new(),
+            scratch: Default::default(),
+        }
+    }
+
+    /// [`from_centres`](Self::from_centres) into this raster's memory.
+    pub fn rebuild(
+        &mut self,
+        index: usize,
+        z: f64,
+        centres: &[Point],
+        region: &Shapes,
+        s: &Settings,
+    ) {
+        let b = s.droplet_width();
+        let r = footprint_diameter(s) / 2.0;
+        let gy = b / ROWS_PER_B;
+        let gx = gy / COLS_PER_ROW;
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for p in all_contours(region).flatten() {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        for p in centres {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k] - r);
+                max[k] = max[k].max(p[k] + r);
+            }
+        }
+        self.edges.clear();
+        for c in all_contours(region) {
+            for i in 0..c.len() {
+                self.edges.push((c[i], c[(i + 1) % c.len()]));
+            }
+        }
+        if !min[0].is_finite() {
+            min = [0.0, 0.0];
+            max = [0.0, 0.0];
+        }
+        let margin = 2.0 * gy;
+        let x0 = min[0] - margin;
+        let y0 = min[1] - margin;
+        let nx = ((max[0] + margin - x0) / gx).ceil() as usize + 1;
+        let ny = ((max[1] + margin - y0) / gy).ceil() as usize + 1;
+        let nw = nx.div_ceil(64);
+        let grid = Grid {
+            x0,
+            y0,
+            gx,
+            gy,
+            nx,
+            ny,
+        };
+        // First the tiles the region and the droplets touch, then their bits.
+        let tiles = &mut self.tiles;
+        tiles.reset(ny, nw, BAND_ROWS, TILE_WORDS);
+        let spans = &mut self.spans;
+        spans.clear();
+        region_spans(region, y0, gy, ny, |k, xa, xb| {
+            if let Some((c0, c1)) = grid.cols(xa, xb) {
+                spans.push((k as u32, c0 as u32, c1 as u32));
+            }
+        });
+        for &(k, c0, c1) in spans.iter() {
+            let k = k as usize;
+            tiles.mark(k, k, c0 as usize >> 6, c1 as usize >> 6);
+        }
+        let (rows, table) = half_width_table(r, gy);
+        // Per phase and row, the columns covered (n, and (n − 1)/2): the rounding carry
+        // depends only on the phase, not on the droplet.
+        let spans: Vec<(i64, f64)> = table
+            .chunks(rows)
+            .flat_map(|widths| {
+                let mut carry = 0.0;
+                widths.iter().map(move |&w| {
+                    let want = 2.0 * w / gx + carry;
+                    // Rounding by truncation: every value here is ≥ 0.
+                    let n = (want + 0.5) as i64;
+                    carry = want - n as f64;
+                    (n, (n - 1) as f64 / 2.0)
+                })
+            })
+            .collect();
+        // Per phase, the widest row: a droplet's columns in every row lie within its columns.
+        let widest: Vec<(i64, f64)> = spans
+            .chunks(rows)
+            .map(|c| c.iter().copied().max_by_key(|s| s.0).unwrap_or((0, 0.0)))
+            .collect();
+        // A droplet's first row, phase, and centre in column units (column c's centre at u = c).
+        let place = |p: &Point| {
+            let v = (p[1] - r - y0) / gy;
+            let k0 = v.floor();
+            let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
+            (k0 as usize, ph, (p[0] - x0) / gx - 0.5)
+        };
+        let places = &mut self.places;
+        places.clear();
+        places.extend(centres.iter().map(place));
+        for &(k0, ph, u) in places.iter() {
+            let (n, half) = widest[ph];
+            if n >= 1 {
+                let c0 = (u - half + 0.5) as i64;
+                // A column to spare on each side.
+                let w0 = (c0 - 1).max(0) as usize >> 6;
+                let w1 = (c0 + n).max(0) as usize >> 6;
+                tiles.mark(k0, k0 + rows - 1, w0, w1);
+            }
+        }
+        let len = tiles.build();
+        self.region_bits.clear();
+        self.region_bits.resize(len, 0);
+        self.drop_bits.clear();
+        self.drop_bits.resize(len, 0);
+        self.extent.clear();
+        self.extent.resize(tiles.row_slots(), (u32::MAX, 0));
+        let (region_bits, drop_bits, extent) =
+            (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
+        let tiles = &*tiles;
+        // Where the last span or droplet row was stored (mostly where the next one is).
+        let mut spot: Option<Spot> = None;
+        for &(k, c0, c1) in self.spans.iter() {
+            let (k, c0, c1) = (k as usize, c0 as usize, c1 as usize);
+            set_cols(tiles, &mut spot, region_bits, extent, k, c0, c1);
+        }
+        for &(k0, ph, u) in self.places.iter() {
+            let rows_of = &spans[ph * rows..(ph + 1) * rows];
+            // Mostly the whole droplet lies in the grid and in one band and segment: its rows
+            // are then one step apart in the storage.
+            let (n, half) = widest[ph];
+            let (w0, k1) = ((u - half + 0.5) as i64, k0 + rows - 1);
+            let whole = n >= 1 && w0 >= 0 && w0 + n <= nx as i64 && k1 < ny;
+            let (w0, w1) = (w0.max(0) as usize, (w0 + n - 1).max(0) as usize);
+            if let Some(sp) = whole
+                .then(|| tiles.spot_cached(&mut spot, k0, w0 >> 6, w1 >> 6))
+                .flatten()
+                .filter(|sp| k1 < sp.end_row)
+            {
+                let shift = 64 * sp.shift;
+                let mut at = 64 * sp.index(k0);
+                for (slot, &(n, half)) in (sp.slot(k0)..).zip(rows_of) {
+                    if n >= 1 {
+                        // Within the widest row's columns: ≥ w0 ≥ 0, so the value is above −1
+                        // and `as i64` truncates it as `as usize` would (one instruction on
+                        // baseline x86-64; `as usize` takes a dozen).
+                        let c0 = (u - half + 0.5) as i64 as usize - shift;
+                        let c1 = c0 + n as usize - 1;
+                        set_range(drop_bits, at + c0, at + c1);
+                        widen(&mut extent[slot], c0, c1);
+                    }
+                    at += 64 * sp.row_len;
+                }
+                continue;
+            }
+            for (j, &(n, half)) in rows_of.iter().enumerate() {
+                let k = k0 + j;
+                if n < 1 || k >= ny {
+                    continue;
+                }
+                let c0 = (u - half + 0.5) as i64;
+                let c1 = c0 + n - 1;
+                if c0 < 0 || c1 >= nx as i64 {
+                    continue;
+                }
+                set_cols(
+                    tiles,
+                    &mut spot,
+                    drop_bits,
+                    extent,
+                    k,
+                    c0 as usize,
+                    c1 as usize,
+                );
+            }
+        }
+        self.index = index;
+        self.z = z;
+        self.droplets = centres.len() as u64;
+        self.region_area = region_area(region);
+        self.b = b;
+        self.grid = grid;
+    }
+
+    /// Words of memory its bitmaps take (for tests of the memory it needs).
+    pub fn stored_words(&self) -> usize {
+        self.region_bits.len() + self.drop_bits.len()
+    }
+}
+
+/// Widens a row's extent (the words of its slice holding any bit) to columns c0..=c1.
+#[inline]
+fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
+    e.0 = e.0.min((c0 >> 6) as u32);
+    e.1 = e.1.max((c1 >> 6) as u32 + 1);
+}
+
+/// Sets grid columns c0..=c1 of row `k` in `bits` (laid out by `tiles`; `spot` where the last
+/// row set was stored) and widens the row's extent.
+#[inline]
+fn set_cols(
+    tiles: &Tiles,
+    spot: &mut Option<Spot>,
+    bits: &mut [u64],
+    extent: &mut [(u32, u32)],
+    k: usize,
+    c0: usize,
+    c1: usize,
+) {
+    let Some(sp) = tiles.spot_cached(spot, k, c0 >> 6, c1 >> 6) else {
+        debug_assert!(false, "bits outside the tiles");
+        return;
+    };
+    let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
+    let at = 64 * sp.index(k);
+    set_range(bits, at + c0, at + c1);
+    widen(&mut extent[sp.slot(k)], c0, c1);
+}
