@@ -28,16 +28,21 @@ pub fn nested(region: &Shapes) -> Vec<Vec<Vec<[f64; 2]>>> {
 pub fn cleaned(shapes: Vec<Vec<Vec<[f64; 2]>>>) -> Shapes {
     shapes_from_overlay(shapes)
         .into_iter()
-        .filter(|s| signed_area(&s.outer).abs() >= MIN_AREA_MM2)
-        .map(|s| {
-            let holes = s
-                .holes
-                .into_iter()
-                .filter(|h| signed_area(h).abs() >= MIN_AREA_MM2)
-                .collect();
-            Shape::new(s.outer, holes)
-        })
+        .filter_map(without_slivers)
         .collect()
+}
+
+/// A shape without its loops of less than [`MIN_AREA_MM2`] (`None` when its outer loop is one).
+pub fn without_slivers(s: Shape) -> Option<Shape> {
+    if signed_area(&s.outer).abs() < MIN_AREA_MM2 {
+        return None;
+    }
+    let holes = s
+        .holes
+        .into_iter()
+        .filter(|h| signed_area(h).abs() >= MIN_AREA_MM2)
+        .collect();
+    Some(Shape::new(s.outer, holes))
 }
 
 /// The region moved outward by `d` mm, round joins with chords within `tolerance` of the arcs (the chords lie inside the arcs: the

@@ -13,6 +13,7 @@
 //! code) and a suggestion outside `droplet_aspect`'s range are refused with a message that says
 //! what to check.
 
+use crate::base::error::grouped;
 use crate::base::error::number;
 use crate::base::settings::{Settings, schema};
 use crate::output::gcode_read::GcodeReader;
@@ -74,19 +75,6 @@ fn range(name: &str) -> (f64, f64) {
         spec.min.unwrap_or(f64::NEG_INFINITY),
         spec.max.unwrap_or(f64::INFINITY),
     )
-}
-
-/// `n` with thousands separators.
-fn grouped(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// The calibration from a droplet count, the code's droplet size, a mass and a density.

@@ -14,6 +14,7 @@
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
 //! filling its memory, and every refusal names the line and the reason.
 
+use crate::base::error::grouped;
 use crate::base::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
 use crate::output::preview::PreviewLayer;
 use crate::slicing::plan::Counts;
@@ -99,19 +100,6 @@ fn shown(word: &str) -> String {
     } else {
         word.to_string()
     }
-}
-
-/// `n` with thousands separators.
-fn grouped(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// A count for a message: "96 million", "1.2e+300", "12,345".

@@ -16,7 +16,7 @@
 //! region itself from the same pass ([`overhang_region`]), so with support on each layer's
 //! figure is the very figure of support off.
 
-use crate::base::boolean::{MIN_AREA_MM2, difference, intersection};
+use crate::base::boolean::{MIN_AREA_MM2, difference, intersection, without_slivers};
 use crate::base::geom::{DVec2, Shape, Shapes, region_area, segment_distance2, signed_area};
 use crate::base::settings::Settings;
 use crate::base::spatial::EdgeIndex;
@@ -95,15 +95,9 @@ fn one_pass(region: &Shapes, below: &Shapes, d: f64) -> Option<Shapes> {
     let shapes: Shapes = crate::base::geom::shapes_from_overlay(out)
         .into_iter()
         .filter(|s| signed_area(&s.outer).abs() >= MIN_AREA_MM2)
-        .map(|s| {
-            points.extend(s.contours().flatten().copied());
-            let holes = s
-                .holes
-                .into_iter()
-                .filter(|h| signed_area(h).abs() >= MIN_AREA_MM2)
-                .collect();
-            Shape::new(s.outer, holes)
-        })
+        // every loop's vertices, the slivers' too, are checked against the mitres
+        .inspect(|s| points.extend(s.contours().flatten().copied()))
+        .filter_map(without_slivers)
         .collect();
     if points.is_empty() {
         return Some(shapes);
