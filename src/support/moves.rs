@@ -3,6 +3,7 @@
 //! single droplets of the droplet-level pass, nearest first.
 
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::base::nearest::nearest_walk;
 use crate::base::settings::Settings;
 use crate::slicing::hatch::{HatchLine, order_greedy};
 use crate::slicing::plan::{Move, MoveKind, Role, hatch_angle, support_settings};
@@ -117,19 +118,14 @@ pub fn support_moves(
             at = l.b;
         }
     }
-    let mut left: Vec<Point> = extra.to_vec();
-    while !left.is_empty() {
-        let next = (0..left.len())
-            .min_by(|&i, &j| dist(at, left[i]).total_cmp(&dist(at, left[j])))
-            .expect("non-empty");
-        let p = left.swap_remove(next);
+    for i in nearest_walk(extra, at, |i| extra[i]) {
+        let p = extra[i];
         moves.push(Move {
             kind: MoveKind::Droplet,
             role: Role::Support,
             to: round_output(p),
             unit: 1,
         });
-        at = p;
     }
     moves
 }
