@@ -4,6 +4,7 @@
 pub mod boolean;
 pub mod error;
 pub mod geom;
+pub mod nearest;
 pub mod parallel;
 pub mod settings;
 pub mod spatial;

@@ -6,9 +6,9 @@
 //! so two layers with the same angle have their lines in the same places; with `stagger`, some
 //! layers use (j + 0)·spacing instead (see [`crate::slicing::plan::hatch_shifted`]).
 
-use crate::base::spatial::each_ring_cell;
+use crate::base::nearest::NearestGrid;
 
-use crate::base::geom::{DVec2, Point, Shapes, dist, scanline_spans, sin_cos_deg};
+use crate::base::geom::{DVec2, Point, Shapes, scanline_spans, sin_cos_deg};
 
 /// One hatch segment: a `G25` line from `a` to `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,10 +88,13 @@ pub fn order_greedy(lines: Vec<HatchLine>, from: Point) -> Vec<HatchLine> {
     if lines.len() <= 1 {
         return lines;
     }
-    let mut grid = EndGrid::new(&lines);
+    // End id = 2·segment + {0: a, 1: b}; of equally near ends, the least id.
+    let mut grid = NearestGrid::new(lines.iter().flat_map(|l| [l.a, l.b]).collect());
     let mut out = Vec::with_capacity(lines.len());
     let mut at = from;
-    while let Some(end) = grid.take_nearest(at) {
+    while let Some(end) = grid.nearest(at, |e| e) {
+        grid.remove(end);
+        grid.remove(end ^ 1);
         let l = lines[end / 2];
         let l = if end % 2 == 0 {
             l
@@ -104,119 +107,10 @@ pub fn order_greedy(lines: Vec<HatchLine>, from: Point) -> Vec<HatchLine> {
     out
 }
 
-/// Uniform grid over segment ends for nearest-end queries (end id = 2·segment + {0: a, 1: b}).
-struct EndGrid {
-    ends: Vec<Point>,
-    alive: Vec<bool>,
-    cells: Vec<Vec<u32>>,
-    min: Point,
-    cell: f64,
-    nx: i64,
-    ny: i64,
-}
-
-impl EndGrid {
-    fn new(lines: &[HatchLine]) -> EndGrid {
-        let ends: Vec<Point> = lines.iter().flat_map(|l| [l.a, l.b]).collect();
-        let mut min = DVec2::INFINITY;
-        let mut max = DVec2::NEG_INFINITY;
-        for p in &ends {
-            for k in 0..2 {
-                min[k] = min[k].min(p[k]);
-                max[k] = max[k].max(p[k]);
-            }
-        }
-        let (w, h) = ((max[0] - min[0]).max(1e-9), (max[1] - min[1]).max(1e-9));
-        let cell = ((w * h) / ends.len() as f64).sqrt().max(w.max(h) / 4096.0);
-        let nx = (w / cell).floor() as i64 + 1;
-        let ny = (h / cell).floor() as i64 + 1;
-        let mut grid = EndGrid {
-            alive: vec![true; ends.len()],
-            cells: vec![Vec::new(); (nx * ny) as usize],
-            ends,
-            min,
-            cell,
-            nx,
-            ny,
-        };
-        for i in 0..grid.ends.len() {
-            let (cx, cy) = grid.cell_of(grid.ends[i]);
-            grid.cells[(cy * nx + cx) as usize].push(i as u32);
-        }
-        grid
-    }
-
-    fn cell_of(&self, p: Point) -> (i64, i64) {
-        let cx = ((p[0] - self.min[0]) / self.cell).floor() as i64;
-        let cy = ((p[1] - self.min[1]) / self.cell).floor() as i64;
-        (cx.clamp(0, self.nx - 1), cy.clamp(0, self.ny - 1))
-    }
-
-    /// Removes the segment with the end nearest to `p` and returns that end's id.
-    fn take_nearest(&mut self, p: Point) -> Option<usize> {
-        let (cx, cy) = self.cell_of(p);
-        let mut best: Option<(f64, usize)> = None;
-        let max_r = self.nx.max(self.ny);
-        for r in 0..=max_r {
-            let mut any_cell = false;
-            let (nx, ny) = (self.nx, self.ny);
-            each_ring_cell(cx, cy, r, nx, ny, |x, y| {
-                any_cell = true;
-                self.scan(x, y, p, &mut best);
-            });
-            // Every end outside rings 0..=r is at least max(r·cell, how far p lies outside the
-            // grid) away; stop once the best is at most that.
-            let bound = (r as f64 * self.cell).max(self.outside_distance(p));
-            if !any_cell || best.is_some_and(|(bd, _)| bd < bound) {
-                break;
-            }
-        }
-        let (_, e) = best?;
-        self.alive[e] = false;
-        self.alive[e ^ 1] = false;
-        Some(e)
-    }
-
-    /// Looks at the live ends of cell (x, y) for one nearer to `p` than `best` (or as near with
-    /// a smaller id).
-    fn scan(&mut self, x: i64, y: i64, p: Point, best: &mut Option<(f64, usize)>) {
-        // A cell whose box lies farther than the best end so far holds no nearer end nor an
-        // equally near one (the slack keeps rounding on the safe side).
-        if let Some((bd, _)) = *best {
-            let lo = self.min + DVec2::new(x as f64, y as f64) * self.cell;
-            let hi = lo + DVec2::splat(self.cell);
-            let d = (lo - p).max(p - hi).max(DVec2::ZERO);
-            if d.length_squared() > bd * bd * (1.0 + 1e-9) + 1e-18 {
-                return;
-            }
-        }
-        let cell = &mut self.cells[(y * self.nx + x) as usize];
-        if cell.is_empty() {
-            return;
-        }
-        let alive = &self.alive;
-        cell.retain(|&e| alive[e as usize]);
-        for &e in cell.iter() {
-            let d = dist(p, self.ends[e as usize]);
-            if best.is_none_or(|(bd, be)| d < bd || (d == bd && (e as usize) < be)) {
-                *best = Some((d, e as usize));
-            }
-        }
-    }
-
-    /// How far `p` lies outside the grid's box (0 inside).
-    fn outside_distance(&self, p: Point) -> f64 {
-        let maxx = self.min[0] + self.nx as f64 * self.cell;
-        let maxy = self.min[1] + self.ny as f64 * self.cell;
-        let dx = (self.min[0] - p[0]).max(p[0] - maxx).max(0.0);
-        let dy = (self.min[1] - p[1]).max(p[1] - maxy).max(0.0);
-        dx.max(dy)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::geom::dist;
     use crate::base::geom::square;
 
     #[test]

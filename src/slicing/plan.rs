@@ -2,6 +2,7 @@
 //! (SPEC.md `contour_order`, `print_order`).
 
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::base::nearest::nearest_walk;
 use crate::base::settings::{ContourOrder, PrintOrder, Settings};
 use crate::slicing::contours::{Loop, contours};
 use crate::slicing::droplets::loop_droplets_spaced;
@@ -210,13 +211,10 @@ pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point
                 })
                 .filter(|(d, _)| !d.is_empty())
                 .collect();
-            while !pending.is_empty() {
-                let next = (0..pending.len())
-                    .min_by(|&i, &j| {
-                        dist(*at, pending[i].0[0]).total_cmp(&dist(*at, pending[j].0[0]))
-                    })
-                    .expect("non-empty");
-                let (drops, role) = pending.swap_remove(next);
+            let starts: Vec<Point> = pending.iter().map(|(d, _)| d[0]).collect();
+            let order = nearest_walk(&starts, *at, |i| pending[i].0[pending[i].0.len() - 1]);
+            for i in order {
+                let (drops, role) = (std::mem::take(&mut pending[i].0), pending[i].1);
                 for p in drops {
                     plan.travel_mm += dist(*at, p);
                     plan.moves.push(Move {

@@ -3,6 +3,7 @@
 //! single droplets of the droplet-level pass, nearest first.
 
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::base::nearest::nearest_walk;
 use crate::base::settings::Settings;
 use crate::slicing::hatch::{HatchLine, order_greedy};
 use crate::slicing::plan::{Move, MoveKind, Role, hatch_angle, support_settings};
@@ -117,7 +118,8 @@ pub fn support_moves(
             at = l.b;
         }
     }
-    for p in super::droplets::nearest_first(extra, at) {
+    for i in nearest_walk(extra, at, |i| extra[i]) {
+        let p = extra[i];
         moves.push(Move {
             kind: MoveKind::Droplet,
             role: Role::Support,

@@ -47,6 +47,11 @@ pub fn overhang_figure(shapes: &Shapes) -> f64 {
 pub fn overhang_region(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes {
     let d = s.overhang_limit * s.droplet_width();
     match below {
+        // A layer whose region is the one below, point for point (prisms: walls straight
+        // up), lies a whole d within the region below grown by d: no overhang, without
+        // the boolean pass (which gives the same on such layers; it costs most where a
+        // layer holds thousands of small parts).
+        Some(b) if b == region && d.is_finite() && d > 2.0 * CHORD_TOLERANCE_MM => Shapes::new(),
         // The first layer, an empty layer or nothing below, a limit too small for the mitres:
         // the construction of `support::overhang` (which answers those cases itself).
         Some(b)
