@@ -47,6 +47,7 @@ pub const MAX_DROPLETS: f64 = 2e9;
 pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
 
 /// What the import found, for the CLI summary, the header and the page.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct JobInfo {
     pub file_name: String,
@@ -74,6 +75,7 @@ pub struct JobInfo {
 }
 
 /// A run of facets of the prepared mesh printed by one discharge unit ([`JobInfo::groups`]).
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct FacetGroup {
     /// How many facets (they follow the run before).

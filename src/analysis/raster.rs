@@ -18,6 +18,7 @@ pub const MIN_PASSAGE_COLS: u32 = 2;
 const PHASES: usize = 256;
 
 /// One connected void of a layer.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Void {
     /// mm².
@@ -31,6 +32,7 @@ pub struct Void {
 }
 
 /// What one layer's droplets cover of its region. Areas in mm², lengths in mm.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct LayerAnalysis {
     /// Layer number from 0.
