@@ -4,7 +4,7 @@
 
 use dropslice::wasm::reader::{GcodeStream, calibrate};
 use dropslice::wasm::{
-    Models, Session, Tally, default_settings, merge_summaries, settings_schema, version,
+    Models, Session, Tally, default_settings, job_schema, merge_summaries, settings_schema, version,
 };
 use serde::Serialize;
 use wasm_bindgen::{JsCast, JsValue};
@@ -92,6 +92,25 @@ fn schema_defaults_and_version() {
         .map(|s| s["name"].as_str().unwrap())
         .collect();
     assert!(names.contains(&"layer_height") && names.contains(&"droplet_aspect"));
+    // the part keys are flagged, and the job schema gives the page their ranges (then copies
+    // and unit): the same rows
+    let rows = schema.as_array().unwrap();
+    let part: Vec<&serde_json::Value> = rows.iter().filter(|s| s["part"] == true).collect();
+    let keys: Vec<&str> = part.iter().map(|s| s["name"].as_str().unwrap()).collect();
+    assert_eq!(keys, dropslice::model::spec::PART_KEYS);
+    assert!(rows.iter().all(|s| s["part"].is_boolean()));
+    let job = json(job_schema().unwrap());
+    let numbers = job["part_numbers"].as_array().unwrap();
+    assert_eq!(
+        &numbers[..part.len()],
+        &part.into_iter().cloned().collect::<Vec<_>>()[..]
+    );
+    let rest: Vec<&str> = numbers[keys.len()..]
+        .iter()
+        .map(|s| s["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(rest, ["copies", "unit"]);
+    assert_eq!(job["max_parts"], dropslice::model::spec::MAX_PARTS);
     let defaults = json(default_settings().unwrap());
     assert_eq!(defaults["layer_height"], 0.2);
     assert_eq!(defaults["contours"], 2);

@@ -4,7 +4,6 @@
 
 import { Cancelled, MAX_WORKERS, Pool } from "./core/client";
 import { checkLine } from "./core/cutline";
-import { PART_KEYS } from "./core/job";
 import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
@@ -268,7 +267,6 @@ async function main(): Promise<void> {
         plateTimer = window.setTimeout(() => void relayout(page), 200);
       }
     },
-    PART_KEYS,
   );
   lastPlate = plate();
   updateButtons(page);

@@ -37,6 +37,7 @@ impl Error {
 
 /// An [`Error`] as the page receives it: `{kind, message, setting?}` (`setting` names the
 /// setting of an [`Error::Setting`]).
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ErrorReport {
     /// [`Error::kind`].

@@ -187,7 +187,23 @@ impl Default for Settings {
     }
 }
 
+/// The settings that belong to a part, not to a job: the schema flags them
+/// ([`SettingSpec::part`]) with their ranges, which a job file's parts are checked against
+/// (`crate::model::spec`); the page takes both from the schema.
+pub const PART_KEYS: [&str; 9] = [
+    "rotate_x",
+    "rotate_y",
+    "rotate_z",
+    "scale_x",
+    "scale_y",
+    "scale_z",
+    "place_x",
+    "place_y",
+    "place_angle",
+];
+
 /// Kind of a setting's value, for the page's form.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Kind {
@@ -198,6 +214,7 @@ pub enum Kind {
 }
 
 /// One row of the settings table: name, unit, range, description.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, Serialize)]
 pub struct SettingSpec {
     pub name: &'static str,
@@ -212,6 +229,10 @@ pub struct SettingSpec {
     pub choices: &'static [&'static str],
     pub group: &'static str,
     pub description: &'static str,
+    /// A key of a part ([`PART_KEYS`]): in a job each part carries its own (docs/jobs.md), and
+    /// a job's settings refuse it.
+    pub part: bool,
+    #[cfg_attr(target_arch = "wasm32", tsify(type = "number | boolean | string"))]
     pub default: serde_json::Value,
 }
 
@@ -235,6 +256,7 @@ fn num(
         choices: NO_CHOICES,
         group,
         description,
+        part: false,
         default: serde_json::Value::Null,
     }
 }
@@ -263,6 +285,7 @@ fn choice(
         choices,
         group,
         description,
+        part: false,
         default: serde_json::Value::Null,
     }
 }
@@ -585,6 +608,7 @@ pub fn schema() -> Vec<SettingSpec> {
     let defaults = serde_json::to_value(Settings::default()).expect("settings serialize");
     for spec in &mut specs {
         spec.default = defaults[spec.name].clone();
+        spec.part = PART_KEYS.contains(&spec.name);
     }
     specs
 }
@@ -820,6 +844,20 @@ mod tests {
             assert!(names.contains(&f.as_str()), "{f} missing in schema");
         }
         Settings::default().validate().unwrap();
+    }
+
+    #[test]
+    fn schema_flags_the_part_keys() {
+        let flagged: Vec<_> = schema()
+            .into_iter()
+            .filter(|s| s.part)
+            .map(|s| s.name)
+            .collect();
+        assert_eq!(flagged, PART_KEYS);
+        for s in schema().into_iter().filter(|s| s.part) {
+            assert_eq!(s.kind, Kind::Number, "{}", s.name);
+            assert!(s.min.is_some() && s.max.is_some(), "{}", s.name);
+        }
     }
 
     #[test]

@@ -15,6 +15,7 @@ pub struct Mesh {
 }
 
 /// Axis-aligned bounding box.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Bounds {
     pub min: [f64; 3],
@@ -28,6 +29,7 @@ impl Bounds {
 }
 
 /// What the import found in the mesh.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MeshStats {
     pub facets_in_file: usize,

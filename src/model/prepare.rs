@@ -15,6 +15,7 @@ pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
 
 /// What the import found, for the CLI summary, the header and the page.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct JobInfo {
     pub file_name: String,
     pub format: stl::Format,
@@ -42,6 +43,7 @@ pub struct JobInfo {
 
 /// A run of facets of the prepared mesh printed by one discharge unit ([`JobInfo::groups`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct FacetGroup {
     /// How many facets (they follow the run before).
     pub facets: usize,

@@ -12,7 +12,7 @@
 
 use crate::base::error::Error;
 use crate::base::geom::{DMat3, DVec3};
-use crate::base::settings::Settings;
+use crate::base::settings::{self, Kind, SettingSpec, Settings};
 use crate::model::import::stl::{self, Format};
 use crate::model::import::{self, Part};
 use crate::model::mesh::{Bounds, Placement, rot, rotation};
@@ -32,36 +32,72 @@ pub const MAX_NAME_CHARS: usize = 80;
 /// Most discharge units (0 and 1).
 pub const UNITS: u8 = 2;
 
-/// Settings that belong to a part, not to the job.
-pub const PART_KEYS: [&str; 9] = [
-    "rotate_x",
-    "rotate_y",
-    "rotate_z",
-    "scale_x",
-    "scale_y",
-    "scale_z",
-    "place_x",
-    "place_y",
-    "place_angle",
-];
+/// The settings that belong to a part, not to the job (the settings schema flags them).
+pub use crate::base::settings::PART_KEYS;
 
-/// The keys of a part in the job file.
-const PART_SPEC_KEYS: [&str; 14] = [
-    "file",
-    "item",
-    "rotate_x",
-    "rotate_y",
-    "rotate_z",
-    "scale_x",
-    "scale_y",
-    "scale_z",
-    "place_x",
-    "place_y",
-    "place_angle",
-    "copies",
-    "unit",
-    "name",
-];
+/// The keys of a part in the job file, in the order messages list them: the file, the 3MF
+/// item, the [`PART_KEYS`], then copies, unit and name.
+fn part_spec_keys() -> Vec<&'static str> {
+    let mut keys = vec!["file", "item"];
+    keys.extend(PART_KEYS);
+    keys.extend(["copies", "unit", "name"]);
+    keys
+}
+
+/// What the page needs to check a job's parts: every number a part carries with its range
+/// (the settings the schema flags [`SettingSpec::part`], then `copies` and `unit`) and the
+/// job's counts. Published to the page as the core's `job_schema`.
+#[derive(Clone, Debug, Serialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+pub struct JobSchema {
+    pub part_numbers: Vec<SettingSpec>,
+    /// [`MAX_PARTS`].
+    pub max_parts: usize,
+    /// [`MAX_INSTANCES`].
+    pub max_instances: usize,
+    /// [`MAX_JOB_FILE_BYTES`].
+    pub max_job_file_bytes: usize,
+}
+
+/// The job schema the page is given (the core's `job_schema`): the part keys' rows of the
+/// settings schema, then `copies` and `unit`, and the job's limits.
+pub fn job_schema() -> JobSchema {
+    let mut part_numbers: Vec<SettingSpec> =
+        settings::schema().into_iter().filter(|s| s.part).collect();
+    let whole = |name, min: u32, max: u32, default: u32, description| SettingSpec {
+        name,
+        kind: Kind::Integer,
+        unit: "",
+        min: Some(min.into()),
+        max: Some(max.into()),
+        min_exclusive: false,
+        choices: &[],
+        group: "Part",
+        description,
+        part: true,
+        default: default.into(),
+    };
+    part_numbers.push(whole(
+        "copies",
+        1,
+        MAX_COPIES,
+        1,
+        "Copies of the part on the plate",
+    ));
+    part_numbers.push(whole(
+        "unit",
+        0,
+        u32::from(UNITS) - 1,
+        0,
+        "The discharge unit that prints the part",
+    ));
+    JobSchema {
+        part_numbers,
+        max_parts: MAX_PARTS,
+        max_instances: MAX_INSTANCES,
+        max_job_file_bytes: MAX_JOB_FILE_BYTES,
+    }
+}
 
 /// A job: the settings of the layers and the parts to print.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -78,6 +114,7 @@ fn one_copy() -> u32 {
 }
 
 /// One part of a job file: a file (or one build item of a 3MF) and its transform.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PartSpec {
@@ -153,6 +190,22 @@ impl PartSpec {
         Some([self.place_x?, self.place_y?])
     }
 
+    /// The value of a [`PART_KEYS`] key (`None` for an unplaced part's place, or another key).
+    pub fn number(&self, key: &str) -> Option<f64> {
+        match key {
+            "rotate_x" => Some(self.rotate_x),
+            "rotate_y" => Some(self.rotate_y),
+            "rotate_z" => Some(self.rotate_z),
+            "scale_x" => Some(self.scale_x),
+            "scale_y" => Some(self.scale_y),
+            "scale_z" => Some(self.scale_z),
+            "place_x" => self.place_x,
+            "place_y" => self.place_y,
+            "place_angle" => Some(self.place_angle),
+            _ => None,
+        }
+    }
+
     /// Checks every value (`i` names the part in messages).
     pub fn validate(&self, i: usize) -> Result<(), Error> {
         let bad = |key: &str, what: String| Err(Error::Job(format!("parts[{i}].{key}: {what}")));
@@ -162,32 +215,30 @@ impl PartSpec {
         if self.file.len() > 4096 {
             return bad("file", "is longer than 4096 bytes".into());
         }
-        // The ranges of the settings of the same name (settings.rs).
-        let ranges: [(&str, f64, f64, bool); 7] = [
-            ("rotate_x", -360.0, 360.0, false),
-            ("rotate_y", -360.0, 360.0, false),
-            ("rotate_z", -360.0, 360.0, false),
-            ("scale_x", 0.0, 1000.0, true),
-            ("scale_y", 0.0, 1000.0, true),
-            ("scale_z", 0.0, 1000.0, true),
-            ("place_angle", -360.0, 360.0, false),
-        ];
-        let values = [
-            self.rotate_x,
-            self.rotate_y,
-            self.rotate_z,
-            self.scale_x,
-            self.scale_y,
-            self.scale_z,
-            self.place_angle,
-        ];
-        for ((key, lo, hi, exclusive), x) in ranges.into_iter().zip(values) {
-            check_range(i, key, x, lo, hi, exclusive)?;
+        // The ranges of the settings of the same name (the schema's part keys); the place
+        // after the others, as a pair.
+        let ranges: Vec<SettingSpec> = settings::schema().into_iter().filter(|s| s.part).collect();
+        let check = |key: &str, x: f64| match ranges.iter().find(|s| s.name == key) {
+            Some(SettingSpec {
+                min: Some(lo),
+                max: Some(hi),
+                min_exclusive,
+                ..
+            }) => check_range(i, key, x, *lo, *hi, *min_exclusive),
+            _ => Err(Error::Internal(format!("no range for the part key {key}"))),
+        };
+        for key in PART_KEYS {
+            if let Some(x) = self.number(key)
+                && key != "place_x"
+                && key != "place_y"
+            {
+                check(key, x)?;
+            }
         }
         match (self.place_x, self.place_y) {
             (Some(x), Some(y)) => {
-                check_range(i, "place_x", x, -10000.0, 10000.0, false)?;
-                check_range(i, "place_y", y, -10000.0, 10000.0, false)?;
+                check("place_x", x)?;
+                check("place_y", y)?;
             }
             (None, None) => {}
             (Some(_), None) => {
@@ -386,7 +437,7 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
                     return bad(k, "must be a finite number (mm) or null");
                 }
             }
-            k if PART_SPEC_KEYS.contains(&k) => {
+            k if PART_KEYS.contains(&k) => {
                 if !v.as_f64().is_some_and(f64::is_finite) {
                     return bad(k, "must be a finite number");
                 }
@@ -395,7 +446,7 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
                 return Err(Error::Job(format!(
                     "parts[{i}]: unknown key '{}'; a part has: {}",
                     crate::base::error::quote(k),
-                    PART_SPEC_KEYS.join(", ")
+                    part_spec_keys().join(", ")
                 )));
             }
         }
@@ -501,6 +552,7 @@ impl Model {
 
 /// What a file holds, for the page: `{name, format, triangles, bounds, items, warnings,
 /// suggested_scale}`.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModelInfo {
     pub name: String,
@@ -516,6 +568,7 @@ pub struct ModelInfo {
 }
 
 /// One build item of a [`ModelInfo`].
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ItemInfo {
     pub name: String,
@@ -662,6 +715,7 @@ impl Frame {
 }
 
 /// One copy of a part on the plate.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Instance {
     /// The part's index in the job's `parts` (from 0).
@@ -696,6 +750,7 @@ pub struct Instance {
 }
 
 /// Where every instance goes.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Layout {
     pub instances: Vec<Instance>,
@@ -1200,6 +1255,47 @@ fn cluster(tris: &[[[f32; 3]; 3]], lo: DVec3, cell: f64, max: usize) -> Option<V
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The ranges the page is given are the ones a job file's parts are held to: each bound
+    /// is accepted, and a step past it is refused naming the key.
+    #[test]
+    fn published_part_ranges_are_the_checked_ones() {
+        let schema = job_schema();
+        let names: Vec<_> = schema.part_numbers.iter().map(|s| s.name).collect();
+        assert_eq!(&names[..PART_KEYS.len()], PART_KEYS);
+        assert_eq!(&names[PART_KEYS.len()..], ["copies", "unit"]);
+        let part = |key: &str, x: f64| {
+            let integer = schema
+                .part_numbers
+                .iter()
+                .any(|s| s.name == key && s.kind == Kind::Integer);
+            let x = if integer {
+                serde_json::Value::from(x as i64)
+            } else {
+                x.into()
+            };
+            let mut v = serde_json::json!({"file": "a.stl", key: x});
+            for (k, other) in [("place_x", "place_y"), ("place_y", "place_x")] {
+                if key == k {
+                    v[other] = 0.0.into();
+                }
+            }
+            part_from_value(3, v)
+        };
+        for s in &schema.part_numbers {
+            let (lo, hi) = (s.min.unwrap(), s.max.unwrap());
+            let step = if s.kind == Kind::Integer { 1.0 } else { 1e-6 };
+            part(s.name, hi).unwrap();
+            if !s.min_exclusive {
+                part(s.name, lo).unwrap();
+            }
+            let below = if s.min_exclusive { lo } else { lo - step };
+            for x in [below, hi + step] {
+                let e = part(s.name, x).unwrap_err().to_string();
+                assert!(e.contains(&format!("parts[3].{}", s.name)), "{x}: {e}");
+            }
+        }
+    }
 
     #[test]
     fn angles_turn_normals_down() {

@@ -24,6 +24,7 @@ use serde::Serialize;
 pub const FILLING_RANGE: (f64, f64) = (0.2, 5.0);
 
 /// Where the droplet count came from.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CountSource {
@@ -36,6 +37,7 @@ pub enum CountSource {
 }
 
 /// The figures and the suggestion.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Calibration {
     pub droplets: u64,

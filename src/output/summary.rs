@@ -15,6 +15,7 @@ use crate::slicing::plan::{Counts, LayerPlan};
 use serde::{Deserialize, Serialize};
 
 /// Totals of some layers of a slice (all of them once every unit is merged).
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Summary {
     /// Layers planned (added with [`Summary::add`]).
@@ -39,6 +40,7 @@ pub struct Summary {
 }
 
 /// The worst layer by some area: the largest connected void, or the largest overhang.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct WorstLayer {
     /// Layer number from 0.
@@ -87,6 +89,7 @@ impl WorstLayer {
 }
 
 /// What the CLI prints and the page shows about a slice.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Figures {
     pub layers: usize,

@@ -46,6 +46,7 @@ pub struct Move {
 
 /// Droplet counts by role (the roles partition the droplets), and how many of them discharge
 /// unit 1 prints.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
     pub outer: u64,

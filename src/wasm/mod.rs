@@ -102,15 +102,29 @@ pub fn version() -> String {
     crate::VERSION.to_string()
 }
 
+/// A point or vector in the plane as serde writes glam's `DVec2` (the analysis' centroids,
+/// boxes and deviations): `[x, y]`, mm. The other types of the values the core hands out are
+/// declared by their `Tsify` derives.
+#[wasm_bindgen(typescript_custom_section)]
+const POINT_TS: &str = r#"/** A point in the plane, mm: [x, y]. */
+export type Point = [number, number];"#;
+
 /// The settings table: `[{name, kind, unit, min, max, min_exclusive, choices, group,
-/// description, default}]`.
-#[wasm_bindgen]
+/// description, part, default}]`.
+#[wasm_bindgen(unchecked_return_type = "SettingSpec[]")]
 pub fn settings_schema() -> Result<JsValue, JsValue> {
     to_js(&settings::schema(), "the settings schema")
 }
 
+/// What the page checks a job's parts against: every number a part carries with its range
+/// (the settings flagged `part`, then copies and unit) and the most parts and instances.
+#[wasm_bindgen(unchecked_return_type = "JobSchema")]
+pub fn job_schema() -> Result<JsValue, JsValue> {
+    to_js(&job::job_schema(), "the job schema")
+}
+
 /// The default settings: `{name: value, ...}`.
-#[wasm_bindgen]
+#[wasm_bindgen(unchecked_return_type = "Record<string, number | boolean | string>")]
 pub fn default_settings() -> Result<JsValue, JsValue> {
     to_js(&Settings::default(), "the default settings")
 }
@@ -131,8 +145,10 @@ pub fn check_settings(settings: JsValue) -> Result<JsValue, JsValue> {
 }
 
 /// Merges the summaries of the units of a slice (any order) into one.
-#[wasm_bindgen]
-pub fn merge_summaries(parts: JsValue) -> Result<JsValue, JsValue> {
+#[wasm_bindgen(unchecked_return_type = "Summary")]
+pub fn merge_summaries(
+    #[wasm_bindgen(unchecked_param_type = "Summary[]")] parts: JsValue,
+) -> Result<JsValue, JsValue> {
     let parts: Vec<Summary> = from_js(parts, "summaries")?;
     to_js(&Summary::merged(&parts), "a summary")
 }
@@ -241,12 +257,14 @@ impl Models {
     /// Reads and imports a `File` under `name` (the job's key for it; a file of the same name
     /// is replaced). Returns `ModelInfo {name, format, triangles, bounds {min, max}, items:
     /// [{name, triangles, bounds}], warnings, suggested_scale}`.
+    #[wasm_bindgen(unchecked_return_type = "ModelInfo")]
     pub fn add(&mut self, file: web_sys::File, name: &str) -> Result<JsValue, JsValue> {
         let bytes = read_file(&file)?;
         self.add_bytes(&bytes, name)
     }
 
     /// [`Models::add`] from bytes.
+    #[wasm_bindgen(unchecked_return_type = "ModelInfo")]
     pub fn add_bytes(&mut self, bytes: &[u8], name: &str) -> Result<JsValue, JsValue> {
         let model = Model::read(bytes, name).map_err(js_error)?;
         let info = model.info();
@@ -263,6 +281,7 @@ impl Models {
     }
 
     /// The files' names, in the order they were added.
+    #[wasm_bindgen(unchecked_return_type = "string[]")]
     pub fn names(&self) -> Result<JsValue, JsValue> {
         let names: Vec<&str> = self.models.iter().map(|m| m.name.as_str()).collect();
         to_js(&names, "the file names")
@@ -287,6 +306,7 @@ impl Models {
     /// bounds, warnings}` (`matrix`: column-major 4×4, model → plate coordinates, exactly
     /// the transform sliced). `job`: `{settings, parts}` as in a job file. Throws
     /// `{kind: "job" | "setting", message, setting?}`.
+    #[wasm_bindgen(unchecked_return_type = "Layout")]
     pub fn layout(&self, job: JsValue) -> Result<JsValue, JsValue> {
         let spec = job_of(job)?;
         let layout = job::layout(&self.models, &spec).map_err(js_error)?;
@@ -294,9 +314,11 @@ impl Models {
     }
 
     /// `{rotate_x, rotate_y}` (degrees) that put a file's (or item's) largest flat face down.
+    #[wasm_bindgen(unchecked_return_type = "Angles")]
     pub fn lay_flat(&self, name: &str, item: Option<usize>) -> Result<JsValue, JsValue> {
         let tris = self.model(name)?.triangles(item).map_err(js_error)?;
         let (rotate_x, rotate_y) = job::lay_flat(&tris);
+        #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
         #[derive(Serialize)]
         struct Angles {
             rotate_x: f64,
@@ -370,6 +392,7 @@ impl Session {
 
 /// The figures of a slice as the page shows them: the merged summary (to keep instead of its
 /// parts), its figures, and "nothing to print" once every layer is in.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Serialize)]
 struct SliceFigures {
     summary: Summary,
@@ -426,7 +449,7 @@ impl Session {
     pub fn from_prepared(
         vertices: &[f64],
         facets: &[u32],
-        info: JsValue,
+        #[wasm_bindgen(unchecked_param_type = "JobInfo")] info: JsValue,
         settings: JsValue,
     ) -> Result<Session, JsValue> {
         let settings = settings_of(settings)?;
@@ -465,6 +488,7 @@ impl Session {
     }
 
     /// Facets, bounds, layers, droplet width and mesh warnings (`JobInfo`).
+    #[wasm_bindgen(unchecked_return_type = "JobInfo")]
     pub fn info(&self) -> Result<JsValue, JsValue> {
         to_js(self.job.info(), "the job info")
     }
@@ -498,7 +522,10 @@ impl Session {
 
     /// The header comment block for a finished slice (`summary`: every unit's summary
     /// merged); `null` gives the same-width placeholder header.
-    pub fn header(&self, summary: JsValue) -> Result<String, JsValue> {
+    pub fn header(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "Summary | null")] summary: JsValue,
+    ) -> Result<String, JsValue> {
         if summary.is_null() || summary.is_undefined() {
             return Ok(self.job.header(None));
         }
@@ -507,7 +534,10 @@ impl Session {
     }
 
     /// The closing comment block.
-    pub fn footer(&self, summary: JsValue) -> Result<String, JsValue> {
+    pub fn footer(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "Summary")] summary: JsValue,
+    ) -> Result<String, JsValue> {
         let summary: Summary = from_js(summary, "summary")?;
         Ok(gcode::footer(&summary))
     }
@@ -515,7 +545,11 @@ impl Session {
     /// Merges `parts` (summaries of units, in any order) and computes the figures with this
     /// session's settings: `{summary, figures, nothing_to_print}` (`nothing_to_print` is the
     /// error `{kind, message}` when every layer is in and not one droplet fits, else `null`).
-    pub fn figures(&self, parts: JsValue) -> Result<JsValue, JsValue> {
+    #[wasm_bindgen(unchecked_return_type = "SliceFigures")]
+    pub fn figures(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "Summary[]")] parts: JsValue,
+    ) -> Result<JsValue, JsValue> {
         let parts: Vec<Summary> = from_js(parts, "summaries")?;
         let summary = Summary::merged(&parts);
         let complete = summary.layers == self.job.layer_count();
@@ -562,6 +596,7 @@ impl Tally {
     }
 
     /// The summary so far (`Summary`).
+    #[wasm_bindgen(unchecked_return_type = "Summary")]
     pub fn summary(&self) -> Result<JsValue, JsValue> {
         to_js(&self.summary, "a summary")
     }
@@ -682,6 +717,7 @@ impl LayerResult {
     /// The layer's void analysis (`analysis::LayerAnalysis`: coverage, void_area,
     /// largest_void {area, centroid, min, max, at_boundary}, overfill_area,
     /// boundary_deviation, ...); `null` unless made by `slice_layer_analysed`.
+    #[wasm_bindgen(unchecked_return_type = "LayerAnalysis | null")]
     pub fn analysis(&self) -> Result<JsValue, JsValue> {
         match &self.analysis {
             Some(a) => to_js(a, "a layer analysis"),

@@ -67,6 +67,7 @@ impl GcodeStream {
 
     /// The header's `name = value` lines as a plain object `{name: value}` (a typed value,
     /// as everything else that crosses the boundary; a later line of the same name wins).
+    #[wasm_bindgen(unchecked_return_type = "Record<string, string>")]
     pub fn header(&self) -> Result<JsValue, JsValue> {
         let map: std::collections::BTreeMap<&str, &str> = self
             .reader
@@ -83,6 +84,7 @@ impl GcodeStream {
     /// After `finish`: the calibration of this file for a measured `mass` (g) and `density`
     /// (g/cm³; `undefined`: the header's material_density, else the default) as a plain
     /// `Calibration` object. Throws the refusal's message (calibrate.rs).
+    #[wasm_bindgen(unchecked_return_type = "Calibration")]
     pub fn calibrate(&self, mass: f64, density: Option<f64>) -> Result<JsValue, JsValue> {
         let c = crate::output::calibrate::calibrate_read(&self.reader, mass, density)
             .map_err(|e| JsValue::from(JsError::new(&e.0)))?;
@@ -92,7 +94,7 @@ impl GcodeStream {
 
 /// The calibration from a slice's droplet count (its summary) and settings: `droplets`,
 /// `layer_height`, `droplet_aspect`, a measured `mass` (g) and `density` (g/cm³).
-#[wasm_bindgen]
+#[wasm_bindgen(unchecked_return_type = "Calibration")]
 pub fn calibrate(
     droplets: f64,
     layer_height: f64,

@@ -11,6 +11,8 @@ import { repo } from "./helpers.mjs";
 
 const out = mkdtempSync(join(tmpdir(), "dropslice-units-"));
 let gcode, share, form, sample;
+/** The core's job schema: a link's parts are checked against it. */
+let jobSchema;
 
 before(async () => {
   const names = ["worker/gcode", "core/share", "core/settings", "core/sample"];
@@ -25,6 +27,9 @@ before(async () => {
   [gcode, share, form, sample] = await Promise.all(names.map((n) => import(pathToFileURL(join(out, `${n}.js`)).href)));
   // the G-code reader is the core's (built into www/pkg by the page build)
   await gcode.loadCore(readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")));
+  const core = await import(pathToFileURL(join(repo, "www", "pkg", "dropslice.js")).href);
+  await core.default({ module_or_path: readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")) });
+  jobSchema = core.job_schema();
 });
 
 after(() => rmSync(out, { recursive: true, force: true }));
@@ -94,7 +99,7 @@ test("preview links: embedded when small, hash only when big", async () => {
   const small = new Uint8Array(1000).fill(7);
   const a = await share.makeLink("http://x/#old", state, new Blob([small]));
   assert.ok(a.embedded && a.url.startsWith("http://x/#p="));
-  const back = await share.readLink(a.url.slice(a.url.indexOf("#")));
+  const back = await share.readLink(a.url.slice(a.url.indexOf("#")), jobSchema);
   assert.deepEqual(back.state, state);
   assert.deepEqual(back.model, small);
   // random bytes do not compress: 300 KB stays above the 256 KB limit
@@ -103,9 +108,9 @@ test("preview links: embedded when small, hash only when big", async () => {
   const b = await share.makeLink("http://x/", state, new Blob([big]));
   assert.equal(b.embedded, false);
   assert.doesNotMatch(b.url, /&m=/);
-  assert.equal((await share.readLink(b.url.slice(b.url.indexOf("#")))).model, null);
-  assert.equal(await share.readLink("#"), null);
-  await assert.rejects(share.readLink("#p=AAAA"));
+  assert.equal((await share.readLink(b.url.slice(b.url.indexOf("#")), jobSchema)).model, null);
+  assert.equal(await share.readLink("#", jobSchema), null);
+  await assert.rejects(share.readLink("#p=AAAA", jobSchema));
 });
 
 test("settings: relaxed input becomes strict values, with messages", () => {

@@ -4,21 +4,50 @@
 // computes no placement of its own: every matrix and box comes from the core's layout. No DOM.
 
 import type { JobFileRef } from "./client";
-import type { JobFile, Layout, ModelInfo, PartSpec, Settings } from "./protocol";
+import type { JobFile, JobSchema, Layout, ModelInfo, PartSpec, SettingSpec, Settings } from "./protocol";
 
-/** The keys of a part (docs/jobs.md): the core refuses them in a job's settings, so the
- *  settings form hides them and the page keeps them in each part's spec. */
-export const PART_KEYS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle"] as const;
+/** The keys of a part (rotate_*, scale_*, place_*): the core's settings schema flags them
+ *  `part`. The core refuses them in a job's settings, so the settings form hides them and the
+ *  page keeps them in each part's spec. */
+export function partKeys(schema: readonly SettingSpec[]): string[] {
+  return schema.filter((s) => s.part).map((s) => s.name);
+}
 
-/** The core's bounds of a part's keys (src/job.rs): the page's panel and links check them too. */
-export const PART_LIMITS = {
-  rotate: 360,
-  scaleMax: 1000,
-  place: 10_000,
-  copies: 100,
-  parts: 256,
-  nameChars: 255,
-} as const;
+/** The settings the core takes for a job: `values` without the part keys (the one place the
+ *  page drops them). */
+export function jobSettings(values: Settings, schema: readonly SettingSpec[]): Settings {
+  const part = new Set(partKeys(schema));
+  const out: Settings = {};
+  for (const [k, v] of Object.entries(values)) if (!part.has(k)) out[k] = v;
+  return out;
+}
+
+/** The core's range of a number of a part (the part keys, copies, unit: the core's
+ *  `job_schema`); undefined for a key that is not one. */
+export function partNumber(job: JobSchema, key: string): SettingSpec | undefined {
+  return job.part_numbers.find((s) => s.name === key);
+}
+
+/** Whether `x` is a value the core takes for the part's number `spec`. */
+export function fitsPart(spec: SettingSpec, x: number): boolean {
+  const { min, max } = spec;
+  if (!Number.isFinite(x) || min === null || max === null) return false;
+  if (spec.kind === "integer" && !Number.isInteger(x)) return false;
+  return (spec.min_exclusive ? x > min : x >= min) && x <= max;
+}
+
+const nf = new Intl.NumberFormat("en-US");
+
+/** The range of a part's number in words: "a whole number 1 … 100", "> 0 and ≤ 1,000",
+ *  "−360 … 360 deg". */
+export function partRangeWords(spec: SettingSpec): string {
+  const unit = spec.unit ? ` ${spec.unit}` : "";
+  const [min, max] = [spec.min ?? -Infinity, spec.max ?? Infinity];
+  const n = (x: number) => (x < 0 ? `−${nf.format(-x)}` : nf.format(x));
+  if (spec.kind === "integer") return `a whole number ${n(min)} … ${n(max)}`;
+  if (spec.min_exclusive) return `> ${n(min)} and ≤ ${n(max)}${unit}`;
+  return `${n(min)} … ${n(max)}${unit}`;
+}
 
 /** Triangles the 3D view draws for a whole job, shared by its instances. */
 export const DISPLAY_BUDGET = 300_000;
@@ -41,7 +70,10 @@ export interface DisplayMesh {
 /** One part: a stable id (the 3D view's ids are `${id}:${copy}`), its file and its spec. */
 export interface Part {
   id: number;
-  spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "place_angle" | "copies" | "unit">> & Pick<PartSpec, "item" | "place_x" | "place_y" | "name">;
+  spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "place_angle" | "copies" | "unit">> & {
+    /** Absent, never null: the whole file, unplaced (arranged), the file's name. */
+    [K in "item" | "place_x" | "place_y" | "name"]?: NonNullable<PartSpec[K]>;
+  };
   mesh: DisplayMesh | null;
 }
 
@@ -99,13 +131,6 @@ export function uniqueName(name: string, taken: (n: string) => boolean): string 
     const n = `${stem} (${k})${ext}`;
     if (!taken(n)) return n;
   }
-}
-
-/** The settings the core takes for a job: the form's, without the part keys. */
-export function jobSettings(values: Settings): Settings {
-  const out: Settings = {};
-  for (const [k, v] of Object.entries(values)) if (!(PART_KEYS as readonly string[]).includes(k)) out[k] = v;
-  return out;
 }
 
 export class Job {

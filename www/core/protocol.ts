@@ -1,94 +1,64 @@
 // Messages between the page (client.ts) and a worker (worker/worker.ts).
 // Every request is {id, kind, data}; the worker answers with any number of
 // "progress" replies and then exactly one "result" or "error" reply with the same id.
+//
+// The values the core hands out (model info, layouts, job info, summaries, figures, layer
+// analyses, the settings schema, calibrations, errors) are typed by the core itself: their
+// declarations are generated from the Rust types (tsify) into the wasm glue's
+// ../pkg/dropslice.d.ts by scripts/build.sh, and re-exported here. Only what the page and
+// its workers make themselves is declared below.
 
-export interface Counts {
-  outer: number;
-  inner: number;
-  fill: number;
-  /** Support droplets (unit 1; the core's figures and a slice's layers). */
-  support?: number;
-  /** Droplets printed by unit 1 (support and unit-1 parts; a .gco file's after `T1`). */
-  unit1?: number;
-}
+import type {
+  Angles,
+  Bounds,
+  Calibration,
+  Counts,
+  CutResult,
+  ErrorReport,
+  Figures,
+  Instance,
+  ItemInfo,
+  JobInfo,
+  JobSchema,
+  LayerAnalysis,
+  Layout,
+  MeshStats,
+  ModelInfo,
+  PartAnalysis,
+  PartSpec,
+  SettingSpec,
+  SliceFigures,
+  Summary,
+  Void,
+  WorstLayer,
+} from "../pkg/dropslice.js";
 
-/** What the core says of an added file (src/job.rs `ModelInfo`); model coordinates in mm. */
-export interface ModelInfo {
-  name: string;
-  format: string;
-  triangles: number;
-  bounds: { min: [number, number, number]; max: [number, number, number] };
-  items: { name: string; triangles: number; bounds: { min: [number, number, number]; max: [number, number, number] } }[];
-  warnings: string[];
-  suggested_scale: number | null;
-}
-
-/** One part of a job file (docs/jobs.md): absent keys take the core's defaults. */
-export interface PartSpec {
-  file: string;
-  item?: number;
-  rotate_x?: number;
-  rotate_y?: number;
-  rotate_z?: number;
-  scale_x?: number;
-  scale_y?: number;
-  scale_z?: number;
-  place_x?: number;
-  place_y?: number;
-  place_angle?: number;
-  copies?: number;
-  unit?: number;
-  name?: string;
-}
+export type {
+  Bounds,
+  Calibration,
+  Counts,
+  Figures,
+  Instance,
+  ItemInfo,
+  JobInfo,
+  JobSchema,
+  LayerAnalysis,
+  Layout,
+  MeshStats,
+  ModelInfo,
+  PartAnalysis,
+  PartSpec,
+  SettingSpec,
+  SliceFigures,
+  Summary,
+  Void,
+  WorstLayer,
+};
 
 /** A job file (docs/jobs.md): the job's settings (no part keys) and its parts. */
 export interface JobFile {
   settings: Settings;
   parts: PartSpec[];
-}
-
-/** One copy of one part on the plate (src/job.rs `Instance`); `part` and `copy` from 0. */
-export interface Instance {
-  part: number;
-  copy: number;
-  copies: number;
-  name: string;
-  file: string;
-  item: number | null;
-  object: string | null;
-  rotate: [number, number, number];
-  scale: [number, number, number];
-  place_angle: number;
-  placed: boolean;
-  /** Where the instance's box minimum went (place_x, place_y when placed). */
-  at: [number, number];
-  unit: number;
-  /** Column-major 4×4, model → plate coordinates (mm). */
-  matrix: number[];
-  min: [number, number, number];
-  max: [number, number, number];
-}
-
-/** Where every instance of a job goes (src/job.rs `Layout`). */
-export interface Layout {
-  instances: Instance[];
-  bounds: { min: [number, number, number]; max: [number, number, number] };
-  warnings: string[];
-}
-
-/** Where a slice came from and what the core said about the mesh. */
-export interface JobInfo {
-  file_name?: string;
-  mesh?: { facets_in_file: number; facets: number; vertices: number; open_edges: number };
-  droplet_width?: number;
-  bounds?: { min: [number, number, number]; max: [number, number, number] };
-  layers?: number;
-  warnings?: string[];
-  /** Scale for x, y and z when the size suggests inches (25.4) or micrometres (0.001). */
-  suggested_scale?: number | null;
-  /** Every copy of every part (a build job; one for a single file). */
-  instances?: Instance[];
-  [key: string]: unknown;
 }
 
 /** One layer as drawn: flat arrays, never an object per droplet. */
@@ -116,30 +86,6 @@ export interface LayerData {
   analysis?: LayerAnalysis;
   /** Coverage mask of the analysis (cells of B/4). */
   mask?: CoverageMask;
-}
-
-/** One connected void of a layer (src/analysis.rs `Void`); areas mm², points mm. */
-export interface Void {
-  area: number;
-  centroid: [number, number];
-  min: [number, number];
-  max: [number, number];
-  at_boundary: boolean;
-}
-
-/** What a layer's droplets cover of its region (src/analysis.rs `LayerAnalysis`). */
-export interface LayerAnalysis {
-  index: number;
-  region_area: number;
-  covered_area: number;
-  coverage: number;
-  void_area: number;
-  enclosed_void_area: number;
-  voids: number;
-  largest_void: Void | null;
-  overfill_area: number;
-  boundary_deviation: number;
-  [key: string]: unknown;
 }
 
 /** The analysis' coverage mask: square cells of `cell` mm, in tiles only where the layer's
@@ -193,63 +139,12 @@ export function coverageMaskOf(r: {
   return { cell: r.mask_cell, tiles };
 }
 
-/** An error as the core throws it (src/error.rs `ErrorReport`: import, setting, job,
- *  nothing_to_print, io, internal) and as a worker replies it; `crash` and `link` are the
- *  page's own kinds. */
-export interface ErrorValue {
-  kind: string;
-  message: string;
-  /** The setting at fault, for kind "setting". */
-  setting?: string;
-}
+/** An error as the core throws it (`ErrorReport`: import, setting, job, nothing_to_print,
+ *  io, internal, …) and as a worker replies it; `crash` and `link` are the page's own kinds. */
+export type ErrorValue = ErrorReport;
 
 /** Settings as the form gives them: `{name: value}`; the core validates them. */
 export type Settings = Record<string, number | boolean | string>;
-
-/** The core's summary of some layers (src/summary.rs `Summary`). The page never adds these
- *  up: it keeps them and asks a worker for the merged figures. */
-export interface Summary {
-  layers: number;
-  counts: Counts;
-  travel_mm: number;
-  layers_with_open_chains: number;
-  reoriented_loops: number;
-  analysis: Record<string, unknown>;
-}
-
-/** Every figure of a slice, as the core computed it (src/summary.rs `Figures`). */
-export interface Figures {
-  layers: number;
-  counts: Counts;
-  droplets: number;
-  volume_mm3: number;
-  mass_g: number;
-  /** Droplets printed by unit 1, their volume (× B₁²H) and mass (unit1_material_density). */
-  unit1_droplets: number;
-  unit1_volume_mm3: number;
-  unit1_mass_g: number;
-  print_seconds: number;
-  unit0_seconds: number;
-  unit1_seconds: number;
-  /** Overhang area summed over the layers, mm², and the layer with the largest. */
-  unsupported_area: number;
-  worst_overhang: { index: number; area: number } | null;
-  travel_mm: number;
-  analysed_layers: number;
-  coverage: number | null;
-  void_area: number | null;
-  worst_layer: { index: number; area: number } | null;
-  repairs: string[];
-}
-
-/** The result of a "figures" request (src/wasm.rs `Session::figures`). */
-export interface SliceFigures {
-  /** The parts merged: keep this instead of them. */
-  summary: Summary;
-  figures: Figures;
-  /** Once every layer is in and not one droplet fits. */
-  nothing_to_print: ErrorValue | null;
-}
 
 /** The result of a "slice" request: what belongs to its run of layers as a whole. */
 export interface SliceUnit {
@@ -261,22 +156,11 @@ export interface SliceUnit {
   summary: Summary;
 }
 
-export interface SettingSpec {
-  name: string;
-  kind: "number" | "integer" | "bool" | "enum";
-  unit: string;
-  min: number | null;
-  max: number | null;
-  min_exclusive?: boolean;
-  choices: string[];
-  group: string;
-  description: string;
-  default: number | boolean | string;
-}
-
 export interface InitResult {
   version: string;
   schema: SettingSpec[];
+  /** The numbers a job's part carries, their ranges and the job's counts. */
+  job: JobSchema;
   defaults: Settings;
 }
 
@@ -325,7 +209,7 @@ export interface Calls {
   /** A decimated copy of a file's (or 3MF item's) triangles for the 3D view (9 floats each). */
   display_mesh: { data: { name: string; item?: number; max: number }; result: Float32Array };
   layout: { data: { job: JobFile }; result: Layout };
-  lay_flat: { data: { name: string; item?: number }; result: { rotate_x: number; rotate_y: number } };
+  lay_flat: { data: { name: string; item?: number }; result: Angles };
   /** Prepares the job `job` of the files added (Session.from_models); like "open". */
   open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
@@ -357,22 +241,6 @@ export interface UnsupportedRequest {
   limitMm: number;
 }
 
-/** src/calibrate.rs `Calibration`. */
-export interface Calibration {
-  droplets: number;
-  count_source: "header" | "commands" | "given";
-  mass_g: number;
-  density_g_cm3: number;
-  layer_height: number;
-  droplet_volume_mm3: number;
-  cell_volume_mm3: number;
-  filling_degree: number;
-  suggested_droplet_aspect: number;
-  current_droplet_aspect: number;
-  /** One line for people, ending in the suggestion. */
-  explanation: string;
-}
-
 /** A vertical cut along `line` = [ax, ay, bx, by] for layers [from, to): `sent` per layer of
  *  [from − 1, to + 1) within the part, the droplet centres sent in `centres` (x, y pairs, every
  *  droplet within B of the line), or [[NOT_SENT]] for a layer the worker plans itself. */
@@ -385,14 +253,10 @@ export interface CutRequest {
 }
 export const NOT_SENT = 0xffffffff;
 
-/** src/wasm_cut.rs `CutResult`: droplets (layer, t, d, role, unit; only layers not sent), spans
- *  (layer, t0, t1), voids (layer, band, t0, t1) of `bands` heights per slab. */
-export interface CutReply {
-  droplets: Float64Array;
-  spans: Float64Array;
-  voids: Float64Array;
-  bands: number;
-}
+/** The core's `CutResult` (src/wasm/cut.rs) as plain arrays: droplets (layer, t, d, role,
+ *  unit; only layers not sent), spans (layer, t0, t1), voids (layer, band, t0, t1) of `bands`
+ *  heights per slab. */
+export type CutReply = Pick<CutResult, "droplets" | "spans" | "voids" | "bands">;
 
 export type RequestKind = keyof Calls;
 export type RequestData<K extends RequestKind> = Calls[K]["data"];

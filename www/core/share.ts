@@ -8,10 +8,11 @@
 // they are decoded, both parts are inflated as a stream that is cancelled as soon as it grows
 // past its cap, and every field of the state is checked (type, finite, range) before the page
 // uses it. Fields that are wrong are dropped and named (`ignored`); a link that is too large or
-// damaged is refused with a [[LinkError]].
+// damaged is refused with a [[LinkError]]. A job's parts are checked against the core's own
+// ranges (its `job_schema`, which the page has from init).
 
-import { PART_LIMITS } from "./job";
-import type { PartSpec } from "./protocol";
+import { fitsPart, partNumber } from "./job";
+import type { JobSchema, PartSpec } from "./protocol";
 import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./view";
 
 export const EMBED_LIMIT = 256 * 1024;
@@ -196,9 +197,10 @@ const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "obj
  * The state of a link as the page may use it: structure and hash checked (a [[LinkError]]
  * otherwise), unusable fields dropped and limited ones brought in range, each named in
  * `ignored`. Settings are checked for their basic type here (finite number, boolean or short
- * text); the page checks each against its own kind and range.
+ * text); the page checks each against its own kind and range. A job's parts are checked
+ * against `job` (the core's job schema).
  */
-export function checkState(raw: unknown): { state: ShareState; ignored: string[] } {
+export function checkState(raw: unknown, job: JobSchema): { state: ShareState; ignored: string[] } {
   if (!isObject(raw)) throw new LinkError("its state is not a preview's state");
   const ignored: string[] = [];
   // a SHA-256 is 64 hexadecimal digits; fewer are accepted (they can only fail to match)
@@ -255,8 +257,8 @@ export function checkState(raw: unknown): { state: ShareState; ignored: string[]
 
   const state: ShareState = { settings, name, sha256 };
   if (raw.files !== undefined || raw.parts !== undefined) {
-    state.files = checkFiles(raw.files);
-    state.parts = checkParts(raw.parts, state.files, ignored);
+    state.files = checkFiles(raw.files, job);
+    state.parts = checkParts(raw.parts, state.files, job, ignored);
   }
   if (layer !== undefined) state.layer = layer;
   if (view !== undefined) state.view = view;
@@ -266,12 +268,13 @@ export function checkState(raw: unknown): { state: ShareState; ignored: string[]
 
 const HEX = /^[0-9a-fA-F]{1,64}$/;
 
-/** The job's files of a link: at most [[PART_LIMITS]].parts, names of at most 255 characters,
- *  distinct; hexadecimal hashes; sizes that add up to at most [[MODEL_MAX_BYTES]]. Anything
- *  else is a [[LinkError]] (the parts could not be matched to their files). */
-function checkFiles(raw: unknown): LinkFile[] {
+/** The job's files of a link: at most the core's `max_parts`, names of at most 255
+ *  characters, distinct; hexadecimal hashes; sizes that add up to at most
+ *  [[MODEL_MAX_BYTES]]. Anything else is a [[LinkError]] (the parts could not be matched to
+ *  their files). */
+function checkFiles(raw: unknown, job: JobSchema): LinkFile[] {
   if (!Array.isArray(raw) || raw.length === 0) throw new LinkError("its job's files are not a list of files");
-  if (raw.length > PART_LIMITS.parts) throw new LinkError(`its job lists ${nf.format(raw.length)} files; at most ${PART_LIMITS.parts} are accepted`);
+  if (raw.length > job.max_parts) throw new LinkError(`its job lists ${nf.format(raw.length)} files; at most ${job.max_parts} are accepted`);
   const out: LinkFile[] = [];
   let total = 0;
   raw.forEach((f, i) => {
@@ -287,27 +290,15 @@ function checkFiles(raw: unknown): LinkFile[] {
   return out;
 }
 
-/** Numbers of a part: [min, max, whole number], as the core checks them (docs/jobs.md). */
-const PART_NUMBERS: Record<string, [number, number, boolean]> = {
-  rotate_x: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
-  rotate_y: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
-  rotate_z: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
-  scale_x: [Number.MIN_VALUE, PART_LIMITS.scaleMax, false],
-  scale_y: [Number.MIN_VALUE, PART_LIMITS.scaleMax, false],
-  scale_z: [Number.MIN_VALUE, PART_LIMITS.scaleMax, false],
-  place_x: [-PART_LIMITS.place, PART_LIMITS.place, false],
-  place_y: [-PART_LIMITS.place, PART_LIMITS.place, false],
-  place_angle: [-PART_LIMITS.rotate, PART_LIMITS.rotate, false],
-  copies: [1, PART_LIMITS.copies, true],
-  unit: [0, 1, true],
-  item: [0, 1_000_000, true],
-};
+/** A 3MF build item's index: a whole number, bounded here only to keep the link's numbers
+ *  sane (the core checks it against the file's items). */
+const ITEM_MAX = 1_000_000;
 
 /** The parts of a link: each names one of `files`; a number that is not finite or out of
  *  range is dropped (the default is used) and named in `ignored`; the core checks all again. */
-function checkParts(raw: unknown, files: LinkFile[], ignored: string[]): PartSpec[] {
+function checkParts(raw: unknown, files: LinkFile[], job: JobSchema, ignored: string[]): PartSpec[] {
   if (!Array.isArray(raw) || raw.length === 0) throw new LinkError("its job's parts are not a list of parts");
-  if (raw.length > PART_LIMITS.parts) throw new LinkError(`its job has ${nf.format(raw.length)} parts; at most ${PART_LIMITS.parts} are accepted`);
+  if (raw.length > job.max_parts) throw new LinkError(`its job has ${nf.format(raw.length)} parts; at most ${job.max_parts} are accepted`);
   return raw.map((p, i) => {
     const at = `its part ${i + 1}`;
     if (!isObject(p)) throw new LinkError(`${at} is not a part`);
@@ -315,14 +306,18 @@ function checkParts(raw: unknown, files: LinkFile[], ignored: string[]): PartSpe
     const out: PartSpec = { file: p.file };
     for (const [k, v] of Object.entries(p)) {
       if (k === "file") continue;
-      const range = PART_NUMBERS[k];
+      const spec = partNumber(job, k);
       if (k === "name") {
         if (typeof v === "string" && v.length <= NAME_MAX) out.name = v;
         else ignored.push(`${at}'s name (not a text of at most ${NAME_MAX} characters)`);
-      } else if (!range) {
+      } else if (k === "item") {
+        if (typeof v === "number" && Number.isInteger(v) && v >= 0 && v <= ITEM_MAX) out.item = v;
+        else ignored.push(`${at}'s item (${shown(v)} is not a whole number in 0 … ${ITEM_MAX}: the whole file is used)`);
+      } else if (!spec) {
         ignored.push(`${at}'s ${/^[a-z_]{1,40}$/.test(k) ? k : "unknown key"} (not a part's setting)`);
-      } else if (typeof v !== "number" || !Number.isFinite(v) || v < range[0] || v > range[1] || (range[2] && !Number.isInteger(v))) {
-        ignored.push(`${at}'s ${k} (${shown(v)} is not ${range[2] ? "a whole number" : "a number"} in ${range[0] === Number.MIN_VALUE ? "(0" : range[0]} … ${range[1]}: the default is used)`);
+      } else if (typeof v !== "number" || !fitsPart(spec, v)) {
+        const whole = spec.kind === "integer";
+        ignored.push(`${at}'s ${k} (${shown(v)} is not ${whole ? "a whole number" : "a number"} in ${spec.min_exclusive ? "(" : ""}${spec.min} … ${spec.max}: the default is used)`);
       } else {
         (out as unknown as Record<string, number>)[k] = v;
       }
@@ -336,10 +331,11 @@ function checkParts(raw: unknown, files: LinkFile[], ignored: string[]): PartSpe
   });
 }
 
-/** Reads a link's fragment; null when it holds no preview. Throws a [[LinkError]] on a link
+/** Reads a link's fragment (parts checked against `job`, the core's job schema); null when it
+ *  holds no preview. Throws a [[LinkError]] on a link
  *  too large or damaged to read; a too large or damaged embedded model is reported in
  *  `modelError` (the state is still usable: the receiver can drop the file in). */
-export async function readLink(hash: string): Promise<SharedLink | null> {
+export async function readLink(hash: string, job: JobSchema): Promise<SharedLink | null> {
   const params = new URLSearchParams(hash.replace(/^#/, ""));
   const p = params.get("p");
   if (!p) return null;
@@ -351,7 +347,7 @@ export async function readLink(hash: string): Promise<SharedLink | null> {
   } catch {
     throw new LinkError("its state is not readable (the link may have been cut or changed)");
   }
-  const { state, ignored } = checkState(raw);
+  const { state, ignored } = checkState(raw, job);
   const m = params.get("m");
   let model: Uint8Array | null = null;
   let models: Uint8Array[] | null = null;

@@ -38,7 +38,8 @@ export interface PendingJob {
 /** Everything known about one slice (or one opened .gco file). */
 export class Slice {
   layers = 0;
-  info: JobInfo = {};
+  /** The core's info of a slice; empty for a .gco file (the core did not prepare it). */
+  info: Partial<JobInfo> = {};
   z: number[] = [];
   counts: (Counts | undefined)[] = [];
   travelMm: number[] = [];
@@ -80,7 +81,7 @@ export class Slice {
     readonly cacheBudget: number,
   ) {}
 
-  open(layers: number, info: JobInfo): void {
+  open(layers: number, info: Partial<JobInfo>): void {
     this.layers = layers;
     this.info = info;
   }

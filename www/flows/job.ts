@@ -78,7 +78,7 @@ export function adoptJob(page: Page, job: Job): void {
 }
 
 function settingsOf(page: Page) {
-  return jobSettings(page.form!.values());
+  return jobSettings(page.form!.values(), page.init!.schema);
 }
 
 /**

@@ -6,10 +6,10 @@
 
 import type { Value } from "../core/settings";
 import { openGcode, startSlice, type Target } from "./slice";
-import { PART_KEYS, PART_LIMITS } from "../core/job";
+import { jobSettings, partKeys } from "../core/job";
 import { adoptJob, newJob, type NewFile } from "./job";
 import type { Page } from "../views/page";
-import type { JobFile, PartSpec } from "../core/protocol";
+import type { JobFile, JobSchema, PartSpec, SettingSpec } from "../core/protocol";
 import { sampleStl } from "../core/sample";
 import { LinkError, readLink, type ShareState, type SharedLink } from "../core/share";
 import type { PendingJob } from "../core/store";
@@ -20,8 +20,8 @@ import { setShowTravel } from "../views/layer";
 import { showModel } from "../views/stats";
 import { setState } from "../views/status";
 
-/** A job file is read on the page's thread: at most this many bytes. */
-export const JOB_FILE_MAX_BYTES = 1024 * 1024;
+/** The longest model file name a job file's part may give (a file system's limit). */
+const FILE_NAME_MAX = 255;
 
 const isGcode = (f: File) => /\.(gco|gcode)$/i.test(f.name);
 const isJobFile = (f: File) => /\.json$/i.test(f.name);
@@ -45,7 +45,7 @@ export async function openFiles(page: Page, files: File[]): Promise<void> {
   const jobFile = files.find(isJobFile);
   const models = files.filter((f) => !isJobFile(f));
   if (jobFile) {
-    const job = await readJobFile(jobFile);
+    const job = await readJobFile(jobFile, page.init!.job);
     if (typeof job === "string") {
       showBanner(TITLES.job, job);
       setState("error");
@@ -79,10 +79,11 @@ async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target:
   return true;
 }
 
-/** Reads a job file (bounded) into its JSON; a message when it is not one. The core checks
- *  every field when the job is laid out. */
-async function readJobFile(file: File): Promise<JobFile | string> {
-  if (file.size > JOB_FILE_MAX_BYTES) return `“${file.name}” is ${nf.format(file.size)} bytes; a job file has at most ${nf.format(JOB_FILE_MAX_BYTES)}.`;
+/** Reads a job file (on the page's thread, at most the core's `max_job_file_bytes`) into its
+ *  JSON; a message when it is not one. The core checks every field when the job is laid out. */
+async function readJobFile(file: File, limits: JobSchema): Promise<JobFile | string> {
+  const maxBytes = limits.max_job_file_bytes;
+  if (file.size > maxBytes) return `“${file.name}” is ${nf.format(file.size)} bytes; a job file has at most ${nf.format(maxBytes)}.`;
   let raw: unknown;
   try {
     raw = JSON.parse(await file.text());
@@ -92,10 +93,11 @@ async function readJobFile(file: File): Promise<JobFile | string> {
   const obj = raw as { settings?: unknown; parts?: unknown };
   if (typeof raw !== "object" || raw === null || Array.isArray(raw)) return `“${file.name}” is not a job file: it must be an object {"settings": {…}, "parts": [{"file": "a.stl"}, …]}.`;
   if (!Array.isArray(obj.parts) || obj.parts.length === 0) return `“${file.name}” lists no parts: a job file has "parts": [{"file": "a.stl"}, …].`;
-  if (obj.parts.length > PART_LIMITS.parts) return `“${file.name}” lists ${nf.format(obj.parts.length)} parts; at most ${PART_LIMITS.parts} are allowed.`;
+  const maxParts = limits.max_parts;
+  if (obj.parts.length > maxParts) return `“${file.name}” lists ${nf.format(obj.parts.length)} parts; at most ${maxParts} are allowed.`;
   const parts = obj.parts as unknown[];
-  const bad = parts.findIndex((p) => typeof p !== "object" || p === null || typeof (p as { file?: unknown }).file !== "string" || (p as { file: string }).file.length > PART_LIMITS.nameChars);
-  if (bad >= 0) return `“${file.name}”: parts[${bad}] has no "file" (the model's file name, at most ${PART_LIMITS.nameChars} characters).`;
+  const bad = parts.findIndex((p) => typeof p !== "object" || p === null || typeof (p as { file?: unknown }).file !== "string" || (p as { file: string }).file.length > FILE_NAME_MAX);
+  if (bad >= 0) return `“${file.name}”: parts[${bad}] has no "file" (the model's file name, at most ${FILE_NAME_MAX} characters).`;
   const settings = obj.settings === undefined || obj.settings === null ? {} : obj.settings;
   if (typeof settings !== "object" || Array.isArray(settings)) return `“${file.name}”: "settings" must be an object {"name": value, …}.`;
   return { settings: settings as Record<string, Value>, parts: parts as PartSpec[] };
@@ -206,16 +208,14 @@ function linkSettings(page: Page, settings: Record<string, Value>, ignored: stri
 
 /** The job of a link: its parts, or (a link of one model from an older page) one part of its
  *  model, which takes the link's part settings (rotate_z, scale_x, …) as its own. */
-function linkJob(state: ShareState, settings: Record<string, Value>): JobFile {
-  const own: Record<string, Value> = {};
+function linkJob(state: ShareState, settings: Record<string, Value>, schema: readonly SettingSpec[]): JobFile {
   const part: PartSpec = { file: state.name };
-  for (const [k, v] of Object.entries(settings)) {
-    if ((PART_KEYS as readonly string[]).includes(k)) {
-      if (typeof v === "number") (part as unknown as Record<string, number>)[k] = v;
-    } else own[k] = v;
+  for (const k of partKeys(schema)) {
+    const v = settings[k];
+    if (typeof v === "number") (part as unknown as Record<string, number>)[k] = v;
   }
   if ((part.place_x === undefined) !== (part.place_y === undefined)) (part.place_x === undefined ? (part.place_x = 0) : (part.place_y = 0));
-  return { settings: own, parts: state.parts ?? [part] };
+  return { settings: jobSettings(settings, schema), parts: state.parts ?? [part] };
 }
 
 /** Opens the preview link in the URL, if there is one (returns whether there was one that the
@@ -224,7 +224,7 @@ function linkJob(state: ShareState, settings: Record<string, Value>): JobFile {
 export async function openLink(page: Page): Promise<boolean> {
   let link: SharedLink | null;
   try {
-    link = await readLink(location.hash);
+    link = await readLink(location.hash, page.init!.job);
   } catch (e) {
     const why = e instanceof LinkError ? e.message : `it could not be read (${e instanceof Error ? e.message : String(e)})`;
     await openSample(page, { title: TITLES.link, message: `This preview link is too large or damaged: ${why}. Showing the sample part instead.` });
@@ -232,7 +232,7 @@ export async function openLink(page: Page): Promise<boolean> {
   }
   if (!link) return false;
   const ignored = [...link.ignored];
-  const job = linkJob(link.state, linkSettings(page, link.state.settings, ignored));
+  const job = linkJob(link.state, linkSettings(page, link.state.settings, ignored), page.init!.schema);
   const unknown = page.form!.set({ ...page.init!.defaults, ...job.settings });
   job.settings = {};
   const extra = unknown.length

@@ -73,7 +73,7 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
   if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone);
   const gen = ++store.generation;
   const values = form.values();
-  const settings = jobSettings(values);
+  const settings = jobSettings(values, page.init!.schema);
   const refs = job.refs();
   const sliced: SlicedJob = { refs, file: job.file(settings), sha256: refs.map((r) => job.models.get(r.name)?.sha256 ?? "") };
   const key = job.key(settings);

@@ -32,9 +32,10 @@ function settingsStatus(page: Page): void {
   }
   const job = store.job;
   const slice = store.slice;
-  const settings = jobSettings(form.values());
+  const schema = page.init!.schema;
+  const settings = jobSettings(form.values(), schema);
   const stale = job !== null && !store.busy && (slice?.source !== "stl" || job.key(settings) !== slice.key);
-  const settingsChanged = slice?.source === "stl" && JSON.stringify(settings) !== JSON.stringify(jobSettings(slice.settings));
+  const settingsChanged = slice?.source === "stl" && JSON.stringify(settings) !== JSON.stringify(jobSettings(slice.settings, schema));
   st.className = "hint";
   st.textContent = !stale ? "" : settingsChanged ? "Settings changed: press Slice (or Enter) to update." : "The parts changed: press Slice (or Enter) to update.";
   btn.classList.toggle("attention", stale);

@@ -27,13 +27,13 @@ export class SettingsForm {
     container: HTMLElement,
     readonly schema: SettingSpec[],
     private onChange: () => void,
-    /** Settings kept at their defaults and not shown (a part's keys: the parts panel has them). */
-    hidden: readonly string[] = [],
   ) {
     container.replaceChildren();
     const groups = new Map<string, HTMLElement>();
     for (const spec of schema) {
-      if (hidden.includes(spec.name)) {
+      // a part's keys (the schema flags them) stay at their defaults, not shown: the parts
+      // panel has them
+      if (spec.part) {
         this.build(spec);
         continue;
       }

@@ -4,7 +4,8 @@
 // arrange, save job). Every change is an action (flows/job.ts), which has the core lay the job out
 // again; what is shown comes from the job and the core's layout only.
 
-import { PART_LIMITS, partName, type Changes, type Part } from "../core/job";
+import { fitsPart, partName, partNumber, partRangeWords, type Changes, type Part } from "../core/job";
+import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
 
@@ -14,19 +15,14 @@ type NumberField = (typeof NUMBER_FIELDS)[number];
 const fmt = (v: number) => String(+v.toFixed(4));
 const mm = (v: number) => v.toFixed(1);
 
-/** A number typed into a field ("0,5" too): the value, or why not. */
-function parseField(k: NumberField, raw: string): { value?: number; error?: string } {
+/** A number typed into a field ("0,5" too): the value, or why not (its range is the core's:
+ *  `job`, the core's job schema). */
+function parseField(k: NumberField, raw: string, job: JobSchema): { value?: number; error?: string } {
   const x = Number(raw.trim().replace(",", "."));
   if (raw.trim() === "" || !Number.isFinite(x)) return { error: "a number is needed" };
-  if (k.startsWith("rotate") || k === "place_angle") {
-    if (Math.abs(x) > PART_LIMITS.rotate) return { error: `−${PART_LIMITS.rotate} … ${PART_LIMITS.rotate}°` };
-  } else if (k.startsWith("scale")) {
-    if (!(x > 0) || x > PART_LIMITS.scaleMax) return { error: `> 0 and ≤ ${PART_LIMITS.scaleMax}` };
-  } else if (k.startsWith("place")) {
-    if (Math.abs(x) > PART_LIMITS.place) return { error: `±${nf.format(PART_LIMITS.place)} mm` };
-  } else if (k === "copies") {
-    if (!Number.isInteger(x) || x < 1 || x > PART_LIMITS.copies) return { error: `a whole number 1 … ${PART_LIMITS.copies}` };
-  }
+  const spec = partNumber(job, k);
+  if (!spec) return { error: `${k} is not a number of a part` };
+  if (!fitsPart(spec, x)) return { error: partRangeWords(spec) };
   return { value: x };
 }
 
@@ -89,7 +85,7 @@ export class PartsPanel implements PartsView {
   private changed(k: NumberField, input: HTMLInputElement): void {
     const p = this.part();
     if (!p) return;
-    const r = parseField(k, input.value);
+    const r = parseField(k, input.value, this.page.init!.job);
     input.setAttribute("aria-invalid", r.error ? "true" : "false");
     input.title = r.error ?? "";
     if (r.value === undefined) return;

@@ -2,7 +2,7 @@
 
 import type { Value } from "../core/settings";
 import type { Page } from "./page";
-import { fullSpec, PART_KEYS, specOut } from "../core/job";
+import { fullSpec, jobSettings, specOut } from "../core/job";
 import { makeLink } from "../core/share";
 import { $ } from "./dom";
 
@@ -50,6 +50,6 @@ export async function share(page: Page): Promise<void> {
 /** The settings that differ from the core's defaults (the link carries only those). */
 function changedFrom(page: Page, values: Record<string, Value>): Record<string, Value> {
   const out: Record<string, Value> = {};
-  for (const [k, v] of Object.entries(values)) if (page.init!.defaults[k] !== v && !(PART_KEYS as readonly string[]).includes(k)) out[k] = v;
+  for (const [k, v] of Object.entries(jobSettings(values, page.init!.schema))) if (page.init!.defaults[k] !== v) out[k] = v;
   return out;
 }

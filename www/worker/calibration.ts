@@ -18,7 +18,7 @@ function refused(e: unknown): unknown {
 /** The core's calibration for `req` (the core is loaded by the caller). */
 export async function calibrateRequest(req: CalibrateRequest): Promise<Calibration> {
   try {
-    if (req.from === "slice") return calibrate(req.droplets, req.layer_height, req.droplet_aspect, req.mass, req.density) as Calibration;
+    if (req.from === "slice") return calibrate(req.droplets, req.layer_height, req.droplet_aspect, req.mass, req.density);
     const reader = new GcodeReader(() => {}, true);
     try {
       await readGcode(req.file, reader);

@@ -45,7 +45,7 @@ export class GcodeReader {
    *  `density` (g/cm³; null: the header's material_density, else the default). Throws the
    *  core's refusal as a plain Error (not a GcodeError: the file itself was read). */
   calibrate(mass: number, density: number | null): Calibration {
-    return this.stream.calibrate(mass, density ?? undefined) as Calibration;
+    return this.stream.calibrate(mass, density ?? undefined);
   }
 
   /** Frees the core's reader (the object is unusable afterwards). */

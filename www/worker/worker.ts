@@ -6,7 +6,7 @@
 // ("adopt"). Everything from the core is a typed value; its
 // errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, { Models, Session, Tally, crash_for_test, default_settings, overhang_face_normal_z, settings_schema, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
+import init, { Models, Session, Tally, crash_for_test, default_settings, job_schema, overhang_face_normal_z, settings_schema, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
@@ -23,10 +23,7 @@ import {
   type RequestKind,
   type ResultOf,
   type SliceUnit,
-  type JobInfo,
-  type Layout,
   type ModelInfo,
-  type Summary,
   type LayerData,
 } from "../core/protocol";
 
@@ -73,7 +70,7 @@ async function sha256Of(file: Blob): Promise<string> {
 function adopt(s: Session): OpenResult {
   session?.free();
   session = s;
-  return { layers: s.layer_count(), info: s.info() as JobInfo };
+  return { layers: s.layer_count(), info: s.info() };
 }
 
 /** Lets other requests (previews) in between two layers of a long slice. */
@@ -133,7 +130,7 @@ async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
       await yieldToQueue();
       if (session !== s) throw internal("the model was replaced during slicing");
     }
-    const unit: SliceUnit = { from, to, summary: parts.tally.summary() as Summary };
+    const unit: SliceUnit = { from, to, summary: parts.tally.summary() };
     if (counted) unit.gcode = new Blob(parts.gcode as BlobPart[], { type: "text/plain" });
     answer("slice", id, unit);
   } finally {
@@ -160,7 +157,7 @@ async function handle(req: Request): Promise<void> {
   switch (req.kind) {
     case "init": {
       await load();
-      const result: InitResult = { version: version(), schema: settings_schema(), defaults: default_settings() };
+      const result: InitResult = { version: version(), schema: settings_schema(), job: job_schema(), defaults: default_settings() };
       answer(req.kind, req.id, result);
       return;
     }
@@ -171,7 +168,7 @@ async function handle(req: Request): Promise<void> {
       const sha256: string[] = [];
       for (const { name, file } of req.data.files) {
         const hash = sha256Of(file);
-        infos.push(models.add(file, name) as ModelInfo);
+        infos.push(models.add(file, name));
         sha256.push(await hash);
       }
       answer(req.kind, req.id, { infos, sha256 });
@@ -189,7 +186,7 @@ async function handle(req: Request): Promise<void> {
       return;
     }
     case "layout":
-      answer(req.kind, req.id, needModels().layout(req.data.job) as Layout);
+      answer(req.kind, req.id, needModels().layout(req.data.job));
       return;
     case "lay_flat":
       answer(req.kind, req.id, needModels().lay_flat(req.data.name, req.data.item) as { rotate_x: number; rotate_y: number });

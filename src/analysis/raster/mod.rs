@@ -29,6 +29,7 @@ pub const MIN_PASSAGE_COLS: u32 = 2;
 
 /// One connected void of a layer.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct Void {
     /// mm².
     pub area: f64,
@@ -42,6 +43,7 @@ pub struct Void {
 
 /// What one layer's droplets cover of its region. Areas in mm², lengths in mm.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct LayerAnalysis {
     /// Layer number from 0.
     pub index: usize,

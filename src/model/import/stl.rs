@@ -15,6 +15,7 @@ pub const MAX_TRIANGLES: usize = 20_000_000;
 
 /// The format a model file was read as: one of the two STL encodings, or OBJ / 3MF
 /// ([`crate::model::import`]). Serialised as `"binary"`, `"ascii"`, `"obj"`, `"3mf"`.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Format {

@@ -65,7 +65,7 @@ export class View3DPanel implements View3DView {
     if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
     this.syncOverhang(page, values);
     const s = store.slice;
-    const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values));
+    const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values, page.init!.schema));
     this.slice = current && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current: store.current } : null;
     // the selected part's instance clicked last stays tinted, else its first copy
     const sel = job?.selected ?? null;
@@ -82,7 +82,7 @@ export class View3DPanel implements View3DView {
       this.overhangFor = "";
       return;
     }
-    const settings = jobSettings(page.form.values());
+    const settings = jobSettings(page.form.values(), page.init!.schema);
     const key = JSON.stringify(["overhang_limit", "droplet_aspect", "layer_height"].map((k) => settings[k]));
     if (key === this.overhangFor) return;
     this.overhangFor = key;
