@@ -70,7 +70,8 @@ enum Command {
         override_usage = "dropslice [slice] MODEL... [OPTIONS]\n       dropslice [slice] JOB.json [OPTIONS]",
         long_about = LONG_ABOUT,
         after_long_help = AFTER_LONG_HELP,
-        args_override_self = true
+        args_override_self = true,
+        display_name = "dropslice"
     )]
     Slice(SliceArgs),
     /// Droplet size from a printed part's mass and its code
@@ -82,6 +83,7 @@ enum Command {
     #[command(
         override_usage = "dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]",
         args_override_self = true,
+        display_name = "dropslice",
         verbatim_doc_comment
     )]
     Calibrate(CalibrateArgs),
