@@ -2,5 +2,6 @@
 
 pub mod import;
 pub mod mesh;
+pub mod models_job;
 pub mod prepare;
 pub mod spec;
