@@ -139,3 +139,54 @@ test("hostile model files: a short banner within seconds, the page keeps answeri
   assert.deepEqual(errors, []);
   await context.close();
 });
+
+/** A 3MF of about a kilobyte that fans out 10^levels inside-out 0.5 mm cubes by components
+ *  (as scripts/many_parts.py `fan`): one cube object, then `levels` objects of ten
+ *  components each, 1 mm apart along x, y, z, then 10 mm, … */
+function fannedCubes3mf(levels) {
+  const rels = `<?xml version="1.0"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>`;
+  let vertices = "";
+  for (let i = 0; i < 8; i++) vertices += `<vertex x="${(i & 1) * 0.5}" y="${((i >> 1) & 1) * 0.5}" z="${((i >> 2) & 1) * 0.5}"/>`;
+  const faces = [[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]];
+  // inside out: every triangle's corners in the other order
+  const triangles = faces.map(([a, b, c]) => `<triangle v1="${a}" v2="${c}" v3="${b}"/>`).join("");
+  let resources = `<object id="1" type="model"><mesh><vertices>${vertices}</vertices><triangles>${triangles}</triangles></mesh></object>`;
+  for (let l = 0; l < levels; l++) {
+    const axis = l % 3;
+    const pitch = 10 ** Math.floor(l / 3);
+    let components = "";
+    for (let k = 0; k < 10; k++) {
+      const t = [0, 1, 2].map((a) => (a === axis ? k * pitch : 0));
+      components += `<component objectid="${l + 1}" transform="1 0 0 0 1 0 0 0 1 ${t.join(" ")}"/>`;
+    }
+    resources += `<object id="${l + 2}" type="model"><components>${components}</components></object>`;
+  }
+  const model = `<?xml version="1.0"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources>${resources}</resources><build><item objectid="${levels + 1}"/></build></model>`;
+  return zip([
+    { name: "_rels/.rels", data: Buffer.from(rels) },
+    { name: "3D/3dmodel.model", data: Buffer.from(model) },
+  ]);
+}
+
+test("10,000 inside-out cubes fanned out by a 1 KB 3MF: turned outward and sliced, the page answering", async () => {
+  const context = await env.browser.newContext({ viewport: { width: 1280, height: 800 } });
+  const page = await context.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  await page.goto(env.url);
+  await settle(page);
+  const buffer = fannedCubes3mf(4);
+  assert.ok(buffer.length < 2000, `${buffer.length} bytes`);
+  const t0 = Date.now();
+  await pick(page, { name: "fanned.3mf", mimeType: "application/octet-stream", buffer });
+  const s = await settle(page, 120_000);
+  assert.equal(s.state, "done", JSON.stringify(s));
+  // every cube printed: two or three layers of one loop of six or seven droplets each
+  // (a plane can fall on a cube's top face, which counts as above it)
+  assert.ok(s.droplets >= 10_000 * 12 && s.droplets <= 10_000 * 21, `${s.droplets} droplets`);
+  const warnings = await page.evaluate(() => document.body.innerText);
+  assert.match(warnings, /10,?000 closed shells were inside out/);
+  console.log(`# 10,000 fanned cubes: ${s.droplets} droplets in ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
