@@ -1,4 +1,4 @@
-// The figures of a slice, as the core computed them (src/summary.rs): droplets by role,
+// The figures of a slice, as the core computed them (src/output/summary.rs): droplets by role,
 // travel, material volume and mass, print time, part coverage, void area, the worst layer,
 // what slicing repaired, and nothing-to-print. The page keeps the core's per-unit summaries
 // (it never adds them up) and asks a worker to merge them into figures; the views only show

@@ -67,7 +67,7 @@ export interface LayerData {
   z: number;
   counts: Counts;
   travelMm: number;
-  /** The core's estimated print time of the layer, s (src/summary.rs `layer_seconds`; the
+  /** The core's estimated print time of the layer, s (src/output/summary.rs `layer_seconds`; the
    *  layers' times add up to the job's `print_seconds`). Absent for a .gco file's layers. */
   seconds?: number;
   /** x,y pairs in mm, every droplet (each one of a G25 line too). */
@@ -106,7 +106,7 @@ export interface MaskTile {
   overfill: Uint8Array;
 }
 
-/** The mask from the core's flat arrays (src/wasm.rs: `mask_cell`, `mask_tiles` = origin x,
+/** The mask from the core's flat arrays (src/wasm/mod.rs: `mask_cell`, `mask_tiles` = origin x,
  *  origin y, width, height per tile, `void_mask` and `overfill_mask` = the tiles' shares one
  *  after the other, `mask_overfilled` = per tile whether it has overfill). The tiles' void
  *  shares are views of one buffer (one copy out of the core per layer); overfill shares are
@@ -202,7 +202,7 @@ export interface Calls {
   hash: { data: { file: Blob }; result: string };
   parse_gcode: { data: { file: Blob }; result: GcodeParseResult };
   crash: { data: null; result: void };
-  /** Build jobs (the job worker's `Models`, src/wasm.rs): files added under their job names
+  /** Build jobs (the job worker's `Models`, src/wasm/mod.rs): files added under their job names
    *  (a name already there is replaced), with their info and SHA-256. */
   models_add: { data: { files: { name: string; file: File }[] }; result: { infos: ModelInfo[]; sha256: string[] } };
   models_remove: { data: { names: string[] }; result: void };
@@ -213,13 +213,13 @@ export interface Calls {
   /** Prepares the job `job` of the files added (Session.from_models); like "open". */
   open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
-   *  within the rule (src/wasm.rs `unsupported_droplets`); `below` null for the first layer. */
+   *  within the rule (src/wasm/mod.rs `unsupported_droplets`); `below` null for the first layer. */
   unsupported: { data: UnsupportedRequest; result: Uint8Array };
   /** The 3D view's overhang tint: faces with normal z below minus this overhang. */
   overhang_face: { data: { settings: Settings }; result: number };
-  /** The vertical cut of layers [from, to) (flows/cut.ts, src/wasm_cut.rs `Session.cut`). */
+  /** The vertical cut of layers [from, to) (flows/cut.ts, src/wasm/cut.rs `Session.cut`). */
   cut: { data: CutRequest; result: CutReply };
-  /** The droplet size from a printed part's mass (views/calibrate.ts, src/calibrate.rs). */
+  /** The droplet size from a printed part's mass (views/calibrate.ts, src/output/calibrate.rs). */
   calibrate: { data: CalibrateRequest; result: Calibration };
 }
 

@@ -1,7 +1,7 @@
 // The vertical cut's runs (views/cut.ts draws the line and takes the pointer; canvas/cutrender.ts
 // draws the section): droplets near the line come from the page's cache at once (binned once
 // per layer and line: t, d, role); the part's section along the line and the 3D estimate's
-// voids come from the workers (src/wasm_cut.rs), in runs of layers from the one shown outwards,
+// voids come from the workers (src/wasm/cut.rs), in runs of layers from the one shown outwards,
 // a few at a time. The page sends the droplets near the line of the layers it holds; a layer it
 // does not hold (evicted) is planned by the worker, which returns its droplets near the line:
 // the page never fetches layers' full previews for the cut. A new line drops the runs not yet

@@ -3,7 +3,7 @@
 // the slice shown (its droplet total, H and droplet_aspect as sliced) or of the opened .gco
 // file (its header's total, else its commands'; its header's H and aspect), give the core's
 // effective droplet volume, cell B²H, filling degree and suggested droplet_aspect. Every figure
-// is the core's (src/calibrate.rs, called in a worker: www/worker/calibration.ts); the page only checks
+// is the core's (src/output/calibrate.rs, called in a worker: www/worker/calibration.ts); the page only checks
 // that the inputs are positive numbers before asking and shows the answer or the core's refusal
 // next to the inputs. "Use droplet_aspect = X" puts the suggestion into the settings form.
 

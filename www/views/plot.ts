@@ -2,7 +2,7 @@
 // time (a line, the right axis) along the layers, the current layer marked. A click or a drag
 // goes to the layer under the pointer (as the slider does); hovering shows that layer's
 // figures. Every figure is the core's: droplets per layer, and the time of each layer
-// (src/summary.rs `layer_seconds`, which add up to the job's print time); the running time is
+// (src/output/summary.rs `layer_seconds`, which add up to the job's print time); the running time is
 // their prefix sum. Layers are binned to device pixels (a column shows its tallest layer), so a
 // draw costs O(layers + width) whatever the count; while the workers run it is redrawn at most
 // every [[BUSY_REDRAW_MS]].

@@ -1,5 +1,5 @@
 // The droplet calibration, run in a worker for views/calibrate.ts: every figure is the core's
-// (src/calibrate.rs through src/wasm_gcode.rs). A slice's calibration is one call with its
+// (src/output/calibrate.rs through src/wasm/reader.rs). A slice's calibration is one call with its
 // droplet total, H and aspect; a .gco file is read again by the core's counting reader (its
 // header's total, else its commands' droplets; its H, aspect and material_density).
 // Refusals become errors of kind "calibration" with the core's message, a file that cannot be
