@@ -3,4 +3,5 @@
 pub mod import;
 pub mod mesh;
 pub mod prepare;
+pub mod shells;
 pub mod spec;

@@ -5,7 +5,8 @@
 use crate::base::error::Error;
 use crate::base::settings::Settings;
 use crate::model::import::{self, stl};
-use crate::model::mesh::{self, Bounds, Mesh, MeshStats, ShellOrientation};
+use crate::model::mesh::{self, Bounds, Mesh, MeshStats};
+use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
 
 /// Most layers a job may have (a guard against settings that would run for hours).
@@ -196,10 +197,7 @@ pub(crate) fn check_volume(
 /// Cracks between near-coincident corners: when the exact weld left open edges, a tolerance
 /// weld, kept if it leaves fewer. Returns the shells of the mesh as it is then, and how many
 /// vertices were merged and facets dropped.
-pub(crate) fn close_cracks(
-    mesh: &mut Mesh,
-    groups: &mut [FacetGroup],
-) -> (mesh::Shells, (usize, usize)) {
+pub(crate) fn close_cracks(mesh: &mut Mesh, groups: &mut [FacetGroup]) -> (Shells, (usize, usize)) {
     let shells = mesh.shells();
     if shells.open_edges == 0 {
         return (shells, (0, 0));

@@ -7,11 +7,12 @@ use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
 use crate::model::import;
-use crate::model::mesh::{self, Mesh, MeshStats};
+use crate::model::mesh::{Mesh, MeshStats};
 use crate::model::prepare::{
     FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_height, check_volume,
     close_cracks, import, keep_groups, suggested_scale, warnings,
 };
+use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
@@ -324,7 +325,7 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
 fn repair(
     mesh: Mesh,
     zs: &[f64],
-    shells: &mesh::ShellOrientation,
+    shells: &ShellOrientation,
     (welded, dropped): (usize, usize),
     duplicates: usize,
     facets_in_file: usize,
