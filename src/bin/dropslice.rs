@@ -16,7 +16,8 @@ fn main() {}
 mod cli {
     use dropslice::analysis::JobAnalysis;
     use dropslice::base::error::quote;
-    use dropslice::model::spec::{self as job, JobSpec, Model, PartSpec};
+    use dropslice::model::models::Model;
+    use dropslice::model::spec::{self as job, JobSpec, PartSpec};
     use dropslice::{Error, Job, Settings, write_gcode_with};
     use staged::Staged;
     use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};

@@ -22,6 +22,20 @@ pub struct Bounds {
 }
 
 impl Bounds {
+    /// A box that holds nothing (every minimum +∞, every maximum −∞), to [`grow`](Self::grow).
+    pub const EMPTY: Bounds = Bounds {
+        min: [f64::INFINITY; 3],
+        max: [f64::NEG_INFINITY; 3],
+    };
+
+    /// Grown to hold the box `lo`..`hi`.
+    pub fn grow(&mut self, lo: [f64; 3], hi: [f64; 3]) {
+        for k in 0..3 {
+            self.min[k] = self.min[k].min(lo[k]);
+            self.max[k] = self.max[k].max(hi[k]);
+        }
+    }
+
     pub fn size(&self) -> [f64; 3] {
         [0, 1, 2].map(|k| self.max[k] - self.min[k])
     }
@@ -89,15 +103,11 @@ impl Mesh {
     }
 
     pub fn bounds(&self) -> Bounds {
-        let mut min = [f64::INFINITY; 3];
-        let mut max = [f64::NEG_INFINITY; 3];
+        let mut b = Bounds::EMPTY;
         for v in &self.vertices {
-            for k in 0..3 {
-                min[k] = min[k].min(v[k]);
-                max[k] = max[k].max(v[k]);
-            }
+            b.grow(*v, *v);
         }
-        Bounds { min, max }
+        b
     }
 
     /// Applies SPEC.md's transforms: rotate about x, y, z (in that order), scale, move the

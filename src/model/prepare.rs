@@ -5,6 +5,7 @@
 use crate::base::error::Error;
 use crate::base::settings::Settings;
 use crate::model::import::{self, stl};
+use crate::model::layout::{Frame, Instance};
 use crate::model::mesh::{self, Bounds, Mesh, MeshStats};
 use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
@@ -32,7 +33,7 @@ pub struct JobInfo {
     pub suggested_scale: Option<f64>,
     /// Every copy of every part: its file, transform, placement, matrix and bounds.
     #[serde(default)]
-    pub instances: Vec<job::Instance>,
+    pub instances: Vec<Instance>,
     /// Which discharge unit prints which facets of the prepared mesh: runs of facets in mesh
     /// order, each the instances of consecutive parts of one unit, in the order the parts are
     /// listed (the order that decides who keeps an overlap). Empty: every facet is unit 0's
@@ -83,7 +84,7 @@ pub(crate) struct Imported {
     pub(crate) format: stl::Format,
     pub(crate) facets_in_file: usize,
     pub(crate) degenerate: usize,
-    pub(crate) instance: job::Instance,
+    pub(crate) instance: Instance,
 }
 
 /// What [`Job::build`] needs besides the mesh.
@@ -92,7 +93,7 @@ pub(crate) struct Input {
     pub(crate) format: stl::Format,
     pub(crate) facets_in_file: usize,
     pub(crate) degenerate: usize,
-    pub(crate) instances: Vec<job::Instance>,
+    pub(crate) instances: Vec<Instance>,
     pub(crate) warnings: Vec<String>,
     /// [`JobInfo::groups`] of the merged mesh (before the repair drops facets).
     pub(crate) groups: Vec<FacetGroup>,
@@ -115,11 +116,11 @@ pub(crate) fn import(
     let facets_in_file = tris.len();
     drop(tris);
     let placement = mesh::Placement::of_settings(settings);
-    let frame = job::Frame::of(mesh.vertices.iter().copied(), &placement)
+    let frame = Frame::of(mesh.vertices.iter().copied(), &placement)
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;
     let name = job::clean_name(&import::stem(file_name));
-    let instance = job::Instance {
+    let instance = Instance {
         part: 0,
         copy: 0,
         copies: 1,

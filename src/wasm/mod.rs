@@ -25,7 +25,9 @@ use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
 use crate::model::mesh::Mesh;
-use crate::model::spec::{self as job, JobSpec, Model};
+use crate::model::models::Model;
+use crate::model::spec::{self as job, JobSpec};
+use crate::model::{display, layout};
 use crate::output::gcode;
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{self, Figures, Summary};
@@ -278,7 +280,7 @@ impl Models {
     ) -> Result<Float32Array, JsValue> {
         let tris = self.model(name)?.triangles(item).map_err(js_error)?;
         Ok(Float32Array::from(
-            &job::display_mesh(&tris, max_triangles as usize)[..],
+            &display::display_mesh(&tris, max_triangles as usize)[..],
         ))
     }
 
@@ -289,14 +291,14 @@ impl Models {
     /// `{kind: "job" | "setting", message, setting?}`.
     pub fn layout(&self, job: JsValue) -> Result<JsValue, JsValue> {
         let spec = job_of(job)?;
-        let layout = job::layout(&self.models, &spec).map_err(js_error)?;
+        let layout = layout::layout(&self.models, &spec).map_err(js_error)?;
         to_js(&layout, "the layout")
     }
 
     /// `{rotate_x, rotate_y}` (degrees) that put a file's (or item's) largest flat face down.
     pub fn lay_flat(&self, name: &str, item: Option<usize>) -> Result<JsValue, JsValue> {
         let tris = self.model(name)?.triangles(item).map_err(js_error)?;
-        let (rotate_x, rotate_y) = job::lay_flat(&tris);
+        let (rotate_x, rotate_y) = layout::lay_flat(&tris);
         #[derive(Serialize)]
         struct Angles {
             rotate_x: f64,
