@@ -174,6 +174,33 @@ fn key(level: u32, c: [u64; 3]) -> u64 {
     (u64::from(level) << 51) | spread(c[0]) << 2 | spread(c[1]) << 1 | spread(c[2])
 }
 
+/// Per shell: its bounding box, its first facet and how many facets it has.
+struct ShellBoxes {
+    bmin: Vec<[f64; 3]>,
+    bmax: Vec<[f64; 3]>,
+    first_facet: Vec<u32>,
+    facet_count: Vec<u32>,
+}
+
+/// The facets of each of the `n` shells, grouped (counting sort): shell `s` has
+/// `grouped[start[s]..start[s + 1]]`.
+fn group_by_shell(facet_shell: &[u32], n: usize) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; n + 1];
+    for &sh in facet_shell {
+        start[sh as usize + 1] += 1;
+    }
+    for k in 0..n {
+        start[k + 1] += start[k];
+    }
+    let mut next = start.clone();
+    let mut grouped = vec![0u32; facet_shell.len()];
+    for (fi, &sh) in facet_shell.iter().enumerate() {
+        grouped[next[sh as usize] as usize] = fi as u32;
+        next[sh as usize] += 1;
+    }
+    (start, grouped)
+}
+
 impl Mesh {
     /// Orients every shell by its signed volume, as the part's author meant it (see
     /// [`Mesh::orient`]).
@@ -224,24 +251,12 @@ impl Mesh {
         let n = closed.len();
         out.closed = closed.iter().filter(|&&c| c).count();
         out.open = n - out.closed;
-        // Bounding boxes, first facet and facet count per shell.
-        let mut bmin = vec![[f64::INFINITY; 3]; n];
-        let mut bmax = vec![[f64::NEG_INFINITY; 3]; n];
-        let mut first_facet = vec![u32::MAX; n];
-        let mut facet_count = vec![0u32; n];
-        for (fi, f) in self.facets.iter().enumerate() {
-            let s = facet_shell[fi] as usize;
-            for v in f.map(|i| self.vertices[i as usize]) {
-                for k in 0..3 {
-                    bmin[s][k] = bmin[s][k].min(v[k]);
-                    bmax[s][k] = bmax[s][k].max(v[k]);
-                }
-            }
-            if first_facet[s] == u32::MAX {
-                first_facet[s] = fi as u32;
-            }
-            facet_count[s] += 1;
-        }
+        let ShellBoxes {
+            bmin,
+            bmax,
+            first_facet,
+            facet_count,
+        } = self.shell_boxes(facet_shell, n);
         let centre = |s: usize| [0, 1, 2].map(|k| 0.5 * (bmin[s][k] + bmax[s][k]));
         // The caps of the open shells' holes (a single facet encloses nothing: skipped).
         let (cap_start, caps) = self.hole_caps(facet_shell, closed, bad, &facet_count);
@@ -283,21 +298,7 @@ impl Mesh {
             out.closed_volume = (0..n).filter(|&s| closed[s]).map(|s| volume[s].abs()).sum();
             return out;
         }
-        // The facets of each shell, grouped (counting sort).
-        let mut start = vec![0u32; n + 1];
-        for &sh in facet_shell {
-            start[sh as usize + 1] += 1;
-        }
-        for k in 0..n {
-            start[k + 1] += start[k];
-        }
-        let mut next = start.clone();
-        let mut grouped = vec![0u32; self.facets.len()];
-        for (fi, &sh) in facet_shell.iter().enumerate() {
-            grouped[next[sh as usize] as usize] = fi as u32;
-            next[sh as usize] += 1;
-        }
-        drop(next);
+        let (start, grouped) = group_by_shell(facet_shell, n);
         // Shells that may enclose another: every closed one, and open ones of 2 facets or more.
         let encloser = |s: usize| closed[s] || facet_count[s] >= 2;
         let index = BoxIndex::new(&bmin, &bmax, (0..n).filter(|&s| encloser(s)));
@@ -350,6 +351,30 @@ impl Mesh {
         }
         out.closed_volume = (0..n).filter(|&s| closed[s]).map(|s| volume[s].abs()).sum();
         out
+    }
+
+    /// Bounding boxes, first facet and facet count of the `n` shells.
+    fn shell_boxes(&self, facet_shell: &[u32], n: usize) -> ShellBoxes {
+        let mut b = ShellBoxes {
+            bmin: vec![[f64::INFINITY; 3]; n],
+            bmax: vec![[f64::NEG_INFINITY; 3]; n],
+            first_facet: vec![u32::MAX; n],
+            facet_count: vec![0u32; n],
+        };
+        for (fi, f) in self.facets.iter().enumerate() {
+            let s = facet_shell[fi] as usize;
+            for v in f.map(|i| self.vertices[i as usize]) {
+                for k in 0..3 {
+                    b.bmin[s][k] = b.bmin[s][k].min(v[k]);
+                    b.bmax[s][k] = b.bmax[s][k].max(v[k]);
+                }
+            }
+            if b.first_facet[s] == u32::MAX {
+                b.first_facet[s] = fi as u32;
+            }
+            b.facet_count[s] += 1;
+        }
+        b
     }
 
     /// The caps that close the holes of the open shells of 2 facets or more, grouped by shell
