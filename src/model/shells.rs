@@ -1,7 +1,7 @@
 //! Shells of a welded [`Mesh`]: the pieces of its surface joined through well-formed edges,
 //! whether each is closed, and their orientation by signed volume ([`Mesh::orient_shells`]):
 //! inside-out shells turned outward unless they lie inside another shell (cavities), decided
-//! by winding numbers and a grid of the shells' bounding boxes ([`BoxIndex`]).
+//! by winding numbers and a grid of the shells' bounding boxes (`BoxIndex`).
 
 use crate::model::mesh::Mesh;
 
@@ -364,9 +364,9 @@ impl Mesh {
         for (fi, f) in self.facets.iter().enumerate() {
             let s = facet_shell[fi] as usize;
             for v in f.map(|i| self.vertices[i as usize]) {
-                for k in 0..3 {
-                    b.bmin[s][k] = b.bmin[s][k].min(v[k]);
-                    b.bmax[s][k] = b.bmax[s][k].max(v[k]);
+                for (k, c) in v.into_iter().enumerate() {
+                    b.bmin[s][k] = b.bmin[s][k].min(c);
+                    b.bmax[s][k] = b.bmax[s][k].max(c);
                 }
             }
             if b.first_facet[s] == u32::MAX {

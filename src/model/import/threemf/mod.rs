@@ -23,8 +23,8 @@
 
 //!
 //! Here: the package side (the ZIP, its bounds, `_rels/.rels`, the model parts to read) and
-//! [`parse`]; [`xml`] the bounded XML reader, [`model`] one model part's elements,
-//! [`transform`] the matrices, [`build`] the build items resolved into parts.
+//! [`parse`]; `xml.rs` the bounded XML reader, `model.rs` one model part's elements,
+//! `transform.rs` the matrices, `build.rs` the build items resolved into parts.
 
 mod build;
 mod model;
