@@ -1,4 +1,7 @@
-//! The model: files in (STL, OBJ, 3MF), the welded mesh, the job file.
+//! The model: files in (STL, OBJ, 3MF: [`import`]), the welded mesh ([`mesh`]) and its shells
+//! ([`shells`]), the job file ([`spec`]), the files a job reads ([`models`]), where its
+//! instances go ([`layout`]), the page's display meshes ([`display`]) and the preparation of
+//! one file's mesh ([`prepare`]).
 
 pub mod display;
 pub mod import;
