@@ -59,6 +59,7 @@ pub(super) struct Document {
     pub(super) items: Vec<Item>,
 }
 
+/// Millimetres per unit of a `<model unit>`.
 fn unit_scale(u: &str) -> Option<f64> {
     Some(match u {
         "micron" => 0.001,
