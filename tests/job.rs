@@ -1,12 +1,15 @@
-//! Build jobs (src/job.rs, `Job::from_models`): the job file, the arrangement, the instance
-//! transforms against the independent oracle (`../shared/tools/oracle_sections.py`), lay_flat,
-//! the display mesh and the CLI.
+//! Build jobs (src/model/spec.rs, layout.rs, display.rs; `Job::from_models`): the job file,
+//! the arrangement, the instance transforms against the independent oracle
+//! (`../shared/tools/oracle_sections.py`), lay_flat, the display mesh and the CLI.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 
 use common::{Rng, TempDir, model, model_bytes, on_plate, run_cli};
-use dropslice::model::spec::{self as job, JobSpec, Model, Rect, arrange};
+use dropslice::model::display::display_mesh;
+use dropslice::model::layout::{Rect, arrange, lay_flat, layout};
+use dropslice::model::models::Model;
+use dropslice::model::spec::{self as job, JobSpec};
 use dropslice::{Error, Job, Settings};
 use serde_json::{Value, json};
 use std::time::Duration;
@@ -306,7 +309,7 @@ fn box_model(name: &str, w: f32, d: f32, h: f32) -> Model {
 fn a_job_that_does_not_fit_is_refused_with_what_to_do() {
     let models = [box_model("big.stl", 60.0, 60.0, 5.0)];
     let s = spec(json!({"parts": [{"file": "big.stl", "copies": 5}]})).unwrap();
-    let e = job::layout(&models, &s).unwrap_err();
+    let e = layout(&models, &s).unwrap_err();
     let m = e.to_string();
     assert_eq!(e.kind(), "job");
     for want in [
@@ -320,7 +323,7 @@ fn a_job_that_does_not_fit_is_refused_with_what_to_do() {
     }
     // 4 fit (2 × 2 with 5 mm between 60 mm boxes: 125 ≤ 154, 125 ≤ 134).
     let s = spec(json!({"parts": [{"file": "big.stl", "copies": 4}]})).unwrap();
-    assert_eq!(job::layout(&models, &s).unwrap().instances.len(), 4);
+    assert_eq!(layout(&models, &s).unwrap().instances.len(), 4);
     // The same through Job::from_models.
     let s = spec(json!({"parts": [{"file": "big.stl", "copies": 5}]})).unwrap();
     assert_eq!(Job::from_models(&models, &s).err().unwrap().kind(), "job");
@@ -330,7 +333,7 @@ fn a_job_that_does_not_fit_is_refused_with_what_to_do() {
 fn one_oversize_part_goes_to_the_origin_with_a_warning() {
     let models = [box_model("huge.stl", 200.0, 20.0, 3.0)];
     let s = spec(json!({"parts": [{"file": "huge.stl"}]})).unwrap();
-    let l = job::layout(&models, &s).unwrap();
+    let l = layout(&models, &s).unwrap();
     assert_eq!(l.instances[0].min, [0.0, 0.0, 0.0]);
     assert!(
         l.warnings
@@ -349,7 +352,7 @@ fn one_oversize_part_goes_to_the_origin_with_a_warning() {
     );
     // Two copies of it: refused.
     let s = spec(json!({"parts": [{"file": "huge.stl", "copies": 2}]})).unwrap();
-    assert!(job::layout(&models, &s).is_err());
+    assert!(layout(&models, &s).is_err());
 }
 
 #[test]
@@ -367,7 +370,7 @@ fn placed_and_arranged_parts_mix() {
         ]
     }))
     .unwrap();
-    let l = job::layout(&models, &s).unwrap();
+    let l = layout(&models, &s).unwrap();
     assert_eq!(l.instances.len(), 6);
     let a0 = &l.instances[0];
     assert!(a0.placed && a0.min == [0.0, 0.0, 0.0] && a0.max == [30.0, 20.0, 5.0]);
@@ -445,7 +448,7 @@ fn unit_1_parts_are_printed_and_files_must_be_known() {
         "{e}"
     );
     let s = spec(json!({"parts": [{"file": "a.stl", "item": 1}]})).unwrap();
-    let e = job::layout(&models, &s).unwrap_err();
+    let e = layout(&models, &s).unwrap_err();
     assert!(
         e.to_string().contains("parts[0]: a.stl has 1 build item"),
         "{e}"
@@ -717,7 +720,7 @@ fn lay_flat_puts_the_largest_face_down() {
         [-75.0, 12.0, 140.0],
     ] {
         let tilted = rotated(&plate, rot);
-        let (rx, ry) = job::lay_flat(&tilted);
+        let (rx, ry) = lay_flat(&tilted);
         let h = height_after(&tilted, rx, ry);
         assert!(
             (h - 4.0).abs() < 1e-3,
@@ -726,14 +729,14 @@ fn lay_flat_puts_the_largest_face_down() {
     }
     // A real model: Benchy rests on its hull's flat bottom already.
     let benchy = all_triangles("3DBenchy.stl");
-    let (rx, ry) = job::lay_flat(&benchy);
+    let (rx, ry) = lay_flat(&benchy);
     assert!(
         (height_after(&benchy, rx, ry) - 48.0).abs() < 0.01,
         "{rx} {ry}"
     );
     // Tipped on its side, it comes back onto a flat face no taller than it was.
     let side = rotated(&benchy, [90.0, 0.0, 0.0]);
-    let (rx, ry) = job::lay_flat(&side);
+    let (rx, ry) = lay_flat(&side);
     let h = height_after(&side, rx, ry);
     assert!(h <= 48.0 + 0.01, "{h}");
 }
@@ -749,10 +752,10 @@ fn display_mesh_stays_within_its_budget() {
             hi[k] = hi[k].max(p[k]);
         }
     }
-    let whole = job::display_mesh(&tris, tris.len());
+    let whole = display_mesh(&tris, tris.len());
     assert_eq!(whole.len(), tris.len() * 9);
     for max in [50_000usize, 5_000, 100] {
-        let d = job::display_mesh(&tris, max);
+        let d = display_mesh(&tris, max);
         assert_eq!(d.len() % 9, 0);
         let n = d.len() / 9;
         assert!(n <= max && n > max / 20, "{max}: {n} triangles");
@@ -763,7 +766,7 @@ fn display_mesh_stays_within_its_budget() {
             }
         }
     }
-    assert!(job::display_mesh(&tris, 0).is_empty());
+    assert!(display_mesh(&tris, 0).is_empty());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,7 +1,14 @@
-//! The model: files in (STL, OBJ, 3MF), the welded mesh, the job file.
+//! The model: files in (STL, OBJ, 3MF: [`import`]), the welded mesh ([`mesh`]) and its shells
+//! ([`shells`]), the job file ([`spec`]), the files a job reads ([`models`]), where its
+//! instances go ([`layout`]), the page's display meshes ([`display`]) and the preparation of
+//! one file's mesh ([`prepare`]).
 
+pub mod display;
 pub mod import;
+pub mod layout;
 pub mod mesh;
+pub mod models;
 pub mod models_job;
 pub mod prepare;
+pub mod shells;
 pub mod spec;

@@ -5,7 +5,9 @@
 use crate::base::error::Error;
 use crate::base::settings::Settings;
 use crate::model::import::{self, stl};
-use crate::model::mesh::{self, Bounds, Mesh, MeshStats, ShellOrientation};
+use crate::model::layout::{Frame, Instance};
+use crate::model::mesh::{self, Bounds, Mesh, MeshStats};
+use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
 
 /// Most layers a job may have (a guard against settings that would run for hours).
@@ -32,7 +34,7 @@ pub struct JobInfo {
     pub suggested_scale: Option<f64>,
     /// Every copy of every part: its file, transform, placement, matrix and bounds.
     #[serde(default)]
-    pub instances: Vec<job::Instance>,
+    pub instances: Vec<Instance>,
     /// Which discharge unit prints which facets of the prepared mesh: runs of facets in mesh
     /// order, each the instances of consecutive parts of one unit, in the order the parts are
     /// listed (the order that decides who keeps an overlap). Empty: every facet is unit 0's
@@ -84,7 +86,7 @@ pub(crate) struct Imported {
     pub(crate) format: stl::Format,
     pub(crate) facets_in_file: usize,
     pub(crate) degenerate: usize,
-    pub(crate) instance: job::Instance,
+    pub(crate) instance: Instance,
 }
 
 /// What [`Job::build`] needs besides the mesh.
@@ -93,7 +95,7 @@ pub(crate) struct Input {
     pub(crate) format: stl::Format,
     pub(crate) facets_in_file: usize,
     pub(crate) degenerate: usize,
-    pub(crate) instances: Vec<job::Instance>,
+    pub(crate) instances: Vec<Instance>,
     pub(crate) warnings: Vec<String>,
     /// [`JobInfo::groups`] of the merged mesh (before the repair drops facets).
     pub(crate) groups: Vec<FacetGroup>,
@@ -116,11 +118,11 @@ pub(crate) fn import(
     let facets_in_file = tris.len();
     drop(tris);
     let placement = mesh::Placement::of_settings(settings);
-    let frame = job::Frame::of(mesh.vertices.iter().copied(), &placement)
+    let frame = Frame::of(mesh.vertices.iter().copied(), &placement)
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;
     let name = job::clean_name(&import::stem(file_name));
-    let instance = job::Instance {
+    let instance = Instance {
         part: 0,
         copy: 0,
         copies: 1,
@@ -198,10 +200,7 @@ pub(crate) fn check_volume(
 /// Cracks between near-coincident corners: when the exact weld left open edges, a tolerance
 /// weld, kept if it leaves fewer. Returns the shells of the mesh as it is then, and how many
 /// vertices were merged and facets dropped.
-pub(crate) fn close_cracks(
-    mesh: &mut Mesh,
-    groups: &mut [FacetGroup],
-) -> (mesh::Shells, (usize, usize)) {
+pub(crate) fn close_cracks(mesh: &mut Mesh, groups: &mut [FacetGroup]) -> (Shells, (usize, usize)) {
     let shells = mesh.shells();
     if shells.open_edges == 0 {
         return (shells, (0, 0));

@@ -20,7 +20,7 @@ pub struct HeaderInput<'a> {
     pub bounds: ([f64; 3], [f64; 3]),
     pub warnings: &'a [String],
     /// Every copy of every part (one line each).
-    pub instances: &'a [crate::model::spec::Instance],
+    pub instances: &'a [crate::model::layout::Instance],
     /// Whether discharge unit 1 prints anything (its settings are listed only then).
     pub unit1_used: bool,
 }
@@ -133,7 +133,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
 
 /// An instance as the header lists it: `part 1 = gear.3mf (object 3), rotate 0/0/90 deg,
 /// scale 1/1/1, at X30.0000 Y5.0000, angle 0 deg, copy 1 of 2, unit 0`.
-pub fn part_line(p: &crate::model::spec::Instance) -> String {
+pub fn part_line(p: &crate::model::layout::Instance) -> String {
     let clean = |s: &str| crate::model::spec::clean_name(s);
     let what = match (&p.object, p.item) {
         (Some(o), _) => format!(" (object {})", clean(o)),

@@ -9,9 +9,9 @@
 
 use crate::base::error::Error;
 use crate::base::settings::{Settings, Support};
+use crate::model::layout::Instance;
 use crate::model::mesh::Mesh;
 use crate::model::prepare::{FacetGroup, MAX_WIDTH_IN_DROPLETS};
-use crate::model::spec::Instance;
 use crate::pipeline::build::{MAX_DROPLETS, check_droplets};
 
 /// Most droplets one layer may hold with support on: the droplet-level pass

@@ -7,11 +7,14 @@ use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
 use crate::model::import;
-use crate::model::mesh::{self, Mesh, MeshStats};
+use crate::model::layout::{Frame, Instance, at_part, place_instances};
+use crate::model::mesh::{Mesh, MeshStats};
+use crate::model::models::{Model, models_of};
 use crate::model::prepare::{
     FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_height, check_volume,
     close_cracks, import, keep_groups, suggested_scale, warnings,
 };
+use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
@@ -48,19 +51,19 @@ impl Job {
     pub fn from_parts(files: &[(&str, &[u8])], spec: &job::JobSpec) -> Result<Job, Error> {
         let models = files
             .iter()
-            .map(|(name, bytes)| job::Model::read(bytes, name))
+            .map(|(name, bytes)| Model::read(bytes, name))
             .collect::<Result<Vec<_>, _>>()?;
         Job::from_models(&models, spec)
     }
 
     /// A build job from imported files: every part welded once, each instance placed (the
-    /// arrangement of [`job::place_instances`]) with [`Mesh::place`] — the very transform of
+    /// arrangement of [`place_instances`]) with [`Mesh::place`] — the very transform of
     /// [`Job::new`] — the instances merged into one mesh and prepared as [`Job::new`] does
     /// (checks, shells, repair, facet index). The job's settings are `spec.settings`.
-    pub fn from_models(models: &[job::Model], spec: &job::JobSpec) -> Result<Job, Error> {
+    pub fn from_models(models: &[Model], spec: &job::JobSpec) -> Result<Job, Error> {
         spec.validate()?;
         let settings = spec.settings.clone();
-        let by_part = job::models_of(models, spec)?;
+        let by_part = models_of(models, spec)?;
         // Runs of consecutive parts of one unit (SPEC.md: where parts of different units
         // overlap, the part listed first keeps the overlap).
         let mut run_of = Vec::with_capacity(spec.parts.len());
@@ -76,7 +79,7 @@ impl Job {
         let mut frames = Vec::with_capacity(spec.parts.len());
         let (mut facets_in_file, mut degenerate, mut facets) = (0usize, 0usize, 0usize);
         for (i, (p, m)) in spec.parts.iter().zip(&by_part).enumerate() {
-            let tris = m.triangles(p.item).map_err(|e| job::at_part(i, e))?;
+            let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
             let (mesh, dropped) = Mesh::weld(&tris);
             let copies = p.copies as usize;
             facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
@@ -86,7 +89,7 @@ impl Job {
                     import::MAX_TRIANGLES
                 )));
             }
-            let frame = job::Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0]));
+            let frame = Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0]));
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
                 return Err(Error::Import(format!(
                     "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
@@ -99,7 +102,7 @@ impl Job {
             welded.push(mesh);
             frames.push(frame);
         }
-        let layout = job::place_instances(&by_part, spec, &frames)?;
+        let layout = place_instances(&by_part, spec, &frames)?;
         let vertices: usize = layout
             .instances
             .iter()
@@ -110,7 +113,7 @@ impl Job {
             facets: Vec::with_capacity(facets),
         };
         // The instances run by run (a job of unit 0 alone: one run, in the layout's order).
-        let mut order: Vec<&job::Instance> = layout.instances.iter().collect();
+        let mut order: Vec<&Instance> = layout.instances.iter().collect();
         order.sort_by_key(|inst| run_of[inst.part]);
         let mut groups: Vec<FacetGroup> = Vec::new();
         for inst in order {
@@ -324,7 +327,7 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
 fn repair(
     mesh: Mesh,
     zs: &[f64],
-    shells: &mesh::ShellOrientation,
+    shells: &ShellOrientation,
     (welded, dropped): (usize, usize),
     duplicates: usize,
     facets_in_file: usize,

@@ -25,7 +25,9 @@ use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
 use crate::model::mesh::Mesh;
-use crate::model::spec::{self as job, JobSpec, Model};
+use crate::model::models::Model;
+use crate::model::spec::{self as job, JobSpec};
+use crate::model::{display, layout};
 use crate::output::gcode;
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{self, Figures, Summary};
@@ -297,7 +299,7 @@ impl Models {
     ) -> Result<Float32Array, JsValue> {
         let tris = self.model(name)?.triangles(item).map_err(js_error)?;
         Ok(Float32Array::from(
-            &job::display_mesh(&tris, max_triangles as usize)[..],
+            &display::display_mesh(&tris, max_triangles as usize)[..],
         ))
     }
 
@@ -309,7 +311,7 @@ impl Models {
     #[wasm_bindgen(unchecked_return_type = "Layout")]
     pub fn layout(&self, job: JsValue) -> Result<JsValue, JsValue> {
         let spec = job_of(job)?;
-        let layout = job::layout(&self.models, &spec).map_err(js_error)?;
+        let layout = layout::layout(&self.models, &spec).map_err(js_error)?;
         to_js(&layout, "the layout")
     }
 
@@ -317,7 +319,7 @@ impl Models {
     #[wasm_bindgen(unchecked_return_type = "Angles")]
     pub fn lay_flat(&self, name: &str, item: Option<usize>) -> Result<JsValue, JsValue> {
         let tris = self.model(name)?.triangles(item).map_err(js_error)?;
-        let (rotate_x, rotate_y) = job::lay_flat(&tris);
+        let (rotate_x, rotate_y) = layout::lay_flat(&tris);
         #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
         #[derive(Serialize)]
         struct Angles {

@@ -8,8 +8,9 @@ use crate::files::{
 use crate::staged::{self, Staged};
 use dropslice::analysis::JobAnalysis;
 use dropslice::base::error::quote;
+use dropslice::model::models::Model;
 use dropslice::model::models_job::{SettingsOverride, models_job_spec, override_settings};
-use dropslice::model::spec::{self as job, JobSpec, Model};
+use dropslice::model::spec::{self as job, JobSpec};
 use dropslice::{Error, Job, Settings, write_gcode_with};
 use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};

@@ -1,0 +1,544 @@
+//! Where the instances of a job go: each part's transform ([`Frame`]), the bottom-left
+//! arrangement on the plate ([`arrange`]), every copy placed ([`place_instances`]) into the
+//! [`Layout`] the page draws, and the rotation that lays a part on its largest flat face
+//! ([`lay_flat`]).
+
+use crate::base::error::Error;
+use crate::base::geom::{DMat3, DVec3};
+use crate::model::mesh::{Bounds, Placement, rot, rotation};
+use crate::model::models::{Model, corners, models_of};
+use crate::model::spec::{JobSpec, PartSpec, clean_name};
+use serde::{Deserialize, Serialize};
+
+/// An instance's transform before its last move: the rotation and scale of [`Placement`],
+/// the bounding box minimum after them (`min1`, moved to the origin), the rotation on the
+/// plate and the bounding box that gives (`qmin`, `qmax`; `qmin.z` = 0).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub rotation: DMat3,
+    pub scale: DVec3,
+    pub min1: DVec3,
+    pub angle: DMat3,
+    pub qmin: DVec3,
+    pub qmax: DVec3,
+}
+
+impl Frame {
+    /// The frame of `points` (every vertex of the part) under `p` (its `place` is not used).
+    /// The same arithmetic as [`crate::model::mesh::Mesh::place`], so `qmin + place` is exactly the
+    /// placed mesh's bounding box.
+    pub fn of<I: Iterator<Item = [f64; 3]> + Clone>(points: I, p: &Placement) -> Option<Frame> {
+        let r = rotation(p.rotate);
+        let scale = DVec3::from(p.scale);
+        let step1 = |v: [f64; 3]| r * DVec3::from(v) * scale;
+        let mut min1 = DVec3::INFINITY;
+        let mut any = false;
+        for v in points.clone() {
+            min1 = min1.min(step1(v));
+            any = true;
+        }
+        if !any {
+            return None;
+        }
+        let angle = rot(2, p.place_angle);
+        let (mut qmin, mut qmax) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for v in points {
+            let q = angle * (step1(v) - min1);
+            qmin = qmin.min(q);
+            qmax = qmax.max(q);
+        }
+        Some(Frame {
+            rotation: r,
+            scale,
+            min1,
+            angle,
+            qmin,
+            qmax,
+        })
+    }
+
+    /// The 4×4 matrix (column-major) of the whole transform with the final move `place`:
+    /// model coordinates → plate coordinates.
+    pub fn matrix(&self, place: [f64; 2]) -> [f64; 16] {
+        let l = self.angle * DMat3::from_diagonal(self.scale) * self.rotation;
+        let t = self.angle * (-self.min1) + DVec3::new(place[0], place[1], 0.0);
+        let c = l.to_cols_array();
+        [
+            c[0], c[1], c[2], 0.0, c[3], c[4], c[5], 0.0, c[6], c[7], c[8], 0.0, t.x, t.y, t.z, 1.0,
+        ]
+    }
+}
+
+/// One copy of a part on the plate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+pub struct Instance {
+    /// The part's index in the job's `parts` (from 0).
+    pub part: usize,
+    /// The copy's index (from 0).
+    pub copy: usize,
+    /// How many copies the part has.
+    pub copies: usize,
+    pub name: String,
+    pub file: String,
+    /// The 3MF build item (from 0), `None`: the whole file.
+    pub item: Option<usize>,
+    /// For a 3MF item, the object it refers to.
+    pub object: Option<String>,
+    pub rotate: [f64; 3],
+    pub scale: [f64; 3],
+    pub place_angle: f64,
+    /// Placed by the job (`place_x`, `place_y`) rather than arranged.
+    pub placed: bool,
+    /// The final move: `place_x`, `place_y` when placed; else where the arrangement put the
+    /// bounding box minimum.
+    pub at: [f64; 2],
+    pub unit: u8,
+    /// Column-major 4×4: the part's model coordinates (after import) → plate coordinates, the
+    /// exact transform applied before slicing.
+    pub matrix: [f64; 16],
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// The final move given to [`crate::model::mesh::Mesh::place`].
+    #[serde(skip)]
+    pub shift: [f64; 2],
+}
+
+/// Where every instance goes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+pub struct Layout {
+    pub instances: Vec<Instance>,
+    pub bounds: Bounds,
+    pub warnings: Vec<String>,
+}
+
+/// An axis-aligned rectangle on the plate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rect {
+    pub min: [f64; 2],
+    pub max: [f64; 2],
+}
+
+impl Rect {
+    /// Whether the two come closer than `gap` (touching at exactly `gap` is allowed).
+    pub fn too_close(&self, o: &Rect, gap: f64) -> bool {
+        let eps = 1e-9 * (1.0 + gap);
+        (0..2).all(|k| self.min[k] < o.max[k] + gap - eps && o.min[k] < self.max[k] + gap - eps)
+    }
+}
+
+/// Bottom-left arrangement: every box of `sizes` (width, depth) gets a slot (its minimum
+/// corner) on the plate [0, plate_x] × [0, plate_y], at least `gap` from every other box and
+/// every `fixed` one; `None` where it does not fit. The boxes are taken largest footprint first
+/// (stable); each goes to the lowest y, then lowest x, of the candidates: the origin, right of
+/// and above every box already there, and those at x = 0 or y = 0.
+pub fn arrange(
+    fixed: &[Rect],
+    sizes: &[[f64; 2]],
+    plate: [f64; 2],
+    gap: f64,
+) -> Vec<Option<[f64; 2]>> {
+    let mut order: Vec<usize> = (0..sizes.len()).collect();
+    order.sort_by(|&a, &b| {
+        let area = |i: usize| sizes[i][0] * sizes[i][1];
+        area(b).total_cmp(&area(a))
+    });
+    let mut there: Vec<Rect> = fixed.to_vec();
+    let mut slots = vec![None; sizes.len()];
+    let eps = 1e-9 * (1.0 + plate[0].max(plate[1]));
+    for i in order {
+        let [w, d] = sizes[i];
+        if w > plate[0] + eps || d > plate[1] + eps {
+            continue;
+        }
+        let mut candidates = vec![[0.0, 0.0]];
+        for r in &there {
+            let (x, y) = (r.max[0] + gap, r.max[1] + gap);
+            candidates.extend([[x, r.min[1]], [r.min[0], y], [x, 0.0], [0.0, y]]);
+        }
+        candidates.retain(|c| {
+            c[0] >= -eps && c[1] >= -eps && c[0] + w <= plate[0] + eps && c[1] + d <= plate[1] + eps
+        });
+        candidates.sort_by(|a, b| a[1].total_cmp(&b[1]).then(a[0].total_cmp(&b[0])));
+        let found = candidates.into_iter().find(|c| {
+            let r = Rect {
+                min: *c,
+                max: [c[0] + w, c[1] + d],
+            };
+            !there.iter().any(|o| r.too_close(o, gap))
+        });
+        if let Some(c) = found {
+            there.push(Rect {
+                min: c,
+                max: [c[0] + w, c[1] + d],
+            });
+            slots[i] = Some(c);
+        }
+    }
+    slots
+}
+
+/// Where every instance of `spec` goes, given each part's [`Frame`] (`frames[i]` for
+/// `spec.parts[i]`). Refuses a job whose arranged instances do not fit the plate (but one
+/// instance alone goes to the origin, with a warning, however large).
+pub fn place_instances(
+    models: &[&Model],
+    spec: &JobSpec,
+    frames: &[Frame],
+) -> Result<Layout, Error> {
+    let s = &spec.settings;
+    let plate = [s.plate_x, s.plate_y];
+    let gap = s.part_spacing;
+    let mut warnings = Vec::new();
+    let mut instances = Vec::new();
+    let mut fixed = Vec::new();
+    let mut free: Vec<(usize, usize)> = Vec::new();
+    let total: usize = spec.parts.iter().map(|p| p.copies as usize).sum();
+    for (i, p) in spec.parts.iter().enumerate() {
+        let f = &frames[i];
+        for copy in 0..p.copies as usize {
+            match p.place() {
+                Some(at) if copy == 0 => {
+                    let r = Rect {
+                        min: [f.qmin.x + at[0], f.qmin.y + at[1]],
+                        max: [f.qmax.x + at[0], f.qmax.y + at[1]],
+                    };
+                    warnings.extend(outside_plate(i, models[i], p, &r, plate));
+                    fixed.push(r);
+                    instances.push(instance(models[i], i, copy, p, f, true, at, [at[0], at[1]]));
+                }
+                _ => {
+                    free.push((i, copy));
+                    // Filled in below.
+                    instances.push(instance(
+                        models[i],
+                        i,
+                        copy,
+                        p,
+                        f,
+                        false,
+                        [0.0, 0.0],
+                        [0.0, 0.0],
+                    ));
+                }
+            }
+        }
+    }
+    let sizes: Vec<[f64; 2]> = free
+        .iter()
+        .map(|&(i, _)| {
+            let f = &frames[i];
+            [f.qmax.x - f.qmin.x, f.qmax.y - f.qmin.y]
+        })
+        .collect();
+    let mut slots = arrange(&fixed, &sizes, plate, gap);
+    if total == 1 && free.len() == 1 && slots[0].is_none() {
+        let [w, d] = sizes[0];
+        warnings.push(format!(
+            "the part ({w:.1} × {d:.1} mm) is larger than the plate ({} × {} mm); it is placed at the origin",
+            plate[0], plate[1]
+        ));
+        slots[0] = Some([0.0, 0.0]);
+    }
+    let missing: Vec<(usize, usize)> = free
+        .iter()
+        .zip(&slots)
+        .filter(|(_, s)| s.is_none())
+        .map(|(&ic, _)| ic)
+        .collect();
+    if !missing.is_empty() {
+        return Err(not_fitting(models, spec, frames, &missing));
+    }
+    let mut k = 0;
+    for inst in instances.iter_mut() {
+        if inst.placed {
+            continue;
+        }
+        let slot = slots[k].expect("every instance has a slot");
+        k += 1;
+        let f = &frames[inst.part];
+        let shift = [slot[0] - f.qmin.x, slot[1] - f.qmin.y];
+        inst.at = slot;
+        inst.shift = shift;
+        inst.matrix = f.matrix(shift);
+        inst.min = [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z];
+        inst.max = [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z];
+    }
+    let mut bounds = Bounds::EMPTY;
+    for inst in &instances {
+        bounds.grow(inst.min, inst.max);
+    }
+    Ok(Layout {
+        instances,
+        bounds,
+        warnings,
+    })
+}
+
+/// A warning when the fixed instance `r` of part `i` reaches outside the plate.
+fn outside_plate(
+    i: usize,
+    model: &Model,
+    p: &PartSpec,
+    r: &Rect,
+    plate: [f64; 2],
+) -> Option<String> {
+    let eps = 1e-9 * (1.0 + plate[0].max(plate[1]));
+    let outside = r.min[0] < -eps
+        || r.min[1] < -eps
+        || r.max[0] > plate[0] + eps
+        || r.max[1] > plate[1] + eps;
+    outside.then(|| {
+        format!(
+            "parts[{i}] ({}) reaches outside the plate ({} × {} mm): X{:.1}..{:.1} Y{:.1}..{:.1}",
+            clean_name(&part_label(model, p)),
+            plate[0],
+            plate[1],
+            r.min[0],
+            r.max[0],
+            r.min[1],
+            r.max[1]
+        )
+    })
+}
+
+/// The refusal of a job whose arranged instances `missing` (part, copy) found no slot.
+fn not_fitting(
+    models: &[&Model],
+    spec: &JobSpec,
+    frames: &[Frame],
+    missing: &[(usize, usize)],
+) -> Error {
+    let s = &spec.settings;
+    let (plate, gap) = ([s.plate_x, s.plate_y], s.part_spacing);
+    let mut parts: Vec<String> = Vec::new();
+    for (i, p) in spec.parts.iter().enumerate() {
+        let n = missing.iter().filter(|m| m.0 == i).count();
+        if n > 0 {
+            let f = &frames[i];
+            parts.push(format!(
+                "parts[{i}] ({}, {:.1} × {:.1} mm): {n} of {} cop{}",
+                clean_name(&part_label(models[i], p)),
+                f.qmax.x - f.qmin.x,
+                f.qmax.y - f.qmin.y,
+                p.copies,
+                if p.copies == 1 { "y" } else { "ies" }
+            ));
+        }
+    }
+    Error::Job(format!(
+        "not every part fits on the plate ({} × {} mm, part_spacing {} mm); these do not: {}. Use a larger plate (plate_x, plate_y), fewer copies or a smaller part_spacing",
+        plate[0],
+        plate[1],
+        gap,
+        parts.join("; ")
+    ))
+}
+
+/// `name` of the spec, else the part's name in its file.
+fn part_label(model: &Model, p: &PartSpec) -> String {
+    p.name.clone().unwrap_or_else(|| model.part_name(p.item))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn instance(
+    model: &Model,
+    part: usize,
+    copy: usize,
+    p: &PartSpec,
+    f: &Frame,
+    placed: bool,
+    at: [f64; 2],
+    shift: [f64; 2],
+) -> Instance {
+    Instance {
+        part,
+        copy,
+        copies: p.copies as usize,
+        name: clean_name(&part_label(model, p)),
+        file: clean_name(&p.file),
+        item: p.item,
+        object: p
+            .item
+            .and_then(|i| model.parts.get(i))
+            .and_then(|x| x.source_object.clone())
+            .map(|o| clean_name(&o)),
+        rotate: [p.rotate_x, p.rotate_y, p.rotate_z],
+        scale: [p.scale_x, p.scale_y, p.scale_z],
+        place_angle: p.place_angle,
+        placed,
+        at,
+        unit: p.unit,
+        matrix: f.matrix(shift),
+        min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
+        max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
+        shift,
+    }
+}
+
+/// The layout of a job from its imported files, without building the meshes (the page's 3D
+/// view; [`crate::Job::from_models`] gives the same instances).
+pub fn layout(models: &[Model], spec: &JobSpec) -> Result<Layout, Error> {
+    spec.validate()?;
+    let by_part = models_of(models, spec)?;
+    let frames = spec
+        .parts
+        .iter()
+        .zip(&by_part)
+        .enumerate()
+        .map(|(i, (p, m))| {
+            let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
+            Frame::of(corners(&tris), &p.placement([0.0, 0.0]))
+                .ok_or_else(|| Error::Job(format!("parts[{i}]: the part has no triangles")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    place_instances(&by_part, spec, &frames)
+}
+
+/// An error of part `i` with the part named.
+pub fn at_part(i: usize, e: Error) -> Error {
+    match e {
+        Error::Job(m) if !m.starts_with("parts[") => Error::Job(format!("parts[{i}]: {m}")),
+        e => e,
+    }
+}
+
+/// Most facets [`lay_flat`] looks at for supporting planes (more are sampled evenly).
+pub const LAY_FLAT_POINTS: usize = 300_000;
+/// Largest planes [`lay_flat`] checks for being a supporting plane.
+const LAY_FLAT_CANDIDATES: usize = 64;
+
+/// `(rotate_x, rotate_y)` in degrees (SPEC's order: x first) that put the part's largest flat
+/// face down: the largest set of coplanar mesh facets (facet normals within about 0.06° and
+/// plane offsets within 1 µm·scale grouped) whose plane touches the part from outside (no
+/// vertex beyond it), so the part rests on it. `(0, 0)` when no flat face supports the part
+/// (e.g. a sphere or a torus). Cost: one pass over the facets and up to 64 passes over at most
+/// [`LAY_FLAT_POINTS`] sampled corners.
+pub fn lay_flat(tris: &[[[f32; 3]; 3]]) -> (f64, f64) {
+    use std::collections::HashMap;
+    if tris.is_empty() {
+        return (0.0, 0.0);
+    }
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for p in corners(tris) {
+        lo = lo.min(DVec3::from(p));
+        hi = hi.max(DVec3::from(p));
+    }
+    let extent = (hi - lo).max_element().max(1e-9);
+    let centre = (lo + hi) / 2.0;
+    // plane key → (area, area-weighted normal, area-weighted offset)
+    let mut planes: HashMap<[i64; 4], (f64, DVec3, f64)> = HashMap::new();
+    for t in tris {
+        let [a, b, c] = t.map(|p| DVec3::from(p.map(f64::from)) - centre);
+        let n2 = (b - a).cross(c - a);
+        let len = n2.length();
+        if len <= 1e-12 * extent * extent || !len.is_finite() {
+            continue;
+        }
+        let n = n2 / len;
+        let d = n.dot(a);
+        let key = [
+            (n.x * 1e3).round() as i64,
+            (n.y * 1e3).round() as i64,
+            (n.z * 1e3).round() as i64,
+            (d / extent * 1e4).round() as i64,
+        ];
+        let e = planes.entry(key).or_insert((0.0, DVec3::ZERO, 0.0));
+        let area = len / 2.0;
+        e.0 += area;
+        e.1 += n * area;
+        e.2 += d * area;
+    }
+    let mut groups: Vec<(f64, DVec3, f64)> = planes.into_values().collect();
+    groups.sort_by(|a, b| b.0.total_cmp(&a.0));
+    groups.truncate(LAY_FLAT_CANDIDATES);
+    let n_points = tris.len() * 3;
+    let stride = n_points.div_ceil(LAY_FLAT_POINTS).max(1);
+    let points: Vec<DVec3> = corners(tris)
+        .step_by(stride)
+        .map(|p| DVec3::from(p) - centre)
+        .collect();
+    let tol = 1e-4 * extent;
+    // The supporting planes among the largest: (area, outward normal).
+    let mut supporting: Vec<(f64, DVec3)> = Vec::new();
+    for (area, nsum, dsum) in groups {
+        let n = nsum.normalize_or_zero();
+        if n == DVec3::ZERO {
+            continue;
+        }
+        let d = dsum / area;
+        let (mut below, mut above) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in &points {
+            let s = n.dot(*p);
+            below = below.min(s);
+            above = above.max(s);
+        }
+        // The facets' side of the part: outward normal n (nothing beyond the plane), or an
+        // inside-out mesh's (nothing behind it).
+        let outward = if above <= d + tol {
+            n
+        } else if below >= d - tol {
+            -n
+        } else {
+            continue;
+        };
+        supporting.push((area, outward));
+    }
+    // The largest; of faces as large (a box's bottom and top), the one facing down most, so a
+    // part already lying flat is not turned over.
+    let Some(largest) = supporting.iter().map(|s| s.0).reduce(f64::max) else {
+        return (0.0, 0.0);
+    };
+    supporting
+        .iter()
+        .filter(|s| s.0 >= largest * (1.0 - 1e-6))
+        .min_by(|a, b| a.1.z.total_cmp(&b.1.z))
+        .map_or((0.0, 0.0), |s| angles_down(s.1))
+}
+
+/// Angles (rotate x first, then y) that turn the unit vector `n` to −z.
+pub fn angles_down(n: DVec3) -> (f64, f64) {
+    // About x: n to (n.x, 0, −m); then about y: (n.x, 0, −m) to (0, 0, −1).
+    let m = (n.y * n.y + n.z * n.z).sqrt();
+    let a = if m < 1e-12 { 0.0 } else { (-n.y).atan2(-n.z) };
+    let b = n.x.atan2(m);
+    let clean = |r: f64| {
+        let d = r.to_degrees();
+        // Exact right angles stay exact (the trig of the transform is exact there).
+        let q = (d / 90.0).round();
+        if (d - q * 90.0).abs() < 1e-9 {
+            q * 90.0 + 0.0
+        } else {
+            d
+        }
+    };
+    (clean(a), clean(b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn angles_turn_normals_down() {
+        for n in [
+            DVec3::X,
+            -DVec3::X,
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::new(0.3, -0.5, 0.8).normalize(),
+            DVec3::new(-0.7, 0.1, -0.2).normalize(),
+        ] {
+            let (a, b) = angles_down(n);
+            let r = rotation([a, b, 0.0]);
+            let down = r * n;
+            assert!(
+                (down - DVec3::new(0.0, 0.0, -1.0)).length() < 1e-12,
+                "{n} → {down}"
+            );
+        }
+    }
+}

@@ -1,0 +1,187 @@
+//! The files of a job as read ([`Model`]: a name, its format and its parts), what a file
+//! holds for the page ([`ModelInfo`]) and the models of a job's parts ([`models_of`]).
+
+use crate::base::error::Error;
+use crate::model::import::stl::{self, Format};
+use crate::model::import::{self, Part};
+use crate::model::mesh::Bounds;
+use crate::model::spec::{JobSpec, clean_name};
+use serde::Serialize;
+use std::borrow::Cow;
+
+/// One imported model file of a job.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The job's key for the file (its name).
+    pub name: String,
+    pub format: Format,
+    /// Its parts: one for STL and OBJ, one per build item for 3MF.
+    pub parts: Vec<Part>,
+}
+
+impl Model {
+    /// Imports a file (see [`import::read_parts`]).
+    pub fn read(bytes: &[u8], name: &str) -> Result<Model, Error> {
+        let format = match import::detect(bytes, name) {
+            Format::Binary | Format::Ascii => {
+                let (triangles, format) = stl::parse(bytes)?;
+                return Ok(Model {
+                    name: name.to_string(),
+                    format,
+                    parts: vec![Part {
+                        name: import::stem(name),
+                        triangles,
+                        transform_applied: import::IDENTITY,
+                        source_object: None,
+                    }],
+                });
+            }
+            f => f,
+        };
+        let parts = import::read_parts(bytes, name)?;
+        if parts.is_empty() {
+            return Err(Error::Import(format!("{} has no parts", clean_name(name))));
+        }
+        Ok(Model {
+            name: name.to_string(),
+            format,
+            parts,
+        })
+    }
+
+    /// The triangles of one item, or of all (in the file's order: as [`import::read_merged`]).
+    pub fn triangles(&self, item: Option<usize>) -> Result<Cow<'_, [[[f32; 3]; 3]]>, Error> {
+        match item {
+            Some(i) => self
+                .parts
+                .get(i)
+                .map(|p| Cow::Borrowed(&p.triangles[..]))
+                .ok_or_else(|| {
+                    Error::Job(format!(
+                        "{} has {} build item{}; item {i} does not exist (items count from 0)",
+                        clean_name(&self.name),
+                        self.parts.len(),
+                        if self.parts.len() == 1 { "" } else { "s" }
+                    ))
+                }),
+            None if self.parts.len() == 1 => Ok(Cow::Borrowed(&self.parts[0].triangles[..])),
+            None => {
+                let n: usize = self.parts.iter().map(|p| p.triangles.len()).sum();
+                let mut all = Vec::with_capacity(n);
+                for p in &self.parts {
+                    all.extend_from_slice(&p.triangles);
+                }
+                Ok(Cow::Owned(all))
+            }
+        }
+    }
+
+    /// A name for an item (or the whole file).
+    pub fn part_name(&self, item: Option<usize>) -> String {
+        match item {
+            Some(i) if i < self.parts.len() => self.parts[i].name.clone(),
+            _ => import::stem(&self.name),
+        }
+    }
+}
+
+/// What a file holds, for the page: `{name, format, triangles, bounds, items, warnings,
+/// suggested_scale}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+pub struct ModelInfo {
+    pub name: String,
+    pub format: Format,
+    pub triangles: usize,
+    /// In the file's coordinates (mm, after its units and 3MF transforms).
+    pub bounds: Bounds,
+    /// The 3MF build items (one item for STL and OBJ).
+    pub items: Vec<ItemInfo>,
+    pub warnings: Vec<String>,
+    /// See [`crate::model::prepare::suggested_scale`].
+    pub suggested_scale: Option<f64>,
+}
+
+/// One build item of a [`ModelInfo`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+pub struct ItemInfo {
+    pub name: String,
+    pub triangles: usize,
+    pub bounds: Bounds,
+}
+
+/// The bounding box of triangles.
+pub fn bounds_of(tris: &[[[f32; 3]; 3]]) -> Bounds {
+    let mut b = Bounds::EMPTY;
+    for p in corners(tris) {
+        b.grow(p, p);
+    }
+    b
+}
+
+impl Model {
+    /// What the file holds.
+    pub fn info(&self) -> ModelInfo {
+        let items: Vec<ItemInfo> = self
+            .parts
+            .iter()
+            .map(|p| ItemInfo {
+                name: clean_name(&p.name),
+                triangles: p.triangles.len(),
+                bounds: bounds_of(&p.triangles),
+            })
+            .collect();
+        let mut bounds = Bounds::EMPTY;
+        for i in &items {
+            bounds.grow(i.bounds.min, i.bounds.max);
+        }
+        let size = bounds.size();
+        let suggested_scale = crate::model::prepare::suggested_scale(&size);
+        let largest = size[0].max(size[1]).max(size[2]);
+        let warnings = match suggested_scale {
+            Some(f) if f > 1.0 => vec![format!(
+                "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f}"
+            )],
+            Some(f) => vec![format!(
+                "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f}"
+            )],
+            None => Vec::new(),
+        };
+        ModelInfo {
+            name: clean_name(&self.name),
+            format: self.format,
+            triangles: items.iter().map(|i| i.triangles).sum(),
+            bounds,
+            items,
+            warnings,
+            suggested_scale,
+        }
+    }
+}
+
+/// The models of `spec`'s parts, in its order, found by file name.
+pub fn models_of<'a>(models: &'a [Model], spec: &JobSpec) -> Result<Vec<&'a Model>, Error> {
+    spec.parts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            models.iter().find(|m| m.name == p.file).ok_or_else(|| {
+                Error::Job(format!(
+                    "parts[{i}].file: '{}' is not among the job's files ({})",
+                    clean_name(&p.file),
+                    models
+                        .iter()
+                        .map(|m| clean_name(&m.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })
+        })
+        .collect()
+}
+
+/// The corners of a list of triangles as f64 points.
+pub fn corners(tris: &[[[f32; 3]; 3]]) -> impl Iterator<Item = [f64; 3]> + Clone + '_ {
+    tris.iter().flatten().map(|p| p.map(f64::from))
+}
