@@ -19,15 +19,17 @@
 //! The core knows nothing of wasm; this file only converts.
 
 mod cut;
+mod models;
 pub mod reader;
+
+pub use models::Models;
+use models::{job_of, read_file};
 
 use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
 use crate::model::mesh::Mesh;
-use crate::model::models::Model;
-use crate::model::spec::{self as job, JobSpec};
-use crate::model::{display, layout};
+use crate::model::spec as job;
 use crate::output::gcode;
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{self, Figures, Summary};
@@ -215,132 +217,6 @@ pub fn overhang_face_normal_z(settings: JsValue) -> Result<f64, JsValue> {
 }
 
 /// A job (`{settings, parts}`, the job file's JSON) from a JS object.
-fn job_of(value: JsValue) -> Result<JobSpec, JsValue> {
-    let value: serde_json::Value = serde_wasm_bindgen::from_value(value).map_err(|e| {
-        js_error(Error::Job(format!(
-            "the job is not a plain object {{settings, parts}}: {e}"
-        )))
-    })?;
-    JobSpec::from_value(value).map_err(js_error)
-}
-
-/// Reads a `File` in the worker (`FileReaderSync`).
-fn read_file(file: &web_sys::File) -> Result<Vec<u8>, JsValue> {
-    let name = file.name();
-    let unreadable = |e: JsValue| {
-        js_error(Error::Import(format!(
-            "the browser could not read {name}: {}",
-            e.as_string()
-                .or_else(|| e.dyn_ref::<js_sys::Error>().map(|e| e.message().into()))
-                .unwrap_or_else(|| format!("{e:?}"))
-        )))
-    };
-    let reader = web_sys::FileReaderSync::new().map_err(unreadable)?;
-    let buffer = reader.read_as_array_buffer(file).map_err(unreadable)?;
-    Ok(Uint8Array::new(&buffer).to_vec())
-}
-
-/// The imported files of a build job, kept in one worker: the page adds and removes files,
-/// asks for their display meshes, the job's layout and lay-flat angles, and builds the merged
-/// job with [`Session::from_models`].
-#[wasm_bindgen]
-#[derive(Default)]
-pub struct Models {
-    models: Vec<Model>,
-}
-
-#[wasm_bindgen]
-impl Models {
-    #[wasm_bindgen(constructor)]
-    pub fn new() -> Models {
-        Models::default()
-    }
-
-    /// Reads and imports a `File` under `name` (the job's key for it; a file of the same name
-    /// is replaced). Returns `ModelInfo {name, format, triangles, bounds {min, max}, items:
-    /// [{name, triangles, bounds}], warnings, suggested_scale}`.
-    #[wasm_bindgen(unchecked_return_type = "ModelInfo")]
-    pub fn add(&mut self, file: web_sys::File, name: &str) -> Result<JsValue, JsValue> {
-        let bytes = read_file(&file)?;
-        self.add_bytes(&bytes, name)
-    }
-
-    /// [`Models::add`] from bytes.
-    #[wasm_bindgen(unchecked_return_type = "ModelInfo")]
-    pub fn add_bytes(&mut self, bytes: &[u8], name: &str) -> Result<JsValue, JsValue> {
-        let model = Model::read(bytes, name).map_err(js_error)?;
-        let info = model.info();
-        self.models.retain(|m| m.name != name);
-        self.models.push(model);
-        to_js(&info, "the model info")
-    }
-
-    /// Forgets a file; whether it was there.
-    pub fn remove(&mut self, name: &str) -> bool {
-        let before = self.models.len();
-        self.models.retain(|m| m.name != name);
-        self.models.len() != before
-    }
-
-    /// The files' names, in the order they were added.
-    #[wasm_bindgen(unchecked_return_type = "string[]")]
-    pub fn names(&self) -> Result<JsValue, JsValue> {
-        let names: Vec<&str> = self.models.iter().map(|m| m.name.as_str()).collect();
-        to_js(&names, "the file names")
-    }
-
-    /// A decimated copy of a file's triangles (one build item, or all) for the 3D view, at
-    /// most `max_triangles`: 9 floats per triangle, model coordinates in mm. Never sliced.
-    pub fn display_mesh(
-        &self,
-        name: &str,
-        item: Option<usize>,
-        max_triangles: u32,
-    ) -> Result<Float32Array, JsValue> {
-        let tris = self.model(name)?.triangles(item).map_err(js_error)?;
-        Ok(Float32Array::from(
-            &display::display_mesh(&tris, max_triangles as usize)[..],
-        ))
-    }
-
-    /// Where every copy of every part goes: `Layout {instances: [{part, copy, copies, name,
-    /// file, item, object, rotate, scale, place_angle, placed, at, unit, matrix, min, max}],
-    /// bounds, warnings}` (`matrix`: column-major 4×4, model → plate coordinates, exactly
-    /// the transform sliced). `job`: `{settings, parts}` as in a job file. Throws
-    /// `{kind: "job" | "setting", message, setting?}`.
-    #[wasm_bindgen(unchecked_return_type = "Layout")]
-    pub fn layout(&self, job: JsValue) -> Result<JsValue, JsValue> {
-        let spec = job_of(job)?;
-        let layout = layout::layout(&self.models, &spec).map_err(js_error)?;
-        to_js(&layout, "the layout")
-    }
-
-    /// `{rotate_x, rotate_y}` (degrees) that put a file's (or item's) largest flat face down.
-    #[wasm_bindgen(unchecked_return_type = "Angles")]
-    pub fn lay_flat(&self, name: &str, item: Option<usize>) -> Result<JsValue, JsValue> {
-        let tris = self.model(name)?.triangles(item).map_err(js_error)?;
-        let (rotate_x, rotate_y) = layout::lay_flat(&tris);
-        #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
-        #[derive(Serialize)]
-        struct Angles {
-            rotate_x: f64,
-            rotate_y: f64,
-        }
-        to_js(&Angles { rotate_x, rotate_y }, "the angles")
-    }
-}
-
-impl Models {
-    fn model(&self, name: &str) -> Result<&Model, JsValue> {
-        self.models.iter().find(|m| m.name == name).ok_or_else(|| {
-            js_error(Error::Job(format!(
-                "no file named '{}' was added",
-                job::clean_name(name)
-            )))
-        })
-    }
-}
-
 impl Session {
     fn check_layer(&self, i: usize) -> Result<(), JsValue> {
         if i >= self.job.layer_count() {

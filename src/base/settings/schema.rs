@@ -1,0 +1,441 @@
+//! The settings' schema: every key with its default, unit, range, choices, group and
+//! meaning; the page builds its form from it and [`super::Settings::validate`] checks every
+//! value against it.
+
+use super::*;
+
+/// The settings that belong to a part, not to a job: the schema flags them
+/// ([`SettingSpec::part`]) with their ranges, which a job file's parts are checked against
+/// (`crate::model::spec`); the page takes both from the schema.
+pub const PART_KEYS: [&str; 9] = [
+    "rotate_x",
+    "rotate_y",
+    "rotate_z",
+    "scale_x",
+    "scale_y",
+    "scale_z",
+    "place_x",
+    "place_y",
+    "place_angle",
+];
+
+/// Kind of a setting's value, for the page's form.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Kind {
+    Number,
+    Integer,
+    Bool,
+    Enum,
+}
+
+/// One row of the settings table: name, unit, range, description.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Debug, Serialize)]
+pub struct SettingSpec {
+    pub name: &'static str,
+    pub kind: Kind,
+    pub unit: &'static str,
+    /// Smallest allowed value (numbers only).
+    pub min: Option<f64>,
+    /// Largest allowed value (numbers only).
+    pub max: Option<f64>,
+    /// `min` itself is not allowed (e.g. a scale must be > 0).
+    pub min_exclusive: bool,
+    pub choices: &'static [&'static str],
+    pub group: &'static str,
+    pub description: &'static str,
+    /// A key of a part ([`PART_KEYS`]): in a job each part carries its own (docs/jobs.md), and
+    /// a job's settings refuse it.
+    pub part: bool,
+    #[cfg_attr(target_arch = "wasm32", tsify(type = "number | boolean | string"))]
+    pub default: serde_json::Value,
+}
+
+const NO_CHOICES: &[&str] = &[];
+
+fn num(
+    name: &'static str,
+    unit: &'static str,
+    min: f64,
+    max: f64,
+    group: &'static str,
+    description: &'static str,
+) -> SettingSpec {
+    SettingSpec {
+        name,
+        kind: Kind::Number,
+        unit,
+        min: Some(min),
+        max: Some(max),
+        min_exclusive: false,
+        choices: NO_CHOICES,
+        group,
+        description,
+        part: false,
+        default: serde_json::Value::Null,
+    }
+}
+
+fn positive(spec: SettingSpec) -> SettingSpec {
+    SettingSpec {
+        min_exclusive: true,
+        ..spec
+    }
+}
+
+fn choice(
+    name: &'static str,
+    kind: Kind,
+    choices: &'static [&'static str],
+    group: &'static str,
+    description: &'static str,
+) -> SettingSpec {
+    SettingSpec {
+        name,
+        kind,
+        unit: "",
+        min: None,
+        max: None,
+        min_exclusive: false,
+        choices,
+        group,
+        description,
+        part: false,
+        default: serde_json::Value::Null,
+    }
+}
+
+/// The settings table in display order, with defaults filled in.
+pub fn schema() -> Vec<SettingSpec> {
+    let mut specs = vec![
+        positive(num(
+            "layer_height",
+            "mm",
+            0.0,
+            5.0,
+            "Droplet",
+            "Layer height H: the height of one droplet",
+        )),
+        positive(num(
+            "droplet_aspect",
+            "",
+            0.0,
+            10.0,
+            "Droplet",
+            "Droplet width B divided by its height H (B = aspect x H)",
+        )),
+        SettingSpec {
+            kind: Kind::Integer,
+            ..num(
+                "contours",
+                "",
+                0.0,
+                100.0,
+                "Contours",
+                "Contour loops printed along every boundary (0 = none)",
+            )
+        },
+        num(
+            "outer_offset",
+            "x B",
+            0.0,
+            10.0,
+            "Contours",
+            "Offset of the first loop from an outer boundary, inward, in droplet widths",
+        ),
+        num(
+            "inner_offset",
+            "x B",
+            0.0,
+            10.0,
+            "Contours",
+            "Offset of the first loop from a hole boundary, into the material, in droplet widths",
+        ),
+        num(
+            "start_jitter",
+            "mm",
+            0.0,
+            1000.0,
+            "Contours",
+            "Each layer's loops start this much further along than the layer below, so loop seams do not stack",
+        ),
+        choice(
+            "stagger",
+            Kind::Bool,
+            NO_CHOICES,
+            "Contours",
+            "Set droplets over the gaps of the layer below: every layer's loop droplets half a droplet along from the layer below's (the start moves by start_jitter rounded to an odd multiple of B/2), hatch lines half a spacing across from the last layer with the same hatch direction",
+        ),
+        choice(
+            "contour_order",
+            Kind::Enum,
+            &["inside_out", "outside_in"],
+            "Contours",
+            "inside_out: inner loops before the outermost; outside_in: outermost first",
+        ),
+        choice(
+            "close_loops",
+            Kind::Bool,
+            NO_CHOICES,
+            "Contours",
+            "Repeat a loop's first droplet at its end to close it",
+        ),
+        choice(
+            "loop_spacing",
+            Kind::Enum,
+            &["exact", "even"],
+            "Contours",
+            "exact: droplets B apart, the first repeated at the end (the thesis); even: n = ceil(L/B) droplets spaced evenly, no double droplet at the seam",
+        ),
+        num(
+            "fill_density",
+            "",
+            0.0,
+            2.0,
+            "Fill",
+            "Hatch spacing = B / fill_density (0 = no fill)",
+        ),
+        num(
+            "fill_overlap",
+            "x B",
+            0.0,
+            1.0,
+            "Fill",
+            "How far fill droplets reach into the innermost loop, in droplet widths",
+        ),
+        num(
+            "hatch_angle",
+            "deg",
+            -360.0,
+            360.0,
+            "Fill",
+            "Hatch direction of the first layer",
+        ),
+        num(
+            "hatch_angle_step",
+            "deg",
+            -360.0,
+            360.0,
+            "Fill",
+            "Added to the hatch direction from one layer to the next",
+        ),
+        choice(
+            "print_order",
+            Kind::Enum,
+            &["contours_first", "fill_first"],
+            "Fill",
+            "contours_first: fill binds to existing loops; fill_first: fill before contours",
+        ),
+        num(
+            "rotate_x",
+            "deg",
+            -360.0,
+            360.0,
+            "Part",
+            "Rotation of the part about x (applied first)",
+        ),
+        num(
+            "rotate_y",
+            "deg",
+            -360.0,
+            360.0,
+            "Part",
+            "Rotation of the part about y (applied second)",
+        ),
+        num(
+            "rotate_z",
+            "deg",
+            -360.0,
+            360.0,
+            "Part",
+            "Rotation of the part about z (applied third)",
+        ),
+        positive(num(
+            "scale_x",
+            "",
+            0.0,
+            1000.0,
+            "Part",
+            "Scale factor in x (25.4 turns inches into mm)",
+        )),
+        positive(num("scale_y", "", 0.0, 1000.0, "Part", "Scale factor in y")),
+        positive(num("scale_z", "", 0.0, 1000.0, "Part", "Scale factor in z")),
+        num(
+            "place_x",
+            "mm",
+            -10000.0,
+            10000.0,
+            "Part",
+            "Position of the part on the table in x, after its bounding box was moved to the origin",
+        ),
+        num(
+            "place_y",
+            "mm",
+            -10000.0,
+            10000.0,
+            "Part",
+            "Position of the part on the table in y, after its bounding box was moved to the origin",
+        ),
+        num(
+            "place_angle",
+            "deg",
+            -360.0,
+            360.0,
+            "Part",
+            "Rotation of the part on the table about z, around the origin, before place_x/place_y",
+        ),
+        choice(
+            "slice_plane",
+            Kind::Enum,
+            &["middle", "top"],
+            "Part",
+            "Cut each layer at its middle (more accurate) or at its top (the thesis)",
+        ),
+        positive(num(
+            "droplet_rate",
+            "Hz",
+            0.0,
+            100000.0,
+            "Machine",
+            "Droplets the discharge unit sets per second (time estimate)",
+        )),
+        positive(num(
+            "travel_speed",
+            "mm/s",
+            0.0,
+            10000.0,
+            "Machine",
+            "Table speed of travel moves (time estimate)",
+        )),
+        positive(num(
+            "material_density",
+            "g/cm³",
+            0.0,
+            30.0,
+            "Machine",
+            "Density of the material (mass estimate)",
+        )),
+        choice(
+            "footprint",
+            Kind::Enum,
+            &["disc", "spread"],
+            "Analysis",
+            "Droplet footprint in the coverage report: disc = diameter B; spread = diameter 2B/sqrt(pi), the area of a B x B cell",
+        ),
+        positive(num(
+            "plate_x",
+            "mm",
+            0.0,
+            100000.0,
+            "Plate",
+            "Build plate size in x: parts without a placement are arranged on it",
+        )),
+        positive(num(
+            "plate_y",
+            "mm",
+            0.0,
+            100000.0,
+            "Plate",
+            "Build plate size in y",
+        )),
+        num(
+            "part_spacing",
+            "mm",
+            0.0,
+            1000.0,
+            "Plate",
+            "Gap between the bounding boxes of arranged parts",
+        ),
+        num(
+            "overhang_limit",
+            "x B",
+            0.0,
+            10.0,
+            "Support",
+            "A droplet is supported when the layer below has material within this many droplet widths of its centre",
+        ),
+        choice(
+            "support",
+            Kind::Enum,
+            &["off", "unit1"],
+            "Support",
+            "off: no support; unit1: support under every overhang, printed by discharge unit 1",
+        ),
+        num(
+            "support_gap_xy",
+            "x B",
+            0.0,
+            10.0,
+            "Support",
+            "Support is kept this many droplet widths away from the part within a layer",
+        ),
+        SettingSpec {
+            kind: Kind::Integer,
+            ..num(
+                "support_gap_z",
+                "layers",
+                0.0,
+                100.0,
+                "Support",
+                "Support ends this many layers below the overhang (0: a soluble support touches the part)",
+            )
+        },
+        positive(num(
+            "support_density",
+            "",
+            0.0,
+            1.0,
+            "Support",
+            "Hatch spacing of the support = B1 / support_density",
+        )),
+        positive(num(
+            "unit1_droplet_aspect",
+            "",
+            0.0,
+            10.0,
+            "Unit 1",
+            "Droplet width B1 of discharge unit 1 divided by the layer height",
+        )),
+        positive(num(
+            "unit1_droplet_rate",
+            "Hz",
+            0.0,
+            100000.0,
+            "Unit 1",
+            "Droplets unit 1 sets per second (time estimate)",
+        )),
+        positive(num(
+            "unit1_material_density",
+            "g/cm³",
+            0.0,
+            30.0,
+            "Unit 1",
+            "Density of unit 1's material (mass estimate)",
+        )),
+        choice(
+            "unit_order",
+            Kind::Enum,
+            &["unit0_first", "unit1_first"],
+            "Unit 1",
+            "Which discharge unit prints first within a layer",
+        ),
+    ];
+    let defaults = serde_json::to_value(Settings::default()).expect("settings serialize");
+    for spec in &mut specs {
+        spec.default = defaults[spec.name].clone();
+        spec.part = PART_KEYS.contains(&spec.name);
+    }
+    specs
+}
+
+/// The schema as JSON, for the page.
+pub fn schema_json() -> String {
+    serde_json::to_string(&schema()).expect("schema serializes")
+}
+
+/// Names of all settings, in schema order.
+pub fn names() -> Vec<&'static str> {
+    schema().into_iter().map(|s| s.name).collect()
+}
