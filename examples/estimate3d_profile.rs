@@ -12,7 +12,7 @@ use dropslice::{Job, Settings};
 
 #[path = "common/cpu.rs"]
 mod cpu;
-use cpu::cpu;
+use cpu::best_time;
 
 /// [`slab_voids`] or [`slab_voids_reference`].
 type SlabFn = fn(
@@ -64,18 +64,18 @@ fn main() {
     let mut best = [f64::INFINITY; 4];
     let mut figures = (Vec::new(), Vec::new());
     for _ in 0..runs {
-        let t = cpu();
-        let fast_maps: Vec<HeightMap> = layers
-            .iter()
-            .map(|(_, c)| HeightMap::new(c, &grid, d))
-            .collect();
-        best[0] = best[0].min(cpu() - t);
-        let t = cpu();
-        let ref_maps: Vec<HeightMap> = layers
-            .iter()
-            .map(|(_, c)| HeightMap::reference(c, &grid, d))
-            .collect();
-        best[1] = best[1].min(cpu() - t);
+        let fast_maps: Vec<HeightMap> = best_time(&mut best[0], || {
+            layers
+                .iter()
+                .map(|(_, c)| HeightMap::new(c, &grid, d))
+                .collect()
+        });
+        let ref_maps: Vec<HeightMap> = best_time(&mut best[1], || {
+            layers
+                .iter()
+                .map(|(_, c)| HeightMap::reference(c, &grid, d))
+                .collect()
+        });
         // Every layer's slab between its real neighbours, by `slab` on `maps`.
         let slabs = |maps: &[HeightMap], slab: SlabFn| -> Vec<(f64, f64)> {
             (0..layers.len())
@@ -85,12 +85,8 @@ fn main() {
                 })
                 .collect()
         };
-        let t = cpu();
-        figures.0 = slabs(&fast_maps, slab_voids);
-        best[2] = best[2].min(cpu() - t);
-        let t = cpu();
-        figures.1 = slabs(&ref_maps, slab_voids_reference);
-        best[3] = best[3].min(cpu() - t);
+        figures.0 = best_time(&mut best[2], || slabs(&fast_maps, slab_voids));
+        figures.1 = best_time(&mut best[3], || slabs(&ref_maps, slab_voids_reference));
     }
     let same_figures = figures
         .0

@@ -9,6 +9,8 @@
 #![cfg(not(target_arch = "wasm32"))]
 #[path = "../tests/common/seams.rs"]
 mod seams;
+#[path = "../tests/common/segment.rs"]
+mod segment;
 
 use dropslice::analysis::JobAnalysis;
 use dropslice::{Job, Settings, write_gcode_with};

@@ -116,37 +116,11 @@ fn parts_far_apart_take_memory_for_the_parts_only() {
 
 /// A binary STL of axis-aligned boxes (min, max), 12 facets each.
 fn boxes_stl(boxes: &[([f32; 3], [f32; 3])]) -> Vec<u8> {
-    let mut out = vec![0u8; 80];
-    out.extend((12 * boxes.len() as u32).to_le_bytes());
-    for &(lo, hi) in boxes {
-        let v = |i: usize| {
-            [
-                if i & 4 != 0 { hi[0] } else { lo[0] },
-                if i & 2 != 0 { hi[1] } else { lo[1] },
-                if i & 1 != 0 { hi[2] } else { lo[2] },
-            ]
-        };
-        // Faces as corners (bit 4: x, 2: y, 1: z), counter-clockwise seen from outside.
-        for q in [
-            [0, 1, 3, 2],
-            [4, 6, 7, 5],
-            [0, 4, 5, 1],
-            [2, 3, 7, 6],
-            [0, 2, 6, 4],
-            [1, 5, 7, 3],
-        ] {
-            for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
-                out.extend([0u8; 12]);
-                for i in t {
-                    for c in v(i) {
-                        out.extend(c.to_le_bytes());
-                    }
-                }
-                out.extend([0u8; 2]);
-            }
-        }
-    }
-    out
+    let tris: Vec<_> = boxes
+        .iter()
+        .flat_map(|&(lo, hi)| common::cuboid(lo, hi))
+        .collect();
+    common::stl_bytes(&tris)
 }
 
 /// Runs `dropslice MODEL -o OUT --report REPORT` on `stl`: the report, and the process's peak

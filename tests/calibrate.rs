@@ -17,6 +17,26 @@ fn cli<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S], dir: &Path) -> c
     r
 }
 
+/// `dropslice calibrate ARGS` (`args` separated by spaces) is refused: exit code 2, a short message containing `want`,
+/// nothing on stdout.
+fn assert_refused(dir: &Path, args: &str, want: &str) {
+    let all: Vec<&str> = ["calibrate"].into_iter().chain(args.split(' ')).collect();
+    let r = cli(&all, dir);
+    assert_eq!(r.code, Some(2), "{all:?}: {r:?}");
+    assert!(
+        r.stderr.contains(want),
+        "{all:?}: expected {want:?} in {:?}",
+        r.stderr
+    );
+    assert!(
+        r.stderr.len() < 600,
+        "{} bytes: {}",
+        r.stderr.len(),
+        r.stderr
+    );
+    assert!(r.stdout.is_empty(), "{all:?}: {}", r.stdout);
+}
+
 /// The cube's code and its header's droplet total.
 fn cube_code(dir: &TempDir) -> (String, u64) {
     let text = common::slice_cli(&common::model("cube_20mm_ascii.stl"), &[]);
@@ -34,7 +54,8 @@ fn cube_code(dir: &TempDir) -> (String, u64) {
 fn known_volume_gives_its_filling_and_aspect() {
     let dir = TempDir::new("calibrate");
     let (text, n) = cube_code(&dir);
-    // A 20 mm cube at B = 0.208, H = 0.2: about 8000 mm³ / B²H droplets.
+    // A 20 mm cube at B = 0.208, H = 0.2: about 8000 mm³ / B²H droplets (six digits, so the
+    // CLI writes them with one thousands separator).
     assert!((800_000..1_000_000).contains(&n), "{n}");
     let rho = 1.18;
     let cell = B * B * H;
@@ -72,24 +93,13 @@ fn known_volume_gives_its_filling_and_aspect() {
         assert!(
             r.stdout.contains(&format!("filling degree    {fill:.3}"))
                 && r.stdout.contains(&format!("{a:.3} suggested (now 1.04)"))
-                && r.stdout.contains(&format!("{} droplets of", grouped(n)))
+                && r.stdout
+                    .contains(&format!("{},{:03} droplets of", n / 1000, n % 1000))
                 && r.stdout.contains("from the header"),
             "{}",
             r.stdout
         );
     }
-}
-
-fn grouped(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 #[test]
@@ -133,79 +143,30 @@ fn refusals_exit_2_with_a_reason() {
     let sane = n as f64 * 1.04 * cell / 1000.0;
     // wide: cell (1.6)²·0.2 = 0.512 mm³; a filling of 4 suggests aspect 16.
     let wide_mass = 1000.0 * 1.04 * 4.0 * 0.512 / 1000.0;
-    let cases: Vec<(Vec<String>, &str)> = vec![
+    // [arguments after `calibrate`, separated by spaces; what the message must say]
+    let cases: Vec<(String, &str)> = vec![
+        ("empty.gco --mass 1".into(), "sets no droplets"),
+        ("cube.gco --mass 0".into(), "positive number of grams"),
+        ("cube.gco --mass -3".into(), "positive number of grams"),
+        ("cube.gco --mass NaN".into(), "not a number"),
+        ("cube.gco --mass inf".into(), "not a number"),
         (
-            vec!["empty.gco".into(), "--mass".into(), "1".into()],
-            "sets no droplets",
-        ),
-        (
-            vec!["cube.gco".into(), "--mass".into(), "0".into()],
-            "positive number of grams",
-        ),
-        (
-            vec!["cube.gco".into(), "--mass".into(), "-3".into()],
-            "positive number of grams",
-        ),
-        (
-            vec!["cube.gco".into(), "--mass".into(), "NaN".into()],
-            "not a number",
-        ),
-        (
-            vec!["cube.gco".into(), "--mass".into(), "inf".into()],
-            "not a number",
-        ),
-        (
-            vec![
-                "cube.gco".into(),
-                "--mass".into(),
-                format!("{}", sane * 10.0),
-            ],
+            format!("cube.gco --mass {}", sane * 10.0),
             "impossible: check the mass",
         ),
+        (format!("cube.gco --mass {}", sane / 10.0), "impossible"),
         (
-            vec![
-                "cube.gco".into(),
-                "--mass".into(),
-                format!("{}", sane / 10.0),
-            ],
-            "impossible",
-        ),
-        (
-            vec![
-                "cube.gco".into(),
-                "--mass".into(),
-                format!("{sane}"),
-                "--density".into(),
-                "0".into(),
-            ],
+            format!("cube.gco --mass {sane} --density 0"),
             "density must be greater than 0",
         ),
-        (
-            vec!["wide.gco".into(), "--mass".into(), format!("{wide_mass}")],
-            "outside its range",
-        ),
-        (
-            vec!["missing.gco".into(), "--mass".into(), "1".into()],
-            "cannot open",
-        ),
-        (
-            vec!["model.stl".into(), "--mass".into(), "1".into()],
-            "not a text file",
-        ),
-        (vec!["cube.gco".into()], "--mass GRAMS is needed"),
-        (vec!["--mass".into(), "1".into()], "no .gco file given"),
+        (format!("wide.gco --mass {wide_mass}"), "outside its range"),
+        ("missing.gco --mass 1".into(), "cannot open"),
+        ("model.stl --mass 1".into(), "not a text file"),
+        ("cube.gco".into(), "--mass GRAMS is needed"),
+        ("--mass 1".into(), "no .gco file given"),
     ];
     for (args, want) in cases {
-        let mut all = vec!["calibrate".to_string()];
-        all.extend(args.iter().cloned());
-        let r = cli(&all, dir.path());
-        assert_eq!(r.code, Some(2), "{all:?}: {r:?}");
-        assert!(
-            r.stderr.contains(want),
-            "{all:?}: expected {want:?} in {:?}",
-            r.stderr
-        );
-        assert!(r.stdout.is_empty(), "{all:?}: {}", r.stdout);
+        assert_refused(dir.path(), &args, want);
     }
 }
 
@@ -264,45 +225,18 @@ fn hostile_arguments_are_refused_briefly() {
     let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
     let long = "7".repeat(100_000);
-    let cases: Vec<(Vec<String>, &str)> = vec![
+    // [arguments after `calibrate`, separated by spaces; what the message must say]
+    let cases: Vec<(String, &str)> = vec![
+        ("cube.gco --mass 1e308".into(), "(1e308 g over"),
         (
-            vec!["cube.gco".into(), "--mass".into(), "1e308".into()],
-            "(1e308 g over",
-        ),
-        (
-            vec![
-                "cube.gco".into(),
-                "--mass".into(),
-                format!("{sane}"),
-                "--density".into(),
-                "1e300".into(),
-            ],
+            format!("cube.gco --mass {sane} --density 1e300"),
             "got 1e300",
         ),
-        (
-            vec!["cube.gco".into(), "--mass".into(), format!("x{long}")],
-            "not a number",
-        ),
-        (
-            vec!["fifo.gco".into(), "--mass".into(), "1".into()],
-            "not a regular file",
-        ),
-        (
-            vec!["/dev/zero".into(), "--mass".into(), "1".into()],
-            "not a regular file",
-        ),
+        (format!("cube.gco --mass x{long}"), "not a number"),
+        ("fifo.gco --mass 1".into(), "not a regular file"),
+        ("/dev/zero --mass 1".into(), "not a regular file"),
     ];
     for (args, want) in cases {
-        let mut all = vec!["calibrate".to_string()];
-        all.extend(args.iter().cloned());
-        let r = cli(&all, dir.path());
-        assert_eq!(r.code, Some(2), "{all:?}: {r:?}");
-        assert!(r.stderr.contains(want), "{want:?} in {:?}", r.stderr);
-        assert!(
-            r.stderr.len() < 600,
-            "{} bytes: {}",
-            r.stderr.len(),
-            r.stderr
-        );
+        assert_refused(dir.path(), &args, want);
     }
 }

@@ -305,12 +305,25 @@ fn sigkill_leaves_nothing_where_unnamed_files_exist() {
     }
 }
 
+/// What `out.gco` holds before a run that must leave it alone.
+const EXISTING: &str = "; existing code\n";
+
+/// `out.gco` still holds [`EXISTING`] and the folder lists what it listed `before`.
+fn assert_left_alone(d: &Path, before: &[String], what: &str) {
+    assert_eq!(
+        std::fs::read_to_string(d.join("out.gco")).unwrap(),
+        EXISTING,
+        "{what}"
+    );
+    assert_eq!(listing(d), before, "{what}");
+}
+
 #[test]
 fn a_failed_run_leaves_the_existing_output_and_nothing_else() {
     for named in MODES {
         let dir = tempfile::tempdir().unwrap();
         let d = dir.path();
-        std::fs::write(d.join("out.gco"), "; existing code\n").unwrap();
+        std::fs::write(d.join("out.gco"), EXISTING).unwrap();
         std::fs::write(d.join("r.json"), "{\"existing\": true}\n").unwrap();
         std::fs::write(d.join("bad.stl"), "solid x\nfacet normal 0 0 1\nendsolid\n").unwrap();
         let before = listing(d);
@@ -333,14 +346,14 @@ fn a_failed_run_leaves_the_existing_output_and_nothing_else() {
             let r = cli(&all, d, named);
             assert_eq!(r.code, Some(code), "{args:?}: {}", r.stderr);
             assert_eq!(
-                std::fs::read_to_string(d.join("out.gco")).unwrap(),
-                "; existing code\n"
-            );
-            assert_eq!(
                 std::fs::read_to_string(d.join("r.json")).unwrap(),
                 "{\"existing\": true}\n"
             );
-            assert_eq!(listing(d), before, "{args:?}, DROPSLICE_NAMED_TEMP={named}");
+            assert_left_alone(
+                d,
+                &before,
+                &format!("{args:?}, DROPSLICE_NAMED_TEMP={named}"),
+            );
         }
     }
 }
@@ -352,7 +365,7 @@ fn an_error_mid_write_leaves_the_existing_output_and_nothing_else() {
         let dir = tempfile::tempdir().unwrap();
         let logs = tempfile::tempdir().unwrap();
         let d = dir.path();
-        std::fs::write(d.join("out.gco"), "; existing code\n").unwrap();
+        std::fs::write(d.join("out.gco"), EXISTING).unwrap();
         let before = listing(d);
         let mut cmd = Command::new(common::bin());
         // Files may not grow past 256 KB (the cube's code is ~3 MB): a write fails with EFBIG
@@ -381,11 +394,7 @@ fn an_error_mid_write_leaves_the_existing_output_and_nothing_else() {
         let (_, r) = wait(child, logs.path());
         assert_eq!(r.code, Some(1), "{}", r.stderr);
         assert!(r.stderr.contains("cannot write"), "{}", r.stderr);
-        assert_eq!(
-            std::fs::read_to_string(d.join("out.gco")).unwrap(),
-            "; existing code\n"
-        );
-        assert_eq!(listing(d), before, "DROPSLICE_NAMED_TEMP={named}");
+        assert_left_alone(d, &before, &format!("DROPSLICE_NAMED_TEMP={named}"));
     }
 }
 

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{B, H, Point, dist, g25_lines, g26_runs, parse_gcode, split_loops};
+use common::{B, H, Point, assert_loop_spacing, g25_lines, g26_runs, parse_gcode, split_loops};
 
 const SIDE: f64 = 20.0;
 /// Tolerance of a droplet centre on its offset square (4-decimal rounding and chords).
@@ -20,6 +20,26 @@ fn on_inset_square(p: Point, d: f64, tol: f64) -> bool {
         .iter()
         .any(|e| e.abs() <= tol);
     inside && near_edge
+}
+
+/// Layer `m`'s contour loops: one run of G26, split where a droplet is more than B from the
+/// one before; a cube's layer has two.
+fn contour_loops(layer: &common::Layer, m: usize) -> Vec<Vec<Point>> {
+    let runs = g26_runs(layer);
+    assert_eq!(runs.len(), 1, "layer {m}: contours are one run of G26");
+    let loops = split_loops(&runs[0], B, SPACING_TOL_MM);
+    assert_eq!(
+        loops.len(),
+        2,
+        "layer {m}: two loops expected, got {}",
+        loops.len()
+    );
+    loops
+}
+
+/// Every droplet of the loop lies on the cube's square inset by `d`.
+fn on_square(lp: &[Point], d: f64) -> bool {
+    lp.iter().all(|&p| on_inset_square(p, d, ON_SQUARE_MM))
 }
 
 fn cube_gcode(sets: &[&str]) -> common::Gcode {
@@ -49,15 +69,7 @@ fn cube_layers_loops_and_hatch() {
         );
 
         // Contours: one run of G26 (contours first), two loops: k = 1 (3B/2) then k = 0 (B/2).
-        let runs = g26_runs(layer);
-        assert_eq!(runs.len(), 1, "layer {m}: contours are one run of G26");
-        let loops = split_loops(&runs[0], B, SPACING_TOL_MM);
-        assert_eq!(
-            loops.len(),
-            2,
-            "layer {m}: two loops expected, got {}",
-            loops.len()
-        );
+        let loops = contour_loops(layer, m);
         for (loop_no, (lp, d)) in loops.iter().zip([1.5 * B, 0.5 * B]).enumerate() {
             let what = if loop_no == 0 {
                 "inner loop (k = 1, printed first)"
@@ -72,26 +84,8 @@ fn cube_layers_loops_and_hatch() {
             }
             // Closed: the last droplet repeats the first, and the gap before it is at most B.
             assert!(lp.len() > 4, "layer {m}: {what} has {} droplets", lp.len());
-            assert_eq!(
-                lp[0],
-                *lp.last().unwrap(),
-                "layer {m}: {what} is not closed"
-            );
+            assert_loop_spacing(lp, B, SPACING_TOL_MM, &format!("layer {m}: {what}"));
             let n = lp.len();
-            for w in 0..n - 2 {
-                let s = dist(lp[w], lp[w + 1]);
-                assert!(
-                    (s - B).abs() <= SPACING_TOL_MM,
-                    "layer {m}: {what}: droplets {:?} → {:?} are {s} apart, not B = {B}",
-                    lp[w],
-                    lp[w + 1]
-                );
-            }
-            let closing = dist(lp[n - 2], lp[n - 1]);
-            assert!(
-                closing <= B + SPACING_TOL_MM,
-                "layer {m}: {what}: closing gap {closing} > B"
-            );
             // The loop goes all the way round: perimeter / B droplets (corners cut a little).
             let perimeter = 4.0 * (SIDE - 2.0 * d);
             let expected = perimeter / B;
@@ -172,21 +166,14 @@ fn cube_outermost_loop_first_with_outside_in() {
     let g = cube_gcode(&["contour_order=outside_in"]);
     assert_eq!(g.layers.len(), 100);
     for (i, layer) in g.layers.iter().enumerate() {
-        let runs = g26_runs(layer);
-        assert_eq!(runs.len(), 1);
-        let loops = split_loops(&runs[0], B, SPACING_TOL_MM);
-        assert_eq!(loops.len(), 2, "layer {}", i + 1);
+        let loops = contour_loops(layer, i + 1);
         assert!(
-            loops[0]
-                .iter()
-                .all(|&p| on_inset_square(p, 0.5 * B, ON_SQUARE_MM)),
+            on_square(&loops[0], 0.5 * B),
             "layer {}: with outside_in the first loop must be the outermost (B/2)",
             i + 1
         );
         assert!(
-            loops[1]
-                .iter()
-                .all(|&p| on_inset_square(p, 1.5 * B, ON_SQUARE_MM)),
+            on_square(&loops[1], 1.5 * B),
             "layer {}: with outside_in the second loop must be at 3B/2",
             i + 1
         );
@@ -201,16 +188,7 @@ fn cube_top_slice_plane_has_100_layers() {
     for (i, layer) in g.layers.iter().enumerate() {
         assert!((layer.z - (i + 1) as f64 * H).abs() < 1e-9);
         // Every layer of a cube is the full square: the outermost loop lies on B/2.
-        let runs = g26_runs(layer);
-        assert_eq!(runs.len(), 1, "layer {}", i + 1);
-        let loops = split_loops(&runs[0], B, SPACING_TOL_MM);
-        assert_eq!(loops.len(), 2, "layer {}", i + 1);
-        assert!(
-            loops[1]
-                .iter()
-                .all(|&p| on_inset_square(p, 0.5 * B, ON_SQUARE_MM)),
-            "layer {}",
-            i + 1
-        );
+        let loops = contour_loops(layer, i + 1);
+        assert!(on_square(&loops[1], 0.5 * B), "layer {}", i + 1);
     }
 }

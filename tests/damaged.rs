@@ -3,38 +3,20 @@
 //! closed sections whose areas stay within 2 % of the undamaged part's.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
+mod common;
+
+use common::Rng;
 use dropslice::{Job, Settings};
-use std::path::PathBuf;
 
 type Tri = [[f32; 3]; 3];
 
-fn shared() -> PathBuf {
-    std::env::var_os("DROPSLICE_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared"))
-}
-
 fn load(model: &str) -> Vec<Tri> {
-    let bytes = std::fs::read(shared().join("models").join(format!("{model}.stl"))).unwrap();
+    let bytes = common::model_bytes(&format!("{model}.stl"));
     dropslice::model::import::stl::parse(&bytes).unwrap().0
 }
 
 fn binary(tris: &[Tri]) -> Vec<u8> {
-    dropslice::model::import::stl::write_binary(b"damaged copy", tris)
-}
-
-/// A small deterministic generator (xorshift64*), so failures reproduce.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
+    common::binary_stl(b"damaged copy", tris)
 }
 
 fn areas(tris: &[Tri]) -> Vec<f64> {
@@ -73,7 +55,7 @@ const MODELS: [&str; 3] = [
 #[test]
 fn flipped_facets() {
     for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng(17 + k as u64);
+        let mut rng = Rng::new(17 + k as u64);
         let mut t = load(model);
         for tri in &mut t {
             if rng.unit() < 0.10 {
@@ -98,7 +80,7 @@ fn inside_out() {
 #[test]
 fn duplicated_facets() {
     for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng(99 + k as u64);
+        let mut rng = Rng::new(99 + k as u64);
         let mut t = load(model);
         let extra: Vec<Tri> = t.iter().filter(|_| rng.unit() < 0.2).copied().collect();
         t.extend(extra);
@@ -111,7 +93,7 @@ fn jittered_vertices() {
     // Every corner of every facet moved by up to 1e-6 mm on its own: exact welding fails
     // everywhere, the tolerance weld closes the cracks.
     for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng(5 + k as u64);
+        let mut rng = Rng::new(5 + k as u64);
         let mut t = load(model);
         for tri in &mut t {
             for v in tri.iter_mut() {
@@ -127,7 +109,7 @@ fn jittered_vertices() {
 #[test]
 fn removed_facets() {
     for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng(31 + k as u64);
+        let mut rng = Rng::new(31 + k as u64);
         let t: Vec<Tri> = load(model)
             .into_iter()
             .filter(|_| rng.unit() >= 0.01)
@@ -158,7 +140,7 @@ fn run_cli(model: &std::path::Path, extra: &[&str]) -> (String, String) {
 #[test]
 fn diagnostics_in_summary_header_and_footer() {
     // The open scan: open edges in the header and the CLI; the repaired layers at the end.
-    let (err, gco) = run_cli(&shared().join("models/stanford_bunny.stl"), &["-q"]);
+    let (err, gco) = run_cli(&common::model("stanford_bunny.stl"), &["-q"]);
     assert!(
         err.contains("warning: the mesh is not closed: 223 open edges"),
         "{err}"
@@ -170,7 +152,7 @@ fn diagnostics_in_summary_header_and_footer() {
     assert!(gco.contains("; warning: the mesh is not closed: 223 open edges"));
     assert!(gco.contains("; repaired: 50 layers had open sections"));
     // Non-manifold edges and several bodies.
-    let (err, gco) = run_cli(&shared().join("models/esca_nonmanifold.stl"), &["-q"]);
+    let (err, gco) = run_cli(&common::model("esca_nonmanifold.stl"), &["-q"]);
     assert!(err.contains("16 non-manifold edges"), "{err}");
     assert!(gco.contains("; warning: 6 separate bodies"), "{gco:.2000}");
     // A part in inches: warned, with the fix, and not rescaled.

@@ -105,20 +105,9 @@ fn slabs_of_real_models_are_the_reference_slabs() {
     }
 }
 
-/// A small deterministic generator (xorshift).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 #[test]
 fn slabs_of_random_droplets_are_the_reference_slabs() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = common::Rng::new(1);
     for footprint in ["disc", "spread"] {
         let mut s = Settings::default();
         s.set("footprint", footprint).unwrap();
@@ -133,8 +122,8 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
                 // A region of one or two boxes (the second sometimes a hole, sometimes far
                 // away), droplets scattered over and around it, some exactly on cell centres
                 // or cell edges, some in a lattice.
-                let (x0, y0) = (rng.next() * 2.0, rng.next() * 2.0);
-                let (w, h) = (0.2 + rng.next() * 3.0, 0.2 + rng.next() * 3.0);
+                let (x0, y0) = (rng.unit() * 2.0, rng.unit() * 2.0);
+                let (w, h) = (0.2 + rng.unit() * 3.0, 0.2 + rng.unit() * 3.0);
                 let rect = common::rect_loop;
                 let mut region: Shapes = vec![Shape::new(rect(x0, y0, w, h), vec![])];
                 match case % 3 {
@@ -147,11 +136,11 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
                     _ => {}
                 }
                 let mut pts: Vec<Point> = Vec::new();
-                let n = (rng.next() * 400.0) as usize;
+                let n = (rng.unit() * 400.0) as usize;
                 for k in 0..n {
                     let (u, v) = (
-                        x0 - 0.3 + rng.next() * (w + 0.6),
-                        y0 - 0.3 + rng.next() * (h + 0.6),
+                        x0 - 0.3 + rng.unit() * (w + 0.6),
+                        y0 - 0.3 + rng.unit() * (h + 0.6),
                     );
                     let p = match k % 4 {
                         // On a cell centre, or on a cell edge.

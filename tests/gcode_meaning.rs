@@ -169,27 +169,7 @@ fn check_loop(model: &str, z: f64, lp: &[Point]) {
     if lp.len() == 1 {
         return; // a loop too small for a second droplet
     }
-    let n = lp.len();
-    assert!(
-        n >= 3 && lp[0] == lp[n - 1],
-        "{model}: Z {z}: a loop of {n} droplets starting at {:?} does not end on its first droplet (ends at {:?})",
-        lp[0],
-        lp[n - 1]
-    );
-    for w in 0..n - 2 {
-        let s = dist(lp[w], lp[w + 1]);
-        assert!(
-            (s - B).abs() <= SPACING_TOL_MM,
-            "{model}: Z {z}: loop droplets {:?} → {:?} are {s} mm apart, not B = {B}",
-            lp[w],
-            lp[w + 1]
-        );
-    }
-    let closing = dist(lp[n - 2], lp[n - 1]);
-    assert!(
-        closing <= B + SPACING_TOL_MM,
-        "{model}: Z {z}: closing gap {closing} > B"
-    );
+    common::assert_loop_spacing(lp, B, SPACING_TOL_MM, &format!("{model}: Z {z}"));
 }
 
 /// Every setting is in the header as `; name = value` (unit 1's only when unit 1 is used), and

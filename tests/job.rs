@@ -32,22 +32,6 @@ fn box_tris(w: f32, d: f32, h: f32) -> Vec<Tri> {
         .collect()
 }
 
-/// A binary STL of `tris` (written here, not by the crate).
-fn stl_bytes(tris: &[Tri]) -> Vec<u8> {
-    let mut b = vec![0u8; 80];
-    b.extend_from_slice(&(tris.len() as u32).to_le_bytes());
-    for t in tris {
-        b.extend_from_slice(&[0u8; 12]);
-        for p in t {
-            for c in p {
-                b.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        b.extend_from_slice(&[0u8; 2]);
-    }
-    b
-}
-
 fn spec(v: Value) -> Result<JobSpec, Error> {
     JobSpec::from_value(v)
 }
@@ -302,7 +286,7 @@ fn arrangement_fills_rows_bottom_left() {
 }
 
 fn box_model(name: &str, w: f32, d: f32, h: f32) -> Model {
-    Model::read(&stl_bytes(&box_tris(w, d, h)), name).unwrap()
+    Model::read(&common::stl_bytes(&box_tris(w, d, h)), name).unwrap()
 }
 
 #[test]
@@ -567,7 +551,7 @@ fn a_job_of_three_parts_slices_as_the_oracle_says() {
         .iter()
         .map(|t| t.map(|p| p.map(|c| c as f32)))
         .collect();
-    std::fs::write(&stl, stl_bytes(&tris)).unwrap();
+    std::fs::write(&stl, common::stl_bytes(&tris)).unwrap();
     let oracle = common::oracle_sections(&stl, 0.2);
     let layers = oracle["layers"].as_array().unwrap();
     assert_eq!(j.layer_count(), layers.len(), "layer count");
@@ -779,7 +763,11 @@ fn run(args: &[&str], dir: &TempDir) -> common::Run {
 #[test]
 fn cli_slices_several_models_and_job_files() {
     let dir = TempDir::new("job-cli");
-    std::fs::write(dir.join("a.stl"), stl_bytes(&box_tris(20.0, 10.0, 2.0))).unwrap();
+    std::fs::write(
+        dir.join("a.stl"),
+        common::stl_bytes(&box_tris(20.0, 10.0, 2.0)),
+    )
+    .unwrap();
     std::fs::create_dir(dir.join("models")).unwrap();
     std::fs::copy(
         model("extruder_idler_quads.obj"),

@@ -7,15 +7,10 @@
 //! faces are ambiguous (the oracle flags them, `near_plane_faces`) and skipped.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
+mod common;
+
 use dropslice::{Job, Settings};
 use serde_json::Value;
-use std::path::PathBuf;
-
-fn shared() -> PathBuf {
-    std::env::var_os("DROPSLICE_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared"))
-}
 
 struct Mismatch {
     layer: usize,
@@ -24,16 +19,8 @@ struct Mismatch {
 
 /// Compares every layer of `model` with its fixture; returns the mismatches and layers compared.
 fn compare(model: &str, fixture: &str, counts: bool) -> (Vec<Mismatch>, usize) {
-    let path = shared().join("models").join(format!("{model}.stl"));
-    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let oracle: Value = serde_json::from_str(
-        &std::fs::read_to_string(
-            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join(format!("tests/fixtures/oracle/{fixture}.json")),
-        )
-        .unwrap(),
-    )
-    .unwrap();
+    let bytes = common::model_bytes(&format!("{model}.stl"));
+    let oracle: Value = common::oracle_fixture(fixture);
     let job = Job::new(&bytes, model, Settings::default()).unwrap();
     let layers = oracle["layers"].as_array().unwrap();
     assert_eq!(job.layer_count(), layers.len(), "{model}: layer count");
@@ -146,7 +133,7 @@ fn m3_screw() {
 fn stanford_bunny_open_mesh_closed_like_the_oracle() {
     let compared = check_fixture("stanford_bunny", "stanford_bunny_close_open", false);
     assert_eq!(compared, 772);
-    let bytes = std::fs::read(shared().join("models/stanford_bunny.stl")).unwrap();
+    let bytes = common::model_bytes("stanford_bunny.stl");
     let job = Job::new(&bytes, "bunny", Settings::default()).unwrap();
     for i in 0..job.layer_count() {
         assert!(!job.section(i).region.is_empty(), "layer {i} is empty");

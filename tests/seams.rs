@@ -12,8 +12,8 @@ mod common;
 mod seams;
 
 use common::B;
+use common::segment; // the nearest-point projection that seams.rs uses
 use seams::TOL;
-use std::path::Path;
 
 const MODELS: [&str; 5] = [
     "cube_20mm_ascii.stl",
@@ -332,27 +332,7 @@ fn coverage_unchanged_and_sections_match_the_oracle() {
             a.droplets,
             b.droplets
         );
-        let oracle: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(
-                Path::new(env!("CARGO_MANIFEST_DIR"))
-                    .join(format!("tests/fixtures/oracle/{fixture}.json")),
-            )
-            .unwrap(),
-        )
-        .unwrap();
-        let layers = oracle["layers"].as_array().unwrap();
-        assert_eq!(even.layers.len(), layers.len(), "{model}: layers");
-        for (l, o) in even.layers.iter().zip(layers) {
-            if o.get("near_plane_faces").is_some() {
-                continue;
-            }
-            let want = o["nonzero"]["area"].as_f64().unwrap();
-            assert!(
-                (l.region_area - want).abs() <= (want * 0.005).max(0.05),
-                "{model} layer {}: area {} vs oracle {want}",
-                l.index + 1,
-                l.region_area
-            );
-        }
+        let areas: Vec<f64> = even.layers.iter().map(|l| l.region_area).collect();
+        common::assert_oracle_areas(fixture, &areas, model);
     }
 }

@@ -8,35 +8,11 @@
 
 mod common;
 
+use common::cuboid;
 use dropslice::{Error, Job, Settings};
-use serde_json::Value;
 use std::path::PathBuf;
 
 type Tri = [[f32; 3]; 3];
-
-/// An axis-aligned box, facets wound counter-clockwise seen from outside (outward).
-fn cuboid(min: [f32; 3], max: [f32; 3]) -> Vec<Tri> {
-    let c = |i: usize| {
-        [
-            if i & 1 == 0 { min[0] } else { max[0] },
-            if i & 2 == 0 { min[1] } else { max[1] },
-            if i & 4 == 0 { min[2] } else { max[2] },
-        ]
-    };
-    // Each face as a quad, counter-clockwise from outside.
-    let quads = [
-        [0, 2, 3, 1], // z = min (outward -z)
-        [4, 5, 7, 6], // z = max
-        [0, 1, 5, 4], // y = min
-        [2, 6, 7, 3], // y = max
-        [0, 4, 6, 2], // x = min
-        [1, 3, 7, 5], // x = max
-    ];
-    quads
-        .iter()
-        .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
-        .collect()
-}
 
 fn inverted(mut t: Vec<Tri>) -> Vec<Tri> {
     for f in &mut t {
@@ -60,6 +36,16 @@ fn areas(job: &Job) -> Vec<(f64, f64)> {
             )
         })
         .collect()
+}
+
+/// The section area of the 20 mm box with the 10 mm cavity [5, 15]³: 400 mm², less the
+/// cavity's 100 mm² at its heights.
+fn cavity_box_area(z: f64) -> f64 {
+    if (5.0..15.0).contains(&z) {
+        300.0
+    } else {
+        400.0
+    }
 }
 
 fn assert_areas(job: &Job, want: impl Fn(f64) -> f64, what: &str) {
@@ -152,17 +138,7 @@ fn an_inverted_box_inside_a_box_is_a_cavity() {
     let j = job(&t).unwrap();
     assert_eq!(j.info().mesh.flipped_shells, 0);
     assert_eq!(j.info().mesh.cavity_shells, 1);
-    assert_areas(
-        &j,
-        |z| {
-            if (5.0..15.0).contains(&z) {
-                300.0
-            } else {
-                400.0
-            }
-        },
-        "box with a cavity",
-    );
+    assert_areas(&j, cavity_box_area, "box with a cavity");
 }
 
 #[test]
@@ -234,33 +210,8 @@ fn a_shared_model_with_one_shell_inside_out_matches_the_oracle() {
     }
     let j = job(&t).unwrap();
     assert_eq!(j.info().mesh.flipped_shells, 1);
-    let oracle: Value = serde_json::from_str(
-        &std::fs::read_to_string(
-            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join(format!("tests/fixtures/oracle/{model}.json")),
-        )
-        .unwrap(),
-    )
-    .unwrap();
-    let layers = oracle["layers"].as_array().unwrap();
-    assert_eq!(j.layer_count(), layers.len());
-    let mut bad = Vec::new();
-    for (i, l) in layers.iter().enumerate() {
-        if l.get("near_plane_faces").is_some() {
-            continue;
-        }
-        let want = l["nonzero"]["area"].as_f64().unwrap();
-        let got = dropslice::base::geom::region_area(&j.section(i).region);
-        if (got - want).abs() > (want * 0.005).max(0.05) {
-            bad.push(format!("layer {i}: {got:.3} vs oracle {want:.3}"));
-        }
-    }
-    assert!(
-        bad.is_empty(),
-        "{} layers differ:\n{}",
-        bad.len(),
-        bad.join("\n")
-    );
+    let areas: Vec<f64> = areas(&j).into_iter().map(|(_, a)| a).collect();
+    common::assert_oracle_areas(model, &areas, "one shell inside out");
 }
 
 #[test]
@@ -465,21 +416,13 @@ fn three_mf(resources: &str, build: &str) -> Vec<u8> {
 fn inverted_cube_object(id: u32) -> String {
     let mut s = format!(r#"<object id="{id}" type="model"><mesh><vertices>"#);
     for i in 0..8 {
-        let c = |b: usize| if (i >> b) & 1 == 1 { "0.5" } else { "0" };
-        s += &format!(r#"<vertex x="{}" y="{}" z="{}"/>"#, c(0), c(1), c(2));
+        let [x, y, z] = common::box_corner([0.0; 3], [0.5; 3], i);
+        s += &format!(r#"<vertex x="{x}" y="{y}" z="{z}"/>"#);
     }
     s += "</vertices><triangles>";
-    for q in [
-        [0, 1, 3, 2],
-        [4, 6, 7, 5],
-        [0, 4, 5, 1],
-        [2, 3, 7, 6],
-        [0, 2, 6, 4],
-        [1, 5, 7, 3],
-    ] {
-        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
-            s += &format!(r#"<triangle v1="{}" v2="{}" v3="{}"/>"#, t[0], t[1], t[2]);
-        }
+    for [a, b, c] in common::BOX_FACETS {
+        // inside-out: each facet wound the other way
+        s += &format!(r#"<triangle v1="{a}" v2="{c}" v3="{b}"/>"#);
     }
     s + "</triangles></mesh></object>"
 }
@@ -653,17 +596,7 @@ fn an_open_inside_out_shell_inside_an_open_shell_stays_a_cavity() {
     let j = job(&t).unwrap();
     let m = &j.info().mesh;
     assert_eq!((m.flipped_open_shells, m.flipped_shells), (0, 0), "{m:?}");
-    for (z, a) in areas(&j) {
-        let want = if (5.0..15.0).contains(&z) {
-            300.0
-        } else {
-            400.0
-        };
-        assert!(
-            (a - want).abs() < 1e-6,
-            "z = {z}: area {a} instead of {want}"
-        );
-    }
+    assert_areas(&j, cavity_box_area, "hollow box, open shells");
 }
 
 #[test]

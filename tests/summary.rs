@@ -175,6 +175,18 @@ fn nothing_to_print_is_one_error() {
     assert_eq!((r.kind, r.setting), ("nothing_to_print", None));
 }
 
+/// The number written just before the word `unit` in `line` ("120 layers" → 120).
+fn figure(line: &str, unit: &str) -> f64 {
+    let words: Vec<&str> = line
+        .split([' ', ',', '(', ')'])
+        .filter(|w| !w.is_empty())
+        .collect();
+    words
+        .windows(2)
+        .find_map(|w| (w[1] == unit).then(|| w[0].parse().ok()).flatten())
+        .unwrap_or_else(|| panic!("no figure in {unit} in {line}"))
+}
+
 #[test]
 fn the_cli_prints_the_librarys_figures() {
     let dir = common::TempDir::new("summary-cli");
@@ -196,18 +208,25 @@ fn the_cli_prints_the_librarys_figures() {
         text.lines().last().unwrap(),
         "dropslice: no overhangs (every layer rests on the one below)"
     );
+    // Each figure is read back from the line (not rebuilt with the CLI's format): the number
+    // written before its unit, to the places the line shows.
     let c = f.counts;
-    let expected = format!(
-        "{} layers, {} droplets ({} outer, {} inner, {} fill), {:.2} cm³, {:.2} g, print time ",
-        f.layers,
-        f.droplets,
-        c.outer,
-        c.inner,
-        c.fill,
-        f.volume_mm3 / 1000.0,
-        f.mass_g
-    );
-    assert!(line.contains(&expected), "{line}\nexpected {expected}");
+    for (unit, want, places) in [
+        ("layers", f.layers as f64, 0),
+        ("droplets", f.droplets as f64, 0),
+        ("outer", c.outer as f64, 0),
+        ("inner", c.inner as f64, 0),
+        ("fill", c.fill as f64, 0),
+        ("cm³", f.volume_mm3 / 1000.0, 2),
+        ("g", f.mass_g, 2),
+    ] {
+        let got = figure(line, unit);
+        assert!(
+            (got - want).abs() <= 0.5 * 10f64.powi(-places) + 1e-9,
+            "{unit}: {got} instead of {want} in {line}"
+        );
+    }
+    assert!(line.contains(" g, print time "), "{line}");
     // the header's counts are the same
     let gco = std::fs::read_to_string(&out).unwrap();
     assert!(gco.contains(&format!("; droplets total       = {:>12}", f.droplets)));

@@ -55,22 +55,6 @@ fn slice_job(dir: &TempDir, job: &Value) -> (String, Gcode) {
     (text, g)
 }
 
-/// A binary STL of `tris` (written here, not by the crate).
-fn stl_bytes(tris: &[Tri]) -> Vec<u8> {
-    let mut b = vec![0u8; 80];
-    b.extend_from_slice(&(tris.len() as u32).to_le_bytes());
-    for t in tris {
-        b.extend_from_slice(&[0u8; 12]);
-        for p in t {
-            for c in p {
-                b.extend_from_slice(&(*c as f32).to_le_bytes());
-            }
-        }
-        b.extend_from_slice(&[0u8; 2]);
-    }
-    b
-}
-
 /// The 12 triangles of the box [x0,x1]×[y0,y1]×[0,h], facing outward.
 fn box_tris(x0: f64, y0: f64, x1: f64, y1: f64, h: f64) -> Vec<Tri> {
     let quads = [
@@ -118,20 +102,7 @@ fn oracle_areas(stl: &std::path::Path, h: f64) -> Vec<Option<f64>> {
 /// `T` lines only where the unit changes, each followed by a command; unit 0 before unit 1
 /// within every layer.
 fn check_unit_lines(text: &str, g: &Gcode) {
-    let lines: Vec<&str> = text.lines().collect();
-    let mut unit = "T0";
-    for (i, l) in lines.iter().enumerate() {
-        if l.starts_with('T') {
-            assert_ne!(*l, unit, "line {}: T line without a change", i + 1);
-            unit = l;
-            let next = lines[i + 1..].iter().find(|l| !l.starts_with(';'));
-            assert!(
-                next.is_some_and(|n| n.starts_with('G')),
-                "line {}: no command after {l}",
-                i + 1
-            );
-        }
-    }
+    common::assert_unit_changes(text, "");
     for l in &g.layers {
         let units: Vec<u8> = l.cmds.iter().map(|c| c.unit).collect();
         assert!(
@@ -185,7 +156,7 @@ fn each_unit_prints_its_own_part_and_covers_it() {
     for (k, (f, at, u)) in parts.iter().enumerate() {
         let tris = placed(f, *at);
         let stl = dir.join(&format!("part{k}.stl"));
-        std::fs::write(&stl, stl_bytes(&tris)).unwrap();
+        std::fs::write(&stl, common::stl_bytes(&tris)).unwrap();
         let areas = oracle_areas(&stl, h);
         let bu = b[*u as usize];
         let mut bad = Vec::new();
@@ -294,7 +265,7 @@ fn box_job(boxes: &[([f64; 4], u8)], h_box: f64) -> (String, Gcode, Vec<Vec<(P, 
         let f = format!("box{k}.stl");
         std::fs::write(
             dir.join(&f),
-            stl_bytes(&box_tris(0.0, 0.0, r[2] - r[0], r[3] - r[1], h_box)),
+            common::stl_bytes(&box_tris(0.0, 0.0, r[2] - r[0], r[3] - r[1], h_box)),
         )
         .unwrap();
         parts.push(json!({"file": f, "place_x": r[0], "place_y": r[1], "unit": u}));

@@ -3,6 +3,8 @@
 //! geometry on a layer's section (non-zero winding point-in-region, distance to the boundary).
 #![allow(dead_code)]
 
+pub mod segment;
+
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -234,6 +236,41 @@ pub fn oracle_python() -> PathBuf {
     PathBuf::from("python3")
 }
 
+/// The stored oracle sections of a shared model (`tests/fixtures/oracle/NAME.json`, made by
+/// `scripts/make_oracle_fixtures.sh`).
+pub fn oracle_fixture(name: &str) -> serde_json::Value {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/fixtures/oracle/{name}.json"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Section areas (`got[i]`: layer i) against the non-zero (union) areas of the stored oracle
+/// fixture `name`, within 0.5 % or 0.05 mm², whichever is larger; layers whose plane holds
+/// horizontal faces (flagged `near_plane_faces` by the oracle: ambiguous) are skipped. Fails
+/// listing every layer (numbered from 1) that differs.
+pub fn assert_oracle_areas(name: &str, got: &[f64], what: &str) {
+    let oracle = oracle_fixture(name);
+    let layers = oracle["layers"].as_array().unwrap();
+    assert_eq!(got.len(), layers.len(), "{what}: layer count");
+    let mut bad = Vec::new();
+    for (i, (l, &g)) in layers.iter().zip(got).enumerate() {
+        if l.get("near_plane_faces").is_some() {
+            continue;
+        }
+        let want = l["nonzero"]["area"].as_f64().unwrap();
+        if (g - want).abs() > (want * 0.005).max(0.05) {
+            bad.push(format!("layer {}: {g:.3} vs oracle {want:.3}", i + 1));
+        }
+    }
+    assert!(
+        bad.is_empty(),
+        "{what}: {} layers differ:\n{}",
+        bad.len(),
+        bad.join("\n")
+    );
+}
+
 /// The independent oracle's cross-sections (`../shared/tools/oracle_sections.py`) of an STL
 /// at layer height `h`, as its JSON.
 pub fn oracle_sections(stl: &Path, h: f64) -> serde_json::Value {
@@ -367,6 +404,25 @@ pub fn parse_gcode(text: &str) -> Gcode {
     g
 }
 
+/// `T` lines (SPEC.md "Machine code") stand only where the unit changes, starting from T0, and
+/// each is followed by a command (comments aside). `what` prefixes failure messages.
+pub fn assert_unit_changes(text: &str, what: &str) {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut unit = "T0";
+    for (i, l) in lines.iter().enumerate() {
+        if l.starts_with('T') {
+            assert_ne!(*l, unit, "{what} line {}: T line without a change", i + 1);
+            unit = l;
+            let next = lines[i + 1..].iter().find(|l| !l.starts_with(';'));
+            assert!(
+                next.is_some_and(|n| n.starts_with('G')),
+                "{what} line {}: no command after {l}",
+                i + 1
+            );
+        }
+    }
+}
+
 /// Layer index (from 0) of a G-code layer: Z = (i + 1)·H.
 pub fn layer_index(z: f64, h: f64) -> usize {
     let i = (z / h).round() as i64 - 1;
@@ -443,6 +499,30 @@ pub fn split_loops(run: &[Point], b: f64, b_tol: f64) -> Vec<Vec<Point>> {
     loops
 }
 
+/// A closed loop of droplets: the last repeats the first, each droplet `b` from the next
+/// (within `tol`), the closing gap before the repeat at most `b + tol`. `what` names the loop
+/// in failures.
+pub fn assert_loop_spacing(lp: &[Point], b: f64, tol: f64, what: &str) {
+    let n = lp.len();
+    assert!(
+        n >= 3 && lp[0] == lp[n - 1],
+        "{what}: a loop of {n} droplets starting at {:?} does not end on its first droplet (ends at {:?})",
+        lp.first(),
+        lp.last()
+    );
+    for w in lp[..n - 1].windows(2) {
+        let s = dist(w[0], w[1]);
+        assert!(
+            (s - b).abs() <= tol,
+            "{what}: droplets {:?} → {:?} are {s} mm apart, not B = {b}",
+            w[0],
+            w[1]
+        );
+    }
+    let closing = dist(lp[n - 2], lp[n - 1]);
+    assert!(closing <= b + tol, "{what}: closing gap {closing} > B");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Geometry on a section (dropslice::base::geom::Shapes: shapes of contours)
 
@@ -479,14 +559,7 @@ fn seg_dist(p: Point, a: Point, b: Point) -> f64 {
 
 /// A section's region as plain arrays (outer boundary first, then the holes).
 pub fn nested(region: &dropslice::base::geom::Shapes) -> Shapes {
-    region
-        .iter()
-        .map(|s| {
-            s.contours()
-                .map(|c| c.iter().map(|p| p.to_array()).collect())
-                .collect()
-        })
-        .collect()
+    dropslice::base::boolean::nested(region)
 }
 
 /// Distance from `p` to the region's boundary (its nearest contour edge).
@@ -565,6 +638,60 @@ impl IndexedRegion {
 
 // ---------------------------------------------------------------------------------------------
 // STL writing
+
+/// A binary STL of the given triangles (zero normals), written here byte by byte rather than by
+/// the crate, for tests whose reference must not lean on the crate's STL writer.
+pub fn stl_bytes<C: Copy + Into<f64>>(tris: &[[[C; 3]; 3]]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+    for t in tris {
+        b.extend_from_slice(&[0u8; 12]);
+        for p in t {
+            for c in p {
+                b.extend_from_slice(&((*c).into() as f32).to_le_bytes());
+            }
+        }
+        b.extend_from_slice(&[0u8; 2]);
+    }
+    b
+}
+
+/// The 12 facets of an axis-aligned box as indices of its corners (corner `i` has bit 0 for x,
+/// bit 1 for y, bit 2 for z at the maximum), each face's two triangles counter-clockwise seen
+/// from outside (facing outward).
+pub const BOX_FACETS: [[usize; 3]; 12] = {
+    // Each face as a quad, counter-clockwise from outside.
+    const QUADS: [[usize; 4]; 6] = [
+        [0, 2, 3, 1], // z = min (outward -z)
+        [4, 5, 7, 6], // z = max
+        [0, 1, 5, 4], // y = min
+        [2, 6, 7, 3], // y = max
+        [0, 4, 6, 2], // x = min
+        [1, 3, 7, 5], // x = max
+    ];
+    let mut out = [[0; 3]; 12];
+    let mut k = 0;
+    while k < 6 {
+        let q = QUADS[k];
+        out[2 * k] = [q[0], q[1], q[2]];
+        out[2 * k + 1] = [q[0], q[2], q[3]];
+        k += 1;
+    }
+    out
+};
+
+/// Corner `i` of the box [min, max] (bit 0: x, bit 1: y, bit 2: z at the maximum).
+pub fn box_corner(min: [f32; 3], max: [f32; 3], i: usize) -> [f32; 3] {
+    [0, 1, 2].map(|a| if i >> a & 1 == 0 { min[a] } else { max[a] })
+}
+
+/// An axis-aligned box, facets wound counter-clockwise seen from outside (outward).
+pub fn cuboid(min: [f32; 3], max: [f32; 3]) -> Vec<[[f32; 3]; 3]> {
+    BOX_FACETS
+        .iter()
+        .map(|t| t.map(|i| box_corner(min, max, i)))
+        .collect()
+}
 
 /// A binary STL of the given triangles (zero normals).
 pub fn binary_stl(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
@@ -679,19 +806,13 @@ pub fn cut(tris: &[[[f64; 3]; 3]], z: f64) -> Vec<(Point, Point)> {
 pub fn deep_inside(segs: &[(Point, Point)], p: Point, d: f64) -> bool {
     let mut crossings = 0;
     for &(a, b) in segs {
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let l2 = dx * dx + dy * dy;
-        let t = if l2 > 0.0 {
-            (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let (ex, ey) = (a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
+        let (_, q) = segment::project(p, a, b);
+        let (ex, ey) = (q[0] - p[0], q[1] - p[1]);
         if ex * ex + ey * ey < d * d {
             return false;
         }
         if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * dx;
+            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
             if x > p[0] {
                 crossings += 1;
             }

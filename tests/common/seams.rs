@@ -16,6 +16,9 @@
 //! the next (the seam, last → first, included); a *chord* is their straight-line distance.
 #![allow(dead_code)]
 
+// `segment` is the crate's: tests/seams.rs takes `common::segment`, examples/seams.rs its own.
+use crate::segment::project;
+
 pub type P = [f64; 2];
 
 /// Rounding of written coordinates (±0.00005 each) moves a point by up to 7.1e-5 mm and a
@@ -210,18 +213,6 @@ pub fn check_paths(
 
 fn seg_dist(p: P, a: P, c: P) -> f64 {
     d(p, project(p, a, c).1)
-}
-
-/// The point of segment a–c nearest to p, and where it lies along the segment (0 … 1).
-fn project(p: P, a: P, c: P) -> (f64, P) {
-    let (dx, dy) = (c[0] - a[0], c[1] - a[1]);
-    let l2 = dx * dx + dy * dy;
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (t, [a[0] + t * dx, a[1] + t * dy])
 }
 
 /// One loop's droplets as written, with where they lie on its path.

@@ -3,76 +3,22 @@
 // absurd droplet sizes, lines expanding to too many droplets). For each: the page keeps
 // answering (page.evaluate within 2 s, polled), the view and layer stay finite and in range,
 // what was refused is named in the banner, and the Content-Security-Policy is never violated.
-import { after, before, test } from "node:test";
+import { test } from "node:test";
 import assert from "node:assert/strict";
-import { createHash } from "node:crypto";
-import { readFileSync } from "node:fs";
-import { join } from "node:path";
 import { deflateRawSync } from "node:zlib";
-import { benchy, countPixels, start, status } from "./helpers.mjs";
+import { answers, b64url, countPixels, cube, cubeSha, openPage, settleAnswering as settle, startForTests, status } from "./helpers.mjs";
 
-let env;
-const cube = readFileSync(join(benchy, "../cube_20mm_ascii.stl"));
-const cubeSha = createHash("sha256").update(cube).digest("hex");
-const b64url = (buf) => Buffer.from(buf).toString("base64url");
-
-before(async () => {
-  env = await start();
-});
-
-after(async () => {
-  await env?.close();
-});
+const env = startForTests();
 
 /** A fresh page that records page errors, console errors and CSP violations. */
-async function open(path = "") {
-  const context = await env.browser.newContext({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
-  await context.addInitScript(() => {
-    window.__csp = [];
-    document.addEventListener("securitypolicyviolation", (e) => window.__csp.push(`${e.violatedDirective} ${e.blockedURI}`));
-  });
-  const page = await context.newPage();
-  const errors = [];
-  page.on("pageerror", (e) => errors.push(String(e)));
-  page.on("console", (m) => {
-    if (m.type() === "error") errors.push(m.text());
-  });
-  await page.goto(env.url + path);
-  return { page, context, errors };
-}
-
-/** The page answers page.evaluate within 2 s, `times` times in a row. */
-async function responsive(page, times = 4) {
-  for (let i = 0; i < times; i++) {
-    const t0 = Date.now();
-    const answer = await Promise.race([
-      page.evaluate(() => 1),
-      new Promise((ok) => setTimeout(() => ok("timeout"), 2000)),
-    ]);
-    assert.equal(answer, 1, `the page did not answer within 2 s (poll ${i + 1})`);
-    assert.ok(Date.now() - t0 < 2000);
-    await page.waitForTimeout(150);
-  }
-}
-
-/** Waits until the page has settled after opening (a slice done or failed, or waiting for a
- *  file), answering all the while. */
-async function settle(page, timeout = 60_000) {
-  const t0 = Date.now();
-  for (;;) {
-    await responsive(page, 1);
-    const s = await status(page);
-    if (["done", "error", "cancelled", "idle"].includes(s.state)) return s;
-    if (Date.now() - t0 > timeout) assert.fail(`the page did not settle: ${JSON.stringify(s)}`);
-  }
-}
+const open = (path = "") => openPage(env.browser, env.url + path, { width: 1280, height: 800, csp: true });
 
 const banner = async (page) => ((await page.isVisible("#banner")) ? await page.locator("#banner").innerText() : "");
 
 /** The page is sane: view finite and within the renderer's limits, layer an integer in range,
  *  no "NaN" in the layer label, no page error, no CSP violation. */
 async function sane(page, errors) {
-  await responsive(page);
+  await answers(page, 4);
   const s = await status(page);
   const v = s.view;
   assert.ok([v.scale, v.cx, v.cy].every(Number.isFinite), `view ${JSON.stringify(v)}`);

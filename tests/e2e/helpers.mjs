@@ -3,8 +3,10 @@
 // download, the pixels of the layer canvas and of the 3D view, test meshes, and a G-code parser
 // for comparisons.
 import assert from "node:assert/strict";
+import { createHash } from "node:crypto";
 import { existsSync, readFileSync, rmSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
+import { after, before } from "node:test";
 import { fileURLToPath } from "node:url";
 import { chromium } from "playwright-core";
 import { serve } from "../../scripts/serve.mjs";
@@ -13,6 +15,11 @@ export const repo = resolve(dirname(fileURLToPath(import.meta.url)), "../..");
 export const shared = resolve(process.env.DROPSLICE_SHARED ?? join(repo, "../shared"));
 export const benchy = join(shared, "models/3DBenchy.stl");
 export const chromiumPath = process.env.CHROMIUM ?? "/usr/bin/chromium";
+/** The shared 20 mm cube (small enough to embed in a link) and its sha-256 in hex. */
+export const cube = readFileSync(join(shared, "models/cube_20mm_ascii.stl"));
+export const cubeSha = createHash("sha256").update(cube).digest("hex");
+/** Bytes in base64url, as links carry them. */
+export const b64url = (buf) => Buffer.from(buf).toString("base64url");
 
 /** Starts the server and the browser; returns { url, browser, close }. */
 export async function start() {
@@ -29,6 +36,15 @@ export async function start() {
       await new Promise((ok) => server.close(ok));
     },
   };
+}
+
+/** start() for the tests of one file: started before them, closed after them. The object it
+ *  returns gets start()'s { url, browser, close } once the tests begin. */
+export function startForTests() {
+  const env = {};
+  before(async () => Object.assign(env, await start()));
+  after(async () => env.close?.());
+  return env;
 }
 
 /** start() and the page most of a test file's tests share; with `settle`, once its sample
@@ -65,9 +81,16 @@ export function launchBrowser() {
   });
 }
 
-/** A new page that fails the test on page errors it did not expect. */
-export async function openPage(browser, url, { width = 1440, height = 900, scale = 1 } = {}) {
+/** A new page that collects page errors and console errors in `errors`, for the test to check;
+ *  with `csp`, also Content-Security-Policy violations in window.__csp. */
+export async function openPage(browser, url, { width = 1440, height = 900, scale = 1, csp = false } = {}) {
   const context = await browser.newContext({ viewport: { width, height }, deviceScaleFactor: scale, acceptDownloads: true });
+  if (csp) {
+    await context.addInitScript(() => {
+      window.__csp = [];
+      document.addEventListener("securitypolicyviolation", (e) => window.__csp.push(`${e.violatedDirective} ${e.blockedURI}`));
+    });
+  }
   const page = await context.newPage();
   const errors = [];
   page.on("pageerror", (e) => errors.push(String(e)));
@@ -90,6 +113,28 @@ export async function waitSettled(page, timeout = 240_000) {
   return status(page);
 }
 
+/** The page answers page.evaluate within 2 s, `times` times in a row (150 ms apart). */
+export async function answers(page, times = 1) {
+  for (let i = 0; i < times; i++) {
+    if (i > 0) await page.waitForTimeout(150);
+    const answer = await Promise.race([page.evaluate(() => 1), new Promise((ok) => setTimeout(() => ok("timeout"), 2000))]);
+    assert.equal(answer, 1, `the page did not answer within 2 s (poll ${i + 1} of ${times})`);
+  }
+}
+
+/** Waits until the page's state is one of `states` (by default: a slice done or failed, or
+ *  waiting for a file), asserting all the while that it answers; returns its status. */
+export async function settleAnswering(page, { timeout = 60_000, states = ["done", "error", "cancelled", "idle"] } = {}) {
+  const t0 = Date.now();
+  for (;;) {
+    await answers(page);
+    const s = await status(page);
+    if (states.includes(s.state)) return s;
+    if (Date.now() - t0 > timeout) assert.fail(`the page did not settle: ${JSON.stringify(s)}`);
+    await page.waitForTimeout(100);
+  }
+}
+
 /** Opens files with the page's file input: paths, or { name, mimeType, buffer }. The page's
  *  state is set to "picking" first, so that waitSettled / waitDone wait for this slice. */
 export async function pick(page, files) {
@@ -104,6 +149,16 @@ export async function waitDone(page, timeout = 240_000) {
   const banner = s.state === "done" ? "" : await page.locator("#banner").innerText().catch(() => "");
   assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
   return s;
+}
+
+/** Opens a share link that does not embed its model (too big): the new page asks for the file,
+ *  naming it (`named`, a RegExp). Returns openPage()'s { page, context, errors }. */
+export async function openLinkAskingForFile(browser, url, named) {
+  assert.doesNotMatch(url, /&m=/, "the model is too big to embed");
+  const other = await openPage(browser, url);
+  await other.page.waitForFunction(() => !document.getElementById("link-note").hidden);
+  assert.match(await other.page.locator("#link-note").innerText(), named);
+  return other;
 }
 
 /** The text of the .gco that the Download button gives. */

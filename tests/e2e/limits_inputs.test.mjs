@@ -3,20 +3,12 @@
 // before it is built) and a 3MF whose vertex has a 15-million-digit number (the message quotes
 // 80 characters of it). For each: a short banner within seconds, a page that keeps answering,
 // and a good model opens after. Inputs are made here, at run time.
-import { after, before, test } from "node:test";
+import { test } from "node:test";
 import assert from "node:assert/strict";
 import { crc32, deflateRawSync } from "node:zlib";
-import { pick, start, status, waitDone } from "./helpers.mjs";
+import { answers, pick, settleAnswering, startForTests, waitDone } from "./helpers.mjs";
 
-let env;
-
-before(async () => {
-  env = await start();
-});
-
-after(async () => {
-  await env?.close();
-});
+const env = startForTests();
 
 /** A ZIP archive of deflated entries ({ name, data }). */
 function zip(entries) {
@@ -80,23 +72,8 @@ function hugeAttribute3mf() {
   ]);
 }
 
-/** The page answers page.evaluate within 2 s. */
-async function answers(page) {
-  const answer = await Promise.race([page.evaluate(() => 1), new Promise((ok) => setTimeout(() => ok("timeout"), 2000))]);
-  assert.equal(answer, 1, "the page did not answer within 2 s");
-}
-
 /** Waits, polling that the page answers, until it has settled; returns its status. */
-async function settle(page, timeout = 60_000) {
-  const t0 = Date.now();
-  for (;;) {
-    await answers(page);
-    const s = await status(page);
-    if (["done", "error", "cancelled"].includes(s.state)) return s;
-    if (Date.now() - t0 > timeout) assert.fail(`the page did not settle: ${JSON.stringify(s)}`);
-    await page.waitForTimeout(100);
-  }
-}
+const settle = (page, timeout) => settleAnswering(page, { timeout, states: ["done", "error", "cancelled"] });
 
 const CASES = [
   ["an OBJ face of 20 M triangles split by vertical tabs", "tabs.obj", verticalTabObj, /20000001 triangles/],

@@ -1,7 +1,7 @@
 // Makes docs/images/cut.png: 3DBenchy's vertical cut (after scripts/build.sh).
 // Usage: [STAGGER=1] [CUT=ax,ay,bx,by] [ZOOM=scale,t,z] [SCREENSHOT=path] node tests/e2e/screenshot-cut.mjs [layer]
 import { join } from "node:path";
-import { benchy, openPage, repo, start, waitSettled } from "./helpers.mjs";
+import { benchy, openPage, pick, repo, start, waitDone, waitSettled } from "./helpers.mjs";
 
 const layer = Number(process.argv[2] ?? 60);
 const env = await start();
@@ -9,10 +9,8 @@ try {
   const { page } = await openPage(env.browser, env.url, { width: 1440, height: 1000, scale: 1 });
   await waitSettled(page, 60_000);
   if (process.env.STAGGER) await page.check("#set-stagger");
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", benchy);
-  const s = await waitSettled(page, 240_000);
-  if (s.state !== "done") throw new Error(`slice failed: ${s.state}`);
+  await pick(page, benchy);
+  const s = await waitDone(page, 240_000);
   await page.evaluate((l) => window.dropslice.show(l), layer);
   await page.click("#btn-cut");
   if (process.env.CUT) {

@@ -6,7 +6,7 @@
 import { copyFileSync, mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, openPage, repo, start, waitSettled } from "./helpers.mjs";
+import { benchy, openPage, pick, repo, start, waitDone, waitSettled } from "./helpers.mjs";
 
 const out = process.env.OUT ?? join(repo, "docs/images");
 const env = await start();
@@ -14,11 +14,7 @@ const tmp = mkdtempSync(join(tmpdir(), "dropslice-shots-"));
 try {
   const { page } = await openPage(env.browser, env.url, { width: 1440, height: 900, scale: 1 });
   await waitSettled(page, 60_000);
-  const settle = async () => {
-    const s = await waitSettled(page, 300_000);
-    if (s.state !== "done") throw new Error(`slice failed: ${s.state}: ${await page.locator("#banner").innerText()}`);
-    return s;
-  };
+  const settle = () => waitDone(page, 300_000);
   const shot = async (name) => {
     await page.waitForTimeout(400);
     await page.screenshot({ path: join(out, name) });
@@ -27,8 +23,7 @@ try {
   const zoom = async (scale, cx, cy) => page.evaluate((v) => window.dropslice.setView(v), { scale, cx, cy });
 
   // without support: the roof's overhang marked
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", benchy);
+  await pick(page, benchy);
   let s = await settle();
   await page.click("#btn-worst-overhang");
   await page.check("#opt-overhangs");
@@ -69,8 +64,7 @@ try {
     const cube = join(benchy, "../cube_20mm_ascii.stl");
     const files = ["cube-a.stl", "cube-b.stl"].map((n) => join(tmp, n));
     for (const f of files) copyFileSync(cube, f);
-    await page.evaluate(() => (document.body.dataset.state = "picking"));
-    await page.setInputFiles("#file-input", files);
+    await pick(page, files);
     await settle();
     await page.click(".part-item:nth-child(2)");
     await page.selectOption("#part-unit", "1");

@@ -10,7 +10,7 @@
 // two copies of M3x10_screw.stl), arranged on a 250 × 200 mm plate, in 3D with 3DBenchy selected:
 //   JOB=1 SCREENSHOT=docs/images/job3d.png node tests/e2e/screenshot.mjs
 import { join } from "node:path";
-import { benchy, open3d, openPage, repo, shared, start, waitSettled } from "./helpers.mjs";
+import { benchy, open3d, openPage, pick, repo, shared, start, waitDone, waitSettled } from "./helpers.mjs";
 
 if (process.env.JOB) {
   const env = await start();
@@ -21,11 +21,9 @@ if (process.env.JOB) {
     await page.click("summary:text('Plate')");
     await page.fill("#set-plate_x", "250");
     await page.fill("#set-plate_y", "200");
-    await page.evaluate(() => (document.body.dataset.state = "picking"));
     const files = ["3DBenchy.stl", "extruder_idler_quads.obj", "cube_gears.3mf", "M3x10_screw.stl"].map((f) => join(shared, "models", f));
-    await page.setInputFiles("#file-input", files);
-    const s = await waitSettled(page, 240_000);
-    if (s.state !== "done") throw new Error(`slice failed: ${s.state}`);
+    await pick(page, files);
+    await waitDone(page, 240_000);
     // two copies of the screw, then slice the job again
     await page.click(".part-item:nth-child(4)");
     await page.fill("#part-copies", "2");
@@ -33,8 +31,7 @@ if (process.env.JOB) {
     await page.waitForFunction(() => window.dropslice.job().layout.instances.length === 5);
     await page.evaluate(() => (document.body.dataset.state = "picking"));
     await page.click("#btn-slice");
-    const again = await waitSettled(page, 240_000);
-    if (again.state !== "done") throw new Error(`slice failed: ${again.state}`);
+    await waitDone(page, 240_000);
     await page.evaluate(() => window.dropslice.show(window.dropslice.status().layers - 1));
     await page.waitForFunction(() => window.dropslice.job().parts.every((p) => p.mesh > 0));
     // 3DBenchy selected: tinted in 3D, its transform in the panel
@@ -56,10 +53,8 @@ try {
   const { page } = await openPage(env.browser, env.url, { width: 1440, height: 860, scale: 1 });
   await waitSettled(page, 60_000);
   if (process.env.VOIDS) await page.check("#opt-voids");
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.setInputFiles("#file-input", benchy);
-  const s = await waitSettled(page, 240_000);
-  if (s.state !== "done") throw new Error(`slice failed: ${s.state}`);
+  await pick(page, benchy);
+  await waitDone(page, 240_000);
   if (worst) await page.click("#btn-worst");
   else await page.evaluate((l) => window.dropslice.show(l), layer);
   if (process.env.DETAIL) {
