@@ -25,7 +25,7 @@ pub type LayerDroplets<'a> = &'a (dyn Fn(usize, Option<Bounds>, &mut Vec<Droplet
 
 /// Centres kept this much inside the rule's distance, so rounding the written positions
 /// cannot break it (positions are rounded to 0.05 µm).
-const MARGIN_MM: f64 = 1e-3;
+pub(crate) const MARGIN_MM: f64 = 1e-3;
 
 mod gaps;
 mod grid;
