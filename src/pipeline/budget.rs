@@ -70,6 +70,10 @@ impl Unit1Parts {
     }
 }
 
+/// An edge's first two down-facing facets (with whether each uses it from the lower vertex
+/// index) and how many use it.
+type EdgeUsers = ([(u32, bool); 2], u32);
+
 /// The down-facing facets of a closed mesh (outward normals), summed over the layers for the
 /// support's bound ([`Overhangs::droplets`]).
 ///
@@ -123,8 +127,7 @@ impl Overhangs {
             }
         }
         // Each edge's facets (the first two, with the direction they use it in) and count.
-        let mut edges: HashMap<(u32, u32), ([(u32, bool); 2], u32)> =
-            HashMap::with_capacity(down.len() * 3 / 2);
+        let mut edges: HashMap<(u32, u32), EdgeUsers> = HashMap::with_capacity(down.len() * 3 / 2);
         for (k, (f, _)) in down.iter().enumerate() {
             for j in 0..3 {
                 let (p, q) = (f[j], f[(j + 1) % 3]);

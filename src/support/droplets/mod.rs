@@ -305,7 +305,6 @@ fn place_under(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::base::geom::Shape;
     use crate::base::geom::square;
 
     fn run(
