@@ -459,14 +459,19 @@ fn budget_rows() -> Vec<Row> {
         r.args = vec!["--set".into(), format!("unit1_droplet_aspect={aspect}")];
         r.all = vec!["unit 1".into(), "raise unit1_droplet_aspect".into()];
         rows.push(r);
-        // Support is printed by unit 1: with a tiny B₁ its droplets are counted too.
-        let mut r = setting_row(
-            format!("support on, unit1_droplet_aspect={aspect}"),
-            "support=unit1".into(),
+        // Support is printed by unit 1: with a tiny B₁ its droplets are counted too (a model
+        // with overhangs: the support lies only under down-facing facets).
+        let mut r = row(
+            format!("overhang.obj, support on, unit1_droplet_aspect={aspect}"),
+            Input::Named("overhang.obj", common::model_bytes("overhang.obj")),
             &["droplets"],
         );
-        r.args
-            .extend(["--set".into(), format!("unit1_droplet_aspect={aspect}")]);
+        r.args = vec![
+            "--set".into(),
+            "support=unit1".into(),
+            "--set".into(),
+            format!("unit1_droplet_aspect={aspect}"),
+        ];
         r.all = vec![
             "bad setting support".into(),
             "B₁".into(),

@@ -463,3 +463,37 @@ fn the_lattice_need_agrees_with_the_region_form() {
         );
     }
 }
+
+/// The support's droplet estimate (issue 22) counts support only under down-facing facets: a
+/// B₁ whose hatch under the whole footprint of the 20 mm cube would be 4·10⁸ droplets is
+/// accepted for the cube (no overhang), and refused for overhang.obj and bridge.obj (their
+/// overhangs would take more than 10⁸).
+#[test]
+fn the_support_estimate_counts_only_under_overhangs() {
+    let settings = |aspect: f64| dropslice::Settings {
+        support: dropslice::base::settings::Support::Unit1,
+        unit1_droplet_aspect: aspect,
+        ..dropslice::Settings::default()
+    };
+    let name = "cube_20mm_ascii.stl";
+    let cube = common::model_bytes(name);
+    assert!(dropslice::Job::new(&cube, name, settings(0.05)).is_ok());
+    for name in ["overhang.obj", "bridge.obj"] {
+        let bytes = common::model_bytes(name);
+        assert!(dropslice::Job::new(&bytes, name, settings(1.04)).is_ok());
+        match dropslice::Job::new(&bytes, name, settings(0.02)) {
+            Err(dropslice::Error::Setting {
+                name: setting,
+                message,
+            }) => {
+                assert!(message.contains("support"), "{name}: {message}");
+                assert!(
+                    setting == "support" || setting == "unit1_droplet_aspect",
+                    "{name}: {setting}"
+                );
+            }
+            Err(other) => panic!("{name}: {other}"),
+            Ok(_) => panic!("{name}: a support of B₁ = 0.004 mm accepted"),
+        }
+    }
+}

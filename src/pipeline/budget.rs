@@ -70,6 +70,172 @@ impl Unit1Parts {
     }
 }
 
+/// An edge's first two down-facing facets (with whether each uses it from the lower vertex
+/// index) and how many use it.
+type EdgeUsers = ([(u32, bool); 2], u32);
+
+/// The down-facing facets of a closed mesh (outward normals), summed over the layers for the
+/// support's bound ([`Overhangs::droplets`]).
+///
+/// **Why the support lies under them.** The support of layer n lies under the overhangs of the
+/// layers above (grown by the support's reach, [`crate::support::support_reach`], within
+/// [`crate::support::SUPPORT_TOLERANCE_MM`]), and overhang(m) ⊂ region(m) − region(m − 1): a
+/// point inside the section at z(m) and outside at z(m − 1) has a surface crossing between the
+/// two planes where the vertical line enters the solid going up, on a facet whose outward
+/// normal points down and whose top is at least z(m − 1). Layer n < m then has z(n) ≤ the
+/// facet's top: a facet of top t counts for the N(t) layers of plane at most t. So layer n's
+/// support lies within the reach of U(n), the projections of the down-facing facets with
+/// N > n.
+///
+/// **The area within r of U(n)** is at most A + P·r + π r²·C: A the sum of their areas, P the
+/// length of U(n)'s boundary, C its pieces (each boundary loop of a polygon, moved out by t,
+/// is at most 2π t longer for an outer loop and no longer for a hole; integrate over t ≤ r).
+/// Two down-facing facets sharing an edge in opposite directions (a closed, oriented shell)
+/// lie on both sides of its projection, so the edge is no boundary of U(n) while both count:
+/// P ≤ Σ over edges of the length × the facets using it that count without their partner.
+/// C is at most the pieces of U(n) joined through shared edges (union–find, the facets added
+/// from the highest N down). Summed over the layers: O(facets) with a hash map of edges.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Overhangs {
+    /// Σₙ A(n) (mm²·layers).
+    area: f64,
+    /// Σₙ P(n) (mm·layers).
+    perimeter: f64,
+    /// Σₙ C(n) (layers).
+    pieces: f64,
+}
+
+impl Overhangs {
+    /// The down-facing facets of `mesh` (oriented outward), sliced at the planes `zs`.
+    pub fn of(mesh: &Mesh, zs: &[f64]) -> Overhangs {
+        use std::collections::HashMap;
+        let count = |top: f64| zs.partition_point(|&z| z <= top) as u32;
+        let mut o = Overhangs::default();
+        // Each down-facing facet that counts for some layer: its corners and N.
+        let mut down: Vec<([u32; 3], u32)> = Vec::new();
+        for f in &mesh.facets {
+            let v = |i: u32| mesh.vertices.get(i as usize).copied();
+            let (Some(a), Some(b), Some(c)) = (v(f[0]), v(f[1]), v(f[2])) else {
+                continue;
+            };
+            // Twice the projection's signed area: negative for a facet facing down.
+            let twice = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            let n = count(a[2].max(b[2]).max(c[2]));
+            if twice < 0.0 && n > 0 {
+                o.area += -0.5 * twice * n as f64;
+                down.push((*f, n));
+            }
+        }
+        // Each edge's facets (the first two, with the direction they use it in) and count.
+        let mut edges: HashMap<(u32, u32), EdgeUsers> = HashMap::with_capacity(down.len() * 3 / 2);
+        for (k, (f, _)) in down.iter().enumerate() {
+            for j in 0..3 {
+                let (p, q) = (f[j], f[(j + 1) % 3]);
+                let e = edges
+                    .entry((p.min(q), p.max(q)))
+                    .or_insert(([(0, false); 2], 0));
+                if e.1 < 2 {
+                    e.0[e.1 as usize] = (k as u32, p < q);
+                }
+                e.1 += 1;
+            }
+        }
+        let top = down.iter().map(|d| d.1).max().unwrap_or(0) as usize;
+        // Pairs of facets sharing an edge, by the layer count both reach.
+        let mut joins: Vec<Vec<(u32, u32)>> = vec![Vec::new(); top + 1];
+        let mut fresh = vec![0u32; top + 1];
+        for &(_, n) in &down {
+            fresh[n as usize] += 1;
+        }
+        for (&(p, q), &(users, used)) in &edges {
+            let len = match (mesh.vertices.get(p as usize), mesh.vertices.get(q as usize)) {
+                (Some(a), Some(b)) => (b[0] - a[0]).hypot(b[1] - a[1]),
+                _ => 0.0,
+            };
+            let n = |u: (u32, bool)| down[u.0 as usize].1;
+            if used == 2 && users[0].1 != users[1].1 {
+                o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;
+            } else {
+                let stored: u32 = users[..used.min(2) as usize].iter().map(|&u| n(u)).sum();
+                o.perimeter += len * (stored as f64 + used.saturating_sub(2) as f64 * top as f64);
+            }
+            if used >= 2 {
+                let level = n(users[0]).min(n(users[1]));
+                joins[level as usize].push((users[0].0, users[1].0));
+            }
+        }
+        drop(edges);
+        let mut parent: Vec<u32> = (0..down.len() as u32).collect();
+        fn root(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                let up = parent[parent[i as usize] as usize];
+                parent[i as usize] = up;
+                i = up;
+            }
+            i
+        }
+        let mut pieces = 0u64;
+        for level in (1..=top).rev() {
+            pieces += fresh[level] as u64;
+            for &(a, b) in &joins[level] {
+                let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+                if ra != rb {
+                    parent[ra as usize] = rb;
+                    pieces -= 1;
+                }
+            }
+            o.pieces += pieces as f64;
+        }
+        o
+    }
+
+    /// Σₙ of the area within `r` of U(n) (mm²·layers), at most: A + P·r + π r²·C.
+    fn grown(&self, r: f64) -> f64 {
+        self.area + self.perimeter * r + std::f64::consts::PI * r * r * self.pieces
+    }
+
+    /// A bound of the support's droplets under these facets with settings `s`, both kinds:
+    ///
+    /// * **Hatch** ([`crate::support::moves::support_moves`]; the support has no contour
+    ///   loop): droplets on a lattice of pitch B₁ along lines B₁ / `support_density` apart,
+    ///   inside the support region, which lies within r = support reach + 2 × the support's
+    ///   tolerance (its offsets and the sections' simplification) of the facets' projections.
+    ///   Each lattice point owns its cell (B₁ × B₁ / `support_density`), which lies within the
+    ///   cell's half-diagonal d of it: at most area(region ⊕ d) × `support_density` / B₁²
+    ///   droplets.
+    /// * **The droplet-level pass** ([`crate::support::droplets::complete`]) adds a droplet
+    ///   to layer n − 1 only under a droplet c of layer n with no droplet of layer n − 1
+    ///   within its reach, at most `place` = B₁/2 + `overhang_limit`·B from c. It skips a c
+    ///   within R' = `place` − 1 µm of a droplet it already added to that layer and tries c
+    ///   itself first, so the added droplets of a layer are more than R' apart (discs of
+    ///   radius R'/2 around them disjoint): at most 4 / (π R'²) per mm² of where they lie,
+    ///   grown by R'/2. Where they lie: c is where layer n overhangs layer n − 1 (under the
+    ///   facets, as the support), and where the hatch is dense (every point within the rule's
+    ///   reach of a lattice point, d ≤ B₁/2 + `overhang_limit`·B) the hatch of layer n − 1
+    ///   supports all of its region but a strip of width d along the edge: so within
+    ///   w = d + `place` + R'/2 of U(n)'s grown edge, an area at most P·(r + w) + π (r + w)²·C
+    ///   per layer (the grown area less U(n)'s own). With sparse hatch, all of U(n) grown by
+    ///   r + w. (A droplet placed beside c, where c itself lies in the part or its gap below,
+    ///   can come nearer an earlier one; those lie at the part's edges, a small share.)
+    pub fn droplets(&self, s: &Settings) -> f64 {
+        let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+        let rho = s.support_density;
+        let r = crate::support::support_reach(s) + 2.0 * crate::support::SUPPORT_TOLERANCE_MM;
+        let d = 0.5 * b1.hypot(b1 / rho);
+        let hatch = self.grown(r + d) * rho / (b1 * b1);
+        let place = 0.5 * b1 + s.overhang_limit * b;
+        let apart = (place - crate::support::droplets::MARGIN_MM).max(0.25 * b1);
+        let w = d + place + 0.5 * apart;
+        let region = if d <= place - crate::support::droplets::MARGIN_MM {
+            self.grown(r + w) - self.area
+        } else {
+            self.grown(r + w)
+        };
+        let pass = region * 4.0 / (std::f64::consts::PI * apart * apart);
+        hatch + pass
+    }
+}
+
 /// The volumes and areas the estimate counts droplets in.
 #[derive(Clone, Debug)]
 pub struct Estimate {
@@ -77,9 +243,10 @@ pub struct Estimate {
     pub unit0_volume: f64,
     /// Unit 1's parts (mm³).
     pub unit1_volume: f64,
-    /// A bound of the support's region (mm³): under each instance's footprint grown by the
-    /// support's reach, from the plate to the instance's top.
-    pub support_volume: f64,
+    /// A bound of the support's droplets (of B₁): the lesser of [`Overhangs::droplets`] (under
+    /// the down-facing facets) and the hatch under each instance's footprint grown by the
+    /// support's reach, from the plate to the instance's top (that alone for open shells).
+    pub support_droplets: f64,
     /// A bound of the area one layer covers (mm²): the instances' footprints, grown.
     pub footprint: f64,
     /// The width of the region unit 1 prints (mm): its parts', or with support the job's grown.
@@ -91,13 +258,16 @@ pub struct Estimate {
 impl Estimate {
     /// The estimate of a job of `size` (mm) whose mesh encloses `volume` (mm³), of which
     /// `unit1` is unit 1's (`open`: some shell is not closed, so unit 1's signed volume means
-    /// nothing and its bounding box is taken), placed as `instances` say.
+    /// nothing and its bounding box is taken, and the support is bounded by the footprints
+    /// alone), placed as `instances` say; `overhangs`: the mesh's down-facing facets (every
+    /// unit's: support goes under either).
     pub fn new(
         volume: f64,
         unit1: Option<Unit1Parts>,
         open: bool,
         size: &[f64; 3],
         instances: &[Instance],
+        overhangs: &Overhangs,
         s: &Settings,
     ) -> Estimate {
         let (b0, b1) = (s.droplet_width(), s.unit1_droplet_width());
@@ -118,7 +288,7 @@ impl Estimate {
         let mut e = Estimate {
             unit0_volume,
             unit1_volume,
-            support_volume: 0.0,
+            support_droplets: 0.0,
             footprint: 0.0,
             unit1_extent,
             size: *size,
@@ -145,10 +315,17 @@ impl Estimate {
         } else {
             whole
         };
-        e.support_volume = if instances.len() > 1 && ok(under) {
+        let under = if instances.len() > 1 && ok(under) {
             under.min(whole * size[2])
         } else {
             whole * size[2]
+        };
+        let footprint_bound = s.support_density * under / (b1 * b1 * s.layer_height);
+        e.support_droplets = if open {
+            // The slicer closes open sections itself: down-facing facets may be missing.
+            footprint_bound
+        } else {
+            footprint_bound.min(overhangs.droplets(s))
         };
         if s.support == Support::Unit1 {
             e.unit1_extent = size[0].max(size[1]) + 2.0 * grow;
@@ -164,11 +341,7 @@ impl Estimate {
         let support = s.support == Support::Unit1;
         let d0 = self.unit0_volume / (b0 * b0 * h);
         let d1 = self.unit1_volume / (b1 * b1 * h);
-        let ds = if support {
-            s.support_density * self.support_volume / (b1 * b1 * h)
-        } else {
-            0.0
-        };
+        let ds = if support { self.support_droplets } else { 0.0 };
         let total = d0 + d1 + ds;
         let [x, y, z] = self.size;
         if over(total, MAX_DROPLETS) {
@@ -285,19 +458,62 @@ mod tests {
         }
     }
 
+    /// A closed box from `lo` to `hi`, facets facing out.
+    fn cuboid(lo: [f64; 3], hi: [f64; 3]) -> Mesh {
+        let vertices = (0..8)
+            .map(|i| [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] }))
+            .collect();
+        let quads = [
+            [0, 2, 3, 1], // z = lo, facing down
+            [4, 5, 7, 6], // z = hi
+            [0, 1, 5, 4], // y = lo
+            [2, 6, 7, 3], // y = hi
+            [0, 4, 6, 2], // x = lo
+            [1, 3, 7, 5], // x = hi
+        ];
+        let facets = quads
+            .iter()
+            .flat_map(|&[a, b, c, d]| [[a, b, c], [a, c, d]])
+            .collect();
+        Mesh { vertices, facets }
+    }
+
+    fn zs(s: &Settings) -> Vec<f64> {
+        crate::slicing::slice::layer_heights(20.0, s.layer_height, s.slice_plane)
+    }
+
+    #[test]
+    fn the_facet_sums_of_a_box() {
+        let s = Settings::default();
+        // On the plate: its bottom reaches no plane, no support.
+        let o = Overhangs::of(&cuboid([0.0; 3], [20.0; 3]), &zs(&s));
+        assert_eq!((o.area, o.perimeter, o.pieces), (0.0, 0.0, 0.0));
+        // Lifted to z = 10: one piece of 400 mm² with 80 mm of edge under 50 layers.
+        let o = Overhangs::of(&cuboid([0.0, 0.0, 10.0], [20.0; 3]), &zs(&s));
+        let n = zs(&s).iter().filter(|&&z| z <= 10.0).count() as f64;
+        assert_eq!(n, 50.0);
+        assert!((o.area - 400.0 * n).abs() < 1e-6, "{o:?}");
+        assert!((o.perimeter - 80.0 * n).abs() < 1e-6, "{o:?}");
+        assert_eq!(o.pieces, n);
+        // The bound holds the hatch of that column: 400 mm² × 50 layers of B₁ = B.
+        let b1 = s.unit1_droplet_width();
+        assert!(o.droplets(&s) >= 400.0 * n / (b1 * b1));
+    }
+
     #[test]
     fn each_unit_and_the_support_count_with_their_own_droplets() {
         let size = [20.0, 20.0, 20.0];
         let s = Settings::default();
+        let none = Overhangs::default();
         // The 20 mm cube by unit 0, with and without support: well within every limit.
-        let e = Estimate::new(8000.0, None, false, &size, &[], &s);
+        let e = Estimate::new(8000.0, None, false, &size, &[], &none, &s);
         assert!(e.check(&s).is_ok());
         let on = Settings {
             support: Support::Unit1,
             ..s.clone()
         };
         assert!(
-            Estimate::new(8000.0, None, false, &size, &[], &on)
+            Estimate::new(8000.0, None, false, &size, &[], &none, &on)
                 .check(&on)
                 .is_ok()
         );
@@ -311,21 +527,37 @@ mod tests {
             support: Support::Unit1,
             ..tiny.clone()
         };
-        let e = Estimate::new(8000.0, None, false, &size, &[], &tiny_on);
+        // With no overhang, the cube needs no support: a B₁ = 0.01 mm whose hatch under the
+        // whole footprint would be 4·10⁸ droplets is fine.
+        let fine_on = Settings {
+            unit1_droplet_aspect: 0.05,
+            ..on.clone()
+        };
+        let flat = Overhangs::of(&cuboid([0.0; 3], size), &zs(&s));
+        let e = Estimate::new(8000.0, None, false, &size, &[], &flat, &fine_on);
+        assert!(e.check(&fine_on).is_ok());
+        // An open mesh keeps the footprint bound.
+        let e = Estimate::new(8000.0, None, true, &size, &[], &flat, &fine_on);
+        assert_eq!(setting(e.check(&fine_on)), "unit1_droplet_aspect");
+        // A box lifted 10 mm off the plate: support under its bottom, refused with a tiny B₁.
+        let lifted = Overhangs::of(&cuboid([0.0, 0.0, 10.0], [20.0, 20.0, 20.0]), &zs(&s));
+        let e = Estimate::new(4000.0, None, false, &size, &[], &lifted, &tiny_on);
         assert_eq!(setting(e.check(&tiny_on)), "support");
+        let e = Estimate::new(4000.0, None, false, &size, &[], &lifted, &on);
+        assert!(e.check(&on).is_ok());
         // A unit-1 part of the whole cube: its droplets are of B₁.
         let cube = Unit1Parts {
             signed_volume: 8000.0,
             min: [0.0; 3],
             max: size,
         };
-        let e = Estimate::new(8000.0, Some(cube), false, &size, &[], &tiny);
+        let e = Estimate::new(8000.0, Some(cube), false, &size, &[], &none, &tiny);
         assert_eq!(e.unit0_volume, 0.0);
         assert_eq!(setting(e.check(&tiny)), "unit1_droplet_aspect");
         assert!(e.check(&s).is_ok());
         // A small unit-0 B: fine alone, too many for the support's pass.
         let small = Settings {
-            droplet_aspect: 0.1,
+            droplet_aspect: 0.09,
             ..s.clone()
         };
         let small_on = Settings {
@@ -333,11 +565,11 @@ mod tests {
             ..small.clone()
         };
         assert!(
-            Estimate::new(8000.0, None, false, &size, &[], &small)
+            Estimate::new(8000.0, None, false, &size, &[], &none, &small)
                 .check(&small)
                 .is_ok()
         );
-        let e = Estimate::new(8000.0, None, false, &size, &[], &small_on);
+        let e = Estimate::new(8000.0, None, false, &size, &[], &none, &small_on);
         assert_eq!(setting(e.check(&small_on)), "droplet_aspect");
     }
 }

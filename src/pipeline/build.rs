@@ -187,8 +187,24 @@ impl Job {
         // One droplet estimate for the whole job: every unit and the support.
         let unit1 = budget::Unit1Parts::of(&mesh, &groups);
         let open = shells.open > 0;
-        let mut estimate =
-            budget::Estimate::new(volume, unit1, open, &size, &input.instances, &settings);
+        let overhangs = if open || settings.support == crate::base::settings::Support::Off {
+            budget::Overhangs::default()
+        } else {
+            let h = settings.layer_height;
+            budget::Overhangs::of(
+                &mesh,
+                &slice::layer_heights(size[2], h, settings.slice_plane),
+            )
+        };
+        let mut estimate = budget::Estimate::new(
+            volume,
+            unit1,
+            open,
+            &size,
+            &input.instances,
+            &overhangs,
+            &settings,
+        );
         estimate.check(&settings)?;
         let zs = plane_heights(&size, &settings)?;
         let (mesh, buckets, stats) = repair(

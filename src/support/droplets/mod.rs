@@ -1,0 +1,384 @@
+//! The support's droplet-level pass (SPEC.md "Two discharge units"; docs/support.md): after
+//! every layer is planned with its support region, find the droplets the layer below does not
+//! support by the overhang rule and add single unit-1 droplets under them, top-down, so that
+//! the rule holds for every droplet of the code (the added droplets need support too).
+//!
+//! The region form ([`crate::support`]) leaves a few droplets unsupported: where a support
+//! region is a sliver, or where a part droplet lies beyond the edge of the part below by less
+//! than the limit but the droplets below sit B/2 inside that edge. The pass works on droplet
+//! centres only (hash grids of the layers' droplets), so it is cheap.
+
+use crate::base::geom::{DVec2, Point, Shapes, dist, round_output};
+use crate::base::settings::Settings;
+use crate::slicing::plan::{Move, MoveKind};
+use gaps::inside;
+use grid::{Added, Below};
+
+/// A droplet centre and its width (B or B₁).
+pub type Droplet = (Point, f64);
+
+/// An axis-aligned box: its least and greatest corners.
+pub type Bounds = (Point, Point);
+
+/// `f(i, within, out)` appends layer i's droplets (in the box `within` if given) to `out`.
+pub type LayerDroplets<'a> = &'a (dyn Fn(usize, Option<Bounds>, &mut Vec<Droplet>) + Sync);
+
+/// Centres kept this much inside the rule's distance, so rounding the written positions
+/// cannot break it (positions are rounded to 0.05 µm).
+pub(crate) const MARGIN_MM: f64 = 1e-3;
+
+mod gaps;
+mod grid;
+mod walk;
+
+pub use gaps::{Clearance, LineGaps, edges_of};
+pub use walk::nearest_first;
+
+/// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
+/// order they are set; with `within = Some((lo, hi))` only those in that box (a line whose
+/// box misses it is not walked).
+pub fn droplets_of(
+    moves: &[Move],
+    b: f64,
+    b1: f64,
+    within: Option<Bounds>,
+    out: &mut Vec<Droplet>,
+) {
+    let mut at = Point::ZERO;
+    let inside = |p: Point| within.is_none_or(|(lo, hi)| p.cmpge(lo).all() && p.cmple(hi).all());
+    for m in moves {
+        let w = if m.unit == 1 { b1 } else { b };
+        match m.kind {
+            MoveKind::Droplet if inside(m.to) => out.push((m.to, w)),
+            MoveKind::Line => {
+                let meets = within.is_none_or(|(lo, hi)| {
+                    at.min(m.to).cmple(hi).all() && at.max(m.to).cmpge(lo).all()
+                });
+                if meets {
+                    out.extend(
+                        crate::base::geom::line_droplets(at, m.to, w)
+                            .filter(|&p| inside(p))
+                            .map(|p| (p, w)),
+                    );
+                }
+            }
+            _ => {}
+        }
+        at = m.to;
+    }
+}
+
+/// Candidate places for a support droplet under `c`: c itself, then rings around it out to
+/// `r` (nearest first).
+fn candidates(c: Point, r: f64) -> impl Iterator<Item = Point> {
+    std::iter::once(c).chain((1..=4).flat_map(move |ring| {
+        let rr = r * ring as f64 / 4.0;
+        let n = 8 * ring;
+        (0..n).map(move |k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            c + rr * DVec2::new(a.cos(), a.sin())
+        })
+    }))
+}
+
+/// What the pass did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct PassFigures {
+    /// Unit-1 droplets added.
+    pub added: usize,
+    /// Droplets left unsupported: no place within the rule outside the part and its gap.
+    pub unplaceable: usize,
+}
+
+/// The unit-1 droplets to add to each layer so that every droplet above the first layer is
+/// supported: `droplets(i, within, out)` appends layer i's planned droplets (both units; in
+/// the box `within` if given, [`droplets_of`]) to `out` (about once per layer, in runs of
+/// layers on all cores; again for a layer under added droplets), so that no layer's droplets
+/// need be kept; `regions[i]` is its part's region. Works top-down; an added droplet needs
+/// support from the layer below as any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
+/// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
+/// support deliberately stops below overhangs, and the pass adds nothing.
+pub fn complete(
+    droplets: LayerDroplets,
+    regions: &[Shapes],
+    s: &Settings,
+) -> (Vec<Vec<Point>>, PassFigures) {
+    let n = regions.len();
+    let mut extra: Vec<Vec<Point>> = vec![Vec::new(); n];
+    let mut figures = PassFigures::default();
+    if n < 2 || s.support_gap_z > 0 {
+        return (extra, figures);
+    }
+    let rule = Rule::new(s);
+    let open = unsupported_by_planned(droplets, n, &rule);
+    let mut buf = Vec::new();
+    // Top-down: layer i's unsupported droplets (planned or added) get droplets in layer i − 1.
+    for i in (1..n).rev() {
+        let mut todo: Vec<Droplet> = open[i].clone();
+        if !extra[i].is_empty() {
+            unsupported_added(droplets, i, &extra[i], &rule, &mut buf, &mut todo);
+        }
+        if todo.is_empty() {
+            continue;
+        }
+        place_under(
+            &todo,
+            &regions[i - 1],
+            &rule,
+            &mut extra[i - 1],
+            &mut figures,
+        );
+    }
+    (extra, figures)
+}
+
+/// The overhang rule's distances for the pass.
+struct Rule {
+    b: f64,
+    b1: f64,
+    /// `overhang_limit`·B.
+    limit: f64,
+    /// The grids' cells: the reach of the wider droplets.
+    cell: f64,
+    /// `support_gap_xy`·B.
+    gap: f64,
+    /// How far from a droplet to support an added droplet may be placed.
+    place: f64,
+}
+
+impl Rule {
+    fn new(s: &Settings) -> Rule {
+        let b = s.droplet_width();
+        let b1 = s.unit1_droplet_width();
+        let limit = s.overhang_limit * b;
+        let mut rule = Rule {
+            b,
+            b1,
+            limit,
+            cell: 0.0,
+            gap: s.support_gap_xy * b,
+            place: 0.0,
+        };
+        rule.cell = rule.reach(b.max(b1));
+        rule.place = rule.reach(b1) - MARGIN_MM;
+        rule
+    }
+
+    /// How far a droplet of width `w` supports: w/2 + the limit.
+    fn reach(&self, w: f64) -> f64 {
+        w / 2.0 + self.limit
+    }
+}
+
+/// Each layer's planned droplets that the layer below's planned droplets leave unsupported
+/// (none for layer 0): runs of consecutive layers on all cores, each layer's droplets listed
+/// and put in a grid once within a run (the grid of layer i then checks layer i + 1).
+fn unsupported_by_planned(droplets: LayerDroplets, n: usize, rule: &Rule) -> Vec<Vec<Droplet>> {
+    const RUN: usize = 8;
+    let (b, b1) = (rule.b, rule.b1);
+    let reach = |w: f64| rule.reach(w);
+    let runs = crate::base::parallel::par_map((n - 1).div_ceil(RUN), &|r| {
+        let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
+        let mut buf = Vec::new();
+        droplets(first - 1, None, &mut buf);
+        let mut below = Below::new(b, b1, reach, &buf);
+        let mut out = Vec::with_capacity(end - first);
+        for i in first..end {
+            buf.clear();
+            droplets(i, None, &mut buf);
+            // Consecutive droplets are neighbours: the droplet below that supported the last
+            // one most often supports the next.
+            let mut last: Option<Droplet> = None;
+            let mut open = Vec::new();
+            for &(p, w) in &buf {
+                if let Some((q, wq)) = last {
+                    let r = reach(wq);
+                    if (p - q).length_squared() <= r * r {
+                        continue;
+                    }
+                }
+                match below.find_within(p, reach) {
+                    Some(d) => last = Some(d),
+                    None => open.push((p, w)),
+                }
+            }
+            out.push(open);
+            if i + 1 < end {
+                below.fill(reach, &buf);
+            }
+        }
+        out
+    });
+    std::iter::once(Vec::new())
+        .chain(runs.into_iter().flatten())
+        .collect()
+}
+
+/// Appends to `todo` the droplets `added` to layer i that layer i − 1's planned droplets leave
+/// unsupported. They are few, so only that layer's droplets within reach of their box are
+/// listed (into `buf`), and scanned once (a grid only for many).
+fn unsupported_added(
+    droplets: LayerDroplets,
+    i: usize,
+    added: &[Point],
+    rule: &Rule,
+    buf: &mut Vec<Droplet>,
+    todo: &mut Vec<Droplet>,
+) {
+    let reach = |w: f64| rule.reach(w);
+    let adds: Vec<Droplet> = added.iter().map(|&p| (p, rule.b1)).collect();
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for (p, _) in &adds {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let (lo, hi) = (lo - DVec2::splat(rule.cell), hi + DVec2::splat(rule.cell));
+    buf.clear();
+    droplets(i - 1, Some((lo, hi)), buf);
+    let mut held = vec![false; adds.len()];
+    if adds.len() > 16 {
+        let below = Below::new(rule.b, rule.b1, reach, buf);
+        for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+            *h = below.find_within(p, reach).is_some();
+        }
+    } else {
+        for &(q, w) in buf.iter() {
+            let r = reach(w);
+            for (h, &(p, _)) in held.iter_mut().zip(&adds) {
+                *h = *h || (p - q).length_squared() <= r * r;
+            }
+        }
+    }
+    todo.extend(
+        adds.iter()
+            .zip(&held)
+            .filter(|(_, h)| !**h)
+            .map(|(d, _)| *d),
+    );
+}
+
+/// Places a unit-1 droplet in the layer below (whose part's region is `region`) under each
+/// droplet of `todo` that no droplet placed so far supports, appending it to `out`: outside
+/// the part and its gap, failing that outside the part (in the gap); counted in `figures`.
+fn place_under(
+    todo: &[Droplet],
+    region: &Shapes,
+    rule: &Rule,
+    out: &mut Vec<Point>,
+    figures: &mut PassFigures,
+) {
+    let (gap, place) = (rule.gap, rule.place);
+    // The gap is kept from the part's edges near the candidates only (within the rule's
+    // reach and the gap of the droplets to support).
+    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+    for (p, _) in todo {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let margin = DVec2::splat(place + gap.max(0.0) + MARGIN_MM);
+    let (lo, hi) = (lo - margin, hi + margin);
+    let mut edges = edges_of(region);
+    edges.retain(|&(a, e)| a.min(e).cmple(hi).all() && a.max(e).cmpge(lo).all());
+    let clear = Clearance::new(&edges, gap, rule.b);
+    let mut added = Added::new(rule.cell);
+    for &(c, _) in todo {
+        // Within the rule of an added droplet: within B₁/2 + limit.
+        if added.any_within(c, rule.reach(rule.b1) - MARGIN_MM) {
+            continue;
+        }
+        let found = candidates(c, place)
+            .find(|&p| clear.keeps(p) && !inside(region, p))
+            .or_else(|| candidates(c, place).find(|&p| !inside(region, p)));
+        // As written: the layer below checks the rounded position.
+        match found.map(round_output) {
+            Some(p) => {
+                debug_assert!(dist(p, c) <= rule.reach(rule.b1));
+                added.add(p);
+                out.push(p);
+                figures.added += 1;
+            }
+            None => figures.unplaceable += 1,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::geom::square;
+
+    fn run(
+        droplets: &[Vec<Droplet>],
+        regions: &[Shapes],
+        s: &Settings,
+    ) -> (Vec<Vec<Point>>, PassFigures) {
+        assert_eq!(droplets.len(), regions.len());
+        complete(
+            &|i, within: Option<Bounds>, out: &mut Vec<Droplet>| {
+                out.extend(droplets[i].iter().filter(|(p, _)| {
+                    within.is_none_or(|(lo, hi)| p.cmpge(lo).all() && p.cmple(hi).all())
+                }))
+            },
+            regions,
+            s,
+        )
+    }
+
+    #[test]
+    fn a_droplet_over_nothing_gets_a_column_down_to_the_plate() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        // Three layers: a droplet at (5, 5) on layer 2, a part (a square far away) on each.
+        let part = square(0.0, 0.0, 2.0);
+        let far = (DVec2::new(1.0, 1.0), b);
+        let droplets = vec![vec![far], vec![far], vec![far, (DVec2::new(5.0, 5.0), b)]];
+        let regions = vec![part.clone(), part.clone(), part];
+        let (extra, figures) = run(&droplets, &regions, &s);
+        assert_eq!(figures.unplaceable, 0);
+        // One droplet under it on layer 1 and one under that on layer 0.
+        assert_eq!(extra[2].len(), 0);
+        assert_eq!(extra[1], vec![DVec2::new(5.0, 5.0)]);
+        assert_eq!(extra[0], vec![DVec2::new(5.0, 5.0)]);
+    }
+
+    #[test]
+    fn added_droplets_keep_the_gap_from_the_part() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        let gap = s.support_gap_xy * b;
+        // Layer 0: a 2 mm square; layer 1: a droplet just beyond its edge, unsupported by the
+        // droplet far inside the square.
+        let part = square(0.0, 0.0, 2.0);
+        let c = DVec2::new(2.0 + 0.2 * b, 1.0);
+        let droplets = vec![vec![(DVec2::new(0.5, 1.0), b)], vec![(c, b)]];
+        let regions = vec![part.clone(), Shapes::new()];
+        let (extra, figures) = run(&droplets, &regions, &s);
+        assert_eq!(figures.added, 1);
+        let p = extra[0][0];
+        assert!(p.x >= 2.0 + gap - 1e-9, "{p}");
+        assert!(dist(p, c) <= b1_reach(&s), "{p}");
+    }
+
+    fn b1_reach(s: &Settings) -> f64 {
+        s.unit1_droplet_width() / 2.0 + s.overhang_limit * s.droplet_width()
+    }
+
+    #[test]
+    fn supported_droplets_need_nothing_and_a_gap_z_adds_nothing() {
+        let s = Settings::default();
+        let b = s.droplet_width();
+        let d = |x: f64| (DVec2::new(x, 0.0), b);
+        let droplets = vec![vec![d(0.0)], vec![d(0.9 * b)], vec![d(1.8 * b)]];
+        let regions = vec![Shapes::new(); 3];
+        let (extra, figures) = run(&droplets, &regions, &s);
+        assert!(extra.iter().all(|e| e.is_empty()));
+        assert_eq!(figures, PassFigures::default());
+        let far = vec![vec![d(0.0)], vec![d(5.0)]];
+        let gap_z = Settings {
+            support_gap_z: 1,
+            ..s
+        };
+        let (extra, _) = run(&far, &regions[..2], &gap_z);
+        assert!(extra.iter().all(|e| e.is_empty()));
+    }
+}
