@@ -29,10 +29,8 @@ pub(crate) const MARGIN_MM: f64 = 1e-3;
 
 mod gaps;
 mod grid;
-mod walk;
 
 pub use gaps::{Clearance, LineGaps, edges_of};
-pub use walk::nearest_first;
 
 /// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
 /// order they are set; with `within = Some((lo, hi))` only those in that box (a line whose
