@@ -67,6 +67,14 @@ fn cli(args: &[&str], cwd: &Path, named: &str) -> Out {
     wait(spawn(args, cwd, named, logs.path()), logs.path()).1
 }
 
+/// The cube sliced to `out.gco` with the report `r.json`, then `extra`.
+fn cube_to_out<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let cube: &'static str = Box::leak(model("cube_20mm_ascii.stl").into_boxed_str());
+    let mut args = vec![cube, "-o", "out.gco", "--report", "r.json"];
+    args.extend_from_slice(extra);
+    args
+}
+
 /// Names in a directory (hidden ones too), sorted.
 fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
@@ -173,18 +181,7 @@ fn an_existing_partial_link_is_not_followed() {
         std::os::unix::fs::symlink(d.join("created.txt"), d.join(".out.gco.partial")).unwrap();
         std::os::unix::fs::symlink(&victim, d.join("r.json.partial")).unwrap();
         let before = listing(d);
-        let r = cli(
-            &[
-                &model("cube_20mm_ascii.stl"),
-                "-o",
-                "out.gco",
-                "--report",
-                "r.json",
-                "-q",
-            ],
-            d,
-            named,
-        );
+        let r = cli(&cube_to_out(&["-q"]), d, named);
         assert_eq!(r.code, Some(0), "{}", r.stderr);
         assert_eq!(
             std::fs::read_to_string(&victim).unwrap(),
@@ -407,17 +404,7 @@ fn a_successful_run_writes_the_same_code_as_the_library_with_the_usual_mode() {
         let dir = tempfile::tempdir().unwrap();
         let d = dir.path();
         std::fs::write(d.join("out.gco"), "; replaced\n").unwrap();
-        let r = cli(
-            &[
-                &model("cube_20mm_ascii.stl"),
-                "-o",
-                "out.gco",
-                "--report",
-                "r.json",
-            ],
-            d,
-            named,
-        );
+        let r = cli(&cube_to_out(&[]), d, named);
         assert_eq!(r.code, Some(0), "{}", r.stderr);
         assert!(r.stderr.contains("→ out.gco"), "{}", r.stderr);
         assert_eq!(listing(d), ["out.gco", "r.json"]);

@@ -182,22 +182,11 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
                     .map(|l| HeightMap::reference(&l.1, &grid, d))
                     .collect();
                 for (lo, hi) in [(Some(0), Some(2)), (None, Some(2)), (Some(0), None)] {
-                    let a = slab_voids(
-                        &layers[1].0,
-                        &grid,
-                        lo.map(|j| &fast[j]),
-                        &fast[1],
-                        hi.map(|j| &fast[j]),
-                        &s,
-                    );
-                    let r = slab_voids_reference(
-                        &layers[1].0,
-                        &grid,
-                        lo.map(|j| &slow[j]),
-                        &slow[1],
-                        hi.map(|j| &slow[j]),
-                        &s,
-                    );
+                    let run = |f: SlabFn, maps: &[HeightMap]| {
+                        let pick = |j: Option<usize>| j.map(|j| &maps[j]);
+                        f(&layers[1].0, &grid, pick(lo), &maps[1], pick(hi), &s)
+                    };
+                    let (a, r) = (run(slab_voids, &fast), run(slab_voids_reference, &slow));
                     assert_eq!(
                         bits(a),
                         bits(r),
@@ -208,6 +197,16 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
         }
     }
 }
+
+/// The signature of `slab_voids` and its reference.
+type SlabFn = fn(
+    &Shapes,
+    &Grid3,
+    Option<&HeightMap>,
+    &HeightMap,
+    Option<&HeightMap>,
+    &Settings,
+) -> (f64, f64);
 
 /// The report when the writing thread computes every slab in order (the layers analysed and
 /// pushed one by one, as before the workers computed them).

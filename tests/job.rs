@@ -760,6 +760,11 @@ fn run(args: &[&str], dir: &TempDir) -> common::Run {
     run_cli(args, dir.path(), Duration::from_secs(300))
 }
 
+/// [`run`] with the arguments as one line of words (no word holds a space).
+fn run_words(words: &str, dir: &TempDir) -> common::Run {
+    run(&words.split_whitespace().collect::<Vec<_>>(), dir)
+}
+
 #[test]
 fn cli_slices_several_models_and_job_files() {
     let dir = TempDir::new("job-cli");
@@ -775,17 +780,7 @@ fn cli_slices_several_models_and_job_files() {
     )
     .unwrap();
     // Two models: arranged, the header lists both.
-    let r = run(
-        &[
-            "a.stl",
-            "models/idler.obj",
-            "-o",
-            "two.gco",
-            "--set",
-            "rotate_z=90",
-        ],
-        &dir,
-    );
+    let r = run_words("a.stl models/idler.obj -o two.gco --set rotate_z=90", &dir);
     assert_eq!(r.code, Some(0), "{r:?}");
     let two = std::fs::read_to_string(dir.join("two.gco")).unwrap();
     assert!(
@@ -840,16 +835,7 @@ fn cli_slices_several_models_and_job_files() {
     let t = std::fs::read_to_string(dir.join("job2.gco")).unwrap();
     assert_eq!(moves(&t), moves(&from_file));
     // --set overrides the job file's settings; a part key is refused there.
-    let r = run(
-        &[
-            "models/job.json",
-            "-o",
-            "job3.gco",
-            "--set",
-            "layer_height=0.3",
-        ],
-        &dir,
-    );
+    let r = run_words("models/job.json -o job3.gco --set layer_height=0.3", &dir);
     assert_eq!(r.code, Some(0), "{r:?}");
     let t = std::fs::read_to_string(dir.join("job3.gco")).unwrap();
     assert!(t.contains("; layer_height = 0.3 (mm)"));
@@ -880,16 +866,9 @@ fn cli_slices_several_models_and_job_files() {
 #[test]
 fn cli_single_model_header_lists_the_part() {
     let dir = TempDir::new("job-cli-one");
-    let r = run(
-        &[
-            model("cube_gears.3mf").to_str().unwrap(),
-            "-o",
-            "one.gco",
-            "--set",
-            "place_x=3",
-            "--set",
-            "place_y=4",
-        ],
+    let cube_gears = model("cube_gears.3mf").display().to_string();
+    let r = run_words(
+        &format!("{cube_gears} -o one.gco --set place_x=3 --set place_y=4"),
         &dir,
     );
     assert_eq!(r.code, Some(0), "{r:?}");

@@ -6,55 +6,14 @@
 //! before the nearest-next orders used a grid, the 100 000 items took minutes.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
+mod common;
+
 use dropslice::output::gcode_read::read_gcode;
 use dropslice::{Job, Settings};
 use std::collections::HashMap;
 
 /// Side of the cubes, mm.
 const SIDE: f64 = 0.5;
-
-/// A 3MF package (deflated) with one model part.
-fn three_mf(resources: &str, build: &str) -> Vec<u8> {
-    use std::io::Write;
-    let rels = r#"<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#;
-    let model = format!(
-        r#"<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources>{resources}</resources><build>{build}</build></model>"#
-    );
-    let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let opt = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
-    for (name, text) in [("_rels/.rels", rels), ("3D/3dmodel.model", model.as_str())] {
-        z.start_file(name, opt).unwrap();
-        z.write_all(text.as_bytes()).unwrap();
-    }
-    z.finish().unwrap().into_inner()
-}
-
-/// `<object id>`: a cube of side [`SIDE`] at the origin, facets outward or (`inverted`)
-/// inside out.
-fn cube_object(id: u32, inverted: bool) -> String {
-    let mut s = format!(r#"<object id="{id}" type="model"><mesh><vertices>"#);
-    for i in 0..8 {
-        let c = |b: usize| if (i >> b) & 1 == 1 { SIDE } else { 0.0 };
-        s += &format!(r#"<vertex x="{}" y="{}" z="{}"/>"#, c(0), c(1), c(2));
-    }
-    s += "</vertices><triangles>";
-    // Quads counter-clockwise seen from outside.
-    for q in [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ] {
-        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
-            let t = if inverted { [t[0], t[2], t[1]] } else { t };
-            s += &format!(r#"<triangle v1="{}" v2="{}" v3="{}"/>"#, t[0], t[1], t[2]);
-        }
-    }
-    s + "</triangles></mesh></object>"
-}
 
 fn translate(x: f64, y: f64, z: f64) -> String {
     format!("1 0 0 0 1 0 0 0 1 {x} {y} {z}")
@@ -133,7 +92,7 @@ fn a_hundred_thousand_build_items_of_small_cubes_slice_alike() {
             )
         })
         .collect();
-    let bytes = three_mf(&cube_object(1, true), &items);
+    let bytes = common::three_mf(&common::cube_object(1, SIDE as f32, true), &items);
     let per_layer = droplets_per_cube(&bytes, "items.3mf", 1.0);
     let columns: Vec<(i64, i64)> = (0..n)
         .map(|i| ((i % side) as i64, (i / side) as i64))
@@ -152,7 +111,7 @@ fn a_small_3mf_fanning_out_ten_thousand_cubes_slices_alike() {
     // Four levels of ten components (x 1 mm, y 1 mm, z 1 mm, x 10 mm apart): 10 000 cubes,
     // 100 × 10 columns of 10 cubes each, from a file of about a kilobyte.
     let levels = 4;
-    let mut res = cube_object(1, false);
+    let mut res = common::cube_object(1, SIDE as f32, false);
     for l in 0..levels {
         let pitch = 10f64.powi(l / 3);
         let comps: String = (0..10)
@@ -171,7 +130,7 @@ fn a_small_3mf_fanning_out_ten_thousand_cubes_slices_alike() {
             l + 2
         );
     }
-    let bytes = three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
+    let bytes = common::three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
     assert!(bytes.len() < 2000, "{} bytes", bytes.len());
     let per_layer = droplets_per_cube(&bytes, "fan.3mf", 1.0);
     let columns: Vec<(i64, i64)> = (0..100)

@@ -395,44 +395,12 @@ fn many_nested_or_overlapping_inverted_shells_stay_within_the_budget() {
     assert_eq!(o.flipped + o.unchecked, k);
 }
 
-/// A 3MF package (deflated) with one model part.
-fn three_mf(resources: &str, build: &str) -> Vec<u8> {
-    use std::io::Write;
-    let rels = r#"<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#;
-    let model = format!(
-        r#"<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources>{resources}</resources><build>{build}</build></model>"#
-    );
-    let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
-    let opt = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
-    for (name, text) in [("_rels/.rels", rels), ("3D/3dmodel.model", model.as_str())] {
-        z.start_file(name, opt).unwrap();
-        z.write_all(text.as_bytes()).unwrap();
-    }
-    z.finish().unwrap().into_inner()
-}
-
-/// `<object id>`: an inside-out cube of side 0.5 mm at the origin.
-fn inverted_cube_object(id: u32) -> String {
-    let mut s = format!(r#"<object id="{id}" type="model"><mesh><vertices>"#);
-    for i in 0..8 {
-        let [x, y, z] = common::box_corner([0.0; 3], [0.5; 3], i);
-        s += &format!(r#"<vertex x="{x}" y="{y}" z="{z}"/>"#);
-    }
-    s += "</vertices><triangles>";
-    for [a, b, c] in common::BOX_FACETS {
-        // inside-out: each facet wound the other way
-        s += &format!(r#"<triangle v1="{a}" v2="{c}" v3="{b}"/>"#);
-    }
-    s + "</triangles></mesh></object>"
-}
-
 #[test]
 fn a_small_3mf_fanning_out_inverted_cubes_by_components_is_oriented_quickly() {
     // Five levels of ten components each: 100 000 inside-out cubes from a file of about a
     // kilobyte, every one outside the others.
     let levels = 5;
-    let mut res = inverted_cube_object(1);
+    let mut res = common::cube_object(1, 0.5, true);
     for l in 0..levels {
         let pitch = 10f64.powi(l / 3);
         let comps: String = (0..10)
@@ -453,7 +421,7 @@ fn a_small_3mf_fanning_out_inverted_cubes_by_components_is_oriented_quickly() {
             l + 2
         );
     }
-    let bytes = three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
+    let bytes = common::three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
     assert!(bytes.len() < 2000, "{} bytes", bytes.len());
     let t = std::time::Instant::now();
     let j = Job::new(&bytes, "fan.3mf", Settings::default()).unwrap();

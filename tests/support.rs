@@ -133,20 +133,7 @@ fn check_with_support(name: &str) {
     );
     // T lines: each changes the unit, and a command of that unit follows.
     let text = slice_cli(&model(name), &["support=unit1"]);
-    let lines: Vec<&str> = text.lines().collect();
-    let mut unit = "T0";
-    for (i, l) in lines.iter().enumerate() {
-        if l.starts_with('T') {
-            assert_ne!(*l, unit, "{name} line {}: T line without a change", i + 1);
-            unit = l;
-            let next = lines[i + 1..].iter().find(|l| !l.starts_with(';'));
-            assert!(
-                next.is_some_and(|n| n.starts_with('G')),
-                "{name} line {}: no command after {l}",
-                i + 1
-            );
-        }
-    }
+    common::assert_unit_changes(&text, name);
     if support > 0 {
         assert!(!on.unit_lines.is_empty());
         assert!(on.get("unit1_droplet_aspect").is_some());

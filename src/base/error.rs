@@ -22,6 +22,14 @@ pub enum Error {
 }
 
 impl Error {
+    /// A refused setting: its name and what to do.
+    pub fn setting(name: &str, message: String) -> Error {
+        Error::Setting {
+            name: name.into(),
+            message,
+        }
+    }
+
     /// A short machine-readable tag: "import", "setting", "job", "nothing_to_print", "io", "internal".
     pub fn kind(&self) -> &'static str {
         match self {

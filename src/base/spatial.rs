@@ -484,23 +484,10 @@ mod tests {
         assert_eq!(t.bands().len(), 4);
         let b0 = t.bands()[0];
         assert_eq!((b0.first_row, b0.end_row, b0.row_len), (0, 64, 8));
-        assert_eq!(
-            t.segments(&b0),
-            [Segment {
-                c0: 4,
-                c1: 12,
-                at: 0
-            }]
-        );
+        let one = |c0, c1| [Segment { c0, c1, at: 0 }];
+        assert_eq!(t.segments(&b0), one(4, 12));
         let b1 = t.bands()[1];
-        assert_eq!(
-            t.segments(&b1),
-            [Segment {
-                c0: 8,
-                c1: 16,
-                at: 0
-            }]
-        );
+        assert_eq!(t.segments(&b1), one(8, 16));
         let last = t.bands()[3];
         assert_eq!((last.first_row, last.end_row), (999_936, 1_000_000));
         assert_eq!(t.segments(&last)[0].c0, 999_000);

@@ -236,32 +236,42 @@ pub(crate) fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
         .filter(|(n, _, _)| *n > 0)
         .map(|(n, before, after)| format!("{before}{n}{after}"))
         .collect();
-    if m.flipped_shells > 0 {
-        w.push(format!(
-            "{} closed shell{} inside out (facets facing inward) and outside every other shell: turned outward and printed as solid",
+    // (count, what, verb for one, verb for several, what was done)
+    let shells: [(usize, &str, &str, &str, &str); 4] = [
+        (
             m.flipped_shells,
-            if m.flipped_shells == 1 { " was" } else { "s were" }
-        ));
-    }
-    if m.flipped_open_shells > 0 {
-        w.push(format!(
-            "{} open shell{} inside out (facets facing inward, holes in the surface) and outside every other shell: turned outward and printed as solid",
+            "closed shell",
+            "was",
+            "were",
+            "inside out (facets facing inward) and outside every other shell: turned outward and printed as solid",
+        ),
+        (
             m.flipped_open_shells,
-            if m.flipped_open_shells == 1 { " was" } else { "s were" }
-        ));
-    }
-    if m.cavity_shells > 0 {
-        w.push(format!(
-            "{} inside-out closed shell{} inside another shell: kept as cavities (hollow inside the part)",
+            "open shell",
+            "was",
+            "were",
+            "inside out (facets facing inward, holes in the surface) and outside every other shell: turned outward and printed as solid",
+        ),
+        (
             m.cavity_shells,
-            if m.cavity_shells == 1 { " lies" } else { "s lie" }
-        ));
-    }
-    if m.unchecked_shells > 0 {
-        w.push(format!(
-            "{} inside-out shells were not checked (too many to check quickly) and are sliced as they are",
-            m.unchecked_shells
-        ));
+            "inside-out closed shell",
+            "lies",
+            "lie",
+            "inside another shell: kept as cavities (hollow inside the part)",
+        ),
+        (
+            m.unchecked_shells,
+            "inside-out shell",
+            "was",
+            "were",
+            "not checked (too many to check quickly) and are sliced as they are",
+        ),
+    ];
+    for (n, what, one, several, done) in shells {
+        if n > 0 {
+            let (s, verb) = if n == 1 { ("", one) } else { ("s", several) };
+            w.push(format!("{n} {what}{s} {verb} {done}"));
+        }
     }
     if m.signed_volume < 0.0 && m.flipped_shells + m.flipped_open_shells == 0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());

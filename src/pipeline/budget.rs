@@ -363,10 +363,7 @@ impl Estimate {
                     ),
                 )
             };
-            return Err(Error::Setting {
-                name: name.into(),
-                message,
-            });
+            return Err(Error::setting(name, message));
         }
         if support && over(total, MAX_DROPLETS_WITH_SUPPORT) {
             let (name, what) = if d0 >= d1.max(ds) {
@@ -385,26 +382,26 @@ impl Estimate {
                     format!("up to {ds:.1e} of support, B₁ = {} mm", mm(b1)),
                 )
             };
-            return Err(Error::Setting {
-                name: name.into(),
-                message: format!(
+            return Err(Error::setting(
+                name,
+                format!(
                     "with support the job could take up to {total:.1e} droplets ({what}), more than the {MAX_DROPLETS_WITH_SUPPORT:.0e} the support's check of every droplet allows; raise {name} (or layer_height), or set support = off"
                 ),
-            });
+            ));
         }
         let used = support || self.unit1_volume > 0.0;
         let lines = self.unit1_extent / b1;
         if used && over(lines, MAX_WIDTH_IN_DROPLETS) {
-            return Err(Error::Setting {
-                name: "unit1_droplet_aspect".into(),
-                message: format!(
+            return Err(Error::setting(
+                "unit1_droplet_aspect",
+                format!(
                     "unit 1's region would be {:.0} mm wide{}, more than {MAX_WIDTH_IN_DROPLETS} droplets of B₁ = {} mm; raise unit1_droplet_aspect{}",
                     self.unit1_extent,
                     if support { " (support)" } else { "" },
                     mm(b1),
                     if support { " or set support = off" } else { "" }
                 ),
-            });
+            ));
         }
         if support {
             let a = self.footprint;
@@ -421,12 +418,12 @@ impl Estimate {
                         format!("unit 1's B₁ = {} mm", mm(b1)),
                     )
                 };
-                return Err(Error::Setting {
-                    name: name.into(),
-                    message: format!(
+                return Err(Error::setting(
+                    name,
+                    format!(
                         "with support a layer of {a:.0} mm² could hold up to {per_layer:.1e} droplets ({what}), more than the {MAX_LAYER_DROPLETS_WITH_SUPPORT:.0e} the support's check of every droplet allows; raise {name} (or layer_height), or set support = off"
                     ),
-                });
+                ));
             }
         }
         Ok(())

@@ -693,6 +693,40 @@ pub fn cuboid(min: [f32; 3], max: [f32; 3]) -> Vec<[[f32; 3]; 3]> {
         .collect()
 }
 
+/// A 3MF package (deflated) with one model part: `resources` and `build` are the XML of the
+/// model's two elements.
+pub fn three_mf(resources: &str, build: &str) -> Vec<u8> {
+    use std::io::Write;
+    let rels = r#"<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>"#;
+    let model = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><model unit="millimeter" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02"><resources>{resources}</resources><build>{build}</build></model>"#
+    );
+    let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let opt = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    for (name, text) in [("_rels/.rels", rels), ("3D/3dmodel.model", model.as_str())] {
+        z.start_file(name, opt).unwrap();
+        z.write_all(text.as_bytes()).unwrap();
+    }
+    z.finish().unwrap().into_inner()
+}
+
+/// `<object id>` of a 3MF model: a cube of side `side` at the origin, facets outward or
+/// (`inverted`) inside out.
+pub fn cube_object(id: u32, side: f32, inverted: bool) -> String {
+    let mut s = format!(r#"<object id="{id}" type="model"><mesh><vertices>"#);
+    for i in 0..8 {
+        let [x, y, z] = box_corner([0.0; 3], [side; 3], i);
+        s += &format!(r#"<vertex x="{x}" y="{y}" z="{z}"/>"#);
+    }
+    s += "</vertices><triangles>";
+    for [a, b, c] in BOX_FACETS {
+        let [b, c] = if inverted { [c, b] } else { [b, c] };
+        s += &format!(r#"<triangle v1="{a}" v2="{b}" v3="{c}"/>"#);
+    }
+    s + "</triangles></mesh></object>"
+}
+
 /// A binary STL of the given triangles (zero normals).
 pub fn binary_stl(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
     dropslice::model::import::stl::write_binary(header, tris)
