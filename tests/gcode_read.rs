@@ -78,10 +78,19 @@ fn figures_come_from_the_header_settings() {
     let travel: f64 = layers.iter().map(|l| l.travel_mm).sum();
     let c = &want.counts;
     let seconds = (c.total() - c.unit1) as f64 / 250.0 + c.unit1 as f64 / 40.0 + travel / 80.0;
-    assert!((got.print_seconds - seconds).abs() < 1e-6 * seconds, "{} vs {seconds}", got.print_seconds);
+    assert!(
+        (got.print_seconds - seconds).abs() < 1e-6 * seconds,
+        "{} vs {seconds}",
+        got.print_seconds
+    );
 
     // a header setting out of range: no figures, the reason named
     let header = "; layer_height = 0.2\n; droplet_aspect = 1\n; droplet_rate = -5\n";
     let (_, bad) = read_gcode(&format!("{header}G26 X1 Y1 Z0.2\n")).expect("read");
-    assert!(bad.figures().unwrap_err().to_string().contains("droplet_rate"));
+    assert!(
+        bad.figures()
+            .unwrap_err()
+            .to_string()
+            .contains("droplet_rate")
+    );
 }

@@ -14,9 +14,9 @@
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
 //! filling its memory, and every refusal names the line and the reason.
 
+use crate::base::error::Error;
 use crate::base::error::grouped;
 use crate::base::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
-use crate::base::error::Error;
 use crate::base::settings::{Settings, schema};
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{Figures, Summary};

@@ -69,8 +69,9 @@ export class SupportColumns {
   }
 
   /** The support as boxes x0, y0, z0, x1, y1, z1 (mm, plate coordinates): a run of cells
-   *  repeated on consecutive layers is one box. At most [[MAX_BOXES]] (cells coarsened until
-   *  they fit). Cached until a layer arrives. */
+   *  repeated on consecutive layers is one box, its top 1 % of a layer below its last layer's
+   *  top (the 3D view clips at a layer's top: a face right on the plane would flicker). At
+   *  most [[MAX_BOXES]] (cells coarsened until they fit). Cached until a layer arrives. */
   columns(): Float32Array {
     if (this.boxes) return this.boxes;
     for (;;) {
@@ -88,7 +89,7 @@ export class SupportColumns {
     let open = new Map<string, number>();
     const close = (key: string, from: number, to: number) => {
       const [row, c0, c1] = key.split(",").map(Number);
-      out.push(c0 * c, row * c, from * h, (c1 + 1) * c, (row + 1) * c, to * h);
+      out.push(c0 * c, row * c, from * h, (c1 + 1) * c, (row + 1) * c, (to - 0.01) * h);
     };
     for (let i = 0; i <= this.layers.length; i++) {
       const r = this.layers[i];

@@ -71,7 +71,8 @@ export class View3DPanel implements View3DView {
     const s = store.slice;
     const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values, page.init!.schema));
     this.slice = current && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current: store.current } : null;
-    this.support = this.slice && s ? supportColumns(s) : null;
+    // the support hides the overhanging faces under it: not drawn while they are tinted
+    this.support = this.slice && s && !page.renderer.showOverhangs ? supportColumns(s) : null;
     // the selected part's instance clicked last stays tinted, else its first copy
     const sel = job?.selected ?? null;
     const keep = this.selected !== null && parts.some((p) => p.id === this.selected) && parseInstanceId(this.selected)?.part === sel;

@@ -22,7 +22,9 @@ export function showSupport(scene: Scene, old: InstancedMesh | null, boxes: Floa
   if (boxes.length % 6 !== 0) throw new Error(`support boxes: ${boxes.length} numbers, not 6 per box`);
   const n = boxes.length / 6;
   const geometry = new BoxGeometry(1, 1, 1).translate(0.5, 0.5, 0.5);
-  const material = new MeshStandardMaterial({ color: SUPPORT_COLOR, roughness: 0.75, metalness: 0, clippingPlanes: [clip] });
+  // drawn in front of a part's face at the same height (support touches the face above it,
+  // support_gap_z = 0): no z-fighting stripes
+  const material = new MeshStandardMaterial({ color: SUPPORT_COLOR, roughness: 0.75, metalness: 0, clippingPlanes: [clip], polygonOffset: true, polygonOffsetFactor: -1, polygonOffsetUnits: -1 });
   const mesh = new InstancedMesh(geometry, material, n);
   const m = new Matrix4();
   for (let i = 0; i < n; i++) {
