@@ -27,6 +27,7 @@ import { wirePartDrag } from "./views/partdrag";
 import { PartsPanel } from "./views/parts";
 import { wirePlot } from "./views/plot";
 import { share } from "./views/share";
+import { wireShortcuts } from "./views/shortcuts";
 import { setState } from "./views/status";
 import { View3DPanel, wireView3D } from "./views/view3d/panel";
 
@@ -79,6 +80,9 @@ const error = actions.error;
 
 function wire(): void {
   $("btn-sample").addEventListener("click", () => void openSample(page));
+  // the file pickers' buttons (real buttons: Tab reaches them, Enter and Space open the picker)
+  $("btn-open").addEventListener("click", () => $<HTMLInputElement>("file-input").click());
+  $("btn-add").addEventListener("click", () => $<HTMLInputElement>("add-input").click());
   $<HTMLInputElement>("file-input").addEventListener("change", (ev) => {
     const input = ev.target as HTMLInputElement;
     const files = [...(input.files ?? [])];
@@ -112,6 +116,7 @@ function wire(): void {
   wireCut(page);
   wirePartDrag(page);
   wirePlot(page, actions.show);
+  wireShortcuts();
   wireCalibrate(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;

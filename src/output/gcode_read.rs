@@ -14,9 +14,12 @@
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
 //! filling its memory, and every refusal names the line and the reason.
 
+use crate::base::error::Error;
 use crate::base::error::grouped;
 use crate::base::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
+use crate::base::settings::{Settings, schema};
 use crate::output::preview::PreviewLayer;
+use crate::output::summary::{Figures, Summary};
 use crate::slicing::plan::Counts;
 use std::collections::VecDeque;
 
@@ -79,6 +82,8 @@ pub struct GcodeReader {
     header_droplets: Option<u64>,
     /// Count only: no droplet positions, roles or travel kept (`dropslice calibrate`).
     counts_only: bool,
+    /// The layers finished so far: their droplets by role and unit, and travel.
+    totals: Summary,
 }
 
 /// The header's droplet size must lie within the settings' ranges (greater than 0, at most
@@ -482,6 +487,9 @@ impl GcodeReader {
         if let Some(mut l) = self.layer.take() {
             l.index = self.index;
             self.index += 1;
+            self.totals.layers += 1;
+            self.totals.counts.add(&l.counts);
+            self.totals.travel_mm += l.travel_mm;
             self.done.push_back(l);
         }
     }
@@ -497,6 +505,36 @@ impl GcodeReader {
             return Err(GcodeError("the file holds no G01/G25/G26 commands".into()));
         }
         Ok(())
+    }
+}
+
+impl GcodeReader {
+    /// The settings of the header's `name = value` lines that name a setting (the others
+    /// take their defaults), checked as `--set` values are. A header without `layer_height`
+    /// is not a dropslice code: refused.
+    pub fn header_settings(&self) -> Result<Settings, Error> {
+        if self.header_value("layer_height").is_none() {
+            return Err(Error::Setting {
+                name: String::new(),
+                message: "the code's header gives no layer_height: it is not a dropslice code, so its time and material are unknown".into(),
+            });
+        }
+        let known = schema();
+        let mut settings = Settings::default();
+        for (name, value) in &self.header {
+            if known.iter().any(|s| s.name == name) {
+                settings.set(name, value)?;
+            }
+        }
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    /// The figures (droplets, material, mass, print time) of the layers read so far, with
+    /// the header's settings ([`header_settings`](Self::header_settings)): the estimate the
+    /// slicer printed when it wrote the file.
+    pub fn figures(&self) -> Result<Figures, Error> {
+        Ok(self.totals.figures(&self.header_settings()?))
     }
 }
 

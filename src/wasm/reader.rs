@@ -90,6 +90,15 @@ impl GcodeStream {
             .map_err(|e| JsValue::from(JsError::new(&e.0)))?;
         crate::wasm::to_js(&c, "the calibration")
     }
+
+    /// After `finish`: the file's figures (droplets, material, mass, print time) with its
+    /// header's settings, as a plain `Figures` object. Throws the reason when the header does
+    /// not give them (not a dropslice code, a setting out of range).
+    #[wasm_bindgen(unchecked_return_type = "Figures")]
+    pub fn figures(&self) -> Result<JsValue, JsValue> {
+        let f = self.reader.figures().map_err(crate::wasm::js_error)?;
+        crate::wasm::to_js(&f, "the figures")
+    }
 }
 
 /// The calibration from a slice's droplet count (its summary) and settings: `droplets`,

@@ -24,3 +24,26 @@ export function checkLine(l: unknown): Line | null {
 export function lineLength(l: Line): number {
   return Math.hypot(l.b[0] - l.a[0], l.b[1] - l.a[1]);
 }
+
+/** Whether the line passes within `margin` of the box (Liang–Barsky clipping of the segment
+ *  to the box grown by `margin`); an empty box (min > max) is never crossed. */
+export function crossesBox(l: Line, box: { minX: number; minY: number; maxX: number; maxY: number }, margin: number): boolean {
+  if (!(box.maxX >= box.minX && box.maxY >= box.minY)) return false;
+  let t0 = 0;
+  let t1 = 1;
+  const d = [l.b[0] - l.a[0], l.b[1] - l.a[1]];
+  const lo = [box.minX - margin - l.a[0], box.minY - margin - l.a[1]];
+  const hi = [box.maxX + margin - l.a[0], box.maxY + margin - l.a[1]];
+  for (let k = 0; k < 2; k++) {
+    if (d[k] === 0) {
+      if (lo[k] > 0 || hi[k] < 0) return false;
+      continue;
+    }
+    let [ta, tb] = [lo[k] / d[k], hi[k] / d[k]];
+    if (ta > tb) [ta, tb] = [tb, ta];
+    t0 = Math.max(t0, ta);
+    t1 = Math.min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}

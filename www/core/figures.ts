@@ -24,6 +24,16 @@ export class Figures {
   private running: Promise<void> | null = null;
   private again = false;
 
+  /** Why a .gco file has no estimates (its header does not give the settings). */
+  readNote: string | null = null;
+
+  /** A .gco file read to its end: the core's figures with its header's settings, or why
+   *  there are none. */
+  setRead(figures: CoreFigures | null, note: string | null): void {
+    this.core = figures;
+    this.readNote = figures ? null : note;
+  }
+
   /** A layer of a .gco file (once per layer). */
   addReadLayer(l: LayerData): void {
     this.read.outer += l.counts.outer;

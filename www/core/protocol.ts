@@ -186,6 +186,10 @@ export interface GcodeParseResult {
   dropletWidth: number;
   layerHeight: number;
   header: Record<string, string>;
+  /** The file's figures with its header's settings (the core's `GcodeStream.figures`), or
+   *  null and the reason why the header does not give them. */
+  figures: Figures | null;
+  figuresError: string | null;
 }
 
 /** Every request a worker answers: what it is sent and what it replies. */

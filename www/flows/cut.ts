@@ -8,7 +8,7 @@
 // sent.
 
 import { Cancelled } from "../core/client";
-import { lineLength, type Line } from "../core/cutline";
+import { crossesBox, lineLength, type Line } from "../core/cutline";
 import { grouped, records } from "../core/grouped";
 import { NOT_SENT, type CutReply, type LayerData } from "../core/protocol";
 import type { Slice } from "../core/store";
@@ -199,7 +199,20 @@ export function updateCut(page: Page): void {
   if (s.complete && s.source === "stl" && state.queue.length === 0 && state.inFlight === 0 && state.resolved.size < s.layers) plan(page);
   cut.request();
   const pending = s.source === "stl" ? s.layers - state.resolved.size : 0;
-  writeCutStatus(s.source === "gco" ? " · voids need a model, not a .gco file" : pending > 0 ? ` · section of ${s.layers - pending} / ${s.layers} layers` : "");
+  writeCutStatus(s.source === "gco" ? " · voids need a model, not a .gco file" : pending > 0 ? ` · section of ${s.layers - pending} / ${s.layers} layers` : "", crossesNothing(s, state.line, pending, cut.layers.values()));
+}
+
+/** Whether the line misses every part: it passes beside the slice's box, or (once the core
+ *  has every layer's section) no layer has a section or a droplet along it. A .gco file has
+ *  no sections: its droplets decide once every layer was binned. */
+function crossesNothing(s: Slice, line: Line, pending: number, layers: Iterable<CutLayer>): boolean {
+  const b = s.info.bounds;
+  const box = b ? { minX: b.min[0], minY: b.min[1], maxX: b.max[0], maxY: b.max[1] } : s.bbox;
+  if (Number.isFinite(box.minX) && !crossesBox(line, box, s.dropletWidth)) return true;
+  const complete = s.source === "stl" ? s.complete && pending === 0 : s.complete && state.binned.size === s.layers;
+  if (!complete || s.layers === 0) return false;
+  for (const l of layers) if (l.near.length || l.spans?.length) return false;
+  return true;
 }
 
 /** Sets the cut line (null: no cut; views/cut.ts shows the panel); `refit` fits the cut's

@@ -10,6 +10,7 @@ import type { Page } from "../views/page";
 import { jobSettings } from "../core/job";
 import { editParts } from "./job";
 import type { Slice, SlicedJob } from "../core/store";
+import { recordSupport } from "../core/supportcolumns";
 import { errorBanner, hideBanner, showBanner, TITLES } from "../views/banner";
 import { updateButtons } from "../views/controls";
 import { saveGcode } from "../views/download";
@@ -118,6 +119,7 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
       layer: (l) => {
         if (gen !== store.generation) return;
         s.put(l, store.current);
+        recordSupport(s, l, s.dropletWidth, s.layerHeight);
         const current = store.current;
         // the layer shown and the one below it: drawn once both have arrived (a draw costs)
         const arrived = (k: number) => k < 0 || s.counts[k] !== undefined;
@@ -259,6 +261,7 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.dropletWidth = r.dropletWidth;
     s.layerHeight = r.layerHeight;
     s.gcodeFile = { file, header: r.header };
+    s.figures.setRead(r.figures, r.figuresError);
     s.complete = true;
     store.slice = s;
     store.job = null;

@@ -21,13 +21,26 @@ let timer = 0;
 export function setLine(page: Page, line: Line | null, refit = true): void {
   drawn = line;
   $("cut-panel").hidden = !line;
+  writePosition(line);
   page.renderer.request();
   page.actions.setCutLine(line, refit);
 }
 
-/** The cut's status line: the line's length, then `more` (the section's progress). */
-export function writeCutStatus(more: string): void {
+/** The cut's status line: the line's length, then `more` (the section's progress); `missed`:
+ *  the line crosses no part, said over the (empty) section. */
+export function writeCutStatus(more: string, missed = false): void {
   $("cut-status").textContent = (drawn ? `${lineLength(drawn).toFixed(1)} mm` : "") + more;
+  $("cut-missed").hidden = !missed;
+}
+
+/** The position field shows where the line is: "y =" its middle's y for a line more along x,
+ *  else "x =" its middle's x (an axis line's own position; a slanted one's middle). */
+function writePosition(line: Line | null): void {
+  if (!line) return;
+  const across = Math.abs(line.b[0] - line.a[0]) >= Math.abs(line.b[1] - line.a[1]) ? "y" : "x";
+  const k = across === "y" ? 1 : 0;
+  $<HTMLSelectElement>("cut-axis").value = across;
+  $<HTMLInputElement>("cut-pos").value = String(Math.round(((line.a[k] + line.b[k]) / 2) * 100) / 100);
 }
 
 /** The line a little longer than the part, through `v` on the other axis. */

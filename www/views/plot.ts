@@ -1,7 +1,9 @@
-// The per-layer plot under the layer slider: droplets per layer (bars) and the running print
-// time (a line, the right axis) along the layers, the current layer marked. A click or a drag
-// goes to the layer under the pointer (as the slider does); hovering shows that layer's
-// figures. Every figure is the core's: droplets per layer, and the time of each layer
+// The per-layer plot under the layer slider: droplets per layer (bars stacked by what prints
+// them: unit 0's parts, unit 1's parts, the support; their sum is the statistics' *This layer*)
+// and the running print time (a line, the right axis) along the layers, the current layer
+// marked. A click or a drag goes to the layer under the pointer (as the slider does); hovering
+// shows that layer's figures. The canvas is a slider for the keyboard (focusable; the page's
+// arrow keys move the layer, views/layer.ts) with the readout as its value text. Every figure is the core's: droplets per layer, and the time of each layer
 // (src/output/summary.rs `layer_seconds`, which add up to the job's print time); the running time is
 // their prefix sum. Layers are binned to device pixels (a column shows its tallest layer), so a
 // draw costs O(layers + width) whatever the count; while the workers run it is redrawn at most
@@ -9,16 +11,21 @@
 
 import { sizeCanvas, watchCanvas } from "./canvas/hidpi";
 import type { Page } from "./page";
+import type { Counts } from "../core/protocol";
 import type { Slice } from "../core/store";
 import { $, duration, nf } from "./dom";
 
 const BUSY_REDRAW_MS = 150;
 /** The plot area inside the canvas, CSS pixels: room for the axes' labels. */
 const PAD = { left: 58, right: 62, top: 16, bottom: 28 };
-const BAR = "#a5c8ec";
+/** The stack's colours, bottom up: unit 0's parts, unit 1's parts, the support (the legend's
+ *  swatches in style.css `.plot-key i.*` match). */
+const BARS = ["#a5c8ec", "#b9a7f4", "#86d0dc"];
 const BAR_EMPTY = "#eef1f5";
 const LINE = "#d9480f";
-const AXIS = "#6b7785";
+/** The time axis' labels: darker than the line, for text contrast ≥ 4.5:1 on white. */
+const LINE_TEXT = "#c2410c";
+const AXIS = "#5c6773";
 const GRID = "#e3e7ee";
 const MARK = "#1f2933";
 const FONT = '11px system-ui, -apple-system, "Segoe UI", Roboto, sans-serif';
@@ -55,6 +62,20 @@ function sumsOf(s: Slice): Sums {
   return sums;
 }
 
+/** A layer's droplets by what prints them: [unit 0's parts, unit 1's parts, support] (the
+ *  core's counts: unit 1 prints the support and its own parts; roles partition the droplets). */
+export function stackOf(c: Counts): [number, number, number] {
+  const support = c.support ?? 0;
+  const total = c.outer + c.inner + c.fill + support;
+  const unit1 = Math.min(total, c.unit1 ?? support);
+  return [total - unit1, Math.max(0, unit1 - support), support];
+}
+
+/** A layer's droplets, all of them: the statistics' *This layer*. */
+export function layerTotal(c: Counts): number {
+  return c.outer + c.inner + c.fill + (c.support ?? 0);
+}
+
 /** The layer under CSS x (clamped), for `layers` layers in a canvas `width` CSS pixels wide. */
 function layerAt(x: number, width: number, layers: number): number {
   const w = Math.max(1, width - PAD.left - PAD.right);
@@ -86,17 +107,40 @@ function writeLabel(): void {
     return;
   }
   const i = hover ?? page.store.current;
+  const text = readout(s, i);
+  out.textContent = text;
+  if (canvas) {
+    canvas.setAttribute("aria-valuemax", String(s.layers));
+    canvas.setAttribute("aria-valuenow", String(page.store.current + 1));
+    canvas.setAttribute("aria-valuetext", hover === null ? text : readout(s, page.store.current));
+  }
+}
+
+/** Layer i's figures in words: its droplets (the total, then by what prints them when unit 1
+ *  prints any), its time and when it starts. */
+function readout(s: Slice, i: number): string {
   const c = s.counts[i];
   const z = s.z[i];
   const parts = [`Layer ${i + 1}`];
   if (z !== undefined) parts.push(`z ${z.toFixed(2)} mm`);
-  parts.push(c ? `${nf.format(c.outer + c.inner + c.fill)} droplets` : "not sliced yet");
+  if (c) {
+    const [u0, u1, support] = stackOf(c);
+    const split = [u1 > 0 ? `${nf.format(u1)} unit 1` : "", support > 0 ? `${nf.format(support)} support` : ""].filter(Boolean);
+    parts.push(`${nf.format(layerTotal(c))} droplets` + (split.length ? ` (${nf.format(u0)} unit 0, ${split.join(", ")})` : ""));
+  } else parts.push("not sliced yet");
   const t = s.layerSeconds[i];
   if (t !== undefined) parts.push(`${duration(t)} to print`);
-  const sum = sumsOf(s);
   let text = parts.join(" · ");
+  const sum = sumsOf(s);
   if (sum.timed) text += ` — layer ${i + 1} starts after ${duration(sum.start[i])}`;
-  out.textContent = text;
+  return text;
+}
+
+/** The legend's entries for what the slice has: unit 0 always, unit 1's parts and the support
+ *  when some layer has them. */
+function writeKey(kinds: boolean[]): void {
+  $("plot-key-unit1").hidden = !kinds[1];
+  $("plot-key-support").hidden = !kinds[2];
 }
 
 /** Draws the plot now. */
@@ -114,9 +158,13 @@ export function drawPlot(): void {
   const s = page.store.slice;
   const n = s?.layers ?? 0;
   canvas.dataset.layers = String(n);
+  canvas.setAttribute("aria-valuemin", "1");
   canvas.dataset.left = String(PAD.left);
   canvas.dataset.right = String(cssW - PAD.right);
-  if (!s || n === 0) return;
+  if (!s || n === 0) {
+    writeKey([true, false, false]);
+    return;
+  }
 
   // the plot area in device pixels
   const x0 = Math.round(PAD.left * dpr);
@@ -126,26 +174,34 @@ export function drawPlot(): void {
   const cols = Math.max(1, x1 - x0);
   const h = Math.max(1, y1 - y0);
 
-  // bin the layers to columns: each column shows its tallest layer (and whether any is missing)
+  // bin the layers to columns: each column shows its tallest layer (its index, -1: none in
+  // yet) and whether any is missing
   const tallest = new Float64Array(cols);
+  const which = new Int32Array(cols).fill(-1);
   const missing = new Uint8Array(cols);
   let maxDroplets = 0;
+  const kinds = [false, false, false];
   for (let c = 0; c < cols; c++) {
     const a = Math.floor((c * n) / cols);
     const b = Math.max(a + 1, Math.floor(((c + 1) * n) / cols));
-    let m = 0;
+    let m = -1;
     for (let i = a; i < b; i++) {
       const k = s.counts[i];
       if (!k) {
         missing[c] = 1;
         continue;
       }
-      const d = k.outer + k.inner + k.fill;
-      if (d > m) m = d;
+      const d = layerTotal(k);
+      if (d > m) {
+        m = d;
+        which[c] = i;
+      }
     }
-    tallest[c] = m;
+    tallest[c] = Math.max(0, m);
     if (m > maxDroplets) maxDroplets = m;
   }
+  for (const k of s.counts) if (k) stackOf(k).forEach((v, j) => (kinds[j] ||= v > 0));
+  writeKey(kinds);
   // whole droplets and whole layers per tick
   const dStep = Math.max(1, step(maxDroplets, Math.max(1, Math.floor(h / (22 * dpr)))));
   const dTop = Math.max(dStep, Math.ceil(maxDroplets / dStep) * dStep);
@@ -179,9 +235,14 @@ export function drawPlot(): void {
       g.fillRect(x0 + c, y1 - 2 * dpr, 1, 2 * dpr);
       continue;
     }
-    const bh = (tallest[c] / dTop) * h;
-    g.fillStyle = BAR;
-    g.fillRect(x0 + c, y1 - bh, 1, bh);
+    if (which[c] < 0) continue;
+    let y = y1;
+    stackOf(s.counts[which[c]]!).forEach((v, j) => {
+      const bh = (v / dTop) * h;
+      g.fillStyle = BARS[j];
+      g.fillRect(x0 + c, y - bh, 1, bh);
+      y -= bh;
+    });
   }
 
   // the running time (right axis), interpolated within a layer
@@ -199,7 +260,7 @@ export function drawPlot(): void {
       else g.lineTo(x0 + c, y);
     }
     g.stroke();
-    g.fillStyle = LINE;
+    g.fillStyle = LINE_TEXT;
     g.textAlign = "left";
     for (const f of [0, 0.5, 1]) g.fillText(shortTime(total * f), x1 + 5 * dpr, y1 - f * h);
     g.save();

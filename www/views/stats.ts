@@ -42,7 +42,7 @@ function writeUnit1(s: Slice | null, current: number): void {
   $("legend-unit1").hidden = !(unit1Parts > 0 || layerUnit1Part > 0);
   setText("stat-support", s ? nf.format(support) : "–");
   setText("stat-unit1", s ? nf.format(u?.droplets ?? 0) : "–");
-  const any = (u?.droplets ?? 0) > 0 && s?.source === "stl";
+  const any = (u?.droplets ?? 0) > 0 && u?.volume !== null;
   $("unit1-stats").hidden = !any;
   if (any && u) {
     setText("stat-volume1", u.volume !== null ? `${(u.volume / 1000).toFixed(2)} cm³` : "–");
@@ -96,6 +96,7 @@ export function writeStats(page: Page): void {
   setText("stat-mass", e ? `${e.mass.toFixed(2)} g` : "–");
   setText("stat-time", e ? (s.complete ? "" : "≥ ") + duration(e.seconds) : "–");
   setText("stat-travel", `${(f.travelTotal / 1000).toFixed(2)} m`);
+  $("stat-time").title = f.readNote ? `No estimate: ${f.readNote}` : "";
   const c = s.counts[current];
   setText("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
   setText("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill + (c.support ?? 0)) : "–");

@@ -5,7 +5,7 @@
 // layers, line length), with the messages that name the line and the reason.
 
 import init, { GcodeStream } from "../pkg/dropslice.js";
-import type { Calibration, LayerData } from "../core/protocol";
+import type { Calibration, Figures, LayerData } from "../core/protocol";
 
 export class GcodeError extends Error {}
 
@@ -46,6 +46,12 @@ export class GcodeReader {
    *  core's refusal as a plain Error (not a GcodeError: the file itself was read). */
   calibrate(mass: number, density: number | null): Calibration {
     return this.stream.calibrate(mass, density ?? undefined);
+  }
+
+  /** After [[finish]]: the file's figures with its header's settings; throws the core's
+   *  reason ({kind, message}) when the header does not give them. */
+  figures(): Figures {
+    return this.stream.figures();
   }
 
   /** Frees the core's reader (the object is unusable afterwards). */

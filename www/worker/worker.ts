@@ -15,6 +15,7 @@ import {
   transferablesOf,
   type ErrorValue,
   type InitResult,
+  type Figures,
   type LayerAnalysis,
   type OpenResult,
   type Reply,
@@ -241,7 +242,16 @@ async function handle(req: Request): Promise<void> {
         post({ id: req.id, kind: "progress", data: { ...layer, fraction } }, transferablesOf(layer)),
       );
       await readGcode(req.data.file, reader, (f) => (fraction = f));
+      let figures: Figures | null = null;
+      let figuresError: string | null = null;
+      try {
+        figures = reader.figures();
+      } catch (e) {
+        figuresError = (e as { message?: string })?.message ?? String(e);
+      }
       answer(req.kind, req.id, {
+        figures,
+        figuresError,
         layers: reader.layers,
         dropletWidth: reader.dropletWidth,
         layerHeight: Number(reader.header.layer_height),

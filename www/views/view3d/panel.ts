@@ -9,6 +9,7 @@
 // worker like the rest of the page.
 
 import { jobSettings } from "../../core/job";
+import { supportColumns } from "../../core/supportcolumns";
 import { errorBanner } from "../banner";
 import { $ } from "../dom";
 import type { Page, View3DView } from "../page";
@@ -28,6 +29,9 @@ export class View3DPanel implements View3DView {
   private parts: View3DPart[] = [];
   private plate = { x: 154, y: 134 };
   private slice: View3DSlice | null = null;
+  /** The slice's support as boxes (core/supportcolumns.ts), and the boxes the view has. */
+  private support: Float32Array | null = null;
+  private shownSupport: Float32Array | null = null;
   private selected: string | null = null;
   /** The job shown, and the one the camera was last fitted to: a new job is framed once
    *  (editing or slicing it again keeps the camera). */
@@ -67,6 +71,8 @@ export class View3DPanel implements View3DView {
     const s = store.slice;
     const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values, page.init!.schema));
     this.slice = current && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current: store.current } : null;
+    // the support hides the overhanging faces under it: not drawn while they are tinted
+    this.support = this.slice && s && !page.renderer.showOverhangs ? supportColumns(s) : null;
     // the selected part's instance clicked last stays tinted, else its first copy
     const sel = job?.selected ?? null;
     const keep = this.selected !== null && parts.some((p) => p.id === this.selected) && parseInstanceId(this.selected)?.part === sel;
@@ -106,6 +112,11 @@ export class View3DPanel implements View3DView {
     v.setPlate(this.plate.x, this.plate.y);
     v.setParts(this.parts);
     v.setSlice(this.slice);
+    if (this.support !== this.shownSupport) {
+      this.shownSupport = this.support;
+      v.setSupport(this.support);
+    }
+    $("legend3d-support").hidden = !this.support?.length;
     v.select(this.selected);
     v.setOverhang(this.overhang);
     if (this.model !== null && this.model !== this.framed) {

@@ -30,6 +30,7 @@
 //   setOverhang(z | null)        tints the faces whose unit normal (plate coordinates) has
 //                                z < −z (overhanging: the core's `overhang_face_normal_z` for
 //                                the job's settings); null = no tint
+//   setSupport(boxes | null)     the support's boxes (support3d.ts), clipped at the layer's top
 //
 // Input is checked (finite numbers, lengths, bounds): bad input throws an Error naming what is
 // wrong. Per frame nothing is allocated and nothing is O(triangles) but the GPU's draw: a part
@@ -70,6 +71,7 @@ import {
   Box3,
 } from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { showSupport } from "./support3d";
 
 export interface View3DPart {
   id: string;
@@ -203,6 +205,7 @@ export class View3D {
   private readonly moved = new Matrix4();
   private readonly box = new Box3();
   private readonly partBox = new Box3();
+  private support: ReturnType<typeof showSupport> = null;
 
   constructor(private readonly container: HTMLElement) {
     this.renderer = new WebGLRenderer({ antialias: true, preserveDrawingBuffer: true, alpha: false });
@@ -435,6 +438,11 @@ export class View3D {
     this.request();
   }
 
+  setSupport(boxes: Float32Array | null): void {
+    this.support = showSupport(this.scene, this.support, boxes, this.clipTop);
+    this.request();
+  }
+
   // ---- camera ----
 
   fit(): void {
@@ -503,13 +511,14 @@ export class View3D {
     this.request();
   }
 
-  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; frames: number; width: number; height: number } {
+  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; support: number; frames: number; width: number; height: number } {
     const z = this.overhangUniforms.uOverhangZ.value;
     return {
       parts: [...this.entries.keys()],
       selected: this.selected,
       slice: this.slice ? { ...this.slice } : null,
       overhang: z > 1 ? null : z,
+      support: this.support?.count ?? 0,
       frames: this.frames,
       width: this.canvas.width,
       height: this.canvas.height,
@@ -628,6 +637,7 @@ export class View3D {
     this.canvas.removeEventListener("pointercancel", this.onPointerCancel);
     this.canvas.removeEventListener("contextmenu", this.preventDefault);
     for (const e of [...this.entries.values()]) this.drop(e);
+    this.support = showSupport(this.scene, this.support, null, this.clipTop);
     disposeObject(this.plate);
     for (const m of Object.values(this.materials)) m.dispose();
     this.renderer.dispose();
