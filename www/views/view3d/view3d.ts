@@ -21,6 +21,7 @@
 //                                cut drawn as a solid cap (back faces in the cut colour), the
 //                                current layer's slab highlighted; null = whole parts
 //   fit()                        an iso-like camera framing the plate and the parts
+//   pose() / setPose(c)          the camera's position and target (plate mm)
 //   dispose()                    frees the GPU resources, the listeners and the canvas
 // Extensions (documented here, used by the page and its tests):
 //   renderNow()                  draws at once (the view otherwise draws on demand, in the next
@@ -80,7 +81,11 @@ export interface View3DPart {
   matrix: number[];
   /** The discharge unit printing the part (1 is drawn in a second colour). */
   unit?: 0 | 1;
+  /** Off the plate: drawn in the warning colour. */
+  warn?: boolean;
 }
+
+export type Camera3D = { position: [number, number, number]; target: [number, number, number] };
 
 export interface View3DSlice {
   layerHeight: number;
@@ -103,6 +108,7 @@ export const COLORS = {
   /** Overhanging faces (the layer view's overhang overlay colour). */
   overhang: 0xe8107a,
   selected: 0x1c7ed6,
+  warn: 0xe03131, // a part off the plate
   /** The current layer's slab (the outer-loop colour of the layer view). */
   slab: 0xe8590c,
   /** The cut through the parts at the current layer's top. */
@@ -183,6 +189,7 @@ export class View3D {
     part: this.bodyMaterial(COLORS.part),
     unit1: this.bodyMaterial(COLORS.unit1),
     selected: this.bodyMaterial(COLORS.selected),
+    warn: this.bodyMaterial(COLORS.warn),
     slab: new MeshStandardMaterial({
       color: COLORS.slab,
       roughness: 0.55,
@@ -407,7 +414,8 @@ export class View3D {
 
   private applyMaterials(): void {
     for (const e of this.entries.values()) {
-      e.body.material = e.id === this.selected ? this.materials.selected : e.unit === 1 ? this.materials.unit1 : this.materials.part;
+      const m = this.materials;
+      e.body.material = e.part.warn ? m.warn : e.id === this.selected ? m.selected : e.unit === 1 ? m.unit1 : m.part;
       e.slab.visible = e.cap.visible = this.slice !== null;
     }
   }
@@ -473,6 +481,23 @@ export class View3D {
     this.request();
   }
 
+  pose(): Camera3D {
+    const [p, t] = [this.camera.position, this.controls.target];
+    return { position: [p.x, p.y, p.z], target: [t.x, t.y, t.z] };
+  }
+
+  setPose(c: Camera3D): void {
+    const all = [...c.position, ...c.target];
+    if (all.length !== 6 || !all.every(Number.isFinite)) throw new Error("a camera is two points of three finite numbers");
+    this.camera.position.fromArray(c.position);
+    this.controls.target.fromArray(c.target);
+    const dist = this.camera.position.distanceTo(this.controls.target);
+    [this.camera.near, this.camera.far] = [Math.max(0.01, dist / 200), Math.max(this.camera.far, dist * 20)];
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.request();
+  }
+
   // ---- drawing ----
 
   private readonly request = (): void => {
@@ -503,10 +528,11 @@ export class View3D {
     this.request();
   }
 
-  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; frames: number; width: number; height: number } {
+  state(): { parts: string[]; warned: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; frames: number; width: number; height: number } {
     const z = this.overhangUniforms.uOverhangZ.value;
     return {
       parts: [...this.entries.keys()],
+      warned: [...this.entries.values()].filter((e) => e.body.material === this.materials.warn).map((e) => e.id),
       selected: this.selected,
       slice: this.slice ? { ...this.slice } : null,
       overhang: z > 1 ? null : z,
