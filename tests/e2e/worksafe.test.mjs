@@ -29,6 +29,20 @@ async function key(page, combo) {
   await page.keyboard.press(combo);
 }
 
+/** Clicks `selector` (Slice, Sample part) and waits for the slice it starts. */
+async function clickSliced(page, selector) {
+  await page.evaluate(() => (document.body.dataset.state = "picking"));
+  await page.click(selector);
+  return waitDone(page);
+}
+
+/** Clicks `selector` (an Undo) and waits until the job has the parts `parts` again. */
+async function undoneTo(page, selector, parts) {
+  await page.click(selector);
+  await page.waitForFunction((n) => window.dropslice.job().parts.length === n, parts.length);
+  assert.deepEqual((await job(page)).parts, parts);
+}
+
 /** Opens `files` as a new job and waits for its slice. */
 async function openJob(page, files) {
   await pick(page, files);
@@ -95,9 +109,7 @@ test("Delete removes the selected part, Ctrl+Z brings it back (and the slice is 
   assert.equal(await disabled(page, "btn-redo"), false);
   await key(page, "Control+y");
   await page.waitForFunction(() => window.dropslice.job().parts.length === 1);
-  await page.click("#btn-undo");
-  await page.waitForFunction(() => window.dropslice.job().parts.length === 2);
-  assert.deepEqual((await job(page)).parts, sliced.parts);
+  await undoneTo(page, "#btn-undo", sliced.parts);
   assert.deepEqual(errors, []);
 });
 
@@ -105,23 +117,17 @@ test("Sample part over a job replaces it with a notice whose Undo brings the job
   const { page, errors } = main;
   const before = await job(page);
   assert.equal(before.parts.length, 2);
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.click("#btn-sample");
-  await waitDone(page);
+  await clickSliced(page, "#btn-sample");
   assert.match((await job(page)).name, /sample/);
   assert.equal(await page.isVisible("#undo-note"), true);
   assert.match(await page.locator("#undo-text").innerText(), /replaced the previous job/);
-  await page.click("#undo-again");
-  await page.waitForFunction(() => window.dropslice.job().parts.length === 2);
-  assert.deepEqual((await job(page)).parts, before.parts);
+  await undoneTo(page, "#undo-again", before.parts);
   assert.deepEqual(errors, []);
 });
 
 test("a part moved off the plate is drawn in the warning colour, named in plain words, never sliced or downloaded", async () => {
   const { page, errors } = main;
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.click("#btn-slice");
-  await waitDone(page);
+  await clickSliced(page, "#btn-slice");
   assert.equal(await disabled(page, "btn-download"), false);
   await page.click(".part-item:nth-child(1)");
   // the 20 mm cube at x = 140 on the 154 mm plate: 6 mm past its right edge
@@ -158,13 +164,9 @@ test("a part moved off the plate is drawn in the warning colour, named in plain 
 test("a link made in 3D opens in 3D with its camera, overlays and the note of the settings it changes", async () => {
   const { page, errors } = main;
   // one part: a page would open it in the layer view
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.click("#btn-sample");
-  await waitDone(page);
+  await clickSliced(page, "#btn-sample");
   await page.fill("#set-layer_height", "0.25");
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.click("#btn-slice");
-  await waitDone(page);
+  await clickSliced(page, "#btn-slice");
   await page.uncheck("#opt-below");
   await open3d(page);
   // orbit: a drag on the empty plate corner
@@ -236,9 +238,7 @@ test("a setting and the view survive a reload; Reset to defaults is undoable; a 
 
 test("calibration: after Use, a new slice does not suggest a new value from the same mass", async () => {
   const { page, errors } = main;
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.click("#btn-sample");
-  await waitDone(page);
+  await clickSliced(page, "#btn-sample");
   await page.click("#calib > summary");
   // a print 5 % lighter than the estimate
   const estimate = Number((await page.locator("#stat-mass").innerText()).replace(/ g$/, ""));
@@ -253,9 +253,7 @@ test("calibration: after Use, a new slice does not suggest a new value from the 
   assert.equal(await page.inputValue("#set-droplet_aspect"), String(Number(suggested)));
   assert.match(await page.locator("#calib-message").innerText(), /print the new code, weigh the print/);
   // slice the new code: the panel asks for a print of it, and suggests nothing from this mass
-  await page.evaluate(() => (document.body.dataset.state = "picking"));
-  await page.click("#btn-slice");
-  await waitDone(page);
+  await clickSliced(page, "#btn-slice");
   await page.waitForFunction(() => /earlier code/.test(document.getElementById("calib-source").innerText));
   assert.equal(await page.isVisible("#calib-result"), false);
   assert.equal(await page.isVisible("#calib-use"), false);

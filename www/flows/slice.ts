@@ -9,6 +9,8 @@ import { restoreModel, showError } from "./errors";
 import type { Page } from "../views/page";
 import { jobSettings } from "../core/job";
 import { editParts } from "./job";
+import { record } from "./history";
+import { undoNotice } from "../views/notices";
 import type { Slice, SlicedJob } from "../core/store";
 import { errorBanner, hideBanner, showBanner, TITLES } from "../views/banner";
 import { sliceState, updateButtons } from "../views/controls";
@@ -264,7 +266,11 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.gcodeFile = { file, header: r.header };
     s.complete = true;
     store.slice = s;
+    const before = store.job;
     store.job = null;
+    // the job it replaced is one Undo away
+    record(page, `open ${file.name}`, "open");
+    if (before?.parts.length) undoNotice(page, `“${file.name}” replaced the job.`);
     page.parts.render();
     setLayers(r.layers);
     showModel(file.name);

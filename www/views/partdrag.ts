@@ -34,7 +34,9 @@ function boxes(page: Page): [number, number, number, number, number, boolean, nu
 function drawBoxes(page: Page): void {
   const list = boxes(page);
   const r = page.renderer;
-  r.canvas.dataset.offPlate = String(list.filter((b) => b[5]).length);
+  const off = list.filter((b) => b[5]).length;
+  r.canvas.dataset.offPlate = String(off);
+  $("legend-off").hidden = off === 0;
   if (list.length === 0) return;
   const ctx = r.canvas.getContext("2d");
   if (!ctx) return;

@@ -65,6 +65,7 @@ export class View3DPanel implements View3DView {
     }
     this.parts = parts;
     this.model = job && parts.length ? job : null;
+    $("legend3d-off").hidden = off.size === 0;
     const px = Number(values?.plate_x);
     const py = Number(values?.plate_y);
     if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
