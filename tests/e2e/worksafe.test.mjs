@@ -7,6 +7,7 @@
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
+import { deflateRawSync, inflateRawSync } from "node:zlib";
 import { join } from "node:path";
 import { boxStl, open3d, openPage, pick, shared, shareLink, startWithPage, status, stop, view3dReady, waitDone, waitSettled } from "./helpers.mjs";
 
@@ -197,6 +198,37 @@ test("a link made in 3D opens in 3D with its camera, overlays and the note of th
   assert.deepEqual(other.errors, []);
   await other.context.close();
   await page.check("#opt-below");
+  assert.deepEqual(errors, []);
+});
+
+test("a link carries the cut line; a link whose view numbers are wrong opens with them ignored and named", async () => {
+  const { page, errors } = main;
+  await page.click("#mode-layer");
+  const line = { a: [2, 10], b: [18, 10] };
+  assert.equal(await page.evaluate((l) => window.dropslice.cut().set(l), line), true);
+  const url = await shareLink(page);
+  const other = await openPage(env.browser, url);
+  await waitDone(other.page);
+  assert.equal(await other.page.getAttribute("#canvas-wrap", "data-mode"), "layer");
+  await other.page.waitForFunction(() => window.dropslice.cut().status().line !== null);
+  assert.deepEqual((await other.page.evaluate(() => window.dropslice.cut().status())).line, line);
+  assert.equal(await other.page.isVisible("#cut-panel"), true);
+  await other.context.close();
+  // the same link with a camera far beyond any plate, a mode of its own, a cut of no length
+  const hash = new URL(url).hash;
+  const p = new URLSearchParams(hash.slice(1));
+  const state = JSON.parse(inflateRawSync(Buffer.from(p.get("p"), "base64url")).toString());
+  Object.assign(state, { mode: "<b>", camera: { position: [1e300, 0, 0], target: [0, 0, 0] }, cut: { a: [1, 1], b: [1, 1] }, overlays: { below: "no" } });
+  p.set("p", deflateRawSync(Buffer.from(JSON.stringify(state))).toString("base64url"));
+  const bad = await openPage(env.browser, `${url.split("#")[0]}#${p}`);
+  await waitDone(bad.page);
+  const banner = await bad.page.locator("#banner").innerText();
+  for (const what of [/its view mode/, /its 3D camera/, /its cut line/, /its layer below overlay/]) assert.match(banner, what);
+  assert.equal(await bad.page.getAttribute("#canvas-wrap", "data-mode"), "layer");
+  assert.equal(await bad.page.evaluate(() => window.dropslice.cut().status().line), null);
+  assert.deepEqual(bad.errors, []);
+  await bad.context.close();
+  await page.click("#cut-close");
   assert.deepEqual(errors, []);
 });
 
