@@ -4,13 +4,17 @@
 
 import { Cancelled, MAX_WORKERS, Pool } from "./core/client";
 import { checkLine } from "./core/cutline";
+import { History, sameSnapshot } from "./core/history";
+import { jobOffPlate } from "./core/plate";
 import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
 import { showError } from "./flows/errors";
 import { addParts, arrangeAll, duplicatePart, editParts, layFlat, movePart, relayout, removePart, saveJob, selectPart } from "./flows/job";
+import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
 import { fit, setShowOverhangs, show } from "./flows/layer";
 import { openFiles, openLink, openSample } from "./flows/open";
+import { applyRemembered, loadRemembered, saveNow, saveSoon } from "./flows/remember";
 import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows/slice";
 import { registerOffline } from "./pwa/offline";
 import { hideBanner } from "./views/banner";
@@ -21,7 +25,9 @@ import { updateButtons } from "./views/controls";
 import { setLine, wireCut } from "./views/cut";
 import { $ } from "./views/dom";
 import { SettingsForm } from "./views/form";
-import { wireLayerView } from "./views/layer";
+import { wireKeys } from "./views/keys";
+import { OVERLAYS, wireLayerView } from "./views/layer";
+import { wireNotices } from "./views/notices";
 import type { Actions, Page, PartsView } from "./views/page";
 import { wirePartDrag } from "./views/partdrag";
 import { PartsPanel } from "./views/parts";
@@ -64,6 +70,13 @@ const actions: Actions = {
   overhangFace: (settings) => page.pool.overhangFace(settings),
   setCutLine: (line, refit) => setCutLine(page, line, refit),
   updateCut: () => updateCut(page),
+  cutLine: () => cutStatus(page).line,
+  undo: () => void undo(page).catch(error),
+  redo: () => void redo(page).catch(error),
+  settingsEdited: () => {
+    settingsChanged(page);
+    saveSoon(page);
+  },
 };
 const page: Page = {
   store: new Store(cacheBudgetBytes(query)),
@@ -73,6 +86,7 @@ const page: Page = {
   view3d: new View3DPanel($("view3d")),
   parts: null as unknown as PartsView,
   actions,
+  history: new History(sameSnapshot),
 };
 (page as { parts: PartsView }).parts = new PartsPanel(page);
 const { store, pool, renderer } = page;
@@ -99,7 +113,7 @@ function wire(): void {
   $("btn-download").addEventListener("click", () => void download(page));
   $("btn-share").addEventListener("click", () => void share(page).catch(error));
   $("btn-slice").addEventListener("click", () => void startSlice(page));
-  $("btn-reset").addEventListener("click", () => page.form!.reset());
+  $("btn-reset").addEventListener("click", () => resetSettings(page));
   $("btn-cancel").addEventListener("click", () => cancel(page));
   $("banner-close").addEventListener("click", hideBanner);
   // the form is never submitted (Enter slices, below); no inline handler: the page's CSP
@@ -112,6 +126,8 @@ function wire(): void {
   });
 
   wireLayerView(page);
+  wireKeys(page);
+  wireNotices(page);
   wireView3D(page);
   wireCut(page);
   wirePartDrag(page);
@@ -136,6 +152,7 @@ function wire(): void {
     if (!form) return;
     form.set({ support: (ev.target as HTMLInputElement).checked ? "unit1" : "off" });
     updateButtons(page);
+    actions.settingsEdited();
   });
   $("btn-worst").addEventListener("click", () => {
     const worst = store.slice?.figures.worst;
@@ -161,6 +178,17 @@ function wire(): void {
     overlay.hidden = true;
     const files = [...(ev.dataTransfer?.files ?? [])];
     if (files.length) void openFiles(page, files);
+  });
+
+  // remembered: the overlays and the mode as they change, everything when the page is left
+  for (const id of Object.values(OVERLAYS)) $(id).addEventListener("change", () => saveSoon(page));
+  for (const id of ["mode-layer", "mode-3d"]) $(id).addEventListener("click", () => saveSoon(page));
+  window.addEventListener("pagehide", () => saveNow(page));
+  // leaving the page with an edited job asks first (the settings are remembered anyway)
+  window.addEventListener("beforeunload", (ev) => {
+    if (!store.edited || !store.job) return;
+    ev.preventDefault();
+    ev.returnValue = "";
   });
 
   window.addEventListener("error", (ev) => error(ev.error ?? ev.message));
@@ -222,6 +250,8 @@ window.dropslice = {
   /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
    *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
   view3d: () => page.view3d.testState(),
+  /** The 3D camera {position, target} (plate mm; null before the view was made). */
+  camera: () => page.view3d.camera(),
   /** The vertical cut (views/cut.ts, flows/cut.ts): set(line), status(), setView(v), redraw(). */
   cut: () => ({
     /** Sets the cut line `{a: [x, y], b: [x, y]}` (mm); false if it is refused. */
@@ -243,8 +273,17 @@ window.dropslice = {
   job: () => {
     const job = store.job;
     if (!job) return null;
-    return { name: job.name, parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: p.mesh ? p.mesh.positions.length / 9 : 0 })), layout: job.layout, selected: job.selected };
+    return {
+      name: job.name,
+      parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: p.mesh ? p.mesh.positions.length / 9 : 0 })),
+      layout: job.layout,
+      selected: job.selected,
+      /** Instances off the plate: {part (index), copy, message}. */
+      offPlate: jobOffPlate(job, page.form?.values()),
+    };
   },
+  /** What Undo and Redo would undo and redo (null: nothing). */
+  history: () => ({ undo: page.history.undoLabel, redo: page.history.redoLabel, edited: store.edited }),
 };
 
 async function main(): Promise<void> {
@@ -259,13 +298,15 @@ async function main(): Promise<void> {
   $("version").textContent = page.init.version;
   // the plate's settings lay the job out again (at most every 200 ms while typing)
   let plateTimer = 0;
-  const plate = () => JSON.stringify(["plate_x", "plate_y", "part_spacing"].map((k) => page.form?.get(k)));
+  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing"].map((k) => page.form?.get(k)));
   let lastPlate = "";
   page.form = new SettingsForm(
     $("settings"),
     page.init.schema,
     () => {
       updateButtons(page);
+      settingsChanged(page);
+      saveSoon(page);
       if (plate() !== lastPlate) {
         lastPlate = plate();
         clearTimeout(plateTimer);
@@ -273,9 +314,12 @@ async function main(): Promise<void> {
       }
     },
   );
+  // the settings and the view of the last visit (a preview link's settings take precedence)
+  const remembered = loadRemembered(page);
+  if (remembered) applyRemembered(page, remembered);
   lastPlate = plate();
   updateButtons(page);
-  if (!(await openLink(page))) await openSample(page);
+  if (!(await openLink(page))) await openSample(page, { layer: remembered?.view.layer ?? undefined });
 }
 
 registerOffline();

@@ -150,7 +150,7 @@ pub fn calibrate(
         CountSource::Given => "",
     };
     let explanation = format!(
-        "Your part weighs {mass_g} g: {} droplets{source} of {volume:.4} mm³ each, {:.0} % of a B²H cell — set droplet_aspect to {suggested:.2} (now {droplet_aspect})",
+        "Your part weighs {mass_g} g: {} droplets{source} of {volume:.4} mm³ each, {:.0} % of a B²H cell — set droplet_aspect to {suggested:.3} (now {droplet_aspect})",
         grouped(droplets),
         100.0 * filling
     );

@@ -67,7 +67,7 @@ function checkShown(got, want, note) {
   assert.equal(got.filling, `${(100 * want.filling).toFixed(1)} %`, note);
   assert.equal(got.aspect, want.aspect.toFixed(3), note);
   assert.equal(got.use, `Use droplet_aspect = ${want.aspect.toFixed(3)}`, note);
-  assert.match(got.explanation, new RegExp(`set droplet_aspect to ${want.aspect.toFixed(2).replace(".", "\\.")} `), note);
+  assert.match(got.explanation, new RegExp(`set droplet_aspect to ${want.aspect.toFixed(3).replace(".", "\\.")} `), note);
 }
 
 /** Sets a field of the settings form (its group opened first). */

@@ -11,6 +11,7 @@
 // damaged is refused with a [[LinkError]]. A job's parts are checked against the core's own
 // ranges (its `job_schema`, which the page has from init).
 
+import { checkLine, type Line } from "./cutline";
 import { fitsPart, partNumber } from "./job";
 import type { JobSchema, PartSpec } from "./protocol";
 import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./view";
@@ -51,12 +52,34 @@ export interface ShareState {
   name: string;
   sha256: string;
   showTravel?: boolean;
+  /** The stage shown: the layer view (with the cut when `cut` is set) or the 3D view. */
+  mode?: "layer" | "3d";
+  /** The 3D view's camera (plate mm). */
+  camera?: LinkCamera;
+  /** The vertical cut's line (plate mm). */
+  cut?: Line;
+  /** The layer view's overlays. */
+  overlays?: Overlays;
   /** The job's files in the order their bytes are embedded: name (as the parts name it),
    *  SHA-256 and size. Absent in a link of one model without a job. */
   files?: LinkFile[];
   /** The job's parts (their `file` names one of `files`). */
   parts?: PartSpec[];
 }
+
+export interface LinkCamera {
+  position: [number, number, number];
+  target: [number, number, number];
+}
+
+export interface Overlays {
+  below?: boolean;
+  voids?: boolean;
+  overhangs?: boolean;
+}
+
+/** The farthest a link's camera may be from the origin (mm): a plate is at most 100 m. */
+const CAMERA_MAX_MM = 1e6;
 
 export interface LinkFile {
   name: string;
@@ -256,6 +279,7 @@ export function checkState(raw: unknown, job: JobSchema): { state: ShareState; i
   else if (raw.showTravel !== undefined) ignored.push(`its travel option (${shown(raw.showTravel)})`);
 
   const state: ShareState = { settings, name, sha256 };
+  checkView(raw, state, ignored);
   if (raw.files !== undefined || raw.parts !== undefined) {
     state.files = checkFiles(raw.files, job);
     state.parts = checkParts(raw.parts, state.files, job, ignored);
@@ -267,6 +291,40 @@ export function checkState(raw: unknown, job: JobSchema): { state: ShareState; i
 }
 
 const HEX = /^[0-9a-fA-F]{1,64}$/;
+
+/** The link's stage: its mode, camera, cut line and overlays, each checked (finite, in range);
+ *  a wrong one is dropped and named in `ignored`. */
+function checkView(raw: Record<string, unknown>, state: ShareState, ignored: string[]): void {
+  if (raw.mode === "layer" || raw.mode === "3d") state.mode = raw.mode;
+  else if (raw.mode !== undefined) ignored.push(`its view mode (${shown(raw.mode)} is neither "layer" nor "3d": the layer view is shown)`);
+  if (raw.camera !== undefined) {
+    const c = raw.camera;
+    const point = (p: unknown): p is [number, number, number] =>
+      Array.isArray(p) && p.length === 3 && p.every((v) => typeof v === "number" && Number.isFinite(v) && Math.abs(v) <= CAMERA_MAX_MM);
+    if (isObject(c) && point(c.position) && point(c.target) && Math.hypot(c.position[0] - c.target[0], c.position[1] - c.target[1], c.position[2] - c.target[2]) > 1e-3) {
+      state.camera = { position: [...c.position], target: [...c.target] };
+    } else {
+      ignored.push(`its 3D camera (not two distinct points of three finite numbers within ±${nf.format(CAMERA_MAX_MM)} mm: the plate is framed instead)`);
+    }
+  }
+  if (raw.cut !== undefined) {
+    const line = checkLine(raw.cut);
+    if (line) state.cut = line;
+    else ignored.push("its cut line (not two distinct points within the page's limits: no cut is shown)");
+  }
+  if (raw.overlays !== undefined) {
+    const o = raw.overlays;
+    if (!isObject(o)) ignored.push(`its overlays (${shown(o)})`);
+    else {
+      const overlays: Overlays = {};
+      for (const k of ["below", "voids", "overhangs"] as const) {
+        if (typeof o[k] === "boolean") overlays[k] = o[k];
+        else if (o[k] !== undefined) ignored.push(`its ${k === "below" ? "layer below" : k} overlay (${shown(o[k])})`);
+      }
+      state.overlays = overlays;
+    }
+  }
+}
 
 /** The job's files of a link: at most the core's `max_parts`, names of at most 255
  *  characters, distinct; hexadecimal hashes; sizes that add up to at most

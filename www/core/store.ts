@@ -184,6 +184,8 @@ export class Store {
   viewTouched = false;
   /** A job (from a link or a job file) waiting for its model files. */
   pending: PendingJob | null = null;
+  /** The job was edited since it was opened (leaving the page asks first). */
+  edited = false;
   /** Bumped by every layout request: only the latest answer is applied. */
   layoutSeq = 0;
   /** When the file being opened was chosen: a slice's time runs from there. */

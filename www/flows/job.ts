@@ -4,7 +4,7 @@
 // job: flows/slice.ts startSlice.
 
 import type { Page } from "../views/page";
-import { DISPLAY_BUDGET, Job, jobSettings, specOut, uniqueName, type Changes, type JobModel, type Part, type Spec } from "../core/job";
+import { DISPLAY_BUDGET, Job, jobSettings, partName, specOut, uniqueName, type Changes, type JobModel, type Part, type Spec } from "../core/job";
 import type { PartSpec } from "../core/protocol";
 import { errorBanner, hideBanner } from "../views/banner";
 import { updateButtons } from "../views/controls";
@@ -12,6 +12,7 @@ import { saveFile } from "../views/download";
 import { SliceError } from "../core/client";
 import { grouped } from "../core/grouped";
 import { showError } from "./errors";
+import { record } from "./history";
 
 /** A file to add to a job: the File and, from a job file or a link, the name it has there. */
 export interface NewFile {
@@ -62,7 +63,7 @@ export async function newJob(page: Page, files: NewFile[], specs?: PartSpec[]): 
 }
 
 /** A layout's refusal: shown until a layout succeeds. */
-function layoutBanner(e: unknown): void {
+export function layoutBanner(e: unknown): void {
   errorBanner(e);
   document.getElementById("banner")!.dataset.layout = "1";
 }
@@ -77,7 +78,7 @@ export function adoptJob(page: Page, job: Job): void {
   updateButtons(page);
 }
 
-function settingsOf(page: Page) {
+export function settingsOf(page: Page) {
   return jobSettings(page.form!.values(), page.init!.schema);
 }
 
@@ -85,9 +86,10 @@ function settingsOf(page: Page) {
  * Lays out `parts` (the job's parts after an edit) and, when the core accepts them, makes them
  * the job's parts (the 3D view, the panel and the Slice button follow). When it refuses (a job
  * that does not fit, a value out of range) its message is shown and nothing changes. Only the
- * latest of overlapping requests is applied. Returns whether the parts were taken.
+ * latest of overlapping requests is applied. Returns whether the parts were taken. A change
+ * taken is recorded for undo as `label` (null: not recorded, the job is as it was).
  */
-export async function applyParts(page: Page, parts: Part[]): Promise<boolean> {
+export async function applyParts(page: Page, parts: Part[], label: string | null = "edit part"): Promise<boolean> {
   const { store } = page;
   const job = store.job;
   if (!job) return false;
@@ -112,11 +114,12 @@ export async function applyParts(page: Page, parts: Part[]): Promise<boolean> {
   page.renderer.request();
   void ensureMeshes(page);
   updateButtons(page);
+  if (label !== null) record(page, label);
   return true;
 }
 
 /** A layout error's banner goes once a layout succeeds. */
-function hideLayoutBanner(): void {
+export function hideLayoutBanner(): void {
   const b = document.getElementById("banner")!;
   if (b.dataset.layout === "1") {
     delete b.dataset.layout;
@@ -128,10 +131,10 @@ function hideLayoutBanner(): void {
 export function relayout(page: Page): Promise<boolean> {
   const job = page.store.job;
   if (!job || page.form!.errors().length) return Promise.resolve(false);
-  return applyParts(page, job.parts);
+  return applyParts(page, job.parts, null);
 }
 
-export function editParts(page: Page, edits: { id: number; changes: Changes }[]): Promise<boolean> {
+export function editParts(page: Page, edits: { id: number; changes: Changes }[], label = "edit part"): Promise<boolean> {
   const job = page.store.job;
   if (!job) return Promise.resolve(false);
   const parts = job.parts.map((p) => {
@@ -146,7 +149,7 @@ export function editParts(page: Page, edits: { id: number; changes: Changes }[])
     }
     return { ...p, spec };
   });
-  return applyParts(page, parts);
+  return applyParts(page, parts, label);
 }
 
 export function selectPart(page: Page, id: number | null): void {
@@ -171,7 +174,7 @@ export async function addParts(page: Page, files: File[]): Promise<void> {
   }
   for (const m of models) job.models.set(m.name, m);
   const added = models.map((m) => job.newPart({ file: m.name }));
-  if (await applyParts(page, [...job.parts, ...added])) {
+  if (await applyParts(page, [...job.parts, ...added], added.length > 1 ? `add ${added.length} parts` : "add part")) {
     selectPart(page, added[added.length - 1].id);
   } else {
     // refused (does not fit): the files go again
@@ -189,20 +192,22 @@ export function duplicatePart(page: Page, id: number): void {
   delete copy.spec.place_y;
   copy.mesh = p.mesh;
   const at = job.parts.indexOf(p) + 1;
-  void applyParts(page, [...job.parts.slice(0, at), copy, ...job.parts.slice(at)]).then((ok) => ok && selectPart(page, copy.id));
+  void applyParts(page, [...job.parts.slice(0, at), copy, ...job.parts.slice(at)], "duplicate part").then((ok) => ok && selectPart(page, copy.id));
 }
 
 export function removePart(page: Page, id: number): void {
   const job = page.store.job;
   if (!job || job.parts.length <= 1) return;
-  void applyParts(page, job.parts.filter((p) => p.id !== id));
+  const p = job.part(id);
+  if (!p) return;
+  void applyParts(page, job.parts.filter((q) => q !== p), `remove ${partName(job, p)}`);
 }
 
 /** Every placement cleared: the core arranges all parts. */
 export function arrangeAll(page: Page): void {
   const job = page.store.job;
   if (!job) return;
-  void editParts(page, job.parts.map((p) => ({ id: p.id, changes: { place: null } })));
+  void editParts(page, job.parts.map((p) => ({ id: p.id, changes: { place: null } })), "arrange");
 }
 
 /** The core's lay-flat angles put into the part (its z rotation and scale kept). */
@@ -212,7 +217,7 @@ export async function layFlat(page: Page, id: number): Promise<void> {
   if (!job || !p) return;
   try {
     const a = await page.pool.layFlat(job.refs(), p.spec.file, p.spec.item);
-    await editParts(page, [{ id, changes: { rotate_x: a.rotate_x, rotate_y: a.rotate_y } }]);
+    await editParts(page, [{ id, changes: { rotate_x: a.rotate_x, rotate_y: a.rotate_y } }], "lay flat");
   } catch (e) {
     showError(page, e);
   }
@@ -225,7 +230,7 @@ export function movePart(page: Page, id: number, copy: number, dx: number, dy: n
   const inst = job?.layout?.instances.find((x) => job.parts[x.part]?.id === id && x.copy === copy);
   if (!job || !inst || !Number.isFinite(dx + dy)) return Promise.resolve(false);
   const round = (v: number) => Math.round(v * 100) / 100;
-  return editParts(page, [{ id, changes: { place_x: round(inst.at[0] + dx), place_y: round(inst.at[1] + dy) } }]);
+  return editParts(page, [{ id, changes: { place_x: round(inst.at[0] + dx), place_y: round(inst.at[1] + dy) } }], "move part");
 }
 
 /** Fetches the display meshes the 3D view lacks: the job's budget shared by its instances

@@ -5,18 +5,21 @@
 // SHA-256 for a link. Each ends in a flow of slice.ts.
 
 import type { Value } from "../core/settings";
-import { openGcode, startSlice, type Target } from "./slice";
+import { dropSlice, openGcode, startSlice, type Target } from "./slice";
+import { record } from "./history";
 import { jobSettings, partKeys } from "../core/job";
 import { adoptJob, newJob, type NewFile } from "./job";
 import type { Page } from "../views/page";
 import type { JobFile, JobSchema, PartSpec, SettingSpec } from "../core/protocol";
 import { sampleStl } from "../core/sample";
-import { LinkError, readLink, type ShareState, type SharedLink } from "../core/share";
+import { LinkError, readLink, type Overlays, type ShareState, type SharedLink } from "../core/share";
 import type { PendingJob } from "../core/store";
 import { note, showBanner, TITLES } from "../views/banner";
 import { updateButtons } from "../views/controls";
 import { nf } from "../views/dom";
-import { setShowTravel } from "../views/layer";
+import { setLine } from "../views/cut";
+import { setOverlay, setShowTravel } from "../views/layer";
+import { linkFromNote, undoNotice } from "../views/notices";
 import { showModel } from "../views/stats";
 import { setState } from "../views/status";
 
@@ -60,24 +63,32 @@ export async function openFiles(page: Page, files: File[]): Promise<void> {
     return;
   }
   note("", "none");
-  await openJob(page, models.map((file) => ({ file })));
+  await openJob(page, models.map((file) => ({ file })), undefined, {}, models.length === 1 ? `open ${models[0].name}` : `open ${models.length} files`);
 }
 
 /** A new job of `files` (or of `specs`), sliced at once; 3D first when it has several
  *  instances. */
-async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target: Target = {}): Promise<boolean> {
+async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target: Target = {}, what = "open files"): Promise<boolean> {
   const job = await newJob(page, files, specs);
   if (!job) return false;
+  const before = page.store.job;
   adoptJob(page, job);
+  record(page, what, "open");
+  // the job replaced is one Undo away
+  if (before && before.parts.length) undoNotice(page, `“${job.name}” replaced the previous job.`);
   if (job.instances > 1) page.view3d.setActive(true);
   if (!job.layout) {
-    // the parts do not fit together: the banner says so; change them, then slice
+    // the parts do not fit together: the banner says so; change them, then slice. The slice
+    // shown was of the job before: it goes with it (never the new parts with the old code)
+    dropSlice(page);
     setState("error");
+    updateButtons(page);
     return true;
   }
   await startSlice(page, target);
   return true;
 }
+
 
 /** Reads a job file (on the page's thread, at most the core's `max_job_file_bytes`) into its
  *  JSON; a message when it is not one. The core checks every field when the job is laid out. */
@@ -137,7 +148,7 @@ async function openPending(page: Page, pending: PendingJob, dropped: File[]): Pr
     const name = pending.files[0].name;
     note(`“${strangers[0].name}” does not match the model of the preview link (“${name}”, SHA-256 ${(pending.files[0].sha256 ?? "").slice(0, 12)}…): this is a different file. It is sliced with the link's settings.`, "warn");
     const job = { ...pending.job, parts: pending.job.parts.map((p) => ({ ...p, file: strangers[0].name })) };
-    await openJob(page, [{ file: strangers[0] }], job.parts);
+    await openJob(page, [{ file: strangers[0] }], job.parts, {}, "open the preview link");
     return;
   }
   if (missing.length === 0) {
@@ -146,7 +157,11 @@ async function openPending(page: Page, pending: PendingJob, dropped: File[]): Pr
     if (pending.source === "link") note(pending.files.length > 1 ? "The dropped files match the models of the preview link." : `“${pending.files[0].file!.name}” matches the model of the preview link.`, "ok");
     const extra = strangers.length ? ` (not part of it: ${strangers.map((f) => `“${f.name}”`).join(", ")})` : "";
     if (extra) note(`The job's files are all here${extra}.`, "warn");
-    if (await openJob(page, pending.files.map((x) => ({ file: x.file!, name: x.name })), pending.job.parts, target)) store.pending = null;
+    const what = pending.source === "link" ? "open the preview link" : "open the job file";
+    if (await openJob(page, pending.files.map((x) => ({ file: x.file!, name: x.name })), pending.job.parts, target, what)) {
+      store.pending = null;
+      if (link) linkStage(page, link);
+    }
     else store.pending = pending;
     return;
   }
@@ -173,12 +188,13 @@ function applyJobSettings(page: Page, settings: JobFile["settings"]): void {
   if (unknown.length) note(`Settings unknown here were ignored: ${unknown.join(", ")}.`, "warn");
 }
 
-export async function openSample(page: Page, notice?: Target["notice"]): Promise<void> {
+/** The sample part as a new job (`target`: the layer, or a notice to show with it). */
+export async function openSample(page: Page, target: Target = {}): Promise<void> {
   const s = sampleStl();
   setState("reading");
   page.store.pending = null;
   note("", "none");
-  await openJob(page, [{ file: new File([s.bytes as BlobPart], s.name, { type: "model/stl" }) }], undefined, { notice });
+  await openJob(page, [{ file: new File([s.bytes as BlobPart], s.name, { type: "model/stl" }) }], undefined, target, "open the sample part");
 }
 
 /** What a link's settings must be for each kind of setting (the form checks the ranges). */
@@ -218,6 +234,28 @@ function linkJob(state: ShareState, settings: Record<string, Value>, schema: rea
   return { settings: jobSettings(settings, schema), parts: state.parts ?? [part] };
 }
 
+/** A link's stage once its job is sliced: the 3D view and its camera, or the layer view with
+ *  the cut line. */
+function linkStage(page: Page, state: ShareState): void {
+  if (state.mode) page.view3d.setActive(state.mode === "3d");
+  if (state.camera) page.view3d.setCamera(state.camera);
+  if (state.cut && page.store.slice) setLine(page, state.cut, true);
+}
+
+/** The settings of a link that differ from the defaults, in words: "layer height 0.2 mm
+ *  (default 0.25)". */
+function differing(page: Page, settings: Record<string, Value>): string[] {
+  const out: string[] = [];
+  for (const spec of page.init!.schema) {
+    const v = settings[spec.name];
+    const d = page.init!.defaults[spec.name];
+    if (v === undefined || v === d || spec.part) continue;
+    const unit = spec.unit && typeof v === "number" ? ` ${spec.unit}` : "";
+    out.push(`${spec.name.replace(/_/g, " ")} ${String(v)}${unit} (default ${String(d)})`);
+  }
+  return out;
+}
+
 /** Opens the preview link in the URL, if there is one (returns whether there was one that the
  *  page now shows or waits for files of). A link too large or damaged is refused with a
  *  message and the sample part is shown; fields it gets wrong are ignored and named. */
@@ -227,7 +265,7 @@ export async function openLink(page: Page): Promise<boolean> {
     link = await readLink(location.hash, page.init!.job);
   } catch (e) {
     const why = e instanceof LinkError ? e.message : `it could not be read (${e instanceof Error ? e.message : String(e)})`;
-    await openSample(page, { title: TITLES.link, message: `This preview link is too large or damaged: ${why}. Showing the sample part instead.` });
+    await openSample(page, { notice: { title: TITLES.link, message: `This preview link is too large or damaged: ${why}. Showing the sample part instead.` } });
     return true;
   }
   if (!link) return false;
@@ -240,6 +278,8 @@ export async function openLink(page: Page): Promise<boolean> {
     : "";
   if (extra) note(extra.trim(), "warn");
   setShowTravel(page, Boolean(link.state.showTravel));
+  for (const [k, on] of Object.entries(link.state.overlays ?? {})) setOverlay(k as keyof Overlays, on);
+  linkFromNote(differing(page, page.form!.values()));
   const notice: Target["notice"] = ignored.length
     ? { title: TITLES.linkPart, message: `This preview link is partly damaged: ${ignored.join("; ")}.`, tone: "info" }
     : undefined;
@@ -251,7 +291,7 @@ export async function openLink(page: Page): Promise<boolean> {
     const wrong = files.findIndex((f, i) => !hashes[i].startsWith(f.sha256));
     if (wrong < 0) {
       page.store.pending = null;
-      await openJob(page, given, job.parts, { layer, view, notice });
+      if (await openJob(page, given, job.parts, { layer, view, notice }, "open the preview link")) linkStage(page, link.state);
       return true;
     }
     link.models = null;

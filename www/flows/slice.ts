@@ -9,10 +9,13 @@ import { restoreModel, showError } from "./errors";
 import type { Page } from "../views/page";
 import { jobSettings } from "../core/job";
 import { editParts } from "./job";
+import { record } from "./history";
+import { undoNotice } from "../views/notices";
 import type { Slice, SlicedJob } from "../core/store";
 import { recordSupport } from "../core/supportcolumns";
 import { errorBanner, hideBanner, showBanner, TITLES } from "../views/banner";
-import { updateButtons } from "../views/controls";
+import { sliceState, updateButtons } from "../views/controls";
+import { jobOffPlate } from "../core/plate";
 import { saveGcode } from "../views/download";
 import { layerLabel, setLayers } from "../views/layer";
 import { clampLayer, show } from "./layer";
@@ -69,6 +72,14 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
   const job = store.job;
   if (!job || job.parts.length === 0) return;
   if (settingsProblem(page)) return;
+  // a job is sliced only when it fits: every part on the plate
+  const off = jobOffPlate(job, form.values());
+  if (off.length || !job.layout) {
+    if (off.length) showBanner("A part is off the plate.", off.map((o) => o.message).join(" "));
+    setState("error");
+    updateButtons(page);
+    return;
+  }
   cancelRunning(page);
   hideBanner();
   if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone);
@@ -164,14 +175,8 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
       setState("cancelled");
       showBanner("Slicing cancelled.", "Change the settings or open another file, then slice again.", "info");
     } else {
-      if (store.slice === s) {
-        // the slice broke half-way: nothing of it can be downloaded
-        store.slice = null;
-        renderer.current = renderer.below = null;
-        renderer.request();
-        page.view3d.sync(page);
-        writeStats(page);
-      }
+      // the slice broke half-way: nothing of it can be downloaded
+      if (store.slice === s) dropSlice(page);
       showError(page, e);
     }
   } finally {
@@ -264,7 +269,11 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.figures.setRead(r.figures, r.figuresError);
     s.complete = true;
     store.slice = s;
+    const before = store.job;
     store.job = null;
+    // the job it replaced is one Undo away
+    record(page, `open ${file.name}`, "open");
+    if (before?.parts.length) undoNotice(page, `“${file.name}” replaced the job.`);
     page.parts.render();
     setLayers(r.layers);
     showModel(file.name);
@@ -281,9 +290,21 @@ export async function openGcode(page: Page, file: File): Promise<void> {
   }
 }
 
+/** The slice is dropped (it broke, was cancelled, or belongs to a job no longer shown):
+ *  nothing of it is shown, downloaded or linked. */
+export function dropSlice(page: Page): void {
+  const { store, renderer } = page;
+  store.slice = null;
+  renderer.current = renderer.below = null;
+  renderer.request();
+  page.view3d.sync(page);
+  writeStats(page);
+  layerLabel(page);
+}
+
 /** Cancel: the workers stop at once; a slice not yet complete is dropped. */
 export function cancel(page: Page): void {
-  const { store, pool, renderer } = page;
+  const { store, pool } = page;
   if (!store.busy) return;
   store.generation++;
   pool.cancel();
@@ -291,14 +312,7 @@ export function cancel(page: Page): void {
   progress(null);
   setState("cancelled");
   showBanner("Slicing cancelled.", "Change the settings or open another file, then slice again.", "info");
-  if (store.slice && !store.slice.complete) {
-    store.slice = null;
-    renderer.current = renderer.below = null;
-    renderer.request();
-    page.view3d.sync(page);
-    writeStats(page);
-    layerLabel(page);
-  }
+  if (store.slice && !store.slice.complete) dropSlice(page);
   restoreModel(page);
   updateButtons(page);
 }
@@ -312,7 +326,7 @@ export function fixUnits(page: Page, factor: number): void {
   const which = suggests.length ? suggests : job.parts;
   // busy from the click on (the layout comes first, then the slice)
   setState("reading");
-  void editParts(page, which.map((p) => ({ id: p.id, changes: { scale_x: p.spec.scale_x * factor, scale_y: p.spec.scale_y * factor, scale_z: p.spec.scale_z * factor } })))
+  void editParts(page, which.map((p) => ({ id: p.id, changes: { scale_x: p.spec.scale_x * factor, scale_y: p.spec.scale_y * factor, scale_z: p.spec.scale_z * factor } })), `scale ×${factor}`)
     .then((ok) => {
       if (ok) void startSlice(page);
       else setState("error");
@@ -323,7 +337,8 @@ export function fixUnits(page: Page, factor: number): void {
 export async function download(page: Page): Promise<void> {
   const { store, pool } = page;
   const s = store.slice;
-  if (!s || !s.complete || s.source !== "stl") return;
+  // only the slice of the job as it is now (the button says so when it is not)
+  if (!s || !s.complete || s.source !== "stl" || sliceState(page) !== "current" || jobOffPlate(store.job, page.form?.values()).length) return;
   const summary = s.figures.summary;
   try {
     if (!summary) throw new SliceError("internal", "the slice has no summary from the core");

@@ -1,6 +1,7 @@
 // Messages: the banner (errors, notices) and the note about a preview link.
 
 import { SliceError } from "../core/client";
+import { plainJobMessage } from "../core/plate";
 import { $ } from "./dom";
 
 export const TITLES: Record<string, string> = {
@@ -43,7 +44,7 @@ export function hideBanner(): void {
 /** The banner of an error: the core's kind of error as its title. */
 export function errorBanner(e: unknown): void {
   if (e instanceof SliceError) {
-    showBanner(TITLES[e.kind] ?? "Error.", capitalize(e.message));
+    showBanner(TITLES[e.kind] ?? "Error.", capitalize(e.kind === "job" ? plainJobMessage(e.message) : e.message));
   } else if (e instanceof Error) {
     showBanner("Something went wrong.", e.message);
   } else {

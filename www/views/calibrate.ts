@@ -6,6 +6,11 @@
 // is the core's (src/output/calibrate.rs, called in a worker: www/worker/calibration.ts); the page only checks
 // that the inputs are positive numbers before asking and shows the answer or the core's refusal
 // next to the inputs. "Use droplet_aspect = X" puts the suggestion into the settings form.
+//
+// The mass belongs to the code that was printed: the panel binds it to the droplet count, H
+// and aspect of the code shown when the mass was typed, and keeps them when the same job is
+// sliced again (a new slice is new code: its print must be weighed). After Use, it asks for
+// the weight of a print of the new code instead of suggesting anything more from this mass.
 
 import { Cancelled, SliceError } from "../core/client";
 import type { Page } from "./page";
@@ -31,6 +36,10 @@ const state = {
   droplets: NaN,
   source: null as Source | null,
   result: null as Calibration | null,
+  /** The code the mass typed was measured on, and the job it was sliced of. */
+  bound: null as { source: Source; job: unknown } | null,
+  /** The value put into the settings by Use (null: none since the last input). */
+  used: null as string | null,
   /** Bumped by every request and every new source: an older answer is dropped. */
   seq: 0,
   timer: 0,
@@ -120,9 +129,18 @@ function suggestion(c: Calibration): string {
   return c.suggested_droplet_aspect.toFixed(3);
 }
 
-/** Checks the inputs and asks the core (after [[DEBOUNCE_MS]] unless `now`). */
-function schedule(page: Page, now = false): void {
+/** Checks the inputs and asks the core (after [[DEBOUNCE_MS]] unless `now`). A mass typed
+ *  (`mass`) is of the code shown now: the panel takes that code's figures. */
+function schedule(page: Page, now = false, mass = false): void {
   clearTimeout(state.timer);
+  state.used = null;
+  if (mass) {
+    const src = sourceOf(page, page.store.slice);
+    if (typeof src !== "string") {
+      state.source = src;
+      setText("calib-source", src.label);
+    }
+  }
   state.seq++;
   settle("pending");
   if (now) void run(page);
@@ -152,6 +170,7 @@ async function run(page: Page): Promise<void> {
     const c = await page.actions.calibrate(src.request(mass.value, density.value));
     if (seq !== state.seq || state.source !== src) return;
     message("");
+    state.bound = { source: src, job: page.store.job };
     showResult(c);
     settle("result");
   } catch (e) {
@@ -172,6 +191,7 @@ export function writeCalibration(page: Page): void {
   state.slice = s;
   state.complete = s?.complete ?? false;
   state.droplets = droplets;
+  if (keepBound(page, s)) return;
   const src = sourceOf(page, s);
   clearTimeout(state.timer);
   state.seq++;
@@ -189,6 +209,24 @@ export function writeCalibration(page: Page): void {
   schedule(page, true);
 }
 
+/** A new slice of the job whose code the mass typed was measured on: the panel keeps that
+ *  code's figures (and says so); after Use it asks for the new print's weight. Returns whether
+ *  it kept them. */
+function keepBound(page: Page, s: Slice | null): boolean {
+  const b = state.bound;
+  const typed = input("calib-mass").value.trim() !== "";
+  if (!b || !typed || !s || s.source !== "stl" || b.source.slice.source !== "stl" || b.job !== page.store.job || s === b.source.slice) {
+    if (!typed || (s && s !== b?.source.slice)) state.bound = null;
+    return false;
+  }
+  if (!s.complete) return true;
+  setText("calib-source", `The mass typed was measured on earlier code (${b.source.label.replace(/^This slice: /, "")}); the slice shown is new code.`);
+  if (state.used !== null) {
+    message(`droplet_aspect is now ${state.used}: print this new code, weigh the print and type its mass to check it.`, "ok");
+  }
+  return true;
+}
+
 /** The suggestion into the settings form (the user slices again). */
 function use(page: Page): void {
   const c = state.result;
@@ -197,21 +235,29 @@ function use(page: Page): void {
   const value = suggestion(c);
   form.set({ droplet_aspect: Number(value) });
   updateButtons(page);
+  page.actions.settingsEdited();
   const field = document.getElementById("set-droplet_aspect");
   field?.closest("details")?.setAttribute("open", "");
   field?.scrollIntoView({ block: "nearest" });
   const again = page.store.job ? "press Slice to slice again" : "open the model and slice it";
-  message(`droplet_aspect is now ${value} in the settings: ${again}.`, "ok");
+  // this mass was of the code before: no more suggestions from it
+  state.used = value;
+  clearTimeout(state.timer);
+  state.seq++;
+  showResult(null);
+  settle("idle");
+  message(`droplet_aspect is now ${value} in the settings: ${again}, then print the new code, weigh the print and type its mass here.`, "ok");
 }
 
 export function wireCalibrate(page: Page): void {
   for (const id of ["calib-mass", "calib-density"]) {
     const el = input(id);
-    el.addEventListener("input", () => schedule(page));
+    const mass = id === "calib-mass";
+    el.addEventListener("input", () => schedule(page, false, mass));
     el.addEventListener("keydown", (ev) => {
       if (ev.key === "Enter") {
         ev.preventDefault();
-        schedule(page, true);
+        schedule(page, true, mass);
       }
     });
   }

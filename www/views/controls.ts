@@ -1,42 +1,77 @@
-// The buttons Download, Copy preview link and Slice, and the settings' status line.
+// The buttons Download, Copy preview link and Slice, the settings' status line, and the marks
+// of a slice that no longer belongs to the job on screen. What is downloaded or linked is
+// always the job on screen: the two buttons are enabled only while the slice is of the job and
+// the settings as they are now (after a change, Slice first), and never for a job with a part
+// off the plate.
 
 import { jobSettings } from "../core/job";
+import { jobOffPlate } from "../core/plate";
 import type { Page } from "./page";
 import { $ } from "./dom";
+
+/** "current": the slice shown is of the job as it is; "stale": of an earlier state of it (or of
+ *  another job); "none": no slice, or one still being made. */
+export function sliceState(page: Page): "current" | "stale" | "none" {
+  const { store, form, init } = page;
+  const s = store.slice;
+  if (!s || s.source !== "stl" || store.busy) return "none";
+  const job = store.job;
+  if (!job || !form || !init) return "stale";
+  return s.key === job.key(jobSettings(form.values(), init.schema)) ? "current" : "stale";
+}
+
+/** The derived figures (statistics, plot, layer figures, calibration) marked out of date. */
+function markStale(stale: boolean): void {
+  document.body.dataset.slice = stale ? "stale" : "ok";
+  for (const el of [$("stats-panel"), document.querySelector(".plotbar"), document.querySelector(".layerbar"), $("calib")]) {
+    if (el instanceof HTMLElement) el.toggleAttribute("data-stale", stale);
+  }
+  $("stale-note").hidden = !stale;
+}
 
 export function updateButtons(page: Page): void {
   const { store, form } = page;
   const s = store.slice;
-  const ready = !store.busy && s !== null && s.complete;
+  const state = sliceState(page);
+  markStale(state === "stale");
+  const off = jobOffPlate(store.job, form?.values());
+  const ready = !store.busy && s !== null && s.complete && (s.source === "gco" || (state === "current" && off.length === 0));
+  const why = state === "stale" ? "The slice is out of date: press Slice first" : off.length ? "A part is off the plate: move it or press Arrange" : "";
   // Like the CLI, no code for a part without a single droplet.
-  ($("btn-download") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && !s!.figures.nothingToPrint);
-  ($("btn-share") as HTMLButtonElement).disabled = !(ready && s!.source === "stl" && s!.job !== null);
-  ($("btn-slice") as HTMLButtonElement).disabled = store.job === null || form === undefined;
+  const download = $<HTMLButtonElement>("btn-download");
+  download.disabled = !(ready && s!.source === "stl" && !s!.figures.nothingToPrint);
+  download.title = why || "Save the G-code of this slice";
+  const share = $<HTMLButtonElement>("btn-share");
+  share.disabled = !(ready && s!.source === "stl" && s!.job !== null);
+  share.title = why || "Copy a link that opens this slice (settings, parts, view)";
+  $<HTMLButtonElement>("btn-slice").disabled = store.job === null || form === undefined || off.length > 0 || !store.job.layout;
   // the support switch shows the setting (a link, a job file or the form may have set it)
   if (form) $<HTMLInputElement>("opt-support").checked = form.get("support") === "unit1";
-  settingsStatus(page);
+  settingsStatus(page, state === "stale", off.map((o) => o.message));
 }
 
-function settingsStatus(page: Page): void {
+function settingsStatus(page: Page, stale: boolean, offPlate: string[]): void {
   const { store, form } = page;
   if (!form) return;
   const st = $("settings-status");
   const errors = form.errors();
   const btn = $("btn-slice");
-  if (errors.length) {
-    st.textContent = `${errors.length} setting${errors.length > 1 ? "s are" : " is"} invalid.`;
+  const bad = (text: string) => {
+    st.textContent = text;
     st.className = "hint bad";
     ($("btn-slice") as HTMLButtonElement).disabled = true;
     btn.classList.remove("attention");
-    return;
-  }
+  };
+  if (errors.length) return bad(`${errors.length} setting${errors.length > 1 ? "s are" : " is"} invalid.`);
+  if (offPlate.length) return bad(offPlate.length > 1 ? `${offPlate[0]} (and ${offPlate.length - 1} more off the plate)` : offPlate[0]);
   const job = store.job;
+  if (job && !job.layout && !store.busy) return bad("The parts do not fit on the plate together: remove, scale or make fewer copies of some.");
   const slice = store.slice;
   const schema = page.init!.schema;
   const settings = jobSettings(form.values(), schema);
-  const stale = job !== null && !store.busy && (slice?.source !== "stl" || job.key(settings) !== slice.key);
+  const unsliced = job !== null && !store.busy && slice?.source !== "stl";
   const settingsChanged = slice?.source === "stl" && JSON.stringify(settings) !== JSON.stringify(jobSettings(slice.settings, schema));
   st.className = "hint";
-  st.textContent = !stale ? "" : settingsChanged ? "Settings changed: press Slice (or Enter) to update." : "The parts changed: press Slice (or Enter) to update.";
-  btn.classList.toggle("attention", stale);
+  st.textContent = !(stale || unsliced) ? "" : settingsChanged ? "Settings changed: press Slice (or Enter) to update." : "The parts changed: press Slice (or Enter) to update.";
+  btn.classList.toggle("attention", stale || unsliced);
 }

@@ -81,3 +81,14 @@ export function setShowTravel(page: Page, on: boolean): void {
   $<HTMLInputElement>("opt-travel").checked = page.renderer.showTravel;
   $("legend-travel").hidden = !page.renderer.showTravel;
 }
+
+/** The overlay checkboxes by name (the layer view's toggles). */
+export const OVERLAYS = { travel: "opt-travel", below: "opt-below", voids: "opt-voids", overhangs: "opt-overhangs" } as const;
+
+/** Turns an overlay on or off as its checkbox would (its own handler does the rest). */
+export function setOverlay(name: keyof typeof OVERLAYS, on: boolean): void {
+  const box = $<HTMLInputElement>(OVERLAYS[name]);
+  if (box.checked === on) return;
+  box.checked = on;
+  box.dispatchEvent(new Event("change"));
+}

@@ -4,6 +4,7 @@
 // flows, so that a view never imports a flow). main.ts makes the one instance.
 
 import type { Pool } from "../core/client";
+import type { History, Snapshot } from "../core/history";
 import type { Changes } from "../core/job";
 import type { CalibrateRequest, Calibration, InitResult, LayerData, Settings } from "../core/protocol";
 import type { Value } from "../core/settings";
@@ -12,7 +13,7 @@ import type { Bounds, View } from "../core/view";
 import type { Line } from "../core/cutline";
 import type { CutLayer, CutView } from "./canvas/cutrender";
 import type { PanZoom } from "./canvas/panzoom";
-import type { View3D } from "./view3d/view3d";
+import type { Camera3D, View3D } from "./view3d/view3d";
 
 export interface Page {
   readonly store: Store;
@@ -27,6 +28,8 @@ export interface Page {
   readonly parts: PartsView;
   /** What the views ask for. */
   readonly actions: Actions;
+  /** Undo and redo of the job and the settings (flows/history.ts records into it). */
+  readonly history: History<Snapshot>;
   /** The settings form, once init has answered. */
   form?: SettingsView;
   /** The core's version, settings schema and defaults, once init has answered. */
@@ -60,6 +63,12 @@ export interface Actions {
   setCutLine(line: Line | null, refit: boolean): void;
   /** Keeps the cut in step with the page (a new slice, layers that arrived, the layer shown). */
   updateCut(): void;
+  /** The cut line shown (null: no cut). */
+  cutLine(): Line | null;
+  undo(): void;
+  redo(): void;
+  /** The settings form was set by a view (not typed): recorded for undo and remembered. */
+  settingsEdited(): void;
 }
 
 /** The layer canvas (views/canvas/render.ts). */
@@ -110,6 +119,10 @@ export interface View3DView {
   /** Shows the page's job, its selection and the slice's layer. */
   sync(page: Page): void;
   fit(): void;
+  /** The camera (plate mm), null before the view was made. */
+  camera(): Camera3D | null;
+  /** Puts the camera there (kept until the view is made and has framed its job). */
+  setCamera(c: Camera3D): void;
   /** For the tests: the view's state after a synchronous draw (null before it was made). */
   testState(): ReturnType<View3D["state"]> | null;
 }

@@ -3,7 +3,9 @@
 // of them moves the part (the outline follows; on release the part is placed there and the core
 // lays the job out again). Elsewhere, or with no part selected, a drag pans as before. The
 // droplets drawn stay the slice's until the job is sliced again (the Slice button says so).
+// Instances off the plate are outlined in the warning colour, selected or not.
 
+import { jobOffPlate } from "../core/plate";
 import type { Page } from "./page";
 import { $ } from "./dom";
 
@@ -18,34 +20,40 @@ interface Drag {
 
 let drag: Drag | null = null;
 
-/** The selected part's instance boxes (plate mm): [copy, minX, minY, maxX, maxY]. */
-function boxes(page: Page): [number, number, number, number, number][] {
+/** The instance boxes to outline (plate mm): [copy, minX, minY, maxX, maxY, off the plate,
+ *  part id] of the selected part's instances and of every instance off the plate. */
+function boxes(page: Page): [number, number, number, number, number, boolean, number][] {
   const job = page.store.job;
-  if (!job?.layout || job.selected === null) return [];
+  if (!job?.layout) return [];
+  const off = new Set(jobOffPlate(job, page.form?.values()).map((o) => `${o.part}:${o.copy}`));
   return job.layout.instances
-    .filter((i) => job.parts[i.part]?.id === job.selected)
-    .map((i) => [i.copy, i.min[0], i.min[1], i.max[0], i.max[1]]);
+    .filter((i) => job.parts[i.part]?.id === job.selected || off.has(`${i.part}:${i.copy}`))
+    .map((i) => [i.copy, i.min[0], i.min[1], i.max[0], i.max[1], off.has(`${i.part}:${i.copy}`), job.parts[i.part].id]);
 }
 
 function drawBoxes(page: Page): void {
   const list = boxes(page);
-  if (list.length === 0) return;
   const r = page.renderer;
+  const off = list.filter((b) => b[5]).length;
+  r.canvas.dataset.offPlate = String(off);
+  $("legend-off").hidden = off === 0;
+  if (list.length === 0) return;
   const ctx = r.canvas.getContext("2d");
   if (!ctx) return;
   const dpr = window.devicePixelRatio || 1;
   ctx.save();
   ctx.setTransform(1, 0, 0, 1, 0, 0);
-  for (const [copy, x0, y0, x1, y1] of list) {
-    const moving = drag && drag.copy === copy;
+  for (const [copy, x0, y0, x1, y1, off, id] of list) {
+    const moving = drag && drag.copy === copy && drag.part === id;
     const [ox, oy] = moving ? [drag!.dx, drag!.dy] : [0, 0];
     const [ax, ay] = r.toPx(x0 + ox, y1 + oy).map((v) => v * dpr);
     const [bx, by] = r.toPx(x1 + ox, y0 + oy).map((v) => v * dpr);
-    ctx.fillStyle = moving ? "rgba(28, 126, 214, 0.12)" : "rgba(28, 126, 214, 0.05)";
+    const rgb = off ? "224, 49, 49" : "28, 126, 214";
+    ctx.fillStyle = `rgba(${rgb}, ${moving ? 0.12 : off ? 0.1 : 0.05})`;
     ctx.fillRect(ax, ay, bx - ax, by - ay);
-    ctx.strokeStyle = "#1c7ed6";
-    ctx.lineWidth = 1.5 * dpr;
-    ctx.setLineDash([6 * dpr, 4 * dpr]);
+    ctx.strokeStyle = off ? "#e03131" : "#1c7ed6";
+    ctx.lineWidth = (off ? 2 : 1.5) * dpr;
+    ctx.setLineDash(off ? [] : [6 * dpr, 4 * dpr]);
     ctx.strokeRect(ax, ay, bx - ax, by - ay);
   }
   ctx.restore();
@@ -70,7 +78,7 @@ export function wirePartDrag(page: Page): void {
       if (ev.button !== 0 || $("btn-cut").getAttribute("aria-pressed") === "true") return;
       const job = page.store.job;
       const [x, y] = at(ev);
-      const hit = boxes(page).find(([, x0, y0, x1, y1]) => x >= x0 && x <= x1 && y >= y0 && y <= y1);
+      const hit = boxes(page).find(([, x0, y0, x1, y1, , id]) => id === job?.selected && x >= x0 && x <= x1 && y >= y0 && y <= y1);
       if (!job || job.selected === null || !hit) return;
       ev.stopImmediatePropagation();
       drag = { pointerId: ev.pointerId, part: job.selected, copy: hit[0], from: [x, y], dx: 0, dy: 0 };

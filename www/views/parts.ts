@@ -5,6 +5,7 @@
 // again; what is shown comes from the job and the core's layout only.
 
 import { fitsPart, partName, partNumber, partRangeWords, type Changes, type Part } from "../core/job";
+import { jobOffPlate, plainJobMessage } from "../core/plate";
 import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
@@ -112,11 +113,13 @@ export class PartsPanel implements PartsView {
     $("parts-panel").hidden = !job;
     if (!job) return;
     const list = $("part-list");
+    const off = jobOffPlate(job, this.page.form?.values());
     const items = job.parts.map((p, i) => {
       const li = document.createElement("li");
       li.className = "part-item";
       li.dataset.id = String(p.id);
       li.setAttribute("aria-selected", String(job.selected === p.id));
+      li.toggleAttribute("data-off-plate", off.some((o) => o.part === i));
       li.tabIndex = 0;
       const name = document.createElement("span");
       name.className = "part-name";
@@ -151,7 +154,9 @@ export class PartsPanel implements PartsView {
       return li;
     });
     list.replaceChildren(...items);
-    const warnings = job.layout?.warnings ?? [];
+    // the page's own words for a part off the plate (core/plate.ts); the core's others reworded
+    const warnings = [...off.map((o) => o.message), ...(job.layout?.warnings ?? []).filter((w) => !/outside the plate/.test(w)).map(plainJobMessage)];
+    $("parts-warnings").classList.toggle("bad", off.length > 0);
     $("parts-warnings").hidden = warnings.length === 0;
     $("parts-warnings").textContent = warnings.join(" ");
     this.renderEditor();

@@ -4,13 +4,17 @@ import type { Value } from "../core/settings";
 import type { Page } from "./page";
 import { fullSpec, jobSettings, specOut } from "../core/job";
 import { makeLink } from "../core/share";
+import { sliceState } from "./controls";
 import { $ } from "./dom";
 
 export async function share(page: Page): Promise<void> {
   const { store, renderer } = page;
   const s = store.slice;
   const job = s?.job;
-  if (!s || !job || s.source !== "stl" || job.refs.length === 0) return;
+  // only the slice of the job as it is now (the button says so when it is not)
+  if (!s || !job || s.source !== "stl" || job.refs.length === 0 || sliceState(page) !== "current") return;
+  const camera = page.view3d.active ? page.view3d.camera() : null;
+  const cut = page.actions.cutLine();
   // the job as it was sliced: its files (embedded in this order when they fit) and parts
   const files = job.refs.map((r, i) => ({ name: r.name, sha256: job.sha256[i], bytes: r.file.size }));
   const { url, embedded } = await makeLink(location.href, {
@@ -20,6 +24,10 @@ export async function share(page: Page): Promise<void> {
     name: files[0].name,
     sha256: files[0].sha256,
     showTravel: renderer.showTravel,
+    mode: page.view3d.active ? "3d" : "layer",
+    ...(camera ? { camera } : {}),
+    ...(cut ? { cut } : {}),
+    overlays: { below: renderer.showBelow, voids: renderer.showVoids, overhangs: renderer.showOverhangs },
     files,
     parts: job.file.parts.map((p) => specOut(fullSpec(p))),
   }, job.refs.map((r) => r.file));

@@ -10,10 +10,11 @@
 
 import { jobSettings } from "../../core/job";
 import { supportColumns } from "../../core/supportcolumns";
+import { jobOffPlate } from "../../core/plate";
 import { errorBanner } from "../banner";
 import { $ } from "../dom";
 import type { Page, View3DView } from "../page";
-import type { View3D, View3DPart, View3DSlice } from "./view3d";
+import type { Camera3D, View3D, View3DPart, View3DSlice } from "./view3d";
 
 /** The 3D view's id of an instance, and back. */
 export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
@@ -42,6 +43,8 @@ export class View3DPanel implements View3DView {
    *  not known yet). */
   private overhang: number | null = null;
   private overhangFor = "";
+  /** A camera asked for (a link's) before the view could take it: set after its first fit. */
+  private wantCamera: Camera3D | null = null;
   active = false;
 
   constructor(private readonly container: HTMLElement) {}
@@ -54,16 +57,19 @@ export class View3DPanel implements View3DView {
     const job = store.job;
     const layout = job?.layout;
     const parts: View3DPart[] = [];
+    const values = page.form?.values();
+    const off = new Set(jobOffPlate(job, values).map((o) => `${o.part}:${o.copy}`));
     if (job && layout) {
       for (const inst of layout.instances) {
         const p = job.parts[inst.part];
         if (!p?.mesh) continue;
-        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: p.mesh.positions, matrix: inst.matrix, unit: inst.unit === 1 ? 1 : 0 });
+        const warn = off.has(`${inst.part}:${inst.copy}`);
+        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: p.mesh.positions, matrix: inst.matrix, unit: inst.unit === 1 ? 1 : 0, warn });
       }
     }
     this.parts = parts;
     this.model = job && parts.length ? job : null;
-    const values = page.form?.values();
+    $("legend3d-off").hidden = off.size === 0;
     const px = Number(values?.plate_x);
     const py = Number(values?.plate_y);
     if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
@@ -123,8 +129,12 @@ export class View3DPanel implements View3DView {
       this.framed = this.model;
       v.fit();
       // once more after the canvas took its size (a view made just now is resized later)
-      requestAnimationFrame(() => v.fit());
+      requestAnimationFrame(() => {
+        v.fit();
+        this.takeCamera();
+      });
     }
+    this.takeCamera();
     $("view3d-empty").hidden = this.parts.length > 0 || this.page?.store.job !== null;
   }
 
@@ -174,6 +184,29 @@ export class View3DPanel implements View3DView {
 
   fit(): void {
     this.view?.fit();
+  }
+
+  camera(): Camera3D | null {
+    return this.view?.pose() ?? this.wantCamera;
+  }
+
+  setCamera(c: Camera3D): void {
+    this.wantCamera = c;
+    this.takeCamera();
+  }
+
+  /** The camera asked for, once the view has framed its job (a later fit would undo it). */
+  private takeCamera(): void {
+    const c = this.wantCamera;
+    if (!c || !this.view || this.model === null || this.model !== this.framed) return;
+    this.view.setPose(c);
+    // the frame after a first fit fits again: the camera is set after it
+    requestAnimationFrame(() => {
+      if (this.wantCamera === c) {
+        this.view?.setPose(c);
+        this.wantCamera = null;
+      }
+    });
   }
 
   /** For the tests: the view's state and a synchronous draw (null before the tab was opened

@@ -21,6 +21,7 @@
 //                                cut drawn as a solid cap (back faces in the cut colour), the
 //                                current layer's slab highlighted; null = whole parts
 //   fit()                        an iso-like camera framing the plate and the parts
+//   pose() / setPose(c)          the camera's position and target (plate mm)
 //   dispose()                    frees the GPU resources, the listeners and the canvas
 // Extensions (documented here, used by the page and its tests):
 //   renderNow()                  draws at once (the view otherwise draws on demand, in the next
@@ -42,16 +43,12 @@ import {
   BackSide,
   BufferAttribute,
   BufferGeometry,
-  CanvasTexture,
   Color,
   DirectionalLight,
-  Float32BufferAttribute,
   FrontSide,
   Group,
   HemisphereLight,
   type Intersection,
-  LineBasicMaterial,
-  LineSegments,
   Matrix4,
   Mesh,
   MeshBasicMaterial,
@@ -59,11 +56,8 @@ import {
   Object3D,
   PerspectiveCamera,
   Plane,
-  PlaneGeometry,
   Raycaster,
   Scene,
-  Sprite,
-  SpriteMaterial,
   SRGBColorSpace,
   Vector2,
   Vector3,
@@ -71,6 +65,7 @@ import {
   Box3,
 } from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import { disposeObject, plateObjects } from "./plate3d";
 import { showSupport } from "./support3d";
 
 export interface View3DPart {
@@ -82,7 +77,11 @@ export interface View3DPart {
   matrix: number[];
   /** The discharge unit printing the part (1 is drawn in a second colour). */
   unit?: 0 | 1;
+  /** Off the plate: drawn in the warning colour. */
+  warn?: boolean;
 }
+
+export type Camera3D = { position: [number, number, number]; target: [number, number, number] };
 
 export interface View3DSlice {
   layerHeight: number;
@@ -105,6 +104,7 @@ export const COLORS = {
   /** Overhanging faces (the layer view's overhang overlay colour). */
   overhang: 0xe8107a,
   selected: 0x1c7ed6,
+  warn: 0xe03131, // a part off the plate
   /** The current layer's slab (the outer-loop colour of the layer view). */
   slab: 0xe8590c,
   /** The cut through the parts at the current layer's top. */
@@ -113,8 +113,6 @@ export const COLORS = {
 
 /** Plates up to this size (mm) are drawn (the settings allow up to 100 m). */
 const PLATE_MAX = 100_000;
-/** Beyond this many grid lines per axis, the grid is drawn every 10^k·10 mm. */
-const GRID_LINES_MAX = 400;
 /** A press and release this close together (px) is a click, not a drag. */
 const CLICK_PX = 4;
 /** A clipping plane's constant far beyond any part: nothing clipped. */
@@ -185,6 +183,7 @@ export class View3D {
     part: this.bodyMaterial(COLORS.part),
     unit1: this.bodyMaterial(COLORS.unit1),
     selected: this.bodyMaterial(COLORS.selected),
+    warn: this.bodyMaterial(COLORS.warn),
     slab: new MeshStandardMaterial({
       color: COLORS.slab,
       roughness: 0.55,
@@ -291,31 +290,7 @@ export class View3D {
       this.plate.remove(c);
       disposeObject(c);
     }
-    // the plate's top face, seen from above only (from below, the parts' bottoms show)
-    const top = new Mesh(
-      new PlaneGeometry(x, y),
-      new MeshBasicMaterial({ color: COLORS.plate, side: FrontSide, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }),
-    );
-    top.position.set(x / 2, y / 2, 0);
-    top.renderOrder = -2;
-    this.plate.add(top);
-
-    let step = 10;
-    while (Math.max(x, y) / step > GRID_LINES_MAX) step *= 10;
-    const minor: number[] = [];
-    const major: number[] = [];
-    for (let gx = step; gx < x - 1e-9; gx += step) (Math.round(gx / step) % 5 === 0 ? major : minor).push(gx, 0, 0, gx, y, 0);
-    for (let gy = step; gy < y - 1e-9; gy += step) (Math.round(gy / step) % 5 === 0 ? major : minor).push(0, gy, 0, x, gy, 0);
-    this.plate.add(lines(minor, COLORS.grid), lines(major, COLORS.gridMajor));
-    this.plate.add(lines([0, 0, 0, x, 0, 0, x, 0, 0, x, y, 0, x, y, 0, 0, y, 0, 0, y, 0, 0, 0, 0], COLORS.outline));
-
-    // axis hint at the origin: x red, y green, with labels
-    const len = Math.min(20, Math.max(5, Math.min(x, y) * 0.15));
-    const axes = new Group();
-    axes.add(lines([0, 0, 0, len, 0, 0], 0xe03131), lines([0, 0, 0, 0, len, 0], 0x2f9e44));
-    axes.add(label("x", "#e03131", len + len * 0.25, 0, 0, len * 0.35), label("y", "#2f9e44", 0, len + len * 0.25, 0, len * 0.35));
-    axes.position.z = 0.01;
-    this.plate.add(axes);
+    this.plate.add(...plateObjects(x, y, COLORS));
     // a hair below z = 0: the cut's cap shows the inside of a part's bottom, at z = 0 itself
     this.plate.position.z = -0.05;
     this.request();
@@ -410,7 +385,8 @@ export class View3D {
 
   private applyMaterials(): void {
     for (const e of this.entries.values()) {
-      e.body.material = e.id === this.selected ? this.materials.selected : e.unit === 1 ? this.materials.unit1 : this.materials.part;
+      const m = this.materials;
+      e.body.material = e.part.warn ? m.warn : e.id === this.selected ? m.selected : e.unit === 1 ? m.unit1 : m.part;
       e.slab.visible = e.cap.visible = this.slice !== null;
     }
   }
@@ -481,6 +457,23 @@ export class View3D {
     this.request();
   }
 
+  pose(): Camera3D {
+    const [p, t] = [this.camera.position, this.controls.target];
+    return { position: [p.x, p.y, p.z], target: [t.x, t.y, t.z] };
+  }
+
+  setPose(c: Camera3D): void {
+    const all = [...c.position, ...c.target];
+    if (all.length !== 6 || !all.every(Number.isFinite)) throw new Error("a camera is two points of three finite numbers");
+    this.camera.position.fromArray(c.position);
+    this.controls.target.fromArray(c.target);
+    const dist = this.camera.position.distanceTo(this.controls.target);
+    [this.camera.near, this.camera.far] = [Math.max(0.01, dist / 200), Math.max(this.camera.far, dist * 20)];
+    this.camera.updateProjectionMatrix();
+    this.controls.update();
+    this.request();
+  }
+
   // ---- drawing ----
 
   private readonly request = (): void => {
@@ -511,10 +504,11 @@ export class View3D {
     this.request();
   }
 
-  state(): { parts: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; support: number; frames: number; width: number; height: number } {
+  state(): { parts: string[]; warned: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; support: number; frames: number; width: number; height: number } {
     const z = this.overhangUniforms.uOverhangZ.value;
     return {
       parts: [...this.entries.keys()],
+      warned: [...this.entries.values()].filter((e) => e.body.material === this.materials.warn).map((e) => e.id),
       selected: this.selected,
       slice: this.slice ? { ...this.slice } : null,
       overhang: z > 1 ? null : z,
@@ -644,41 +638,3 @@ export class View3D {
     this.canvas.remove();
   }
 }
-
-function lines(xyz: number[], color: number): LineSegments {
-  const g = new BufferGeometry();
-  g.setAttribute("position", new Float32BufferAttribute(xyz, 3));
-  return new LineSegments(g, new LineBasicMaterial({ color }));
-}
-
-/** A text label facing the camera, `size` mm tall, centred at (x, y, z). */
-function label(text: string, color: string, x: number, y: number, z: number, size: number): Sprite {
-  const c = document.createElement("canvas");
-  c.width = c.height = 64;
-  const g = c.getContext("2d")!;
-  g.fillStyle = color;
-  g.font = "600 48px system-ui, sans-serif";
-  g.textAlign = "center";
-  g.textBaseline = "middle";
-  g.fillText(text, 32, 34);
-  const tex = new CanvasTexture(c);
-  tex.colorSpace = SRGBColorSpace;
-  const s = new Sprite(new SpriteMaterial({ map: tex, transparent: true, depthWrite: false }));
-  s.position.set(x, y, z);
-  s.scale.set(size, size, 1);
-  return s;
-}
-
-/** Frees the geometries, materials and textures of `o` and everything below it. */
-function disposeObject(o: Object3D): void {
-  o.traverse((c) => {
-    const m = c as Partial<Mesh>;
-    m.geometry?.dispose();
-    const mats = m.material === undefined ? [] : Array.isArray(m.material) ? m.material : [m.material];
-    for (const mat of mats) {
-      (mat as SpriteMaterial).map?.dispose();
-      mat.dispose();
-    }
-  });
-}
-
