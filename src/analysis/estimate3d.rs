@@ -225,6 +225,19 @@ struct Fill {
 }
 
 impl Fill {
+    fn new(s: &Settings) -> Fill {
+        let h = s.layer_height;
+        let c = spheroid_half_height(s);
+        let half = h / 2.0;
+        Fill {
+            h,
+            half,
+            c,
+            // A neighbour's droplet reaches into this slab where c·√q > H/2.
+            q_reach: ((half / c) * (half / c)) as f32,
+        }
+    }
+
     /// The filled length of a cell's column (of height H) given the q of its own layer's map
     /// (`t`) and of the layers below (`b`) and above (`a`): the union of [0, lo] from below,
     /// [H/2 − a, H/2 + a] from its own droplet and [H − hi, H] from above, computed with the
@@ -295,20 +308,11 @@ pub fn slab_voids(
     above: Option<&HeightMap>,
     s: &Settings,
 ) -> (f64, f64) {
-    let h = s.layer_height;
-    let c = spheroid_half_height(s);
-    let half = h / 2.0;
+    let fill = Fill::new(s);
     let Some((k0, ny, y0)) = slab_rows(region, grid) else {
         return (0.0, 0.0);
     };
     let (mut cells, mut filled) = (0u64, 0.0f64);
-    let fill = Fill {
-        h,
-        half,
-        c,
-        // A neighbour's droplet reaches into this slab where c·√q > H/2.
-        q_reach: ((half / c) * (half / c)) as f32,
-    };
     let mut col = [0f64; CHUNK];
     region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
         let iy = k0 + k as i64;
@@ -357,6 +361,6 @@ pub fn slab_voids(
         }
     });
     let area = grid.cell * grid.cell;
-    let volume = cells as f64 * area * h;
+    let volume = cells as f64 * area * fill.h;
     (volume, (volume - filled * area).max(0.0))
 }

@@ -2,7 +2,6 @@
 //! path ([`super`]) is tested against (tests/estimate3d_fast.rs) and timed against
 //! (examples/estimate3d_profile.rs). Built for tests and with the `reference` feature only.
 
-use super::super::droplet::spheroid_half_height;
 use super::super::raster::region_spans;
 use super::{Grid3, HeightMap, MAP_BAND_ROWS, MAP_TILE_COLS, MapRow};
 use crate::base::geom::{Point, Shapes};
@@ -102,15 +101,16 @@ pub fn slab_voids_reference(
     above: Option<&HeightMap>,
     s: &Settings,
 ) -> (f64, f64) {
-    let h = s.layer_height;
-    let c = spheroid_half_height(s);
-    let half = h / 2.0;
+    let super::Fill {
+        h,
+        half,
+        c,
+        q_reach,
+    } = super::Fill::new(s);
     let Some((k0, ny, y0)) = super::slab_rows(region, grid) else {
         return (0.0, 0.0);
     };
     let (mut cells, mut filled) = (0u64, 0.0f64);
-    // A neighbour's droplet reaches into this slab where c·√q > H/2.
-    let q_reach = ((half / c) * (half / c)) as f32;
     let ext = |q: f32| -> f64 {
         if q > q_reach {
             (c * (q as f64).sqrt() - half).max(0.0)
