@@ -331,6 +331,11 @@ function describe(e: unknown): ErrorValue {
   return internal(e instanceof Error ? e.message : String(e));
 }
 
+// The module is compiled and instantiated as soon as the worker starts, not at its first
+// request: a worker that adopts a prepared mesh would otherwise compile it only then, on the
+// slice's path. A failure is reported to the first request that needs the core.
+load().catch(() => {});
+
 scope.onmessage = (ev: MessageEvent<Request>) => {
   const req = ev.data;
   if (broken) {
