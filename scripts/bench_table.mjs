@@ -8,10 +8,12 @@
 //
 // Environment: BENCH_RUNS (5), BENCH_BUILD (1: cargo build --release --bin dropslice and
 // scripts/build.sh first; 0: use what is built), BENCH_PAGE (1; 0: CLI figures only),
-// BENCH_DIR (target/bench: the private CLI copy, the generated torus, Cura's definitions, the
-// raw runs in table.tsv), DROPSLICE_SHARED (../shared), CURA_DEFS (the folder of Cura's
-// fdmprinter.def.json; else unpacked from Debian's `cura` package), BENCH_PROFILE (1: also
-// print the page's per-stage profile, from the workers' counters).
+// BENCH_PROFILE (1: also print the page's per-stage profile, from the page's and the
+// workers' counters), BENCH_DIR (target/bench: the private CLI copy, the generated torus,
+// Cura's definitions, the raw runs in table.json), PYTHON (a python3 with numpy for
+// shared/tools/gen_mesh.py; default target/pyenv's), DROPSLICE_SHARED (../shared), CURA_DEFS
+// (the folder of Cura's fdmprinter.def.json; else unpacked from Debian's `cura` package),
+// BENCH_INSTALL (1: install CuraEngine from Debian if it is missing; 0: do not).
 //
 // CuraEngine runs with shared/bench/peers.sh's matched FDM settings (its run_cura, read out of
 // that file): the same 240 layers, 100 % fill. Where CuraEngine is not installed (Debian
@@ -53,9 +55,8 @@ function torus1m() {
   const f = join(dir, "models/torus_1000000.stl");
   if (!existsSync(f) || statSync(f).size === 0) {
     log("generating the 1M torus (shared/tools/gen_mesh.py -n 1000000)");
-    const py = [process.env.PYTHON, join(repo, "target/pyenv/bin/python3"), "/work/main/target/pyenv/bin/python3", "python3"]
-      .filter(Boolean)
-      .find((p) => p === "python3" || existsSync(p));
+    // gen_mesh.py needs numpy: the project's environment (scripts/setup.sh), else PYTHON or python3
+    const py = [process.env.PYTHON, join(repo, "target/pyenv/bin/python3"), "python3"].filter(Boolean).find((p) => p === "python3" || existsSync(p));
     execFileSync(py, [join(shared, "tools/gen_mesh.py"), "-n", "1000000", "-o", `${f}.tmp`], { stdio: ["ignore", 2, 2] });
     execFileSync("mv", [`${f}.tmp`, f]);
   }
@@ -65,8 +66,14 @@ const torus = torus1m();
 
 // ------------------------------------------------------------------ CuraEngine
 function curaCommand() {
-  const which = spawnSync("bash", ["-c", "command -v CuraEngine"], { encoding: "utf8" });
-  if (which.status !== 0) return { missing: "CuraEngine is not installed (Debian: apt-get install cura-engine)" };
+  const has = () => spawnSync("bash", ["-c", "command -v CuraEngine"]).status === 0;
+  if (!has() && process.env.BENCH_INSTALL !== "0") {
+    // as scripts/bench.sh does: Debian's package (root, or sudo)
+    log("installing CuraEngine (apt-get install cura-engine)");
+    const sudo = process.getuid?.() === 0 ? "" : "sudo ";
+    spawnSync("bash", ["-c", `${sudo}apt-get update -qq && DEBIAN_FRONTEND=noninteractive ${sudo}apt-get install -y -qq --no-install-recommends cura-engine`], { stdio: ["ignore", 2, 2] });
+  }
+  if (!has()) return { missing: "CuraEngine is not installed and could not be (Debian: apt-get install cura-engine)" };
   const peers = join(shared, "bench/peers.sh");
   if (!existsSync(peers)) return { missing: `${peers} is missing` };
   const m = readFileSync(peers, "utf8").match(/^run_cura\(\) \{\n[\s\S]*?^\}/m);

@@ -6,8 +6,8 @@
 // repeated). The pool remembers which Files the job worker holds and adds them again to a
 // fresh worker (after a cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
-// flight, so it never waits for the page between units). Layers come back as progress replies
-// (buffers transferred) and are stored by index, so the page sees them in layer order however
+// flight, so it never waits for the page between units). Layers come back in batches ("layers" replies,
+// buffers transferred) and are stored by index, so the page sees them in layer order however
 // the workers finish; a unit's result carries its G-code as one Blob. Cancel terminates every
 // worker at once, rejects what was pending and starts fresh workers.
 
