@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Benchmark of the dropslice CLI against CuraEngine 4.13 and PrusaSlicer 2.5 (issue 5).
 #
-#   bash scripts/bench.sh            (or: npm run bench)
+#   bash scripts/bench.sh            (or: npm run bench:models; `npm run bench` is the short
+#                                     table of scripts/bench_table.mjs)
 #
 # What it does
 #   1. builds the release CLI (cargo build --release --bin dropslice);

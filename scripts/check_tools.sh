@@ -29,7 +29,7 @@ need "Chromium at /usr/bin/chromium" "4, apt-get install chromium" test -x /usr/
 need "the oracle's Python with numpy and shapely (target/pyenv)" \
   "5, python3 -m venv target/pyenv && target/pyenv/bin/pip install numpy==2.4.6 shapely==2.2.0" \
   "${ORACLE_PYTHON:-target/pyenv/bin/python3}" -c 'import numpy, shapely'
-for bin in esbuild tsc; do
+for bin in esbuild tsc wasm-opt; do
   need "node_modules/.bin/$bin" "6, npm ci" test -x "node_modules/.bin/$bin"
 done
 need "node_modules/playwright-core" "6, npm ci" test -d node_modules/playwright-core

@@ -68,7 +68,8 @@ fi
 # npm writes node_modules/.package-lock.json on every install: missing or older than
 # package-lock.json means node_modules is absent, incomplete or stale.
 if [ ! -f node_modules/.package-lock.json ] || [ package-lock.json -nt node_modules/.package-lock.json ] \
-   || [ ! -e node_modules/.bin/esbuild ] || [ ! -e node_modules/.bin/tsc ] || [ ! -d node_modules/playwright-core ]; then
+   || [ ! -e node_modules/.bin/esbuild ] || [ ! -e node_modules/.bin/tsc ] || [ ! -d node_modules/playwright-core ] \
+   || [ ! -e node_modules/.bin/wasm-opt ]; then
   echo "setup: npm ci" >&2
   npm ci --no-audit --no-fund
 fi

@@ -1,5 +1,5 @@
 //! What every stage shares: geometry types, the boolean engine's operations, the spatial
-//! index, work on all cores, settings and errors.
+//! index, work on all cores, settings and errors, the per-stage time counters.
 
 pub mod boolean;
 pub mod error;
@@ -8,3 +8,4 @@ pub mod nearest;
 pub mod parallel;
 pub mod settings;
 pub mod spatial;
+pub mod stages;

@@ -3,6 +3,7 @@
 
 use crate::base::geom;
 use crate::base::settings::{self, Settings};
+use crate::base::stages::{self, Stage};
 use crate::model::mesh::Mesh;
 use crate::model::prepare::JobInfo;
 use crate::output::gcode;
@@ -88,7 +89,9 @@ impl Job {
 
     /// The cross-section of layer `i`.
     pub fn section(&self, i: usize) -> Section {
-        slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i])
+        stages::time(Stage::Section, || {
+            slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i])
+        })
     }
 
     /// The closed loops of layer `i` before their union (for diagnostics).
@@ -128,7 +131,7 @@ impl Job {
         if self.settings.support == settings::Support::Unit1 {
             return self.supported_plans()[i].clone();
         }
-        let (mut plan, region) = self.plan_parts(i, &section);
+        let (mut plan, region) = stages::time(Stage::Plan, || self.plan_parts(i, &section));
         // Layers stay independent: the overhang needs only the section below.
         let sliced;
         let below = match (i.checked_sub(1), below) {
@@ -139,7 +142,9 @@ impl Job {
                 Some(&sliced)
             }
         };
-        plan.unsupported_area = overhang::overhang_area(&section.region, below, &self.settings);
+        plan.unsupported_area = stages::time(Stage::Overhang, || {
+            overhang::overhang_area(&section.region, below, &self.settings)
+        });
         (plan, region)
     }
 

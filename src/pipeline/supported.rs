@@ -3,6 +3,7 @@
 
 use crate::base::geom;
 use crate::base::parallel::{both, par_map};
+use crate::base::stages::{self, Stage};
 use crate::pipeline::Job;
 use crate::slicing::plan::{self, LayerPlan};
 use crate::support::{self, droplets as support_droplets};
@@ -35,14 +36,20 @@ impl Job {
             // The support regions (their top-down union is sequential) beside the parts' own
             // plans, which do not depend on them.
             let (layers, parts) = both(
-                || support::support_layers(&regions, s),
-                || par_map(n, &|i| self.plan_parts(i, &sections[i])),
+                || stages::time(Stage::Support, || support::support_layers(&regions, s)),
+                || {
+                    par_map(n, &|i| {
+                        stages::time(Stage::Plan, || self.plan_parts(i, &sections[i]))
+                    })
+                },
             );
             drop(sections);
             // Unit 1's hatch moves of each layer, after its part plan.
             let hatches = par_map(n, &|i| {
                 let start = plan::unit1_start(&parts[i].0, s);
-                support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
+                stages::time(Stage::Support, || {
+                    support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
+                })
             });
             let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> = parts
                 .into_iter()
@@ -57,14 +64,16 @@ impl Job {
             // The droplet-level pass reads each layer's droplets from its moves when it needs
             // them (no list of all droplets is kept).
             let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
-            let (extra, figures) = support_droplets::complete(
-                &|i, within, out: &mut Vec<support_droplets::Droplet>| {
-                    support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
-                    support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
-                },
-                &regions,
-                s,
-            );
+            let (extra, figures) = stages::time(Stage::Support, || {
+                support_droplets::complete(
+                    &|i, within, out: &mut Vec<support_droplets::Droplet>| {
+                        support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
+                        support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
+                    },
+                    &regions,
+                    s,
+                )
+            });
             let plans = planned
                 .into_iter()
                 .enumerate()

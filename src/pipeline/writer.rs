@@ -4,6 +4,7 @@
 
 use crate::base::error::Error;
 use crate::base::geom;
+use crate::base::stages::{self, Stage};
 use crate::output::gcode;
 use crate::output::summary::Summary;
 use crate::pipeline::Job;
@@ -54,6 +55,12 @@ where
         written: usize,
     }
     let io = |e: std::io::Error| Error::Io(format!("cannot write the code: {e}"));
+    // DROPSLICE_STAGES=1: the time of each stage, summed over the threads, to stderr at the end
+    let profile = std::env::var_os("DROPSLICE_STAGES").is_some_and(|v| v == "1");
+    if profile {
+        stages::enable(true);
+    }
+    let started = std::time::Instant::now();
     out.write_all(job.header(None).as_bytes()).map_err(io)?;
     let n = job.layer_count();
     let threads = std::thread::available_parallelism()
@@ -135,8 +142,9 @@ where
                     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                         let section = section.unwrap_or_else(|p| std::panic::resume_unwind(p));
                         let (mut p, region) = job.plan_layer_with(i, section, below.as_deref());
-                        let text = gcode::layer_text(&p);
-                        let extra = K::per_layer(&mut state, i, &region, &p);
+                        let text = stages::time(Stage::Text, || gcode::layer_text(&p));
+                        let extra =
+                            stages::time(Stage::Sink, || K::per_layer(&mut state, i, &region, &p));
                         let units = (p.first_unit(), p.moves.last().map(|m| m.unit));
                         p.moves = Vec::new();
                         (text, p, extra, units.0, units.1)
@@ -189,5 +197,16 @@ where
     })?;
     out.write_all(gcode::footer(&summary).as_bytes())
         .map_err(io)?;
+    if profile {
+        let parts: Vec<String> = stages::read()
+            .iter()
+            .map(|(name, ms)| format!("{name} {ms:.0}"))
+            .collect();
+        eprintln!(
+            "stages (ms, summed over {threads} threads): {}; the writer's wall {:.0}",
+            parts.join(", "),
+            started.elapsed().as_secs_f64() * 1e3
+        );
+    }
     Ok(summary)
 }

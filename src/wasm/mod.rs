@@ -28,6 +28,7 @@ use models::{job_of, read_file};
 use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
+use crate::base::stages::{self, Stage};
 use crate::model::mesh::Mesh;
 use crate::model::spec as job;
 use crate::output::gcode;
@@ -131,6 +132,21 @@ pub fn job_schema() -> Result<JsValue, JsValue> {
 #[wasm_bindgen(unchecked_return_type = "Record<string, number | boolean | string>")]
 pub fn default_settings() -> Result<JsValue, JsValue> {
     to_js(&Settings::default(), "the default settings")
+}
+
+/// Turns the core's per-stage time counters on (from zero) or off ([`crate::base::stages`]):
+/// the page's per-stage profile (docs/performance.md), off unless a benchmark asks.
+#[wasm_bindgen]
+pub fn profile_stages(on: bool) {
+    stages::enable(on);
+}
+
+/// The core's time per stage since [`profile_stages`] turned the counters on:
+/// `{prepare, section, plan, overhang, support, text, preview, sink}`, ms.
+#[wasm_bindgen(unchecked_return_type = "Record<string, number>")]
+pub fn stage_times() -> Result<JsValue, JsValue> {
+    let map: std::collections::BTreeMap<&str, f64> = stages::read().into_iter().collect();
+    to_js(&map, "the stage times")
 }
 
 /// Panics on purpose: lets the page's tests check that a crash becomes an error message.
@@ -263,7 +279,7 @@ impl Session {
             _ => self.job.unit_before(i),
         };
         self.unit_after.set(Some((i, plan.unit_after(before))));
-        let text = gcode::layer_text_after(&plan, before);
+        let text = stages::time(Stage::Text, || gcode::layer_text_after(&plan, before));
         (plan, region, text)
     }
 }
@@ -308,7 +324,8 @@ impl Session {
     pub fn from_file(file: web_sys::File, settings: JsValue) -> Result<Session, JsValue> {
         let settings = settings_of(settings)?;
         let bytes = read_file(&file)?;
-        let job = Job::new(&bytes, &file.name(), settings).map_err(js_error)?;
+        let job = stages::time(Stage::Prepare, || Job::new(&bytes, &file.name(), settings))
+            .map_err(js_error)?;
         Ok(Session::with(job))
     }
 
@@ -318,7 +335,8 @@ impl Session {
     /// [`Session::from_prepared`] (with the same settings) as for one file.
     pub fn from_models(models: &Models, job: JsValue) -> Result<Session, JsValue> {
         let spec = job_of(job)?;
-        let job = Job::from_models(&models.models, &spec).map_err(js_error)?;
+        let job = stages::time(Stage::Prepare, || Job::from_models(&models.models, &spec))
+            .map_err(js_error)?;
         Ok(Session::with(job))
     }
 
@@ -344,7 +362,8 @@ impl Session {
                 .collect(),
             facets: facets.chunks_exact(3).map(|f| [f[0], f[1], f[2]]).collect(),
         };
-        let job = Job::from_prepared(mesh, info, settings).map_err(js_error)?;
+        let job = stages::time(Stage::Prepare, || Job::from_prepared(mesh, info, settings))
+            .map_err(js_error)?;
         Ok(Session::with(job))
     }
 
@@ -507,7 +526,9 @@ impl LayerResult {
             unsupported_area: plan.unsupported_area,
             summary: Summary::of_layer(plan),
             gcode,
-            preview: PreviewLayer::from_plan(plan, settings.droplet_width()),
+            preview: stages::time(Stage::Preview, || {
+                PreviewLayer::from_plan(plan, settings.droplet_width())
+            }),
             analysis: None,
             mask: None,
         }

@@ -6,8 +6,8 @@
 // repeated). The pool remembers which Files the job worker holds and adds them again to a
 // fresh worker (after a cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
-// flight, so it never waits for the page between units). Layers come back as progress replies
-// (buffers transferred) and are stored by index, so the page sees them in layer order however
+// flight, so it never waits for the page between units). Layers come back in batches ("layers" replies,
+// buffers transferred) and are stored by index, so the page sees them in layer order however
 // the workers finish; a unit's result carries its G-code as one Blob. Cancel terminates every
 // worker at once, rejects what was pending and starts fresh workers.
 
@@ -27,6 +27,10 @@ import type {
   SliceUnit,
   Summary,
 } from "./protocol";
+import { StageClock, publish } from "./stages";
+
+/** The page's side of the per-stage profile (core/stages.ts). */
+const clock = publish(new StageClock());
 
 /** An error from a worker: the core's `{kind, message, setting?}` or the page's "crash". */
 export class SliceError extends Error {
@@ -93,6 +97,10 @@ class WorkerHandle {
     if (!p) return;
     if (reply.kind === "progress") {
       p.progress?.(reply.data);
+      return;
+    }
+    if (reply.kind === "layers") {
+      for (const l of reply.data) p.progress?.(l);
       return;
     }
     this.pending.delete(reply.id);
@@ -165,16 +173,21 @@ async function syncModels(h: WorkerHandle, files: JobFileRef[]): Promise<void> {
     await h.call("models_remove", { names: gone });
   }
   const missing = files.filter((f) => h.models.get(f.name) !== f.file);
-  if (missing.length) await addTo(h, missing);
+  if (missing.length) await addTo(h, missing, null);
 }
 
 /** Adds `files` to `h`'s Models and records them; on a refusal the names are forgotten (the
- *  worker may have replaced some of them before refusing one). */
-async function addTo(h: WorkerHandle, files: JobFileRef[]): Promise<ResultOf<"models_add">> {
+ *  worker may have replaced some of them before refusing one). Their SHA-256 comes from
+ *  `hasher`: another worker hashes while `h` reads and imports (in `h` the hash would wait for
+ *  the import: its thread is busy); `h` itself hashes after reading; `null`: no hash. */
+async function addTo(h: WorkerHandle, files: JobFileRef[], hasher: WorkerHandle | null): Promise<ResultOf<"models_add">> {
   try {
-    const r = await h.call("models_add", { files });
+    const aside = hasher && hasher !== h ? Promise.all(files.map((f) => hasher.call("hash", { file: f.file }))) : null;
+    aside?.catch(() => {}); // awaited below; a refusal of the import must not leave it unhandled
+    const r = await h.call("models_add", { files, hash: hasher === h });
+    const sha256 = aside ? await aside : r.sha256;
     for (const f of files) h.models.set(f.name, f.file);
-    return r;
+    return { infos: r.infos, sha256 };
   } catch (e) {
     for (const f of files) h.models.delete(f.name);
     throw e;
@@ -287,7 +300,9 @@ export class Pool {
           nextUnit = unitCounter(r.layers, handles.length);
           cb.opened(r);
         }
-        await this.units(h, nextUnit, { analyse }, cb.layer, cb.unit);
+        const layer = (l: LayerData) => clock.time("page: layer arrived (store, draw)", () => cb.layer(l));
+        const unit = (u: SliceUnit) => clock.time("page: unit arrived (figures)", () => cb.unit(u));
+        await this.units(h, nextUnit, { analyse }, layer, unit);
       });
     });
   }
@@ -353,7 +368,7 @@ export class Pool {
    *  order. A name it holds already is replaced. Nothing else of the job changes. */
   addModels(files: JobFileRef[]): Promise<{ infos: ModelInfo[]; sha256: string[] }> {
     this.heal();
-    return this.guarded(() => addTo(this.handles[0], files));
+    return this.guarded(() => addTo(this.handles[0], files, this.handles[1] ?? this.handles[0]));
   }
 
   /** Where every instance of `job` goes (the core's arrangement; it checks the whole job). */

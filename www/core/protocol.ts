@@ -1,6 +1,7 @@
 // Messages between the page (client.ts) and a worker (worker/worker.ts).
 // Every request is {id, kind, data}; the worker answers with any number of
-// "progress" replies and then exactly one "result" or "error" reply with the same id.
+// "progress" replies (a slice's: "layers", a batch of layers in one message) and then exactly
+// one "result" or "error" reply with the same id.
 //
 // The values the core hands out (model info, layouts, job info, summaries, figures, layer
 // analyses, the settings schema, calibrations, errors) are typed by the core itself: their
@@ -208,7 +209,9 @@ export interface Calls {
   crash: { data: null; result: void };
   /** Build jobs (the job worker's `Models`, src/wasm/mod.rs): files added under their job names
    *  (a name already there is replaced), with their info and SHA-256. */
-  models_add: { data: { files: { name: string; file: File }[] }; result: { infos: ModelInfo[]; sha256: string[] } };
+  /** `hash: false`: no SHA-256 here (`sha256` empty; the pool has another worker hash the
+   *  files meanwhile, or needs no hash). */
+  models_add: { data: { files: { name: string; file: File }[]; hash?: boolean }; result: { infos: ModelInfo[]; sha256: string[] } };
   models_remove: { data: { names: string[] }; result: void };
   /** A decimated copy of a file's (or 3MF item's) triangles for the 3D view (9 floats each). */
   display_mesh: { data: { name: string; item?: number; max: number }; result: Float32Array };
@@ -270,6 +273,7 @@ export type Request = { [K in RequestKind]: { id: number; kind: K; data: Request
 
 export type Reply =
   | { id: number; kind: "progress"; data: LayerData }
+  | { id: number; kind: "layers"; data: LayerData[] }
   | { id: number; kind: "result"; data: ResultOf<RequestKind> }
   | { id: number; kind: "error"; data: ErrorValue };
 

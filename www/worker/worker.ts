@@ -1,12 +1,13 @@
 // One worker = one wasm instance = at most one Session (one prepared slicing job), and in the
 // job worker (the pool's first) the job's `Models` (its imported files). Answers the requests
-// of core/protocol.ts; streams layers as "progress" replies with their buffers transferred. The
+// of core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred). The
 // model files arrive as Files and are read here (by the core, with FileReaderSync), never on
 // the page's thread; the worker that prepares a job hands the prepared mesh to the others
 // ("adopt"). Everything from the core is a typed value; its
 // errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, { Models, Session, Tally, crash_for_test, default_settings, job_schema, overhang_face_normal_z, settings_schema, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
+import init, { Models, Session, Tally, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
+import { StageClock, publish } from "../core/stages";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
@@ -29,6 +30,15 @@ import {
 } from "../core/protocol";
 
 const scope = self as unknown as DedicatedWorkerGlobalScope;
+/** The per-stage profile (core/stages.ts): this worker's hand-offs and the core's counters. */
+const clock = publish(
+  new StageClock({
+    reset: (on) => {
+      if (memory) profile_stages(on);
+    },
+    read: () => (memory ? stage_times() : {}),
+  }),
+);
 
 let wasm: Promise<InitOutput> | null = null;
 let memory: WebAssembly.Memory | null = null;
@@ -84,7 +94,8 @@ function yieldToQueue(): Promise<void> {
 }
 
 function layerOf(s: Session, index: number, unit: { gcode: Uint8Array[]; tally: Tally } | null, analyse = false, counted = true): LayerData {
-  const r = analyse ? s.slice_layer_analysed(index) : s.slice_layer(index);
+  const r = clock.time("core: a layer (all its stages)", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index)));
+  const t0 = performance.now();
   try {
     if (unit) {
       if (counted) {
@@ -111,28 +122,42 @@ function layerOf(s: Session, index: number, unit: { gcode: Uint8Array[]; tally: 
     return layer;
   } finally {
     r.free();
+    clock.since("worker: copy out of wasm", t0);
   }
 }
 
 /** The unit being sliced: the next one starts when it ends. */
 let slicing: Promise<void> = Promise.resolve();
 
-/** Slices layers [from, to): each a progress reply, then the unit's G-code and summary. With
- *  `gcode: false` (an analysis after the slice) the summary holds only the layers' analysis. */
+/** A batch of layers is posted (and other requests let in) once it is this old, ms: a
+ *  message per layer cost about a tenth of the worker's time, and as much on the page's thread. */
+const BATCH_MS = 25;
+
+/** Slices layers [from, to): batches of layers as "layers" replies, then the unit's G-code and
+ *  summary. With `gcode: false` (an analysis after the slice) the summary holds only the
+ *  layers' analysis. */
 async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
   const s = need();
   const { from, to } = req;
   const counted = req.gcode ?? true;
   const parts = { gcode: [] as Uint8Array[], tally: new Tally() };
+  let batch: LayerData[] = [];
+  let since = performance.now();
   try {
     for (let i = from; i < to; i++) {
-      const layer = layerOf(s, i, parts, req.analyse, counted);
-      post({ id, kind: "progress", data: layer }, transferablesOf(layer));
+      batch.push(layerOf(s, i, parts, req.analyse, counted));
+      if (i + 1 < to && performance.now() - since < BATCH_MS) continue;
+      const sent = batch;
+      batch = [];
+      clock.time("worker: post", () => post({ id, kind: "layers", data: sent }, sent.flatMap(transferablesOf)));
+      const t0 = performance.now();
       await yieldToQueue();
+      clock.since("worker: yield to the queue", t0);
+      since = performance.now();
       if (session !== s) throw internal("the model was replaced during slicing");
     }
     const unit: SliceUnit = { from, to, summary: parts.tally.summary() };
-    if (counted) unit.gcode = new Blob(parts.gcode as BlobPart[], { type: "text/plain" });
+    if (counted) unit.gcode = clock.time("worker: blob", () => new Blob(parts.gcode as BlobPart[], { type: "text/plain" }));
     answer("slice", id, unit);
   } finally {
     parts.tally.free();
@@ -167,10 +192,16 @@ async function handle(req: Request): Promise<void> {
       models ??= new Models();
       const infos: ModelInfo[] = [];
       const sha256: string[] = [];
+      const hashing = req.data.hash ?? true;
       for (const { name, file } of req.data.files) {
-        const hash = sha256Of(file);
-        infos.push(models.add(file, name));
-        sha256.push(await hash);
+        const hash = hashing ? sha256Of(file) : null;
+        const m = models;
+        infos.push(clock.time("worker: file read and parsed", () => m.add(file, name)));
+        if (hash) {
+          const t0 = performance.now();
+          sha256.push(await hash);
+          clock.since("worker: waiting for SHA-256", t0);
+        }
       }
       answer(req.kind, req.id, { infos, sha256 });
       return;
@@ -199,7 +230,7 @@ async function handle(req: Request): Promise<void> {
       const transfer: Transferable[] = [];
       if (req.data.prepare) {
         const s = need();
-        result.prepared = { vertices: s.vertices(), facets: s.facets(), info: result.info };
+        result.prepared = clock.time("worker: prepared mesh out", () => ({ vertices: s.vertices(), facets: s.facets(), info: result.info }));
         transfer.push(result.prepared.vertices.buffer, result.prepared.facets.buffer);
       }
       answer(req.kind, req.id, result, transfer);
@@ -309,6 +340,11 @@ function describe(e: unknown): ErrorValue {
   if (isErrorValue(e)) return { kind: e.kind, message: e.message, ...(e.setting ? { setting: e.setting } : {}) };
   return internal(e instanceof Error ? e.message : String(e));
 }
+
+// The module is compiled and instantiated as soon as the worker starts, not at its first
+// request: a worker that adopts a prepared mesh would otherwise compile it only then, on the
+// slice's path. A failure is reported to the first request that needs the core.
+load().catch(() => {});
 
 scope.onmessage = (ev: MessageEvent<Request>) => {
   const req = ev.data;
