@@ -31,15 +31,7 @@ pub fn models_job_spec(files: &[String], settings: &Settings) -> Result<JobSpec,
     }
     let parts = files
         .iter()
-        .map(|file| PartSpec {
-            rotate_x: s.rotate_x,
-            rotate_y: s.rotate_y,
-            rotate_z: s.rotate_z,
-            scale_x: s.scale_x,
-            scale_y: s.scale_y,
-            scale_z: s.scale_z,
-            ..PartSpec::new(file)
-        })
+        .map(|file| PartSpec::shaped_like(file, s))
         .collect();
     Ok(JobSpec {
         settings: without_part_keys(s),
@@ -49,19 +41,13 @@ pub fn models_job_spec(files: &[String], settings: &Settings) -> Result<JobSpec,
 
 /// The settings with the part keys at their defaults (they went to the parts).
 fn without_part_keys(s: &Settings) -> Settings {
-    let d = Settings::default();
-    Settings {
-        rotate_x: d.rotate_x,
-        rotate_y: d.rotate_y,
-        rotate_z: d.rotate_z,
-        scale_x: d.scale_x,
-        scale_y: d.scale_y,
-        scale_z: d.scale_z,
-        place_x: d.place_x,
-        place_y: d.place_y,
-        place_angle: d.place_angle,
-        ..s.clone()
+    let defaults = serde_json::to_value(Settings::default()).expect("settings serialise");
+    let mut out = s.clone();
+    for k in PART_KEYS {
+        out.set_value(k, defaults[k].clone())
+            .expect("a part key's default is a valid value");
     }
+    out
 }
 
 /// Applies `overrides` in order to a job file's settings. A part key (rotate_*, scale_*,

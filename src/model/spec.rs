@@ -161,15 +161,20 @@ pub struct PartSpec {
 impl PartSpec {
     /// A part of `file` with no transform, arranged, one copy, unit 0.
     pub fn new(file: &str) -> PartSpec {
+        PartSpec::shaped_like(file, &Settings::default())
+    }
+
+    /// A part of `file` rotated and scaled as `s` says, arranged, one copy, unit 0.
+    pub fn shaped_like(file: &str, s: &Settings) -> PartSpec {
         PartSpec {
             file: file.to_string(),
             item: None,
-            rotate_x: 0.0,
-            rotate_y: 0.0,
-            rotate_z: 0.0,
-            scale_x: 1.0,
-            scale_y: 1.0,
-            scale_z: 1.0,
+            rotate_x: s.rotate_x,
+            rotate_y: s.rotate_y,
+            rotate_z: s.rotate_z,
+            scale_x: s.scale_x,
+            scale_y: s.scale_y,
+            scale_z: s.scale_z,
             place_x: None,
             place_y: None,
             place_angle: 0.0,

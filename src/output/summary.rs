@@ -294,31 +294,29 @@ impl PartAnalysis {
             self.largest_void = Some(v);
             self.largest_void_layer = o.largest_void_layer;
         }
-        if o.max_deviation_layer.is_some()
-            && (self.max_deviation_layer.is_none()
-                || better(
-                    o.max_boundary_deviation,
-                    o.max_deviation_layer,
-                    self.max_boundary_deviation,
-                    self.max_deviation_layer,
-                ))
-        {
-            self.max_boundary_deviation = o.max_boundary_deviation;
-            self.max_deviation_layer = o.max_deviation_layer;
-        }
+        // The larger figure of the two and its layer (ties: the lower layer).
+        let keep_max = |mine: (&mut f64, &mut Option<usize>), theirs: (f64, Option<usize>)| {
+            if theirs.1.is_some()
+                && (mine.1.is_none() || better(theirs.0, theirs.1, *mine.0, *mine.1))
+            {
+                (*mine.0, *mine.1) = theirs;
+            }
+        };
+        keep_max(
+            (
+                &mut self.max_boundary_deviation,
+                &mut self.max_deviation_layer,
+            ),
+            (o.max_boundary_deviation, o.max_deviation_layer),
+        );
         self.unsupported_area += o.unsupported_area;
-        if o.max_unsupported_area_layer.is_some()
-            && (self.max_unsupported_area_layer.is_none()
-                || better(
-                    o.max_unsupported_area,
-                    o.max_unsupported_area_layer,
-                    self.max_unsupported_area,
-                    self.max_unsupported_area_layer,
-                ))
-        {
-            self.max_unsupported_area = o.max_unsupported_area;
-            self.max_unsupported_area_layer = o.max_unsupported_area_layer;
-        }
+        keep_max(
+            (
+                &mut self.max_unsupported_area,
+                &mut self.max_unsupported_area_layer,
+            ),
+            (o.max_unsupported_area, o.max_unsupported_area_layer),
+        );
         self.volume += o.volume;
         self.void_volume += o.void_volume;
         self.void_fraction = if self.volume > 0.0 {

@@ -382,11 +382,12 @@ impl Estimate {
                     format!("up to {ds:.1e} of support, B₁ = {} mm", mm(b1)),
                 )
             };
-            return Err(Error::setting(
+            let figure = format!("the job could take up to {total:.1e} droplets");
+            return Err(too_many_with_support(
                 name,
-                format!(
-                    "with support the job could take up to {total:.1e} droplets ({what}), more than the {MAX_DROPLETS_WITH_SUPPORT:.0e} the support's check of every droplet allows; raise {name} (or layer_height), or set support = off"
-                ),
+                &figure,
+                &what,
+                MAX_DROPLETS_WITH_SUPPORT,
             ));
         }
         let used = support || self.unit1_volume > 0.0;
@@ -418,11 +419,13 @@ impl Estimate {
                         format!("unit 1's B₁ = {} mm", mm(b1)),
                     )
                 };
-                return Err(Error::setting(
+                let figure =
+                    format!("a layer of {a:.0} mm² could hold up to {per_layer:.1e} droplets");
+                return Err(too_many_with_support(
                     name,
-                    format!(
-                        "with support a layer of {a:.0} mm² could hold up to {per_layer:.1e} droplets ({what}), more than the {MAX_LAYER_DROPLETS_WITH_SUPPORT:.0e} the support's check of every droplet allows; raise {name} (or layer_height), or set support = off"
-                    ),
+                    &figure,
+                    &what,
+                    MAX_LAYER_DROPLETS_WITH_SUPPORT,
                 ));
             }
         }
@@ -431,6 +434,16 @@ impl Estimate {
 }
 
 /// Whether `x` is beyond `limit` (or not a number).
+/// The refusal of a job whose support pass would check more droplets than `cap`.
+fn too_many_with_support(name: &str, figure: &str, what: &str, cap: f64) -> Error {
+    Error::setting(
+        name,
+        format!(
+            "with support {figure} ({what}), more than the {cap:.0e} the support's check of every droplet allows; raise {name} (or layer_height), or set support = off"
+        ),
+    )
+}
+
 fn over(x: f64, limit: f64) -> bool {
     x.is_nan() || x > limit
 }

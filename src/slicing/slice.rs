@@ -251,14 +251,8 @@ fn chain_directed(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec
         .map(|(i, s)| (s.start, i as u32))
         .collect();
     by_start.sort_unstable();
-    let find_start = |key: u64, used: &[bool]| -> Option<usize> {
-        let from = by_start.partition_point(|e| e.0 < key);
-        by_start[from..]
-            .iter()
-            .take_while(|e| e.0 == key)
-            .map(|e| e.1 as usize)
-            .find(|&i| !used[i])
-    };
+    let find_start =
+        |key: u64, used: &[bool]| -> Option<usize> { first_of_key(&by_start, key, |i| !used[i]) };
 
     let mut loops = Vec::new();
     let mut leftovers: Vec<usize> = Vec::new();
@@ -310,14 +304,8 @@ fn chain_undirected(
     for &i in leftovers {
         free[i] = true;
     }
-    let neighbour = |key: u64, free: &[bool]| -> Option<usize> {
-        let from = by_key.partition_point(|e| e.0 < key);
-        by_key[from..]
-            .iter()
-            .take_while(|e| e.0 == key)
-            .map(|e| e.1 as usize)
-            .find(|&i| free[i])
-    };
+    let neighbour =
+        |key: u64, free: &[bool]| -> Option<usize> { first_of_key(&by_key, key, |i| free[i]) };
     let mut open: Vec<(usize, Vec<Point>)> = Vec::new();
     for &s0 in leftovers {
         if !free[s0] {
@@ -483,6 +471,17 @@ pub fn simplify_closed(c: &[Point], tol: f64) -> Contour {
         }
     }
     (0..n).filter(|&i| keep[i]).map(|i| c[i]).collect()
+}
+
+/// In `sorted` (pairs of key and index, sorted), the first index of `key` that `ok` accepts.
+#[inline]
+fn first_of_key(sorted: &[(u64, u32)], key: u64, ok: impl Fn(usize) -> bool) -> Option<usize> {
+    let from = sorted.partition_point(|e| e.0 < key);
+    sorted[from..]
+        .iter()
+        .take_while(|e| e.0 == key)
+        .map(|e| e.1 as usize)
+        .find(|&i| ok(i))
 }
 
 #[cfg(test)]

@@ -11,50 +11,24 @@
 
 import type {
   Angles,
-  Bounds,
   Calibration,
   Counts,
   CutResult,
   ErrorReport,
   Figures,
-  Instance,
-  ItemInfo,
   JobInfo,
   JobSchema,
   LayerAnalysis,
   Layout,
-  MeshStats,
   ModelInfo,
-  PartAnalysis,
   PartSpec,
   SettingSpec,
   SliceFigures,
   Summary,
-  Void,
-  WorstLayer,
 } from "../pkg/dropslice.js";
 
-export type {
-  Bounds,
-  Calibration,
-  Counts,
-  Figures,
-  Instance,
-  ItemInfo,
-  JobInfo,
-  JobSchema,
-  LayerAnalysis,
-  Layout,
-  MeshStats,
-  ModelInfo,
-  PartAnalysis,
-  PartSpec,
-  SettingSpec,
-  SliceFigures,
-  Summary,
-  Void,
-  WorstLayer,
-};
+// Every type the core generates (tsify) is part of the protocol.
+export type * from "../pkg/dropslice.js";
 
 /** A job file (docs/jobs.md): the job's settings (no part keys) and its parts. */
 export interface JobFile {

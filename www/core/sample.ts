@@ -34,30 +34,29 @@ export function sampleStl(): { name: string; bytes: Uint8Array } {
   const tris: number[][] = [];
   const tri = (p: P2, pz: number, q: P2, qz: number, r: P2, rz: number) =>
     tris.push([p[0], p[1], pz, q[0], q[1], qz, r[0], r[1], rz]);
+  type V = [P2, number];
+  // the quad a b c d (counter-clockwise seen from its front), or seen from its back (flip)
+  const quad = (a: V, b: V, c: V, d: V, flip: boolean) => {
+    if (flip) {
+      tri(...a, ...c, ...b);
+      tri(...a, ...d, ...c);
+    } else {
+      tri(...a, ...b, ...c);
+      tri(...a, ...c, ...d);
+    }
+  };
   // flat band between outer curve P and inner curve Q at height z; up = normal +z
   const ring = (P: P2[], Q: P2[], z: number, up: boolean) => {
     for (let i = 0; i < N; i++) {
       const j = (i + 1) % N;
-      if (up) {
-        tri(Q[i], z, P[i], z, P[j], z);
-        tri(Q[i], z, P[j], z, Q[j], z);
-      } else {
-        tri(Q[i], z, P[j], z, P[i], z);
-        tri(Q[i], z, Q[j], z, P[j], z);
-      }
+      quad([Q[i], z], [P[i], z], [P[j], z], [Q[j], z], !up);
     }
   };
   // vertical wall along curve P from z0 to z1; out = normal away from the axis
   const wall = (P: P2[], z0: number, z1: number, out: boolean) => {
     for (let i = 0; i < N; i++) {
       const j = (i + 1) % N;
-      if (out) {
-        tri(P[i], z0, P[j], z0, P[j], z1);
-        tri(P[i], z0, P[j], z1, P[i], z1);
-      } else {
-        tri(P[i], z0, P[j], z1, P[j], z0);
-        tri(P[i], z0, P[i], z1, P[j], z1);
-      }
+      quad([P[i], z0], [P[j], z0], [P[j], z1], [P[i], z1], !out);
     }
   };
   ring(square, hole, 0, false);

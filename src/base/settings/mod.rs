@@ -431,10 +431,14 @@ mod tests {
     #[test]
     fn set_parses_and_validates() {
         let mut s = Settings::default();
-        s.set("contours", "3").unwrap();
-        s.set("contour_order", "outside_in").unwrap();
-        s.set("close_loops", "false").unwrap();
-        s.set("layer_height", "0.265").unwrap();
+        for (k, v) in [
+            ("contours", "3"),
+            ("contour_order", "outside_in"),
+            ("close_loops", "false"),
+            ("layer_height", "0.265"),
+        ] {
+            s.set(k, v).unwrap();
+        }
         assert_eq!(s.contours, 3);
         assert_eq!(s.contour_order, ContourOrder::OutsideIn);
         assert!(!s.close_loops);

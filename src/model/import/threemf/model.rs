@@ -357,12 +357,7 @@ impl Reader<'_> {
         totals: &mut Totals,
     ) -> Result<(), Error> {
         let p = self.part;
-        totals.vertices += 1;
-        if totals.vertices > MAX_VERTICES {
-            return Err(err(format!(
-                "the 3MF file has more than {MAX_VERTICES} vertices; at most that many are accepted — simplify the model"
-            )));
-        }
+        count(&mut totals.vertices, MAX_VERTICES, "vertices")?;
         let mut v = [0f32; 3];
         for (k, n) in ["x", "y", "z"].iter().enumerate() {
             let s = attr(attrs, n).ok_or_else(|| {
@@ -399,12 +394,7 @@ impl Reader<'_> {
         totals: &mut Totals,
     ) -> Result<(), Error> {
         let p = self.part;
-        totals.triangles += 1;
-        if totals.triangles > MAX_TRIANGLES {
-            return Err(err(format!(
-                "the 3MF file has more than {MAX_TRIANGLES} triangles; at most that many are accepted — simplify the model"
-            )));
-        }
+        count(&mut totals.triangles, MAX_TRIANGLES, "triangles")?;
         let t = [
             index(attr(attrs, "v1"), "a triangle's v1", p)?,
             index(attr(attrs, "v2"), "a triangle's v2", p)?,
@@ -479,4 +469,15 @@ impl Reader<'_> {
         });
         Ok(())
     }
+}
+
+/// Counts one more of `what` in the file, refused beyond `max`.
+fn count(n: &mut usize, max: usize, what: &str) -> Result<(), Error> {
+    *n += 1;
+    if *n > max {
+        return Err(err(format!(
+            "the 3MF file has more than {max} {what}; at most that many are accepted — simplify the model"
+        )));
+    }
+    Ok(())
 }
