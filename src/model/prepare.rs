@@ -41,6 +41,9 @@ pub struct JobInfo {
     /// (every job without unit-1 parts).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groups: Vec<FacetGroup>,
+    /// The profiles applied to the settings, in order (`name (kind)`), for the header.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profiles: Vec<String>,
 }
 
 /// A run of facets of the prepared mesh printed by one discharge unit ([`JobInfo::groups`]).
@@ -117,7 +120,7 @@ pub(crate) fn import(
     }
     let facets_in_file = tris.len();
     drop(tris);
-    let placement = mesh::Placement::of_settings(settings);
+    let placement = mesh::Placement::of_settings(settings).compensated(settings.shrink_factors(0));
     let frame = Frame::of(mesh.vertices.iter().copied(), &placement)
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;
@@ -131,7 +134,7 @@ pub(crate) fn import(
         item: None,
         object: None,
         rotate: placement.rotate,
-        scale: placement.scale,
+        scale: [settings.scale_x, settings.scale_y, settings.scale_z],
         place_angle: placement.place_angle,
         placed: true,
         at: place,
@@ -149,7 +152,7 @@ pub(crate) fn import(
         ],
         shift: place,
     };
-    mesh.transform(settings);
+    mesh.place(&placement);
     Ok(Imported {
         mesh,
         format,
@@ -166,6 +169,15 @@ pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), E
         return Err(Error::NothingToPrint(
             "the part is flat (0 mm tall after rotation): check rotate_x/rotate_y".into(),
         ));
+    }
+    if size[2] > settings.plate_z * (1.0 + 1e-12) {
+        return Err(Error::Setting {
+            name: "plate_z".into(),
+            message: format!(
+                "the job is {:.3} mm tall (after scale and shrinkage compensation), taller than the build chamber (plate_z = {} mm): lay the part down (rotate_x/rotate_y, dropslice orient), scale it down, or set plate_z to the machine's chamber height",
+                size[2], settings.plate_z
+            ),
+        });
     }
     let layers_needed = size[2] / h;
     if layers_needed > MAX_LAYERS as f64 {

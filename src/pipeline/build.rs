@@ -89,7 +89,7 @@ impl Job {
                     import::MAX_TRIANGLES
                 )));
             }
-            let frame = Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0]));
+            let frame = Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0], &settings));
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
                 return Err(Error::Import(format!(
                     "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
@@ -118,7 +118,7 @@ impl Job {
         let mut groups: Vec<FacetGroup> = Vec::new();
         for inst in order {
             let mut m = welded[inst.part].clone();
-            m.place(&spec.parts[inst.part].placement(inst.shift));
+            m.place(&spec.parts[inst.part].placement(inst.shift, &settings));
             let base = mesh.vertices.len() as u32;
             mesh.vertices.extend_from_slice(&m.vertices);
             mesh.facets
@@ -236,6 +236,7 @@ impl Job {
             droplet_width: settings.droplet_width(),
             instances: input.instances,
             groups,
+            profiles: Vec::new(),
         };
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
