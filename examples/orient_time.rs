@@ -13,7 +13,9 @@ use std::time::Instant;
 fn main() {
     let mut args = std::env::args().skip(1);
     let path = args.next().expect("usage: orient_time MODEL [RUNS]");
-    let runs: usize = args.next().map_or(7, |r| r.parse().expect("RUNS: a number"));
+    let runs: usize = args
+        .next()
+        .map_or(7, |r| r.parse().expect("RUNS: a number"));
     let bytes = std::fs::read(&path).expect("read the model");
     let model = Model::read(&bytes, &path).expect("a model");
     let tris = model.triangles(None).expect("triangles");

@@ -170,15 +170,6 @@ pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), E
             "the part is flat (0 mm tall after rotation): check rotate_x/rotate_y".into(),
         ));
     }
-    if size[2] > settings.plate_z * (1.0 + 1e-12) {
-        return Err(Error::Setting {
-            name: "plate_z".into(),
-            message: format!(
-                "the job is {:.3} mm tall (after scale and shrinkage compensation), taller than the build chamber (plate_z = {} mm): lay the part down (rotate_x/rotate_y, dropslice orient), scale it down, or set plate_z to the machine's chamber height",
-                size[2], settings.plate_z
-            ),
-        });
-    }
     let layers_needed = size[2] / h;
     if layers_needed > MAX_LAYERS as f64 {
         return Err(Error::Setting {
@@ -186,6 +177,15 @@ pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), E
             message: format!(
                 "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
                 size[2], layers_needed
+            ),
+        });
+    }
+    if size[2] > settings.plate_z * (1.0 + 1e-12) {
+        return Err(Error::Setting {
+            name: "plate_z".into(),
+            message: format!(
+                "the job is {:.3} mm tall (after scale and shrinkage compensation), taller than the build chamber (plate_z = {} mm): lay the part down (rotate_x/rotate_y, dropslice orient), scale it down, or set plate_z to the machine's chamber height",
+                size[2], settings.plate_z
             ),
         });
     }

@@ -89,7 +89,10 @@ impl Job {
                     import::MAX_TRIANGLES
                 )));
             }
-            let frame = Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0], &settings));
+            let frame = Frame::of(
+                mesh.vertices.iter().copied(),
+                &p.placement([0.0, 0.0], &settings),
+            );
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
                 return Err(Error::Import(format!(
                     "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",

@@ -103,13 +103,9 @@ impl Profile {
                 text.len()
             )));
         }
-        let raw: Raw = serde_json::from_str(text).map_err(|e| {
-            bad(format!(
-                "not a profile ({{\"name\": …, \"kind\": \"machine\" | \"material\", \"settings\": {{…}}}}): {}",
-                quote(&e.to_string())
-            ))
-        })?;
-        Profile::checked(raw)
+        let value: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| bad(format!("not JSON: {}", quote(&e.to_string()))))?;
+        Profile::from_value(value)
     }
 
     /// A profile from a parsed JSON value (e.g. from the page), checked.
@@ -242,6 +238,11 @@ mod tests {
             r#"{{"name": "{}", "kind": "machine", "settings": {{}}}}"#,
             "a".repeat(MAX_PROFILE_BYTES)
         );
-        assert!(Profile::from_json(&big).unwrap_err().to_string().contains("bytes"));
+        assert!(
+            Profile::from_json(&big)
+                .unwrap_err()
+                .to_string()
+                .contains("bytes")
+        );
     }
 }

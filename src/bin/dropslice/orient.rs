@@ -26,16 +26,7 @@ use std::process::ExitCode;
 const SHOWN: usize = 3;
 
 pub fn main(args: OrientArgs) -> ExitCode {
-    match run(&args) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("dropslice orient: {e}");
-            match e {
-                Error::Io(_) | Error::Internal(_) => ExitCode::from(1),
-                _ => ExitCode::from(2),
-            }
-        }
-    }
+    crate::slice::finish("dropslice orient", run(&args))
 }
 
 fn run(args: &OrientArgs) -> Result<(), Error> {
@@ -67,8 +58,7 @@ fn run(args: &OrientArgs) -> Result<(), Error> {
                 "parts[{i}] ({})",
                 clean_name(&p.name.clone().unwrap_or_else(|| model.part_name(p.item)))
             );
-            let o = orient_part(model, p, &spec.settings)
-                .map_err(|e| in_job_file(path, e))?;
+            let o = orient_part(model, p, &spec.settings).map_err(|e| in_job_file(path, e))?;
             print(&label, &o);
             chosen.push(o.best());
         }
@@ -85,8 +75,12 @@ fn run(args: &OrientArgs) -> Result<(), Error> {
         }
     }
     settings.validate()?;
-    let bytes = read_regular(path, dropslice::model::import::MAX_FILE_BYTES, "a model file")
-        .map_err(Error::Import)?;
+    let bytes = read_regular(
+        path,
+        dropslice::model::import::MAX_FILE_BYTES,
+        "a model file",
+    )
+    .map_err(Error::Import)?;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -148,8 +142,12 @@ fn angle(x: f64) -> serde_json::Value {
 
 /// The job file with each part's chosen rotation, the rest of the file kept.
 fn apply_to_job_file(path: &Path, chosen: &[Orientation]) -> Result<(), Error> {
-    let bytes = read_regular(path, dropslice::model::spec::MAX_JOB_FILE_BYTES as u64, "a job file")
-        .map_err(|e| Error::Job(format!("the job file: {e}")))?;
+    let bytes = read_regular(
+        path,
+        dropslice::model::spec::MAX_JOB_FILE_BYTES as u64,
+        "a job file",
+    )
+    .map_err(|e| Error::Job(format!("the job file: {e}")))?;
     let mut value: serde_json::Value = serde_json::from_slice(&bytes)
         .map_err(|e| Error::Job(format!("{}: {}", shown_path(path), quote(&e.to_string()))))?;
     let parts = value

@@ -53,10 +53,15 @@ pub fn main(cli: SliceArgs, settings: Vec<SettingsArg>) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run(&args, &output, out, report) {
+    finish("dropslice", run(&args, &output, out, report))
+}
+
+/// The message of a failed command and its exit code: 1 for I/O and internal errors, else 2.
+pub fn finish(who: &str, result: Result<(), Error>) -> ExitCode {
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("dropslice: {e}");
+            eprintln!("{who}: {e}");
             match e {
                 Error::Io(_) | Error::Internal(_) => ExitCode::from(1),
                 _ => ExitCode::from(2),
