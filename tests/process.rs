@@ -23,6 +23,19 @@ fn settings(sets: &[(&str, &str)]) -> Settings {
     s
 }
 
+/// The CLI run in `dir` with the arguments as one line of words (no word holds a space;
+/// `@NAME` stands for the shared model NAME).
+fn cli(dir: &TempDir, words: &str) -> common::Run {
+    let args: Vec<String> = words
+        .split_whitespace()
+        .map(|w| match w.strip_prefix('@') {
+            Some(name) => model(name).display().to_string(),
+            None => w.to_string(),
+        })
+        .collect();
+    run_cli(&args, dir.path(), T)
+}
+
 /// The triangles of a shared model.
 fn triangles(name: &str) -> Vec<[[f32; 3]; 3]> {
     Model::read(&model_bytes(name), name)
@@ -119,21 +132,12 @@ fn shrinkage_is_per_unit_and_the_arrangement_uses_the_compensated_size() {
 #[test]
 fn the_header_lists_the_four_shrinkage_values() {
     let dir = TempDir::new("shrink-header");
-    let out = dir.join("c.gco");
-    let r = run_cli(
-        &[
-            model("cube_20mm_ascii.stl").display().to_string(),
-            "-q".into(),
-            "-o".into(),
-            out.display().to_string(),
-            "--set".into(),
-            "unit1_shrink_z=0.5".into(),
-        ],
-        dir.path(),
-        T,
+    let r = cli(
+        &dir,
+        "@cube_20mm_ascii.stl -q -o c.gco --set unit1_shrink_z=0.5",
     );
     assert_eq!(r.code, Some(0), "{r:?}");
-    let text = std::fs::read_to_string(&out).unwrap();
+    let text = std::fs::read_to_string(dir.join("c.gco")).unwrap();
     for line in [
         "; shrink_xy = 0.0 (%)",
         "; shrink_z = 0.0 (%)",
@@ -151,18 +155,9 @@ fn the_header_lists_the_four_shrinkage_values() {
 #[test]
 fn a_job_taller_than_the_chamber_is_refused_before_writing() {
     let dir = TempDir::new("plate-z");
-    let r = run_cli(
-        &[
-            model("cube_20mm_ascii.stl").display().to_string(),
-            "-o".into(),
-            "cube.gco".into(),
-            "--set".into(),
-            "plate_z=20.1".into(),
-            "--set".into(),
-            "shrink_z=1".into(),
-        ],
-        dir.path(),
-        T,
+    let r = cli(
+        &dir,
+        "@cube_20mm_ascii.stl -o cube.gco --set plate_z=20.1 --set shrink_z=1",
     );
     assert_eq!(r.code, Some(2), "{r:?}");
     assert!(
@@ -172,17 +167,9 @@ fn a_job_taller_than_the_chamber_is_refused_before_writing() {
     );
     assert!(dir.files().is_empty(), "{:?}", dir.files());
     // Without the compensation it fits.
-    let ok = run_cli(
-        &[
-            model("cube_20mm_ascii.stl").display().to_string(),
-            "-q".into(),
-            "-o".into(),
-            "cube.gco".into(),
-            "--set".into(),
-            "plate_z=20.1".into(),
-        ],
-        dir.path(),
-        T,
+    let ok = cli(
+        &dir,
+        "@cube_20mm_ascii.stl -q -o cube.gco --set plate_z=20.1",
     );
     assert_eq!(ok.code, Some(0), "{ok:?}");
     // A job file's parts are checked too (the library refuses it, as the page's Session).
@@ -322,7 +309,7 @@ fn orient_apply_writes_the_rotation_into_a_job_file_or_a_new_one() {
         r#"{"settings": {"layer_height": 0.2}, "parts": [{"file": "bridge.obj", "copies": 2, "name": "B"}]}"#,
     )
     .unwrap();
-    let r = run_cli(&["orient", "job.json", "--apply"], dir.path(), T);
+    let r = cli(&dir, "orient job.json --apply");
     assert_eq!(r.code, Some(0), "{r:?}");
     assert!(r.stdout.contains("parts[0] (B)"), "{}", r.stdout);
     assert!(r.stdout.contains("400.0 mm² → 0.0 mm²"), "{}", r.stdout);
@@ -336,20 +323,20 @@ fn orient_apply_writes_the_rotation_into_a_job_file_or_a_new_one() {
     );
     assert_eq!(job["settings"]["layer_height"].as_f64(), Some(0.2));
     // A model: a new job file beside it, never replaced.
-    let r = run_cli(&["orient", "bridge.obj", "--apply"], dir.path(), T);
+    let r = cli(&dir, "orient bridge.obj --apply");
     assert_eq!(r.code, Some(0), "{r:?}");
     let new: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("bridge.job.json")).unwrap())
             .unwrap();
     assert_eq!(new["parts"][0]["file"].as_str(), Some("bridge.obj"));
     assert_eq!(new["parts"][0]["rotate_x"].as_f64().unwrap().abs(), 180.0);
-    let again = run_cli(&["orient", "bridge.obj", "--apply"], dir.path(), T);
+    let again = cli(&dir, "orient bridge.obj --apply");
     assert_eq!(again.code, Some(2), "{again:?}");
     assert!(again.stderr.contains("exists"), "{}", again.stderr);
     // The job file slices.
-    let s = run_cli(&["bridge.job.json", "-q", "-o", "b.gco"], dir.path(), T);
+    let s = cli(&dir, "bridge.job.json -q -o b.gco");
     assert_eq!(s.code, Some(0), "{s:?}");
-    let bad = run_cli(&["orient", "missing.stl"], dir.path(), T);
+    let bad = cli(&dir, "orient missing.stl");
     assert_eq!(bad.code, Some(2), "{bad:?}");
 }
 
@@ -359,17 +346,7 @@ fn orient_apply_writes_the_rotation_into_a_job_file_or_a_new_one() {
 #[test]
 fn the_predicted_density_is_one_minus_the_3d_void_fraction() {
     let dir = TempDir::new("density");
-    let r = run_cli(
-        &[
-            model("bridge.obj").display().to_string(),
-            "-o".into(),
-            "b.gco".into(),
-            "--report".into(),
-            "b.json".into(),
-        ],
-        dir.path(),
-        T,
-    );
+    let r = cli(&dir, "@bridge.obj -o b.gco --report b.json");
     assert_eq!(r.code, Some(0), "{r:?}");
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("b.json")).unwrap()).unwrap();
@@ -402,21 +379,9 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
         r#"{"name": "Chamber", "kind": "machine", "settings": {"plate_z": 100}}"#,
     )
     .unwrap();
-    let r = run_cli(
-        &[
-            model("cube_20mm_ascii.stl").display().to_string(),
-            "-q".into(),
-            "-o".into(),
-            "c.gco".into(),
-            "--set".into(),
-            "material_density=1.1".into(),
-            "--profile".into(),
-            "pc.json".into(),
-            "--profile".into(),
-            "machine.json".into(),
-        ],
-        dir.path(),
-        T,
+    let r = cli(
+        &dir,
+        "@cube_20mm_ascii.stl -q -o c.gco --set material_density=1.1 --profile pc.json --profile machine.json",
     );
     assert_eq!(r.code, Some(0), "{r:?}");
     let text = std::fs::read_to_string(dir.join("c.gco")).unwrap();
@@ -442,17 +407,7 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
         (r#"{"name": "M", "settings": {}}"#, "kind"),
     ] {
         std::fs::write(dir.join("bad.json"), body).unwrap();
-        let r = run_cli(
-            &[
-                model("cube_20mm_ascii.stl").display().to_string(),
-                "-o".into(),
-                "bad.gco".into(),
-                "--profile".into(),
-                "bad.json".into(),
-            ],
-            dir.path(),
-            T,
-        );
+        let r = cli(&dir, "@cube_20mm_ascii.stl -o bad.gco --profile bad.json");
         assert_eq!(r.code, Some(2), "{r:?}");
         assert!(
             r.stderr.contains("bad.json") && r.stderr.contains(expected),
@@ -478,19 +433,9 @@ fn a_profile_applies_to_a_job_file_before_set() {
     )
     .unwrap();
     std::fs::write(dir.join("s.json"), r#"{"droplet_rate": 90}"#).unwrap();
-    let r = run_cli(
-        &[
-            "job.json",
-            "-q",
-            "-o",
-            "j.gco",
-            "--profile",
-            "m.json",
-            "--settings",
-            "s.json",
-        ],
-        dir.path(),
-        T,
+    let r = cli(
+        &dir,
+        "job.json -q -o j.gco --profile m.json --settings s.json",
     );
     assert_eq!(r.code, Some(0), "{r:?}");
     let text = std::fs::read_to_string(dir.join("j.gco")).unwrap();

@@ -180,6 +180,12 @@ pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), E
             ),
         });
     }
+    Ok(())
+}
+
+/// Checks the job's height against the chamber (`plate_z`), after the other checks of the job
+/// (so a job refused for its size or droplets says that first), before anything is sliced.
+pub(crate) fn check_chamber(size: &[f64; 3], settings: &Settings) -> Result<(), Error> {
     if size[2] > settings.plate_z * (1.0 + 1e-12) {
         return Err(Error::Setting {
             name: "plate_z".into(),

@@ -11,8 +11,8 @@ use crate::model::layout::{Frame, Instance, at_part, place_instances};
 use crate::model::mesh::{Mesh, MeshStats};
 use crate::model::models::{Model, models_of};
 use crate::model::prepare::{
-    FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_height, check_volume,
-    close_cracks, import, keep_groups, suggested_scale, warnings,
+    FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_chamber, check_height,
+    check_volume, close_cracks, import, keep_groups, suggested_scale, warnings,
 };
 use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
@@ -226,6 +226,7 @@ impl Job {
             estimate.unit0_volume = sampled_volume(&mesh, &buckets, &zs, h);
             estimate.check(&settings)?;
         }
+        check_chamber(&size, &settings)?;
         let mut all_warnings = input.warnings;
         all_warnings.extend(warnings(&stats, &size));
         let info = JobInfo {

@@ -26,15 +26,16 @@ use std::process::ExitCode;
 const SHOWN: usize = 3;
 
 pub fn main(args: OrientArgs) -> ExitCode {
-    crate::slice::finish("dropslice orient", run(&args))
+    let Some(path) = args.file.clone() else {
+        eprintln!(
+            "dropslice orient: no model or job file given (usage: dropslice orient MODEL_OR_JOB [--apply]); see dropslice orient --help"
+        );
+        return ExitCode::from(2);
+    };
+    crate::slice::finish("dropslice orient", run(&path, &args))
 }
 
-fn run(args: &OrientArgs) -> Result<(), Error> {
-    let path = args.file.as_deref().ok_or_else(|| {
-        Error::Job(
-            "no model or job file given (usage: dropslice orient MODEL_OR_JOB [--apply])".into(),
-        )
-    })?;
+fn run(path: &Path, args: &OrientArgs) -> Result<(), Error> {
     let mut overrides = Vec::new();
     for kv in &args.set {
         let (k, v) = kv.split_once('=').ok_or_else(|| Error::Setting {
