@@ -917,8 +917,11 @@ fn set_number(s: &mut Settings, name: &str, x: f64) {
         "droplet_rate" => &mut s.droplet_rate,
         "travel_speed" => &mut s.travel_speed,
         "material_density" => &mut s.material_density,
+        "shrink_xy" => &mut s.shrink_xy,
+        "shrink_z" => &mut s.shrink_z,
         "plate_x" => &mut s.plate_x,
         "plate_y" => &mut s.plate_y,
+        "plate_z" => &mut s.plate_z,
         "part_spacing" => &mut s.part_spacing,
         "overhang_limit" => &mut s.overhang_limit,
         "support_gap_xy" => &mut s.support_gap_xy,
@@ -926,6 +929,8 @@ fn set_number(s: &mut Settings, name: &str, x: f64) {
         "unit1_droplet_aspect" => &mut s.unit1_droplet_aspect,
         "unit1_droplet_rate" => &mut s.unit1_droplet_rate,
         "unit1_material_density" => &mut s.unit1_material_density,
+        "unit1_shrink_xy" => &mut s.unit1_shrink_xy,
+        "unit1_shrink_z" => &mut s.unit1_shrink_z,
         "support_gap_z" => {
             s.support_gap_z = if x.is_nan() { 0 } else { x as u32 };
             return;

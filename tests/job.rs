@@ -553,21 +553,8 @@ fn a_job_of_three_parts_slices_as_the_oracle_says() {
         .collect();
     std::fs::write(&stl, common::stl_bytes(&tris)).unwrap();
     let oracle = common::oracle_sections(&stl, 0.2);
-    let layers = oracle["layers"].as_array().unwrap();
-    assert_eq!(j.layer_count(), layers.len(), "layer count");
-    let mut bad = Vec::new();
-    let mut compared = 0;
-    for (i, l) in layers.iter().enumerate() {
-        if l.get("near_plane_faces").is_some() {
-            continue;
-        }
-        compared += 1;
-        let want = l["nonzero"]["area"].as_f64().unwrap();
-        let got = dropslice::base::geom::region_area(&j.section(i).region);
-        if (got - want).abs() > (want * 0.005).max(0.05) {
-            bad.push(format!("layer {i}: {got:.4} vs oracle {want:.4}"));
-        }
-    }
+    let (compared, bad) =
+        common::oracle_area_mismatches(&j, &oracle, |want| (want * 0.005).max(0.05));
     assert!(compared > 100, "{compared} layers compared");
     assert!(
         bad.is_empty(),

@@ -4,7 +4,8 @@
 
 use dropslice::wasm::reader::{GcodeStream, calibrate};
 use dropslice::wasm::{
-    Models, Session, Tally, default_settings, job_schema, merge_summaries, settings_schema, version,
+    Models, Session, Tally, check_profile, default_settings, job_schema, merge_summaries,
+    settings_schema, version,
 };
 use serde::Serialize;
 use wasm_bindgen::{JsCast, JsValue};
@@ -868,4 +869,86 @@ fn calibrates_a_gcode_stream() {
     // an impossible mass is refused with the core's message
     let m = error_message(read(&text, true).calibrate(1.0e6, None).unwrap_err());
     assert!(m.starts_with("impossible"), "{m}");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The process engineer's tools (docs/process.md)
+
+#[wasm_bindgen_test]
+fn orient_ranks_a_part_as_sliced_and_names_a_missing_one() {
+    let mut models = Models::new();
+    models
+        .add_bytes(box_stl(20.0, 10.0, 2.0).as_bytes(), "a.stl")
+        .unwrap();
+    // Standing on its long edge (10 mm tall), with z compensated by 1/(1 - 0.05).
+    let job = serde_json::json!({
+        "settings": {"shrink_z": 5},
+        "parts": [{"file": "a.stl", "rotate_x": 90}]
+    });
+    let o = json(models.orient(js(job.clone()), 0).unwrap());
+    let height = |v: &serde_json::Value| v["height"].as_f64().unwrap();
+    assert!((height(&o["current"]) - 10.0 / 0.95).abs() < 1e-9, "{o}");
+    let best = &o["candidates"][0];
+    assert!((height(best) - 2.0 / 0.95).abs() < 1e-9, "{o}");
+    assert_eq!(best["unsupported_area"], 0.0);
+    assert!(o["candidates"].as_array().unwrap().len() >= 3);
+    let e = thrown(models.orient(js(job), 1).unwrap_err());
+    assert_eq!(e["kind"], "job");
+    assert!(e["message"].as_str().unwrap().contains("parts[1]"), "{e}");
+}
+
+#[wasm_bindgen_test]
+fn a_session_refuses_a_job_taller_than_the_chamber() {
+    let mut models = Models::new();
+    models
+        .add_bytes(box_stl(5.0, 5.0, 3.0).as_bytes(), "b.stl")
+        .unwrap();
+    let job = serde_json::json!({"settings": {"plate_z": 2.5}, "parts": [{"file": "b.stl"}]});
+    let e = thrown(Session::from_models(&models, js(job)).err().unwrap());
+    assert_eq!(
+        (e["kind"].as_str(), e["setting"].as_str()),
+        (Some("setting"), Some("plate_z"))
+    );
+    assert!(
+        e["message"].as_str().unwrap().contains("3.000 mm tall"),
+        "{e}"
+    );
+    // The schema carries the new settings with their units and ranges.
+    let schema = json(settings_schema().unwrap());
+    for (name, unit, max) in [
+        ("shrink_xy", "%", 5.0),
+        ("unit1_shrink_z", "%", 5.0),
+        ("plate_z", "mm", 1e5),
+    ] {
+        let spec = schema
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["name"] == name)
+            .unwrap();
+        assert_eq!(
+            (spec["unit"].as_str(), spec["max"].as_f64()),
+            (Some(unit), Some(max))
+        );
+    }
+}
+
+#[wasm_bindgen_test]
+fn check_profile_returns_the_profile_or_names_the_key() {
+    let p = json(
+        check_profile(r#"{"name": " M ", "kind": "machine", "settings": {"plate_z": 180}}"#)
+            .unwrap(),
+    );
+    assert_eq!(
+        p,
+        serde_json::json!({"name": "M", "kind": "machine", "settings": {"plate_z": 180}})
+    );
+    let e = thrown(
+        check_profile(r#"{"name": "M", "kind": "machine", "settings": {"shrink_z": 1}}"#)
+            .unwrap_err(),
+    );
+    assert_eq!(
+        (e["kind"].as_str(), e["setting"].as_str()),
+        (Some("setting"), Some("shrink_z"))
+    );
 }

@@ -35,6 +35,11 @@ pub struct PartAnalysis {
     pub void_volume: f64,
     /// void_volume / volume.
     pub void_fraction: f64,
+    /// The predicted density, %: 100 × (1 − void_fraction), once the 3D estimate has a
+    /// volume (`None` for a 2D analysis alone). A geometric estimate from the droplet model
+    /// (docs/process.md), not a measured density.
+    #[serde(default)]
+    pub predicted_density: Option<f64>,
     /// Overhang area summed over the layers, mm².
     #[serde(default)]
     pub unsupported_area: f64,
@@ -77,11 +82,18 @@ impl PartAnalysis {
         }
         self.volume += slab_volume;
         self.void_volume += slab_void;
-        self.void_fraction = if self.volume > 0.0 {
+        self.update_fraction();
+    }
+
+    /// `void_fraction` and `predicted_density` from the volumes.
+    pub fn update_fraction(&mut self) {
+        let some = self.volume > 0.0;
+        self.void_fraction = if some {
             self.void_volume / self.volume
         } else {
             0.0
         };
+        self.predicted_density = some.then_some(100.0 * (1.0 - self.void_fraction));
     }
 }
 

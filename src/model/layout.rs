@@ -389,7 +389,7 @@ pub fn layout(models: &[Model], spec: &JobSpec) -> Result<Layout, Error> {
         .enumerate()
         .map(|(i, (p, m))| {
             let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
-            Frame::of(corners(&tris), &p.placement([0.0, 0.0]))
+            Frame::of(corners(&tris), &p.placement([0.0, 0.0], &spec.settings))
                 .ok_or_else(|| Error::Job(format!("parts[{i}]: the part has no triangles")))
         })
         .collect::<Result<Vec<_>, _>>()?;

@@ -355,6 +355,15 @@ impl Placement {
             place: [s.place_x, s.place_y],
         }
     }
+
+    /// The same placement with its scale multiplied by `factors` (the shrinkage
+    /// compensation, [`Settings::shrink_factors`]): exactly unchanged for factors of 1.
+    pub fn compensated(self, factors: [f64; 3]) -> Placement {
+        Placement {
+            scale: [0, 1, 2].map(|k| self.scale[k] * factors[k]),
+            ..self
+        }
+    }
 }
 
 /// The rotation of [`Mesh::place`]: about x, then y, then z (degrees).

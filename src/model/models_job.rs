@@ -16,6 +16,9 @@ pub enum SettingsOverride {
         file: String,
         values: serde_json::Map<String, serde_json::Value>,
     },
+    /// A profile (`--profile FILE.json`): its values set on the settings before it; a settings
+    /// file given later keeps them.
+    Profile(crate::base::settings::Profile),
 }
 
 /// The job of several model files (`files`: each one's key in the job's models; a file may
@@ -54,7 +57,7 @@ fn without_part_keys(s: &Settings) -> Settings {
 /// place_*) is refused: it belongs to the job file's parts. Not validated; call
 /// [`JobSpec::validate`].
 pub fn override_settings(spec: &mut JobSpec, overrides: &[SettingsOverride]) -> Result<(), Error> {
-    let base = spec.settings.clone();
+    let mut base = spec.settings.clone();
     let part_key = |k: &str| {
         Error::Job(format!(
             "{k} belongs to a part: give it in the job file's parts, not with --set or --settings"
@@ -67,6 +70,10 @@ pub fn override_settings(spec: &mut JobSpec, overrides: &[SettingsOverride]) -> 
                     return Err(part_key(name));
                 }
                 spec.settings.set(name, value)?;
+            }
+            SettingsOverride::Profile(p) => {
+                p.apply(&mut spec.settings)?;
+                p.apply(&mut base)?;
             }
             SettingsOverride::File { file, values } => {
                 spec.settings = base.clone();

@@ -41,6 +41,9 @@ pub struct JobInfo {
     /// (every job without unit-1 parts).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groups: Vec<FacetGroup>,
+    /// The profiles applied to the settings, in order (`name (kind)`), for the header.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profiles: Vec<String>,
 }
 
 /// A run of facets of the prepared mesh printed by one discharge unit ([`JobInfo::groups`]).
@@ -117,7 +120,7 @@ pub(crate) fn import(
     }
     let facets_in_file = tris.len();
     drop(tris);
-    let placement = mesh::Placement::of_settings(settings);
+    let placement = mesh::Placement::of_settings(settings).compensated(settings.shrink_factors(0));
     let frame = Frame::of(mesh.vertices.iter().copied(), &placement)
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;
@@ -131,7 +134,7 @@ pub(crate) fn import(
         item: None,
         object: None,
         rotate: placement.rotate,
-        scale: placement.scale,
+        scale: [settings.scale_x, settings.scale_y, settings.scale_z],
         place_angle: placement.place_angle,
         placed: true,
         at: place,
@@ -149,7 +152,7 @@ pub(crate) fn import(
         ],
         shift: place,
     };
-    mesh.transform(settings);
+    mesh.place(&placement);
     Ok(Imported {
         mesh,
         format,
@@ -174,6 +177,21 @@ pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), E
             message: format!(
                 "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
                 size[2], layers_needed
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// Checks the job's height against the chamber (`plate_z`), after the other checks of the job
+/// (so a job refused for its size or droplets says that first), before anything is sliced.
+pub(crate) fn check_chamber(size: &[f64; 3], settings: &Settings) -> Result<(), Error> {
+    if size[2] > settings.plate_z * (1.0 + 1e-12) {
+        return Err(Error::Setting {
+            name: "plate_z".into(),
+            message: format!(
+                "the job is {:.3} mm tall (after scale and shrinkage compensation), taller than the build chamber (plate_z = {} mm): lay the part down (rotate_x/rotate_y, dropslice orient), scale it down, or set plate_z to the machine's chamber height",
+                size[2], settings.plate_z
             ),
         });
     }

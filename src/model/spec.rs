@@ -184,14 +184,16 @@ impl PartSpec {
         }
     }
 
-    /// Its transform with the bounding box minimum moved by `place`.
-    pub fn placement(&self, place: [f64; 2]) -> Placement {
+    /// Its transform with the bounding box minimum moved by `place`, its scale compensating
+    /// the shrinkage of its unit's material (`settings`' `shrink_*` or `unit1_shrink_*`).
+    pub fn placement(&self, place: [f64; 2], settings: &Settings) -> Placement {
         Placement {
             rotate: [self.rotate_x, self.rotate_y, self.rotate_z],
             scale: [self.scale_x, self.scale_y, self.scale_z],
             place_angle: self.place_angle,
             place,
         }
+        .compensated(settings.shrink_factors(self.unit))
     }
 
     /// The explicit placement, if any.

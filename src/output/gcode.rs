@@ -23,6 +23,8 @@ pub struct HeaderInput<'a> {
     pub instances: &'a [crate::model::layout::Instance],
     /// Whether discharge unit 1 prints anything (its settings are listed only then).
     pub unit1_used: bool,
+    /// The profiles applied to the settings, in order (one line when there are some).
+    pub profiles: &'a [String],
 }
 
 /// Width of the droplet count fields in the header.
@@ -118,6 +120,14 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
     }
     for w in input.warnings {
         let _ = writeln!(h, "; warning: {}", w.replace(['\n', '\r'], " "));
+    }
+    if !input.profiles.is_empty() {
+        let names: Vec<String> = input
+            .profiles
+            .iter()
+            .map(|p| p.replace(['\n', '\r'], " "))
+            .collect();
+        let _ = writeln!(h, "; profiles = {}", names.join(", "));
     }
     let _ = writeln!(h, "; settings:");
     for (name, value, unit) in s.entries_with(input.unit1_used) {

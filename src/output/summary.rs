@@ -125,6 +125,10 @@ pub struct Figures {
     /// Uncovered area summed over the analysed layers, mm².
     pub void_area: Option<f64>,
     pub worst_layer: Option<WorstLayer>,
+    /// Predicted density of the analysed part, % (100 × (1 − the 3D void fraction)); `None`
+    /// without the 3D estimate. A geometric estimate from the droplet model, not a measured
+    /// density.
+    pub predicted_density: Option<f64>,
     /// What slicing repaired, in plain language.
     pub repairs: Vec<String>,
 }
@@ -241,6 +245,7 @@ impl Summary {
                 }),
                 _ => None,
             },
+            predicted_density: a.predicted_density,
             repairs: self.repairs(),
         }
     }
@@ -319,10 +324,6 @@ impl PartAnalysis {
         );
         self.volume += o.volume;
         self.void_volume += o.void_volume;
-        self.void_fraction = if self.volume > 0.0 {
-            self.void_volume / self.volume
-        } else {
-            0.0
-        };
+        self.update_fraction();
     }
 }

@@ -11,8 +11,8 @@ use crate::model::layout::{Frame, Instance, at_part, place_instances};
 use crate::model::mesh::{Mesh, MeshStats};
 use crate::model::models::{Model, models_of};
 use crate::model::prepare::{
-    FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_height, check_volume,
-    close_cracks, import, keep_groups, suggested_scale, warnings,
+    FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_chamber, check_height,
+    check_volume, close_cracks, import, keep_groups, suggested_scale, warnings,
 };
 use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
@@ -89,7 +89,10 @@ impl Job {
                     import::MAX_TRIANGLES
                 )));
             }
-            let frame = Frame::of(mesh.vertices.iter().copied(), &p.placement([0.0, 0.0]));
+            let frame = Frame::of(
+                mesh.vertices.iter().copied(),
+                &p.placement([0.0, 0.0], &settings),
+            );
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
                 return Err(Error::Import(format!(
                     "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
@@ -118,7 +121,7 @@ impl Job {
         let mut groups: Vec<FacetGroup> = Vec::new();
         for inst in order {
             let mut m = welded[inst.part].clone();
-            m.place(&spec.parts[inst.part].placement(inst.shift));
+            m.place(&spec.parts[inst.part].placement(inst.shift, &settings));
             let base = mesh.vertices.len() as u32;
             mesh.vertices.extend_from_slice(&m.vertices);
             mesh.facets
@@ -223,6 +226,7 @@ impl Job {
             estimate.unit0_volume = sampled_volume(&mesh, &buckets, &zs, h);
             estimate.check(&settings)?;
         }
+        check_chamber(&size, &settings)?;
         let mut all_warnings = input.warnings;
         all_warnings.extend(warnings(&stats, &size));
         let info = JobInfo {
@@ -236,6 +240,7 @@ impl Job {
             droplet_width: settings.droplet_width(),
             instances: input.instances,
             groups,
+            profiles: Vec::new(),
         };
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }

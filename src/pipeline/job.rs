@@ -206,6 +206,11 @@ impl Job {
         regions
     }
 
+    /// Names the profiles applied to the settings (`name (kind)`, in order) in the header.
+    pub fn set_profiles(&mut self, profiles: Vec<String>) {
+        self.info.profiles = profiles;
+    }
+
     /// The header; with `None` the droplet counts are fixed-width placeholders.
     pub fn header(&self, summary: Option<&Summary>) -> String {
         let b = &self.info.bounds;
@@ -219,6 +224,7 @@ impl Job {
                 warnings: &self.info.warnings,
                 instances: &self.info.instances,
                 unit1_used: self.uses_unit1(),
+                profiles: &self.info.profiles,
             },
             summary,
         )

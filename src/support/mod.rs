@@ -27,10 +27,14 @@
 //! part (no offset of the part); the droplet-level pass ([`crate::support::droplets`]) then
 //! adds droplets wherever the rule still fails.
 //! `tests/support.rs` checks the rule on the printed droplets.
+//!
+//! **Orientation** ([`orient`]): the rotation of a part with the least unsupported area by the
+//! same rule, judged from its facets.
 
 pub mod droplets;
 pub mod lattice;
 pub mod moves;
+pub mod orient;
 pub mod overhang;
 pub mod regions;
 

@@ -22,7 +22,7 @@ mod cut;
 mod models;
 pub mod reader;
 
-pub use models::Models;
+pub use models::{Models, check_profile};
 use models::{job_of, read_file};
 
 use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};

@@ -122,6 +122,34 @@ impl Models {
         }
         to_js(&Angles { rotate_x, rotate_y }, "the angles")
     }
+
+    /// The orientations of `job.parts[part]` (SPEC.md "Orientation"; its rotation, scale and
+    /// unit's shrinkage as sliced, the rule of `job.settings`): `{current, candidates}`, each
+    /// `{rotate_x, rotate_y, rotate_z, unsupported_area (mm²), height (mm)}`, the candidates
+    /// best first. Throws `{kind: "job" | "setting", message}`.
+    #[wasm_bindgen(unchecked_return_type = "Orientations")]
+    pub fn orient(&self, job: JsValue, part: usize) -> Result<JsValue, JsValue> {
+        let spec = job_of(job)?;
+        let p = spec.parts.get(part).ok_or_else(|| {
+            js_error(Error::Job(format!(
+                "parts[{part}] asked for, but the job has {} parts",
+                spec.parts.len()
+            )))
+        })?;
+        let model = self.model(&p.file)?;
+        let o = crate::support::orient::orient_part(model, p, &spec.settings)
+            .map_err(|e| js_error(layout::at_part(part, e)))?;
+        to_js(&o, "the orientations")
+    }
+}
+
+/// A profile's JSON text (an imported file, or one the page kept) checked: `{name, kind,
+/// settings}` with every key of its kind and every value in range. Throws `{kind: "setting",
+/// message, setting?}` naming the key.
+#[wasm_bindgen(unchecked_return_type = "Profile")]
+pub fn check_profile(text: &str) -> Result<JsValue, JsValue> {
+    let profile = crate::base::settings::Profile::from_json(text).map_err(js_error)?;
+    to_js(&profile, "the profile")
 }
 
 impl Models {

@@ -289,6 +289,32 @@ pub fn oracle_sections(stl: &Path, h: f64) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).expect("the oracle writes JSON")
 }
 
+/// The job's section areas against the oracle's layers (`oracle_sections`; layers with faces
+/// near the plane skipped): (layers compared, the layers whose areas differ by more than
+/// `tolerance(oracle area)`).
+pub fn oracle_area_mismatches(
+    job: &dropslice::Job,
+    oracle: &serde_json::Value,
+    tolerance: impl Fn(f64) -> f64,
+) -> (usize, Vec<String>) {
+    let layers = oracle["layers"].as_array().expect("the oracle's layers");
+    assert_eq!(job.layer_count(), layers.len(), "layer count");
+    let mut bad = Vec::new();
+    let mut compared = 0;
+    for (i, l) in layers.iter().enumerate() {
+        if l.get("near_plane_faces").is_some() {
+            continue;
+        }
+        compared += 1;
+        let want = l["nonzero"]["area"].as_f64().expect("an area");
+        let got = dropslice::base::geom::region_area(&job.section(i).region);
+        if (got - want).abs() > tolerance(want) {
+            bad.push(format!("layer {i}: {got:.4} vs oracle {want:.4}"));
+        }
+    }
+    (compared, bad)
+}
+
 /// The commands of one layer (consecutive commands with the same Z).
 #[derive(Clone, Debug)]
 pub struct Layer {

@@ -4,8 +4,12 @@
 //! and the G-code header. [`schema()`] exports units, ranges and descriptions so the page can
 //! build its form from them; [`Settings::validate`] checks every value against the same table.
 
+mod profile;
 mod schema;
 
+pub use profile::{
+    MACHINE_KEYS, MATERIAL_KEYS, MAX_PROFILE_BYTES, MAX_PROFILE_NAME_CHARS, Profile, ProfileKind,
+};
 pub use schema::{Kind, PART_KEYS, SettingSpec, names, schema, schema_json};
 
 use crate::base::error::Error;
@@ -116,11 +120,18 @@ pub struct Settings {
     pub travel_speed: f64,
     /// Density of the material (for the mass estimate).
     pub material_density: f64,
+    /// Linear shrinkage of unit 0's material in x and y (%): its parts are sliced scaled by
+    /// 1 / (1 − s/100) (SPEC.md "Shrinkage compensation").
+    pub shrink_xy: f64,
+    /// Linear shrinkage of unit 0's material in z (%).
+    pub shrink_z: f64,
     /// Droplet footprint model of the coverage analysis.
     pub footprint: Footprint,
     /// Build plate size in x and y (mm): parts are arranged on it.
     pub plate_x: f64,
     pub plate_y: f64,
+    /// Height of the build chamber (mm): a taller job is refused before slicing.
+    pub plate_z: f64,
     /// Gap between the bounding boxes of arranged parts (mm).
     pub part_spacing: f64,
     /// A droplet is supported when the layer below has material within this many B.
@@ -139,6 +150,10 @@ pub struct Settings {
     pub unit1_droplet_rate: f64,
     /// Density of unit 1's material (mass estimate).
     pub unit1_material_density: f64,
+    /// Linear shrinkage of unit 1's material in x and y (%), for unit 1's parts.
+    pub unit1_shrink_xy: f64,
+    /// Linear shrinkage of unit 1's material in z (%).
+    pub unit1_shrink_z: f64,
     /// Which unit prints first within a layer.
     pub unit_order: UnitOrder,
 }
@@ -174,9 +189,12 @@ impl Default for Settings {
             droplet_rate: 100.0,
             travel_speed: 50.0,
             material_density: 1.04,
+            shrink_xy: 0.0,
+            shrink_z: 0.0,
             footprint: Footprint::Disc,
             plate_x: 154.0,
             plate_y: 134.0,
+            plate_z: 230.0,
             part_spacing: 5.0,
             overhang_limit: 0.5,
             support: Support::Off,
@@ -186,6 +204,8 @@ impl Default for Settings {
             unit1_droplet_aspect: 1.04,
             unit1_droplet_rate: 100.0,
             unit1_material_density: 1.04,
+            unit1_shrink_xy: 0.0,
+            unit1_shrink_z: 0.0,
             unit_order: UnitOrder::Unit0First,
         }
     }
@@ -357,6 +377,18 @@ impl Settings {
         self.layer_height * self.unit1_droplet_aspect
     }
 
+    /// The scale that compensates the shrinkage of discharge unit `unit`'s material: a part
+    /// of shrinkage s (%) is sliced scaled by 1 / (1 − s/100) in that axis (exactly 1 for 0).
+    pub fn shrink_factors(&self, unit: u8) -> [f64; 3] {
+        let (xy, z) = if unit == 1 {
+            (self.unit1_shrink_xy, self.unit1_shrink_z)
+        } else {
+            (self.shrink_xy, self.shrink_z)
+        };
+        let f = |s: f64| 1.0 / (1.0 - s / 100.0);
+        [f(xy), f(xy), f(z)]
+    }
+
     /// The settings as `(name, value)` pairs in schema order, values as they appear in the header.
     pub fn entries(&self) -> Vec<(&'static str, String, &'static str)> {
         self.entries_with(true)
@@ -383,7 +415,8 @@ impl Settings {
 
 /// Settings that only discharge unit 1 uses (listed in the header when unit 1 is used).
 pub fn is_unit1_setting(name: &str) -> bool {
-    name.starts_with("unit1_")
+    // The four shrinkage values are always listed (SPEC.md "Shrinkage compensation").
+    (name.starts_with("unit1_") && !name.starts_with("unit1_shrink_"))
         || name == "unit_order"
         || matches!(name, "support_gap_xy" | "support_gap_z" | "support_density")
 }

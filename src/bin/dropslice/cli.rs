@@ -9,7 +9,8 @@ use std::path::PathBuf;
 
 const USAGE: &str = "dropslice [slice] MODEL... [OPTIONS]
        dropslice [slice] JOB.json [OPTIONS]
-       dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]";
+       dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]
+       dropslice orient MODEL_OR_JOB [--apply] [--set NAME=VALUE]...";
 
 const ABOUT: &str =
     "Slices models into droplet machine code (.gco) for droplet-based plastic 3D printing";
@@ -87,6 +88,35 @@ enum Command {
         verbatim_doc_comment
     )]
     Calibrate(CalibrateArgs),
+    /// The rotation of each part that needs the least support
+    ///
+    /// Compares the part's orientations (its largest flat faces down, and its right-angle
+    /// turns) by the overhang rule, from the facets: the projected area of the facets
+    /// facing down more steeply than overhang_limit allows; ties go to the lower height.
+    /// Prints the chosen rotate_x/y/z and the area before and after. --apply writes them
+    /// into the job file, or for a model a new job file MODEL.job.json beside it.
+    #[command(
+        override_usage = "dropslice orient MODEL_OR_JOB [--apply] [--set NAME=VALUE]...",
+        args_override_self = true,
+        display_name = "dropslice",
+        verbatim_doc_comment
+    )]
+    Orient(OrientArgs),
+}
+
+/// `dropslice orient ...`.
+#[derive(Args, Debug, Clone)]
+pub struct OrientArgs {
+    /// A model (STL, OBJ, 3MF) or a job file (JSON)
+    #[arg(value_name = "MODEL_OR_JOB")]
+    pub file: Option<PathBuf>,
+    /// Write the chosen rotation into the job file (for a model: a new MODEL.job.json)
+    #[arg(long)]
+    pub apply: bool,
+    /// Change one setting (overhang_limit, layer_height, droplet_aspect decide the rule;
+    /// for a model also its rotate_* and scale_*)
+    #[arg(long, value_name = "NAME=VALUE", allow_hyphen_values = true)]
+    pub set: Vec<String>,
 }
 
 /// `dropslice [slice] ...`.
@@ -112,6 +142,19 @@ pub struct SliceArgs {
         verbatim_doc_comment
     )]
     settings: Vec<PathBuf>,
+    /// Apply a machine or material profile (JSON; repeatable, in order, before --set)
+    ///
+    /// {"name": "...", "kind": "machine" | "material", "settings": {...}}: a machine
+    /// profile holds plate_x/y/z, droplet_rate, unit1_droplet_rate, travel_speed; a
+    /// material profile droplet_aspect, material_density, shrink_xy, shrink_z and their
+    /// unit1_ forms. The header names the profiles used (docs/process.md).
+    #[arg(
+        long,
+        value_name = "FILE.json",
+        allow_hyphen_values = true,
+        verbatim_doc_comment
+    )]
+    pub profile: Vec<PathBuf>,
     /// Print every setting with its default, unit, range and meaning
     #[arg(long)]
     pub list_settings: bool,
@@ -160,6 +203,7 @@ pub enum SettingsArg {
 pub enum Action {
     Slice(SliceArgs, Vec<SettingsArg>),
     Calibrate(CalibrateArgs),
+    Orient(OrientArgs),
 }
 
 /// Parses the command line (`argv` with the program's name first). The error is clap's: help
@@ -169,6 +213,7 @@ pub fn parse(argv: impl IntoIterator<Item = OsString>) -> Result<Action, clap::E
     let cli = Cli::from_arg_matches(&matches)?;
     Ok(match (cli.command, matches.subcommand()) {
         (Some(Command::Calibrate(c)), _) => Action::Calibrate(c),
+        (Some(Command::Orient(o)), _) => Action::Orient(o),
         (Some(Command::Slice(s)), Some((_, m))) => Action::Slice(s, settings_in_order(m)),
         _ => Action::Slice(cli.slice, settings_in_order(&matches)),
     })
@@ -197,8 +242,11 @@ pub fn exit(e: clap::Error, argv: &[OsString]) -> std::process::ExitCode {
         return std::process::ExitCode::SUCCESS;
     }
     let calibrate = argv.get(1).is_some_and(|a| a == "calibrate");
+    let orient = argv.get(1).is_some_and(|a| a == "orient");
     let (who, help) = if calibrate {
         ("dropslice calibrate", "dropslice calibrate --help")
+    } else if orient {
+        ("dropslice orient", "dropslice orient --help")
     } else {
         ("dropslice", "dropslice --help")
     };

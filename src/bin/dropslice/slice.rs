@@ -8,6 +8,7 @@ use crate::files::{
 use crate::staged::{self, Staged};
 use dropslice::analysis::JobAnalysis;
 use dropslice::base::error::quote;
+use dropslice::base::settings::{MAX_PROFILE_BYTES, Profile};
 use dropslice::model::models::Model;
 use dropslice::model::models_job::{SettingsOverride, models_job_spec, override_settings};
 use dropslice::model::spec::{self as job, JobSpec};
@@ -27,6 +28,8 @@ struct Args {
     overrides: Vec<SettingsOverride>,
     quiet: bool,
     report: Option<PathBuf>,
+    /// The profiles applied, as the header names them.
+    profiles: Vec<String>,
 }
 
 pub fn main(cli: SliceArgs, settings: Vec<SettingsArg>) -> ExitCode {
@@ -50,10 +53,15 @@ pub fn main(cli: SliceArgs, settings: Vec<SettingsArg>) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match run(&args, &output, out, report) {
+    finish("dropslice", run(&args, &output, out, report))
+}
+
+/// The message of a failed command and its exit code: 1 for I/O and internal errors, else 2.
+pub fn finish(who: &str, result: Result<(), Error>) -> ExitCode {
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("dropslice: {e}");
+            eprintln!("{who}: {e}");
             match e {
                 Error::Io(_) | Error::Internal(_) => ExitCode::from(1),
                 _ => ExitCode::from(2),
@@ -68,6 +76,15 @@ impl Args {
     fn new(cli: SliceArgs, options: Vec<SettingsArg>) -> Result<Args, String> {
         let mut settings = Settings::default();
         let mut overrides = Vec::new();
+        let mut profiles = Vec::new();
+        for path in &cli.profile {
+            let profile = read_profile(path)?;
+            profile.apply(&mut settings).map_err(|e| e.to_string())?;
+            profiles.push(profile.label());
+            overrides.push(SettingsOverride::Profile(profile));
+        }
+        // What a settings file starts from: the defaults with the profiles.
+        let base = settings.clone();
         for option in options {
             match option {
                 SettingsArg::Set(kv) => {
@@ -91,8 +108,14 @@ impl Args {
                     let text = String::from_utf8(bytes).map_err(|_| {
                         format!("the settings file {shown} is not text (UTF-8): it is not a JSON settings file")
                     })?;
-                    settings = Settings::from_json(&text).map_err(|e| format!("{shown}: {e}"))?;
+                    Settings::from_json(&text).map_err(|e| format!("{shown}: {e}"))?;
                     if let Ok(serde_json::Value::Object(values)) = serde_json::from_str(&text) {
+                        settings = base.clone();
+                        for (k, v) in &values {
+                            settings
+                                .set_value(k, v.clone())
+                                .map_err(|e| format!("{shown}: {e}"))?;
+                        }
                         overrides.push(SettingsOverride::File {
                             file: shown.to_string(),
                             values,
@@ -122,8 +145,20 @@ impl Args {
             overrides,
             quiet: cli.quiet,
             report: cli.report,
+            profiles,
         })
     }
+}
+
+/// Reads and checks a profile file (`--profile`); the message names the file.
+fn read_profile(path: &Path) -> Result<Profile, String> {
+    let shown = path.display();
+    let bytes = read_regular(path, MAX_PROFILE_BYTES as u64, "a profile")
+        .map_err(|e| format!("the profile: {e}"))?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        format!("the profile {shown} is not text (UTF-8): it is not a JSON profile")
+    })?;
+    Profile::from_json(&text).map_err(|e| format!("the profile {shown}: {e}"))
 }
 
 fn list_settings() -> String {
@@ -201,7 +236,8 @@ fn prepare(args: &Args) -> Result<(PathBuf, Staged, Option<Staged>), String> {
 
 fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> Result<(), Error> {
     let t0 = Instant::now();
-    let (job, name) = load(args)?;
+    let (mut job, name) = load(args)?;
+    job.set_profiles(args.profiles.clone());
     for w in &job.info().warnings {
         eprintln!("dropslice: warning: {w}");
     }
@@ -255,6 +291,7 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
     finish().map_err(|e| io("write", output, e))?;
     summary.printable(job.settings())?;
     let mut voids = String::new();
+    let mut density = None;
     let mut report_done = None;
     if let (Some(mut staged), Some(analysis)) = (report, analysis) {
         let path = staged.target().to_path_buf();
@@ -271,6 +308,7 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             100.0 * report.part.coverage,
             path.display()
         );
+        density = report.part.predicted_density;
         report_done = Some(staged);
     }
     // Everything is written: only now are the files put in place.
@@ -300,6 +338,11 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             t0.elapsed().as_secs_f64()
         );
         eprintln!("dropslice: {}", overhang_line(&f));
+        if let Some(d) = density {
+            eprintln!(
+                "dropslice: predicted density {d:.1} % (100 % − the 3D void fraction: a geometric estimate from the droplet model, not a measured density)"
+            );
+        }
         if f.unit1_droplets > 0 {
             eprintln!(
                 "dropslice: unit 1: {} droplets ({} support), {:.2} cm³, {:.2} g, {} of unit 1 and {} of unit 0",
@@ -354,7 +397,7 @@ fn load(args: &Args) -> Result<(Job, String), Error> {
 }
 
 /// An import error naming the file it is about.
-fn named(file: &str, e: Error) -> Error {
+pub fn named(file: &str, e: Error) -> Error {
     match e {
         Error::Import(m) => Error::Import(format!("{}: {m}", job::clean_name(file))),
         e => e,
@@ -364,6 +407,23 @@ fn named(file: &str, e: Error) -> Error {
 /// Reads a job file (at most [`job::MAX_JOB_FILE_BYTES`]) and its parts' files (relative
 /// to its folder); `overrides` (the settings options) override its settings.
 fn job_file(path: &Path, overrides: &[SettingsOverride]) -> Result<Job, Error> {
+    let (spec, models) = read_job_file(path, overrides)?;
+    Job::from_models(&models, &spec).map_err(|e| in_job_file(path, e))
+}
+
+/// A job error with the job file named.
+pub fn in_job_file(path: &Path, e: Error) -> Error {
+    match e {
+        Error::Job(m) => Error::Job(format!("{}: {m}", shown_path(path))),
+        e => e,
+    }
+}
+
+/// A job file's spec (with `overrides`) and the models its parts name, read.
+pub fn read_job_file(
+    path: &Path,
+    overrides: &[SettingsOverride],
+) -> Result<(JobSpec, Vec<Model>), Error> {
     let shown = shown_path(path);
     let bytes = read_regular(path, job::MAX_JOB_FILE_BYTES as u64, "a job file")
         .map_err(|e| Error::Job(format!("the job file: {e}")))?;
@@ -372,11 +432,7 @@ fn job_file(path: &Path, overrides: &[SettingsOverride]) -> Result<Job, Error> {
             "the job file {shown} is not text (UTF-8): it is not a JSON job file"
         ))
     })?;
-    let in_file = |e: Error| match e {
-        Error::Job(m) => Error::Job(format!("{shown}: {m}")),
-        e => e,
-    };
-    let mut spec = JobSpec::from_json(&text).map_err(in_file)?;
+    let mut spec = JobSpec::from_json(&text).map_err(|e| in_job_file(path, e))?;
     override_settings(&mut spec, overrides)?;
     spec.validate()?;
     let dir = parent_dir(path);
@@ -395,7 +451,7 @@ fn job_file(path: &Path, overrides: &[SettingsOverride]) -> Result<Job, Error> {
         .map_err(|e| Error::Import(format!("parts[{i}].file: {e} (named in {shown})")))?;
         models.push(Model::read(&bytes, &p.file).map_err(|e| named(&p.file, e))?);
     }
-    Job::from_models(&models, &spec).map_err(in_file)
+    Ok((spec, models))
 }
 
 /// The unsupported area (support on or off): total and the worst layer.
