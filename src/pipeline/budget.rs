@@ -516,27 +516,23 @@ mod tests {
         let s = Settings::default();
         let none = Overhangs::default();
         // The 20 mm cube by unit 0, with and without support: well within every limit.
-        let e = Estimate::new(8000.0, None, false, &size, &[], &none, &s);
-        assert!(e.check(&s).is_ok());
-        let on = Settings {
+        let cube_check =
+            |s: &Settings| Estimate::new(8000.0, None, false, &size, &[], &none, s).check(s);
+        let with_support = |s: &Settings| Settings {
             support: Support::Unit1,
             ..s.clone()
         };
-        assert!(
-            Estimate::new(8000.0, None, false, &size, &[], &none, &on)
-                .check(&on)
-                .is_ok()
-        );
+        let e = Estimate::new(8000.0, None, false, &size, &[], &none, &s);
+        assert!(e.check(&s).is_ok());
+        let on = with_support(&s);
+        assert!(cube_check(&on).is_ok());
         // A tiny B₁ does not matter without unit 1, and is refused for the support with it.
         let tiny = Settings {
             unit1_droplet_aspect: 1e-3,
             ..s.clone()
         };
         assert!(e.check(&tiny).is_ok());
-        let tiny_on = Settings {
-            support: Support::Unit1,
-            ..tiny.clone()
-        };
+        let tiny_on = with_support(&tiny);
         // With no overhang, the cube needs no support: a B₁ = 0.01 mm whose hatch under the
         // whole footprint would be 4·10⁸ droplets is fine.
         let fine_on = Settings {
@@ -570,16 +566,7 @@ mod tests {
             droplet_aspect: 0.09,
             ..s.clone()
         };
-        let small_on = Settings {
-            support: Support::Unit1,
-            ..small.clone()
-        };
-        assert!(
-            Estimate::new(8000.0, None, false, &size, &[], &none, &small)
-                .check(&small)
-                .is_ok()
-        );
-        let e = Estimate::new(8000.0, None, false, &size, &[], &none, &small_on);
-        assert_eq!(setting(e.check(&small_on)), "droplet_aspect");
+        assert!(cube_check(&small).is_ok());
+        assert_eq!(setting(cube_check(&with_support(&small))), "droplet_aspect");
     }
 }
