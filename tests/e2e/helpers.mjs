@@ -109,6 +109,8 @@ export async function slicedPage(env, { width, height, files = benchy, check = [
   await waitSettled(page, 60_000);
   for (const selector of check) await page.check(selector);
   await prepare(page);
+  // what a box or setting set off on the sample (the voids analysis) ends before the pick
+  await waitSettled(page, 60_000);
   await pick(page, files);
   return { page, s: await waitDone(page, 240_000) };
 }
