@@ -13,16 +13,9 @@ use dropslice::{Job, Settings};
 #[path = "common/cpu.rs"]
 mod cpu;
 use cpu::best_time;
-
-/// [`slab_voids`] or [`slab_voids_reference`].
-type SlabFn = fn(
-    &dropslice::base::geom::Shapes,
-    &Grid3,
-    Option<&HeightMap>,
-    &HeightMap,
-    Option<&HeightMap>,
-    &Settings,
-) -> (f64, f64);
+#[path = "../tests/common/slab.rs"]
+mod slab;
+use slab::SlabFn;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

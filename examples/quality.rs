@@ -7,19 +7,16 @@ use dropslice::analysis::JobAnalysis;
 use dropslice::{Job, Settings, write_gcode, write_gcode_with};
 use std::time::Instant;
 
+#[path = "common/table.rs"]
+mod table;
+
 fn main() {
     let paths: Vec<String> = std::env::args().skip(1).collect();
-    println!(
-        "| model | stagger | coverage | void area share | enclosed void share | overfill share | largest void mm² (layer) | max deviation mm | 3D void fraction | slicing s | slicing + analysis s |"
+    table::header(
+        "model | stagger | coverage | void area share | enclosed void share | overfill share | largest void mm² (layer) | max deviation mm | 3D void fraction | slicing s | slicing + analysis s",
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     for path in &paths {
-        let bytes = std::fs::read(path).expect("read model");
-        let name = std::path::Path::new(path)
-            .file_name()
-            .unwrap()
-            .to_string_lossy()
-            .into_owned();
+        let (bytes, name) = table::read_model(path, false);
         for stagger in [false, true] {
             let s = Settings {
                 stagger,

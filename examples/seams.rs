@@ -11,6 +11,8 @@
 mod seams;
 #[path = "../tests/common/segment.rs"]
 mod segment;
+#[path = "common/table.rs"]
+mod table;
 
 use dropslice::analysis::JobAnalysis;
 use dropslice::{Job, Settings, write_gcode_with};
@@ -28,17 +30,11 @@ fn main() {
             paths.push(format!("{shared}{m}.stl"));
         }
     }
-    println!(
-        "| model | loop_spacing | loops (≥ 3 droplets) | seams < B/4 | min arc gap mm | min straight-line gap mm | loops adjusted | loops breaking a bound | 3D void fraction | coverage |"
+    table::header(
+        "model | loop_spacing | loops (≥ 3 droplets) | seams < B/4 | min arc gap mm | min straight-line gap mm | loops adjusted | loops breaking a bound | 3D void fraction | coverage",
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
     for path in &paths {
-        let bytes = std::fs::read(path).expect("read model");
-        let name = std::path::Path::new(path)
-            .file_stem()
-            .unwrap()
-            .to_string_lossy()
-            .into_owned();
+        let (bytes, name) = table::read_model(path, true);
         for even in [false, true] {
             let mut s = Settings::default();
             if even {

@@ -20,13 +20,19 @@ const MODELS: [&str; 4] = [
     "esca_nonmanifold.stl",
 ];
 
-/// Every `step`-th layer of `model` with `stagger`, as rasters.
-fn rasters(model: &str, stagger: bool, step: usize) -> Vec<Raster> {
-    let s = Settings {
-        stagger,
-        ..Settings::default()
-    };
-    rasters_with(model, s, step)
+/// Every `step`-th layer of each of [`MODELS`], stagger off and on, as rasters, each with its
+/// model and stagger.
+fn rasters(step: usize) -> impl Iterator<Item = (&'static str, bool, Raster)> {
+    MODELS.into_iter().flat_map(move |model| {
+        [false, true].into_iter().flat_map(move |stagger| {
+            let s = Settings {
+                stagger,
+                ..Settings::default()
+            };
+            let layers = rasters_with(model, s, step);
+            layers.into_iter().map(move |r| (model, stagger, r))
+        })
+    })
 }
 
 fn rasters_with(model: &str, s: Settings, step: usize) -> Vec<Raster> {
@@ -44,30 +50,26 @@ fn rasters_with(model: &str, s: Settings, step: usize) -> Vec<Raster> {
 #[test]
 fn masks_are_those_counted_range_by_range() {
     let b = Settings::default().droplet_width();
-    for model in MODELS {
-        for stagger in [false, true] {
-            for r in rasters(model, stagger, 23) {
-                // B/4: the page's cells (4-bit groups); B, 7.3 B: by windows.
-                let cells: &[f64] = if stagger {
-                    &[b / 4.0]
-                } else {
-                    &[b / 4.0, b / 6.0, b, 7.3 * b]
-                };
-                for &cell in cells {
-                    let want = r.mask_reference(cell);
-                    assert_eq!(
-                        r.mask(cell),
-                        want,
-                        "{model}, stagger {stagger}, cell {cell}"
-                    );
-                    // The page's: the same without the covered shares.
-                    assert_eq!(
-                        r.page_mask(cell),
-                        without_covered(want),
-                        "page mask: {model}, stagger {stagger}, cell {cell}"
-                    );
-                }
-            }
+    for (model, stagger, r) in rasters(23) {
+        // B/4: the page's cells (4-bit groups); B, 7.3 B: by windows.
+        let cells: &[f64] = if stagger {
+            &[b / 4.0]
+        } else {
+            &[b / 4.0, b / 6.0, b, 7.3 * b]
+        };
+        for &cell in cells {
+            let want = r.mask_reference(cell);
+            assert_eq!(
+                r.mask(cell),
+                want,
+                "{model}, stagger {stagger}, cell {cell}"
+            );
+            // The page's: the same without the covered shares.
+            assert_eq!(
+                r.page_mask(cell),
+                without_covered(want),
+                "page mask: {model}, stagger {stagger}, cell {cell}"
+            );
         }
     }
 }
@@ -114,26 +116,21 @@ fn one_raster_reused_gives_the_figures_of_new_ones() {
 
 #[test]
 fn layer_figures_are_those_of_the_reference_labelling() {
-    for model in MODELS {
-        for stagger in [false, true] {
-            for r in rasters(model, stagger, 29) {
-                let want = r.analysis_reference();
-                assert_eq!(r.analysis(), want, "{model} stagger {stagger}");
-                // Natively the fast path may take the popcount instruction: also without it.
-                assert_eq!(
-                    r.analysis_portable(),
-                    want,
-                    "portable: {model} stagger {stagger}"
-                );
-            }
-        }
+    for (model, stagger, r) in rasters(29) {
+        let want = r.analysis_reference();
+        assert_eq!(r.analysis(), want, "{model} stagger {stagger}");
+        // Natively the fast path may take the popcount instruction: also without it.
+        assert_eq!(
+            r.analysis_portable(),
+            want,
+            "portable: {model} stagger {stagger}"
+        );
     }
 }
 
 #[test]
 fn figures_and_masks_with_evenly_spaced_loops() {
-    let mut s = Settings::default();
-    s.set("loop_spacing", "even").unwrap();
+    let s = common::settings_with("loop_spacing", "even");
     let b = s.droplet_width();
     for r in rasters_with("3DBenchy.stl", s, 31) {
         assert_eq!(r.analysis(), r.analysis_reference());

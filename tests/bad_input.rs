@@ -480,31 +480,27 @@ fn budget_rows() -> Vec<Row> {
         ];
         rows.push(r);
     }
-    // A small unit-0 B that is fine without support (1.6e9 droplets at most): with support the
-    // pass would list up to 1.7e7 droplets of a layer at once.
-    let mut r = setting_row(
-        "support on, droplet_aspect=0.025",
-        "support=unit1".into(),
-        &["droplets"],
-    );
-    r.args
-        .extend(["--set".into(), "droplet_aspect=0.025".into()]);
-    r.all = vec![
-        "bad setting droplet_aspect".into(),
-        "unit 0".into(),
-        "support = off".into(),
+    // With support on: a small unit-0 B that is fine without support (1.6e9 droplets at most),
+    // but with support the pass would list up to 1.7e7 droplets of a layer at once; and far
+    // too small a unit-0 B, refused by unit 0's own count, support or not.
+    let cases: [(&str, &[&str]); 2] = [
+        (
+            "0.025",
+            &["bad setting droplet_aspect", "unit 0", "support = off"],
+        ),
+        ("0.001", &["unit 0", "droplet_aspect"]),
     ];
-    rows.push(r);
-    // Far too small a unit-0 B: refused by unit 0's own count, support or not.
-    let mut r = setting_row(
-        "support on, droplet_aspect=0.001",
-        "support=unit1".into(),
-        &["droplets"],
-    );
-    r.args
-        .extend(["--set".into(), "droplet_aspect=0.001".into()]);
-    r.all = vec!["unit 0".into(), "droplet_aspect".into()];
-    rows.push(r);
+    for (aspect, all) in cases {
+        let mut r = setting_row(
+            format!("support on, droplet_aspect={aspect}"),
+            "support=unit1".into(),
+            &["droplets"],
+        );
+        r.args
+            .extend(["--set".into(), format!("droplet_aspect={aspect}")]);
+        r.all = all.iter().map(|&w| w.into()).collect();
+        rows.push(r);
+    }
     rows
 }
 

@@ -17,11 +17,30 @@ fn cli<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S], dir: &Path) -> c
     r
 }
 
+/// `dropslice calibrate ARGS` (`args` separated by spaces): the arguments and the run.
+fn calibrate<'a>(dir: &Path, args: &'a str) -> (Vec<&'a str>, common::Run) {
+    let all: Vec<&str> = ["calibrate"].into_iter().chain(args.split(' ')).collect();
+    let r = cli(&all, dir);
+    (all, r)
+}
+
+/// `dropslice calibrate ARGS` (`args` separated by spaces) succeeds and prints each of `want`.
+fn assert_calibrates(dir: &Path, args: &str, want: &[&str]) {
+    let (all, r) = calibrate(dir, args);
+    assert_eq!(r.code, Some(0), "{all:?}: {r:?}");
+    for w in want {
+        assert!(
+            r.stdout.contains(w),
+            "{all:?}: expected {w:?} in {}",
+            r.stdout
+        );
+    }
+}
+
 /// `dropslice calibrate ARGS` (`args` separated by spaces) is refused: exit code 2, a short message containing `want`,
 /// nothing on stdout.
 fn assert_refused(dir: &Path, args: &str, want: &str) {
-    let all: Vec<&str> = ["calibrate"].into_iter().chain(args.split(' ')).collect();
-    let r = cli(&all, dir);
+    let (all, r) = calibrate(dir, args);
     assert_eq!(r.code, Some(2), "{all:?}: {r:?}");
     assert!(
         r.stderr.contains(want),
@@ -78,26 +97,15 @@ fn known_volume_gives_its_filling_and_aspect() {
         assert_eq!(c.current_droplet_aspect, 1.04);
 
         // The CLI prints the same figures.
-        let r = cli(
-            &[
-                "calibrate",
-                "cube.gco",
-                "--mass",
-                &format!("{mass}"),
-                "--density",
-                &format!("{rho}"),
-            ],
+        assert_calibrates(
             dir.path(),
-        );
-        assert_eq!(r.code, Some(0), "{r:?}");
-        assert!(
-            r.stdout.contains(&format!("filling degree    {fill:.3}"))
-                && r.stdout.contains(&format!("{a:.3} suggested (now 1.04)"))
-                && r.stdout
-                    .contains(&format!("{},{:03} droplets of", n / 1000, n % 1000))
-                && r.stdout.contains("from the header"),
-            "{}",
-            r.stdout
+            &format!("cube.gco --mass {mass} --density {rho}"),
+            &[
+                &format!("filling degree    {fill:.3}"),
+                &format!("{a:.3} suggested (now 1.04)"),
+                &format!("{},{:03} droplets of", n / 1000, n % 1000),
+                "from the header",
+            ],
         );
     }
 }
@@ -117,9 +125,7 @@ fn count_from_the_commands_without_a_header_total() {
     assert_eq!(c.droplets, n, "counted from G25/G26 as the header counts");
     // The header's material_density (1.04) is the default density.
     assert_eq!(c.density_g_cm3, 1.04);
-    let r = cli(&["calibrate", "bare.gco", "--mass", "10"], dir.path());
-    assert_eq!(r.code, Some(0), "{r:?}");
-    assert!(r.stdout.contains("counted from the code"), "{}", r.stdout);
+    assert_calibrates(dir.path(), "bare.gco --mass 10", &["counted from the code"]);
 }
 
 #[test]
@@ -202,15 +208,10 @@ fn large_codes_are_counted_not_expanded() {
         let c = calibrate_gcode(text, mass, None).unwrap();
         assert_eq!((c.droplets, c.count_source), (n, source), "{file}");
         assert!((c.filling_degree - 1.0).abs() < 1e-9, "{file}: {c:?}");
-        let r = cli(
-            &["calibrate", file, "--mass", &format!("{mass}")],
+        assert_calibrates(
             dir.path(),
-        );
-        assert_eq!(r.code, Some(0), "{file}: {r:?}");
-        assert!(
-            r.stdout.contains(&format!("droplets          {n} (")),
-            "{file}: {}",
-            r.stdout
+            &format!("{file} --mass {mass}"),
+            &[&format!("droplets          {n} (")],
         );
     }
 }

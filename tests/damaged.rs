@@ -52,18 +52,26 @@ const MODELS: [&str; 3] = [
     "M3x10_screw",
 ];
 
+/// Each of [`MODELS`], damaged by `damage` (with a generator seeded `seed` + its index),
+/// slices as the undamaged model does ([`assert_close`]).
+fn assert_heals(seed: u64, what: &str, damage: impl Fn(Vec<Tri>, &mut Rng) -> Vec<Tri>) {
+    for (k, model) in MODELS.iter().enumerate() {
+        let mut rng = Rng::new(seed + k as u64);
+        let t = damage(load(model), &mut rng);
+        assert_close(model, what, &t);
+    }
+}
+
 #[test]
 fn flipped_facets() {
-    for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng::new(17 + k as u64);
-        let mut t = load(model);
+    assert_heals(17, "10 % flipped", |mut t, rng| {
         for tri in &mut t {
             if rng.unit() < 0.10 {
                 tri.swap(1, 2);
             }
         }
-        assert_close(model, "10 % flipped", &t);
-    }
+        t
+    });
 }
 
 #[test]
@@ -79,43 +87,30 @@ fn inside_out() {
 
 #[test]
 fn duplicated_facets() {
-    for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng::new(99 + k as u64);
-        let mut t = load(model);
+    assert_heals(99, "20 % duplicated", |mut t, rng| {
         let extra: Vec<Tri> = t.iter().filter(|_| rng.unit() < 0.2).copied().collect();
         t.extend(extra);
-        assert_close(model, "20 % duplicated", &t);
-    }
+        t
+    });
 }
 
 #[test]
 fn jittered_vertices() {
     // Every corner of every facet moved by up to 1e-6 mm on its own: exact welding fails
     // everywhere, the tolerance weld closes the cracks.
-    for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng::new(5 + k as u64);
-        let mut t = load(model);
-        for tri in &mut t {
-            for v in tri.iter_mut() {
-                for c in v.iter_mut() {
-                    *c += ((rng.unit() - 0.5) * 2e-6) as f32;
-                }
-            }
+    assert_heals(5, "jittered 1e-6", |mut t, rng| {
+        for c in t.iter_mut().flatten().flatten() {
+            *c += ((rng.unit() - 0.5) * 2e-6) as f32;
         }
-        assert_close(model, "jittered 1e-6", &t);
-    }
+        t
+    });
 }
 
 #[test]
 fn removed_facets() {
-    for (k, model) in MODELS.iter().enumerate() {
-        let mut rng = Rng::new(31 + k as u64);
-        let t: Vec<Tri> = load(model)
-            .into_iter()
-            .filter(|_| rng.unit() >= 0.01)
-            .collect();
-        assert_close(model, "1 % removed", &t);
-    }
+    assert_heals(31, "1 % removed", |t, rng| {
+        t.into_iter().filter(|_| rng.unit() >= 0.01).collect()
+    });
 }
 
 fn run_cli(model: &std::path::Path, extra: &[&str]) -> (String, String) {

@@ -7,6 +7,8 @@
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
+#[path = "common/slab.rs"]
+mod slab;
 
 use dropslice::analysis::{
     GRID3_PER_B, Grid3, HeightMap, JobAnalysis, droplet_centres, footprint_diameter, slab_voids,
@@ -14,6 +16,7 @@ use dropslice::analysis::{
 };
 use dropslice::base::geom::{Point, Shape, Shapes};
 use dropslice::{Job, Settings};
+use slab::SlabFn;
 
 fn bits(f: (f64, f64)) -> (u64, u64) {
     (f.0.to_bits(), f.1.to_bits())
@@ -22,43 +25,42 @@ fn bits(f: (f64, f64)) -> (u64, u64) {
 /// Every slab of `layers` (region, droplet centres), fast and reference, equal to the bit.
 fn assert_slabs_equal(what: &str, layers: &[(Shapes, Vec<Point>)], grid: &Grid3, s: &Settings) {
     let d = footprint_diameter(s);
-    let fast: Vec<HeightMap> = layers
-        .iter()
-        .map(|l| HeightMap::new(&l.1, grid, d))
-        .collect();
-    let slow: Vec<HeightMap> = layers
-        .iter()
-        .map(|l| HeightMap::reference(&l.1, grid, d))
-        .collect();
+    let [fast, slow] = [
+        HeightMap::new as fn(&[Point], &Grid3, f64) -> HeightMap,
+        HeightMap::reference,
+    ]
+    .map(|make| {
+        layers
+            .iter()
+            .map(|l| make(&l.1, grid, d))
+            .collect::<Vec<_>>()
+    });
     let mut nonzero = 0;
     for i in 0..layers.len() {
-        let (lo, hi) = (i.checked_sub(1), i + 1);
-        let a = slab_voids(
-            &layers[i].0,
-            grid,
-            lo.map(|j| &fast[j]),
-            &fast[i],
-            fast.get(hi),
-            s,
-        );
-        let b = slab_voids_reference(
-            &layers[i].0,
-            grid,
-            lo.map(|j| &slow[j]),
-            &slow[i],
-            slow.get(hi),
-            s,
-        );
-        assert_eq!(bits(a), bits(b), "{what}, slab {i}: {a:?} against {b:?}");
-        // Without neighbours, too.
-        let a = slab_voids(&layers[i].0, grid, None, &fast[i], None, s);
-        let b = slab_voids_reference(&layers[i].0, grid, None, &slow[i], None, s);
-        assert_eq!(
-            bits(a),
-            bits(b),
-            "{what}, slab {i} alone: {a:?} against {b:?}"
-        );
-        nonzero += usize::from(a.1 > 0.0 && a.1 < a.0);
+        // Between its neighbours, then without them.
+        for alone in [false, true] {
+            let slab = |f: SlabFn, maps: &[HeightMap]| {
+                let near = |j: Option<usize>| j.filter(|_| !alone).and_then(|j| maps.get(j));
+                f(
+                    &layers[i].0,
+                    grid,
+                    near(i.checked_sub(1)),
+                    &maps[i],
+                    near(Some(i + 1)),
+                    s,
+                )
+            };
+            let (a, b) = (slab(slab_voids, &fast), slab(slab_voids_reference, &slow));
+            let how = if alone { " alone" } else { "" };
+            assert_eq!(
+                bits(a),
+                bits(b),
+                "{what}, slab {i}{how}: {a:?} against {b:?}"
+            );
+            if alone {
+                nonzero += usize::from(a.1 > 0.0 && a.1 < a.0);
+            }
+        }
     }
     // The comparison saw partly filled slabs, not only empty or full ones.
     assert!(nonzero > 0, "{what}: no slab partly filled");
@@ -109,8 +111,7 @@ fn slabs_of_real_models_are_the_reference_slabs() {
 fn slabs_of_random_droplets_are_the_reference_slabs() {
     let mut rng = common::Rng::new(1);
     for footprint in ["disc", "spread"] {
-        let mut s = Settings::default();
-        s.set("footprint", footprint).unwrap();
+        let s = common::settings_with("footprint", footprint);
         let b = s.droplet_width();
         let grid = Grid3 {
             origin: [-1.3, -0.7].into(),
@@ -197,16 +198,6 @@ fn slabs_of_random_droplets_are_the_reference_slabs() {
         }
     }
 }
-
-/// The signature of `slab_voids` and its reference.
-type SlabFn = fn(
-    &Shapes,
-    &Grid3,
-    Option<&HeightMap>,
-    &HeightMap,
-    Option<&HeightMap>,
-    &Settings,
-) -> (f64, f64);
 
 /// The report when the writing thread computes every slab in order (the layers analysed and
 /// pushed one by one, as before the workers computed them).

@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::bounds;
 use std::time::{Duration, Instant};
 
 use dropslice::Error;
@@ -14,18 +15,6 @@ use dropslice::model::import::{self, IDENTITY, Part};
 
 type Tri = [[f32; 3]; 3];
 type P3 = [f64; 3];
-
-fn bounds(tris: &[Tri]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in tris.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k] as f64);
-            hi[k] = hi[k].max(p[k] as f64);
-        }
-    }
-    (lo, hi)
-}
 
 fn volume(tris: &[Tri]) -> f64 {
     tris.iter()
@@ -40,6 +29,48 @@ fn volume(tris: &[Tri]) -> f64 {
 
 fn close(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
     (0..3).all(|k| (a[k] - b[k]).abs() <= tol)
+}
+
+/// Makes `count` damaged copies of the shared model `name` one after the other, copy `i` by
+/// `damage(i, copy, rng)` (one generator seeded `seed` for all), and hands each to `check`.
+fn damaged_copies(
+    name: &str,
+    seed: u64,
+    count: u64,
+    damage: impl Fn(u64, &mut Vec<u8>, &mut common::Rng),
+    check: impl Fn(&[u8]),
+) {
+    let base = common::model_bytes(name);
+    let mut rng = common::Rng::new(seed);
+    for i in 0..count {
+        let mut b = base.clone();
+        damage(i, &mut b, &mut rng);
+        check(&b);
+    }
+}
+
+/// Overwrites `count` bytes of `b`, each at a random place, with a byte `byte` draws.
+fn scramble(
+    b: &mut [u8],
+    count: u64,
+    rng: &mut common::Rng,
+    byte: impl Fn(&mut common::Rng) -> u8,
+) {
+    for _ in 0..count {
+        let k = rng.below(b.len() as u64) as usize;
+        b[k] = byte(rng);
+    }
+}
+
+/// `p` has `n` triangles, and the box around them has corners within `tol` of `lo` and `hi`.
+fn assert_triangles(p: &Part, n: usize, lo: P3, hi: P3, tol: f64) {
+    assert_eq!(p.triangles.len(), n, "{}", p.name);
+    let (l, h) = bounds(&p.triangles);
+    assert!(
+        close(l, lo, tol) && close(h, hi, tol),
+        "{}: {l:?} {h:?}",
+        p.name
+    );
 }
 
 fn import_err(r: Result<Vec<Part>, Error>) -> String {
@@ -88,12 +119,7 @@ fn obj_models() {
         assert_eq!(p.name, name.trim_end_matches(".obj"));
         assert_eq!(p.transform_applied, IDENTITY);
         assert_eq!(p.source_object, None);
-        assert_eq!(p.triangles.len(), n, "{name}");
-        let (l, h) = bounds(&p.triangles);
-        assert!(
-            close(l, lo, 1e-5) && close(h, hi, 1e-5),
-            "{name}: {l:?} {h:?}"
-        );
+        assert_triangles(p, n, lo, hi, 1e-5);
         let v = volume(&p.triangles);
         assert!(
             (v - vol).abs() < 1e-6 * vol.abs() + 1e-6,
@@ -192,17 +218,20 @@ fn obj_errors_name_the_line() {
 
 #[test]
 fn obj_garbage_never_panics() {
-    let base = common::model_bytes("bridge.obj");
-    let mut rng = common::Rng::new(12);
-    for i in 0..400 {
-        let mut b = base.clone();
-        for _ in 0..1 + i % 8 {
-            let k = rng.below(b.len() as u64) as usize;
-            b[k] = b" \n-0123456789/fvo#.eE"[rng.below(21) as usize];
-        }
-        let cut = rng.below(b.len() as u64 + 1) as usize;
-        let _ = import::read_parts(&b[..cut], "f.obj");
-    }
+    damaged_copies(
+        "bridge.obj",
+        12,
+        400,
+        |i, b, rng| {
+            scramble(b, 1 + i % 8, rng, |r| {
+                b" \n-0123456789/fvo#.eE"[r.below(21) as usize]
+            });
+            b.truncate(rng.below(b.len() as u64 + 1) as usize);
+        },
+        |b| {
+            let _ = import::read_parts(b, "f.obj");
+        },
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -269,12 +298,7 @@ fn cube_gears_3mf() {
         assert_eq!(p.name, name);
         assert_eq!(p.source_object, Some(id.to_string()));
         assert_eq!(p.transform_applied, item);
-        assert_eq!(p.triangles.len(), n, "{name}");
-        let (l, h) = bounds(&p.triangles);
-        assert!(
-            close(l, lo, 6e-5) && close(h, hi, 6e-5),
-            "{name}: {l:?} {h:?}"
-        );
+        assert_triangles(p, n, lo, hi, 6e-5);
     }
     let (all, _) = import::read_merged(&bytes, "cube_gears.3mf").unwrap();
     assert_eq!(all.len(), 25_692);
@@ -455,35 +479,9 @@ const RELS: &str = r#"<?xml version="1.0" encoding="UTF-8"?><Relationships xmlns
 const HEAD: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <model unit="UNIT" xmlns="http://schemas.microsoft.com/3dmanufacturing/core/2015/02" xmlns:p="http://schemas.microsoft.com/3dmanufacturing/production/2015/06">"#;
 
-/// A 1×1×1 cube (12 triangles) as `<object id>`.
+/// A 1×1×1 cube (12 triangles, facing outward) as `<object id>`.
 fn cube(id: u32) -> String {
-    let mut s = format!(r#"<object id="{id}" type="model"><mesh><vertices>"#);
-    for i in 0..8 {
-        s += &format!(
-            r#"<vertex x="{}" y="{}" z="{}"/>"#,
-            i & 1,
-            (i >> 1) & 1,
-            (i >> 2) & 1
-        );
-    }
-    s += "</vertices><triangles>";
-    for t in [
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ] {
-        s += &format!(r#"<triangle v1="{}" v2="{}" v3="{}"/>"#, t[0], t[1], t[2]);
-    }
-    s + "</triangles></mesh></object>"
+    common::cube_object(id, 1.0, false)
 }
 
 /// A 3MF object `id` of 1000 components, each the object `child`.
@@ -740,7 +738,7 @@ fn refused_3mf() {
             "triangle index out of range",
             package(
                 "millimeter",
-                &cube(1).replace(r#"v1="3" v2="7" v3="5""#, r#"v1="3" v2="8" v3="5""#),
+                &cube(1).replace(r#"v1="1" v2="7" v3="5""#, r#"v1="1" v2="8" v3="5""#),
                 ok_build,
                 vec![],
             ),
@@ -969,20 +967,21 @@ fn zip_bombs_are_refused_quickly() {
 
 #[test]
 fn damaged_3mf_never_panics() {
-    let base = common::model_bytes("box.3mf");
-    let mut rng = common::Rng::new(3);
-    for i in 0..600 {
-        let mut b = base.clone();
-        if i % 3 != 0 {
-            for _ in 0..1 + i % 5 {
-                let k = rng.below(b.len() as u64) as usize;
-                b[k] = rng.next_u64() as u8;
+    damaged_copies(
+        "box.3mf",
+        3,
+        600,
+        |i, b, rng| {
+            if i % 3 != 0 {
+                scramble(b, 1 + i % 5, rng, |r| r.next_u64() as u8);
+            } else {
+                b.truncate(rng.below(b.len() as u64) as usize);
             }
-        } else {
-            b.truncate(rng.below(b.len() as u64) as usize);
-        }
-        let _ = std::panic::catch_unwind(|| read(&b)).expect("no panic");
-    }
+        },
+        |b| {
+            let _ = std::panic::catch_unwind(|| read(b)).expect("no panic");
+        },
+    );
 }
 
 /// 20 MB of repeated ZIP signatures (end-of-directory records, ZIP64 records, directory

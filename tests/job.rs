@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{Rng, TempDir, model, model_bytes, on_plate, run_cli};
+use common::{Rng, TempDir, bounds, model, model_bytes, on_plate, run_cli};
 use dropslice::model::display::display_mesh;
 use dropslice::model::layout::{Rect, arrange, lay_flat, layout};
 use dropslice::model::models::Model;
@@ -518,14 +518,7 @@ fn a_job_of_three_parts_slices_as_the_oracle_says() {
     ];
     for (k, (tris, rot, scale, at)) in parts.iter().enumerate() {
         let p = placed(tris, *rot, *scale, *at);
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for q in p.iter().flatten() {
-            for c in 0..3 {
-                lo[c] = lo[c].min(q[c]);
-                hi[c] = hi[c].max(q[c]);
-            }
-        }
+        let (lo, hi) = bounds(&p);
         for c in 0..3 {
             assert!(
                 (lo[c] - inst[k].min[c]).abs() < 1e-4,
@@ -715,14 +708,7 @@ fn lay_flat_puts_the_largest_face_down() {
 #[test]
 fn display_mesh_stays_within_its_budget() {
     let tris = all_triangles("3DBenchy.stl");
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for p in tris.iter().flatten() {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = bounds(&tris);
     let whole = display_mesh(&tris, tris.len());
     assert_eq!(whole.len(), tris.len() * 9);
     for max in [50_000usize, 5_000, 100] {
@@ -733,7 +719,8 @@ fn display_mesh_stays_within_its_budget() {
         // Every corner lies within the model's bounds (cells average their corners).
         for c in d.chunks(3) {
             for k in 0..3 {
-                assert!(c[k] >= lo[k] - 1e-3 && c[k] <= hi[k] + 1e-3, "{c:?}");
+                let x = f64::from(c[k]);
+                assert!(x >= lo[k] - 1e-3 && x <= hi[k] + 1e-3, "{c:?}");
             }
         }
     }

@@ -78,6 +78,23 @@ fn same_on_every_cube(
     (layers, per_cube)
 }
 
+/// Slices `bytes` (cubes on a 1 mm grid, see [`droplets_per_cube`]) and checks that every
+/// non-empty layer holds the same droplets on each column of `columns`
+/// ([`same_on_every_cube`]), that the number of such layers lies in `layers`, and that a
+/// column (`per`: how the message names it) gets at least four droplets on each of them.
+fn assert_cubes_alike(
+    bytes: &[u8],
+    name: &str,
+    columns: &[(i64, i64)],
+    layers: std::ops::RangeInclusive<usize>,
+    per: &str,
+) {
+    let per_layer = droplets_per_cube(bytes, name, 1.0);
+    let (n, per_cube) = same_on_every_cube(&per_layer, columns);
+    assert!(layers.contains(&n), "{n} layers");
+    assert!(per_cube >= 4 * n as u32, "{per_cube} droplets per {per}");
+}
+
 #[test]
 fn a_hundred_thousand_build_items_of_small_cubes_slice_alike() {
     // 100 000 items of one inside-out 0.5 mm cube, 1 mm apart on a grid 317 wide (the last
@@ -93,54 +110,22 @@ fn a_hundred_thousand_build_items_of_small_cubes_slice_alike() {
         })
         .collect();
     let bytes = common::three_mf(&common::cube_object(1, SIDE as f32, true), &items);
-    let per_layer = droplets_per_cube(&bytes, "items.3mf", 1.0);
     let columns: Vec<(i64, i64)> = (0..n)
         .map(|i| ((i % side) as i64, (i / side) as i64))
         .collect();
-    let (layers, per_cube) = same_on_every_cube(&per_layer, &columns);
     // 0.5 mm at 0.2 mm layers: 2 or 3 layers, a loop of droplets around each square in each.
-    assert!((2..=3).contains(&layers), "{layers} layers");
-    assert!(
-        per_cube >= 4 * layers as u32,
-        "{per_cube} droplets per cube"
-    );
+    assert_cubes_alike(&bytes, "items.3mf", &columns, 2..=3, "cube");
 }
 
 #[test]
 fn a_small_3mf_fanning_out_ten_thousand_cubes_slices_alike() {
     // Four levels of ten components (x 1 mm, y 1 mm, z 1 mm, x 10 mm apart): 10 000 cubes,
     // 100 × 10 columns of 10 cubes each, from a file of about a kilobyte.
-    let levels = 4;
-    let mut res = common::cube_object(1, SIDE as f32, false);
-    for l in 0..levels {
-        let pitch = 10f64.powi(l / 3);
-        let comps: String = (0..10)
-            .map(|k| {
-                let mut d = [0.0; 3];
-                d[(l % 3) as usize] = k as f64 * pitch;
-                format!(
-                    r#"<component objectid="{}" transform="{}"/>"#,
-                    l + 1,
-                    translate(d[0], d[1], d[2])
-                )
-            })
-            .collect();
-        res += &format!(
-            r#"<object id="{}" type="model"><components>{comps}</components></object>"#,
-            l + 2
-        );
-    }
-    let bytes = common::three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
+    let bytes = common::fanned_cubes_3mf(4, SIDE as f32, false);
     assert!(bytes.len() < 2000, "{} bytes", bytes.len());
-    let per_layer = droplets_per_cube(&bytes, "fan.3mf", 1.0);
     let columns: Vec<(i64, i64)> = (0..100)
         .flat_map(|x| (0..10).map(move |y| (x, y)))
         .collect();
-    let (layers, per_cube) = same_on_every_cube(&per_layer, &columns);
     // Ten cubes one above the other in each column, 2 or 3 layers each.
-    assert!((20..=30).contains(&layers), "{layers} layers");
-    assert!(
-        per_cube >= 4 * layers as u32,
-        "{per_cube} droplets per column"
-    );
+    assert_cubes_alike(&bytes, "fan.3mf", &columns, 20..=30, "column");
 }

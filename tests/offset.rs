@@ -187,8 +187,7 @@ fn every_vertex_keeps_its_distance_from_the_boundary() {
 fn loops_far_inside_match_direct_offsets() {
     // With many contours the loops farther in than 3 B are offsets of the previous loop (one
     // B at a time); they must be the part's region moved in by the whole distance.
-    let mut s = Settings::default();
-    s.set("contours", "12").unwrap();
+    let s = common::settings_with("contours", "12");
     let b = s.droplet_width();
     let mut compared = 0;
     for name in ["3DBenchy.stl", "extruder_idler.stl", "esca_nonmanifold.stl"] {

@@ -58,30 +58,36 @@ fn assert_areas(job: &Job, want: impl Fn(f64) -> f64, what: &str) {
     }
 }
 
-#[test]
-fn an_inverted_box_beside_a_box_is_printed() {
+/// One of the job's warnings contains every one of `parts`.
+fn assert_warned(j: &Job, parts: &[&str]) {
+    let warnings = &j.info().warnings;
+    assert!(
+        warnings.iter().any(|w| parts.iter().all(|p| w.contains(p))),
+        "{warnings:?}"
+    );
+}
+
+/// The job of a 10 mm box at the origin and an inside-out 10 mm box at `at`, whose one shell
+/// turned outward it checks.
+fn box_and_inverted_box(at: [f32; 3]) -> Job {
     let mut t = cuboid([0.0; 3], [10.0; 3]);
-    t.extend(inverted(cuboid([20.0, 0.0, 0.0], [30.0, 10.0, 10.0])));
+    t.extend(inverted(cuboid(at, at.map(|c| c + 10.0))));
     let j = job(&t).unwrap();
     assert_eq!(j.info().mesh.flipped_shells, 1);
-    assert!(
-        j.info()
-            .warnings
-            .iter()
-            .any(|w| w.contains("1 closed shell was inside out")),
-        "{:?}",
-        j.info().warnings
-    );
+    j
+}
+
+#[test]
+fn an_inverted_box_beside_a_box_is_printed() {
+    let j = box_and_inverted_box([20.0, 0.0, 0.0]);
+    assert_warned(&j, &["1 closed shell was inside out"]);
     assert_areas(&j, |_| 200.0, "two boxes, one inverted");
 }
 
 #[test]
 fn an_inverted_box_overlapping_a_box_gives_their_union() {
     // Without orientation the overlap's winding numbers cancel (+1 − 1 = 0) and it vanishes.
-    let mut t = cuboid([0.0; 3], [10.0; 3]);
-    t.extend(inverted(cuboid([5.0, 0.0, 0.0], [15.0, 10.0, 10.0])));
-    let j = job(&t).unwrap();
-    assert_eq!(j.info().mesh.flipped_shells, 1);
+    let j = box_and_inverted_box([5.0, 0.0, 0.0]);
     assert_areas(&j, |_| 150.0, "overlapping boxes, one inverted");
 }
 
@@ -399,29 +405,7 @@ fn many_nested_or_overlapping_inverted_shells_stay_within_the_budget() {
 fn a_small_3mf_fanning_out_inverted_cubes_by_components_is_oriented_quickly() {
     // Five levels of ten components each: 100 000 inside-out cubes from a file of about a
     // kilobyte, every one outside the others.
-    let levels = 5;
-    let mut res = common::cube_object(1, 0.5, true);
-    for l in 0..levels {
-        let pitch = 10f64.powi(l / 3);
-        let comps: String = (0..10)
-            .map(|k| {
-                let mut d = [0.0; 3];
-                d[(l % 3) as usize] = k as f64 * pitch;
-                format!(
-                    r#"<component objectid="{}" transform="1 0 0 0 1 0 0 0 1 {} {} {}"/>"#,
-                    l + 1,
-                    d[0],
-                    d[1],
-                    d[2]
-                )
-            })
-            .collect();
-        res += &format!(
-            r#"<object id="{}" type="model"><components>{comps}</components></object>"#,
-            l + 2
-        );
-    }
-    let bytes = common::three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1));
+    let bytes = common::fanned_cubes_3mf(5, 0.5, true);
     assert!(bytes.len() < 2000, "{} bytes", bytes.len());
     let t = std::time::Instant::now();
     let j = Job::new(&bytes, "fan.3mf", Settings::default()).unwrap();
@@ -432,14 +416,7 @@ fn a_small_3mf_fanning_out_inverted_cubes_by_components_is_oriented_quickly() {
     let m = &j.info().mesh;
     assert_eq!((m.flipped_shells, m.unchecked_shells), (100_000, 0));
     assert!(m.signed_volume > 0.0);
-    assert!(
-        j.info()
-            .warnings
-            .iter()
-            .any(|w| w.contains("100000 closed shells were inside out")),
-        "{:?}",
-        j.info().warnings
-    );
+    assert_warned(&j, &["100000 closed shells were inside out"]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -517,14 +494,7 @@ fn mirrored_open_halves_print_as_their_union() {
     let m = &j.info().mesh;
     assert_eq!((m.flipped_open_shells, m.flipped_shells), (1, 0), "{m:?}");
     assert!(m.open_edges > 0);
-    assert!(
-        j.info()
-            .warnings
-            .iter()
-            .any(|w| w.contains("1 open shell was inside out") && w.contains("turned outward")),
-        "{:?}",
-        j.info().warnings
-    );
+    assert_warned(&j, &["1 open shell was inside out", "turned outward"]);
     let layers = oracle["layers"].as_array().unwrap();
     assert_eq!(j.layer_count(), layers.len());
     let mut bad = Vec::new();

@@ -37,6 +37,15 @@ fn box_stl(w: f64, d: f64, h: f64) -> String {
     s
 }
 
+/// Models holding, under each name, a box of (width, depth, height) as [`box_stl`] makes it.
+fn boxes(files: &[(&str, [f64; 3])]) -> Models {
+    let mut models = Models::new();
+    for &(name, [w, d, h]) in files {
+        models.add_bytes(box_stl(w, d, h).as_bytes(), name).unwrap();
+    }
+    models
+}
+
 /// Two boxes as one ASCII STL, the second moved by (dx, dy).
 fn two_boxes_stl(w: f64, d: f64, h: f64, dx: f64, dy: f64) -> String {
     let one = box_stl(w, d, h);
@@ -74,13 +83,23 @@ fn defaults() -> JsValue {
     js(serde_json::json!({}))
 }
 
-/// The thrown error as `{kind, message, setting?}`.
-fn thrown(e: JsValue) -> serde_json::Value {
+/// The error `r` threw (it must have thrown) as `{kind, message, setting?}`.
+fn thrown<T>(r: Result<T, JsValue>) -> serde_json::Value {
+    let Err(e) = r else {
+        panic!("no error was thrown")
+    };
     assert!(
         !e.is_instance_of::<js_sys::Error>(),
         "a plain object, not an Error"
     );
     json(e)
+}
+
+/// [`thrown`], checking that the error is of `kind`.
+fn throws<T>(r: Result<T, JsValue>, kind: &str) -> serde_json::Value {
+    let e = thrown(r);
+    assert_eq!(e["kind"], kind, "{e}");
+    e
 }
 
 #[wasm_bindgen_test]
@@ -207,8 +226,7 @@ fn settings_change_the_slice() {
 #[wasm_bindgen_test]
 fn errors_are_typed_objects() {
     let garbage = b"this is not an STL file at all, just some words";
-    let e = thrown(Session::new(garbage, "x.stl", defaults()).err().unwrap());
-    assert_eq!(e["kind"], "import", "{e}");
+    let e = throws(Session::new(garbage, "x.stl", defaults()), "import");
     assert!(
         e["message"]
             .as_str()
@@ -219,57 +237,41 @@ fn errors_are_typed_objects() {
     assert!(e.get("setting").is_none(), "{e}");
 
     let stl = box_stl(10.0, 6.0, 2.0);
+    // each of these is a setting error
     let bad = |settings: serde_json::Value| {
-        thrown(
-            Session::new(stl.as_bytes(), "box.stl", js(settings))
-                .err()
-                .unwrap(),
+        throws(
+            Session::new(stl.as_bytes(), "box.stl", js(settings)),
+            "setting",
         )
     };
     let e = bad(serde_json::json!({"layer_height": -1}));
-    assert_eq!(e["kind"], "setting", "{e}");
     assert_eq!(e["setting"], "layer_height", "{e}");
     assert!(
         e["message"].as_str().unwrap().contains("layer_height"),
         "{e}"
     );
     let e = bad(serde_json::json!({"contours": "many"}));
-    assert_eq!(
-        (&e["kind"], &e["setting"]),
-        (&"setting".into(), &"contours".into()),
-        "{e}"
-    );
-    let e = bad(serde_json::json!({"no_such_setting": 1}));
-    assert_eq!(e["kind"], "setting", "{e}");
+    assert_eq!(e["setting"], "contours", "{e}");
+    bad(serde_json::json!({"no_such_setting": 1}));
     let e = bad(serde_json::json!("not an object"));
-    assert_eq!(e["kind"], "setting", "{e}");
     assert!(e.get("setting").is_none(), "{e}");
     // a part thinner than half a layer
-    let e = thrown(
-        Session::new(box_stl(10.0, 6.0, 0.05).as_bytes(), "thin.stl", defaults())
-            .err()
-            .unwrap(),
+    let thin = box_stl(10.0, 6.0, 0.05);
+    throws(
+        Session::new(thin.as_bytes(), "thin.stl", defaults()),
+        "nothing_to_print",
     );
-    assert_eq!(e["kind"], "nothing_to_print", "{e}");
 
-    let e = thrown(Session::new(&[], "empty.stl", defaults()).err().unwrap());
-    assert_eq!(e["kind"], "import", "{e}");
+    throws(Session::new(&[], "empty.stl", defaults()), "import");
     // a truncated binary STL
     let mut bin = vec![0u8; 84];
     bin[80] = 5;
     bin.extend_from_slice(&[0u8; 60]);
-    let e = thrown(Session::new(&bin, "cut.stl", defaults()).err().unwrap());
-    assert_eq!(e["kind"], "import", "{e}");
+    throws(Session::new(&bin, "cut.stl", defaults()), "import");
     // a layer out of range and a summary the core did not make are internal errors
     let s = Session::new(stl.as_bytes(), "box.stl", defaults()).unwrap();
-    let e = thrown(s.slice_layer(99).err().unwrap());
-    assert_eq!(e["kind"], "internal", "{e}");
-    let e = thrown(
-        s.footer(js(serde_json::json!({"counts": 5})))
-            .err()
-            .unwrap(),
-    );
-    assert_eq!(e["kind"], "internal", "{e}");
+    throws(s.slice_layer(99), "internal");
+    throws(s.footer(js(serde_json::json!({"counts": 5}))), "internal");
 }
 
 #[wasm_bindgen_test]
@@ -332,16 +334,11 @@ fn a_session_from_the_prepared_mesh_slices_the_same() {
     let merged = json(merge_summaries(js(serde_json::json!([sa]))).unwrap());
     assert_eq!(merged["counts"], sa["counts"]);
     // other settings than the prepared mesh was made with are refused
-    let e = thrown(
-        prepared_copy(
-            &first,
-            first.info().unwrap(),
-            js(serde_json::json!({"layer_height": 0.1})),
-        )
-        .err()
-        .unwrap(),
+    let other_settings = js(serde_json::json!({"layer_height": 0.1}));
+    throws(
+        prepared_copy(&first, first.info().unwrap(), other_settings),
+        "internal",
     );
-    assert_eq!(e["kind"], "internal", "{e}");
 }
 
 #[wasm_bindgen_test]
@@ -548,47 +545,32 @@ fn models_give_infos_layouts_and_a_merged_session() {
 
 #[wasm_bindgen_test]
 fn refused_jobs_throw_typed_errors() {
-    let mut models = Models::new();
-    models
-        .add_bytes(box_stl(100.0, 100.0, 2.0).as_bytes(), "big.stl")
-        .unwrap();
+    let mut models = boxes(&[("big.stl", [100.0, 100.0, 2.0])]);
     let job = js(serde_json::json!({"parts": [{"file": "big.stl", "copies": 2}]}));
-    let e = thrown(models.layout(job).unwrap_err());
-    assert_eq!(e["kind"], "job");
+    let e = throws(models.layout(job), "job");
     assert!(e["message"].as_str().unwrap().contains("do not"), "{e}");
     let job = js(serde_json::json!({"parts": [{"file": "big.stl", "copies": 2}]}));
-    assert_eq!(
-        thrown(Session::from_models(&models, job).err().unwrap())["kind"],
-        "job"
-    );
+    throws(Session::from_models(&models, job), "job");
     let job = js(serde_json::json!({"parts": [{"file": "big.stl", "scale_x": 0}]}));
-    let e = thrown(models.layout(job).unwrap_err());
+    let e = thrown(models.layout(job));
     assert!(
         e["message"].as_str().unwrap().contains("parts[0].scale_x"),
         "{e}"
     );
     let job =
         js(serde_json::json!({"settings": {"layer_height": 0}, "parts": [{"file": "big.stl"}]}));
-    let e = thrown(models.layout(job).unwrap_err());
+    let e = thrown(models.layout(job));
     assert_eq!(
         (e["kind"].as_str(), e["setting"].as_str()),
         (Some("setting"), Some("layer_height"))
     );
-    let e = thrown(models.display_mesh("nope.stl", None, 10).unwrap_err());
-    assert_eq!(e["kind"], "job");
-    let e = thrown(models.add_bytes(b"not a model", "x.stl").unwrap_err());
-    assert_eq!(e["kind"], "import");
+    throws(models.display_mesh("nope.stl", None, 10), "job");
+    throws(models.add_bytes(b"not a model", "x.stl"), "import");
 }
 
 #[wasm_bindgen_test]
 fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
-    let mut models = Models::new();
-    models
-        .add_bytes(box_stl(10.0, 10.0, 2.0).as_bytes(), "a.stl")
-        .unwrap();
-    models
-        .add_bytes(box_stl(10.0, 10.0, 3.0).as_bytes(), "b.stl")
-        .unwrap();
+    let models = boxes(&[("a.stl", [10.0, 10.0, 2.0]), ("b.stl", [10.0, 10.0, 3.0])]);
     // b overlaps a by 4 mm in x; a is listed first and keeps the overlap.
     let job = serde_json::json!({
         "settings": {"unit1_droplet_aspect": 1.5},

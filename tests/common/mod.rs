@@ -753,6 +753,54 @@ pub fn cube_object(id: u32, side: f32, inverted: bool) -> String {
     s + "</triangles></mesh></object>"
 }
 
+/// The default settings with the setting `name` set to `value` (which must be valid).
+pub fn settings_with(name: &str, value: &str) -> dropslice::Settings {
+    let mut s = dropslice::Settings::default();
+    s.set(name, value).unwrap();
+    s
+}
+
+/// A 3MF of about a kilobyte that fans out 10^`levels` cubes of side `side` (as
+/// [`cube_object`]) by components: object 1 the cube, then `levels` objects of ten components
+/// each, 1 mm apart along x, y, z, then 10 mm apart along x, y, z, …; the build holds the last.
+pub fn fanned_cubes_3mf(levels: i32, side: f32, inverted: bool) -> Vec<u8> {
+    let mut res = cube_object(1, side, inverted);
+    for l in 0..levels {
+        let pitch = 10f64.powi(l / 3);
+        let comps: String = (0..10)
+            .map(|k| {
+                let mut d = [0.0; 3];
+                d[(l % 3) as usize] = k as f64 * pitch;
+                format!(
+                    r#"<component objectid="{}" transform="1 0 0 0 1 0 0 0 1 {} {} {}"/>"#,
+                    l + 1,
+                    d[0],
+                    d[1],
+                    d[2]
+                )
+            })
+            .collect();
+        res += &format!(
+            r#"<object id="{}" type="model"><components>{comps}</components></object>"#,
+            l + 2
+        );
+    }
+    three_mf(&res, &format!(r#"<item objectid="{}"/>"#, levels + 1))
+}
+
+/// The lower and upper corners of the box around every corner of `tris`.
+pub fn bounds<T: Copy + Into<f64>>(tris: &[[[T; 3]; 3]]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in tris.iter().flatten() {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k].into());
+            hi[k] = hi[k].max(p[k].into());
+        }
+    }
+    (lo, hi)
+}
+
 /// A binary STL of the given triangles (zero normals).
 pub fn binary_stl(header: &[u8], tris: &[[[f32; 3]; 3]]) -> Vec<u8> {
     dropslice::model::import::stl::write_binary(header, tris)

@@ -101,6 +101,20 @@ export async function openPage(browser, url, { width = 1440, height = 900, scale
   return { page, context, errors };
 }
 
+/** For the screenshot scripts: a page of `width` × `height` that has settled on the sample,
+ *  then ticked the checkboxes `check` (selectors), had `prepare(page)` done and sliced `files`
+ *  (3DBenchy unless given); returns the page and the status once done. */
+export async function slicedPage(env, { width, height, files = benchy, check = [], prepare = async () => {} }) {
+  const { page } = await openPage(env.browser, env.url, { width, height, scale: 1 });
+  await waitSettled(page, 60_000);
+  for (const selector of check) await page.check(selector);
+  await prepare(page);
+  // what a box or setting set off on the sample (the voids analysis) ends before the pick
+  await waitSettled(page, 60_000);
+  await pick(page, files);
+  return { page, s: await waitDone(page, 240_000) };
+}
+
 export const status = (page) => page.evaluate(() => window.dropslice.status());
 
 /** Waits until the page has finished a slice (or failed); returns its status. */
@@ -275,6 +289,12 @@ export function countPixels(page, test) {
     return n;
   })()`);
 }
+
+/** Coloured (non-background, non-grid) pixels of the canvas: the droplets drawn. */
+export const inkPixels = (page) => countPixels(page, "Math.max(r, g, b) - Math.min(r, g, b) > 60");
+
+/** Canvas pixels in the void overlay's magenta. */
+export const voidPixels = (page) => countPixels(page, "r > 150 && b > 90 && g < 110 && r - g > 80 && b - g > 30");
 
 /** Pixels of the canvas as a data URL (changes whenever anything drawn changes). */
 export const canvasPixels = (page) => page.evaluate(() => document.getElementById("view").toDataURL("image/png"));

@@ -6,7 +6,7 @@ import { execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, canvasPixels, countPixels, openLinkAskingForFile, openPage, parseGcode, pick, repo, shareLink, startWithPage, status, stop, torusStl, waitDone, waitSettled } from "./helpers.mjs";
+import { benchy, canvasPixels, inkPixels, openLinkAskingForFile, openPage, parseGcode, pick, repo, shareLink, startWithPage, status, stop, torusStl, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main; // the page most tests share
@@ -16,11 +16,6 @@ const cli = join(repo, "target/release/dropslice");
 before(async () => ({ env, main } = await startWithPage()));
 
 after(() => stop(env, tmp));
-
-/** Coloured (non-background, non-grid) pixels of the canvas. */
-function inkPixels(page) {
-  return countPixels(page, "Math.max(r, g, b) - Math.min(r, g, b) > 60");
-}
 
 test("the sample part is sliced and drawn on first visit", async () => {
   const { page, errors } = main;

@@ -1,16 +1,12 @@
 // Makes docs/images/cut.png: 3DBenchy's vertical cut (after scripts/build.sh).
 // Usage: [STAGGER=1] [CUT=ax,ay,bx,by] [ZOOM=scale,t,z] [SCREENSHOT=path] node tests/e2e/screenshot-cut.mjs [layer]
 import { join } from "node:path";
-import { benchy, openPage, pick, repo, start, waitDone, waitSettled } from "./helpers.mjs";
+import { repo, slicedPage, start } from "./helpers.mjs";
 
 const layer = Number(process.argv[2] ?? 60);
 const env = await start();
 try {
-  const { page } = await openPage(env.browser, env.url, { width: 1440, height: 1000, scale: 1 });
-  await waitSettled(page, 60_000);
-  if (process.env.STAGGER) await page.check("#set-stagger");
-  await pick(page, benchy);
-  const s = await waitDone(page, 240_000);
+  const { page, s } = await slicedPage(env, { width: 1440, height: 1000, check: process.env.STAGGER ? ["#set-stagger"] : [] });
   await page.evaluate((l) => window.dropslice.show(l), layer);
   await page.click("#btn-cut");
   if (process.env.CUT) {

@@ -10,20 +10,23 @@
 // two copies of M3x10_screw.stl), arranged on a 250 × 200 mm plate, in 3D with 3DBenchy selected:
 //   JOB=1 SCREENSHOT=docs/images/job3d.png node tests/e2e/screenshot.mjs
 import { join } from "node:path";
-import { benchy, open3d, openPage, pick, repo, shared, start, waitDone, waitSettled } from "./helpers.mjs";
+import { open3d, repo, shared, slicedPage, start, waitDone } from "./helpers.mjs";
 
 if (process.env.JOB) {
   const env = await start();
   try {
-    const { page } = await openPage(env.browser, env.url, { width: 1440, height: 860, scale: 1 });
-    await waitSettled(page, 60_000);
-    // cube_gears' build alone is 168 mm wide: a larger plate than the default 154 × 134 mm
-    await page.click("summary:text('Plate')");
-    await page.fill("#set-plate_x", "250");
-    await page.fill("#set-plate_y", "200");
     const files = ["3DBenchy.stl", "extruder_idler_quads.obj", "cube_gears.3mf", "M3x10_screw.stl"].map((f) => join(shared, "models", f));
-    await pick(page, files);
-    await waitDone(page, 240_000);
+    const { page } = await slicedPage(env, {
+      width: 1440,
+      height: 860,
+      files,
+      // cube_gears' build alone is 168 mm wide: a larger plate than the default 154 × 134 mm
+      prepare: async (p) => {
+        await p.click("summary:text('Plate')");
+        await p.fill("#set-plate_x", "250");
+        await p.fill("#set-plate_y", "200");
+      },
+    });
     // two copies of the screw, then slice the job again
     await page.click(".part-item:nth-child(4)");
     await page.fill("#part-copies", "2");
@@ -50,11 +53,7 @@ const worst = process.argv[2] === "worst";
 const layer = worst ? -1 : Number(process.argv[2] ?? 60);
 const env = await start();
 try {
-  const { page } = await openPage(env.browser, env.url, { width: 1440, height: 860, scale: 1 });
-  await waitSettled(page, 60_000);
-  if (process.env.VOIDS) await page.check("#opt-voids");
-  await pick(page, benchy);
-  await waitDone(page, 240_000);
+  const { page } = await slicedPage(env, { width: 1440, height: 860, check: process.env.VOIDS ? ["#opt-voids"] : [] });
   if (worst) await page.click("#btn-worst");
   else await page.evaluate((l) => window.dropslice.show(l), layer);
   if (process.env.DETAIL) {

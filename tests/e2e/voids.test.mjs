@@ -2,7 +2,7 @@
 // canvas, "Go to worst layer". Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { canvasPixels, countPixels, startWithPage, status, stop, waitSettled } from "./helpers.mjs";
+import { canvasPixels, startWithPage, status, stop, voidPixels, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -10,11 +10,6 @@ let main;
 before(async () => ({ env, main } = await startWithPage()));
 
 after(() => stop(env));
-
-/** Canvas pixels in the overlay's magenta (void) colour. */
-function voidPixels(page) {
-  return countPixels(page, "r > 150 && b > 90 && g < 110 && r - g > 80 && b - g > 30");
-}
 
 test("the voids overlay: figures, canvas, worst layer", async () => {
   const { page, errors } = main;
