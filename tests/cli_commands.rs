@@ -1,5 +1,6 @@
 //! The command line's forms (clap): `slice` as the default command, the settings options in
 //! the order given, help and version on stdout, usage errors as one short line with exit 2.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
 

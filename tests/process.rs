@@ -25,6 +25,13 @@ fn settings(sets: &[(&str, &str)]) -> Settings {
 
 /// The CLI run in `dir` with the arguments as one line of words (no word holds a space;
 /// `@NAME` stands for the shared model NAME).
+/// [`cli`] that must succeed; the G-code it wrote to `out`.
+fn sliced(dir: &TempDir, words: &str, out: &str) -> String {
+    let r = cli(dir, words);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    std::fs::read_to_string(dir.join(out)).unwrap()
+}
+
 fn cli(dir: &TempDir, words: &str) -> common::Run {
     let args: Vec<String> = words
         .split_whitespace()
@@ -132,12 +139,11 @@ fn shrinkage_is_per_unit_and_the_arrangement_uses_the_compensated_size() {
 #[test]
 fn the_header_lists_the_four_shrinkage_values() {
     let dir = TempDir::new("shrink-header");
-    let r = cli(
+    let text = sliced(
         &dir,
         "@cube_20mm_ascii.stl -q -o c.gco --set unit1_shrink_z=0.5",
+        "c.gco",
     );
-    assert_eq!(r.code, Some(0), "{r:?}");
-    let text = std::fs::read_to_string(dir.join("c.gco")).unwrap();
     for line in [
         "; shrink_xy = 0.0 (%)",
         "; shrink_z = 0.0 (%)",
@@ -379,12 +385,11 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
         r#"{"name": "Chamber", "kind": "machine", "settings": {"plate_z": 100}}"#,
     )
     .unwrap();
-    let r = cli(
+    let text = sliced(
         &dir,
         "@cube_20mm_ascii.stl -q -o c.gco --set material_density=1.1 --profile pc.json --profile machine.json",
+        "c.gco",
     );
-    assert_eq!(r.code, Some(0), "{r:?}");
-    let text = std::fs::read_to_string(dir.join("c.gco")).unwrap();
     assert!(text.contains("; profiles = PC test (material), Chamber (machine)\n"));
     assert!(text.contains("; shrink_xy = 1.0 (%)"));
     assert!(text.contains("; plate_z = 100.0 (mm)"));
@@ -433,12 +438,11 @@ fn a_profile_applies_to_a_job_file_before_set() {
     )
     .unwrap();
     std::fs::write(dir.join("s.json"), r#"{"droplet_rate": 90}"#).unwrap();
-    let r = cli(
+    let text = sliced(
         &dir,
         "job.json -q -o j.gco --profile m.json --settings s.json",
+        "j.gco",
     );
-    assert_eq!(r.code, Some(0), "{r:?}");
-    let text = std::fs::read_to_string(dir.join("j.gco")).unwrap();
     assert!(text.contains("; profiles = M (material)"));
     // The profile over the job file's settings; a settings file keeps the profile.
     assert!(text.contains("; material_density = 1.2 (g/cm³)"));

@@ -1,5 +1,6 @@
 //! The per-stage time counters (base::stages): off by default, a stage inside another counts
 //! only in the outer one, and the writer's run with them on writes the same code.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 mod common;
 use dropslice::base::stages::{self, Stage};
 

@@ -858,10 +858,7 @@ fn calibrates_a_gcode_stream() {
 
 #[wasm_bindgen_test]
 fn orient_ranks_a_part_as_sliced_and_names_a_missing_one() {
-    let mut models = Models::new();
-    models
-        .add_bytes(box_stl(20.0, 10.0, 2.0).as_bytes(), "a.stl")
-        .unwrap();
+    let models = boxes(&[("a.stl", [20.0, 10.0, 2.0])]);
     // Standing on its long edge (10 mm tall), with z compensated by 1/(1 - 0.05).
     let job = serde_json::json!({
         "settings": {"shrink_z": 5},
@@ -874,19 +871,15 @@ fn orient_ranks_a_part_as_sliced_and_names_a_missing_one() {
     assert!((height(best) - 2.0 / 0.95).abs() < 1e-9, "{o}");
     assert_eq!(best["unsupported_area"], 0.0);
     assert!(o["candidates"].as_array().unwrap().len() >= 3);
-    let e = thrown(models.orient(js(job), 1).unwrap_err());
-    assert_eq!(e["kind"], "job");
+    let e = throws(models.orient(js(job), 1), "job");
     assert!(e["message"].as_str().unwrap().contains("parts[1]"), "{e}");
 }
 
 #[wasm_bindgen_test]
 fn a_session_refuses_a_job_taller_than_the_chamber() {
-    let mut models = Models::new();
-    models
-        .add_bytes(box_stl(5.0, 5.0, 3.0).as_bytes(), "b.stl")
-        .unwrap();
+    let models = boxes(&[("b.stl", [5.0, 5.0, 3.0])]);
     let job = serde_json::json!({"settings": {"plate_z": 2.5}, "parts": [{"file": "b.stl"}]});
-    let e = thrown(Session::from_models(&models, js(job)).err().unwrap());
+    let e = thrown(Session::from_models(&models, js(job)));
     assert_eq!(
         (e["kind"].as_str(), e["setting"].as_str()),
         (Some("setting"), Some("plate_z"))
@@ -925,10 +918,9 @@ fn check_profile_returns_the_profile_or_names_the_key() {
         p,
         serde_json::json!({"name": "M", "kind": "machine", "settings": {"plate_z": 180}})
     );
-    let e = thrown(
-        check_profile(r#"{"name": "M", "kind": "machine", "settings": {"shrink_z": 1}}"#)
-            .unwrap_err(),
-    );
+    let e = thrown(check_profile(
+        r#"{"name": "M", "kind": "machine", "settings": {"shrink_z": 1}}"#,
+    ));
     assert_eq!(
         (e["kind"].as_str(), e["setting"].as_str()),
         (Some("setting"), Some("shrink_z"))
