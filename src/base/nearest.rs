@@ -6,11 +6,19 @@
 use crate::base::geom::{DVec2, Point, dist};
 use crate::base::spatial::each_ring_cell;
 
+/// Cells a side of a block of [`NearestGrid`]'s live counts.
+const BLOCK: i64 = 8;
+
 /// Points in a uniform grid, for repeated "nearest point not yet taken" queries.
 pub struct NearestGrid {
     points: Vec<Point>,
     alive: Vec<bool>,
     cells: Vec<Vec<u32>>,
+    /// Live points per block of [`BLOCK`] × [`BLOCK`] cells (`bx` blocks a row), and in all:
+    /// a search skips the rings of cells in blocks with none, whose scan finds nothing.
+    block_live: Vec<u32>,
+    bx: i64,
+    live: usize,
     min: Point,
     cell: f64,
     nx: i64,
@@ -35,9 +43,13 @@ impl NearestGrid {
         let cell = ((w * h) / n).sqrt().max(w.max(h) / 4096.0);
         let nx = (w / cell).floor() as i64 + 1;
         let ny = (h / cell).floor() as i64 + 1;
+        let (bx, by) = ((nx + BLOCK - 1) / BLOCK, (ny + BLOCK - 1) / BLOCK);
         let mut grid = NearestGrid {
             alive: vec![true; points.len()],
             cells: vec![Vec::new(); (nx * ny) as usize],
+            block_live: vec![0; (bx * by) as usize],
+            bx,
+            live: points.len(),
             points,
             min,
             cell,
@@ -47,8 +59,27 @@ impl NearestGrid {
         for i in 0..grid.points.len() {
             let (cx, cy) = grid.cell_of(grid.points[i]);
             grid.cells[(cy * nx + cx) as usize].push(i as u32);
+            grid.block_live[((cy / BLOCK) * bx + cx / BLOCK) as usize] += 1;
         }
         grid
+    }
+
+    /// The first ring of cells around cell (cx, cy) that may hold a live point: every ring
+    /// before it lies in blocks holding none (a block at Chebyshev distance R ≥ 1 from the
+    /// cell's block has no cell nearer than (R − 1)·BLOCK + 1 to it).
+    fn first_ring(&self, cx: i64, cy: i64) -> i64 {
+        let (bx, by) = (self.bx, self.block_live.len() as i64 / self.bx);
+        let (x, y) = (cx / BLOCK, cy / BLOCK);
+        for r in 0..=bx.max(by) {
+            let mut any = false;
+            each_ring_cell(x, y, r, bx, by, |i, j| {
+                any |= self.block_live[(j * bx + i) as usize] > 0;
+            });
+            if any {
+                return if r == 0 { 0 } else { (r - 1) * BLOCK + 1 };
+            }
+        }
+        0
     }
 
     fn cell_of(&self, p: Point) -> (i64, i64) {
@@ -59,16 +90,25 @@ impl NearestGrid {
 
     /// Takes point `i` out of the grid.
     pub fn remove(&mut self, i: usize) {
-        self.alive[i] = false;
+        if std::mem::replace(&mut self.alive[i], false) {
+            let (cx, cy) = self.cell_of(self.points[i]);
+            self.block_live[((cy / BLOCK) * self.bx + cx / BLOCK) as usize] -= 1;
+            self.live -= 1;
+        }
     }
 
     /// The point not yet removed nearest to `p` (by [`dist`]); of equally near ones, the one
     /// with the least `rank`. None when every point is removed.
     pub fn nearest(&mut self, p: Point, rank: impl Fn(usize) -> usize) -> Option<usize> {
+        if self.live == 0 {
+            return None;
+        }
         let (cx, cy) = self.cell_of(p);
         let mut best: Option<(f64, usize)> = None;
         let max_r = self.nx.max(self.ny);
-        for r in 0..=max_r {
+        // The rings before the first that may hold a live point hold none: scanning them
+        // changes nothing.
+        for r in self.first_ring(cx, cy)..=max_r {
             let mut any_cell = false;
             let (nx, ny) = (self.nx, self.ny);
             each_ring_cell(cx, cy, r, nx, ny, |x, y| {
@@ -96,6 +136,10 @@ impl NearestGrid {
         rank: &impl Fn(usize) -> usize,
         best: &mut Option<(f64, usize)>,
     ) {
+        let at = (y * self.nx + x) as usize;
+        if self.cells[at].is_empty() {
+            return;
+        }
         // A cell whose box lies farther than the best point so far holds no nearer point nor
         // an equally near one (the slack keeps rounding on the safe side).
         if let Some((bd, _)) = *best {
@@ -106,10 +150,7 @@ impl NearestGrid {
                 return;
             }
         }
-        let cell = &mut self.cells[(y * self.nx + x) as usize];
-        if cell.is_empty() {
-            return;
-        }
+        let cell = &mut self.cells[at];
         let alive = &self.alive;
         cell.retain(|&i| alive[i as usize]);
         for &i in cell.iter() {

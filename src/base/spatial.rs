@@ -6,20 +6,29 @@ use crate::base::geom::{Point, segment_distance2};
 /// `nx` × `ny` grid: the ring searched in step `r` of a nearest-neighbour search.
 pub fn each_ring_cell(cx: i64, cy: i64, r: i64, nx: i64, ny: i64, mut f: impl FnMut(i64, i64)) {
     // Full rows at the ring's top and bottom, only the two ends of the rows between (plain
-    // loops: this runs for every nearest-end query of the hatch order).
+    // loops: this runs for every nearest-end query of the hatch order), skipped when both
+    // ends lie outside the grid (a ring wider than the grid would walk its rows for nothing).
     let inside_x = |x: i64| (0..nx).contains(&x);
-    for y in (cy - r).max(0)..=(cy + r).min(ny - 1) {
-        if y == cy - r || y == cy + r {
-            for x in (cx - r).max(0)..=(cx + r).min(nx - 1) {
-                f(x, y);
-            }
-        } else {
-            if inside_x(cx - r) {
+    let (left, right) = (inside_x(cx - r), inside_x(cx + r));
+    let (x0, x1) = ((cx - r).max(0), (cx + r).min(nx - 1));
+    if (0..ny).contains(&(cy - r)) {
+        for x in x0..=x1 {
+            f(x, cy - r);
+        }
+    }
+    if r > 0 && (left || right) {
+        for y in (cy - r + 1).max(0)..=(cy + r - 1).min(ny - 1) {
+            if left {
                 f(cx - r, y);
             }
-            if inside_x(cx + r) {
+            if right {
                 f(cx + r, y);
             }
+        }
+    }
+    if r > 0 && (0..ny).contains(&(cy + r)) {
+        for x in x0..=x1 {
+            f(x, cy + r);
         }
     }
 }
@@ -558,5 +567,22 @@ mod tests {
             });
         }
         assert!(seen.iter().all(|&n| n == 1));
+    }
+
+    #[test]
+    fn rings_visit_their_cells_in_row_order() {
+        // Narrow and wide grids, centres inside and outside, rings wider than the grid: the
+        // cells in the order of a row-major scan (the searches' ties depend on it).
+        for (nx, ny, cx, cy) in [(3, 40, 1, 20), (40, 2, 39, 0), (5, 5, -7, 2), (1, 1, 0, 0)] {
+            for r in 0..50 {
+                let mut got = Vec::new();
+                each_ring_cell(cx, cy, r, nx, ny, |x, y| got.push((x, y)));
+                let want: Vec<(i64, i64)> = (0..ny)
+                    .flat_map(|y| (0..nx).map(move |x| (x, y)))
+                    .filter(|&(x, y)| (x - cx).abs().max((y - cy).abs()) == r)
+                    .collect();
+                assert_eq!(got, want, "{nx}×{ny} around ({cx}, {cy}), ring {r}");
+            }
+        }
     }
 }

@@ -108,7 +108,9 @@ pub struct Overhangs {
 impl Overhangs {
     /// The down-facing facets of `mesh` (oriented outward), sliced at the planes `zs`.
     pub fn of(mesh: &Mesh, zs: &[f64]) -> Overhangs {
-        use std::collections::HashMap;
+        // Fx hashing: the edges' order does not matter to the figures but for the last bits
+        // of the perimeter's sum (which the default hasher's random seed varied from run to run).
+        use rustc_hash::FxHashMap as HashMap;
         let count = |top: f64| zs.partition_point(|&z| z <= top) as u32;
         let mut o = Overhangs::default();
         // Each down-facing facet that counts for some layer: its corners and N.
@@ -127,7 +129,8 @@ impl Overhangs {
             }
         }
         // Each edge's facets (the first two, with the direction they use it in) and count.
-        let mut edges: HashMap<(u32, u32), EdgeUsers> = HashMap::with_capacity(down.len() * 3 / 2);
+        let mut edges: HashMap<(u32, u32), EdgeUsers> =
+            HashMap::with_capacity_and_hasher(down.len() * 3 / 2, Default::default());
         for (k, (f, _)) in down.iter().enumerate() {
             for j in 0..3 {
                 let (p, q) = (f[j], f[(j + 1) % 3]);
