@@ -32,6 +32,12 @@ export abstract class PanZoomCanvas {
   protected resize(): void {
     ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
     this.resized();
+    this.frameDraw();
+  }
+
+  /** A draw for the next frame (a resize, a request): by default `draw()`; a subclass may
+   *  spread a costly picture over several frames (calling `request()` for the rest). */
+  protected frameDraw(): void {
     this.draw();
   }
 
@@ -50,7 +56,7 @@ export abstract class PanZoomCanvas {
     if (this.frame) return;
     this.frame = requestAnimationFrame(() => {
       this.frame = 0;
-      this.draw();
+      this.frameDraw();
     });
   }
 

@@ -1,6 +1,8 @@
 // Draws one layer on a 2D canvas: every droplet a disc of diameter B coloured by role, the
 // layer below faintly, travel moves on demand, a millimetre grid and a scale bar.
-// Zoomed in, droplets are batched by role into one Path2D per colour (one fill call each) and
+// Discs up to STAMP_MAX device pixels wide are stamped into a pixel buffer (discs.ts: a few ms
+// where Canvas paths cost the page's thread 150–300 ms on a 25,000-droplet layer). Zoomed in
+// further, droplets are batched by role into one Path2D per colour (one fill call each) and
 // droplets outside the view are skipped. Zoomed out on a big layer (a disc at most 3 device
 // pixels wide, over 60,000 droplets), droplets are written straight into a pixel buffer as
 // small squares: ~330,000 droplets then take ~10 ms instead of ~100 ms of path filling.
@@ -8,6 +10,7 @@
 import type { CoverageMask, LayerData } from "../../core/protocol";
 import type { Bounds } from "../../core/view";
 import type { LayerCanvas } from "../page";
+import { DiscBuffer, DiscStamps, rgb } from "./discs";
 import { PanZoomCanvas } from "./panzoom";
 
 export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
@@ -32,6 +35,13 @@ const BELOW_COLOR = "#dde2ea";
 const PIXEL_MODE_MAX = 3;
 /** Below this many droplets, discs are cheap enough at any zoom (and look smoother). */
 const PIXEL_MODE_MIN_DROPLETS = 60_000;
+/** Largest droplet, in device pixels, stamped into a pixel buffer rather than filled as a path
+ *  (wider, few droplets fit on the screen and paths are cheap enough). */
+const STAMP_MAX = 24;
+/** Time a frame's draw spends stamping droplets (ms); the rest is stamped in the next frames. */
+const FRAME_BUDGET_MS = 8;
+/** The overhang overlay's disc, in droplet widths. */
+const OVERHANG_DIAMETER = 1.24;
 
 /** "#rrggbb" as a little-endian RGBA pixel. */
 function pixel(hex: string): number {
@@ -67,6 +77,16 @@ export function drawTag(
   ctx.fillStyle = style.color;
   ctx.textBaseline = "middle";
   ctx.fillText(label, lx + style.pad, ly + th / 2);
+}
+
+/** One colour of the stamping: discs of `stamps` at `at` (device px) whose `pick` is `want`. */
+interface StampPass {
+  stamps: DiscStamps;
+  color: [number, number, number];
+  at: Float64Array;
+  count: number;
+  pick: Uint8Array | null;
+  want: number;
 }
 
 export class Renderer extends PanZoomCanvas implements LayerCanvas {
@@ -122,14 +142,16 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
       maxY: cy + H / 2 / k + half,
     };
     const many = (this.current?.roles.length ?? 0) + (this.below?.roles.length ?? 0) > PIXEL_MODE_MIN_DROPLETS;
-    if (many && this.dropletWidth * k <= PIXEL_MODE_MAX) {
+    const disc = this.dropletWidth * k;
+    if (many && disc <= PIXEL_MODE_MAX) {
       this.drawPixels(ctx, k);
+    } else if (disc <= STAMP_MAX) {
+      this.drawStamped(ctx, k);
     } else {
       if (this.showBelow && this.below) this.drawDroplets(ctx, this.below, k, vis, true);
       if (this.current) this.drawDroplets(ctx, this.current, k, vis, false);
-    }
-    if (this.current && this.overhangs && this.overhangs.length === this.current.roles.length && !(many && this.dropletWidth * k <= PIXEL_MODE_MAX)) {
-      this.drawOverhangs(ctx, this.current, this.overhangs, vis);
+      const marks = this.marks();
+      if (this.current && marks) this.drawOverhangs(ctx, this.current, marks, vis);
     }
     if (this.current && this.showTravel) this.drawTravel(ctx, this.current, k);
     if (this.current?.mask && this.showVoids) this.drawVoids(ctx, this.current.mask);
@@ -141,17 +163,133 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
 
   private image: ImageData | null = null;
   private scratch: OffscreenCanvas | null = null;
+  private discs: DiscBuffer | null = null;
+  private stamps: DiscStamps[] = [];
+  /** The stamping under way: what it draws (compared item by item), its passes (one colour
+   *  each), and where it stands. */
+  private stamping: { key: unknown[]; passes: StampPass[]; pass: number; next: number } | null = null;
+  /** The time the current draw may spend stamping (ms): a frame's draw has FRAME_BUDGET_MS,
+   *  a direct `draw()` (the tests, a PNG export) all it needs. */
+  private budget = Infinity;
 
-  /** Zoomed far out: droplets as squares of ceil(B) device pixels, written into a buffer. */
-  private drawPixels(ctx: CanvasRenderingContext2D, k: number): void {
+  protected frameDraw(): void {
+    this.budget = FRAME_BUDGET_MS;
+    try {
+      this.draw();
+    } finally {
+      this.budget = Infinity;
+    }
+  }
+
+  /** The overhang marks of the current layer, when they belong to it. */
+  private marks(): Uint8Array | null {
+    const m = this.overhangs;
+    return this.current && m && m.length === this.current.roles.length ? m : null;
+  }
+
+  /** The canvas-sized pixel buffer, cleared. */
+  private pixelBuffer(): ImageData {
     const W = this.canvas.width;
     const H = this.canvas.height;
     if (!this.image || this.image.width !== W || this.image.height !== H) {
       this.image = new ImageData(W, H);
       this.scratch = new OffscreenCanvas(W, H);
+      this.discs = new DiscBuffer(this.image);
     }
-    const buf = new Uint32Array(this.image.data.buffer);
-    buf.fill(0);
+    this.discs!.clear();
+    return this.image;
+  }
+
+  /** The pixel buffer over what is drawn. */
+  private blit(ctx: CanvasRenderingContext2D): void {
+    // only the box painted: a whole-canvas copy costs the page's thread 10–20 ms a frame
+    const { x0, y0, x1, y1 } = this.discs!.dirty;
+    if (!(x1 > x0 && y1 > y0)) return;
+    this.scratch!.getContext("2d")!.putImageData(this.image!, 0, 0, x0, y0, x1 - x0, y1 - y0);
+    ctx.save();
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.drawImage(this.scratch!, x0, y0, x1 - x0, y1 - y0, x0, y0, x1 - x0, y1 - y0);
+    ctx.restore();
+  }
+
+  /** Coverage stamps of a disc `diameter` device px wide (the last two sizes are kept). */
+  private stampsFor(diameter: number): DiscStamps {
+    const r = diameter / 2;
+    let s = this.stamps.find((x) => x.radius === r);
+    if (!s) {
+      s = new DiscStamps(r);
+      this.stamps = [s, ...this.stamps.slice(0, 1)];
+    }
+    return s;
+  }
+
+  /** Droplets as anti-aliased discs stamped into the pixel buffer: the layer below, the
+   *  current layer's colour classes in CLASS_ORDER, the overhang marks over them. Within a
+   *  frame's budget: what is left is stamped in the next frames (the picture so far shown),
+   *  started again when anything it draws changes. */
+  private drawStamped(ctx: CanvasRenderingContext2D, k: number): void {
+    const { cx, cy } = this.view;
+    const W = this.canvas.width;
+    const H = this.canvas.height;
+    const ox = W / 2 - cx * k;
+    const oy = H / 2 + cy * k;
+    const marks = this.marks();
+    const below = this.showBelow ? this.below : null;
+    const key = [this.current, below, marks, k, ox, oy, W, H, this.dropletWidth];
+    let job = this.stamping;
+    if (!job || job.key.length !== key.length || job.key.some((v, i) => v !== key[i])) {
+      this.pixelBuffer();
+      job = this.stamping = { key, passes: this.stampPasses(k, ox, oy, below, marks), pass: 0, next: 0 };
+    }
+    const deadline = performance.now() + this.budget;
+    const buf = this.discs!;
+    while (job.pass < job.passes.length) {
+      const p = job.passes[job.pass];
+      job.next = buf.paint(p.stamps, p.color, p.at, p.count, p.pick, p.want, job.next, deadline);
+      if (job.next < p.count) break;
+      job.pass++;
+      job.next = 0;
+    }
+    this.blit(ctx);
+    if (job.pass < job.passes.length) this.request();
+  }
+
+  /** The stamping's passes: the layer below, the colour classes, the overhang marks. */
+  private stampPasses(k: number, ox: number, oy: number, below: LayerData | null, marks: Uint8Array | null): StampPass[] {
+    const drop = this.stampsFor(this.dropletWidth * k);
+    /** The layer's droplets in device px (x, y pairs). */
+    const place = (layer: LayerData): Float64Array => {
+      const d = layer.droplets;
+      const n = layer.roles.length;
+      const at = new Float64Array(2 * n);
+      for (let i = 0; i < n; i++) {
+        at[2 * i] = d[2 * i] * k + ox;
+        at[2 * i + 1] = oy - d[2 * i + 1] * k;
+      }
+      return at;
+    };
+    const passes: StampPass[] = [];
+    if (below) passes.push({ stamps: drop, color: rgb(BELOW_COLOR), at: place(below), count: below.roles.length, pick: null, want: 0 });
+    const cur = this.current;
+    if (cur) {
+      const n = cur.roles.length;
+      const at = place(cur);
+      const cls = new Uint8Array(n);
+      for (let i = 0; i < n; i++) cls[i] = dropletClass(cur.roles[i], cur.units?.[i] ?? 0);
+      for (const c of CLASS_ORDER) passes.push({ stamps: drop, color: rgb(CLASS_COLORS[c]), at, count: n, pick: cls, want: c });
+      if (marks) passes.push({ stamps: this.stampsFor(this.dropletWidth * k * OVERHANG_DIAMETER), color: rgb(OVERHANG_COLOR), at, count: n, pick: marks, want: 1 });
+    }
+    return passes;
+  }
+
+  /** Zoomed far out: droplets as squares of ceil(B) device pixels, written into a buffer. */
+  private drawPixels(ctx: CanvasRenderingContext2D, k: number): void {
+    const W = this.canvas.width;
+    const H = this.canvas.height;
+    this.pixelBuffer();
+    this.stamping = null; // the buffer is this picture's now
+    this.discs!.touchAll();
+    const buf = this.discs!.pixels;
     const size = Math.max(1, Math.ceil(this.dropletWidth * k));
     const { cx, cy } = this.view;
     const ox = W / 2 - cx * k - size / 2;
@@ -183,12 +321,7 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
       const color = pixel(OVERHANG_COLOR);
       for (let i = 0; i < marks.length; i++) if (marks[i]) square(d[2 * i], d[2 * i + 1], size + 2, color);
     }
-    const sctx = this.scratch!.getContext("2d")!;
-    sctx.putImageData(this.image, 0, 0);
-    ctx.save();
-    ctx.setTransform(1, 0, 0, 1, 0, 0);
-    ctx.drawImage(this.scratch!, 0, 0);
-    ctx.restore();
+    this.blit(ctx);
   }
 
   private drawDroplets(ctx: CanvasRenderingContext2D, layer: LayerData, _k: number, vis: Bounds, faint: boolean): void {
@@ -221,7 +354,7 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
   /** The unsupported droplets of the layer, as larger discs over the droplets. */
   private drawOverhangs(ctx: CanvasRenderingContext2D, layer: LayerData, marks: Uint8Array, vis: Bounds): void {
     const d = layer.droplets;
-    const r = this.dropletWidth * 0.62;
+    const r = (this.dropletWidth * OVERHANG_DIAMETER) / 2;
     const p = new Path2D();
     for (let i = 0; i < marks.length; i++) {
       if (!marks[i]) continue;
