@@ -109,6 +109,7 @@ function writeLabel(): void {
   const i = hover ?? page.store.current;
   const text = readout(s, i);
   out.textContent = text;
+  out.title = text; // the whole readout where one line cuts it short
   if (canvas) {
     canvas.setAttribute("aria-valuemax", String(s.layers));
     canvas.setAttribute("aria-valuenow", String(page.store.current + 1));
