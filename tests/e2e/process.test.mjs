@@ -75,7 +75,7 @@ test("Orient lists candidates; applying the best turns the part in the 3D view; 
 
 test("a profile saved, exported, deleted and imported again gives the same settings; a bad file changes nothing", async () => {
   const { page, errors } = await openPage(env.browser, env.url);
-  page.on("dialog", (d) => void d.accept());
+  page.on("dialog", (d) => void (d.type() === "prompt" ? d.accept("Chamber 180") : d.accept()));
   await waitDone(page, 60_000);
   await page.click("#profiles summary");
   await setField(page, "plate_z", 180);
@@ -124,7 +124,9 @@ test("a profile saved, exported, deleted and imported again gives the same setti
   assert.deepEqual(await formValues(page), wanted);
   assert.equal((await page.evaluate(() => window.dropslice.history())).undo, "use profile Test machine");
 
-  // kept across a reload, and a corrupt entry beside it ignored
+  // renamed (a prompt), then kept across a reload, and a corrupt entry beside it ignored
+  await page.click('#profile-list li[data-name="Test machine"] .profile-rename');
+  await page.waitForSelector('#profile-list li[data-name="Chamber 180"]');
   await page.evaluate(() => {
     const list = JSON.parse(localStorage.getItem("dropslice.profiles.v1"));
     list.push({ name: "Corrupt", kind: "machine", settings: { plate_z: "tall" } }, 42);
@@ -132,7 +134,7 @@ test("a profile saved, exported, deleted and imported again gives the same setti
   });
   await page.reload();
   await waitDone(page, 60_000);
-  assert.deepEqual(await page.$$eval("#profile-list li", (lis) => lis.map((li) => li.dataset.name)), ["Test machine"]);
+  assert.deepEqual(await page.$$eval("#profile-list li", (lis) => lis.map((li) => li.dataset.name)), ["Chamber 180"]);
   assert.deepEqual(errors, []);
   await page.context().close();
 });
