@@ -10,7 +10,8 @@ import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
 import { showError } from "./flows/errors";
-import { addParts, arrangeAll, duplicatePart, editParts, layFlat, movePart, relayout, removePart, saveJob, selectPart } from "./flows/job";
+import { addParts, applyOrientation, arrangeAll, duplicatePart, editParts, layFlat, movePart, orientations, relayout, removePart, saveJob, selectPart } from "./flows/job";
+import { deleteProfile, exportProfile, importProfile, renameProfile, saveProfile, showProfiles, useProfile } from "./flows/profiles";
 import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
 import { fit, setShowOverhangs, show } from "./flows/layer";
 import { openFiles, openLink, openSample } from "./flows/open";
@@ -31,6 +32,7 @@ import { wireNotices } from "./views/notices";
 import type { Actions, Page, PartsView } from "./views/page";
 import { wirePartDrag } from "./views/partdrag";
 import { PartsPanel } from "./views/parts";
+import { wireProfiles } from "./views/profiles";
 import { wirePlot } from "./views/plot";
 import { share } from "./views/share";
 import { wireShortcuts } from "./views/shortcuts";
@@ -61,6 +63,14 @@ const actions: Actions = {
   editParts: (edits) => editParts(page, edits),
   movePart: (id, copy, dx, dy) => movePart(page, id, copy, dx, dy),
   layFlat: (id) => void layFlat(page, id),
+  orient: (id) => orientations(page, id),
+  applyOrientation: (id, o) => applyOrientation(page, id, o),
+  profileSave: (name, kind) => saveProfile(page, name, kind),
+  profileUse: (name) => useProfile(page, name),
+  profileRename: (name, to) => renameProfile(page, name, to),
+  profileDelete: (name) => deleteProfile(page, name),
+  profileExport: (name) => exportProfile(page, name),
+  profileImport: (file) => void importProfile(page, file),
   duplicatePart: (id) => duplicatePart(page, id),
   removePart: (id) => removePart(page, id),
   arrangeAll: () => arrangeAll(page),
@@ -110,6 +120,7 @@ function wire(): void {
     if (files.length) void addParts(page, files);
   });
   page.parts.wire();
+  wireProfiles(page);
   $("btn-download").addEventListener("click", () => void download(page));
   $("btn-share").addEventListener("click", () => void share(page).catch(error));
   $("btn-slice").addEventListener("click", () => void startSlice(page));
@@ -317,6 +328,7 @@ async function main(): Promise<void> {
   // the settings and the view of the last visit (a preview link's settings take precedence)
   const remembered = loadRemembered(page);
   if (remembered) applyRemembered(page, remembered);
+  showProfiles(page);
   lastPlate = plate();
   updateButtons(page);
   if (!(await openLink(page))) await openSample(page, { layer: remembered?.view.layer ?? undefined });

@@ -386,6 +386,11 @@ export class Pool {
     return this.onJobWorker(files, (h) => h.call("lay_flat", { name, item }));
   }
 
+  /** The candidate orientations of `job.parts[part]`, best first. */
+  orient(files: JobFileRef[], job: JobFile, part: number): Promise<ResultOf<"orient">> {
+    return this.onJobWorker(files, (h) => h.call("orient", { job, part }));
+  }
+
   /** Runs `run` on the job worker once it holds exactly `files`. */
   private onJobWorker<T>(files: JobFileRef[], run: (h: WorkerHandle) => Promise<T>): Promise<T> {
     this.heal();
@@ -444,6 +449,12 @@ export class Pool {
   calibrate(data: RequestData<"calibrate">): Promise<ResultOf<"calibrate">> {
     this.heal();
     return this.guarded(() => this.handles[0].call("calibrate", data));
+  }
+
+  /** A profile's JSON text checked by the core. */
+  checkProfile(text: string): Promise<ResultOf<"check_profile">> {
+    this.heal();
+    return this.guarded(() => this.handles[0].call("check_profile", { text }));
   }
 
   /** For tests: makes the wasm panic in one worker. */

@@ -20,6 +20,8 @@ import type {
   JobSchema,
   LayerAnalysis,
   Layout,
+  Orientations,
+  Profile,
   ModelInfo,
   PartSpec,
   SettingSpec,
@@ -191,6 +193,10 @@ export interface Calls {
   display_mesh: { data: { name: string; item?: number; max: number }; result: Float32Array };
   layout: { data: { job: JobFile }; result: Layout };
   lay_flat: { data: { name: string; item?: number }; result: Angles };
+  /** The candidate orientations of `job.parts[part]`, best first (src/wasm/models.rs `orient`). */
+  orient: { data: { job: JobFile; part: number }; result: Orientations };
+  /** A profile's JSON text checked by the core (`check_profile`); needs no model. */
+  check_profile: { data: { text: string }; result: Profile };
   /** Prepares the job `job` of the files added (Session.from_models); like "open". */
   open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below

@@ -5,7 +5,7 @@
 
 import type { Page } from "../views/page";
 import { DISPLAY_BUDGET, Job, jobSettings, partName, specOut, uniqueName, type Changes, type JobModel, type Part, type Spec } from "../core/job";
-import type { PartSpec } from "../core/protocol";
+import type { Orientation, Orientations, PartSpec } from "../core/protocol";
 import { errorBanner, hideBanner } from "../views/banner";
 import { updateButtons } from "../views/controls";
 import { saveFile } from "../views/download";
@@ -221,6 +221,19 @@ export async function layFlat(page: Page, id: number): Promise<void> {
   } catch (e) {
     showError(page, e);
   }
+}
+
+/** The part's candidate orientations (the core's, by the overhang rule), best first. */
+export function orientations(page: Page, id: number): Promise<Orientations> {
+  const job = page.store.job;
+  const p = job?.part(id);
+  if (!job || !p) return Promise.reject(new Error("the part is no longer in the job"));
+  return page.pool.orient(job.refs(), job.file(settingsOf(page)), job.parts.indexOf(p));
+}
+
+/** The part turned to the orientation `o` picked (its scale and placement kept). */
+export function applyOrientation(page: Page, id: number, o: Orientation): Promise<boolean> {
+  return editParts(page, [{ id, changes: { rotate_x: o.rotate_x, rotate_y: o.rotate_y, rotate_z: o.rotate_z } }], "orient");
 }
 
 /** A drag in the 3D view (or the layer view) ended: the part's first copy goes where the

@@ -6,7 +6,8 @@
 import type { Pool } from "../core/client";
 import type { History, Snapshot } from "../core/history";
 import type { Changes } from "../core/job";
-import type { CalibrateRequest, Calibration, InitResult, LayerData, Settings } from "../core/protocol";
+import type { ProfileKind } from "../core/profiles";
+import type { CalibrateRequest, Calibration, InitResult, LayerData, Orientation, Orientations, Settings } from "../core/protocol";
 import type { Value } from "../core/settings";
 import type { Store } from "../core/store";
 import type { Bounds, View } from "../core/view";
@@ -49,6 +50,18 @@ export interface Actions {
   /** A dragged instance dropped `dx`, `dy` mm away: its part placed there. */
   movePart(id: number, copy: number, dx: number, dy: number): Promise<boolean>;
   layFlat(id: number): void;
+  /** The part's candidate orientations, best first (the core's; throws its error). */
+  orient(id: number): Promise<Orientations>;
+  /** The part turned to `o` (one undoable part edit). */
+  applyOrientation(id: number, o: Orientation): Promise<boolean>;
+  /** Profiles (flows/profiles.ts): save the current settings of `kind` as `name`, use,
+   *  rename, delete, export one, import a file. */
+  profileSave(name: string, kind: ProfileKind): void;
+  profileUse(name: string): void;
+  profileRename(name: string, to: string): void;
+  profileDelete(name: string): void;
+  profileExport(name: string): void;
+  profileImport(file: File): void;
   duplicatePart(id: number): void;
   removePart(id: number): void;
   arrangeAll(): void;

@@ -9,6 +9,7 @@ import { jobOffPlate, plainJobMessage } from "../core/plate";
 import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
+import { orientEditorShows, orientPart } from "./orient";
 
 const NUMBER_FIELDS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "copies"] as const;
 type NumberField = (typeof NUMBER_FIELDS)[number];
@@ -59,6 +60,7 @@ export class PartsPanel implements PartsView {
       if (p && (unit === 0 || unit === 1) && unit !== p.spec.unit) void this.edit(p, { unit }).then((ok) => ok || this.renderEditor());
     });
     $("part-lay-flat").addEventListener("click", () => this.part() && actions.layFlat(this.part()!.id));
+    $("part-orient").addEventListener("click", () => this.part() && void orientPart(this.page, this.part()!));
     $("part-duplicate").addEventListener("click", () => this.part() && actions.duplicatePart(this.part()!.id));
     $("part-remove").addEventListener("click", () => this.part() && actions.removePart(this.part()!.id));
     $("btn-arrange").addEventListener("click", () => actions.arrangeAll());
@@ -166,6 +168,7 @@ export class PartsPanel implements PartsView {
     const p = this.part();
     const editor = $("part-editor");
     editor.hidden = !p;
+    orientEditorShows(this.page, p);
     if (!p) return;
     const job = this.page.store.job!;
     $("part-editor-title").textContent = partName(job, p);

@@ -15,6 +15,11 @@ export function writeVoids(s: Slice | null, current: number): void {
   const partial = s && s.analysed < s.layers ? " so far" : "";
   const coverage = s?.figures.partCoverage ?? null;
   setText("stat-part-coverage", coverage !== null ? pct(coverage) + partial : "–");
+  // the core's 3D void estimate only (the page never makes up a density of its own)
+  const density = s?.figures.core?.predicted_density ?? null;
+  setText("stat-density", density !== null && Number.isFinite(density) ? `${density.toFixed(1)} %${partial}` : "–");
+  $("stat-density").title =
+    density !== null ? "100 % minus the 3D void fraction of the analysed layers: a geometric estimate from the droplet model, not a measured density" : "Needs the 3D void analysis (the command line's --report gives it); the page's layer analysis does not estimate it";
   const worst = s?.figures.worst;
   setText("stat-worst", worst ? `${nf.format(worst.index + 1)} · ${mm2(worst.area)}` : "–");
   ($("btn-worst") as HTMLButtonElement).disabled = !worst;

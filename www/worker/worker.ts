@@ -6,7 +6,7 @@
 // ("adopt"). Everything from the core is a typed value; its
 // errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
-import init, { Models, Session, Tally, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
+import init, { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
 import { GcodeError, GcodeReader, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
@@ -222,6 +222,13 @@ async function handle(req: Request): Promise<void> {
       return;
     case "lay_flat":
       answer(req.kind, req.id, needModels().lay_flat(req.data.name, req.data.item) as { rotate_x: number; rotate_y: number });
+      return;
+    case "orient":
+      answer(req.kind, req.id, needModels().orient(req.data.job, req.data.part));
+      return;
+    case "check_profile":
+      await load();
+      answer(req.kind, req.id, check_profile(req.data.text));
       return;
     case "open_job": {
       await load();

@@ -28,7 +28,7 @@ export class View3DPanel implements View3DView {
   /** Whether the view's code was asked for (it loads once; the view is made when it is in). */
   private loading = false;
   private parts: View3DPart[] = [];
-  private plate = { x: 154, y: 134 };
+  private plate = { x: 154, y: 134, z: 0 };
   private slice: View3DSlice | null = null;
   /** The slice's support as boxes (core/supportcolumns.ts), and the boxes the view has. */
   private support: Float32Array | null = null;
@@ -72,7 +72,8 @@ export class View3DPanel implements View3DView {
     $("legend3d-off").hidden = off.size === 0;
     const px = Number(values?.plate_x);
     const py = Number(values?.plate_y);
-    if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py };
+    const pz = Number(values?.plate_z);
+    if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py, z: pz >= 0 && Number.isFinite(pz) ? pz : 0 };
     this.syncOverhang(page, values);
     const s = store.slice;
     const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values, page.init!.schema));
@@ -115,7 +116,7 @@ export class View3DPanel implements View3DView {
   private apply(): void {
     const v = this.view;
     if (!v) return;
-    v.setPlate(this.plate.x, this.plate.y);
+    v.setPlate(this.plate.x, this.plate.y, this.plate.z);
     v.setParts(this.parts);
     v.setSlice(this.slice);
     if (this.support !== this.shownSupport) {

@@ -29,8 +29,9 @@ export interface PlateColors {
   outline: number;
 }
 
-/** The objects of a plate [0, x] × [0, y] at z = 0 (mm). */
-export function plateObjects(x: number, y: number, colors: PlateColors): Object3D[] {
+/** The objects of a plate [0, x] × [0, y] at z = 0 (mm), and the build chamber above it up to
+ *  `z` (mm; 0: none) as a faint box: its four vertical edges and its top outline. */
+export function plateObjects(x: number, y: number, colors: PlateColors, z = 0): Object3D[] {
   // the plate's top face, seen from above only (from below, the parts' bottoms show)
   const top = new Mesh(
     new PlaneGeometry(x, y),
@@ -53,7 +54,26 @@ export function plateObjects(x: number, y: number, colors: PlateColors): Object3
   axes.add(lines([0, 0, 0, len, 0, 0], 0xe03131), lines([0, 0, 0, 0, len, 0], 0x2f9e44));
   axes.add(label("x", "#e03131", len + len * 0.25, 0, 0, len * 0.35), label("y", "#2f9e44", 0, len + len * 0.25, 0, len * 0.35));
   axes.position.z = 0.01;
-  return [top, lines(minor, colors.grid), lines(major, colors.gridMajor), outline, axes];
+  const objects = [top, lines(minor, colors.grid), lines(major, colors.gridMajor), outline, axes];
+  if (z > 0) objects.push(chamber(x, y, z, colors.outline));
+  return objects;
+}
+
+/** The chamber's box above the plate: faint lines that never hide a part. */
+function chamber(x: number, y: number, z: number, color: number): LineSegments {
+  const corners = [0, 0, x, 0, x, y, 0, y];
+  const xyz: number[] = [];
+  for (let i = 0; i < 8; i += 2) {
+    const [ax, ay, bx, by] = [corners[i], corners[i + 1], corners[(i + 2) % 8], corners[(i + 3) % 8]];
+    xyz.push(ax, ay, 0, ax, ay, z, ax, ay, z, bx, by, z);
+  }
+  const box = lines(xyz, color);
+  const m = box.material as LineBasicMaterial;
+  m.transparent = true;
+  m.opacity = 0.3;
+  m.depthWrite = false;
+  box.name = "chamber";
+  return box;
 }
 
 export function lines(xyz: number[], color: number): LineSegments {

@@ -3,7 +3,8 @@
 //
 // API (kept stable for the build-job parts panel):
 //   new View3D(container)        a canvas filling `container`, resized with it (ResizeObserver)
-//   setPlate(x, y)               the plate [0,x]×[0,y] at z = 0 (mm), a 10 mm grid, its outline
+//   setPlate(x, y, z)            the plate [0,x]×[0,y] at z = 0 (mm), a 10 mm grid, its outline,
+//                                the build chamber's height z (a faint box; 0: none)
 //   setParts(parts)              the parts; geometry cached by id (same id + same positions
 //                                array => no re-upload), matrices applied
 //   setMatrix(id, matrix)        a cheap move (16 numbers, column-major, model -> plate, mm)
@@ -161,7 +162,7 @@ export class View3D {
   private readonly plate = new Group();
   private readonly partsGroup = new Group();
   private readonly entries = new Map<string, Entry>();
-  private plateSize = { x: 0, y: 0 };
+  private plateSize = { x: 0, y: 0, z: 0 };
   private selected: string | null = null;
   private slice: Required<View3DSlice> | null = null;
   private selectCb: ((id: string | null) => void) | null = null;
@@ -280,17 +281,18 @@ export class View3D {
 
   // ---- plate ----
 
-  setPlate(x: number, y: number): void {
+  setPlate(x: number, y: number, z = 0): void {
     if (!(Number.isFinite(x) && Number.isFinite(y) && x > 0 && y > 0 && x <= PLATE_MAX && y <= PLATE_MAX)) {
       throw new Error(`plate ${x} × ${y} mm: each side must be a number above 0 and at most ${PLATE_MAX} mm`);
     }
-    if (x === this.plateSize.x && y === this.plateSize.y) return;
-    this.plateSize = { x, y };
+    if (!(Number.isFinite(z) && z >= 0 && z <= PLATE_MAX)) throw new Error(`chamber height ${z} mm: it must be a number from 0 to ${PLATE_MAX} mm`);
+    if (x === this.plateSize.x && y === this.plateSize.y && z === this.plateSize.z) return;
+    this.plateSize = { x, y, z };
     for (const c of [...this.plate.children]) {
       this.plate.remove(c);
       disposeObject(c);
     }
-    this.plate.add(...plateObjects(x, y, COLORS));
+    this.plate.add(...plateObjects(x, y, COLORS, z));
     // a hair below z = 0: the cut's cap shows the inside of a part's bottom, at z = 0 itself
     this.plate.position.z = -0.05;
     this.request();
@@ -504,10 +506,12 @@ export class View3D {
     this.request();
   }
 
-  state(): { parts: string[]; warned: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; support: number; frames: number; width: number; height: number } {
+  state(): { parts: string[]; matrices: Record<string, number[]>; chamber: number; warned: string[]; selected: string | null; slice: View3DSlice | null; overhang: number | null; support: number; frames: number; width: number; height: number } {
     const z = this.overhangUniforms.uOverhangZ.value;
     return {
       parts: [...this.entries.keys()],
+      matrices: Object.fromEntries([...this.entries.values()].map((e) => [e.id, e.group.matrix.toArray()])),
+      chamber: this.plateSize.z,
       warned: [...this.entries.values()].filter((e) => e.body.material === this.materials.warn).map((e) => e.id),
       selected: this.selected,
       slice: this.slice ? { ...this.slice } : null,

@@ -1,0 +1,100 @@
+// Profiles (SPEC.md "Profiles"): named sets of settings of one kind, `{name, kind: "machine" |
+// "material", settings}`, kept in the browser under one local-storage key. What is read back is
+// checked entry by entry (a corrupt entry is dropped, the others kept); a file the user imports
+// is checked by the core (`check_profile`, flows/profiles.ts) before it is added here.
+
+import type { SettingSpec } from "./protocol";
+import { checkSettings } from "./remember";
+import type { Value } from "./settings";
+
+export const PROFILES_KEY = "dropslice.profiles.v1";
+/** Most profiles kept (each is a dozen settings at most). */
+export const MAX_PROFILES = 200;
+/** Longest name, in characters (the core's `MAX_PROFILE_NAME_CHARS`). */
+export const MAX_NAME_CHARS = 100;
+/** Largest profile file imported, bytes (the core's `MAX_PROFILE_BYTES`). */
+export const MAX_PROFILE_BYTES = 64 << 10;
+
+export type ProfileKind = "machine" | "material";
+
+/** The settings a profile of each kind holds (src/base/settings/profile.rs `MACHINE_KEYS`,
+ *  `MATERIAL_KEYS`; the core refuses any other key when it checks a profile). */
+export const PROFILE_KEYS: Record<ProfileKind, readonly string[]> = {
+  machine: ["plate_x", "plate_y", "plate_z", "droplet_rate", "unit1_droplet_rate", "travel_speed"],
+  material: ["droplet_aspect", "material_density", "shrink_xy", "shrink_z", "unit1_droplet_aspect", "unit1_material_density", "unit1_shrink_xy", "unit1_shrink_z"],
+};
+
+export interface StoredProfile {
+  name: string;
+  kind: ProfileKind;
+  settings: Record<string, Value>;
+}
+
+const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "object" && v !== null && !Array.isArray(v);
+
+/** Why `raw` is not a usable profile name (null: it is). */
+export function nameProblem(raw: string): string | null {
+  const name = raw.trim();
+  if (name === "" || [...name].length > MAX_NAME_CHARS) return `A profile's name must have 1 to ${MAX_NAME_CHARS} characters.`;
+  // eslint-disable-next-line no-control-regex
+  if (/[\u0000-\u001f\u007f-\u009f]/.test(name)) return "A profile's name must not hold line breaks or tabs.";
+  return null;
+}
+
+/** `raw` as a profile: every setting of its kind's, known to the schema and in range, none
+ *  else (null: not a profile, or a value the schema refuses). */
+export function checkProfile(raw: unknown, schema: readonly SettingSpec[]): StoredProfile | null {
+  if (!isObject(raw) || typeof raw.name !== "string" || nameProblem(raw.name) !== null) return null;
+  if (raw.kind !== "machine" && raw.kind !== "material") return null;
+  if (!isObject(raw.settings)) return null;
+  const keys = PROFILE_KEYS[raw.kind];
+  const given = Object.keys(raw.settings);
+  if (given.some((k) => !keys.includes(k))) return null;
+  const settings = checkSettings(raw.settings, schema);
+  if (Object.keys(settings).length !== given.length) return null;
+  return { name: raw.name.trim(), kind: raw.kind, settings };
+}
+
+/** The profiles kept in `text` (the storage's entry): the good ones, names unique. */
+export function readProfiles(text: string | null, schema: readonly SettingSpec[]): StoredProfile[] {
+  if (!text) return [];
+  let raw: unknown;
+  try {
+    raw = JSON.parse(text);
+  } catch {
+    return [];
+  }
+  if (!Array.isArray(raw)) return [];
+  const out: StoredProfile[] = [];
+  for (const entry of raw.slice(0, MAX_PROFILES)) {
+    const p = checkProfile(entry, schema);
+    if (p && !out.some((q) => q.name === p.name)) out.push(p);
+  }
+  return out;
+}
+
+export const profilesText = (list: readonly StoredProfile[]): string => JSON.stringify(list);
+
+/** A profile of `kind` with the current `values` of its settings. */
+export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>): StoredProfile {
+  const settings: Record<string, Value> = {};
+  for (const k of PROFILE_KEYS[kind]) if (values[k] !== undefined) settings[k] = values[k];
+  return { name: name.trim(), kind, settings };
+}
+
+/** The file a profile is exported as (SPEC.md's JSON). */
+export function profileFileText(p: StoredProfile): string {
+  return JSON.stringify({ name: p.name, kind: p.kind, settings: p.settings }, null, 2) + "\n";
+}
+
+/** A file name for the profile: its name's letters and digits. */
+export function profileFileName(p: StoredProfile): string {
+  const base = p.name.replace(/[^\p{L}\p{N}._-]+/gu, "-").replace(/^-+|-+$/g, "").slice(0, 60);
+  return `${base || "profile"}.${p.kind}.json`;
+}
+
+/** `list` with `p` in it: a profile of the same name is replaced in place. */
+export function withProfile(list: readonly StoredProfile[], p: StoredProfile): StoredProfile[] {
+  const i = list.findIndex((q) => q.name === p.name);
+  return i < 0 ? [...list, p] : list.map((q, j) => (j === i ? p : q));
+}
