@@ -19,6 +19,8 @@ try {
   const per = await page.evaluate(() => window.dropslice.layerUnits());
   const supported = per.map((u, i) => ((u?.[0] ?? 0) > 0 ? i : -1)).filter((i) => i >= 0);
   await page.evaluate((i) => window.dropslice.show(i), supported[Math.floor(supported.length / 2)] ?? 0);
+  // the pictures are of the page, not of the passing "… replaced the previous job" notice
+  if (await page.isVisible("#undo-close")) await page.click("#undo-close");
   const shot = async (name, width, height, fullPage) => {
     await page.setViewportSize({ width, height });
     await page.waitForTimeout(500);
