@@ -15,7 +15,7 @@ import { deleteProfile, exportProfile, importProfile, renameProfile, saveProfile
 import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
 import { fit, setShowOverhangs, show } from "./flows/layer";
 import { openFiles, openLink, openSample } from "./flows/open";
-import { applyRemembered, loadRemembered, saveNow, saveSoon } from "./flows/remember";
+import { applyRemembered, holdForLink, loadRemembered, saveNow, saveSoon, settingsTouched } from "./flows/remember";
 import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows/slice";
 import { registerOffline } from "./pwa/offline";
 import { hideBanner } from "./views/banner";
@@ -317,6 +317,7 @@ async function main(): Promise<void> {
     () => {
       updateButtons(page);
       settingsChanged(page);
+      settingsTouched();
       saveSoon(page);
       if (plate() !== lastPlate) {
         lastPlate = plate();
@@ -331,7 +332,13 @@ async function main(): Promise<void> {
   showProfiles(page);
   lastPlate = plate();
   updateButtons(page);
-  if (!(await openLink(page))) await openSample(page, { layer: remembered?.view.layer ?? undefined });
+  // a link's settings are shown, not remembered over the visitor's own until they edit one
+  holdForLink(location.hash.length > 1);
+  const fromLink = await openLink(page);
+  if (!fromLink) {
+    holdForLink(false);
+    await openSample(page, { layer: remembered?.view.layer ?? undefined });
+  }
 }
 
 registerOffline();

@@ -292,3 +292,43 @@ test("calibration: after Use, a new slice does not suggest a new value from the 
   assert.match(await page.locator("#calib-message").innerText(), new RegExp(`droplet_aspect is now ${suggested.replace(".", "\\.")}: print this new code, weigh the print`));
   assert.deepEqual(errors, []);
 });
+
+test("a link's settings are shown, not remembered over the visitor's own until they change one", async () => {
+  const { page, errors } = main;
+  await page.locator("#set-layer_height").evaluate((e) => (e.closest("details").open = true));
+  const own = await page.inputValue("#set-layer_height");
+  await page.fill("#set-layer_height", "0.3");
+  await clickSliced(page, "#btn-slice");
+  const url = await shareLink(page);
+  await page.fill("#set-layer_height", own);
+  await clickSliced(page, "#btn-slice");
+  const other = await openPage(env.browser, url.split("#")[0]);
+  const p = other.page;
+  await waitDone(p, 60_000);
+  await p.locator("#set-layer_height").evaluate((e) => (e.closest("details").open = true));
+  await p.fill("#set-layer_height", "0.15");
+  await p.waitForTimeout(500);
+  // a stranger's link opened in the same browser, then the page again without it
+  await p.goto("about:blank");
+  await p.goto(url);
+  await waitDone(p, 60_000);
+  assert.equal(await p.inputValue("#set-layer_height"), "0.3", "the link's settings are shown");
+  await p.goto("about:blank");
+  await p.goto(url.split("#")[0]);
+  await waitDone(p, 60_000);
+  assert.equal(await p.inputValue("#set-layer_height"), "0.15", "the visitor's own settings were kept");
+  // once the visitor changes a setting of the link's page, those are remembered
+  await p.goto("about:blank");
+  await p.goto(url);
+  await waitDone(p, 60_000);
+  await p.locator("#set-layer_height").evaluate((e) => (e.closest("details").open = true));
+  await p.fill("#set-layer_height", "0.25");
+  await p.waitForTimeout(500);
+  await p.goto("about:blank");
+  await p.goto(url.split("#")[0]);
+  await waitDone(p, 60_000);
+  assert.equal(await p.inputValue("#set-layer_height"), "0.25");
+  assert.deepEqual(other.errors, []);
+  await other.context.close();
+  assert.deepEqual(errors, []);
+});

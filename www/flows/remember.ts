@@ -10,6 +10,19 @@ import type { Page } from "../views/page";
 /** Changes settle this long before they are written. */
 const SAVE_MS = 300;
 let timer = 0;
+/** Set while the page shows a preview link's settings: the visitor's own remembered settings
+ *  are not overwritten by a stranger's until the visitor changes a setting. */
+let heldForLink = false;
+
+/** A preview link is being opened (or not, `held` false). */
+export function holdForLink(held: boolean): void {
+  heldForLink = held;
+}
+
+/** The visitor changed a setting: from now on the page's settings are theirs to remember. */
+export function settingsTouched(): void {
+  heldForLink = false;
+}
 
 /** What the page remembered (null: nothing usable). */
 export function loadRemembered(page: Page): Remembered | null {
@@ -35,6 +48,7 @@ export function saveSoon(page: Page): void {
 
 export function saveNow(page: Page): void {
   clearTimeout(timer);
+  if (heldForLink) return;
   const { form, init, renderer, store } = page;
   if (!form || !init) return;
   const view = {
