@@ -25,6 +25,11 @@ fn settings(sets: &[(&str, &str)]) -> Settings {
 
 /// The CLI run in `dir` with the arguments as one line of words (no word holds a space;
 /// `@NAME` stands for the shared model NAME).
+/// Writes `text` to `name` in `dir`.
+fn write(dir: &TempDir, name: &str, text: &str) {
+    std::fs::write(dir.join(name), text).unwrap();
+}
+
 /// [`cli`] that must succeed; the G-code it wrote to `out`.
 fn sliced(dir: &TempDir, words: &str, out: &str) -> String {
     let r = cli(dir, words);
@@ -310,11 +315,11 @@ fn the_bridge_is_turned_over_and_the_upside_down_u_stood_or_laid_down() {
 fn orient_apply_writes_the_rotation_into_a_job_file_or_a_new_one() {
     let dir = TempDir::new("orient-apply");
     std::fs::copy(model("bridge.obj"), dir.join("bridge.obj")).unwrap();
-    std::fs::write(
-        dir.join("job.json"),
+    write(
+        &dir,
+        "job.json",
         r#"{"settings": {"layer_height": 0.2}, "parts": [{"file": "bridge.obj", "copies": 2, "name": "B"}]}"#,
-    )
-    .unwrap();
+    );
     let r = cli(&dir, "orient job.json --apply");
     assert_eq!(r.code, Some(0), "{r:?}");
     assert!(r.stdout.contains("parts[0] (B)"), "{}", r.stdout);
@@ -375,16 +380,16 @@ fn the_predicted_density_is_one_minus_the_3d_void_fraction() {
 #[test]
 fn a_profile_applies_before_set_and_is_named_in_the_header() {
     let dir = TempDir::new("profile");
-    std::fs::write(
-        dir.join("pc.json"),
+    write(
+        &dir,
+        "pc.json",
         r#"{"name": "PC test", "kind": "material", "settings": {"shrink_xy": 1, "material_density": 1.2}}"#,
-    )
-    .unwrap();
-    std::fs::write(
-        dir.join("machine.json"),
+    );
+    write(
+        &dir,
+        "machine.json",
         r#"{"name": "Chamber", "kind": "machine", "settings": {"plate_z": 100}}"#,
-    )
-    .unwrap();
+    );
     let text = sliced(
         &dir,
         "@cube_20mm_ascii.stl -q -o c.gco --set material_density=1.1 --profile pc.json --profile machine.json",
@@ -411,7 +416,7 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
         ),
         (r#"{"name": "M", "settings": {}}"#, "kind"),
     ] {
-        std::fs::write(dir.join("bad.json"), body).unwrap();
+        write(&dir, "bad.json", body);
         let r = cli(&dir, "@cube_20mm_ascii.stl -o bad.gco --profile bad.json");
         assert_eq!(r.code, Some(2), "{r:?}");
         assert!(
@@ -427,17 +432,17 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
 fn a_profile_applies_to_a_job_file_before_set() {
     let dir = TempDir::new("profile-job");
     std::fs::copy(model("cube_20mm_ascii.stl"), dir.join("cube.stl")).unwrap();
-    std::fs::write(
-        dir.join("job.json"),
+    write(
+        &dir,
+        "job.json",
         r#"{"settings": {"material_density": 1.3}, "parts": [{"file": "cube.stl"}]}"#,
-    )
-    .unwrap();
-    std::fs::write(
-        dir.join("m.json"),
+    );
+    write(
+        &dir,
+        "m.json",
         r#"{"name": "M", "kind": "material", "settings": {"material_density": 1.2, "shrink_z": 2}}"#,
-    )
-    .unwrap();
-    std::fs::write(dir.join("s.json"), r#"{"droplet_rate": 90}"#).unwrap();
+    );
+    write(&dir, "s.json", r#"{"droplet_rate": 90}"#);
     let text = sliced(
         &dir,
         "job.json -q -o j.gco --profile m.json --settings s.json",

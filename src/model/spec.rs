@@ -79,6 +79,7 @@ pub fn job_schema() -> JobSchema {
         group: "Part",
         description,
         part: true,
+        profile: None,
         default: default.into(),
     };
     part_numbers.push(whole(

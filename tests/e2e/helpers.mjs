@@ -118,6 +118,13 @@ export async function slicedPage(env, { width, height, files = benchy, check = [
 export const status = (page) => page.evaluate(() => window.dropslice.status());
 
 /** Waits until the page has finished a slice (or failed); returns its status. */
+/** Saves the page's picture at $SCREENSHOT, else at `path` in the repository; returns where. */
+export async function screenshotTo(page, path) {
+  const out = process.env.SCREENSHOT ?? join(repo, path);
+  await page.screenshot({ path: out });
+  return out;
+}
+
 export async function waitSettled(page, timeout = 240_000) {
   await page.waitForFunction(
     () => ["done", "error", "cancelled"].includes(document.body.dataset.state ?? ""),

@@ -1,7 +1,6 @@
 // Makes docs/images/cut.png: 3DBenchy's vertical cut (after scripts/build.sh).
 // Usage: [STAGGER=1] [CUT=ax,ay,bx,by] [ZOOM=scale,t,z] [SCREENSHOT=path] node tests/e2e/screenshot-cut.mjs [layer]
-import { join } from "node:path";
-import { repo, slicedPage, start } from "./helpers.mjs";
+import { screenshotTo, slicedPage, start } from "./helpers.mjs";
 
 const layer = Number(process.argv[2] ?? 60);
 const env = await start();
@@ -27,8 +26,7 @@ try {
   await page.evaluate(() => window.dropslice.cut().redraw());
   console.log(`draw ${(performance.now() - d0).toFixed(0)} ms (with the round trip)`);
   await page.waitForTimeout(300);
-  const out = process.env.SCREENSHOT ?? join(repo, "docs/images/cut.png");
-  await page.screenshot({ path: out });
+  const out = await screenshotTo(page, "docs/images/cut.png");
   console.log(`wrote ${out}`, JSON.stringify({ ...(await page.evaluate(() => window.dropslice.cut().status())), view: 0 }));
 } finally {
   await env.close();

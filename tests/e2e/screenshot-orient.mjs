@@ -2,7 +2,7 @@
 // candidates listed beside the 3D view (after scripts/build.sh).
 // Usage: [SCREENSHOT=path] node tests/e2e/screenshot-orient.mjs
 import { join } from "node:path";
-import { open3d, openPage, pick, repo, shared, start, waitDone, waitSettled } from "./helpers.mjs";
+import { open3d, openPage, pick, screenshotTo, shared, start, waitDone, waitSettled } from "./helpers.mjs";
 
 const env = await start();
 try {
@@ -15,8 +15,7 @@ try {
   await page.waitForSelector("#orient-list .orient-pick", { timeout: 30_000 });
   await page.locator("#orient-box").scrollIntoViewIfNeeded();
   await page.waitForTimeout(500);
-  const out = process.env.SCREENSHOT ?? join(repo, "docs/images/orient-page.png");
-  await page.screenshot({ path: out });
+  const out = await screenshotTo(page, "docs/images/orient-page.png");
   console.log(`wrote ${out}`);
 } finally {
   await env.close();

@@ -10,7 +10,7 @@
 // two copies of M3x10_screw.stl), arranged on a 250 × 200 mm plate, in 3D with 3DBenchy selected:
 //   JOB=1 SCREENSHOT=docs/images/job3d.png node tests/e2e/screenshot.mjs
 import { join } from "node:path";
-import { open3d, repo, shared, slicedPage, start, waitDone } from "./helpers.mjs";
+import { open3d, screenshotTo, shared, slicedPage, start, waitDone } from "./helpers.mjs";
 
 if (process.env.JOB) {
   const env = await start();
@@ -40,8 +40,7 @@ if (process.env.JOB) {
     // 3DBenchy selected: tinted in 3D, its transform in the panel
     await page.click(".part-item:nth-child(1)");
     await page.waitForTimeout(300);
-    const out = process.env.SCREENSHOT ?? join(repo, "docs/images/job3d.png");
-    await page.screenshot({ path: out });
+    const out = await screenshotTo(page, "docs/images/job3d.png");
     console.log(`wrote ${out}`);
   } finally {
     await env.close();
@@ -63,8 +62,7 @@ try {
   }
   if (process.env.VIEW3D) await open3d(page);
   await page.waitForTimeout(300);
-  const out = process.env.SCREENSHOT ?? join(repo, "docs/screenshot-benchy.png");
-  await page.screenshot({ path: out });
+  const out = await screenshotTo(page, "docs/screenshot-benchy.png");
   const shown = await page.evaluate(() => window.dropslice.status().layer);
   console.log(`wrote ${out} (layer ${shown + 1})`);
 } finally {

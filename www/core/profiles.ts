@@ -17,12 +17,10 @@ export const MAX_PROFILE_BYTES = 64 << 10;
 
 export type ProfileKind = "machine" | "material";
 
-/** The settings a profile of each kind holds (src/base/settings/profile.rs `MACHINE_KEYS`,
- *  `MATERIAL_KEYS`; the core refuses any other key when it checks a profile). */
-export const PROFILE_KEYS: Record<ProfileKind, readonly string[]> = {
-  machine: ["plate_x", "plate_y", "plate_z", "droplet_rate", "unit1_droplet_rate", "travel_speed"],
-  material: ["droplet_aspect", "material_density", "shrink_xy", "shrink_z", "unit1_droplet_aspect", "unit1_material_density", "unit1_shrink_xy", "unit1_shrink_z"],
-};
+/** The settings a profile of `kind` holds: the core's schema flags them (`SettingSpec.profile`,
+ *  from src/base/settings/profile.rs); the core refuses any other key when it checks one. */
+export const profileKeys = (kind: ProfileKind, schema: readonly SettingSpec[]): string[] =>
+  schema.filter((s) => s.profile === kind).map((s) => s.name);
 
 export interface StoredProfile {
   name: string;
@@ -47,7 +45,7 @@ export function checkProfile(raw: unknown, schema: readonly SettingSpec[]): Stor
   if (!isObject(raw) || typeof raw.name !== "string" || nameProblem(raw.name) !== null) return null;
   if (raw.kind !== "machine" && raw.kind !== "material") return null;
   if (!isObject(raw.settings)) return null;
-  const keys = PROFILE_KEYS[raw.kind];
+  const keys = profileKeys(raw.kind, schema);
   const given = Object.keys(raw.settings);
   if (given.some((k) => !keys.includes(k))) return null;
   const settings = checkSettings(raw.settings, schema);
@@ -76,9 +74,9 @@ export function readProfiles(text: string | null, schema: readonly SettingSpec[]
 export const profilesText = (list: readonly StoredProfile[]): string => JSON.stringify(list);
 
 /** A profile of `kind` with the current `values` of its settings. */
-export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>): StoredProfile {
+export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>, schema: readonly SettingSpec[]): StoredProfile {
   const settings: Record<string, Value> = {};
-  for (const k of PROFILE_KEYS[kind]) if (values[k] !== undefined) settings[k] = values[k];
+  for (const k of profileKeys(kind, schema)) if (values[k] !== undefined) settings[k] = values[k];
   return { name: name.trim(), kind, settings };
 }
 

@@ -56,7 +56,7 @@ export function saveProfile(page: Page, name: string, kind: ProfileKind): void {
   const problem = nameProblem(name);
   if (problem) return profileMessage(problem, true);
   if (form.errors().length) return profileMessage("Fix the settings marked in red first.", true);
-  const p = profileOf(name, kind, form.values());
+  const p = profileOf(name, kind, form.values(), page.init!.schema);
   const list = load(page);
   const replaced = list.some((q) => q.name === p.name);
   if (store(page, withProfile(list, p))) profileMessage(`${replaced ? "Replaced" : "Saved"} the ${kind} profile “${p.name}”.`);

@@ -49,6 +49,8 @@ pub struct SettingSpec {
     /// A key of a part ([`PART_KEYS`]): in a job each part carries its own (docs/jobs.md), and
     /// a job's settings refuse it.
     pub part: bool,
+    /// The kind of profile that holds it (docs/process.md), `None`: no profile does.
+    pub profile: Option<super::ProfileKind>,
     #[cfg_attr(target_arch = "wasm32", tsify(type = "number | boolean | string"))]
     pub default: serde_json::Value,
 }
@@ -74,6 +76,7 @@ fn num(
         group,
         description,
         part: false,
+        profile: None,
         default: serde_json::Value::Null,
     }
 }
@@ -103,6 +106,7 @@ fn choice(
         group,
         description,
         part: false,
+        profile: None,
         default: serde_json::Value::Null,
     }
 }
@@ -466,6 +470,9 @@ pub fn schema() -> Vec<SettingSpec> {
     for spec in &mut specs {
         spec.default = defaults[spec.name].clone();
         spec.part = PART_KEYS.contains(&spec.name);
+        spec.profile = [super::ProfileKind::Machine, super::ProfileKind::Material]
+            .into_iter()
+            .find(|k| k.keys().contains(&spec.name));
     }
     specs
 }
