@@ -36,6 +36,20 @@ const BUSY_REDRAW_MS = 150;
 
 /** Runs `update` within [[BUSY_REDRAW_MS]], once for all calls until then, unless the run `gen`
  *  has ended by then (the page is then drawn by whatever ended it). */
+let frameWork: (() => void) | null = null;
+
+/** Runs `work` in the next animation frame; a later call before it replaces it. */
+function inNextFrame(work: () => void): void {
+  const pending = frameWork !== null;
+  frameWork = work;
+  if (pending) return;
+  requestAnimationFrame(() => {
+    const w = frameWork;
+    frameWork = null;
+    w?.();
+  });
+}
+
 function whileBusy(page: Page, gen: number, update: () => void): void {
   const store = page.store;
   const pending = store.busyRedraw !== null;
@@ -138,10 +152,9 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
         // the last layer shows 100 % at once; before it the figures are redrawn now and then
         if (s.done === s.layers) progress(1);
         else {
-          whileBusy(page, gen, () => {
-            progress(s.done / Math.max(1, s.layers));
-            writeStats(page);
-          });
+          // the bar is cheap: once a frame; the figures cost: now and then
+          inNextFrame(() => gen === store.generation && s.done < s.layers && progress(s.done / Math.max(1, s.layers)));
+          whileBusy(page, gen, () => writeStats(page));
         }
       },
       unit: (u) => {
