@@ -233,5 +233,31 @@ fn slabs_from_the_workers_give_the_report_of_the_ordered_slabs() {
         }
         assert_eq!(workers.part.volume.to_bits(), volume.to_bits(), "{model}");
         assert!(workers.part.void_volume > 0.0 && workers.part.void_fraction < 0.5);
+        assert!(workers.part.unit1.is_none(), "{model}");
     }
+}
+
+#[test]
+fn a_second_material_has_its_own_estimate_from_the_workers_and_in_order() {
+    use dropslice::model::models::Model;
+    use dropslice::model::spec::JobSpec;
+    let models = vec![
+        Model::read(&common::model_bytes("3DBenchy.stl"), "benchy.stl").unwrap(),
+        Model::read(&common::model_bytes("cube_20mm_ascii.stl"), "cube.stl").unwrap(),
+    ];
+    let spec = JobSpec::from_json(
+        r#"{"settings": {"unit1_droplet_aspect": 1.5, "stagger": true}, "parts": [{"file": "benchy.stl"}, {"file": "cube.stl", "unit": 1}]}"#,
+    )
+    .unwrap();
+    let job = Job::from_models(&models, &spec).unwrap();
+    let mut analysis = JobAnalysis::new(&job.analysis_grid(), job.settings());
+    dropslice::write_gcode_with(&job, &mut std::io::sink(), |_, _| {}, &mut analysis).unwrap();
+    let workers = analysis.finish();
+    let ordered = report_in_order(&job);
+    assert_eq!(workers.part, ordered.part);
+    let u1 = workers.part.unit1.expect("unit 1's estimate");
+    // the cube (8 cm³, 20 mm high) ends below the boat's top: its slabs are all in
+    assert!((u1.volume - 8000.0).abs() < 1.0, "{u1:?}");
+    assert!(u1.void_volume > 0.0 && u1.void_fraction < 0.5, "{u1:?}");
+    assert_eq!(u1.predicted_density, Some(100.0 * (1.0 - u1.void_fraction)));
 }

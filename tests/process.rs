@@ -374,6 +374,79 @@ fn the_predicted_density_is_one_minus_the_3d_void_fraction() {
     );
 }
 
+#[test]
+fn the_predicted_density_is_per_unit() {
+    let dir = TempDir::new("density-units");
+    std::fs::copy(model("cube_20mm_ascii.stl"), dir.join("cube.stl")).unwrap();
+    let report = |name: &str, words: &str| -> (serde_json::Value, String) {
+        let r = cli(
+            &dir,
+            &format!("{words} -o {name}.gco --report {name}.report.json"),
+        );
+        assert_eq!(r.code, Some(0), "{r:?}");
+        let text = std::fs::read_to_string(dir.join(&format!("{name}.report.json"))).unwrap();
+        (
+            serde_json::from_str::<serde_json::Value>(&text).unwrap()["part"].clone(),
+            r.stderr,
+        )
+    };
+    // Unit 1 alone prints the cube as unit 0 prints it with droplet_aspect = B₁ / H: the same
+    // droplets, so the same estimate to the bit.
+    write(
+        &dir,
+        "one.json",
+        r#"{"settings": {"unit1_droplet_aspect": 1.5}, "parts": [{"file": "cube.stl", "unit": 1}]}"#,
+    );
+    let (one, stderr) = report("one", "one.json");
+    let (alone, _) = report("alone", "cube.stl --set droplet_aspect=1.5");
+    assert!(
+        one["predicted_density"].is_null() && one["volume"] == 0.0,
+        "{one}"
+    );
+    let u1 = &one["unit1"];
+    for key in [
+        "volume",
+        "void_volume",
+        "void_fraction",
+        "predicted_density",
+    ] {
+        assert_eq!(u1[key], alone[key], "{key}: {u1} against {alone}");
+    }
+    let d1 = u1["predicted_density"].as_f64().unwrap();
+    assert!(
+        stderr.contains(&format!("predicted density: unit 1's parts {d1:.1} %")),
+        "{stderr}"
+    );
+    // Two materials: each unit's parts measured on their own (a cube each), in the summary too.
+    write(
+        &dir,
+        "two.json",
+        r#"{"settings": {"part_spacing": 5, "unit1_droplet_aspect": 1.5}, "parts": [{"file": "cube.stl"}, {"file": "cube.stl", "unit": 1}]}"#,
+    );
+    let (two, stderr) = report("two", "two.json");
+    let (d0, u1) = (two["predicted_density"].as_f64().unwrap(), &two["unit1"]);
+    let d1 = u1["predicted_density"].as_f64().unwrap();
+    for (v, fraction, density) in [
+        (&two["volume"], &two["void_fraction"], d0),
+        (&u1["volume"], &u1["void_fraction"], d1),
+    ] {
+        assert!((v.as_f64().unwrap() - 8000.0).abs() < 1.0, "{two}");
+        let fraction = fraction.as_f64().unwrap();
+        assert!(fraction > 0.0 && fraction < 0.5, "{two}");
+        assert!((density - 100.0 * (1.0 - fraction)).abs() < 1e-9);
+    }
+    assert!(
+        stderr.contains(&format!(
+            "predicted density: unit 0's parts {d0:.1} %, unit 1's parts {d1:.1} %"
+        )),
+        "{stderr}"
+    );
+    // Support is not a part: a job with support on has no unit-1 density.
+    let (supported, _) = report("supported", "@bridge.obj --set support=unit1");
+    assert!(supported["unit1"].is_null(), "{supported}");
+    assert!(supported["predicted_density"].as_f64().is_some());
+}
+
 // ---------------------------------------------------------------------------------------------
 // Profiles
 

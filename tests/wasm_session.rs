@@ -149,7 +149,7 @@ fn slices_a_box() {
     let mut tally = Tally::new();
     let mut seconds = 0.0;
     for i in 0..s.layer_count() {
-        let l = s.slice_layer(i).unwrap();
+        let mut l = s.slice_layer(i).unwrap();
         assert_eq!(l.index(), i);
         // the layer's time: droplets at droplet_rate (100/s), travel at travel_speed (50 mm/s)
         let t = (l.outer() + l.inner() + l.fill()) / 100.0 + l.travel_mm() / 50.0;
@@ -177,7 +177,7 @@ fn slices_a_box() {
             *t += roles.iter().filter(|&&r| r as usize == k).count() as u64;
         }
         text.push_str(&String::from_utf8(l.gcode().to_vec()).unwrap());
-        tally.add_layer(&l);
+        tally.add_layer(&mut l);
     }
     assert!(text.contains("G26 ") && text.contains("G25 ") && text.contains("G01 "));
     let summary = json(tally.summary().unwrap());
@@ -281,7 +281,7 @@ fn nothing_to_print_comes_with_the_figures() {
     let s = Session::new(stl.as_bytes(), "wall.stl", defaults()).unwrap();
     let mut tally = Tally::new();
     for i in 0..s.layer_count() {
-        tally.add_layer(&s.slice_layer(i).unwrap());
+        tally.add_layer(&mut s.slice_layer(i).unwrap());
     }
     let f = json(
         s.figures(js(serde_json::json!([json(tally.summary().unwrap())])))
@@ -313,7 +313,7 @@ fn a_session_from_the_prepared_mesh_slices_the_same() {
     );
     let (mut a, mut b) = (Tally::new(), Tally::new());
     for i in 0..first.layer_count() {
-        let (x, y) = (
+        let (mut x, mut y) = (
             first.slice_layer_analysed(i).unwrap(),
             other.slice_layer_analysed(i).unwrap(),
         );
@@ -325,8 +325,8 @@ fn a_session_from_the_prepared_mesh_slices_the_same() {
             json(y.analysis().unwrap()),
             "layer {i}"
         );
-        a.add_layer(&x);
-        b.add_layer(&y);
+        a.add_layer(&mut x);
+        b.add_layer(&mut y);
     }
     assert_eq!(json(a.summary().unwrap()), json(b.summary().unwrap()));
     // merged in another order, the summary is the same
@@ -568,18 +568,24 @@ fn refused_jobs_throw_typed_errors() {
     throws(models.add_bytes(b"not a model", "x.stl"), "import");
 }
 
-#[wasm_bindgen_test]
-fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
-    let models = boxes(&[("a.stl", [10.0, 10.0, 2.0]), ("b.stl", [10.0, 10.0, 3.0])]);
-    // b overlaps a by 4 mm in x; a is listed first and keeps the overlap.
+/// A job of a box a (10 × 10 × 2 mm) at the origin in unit 0 and a box b of `b` at x = `b_x`
+/// in unit 1 (`unit1_droplet_aspect` 1.5): its session and the job.
+fn two_units(b: [f64; 3], b_x: f64) -> (Session, serde_json::Value) {
+    let models = boxes(&[("a.stl", [10.0, 10.0, 2.0]), ("b.stl", b)]);
     let job = serde_json::json!({
         "settings": {"unit1_droplet_aspect": 1.5},
         "parts": [
             {"file": "a.stl", "place_x": 0, "place_y": 0},
-            {"file": "b.stl", "place_x": 6, "place_y": 0, "unit": 1}
+            {"file": "b.stl", "place_x": b_x, "place_y": 0, "unit": 1}
         ]
     });
-    let s = Session::from_models(&models, js(job.clone())).unwrap();
+    (Session::from_models(&models, js(job.clone())).unwrap(), job)
+}
+
+#[wasm_bindgen_test]
+fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
+    // b overlaps a by 4 mm in x; a is listed first and keeps the overlap.
+    let (s, job) = two_units([10.0, 10.0, 3.0], 6.0);
     let other = prepared_copy(&s, s.info().unwrap(), js(job["settings"].clone())).unwrap();
     assert_eq!(json(other.info().unwrap()), json(s.info().unwrap()));
     assert_eq!(
@@ -591,10 +597,10 @@ fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
     let (mut ta, mut tb) = (Tally::new(), Tally::new());
     let mut text = String::new();
     for i in 0..s.layer_count() {
-        let (x, y) = (s.slice_layer(i).unwrap(), other.slice_layer(i).unwrap());
+        let (mut x, mut y) = (s.slice_layer(i).unwrap(), other.slice_layer(i).unwrap());
         assert_eq!(x.gcode().to_vec(), y.gcode().to_vec(), "layer {i}");
-        ta.add_layer(&x);
-        tb.add_layer(&y);
+        ta.add_layer(&mut x);
+        tb.add_layer(&mut y);
         text.push_str(&String::from_utf8(x.gcode().to_vec()).unwrap());
     }
     let summary = json(ta.summary().unwrap());
@@ -791,10 +797,10 @@ fn calibrates_a_gcode_stream() {
     let mut tally = Tally::new();
     let mut n = 0.0;
     for i in 0..s.layer_count() {
-        let l = s.slice_layer(i).unwrap();
+        let mut l = s.slice_layer(i).unwrap();
         n += l.outer() + l.inner() + l.fill();
         body.push_str(&String::from_utf8(l.gcode().to_vec()).unwrap());
-        tally.add_layer(&l);
+        tally.add_layer(&mut l);
     }
     let summary = tally.summary().unwrap();
     let text = s.header(summary.clone()).unwrap() + &body + &s.footer(summary).unwrap();
@@ -925,4 +931,54 @@ fn check_profile_returns_the_profile_or_names_the_key() {
         (e["kind"].as_str(), e["setting"].as_str()),
         (Some("setting"), Some("shrink_z"))
     );
+}
+
+/// The merged summary of a session's layers analysed in runs of layers [from, to), each run's
+/// tally finished as a worker finishes it.
+fn density_in_runs(s: &Session, runs: &[(usize, usize)]) -> serde_json::Value {
+    let mut parts = Vec::new();
+    for &(from, to) in runs {
+        let mut tally = Tally::new();
+        for i in from..to {
+            tally.add_layer(&mut s.slice_layer_analysed(i).unwrap());
+        }
+        s.finish_slabs(&mut tally);
+        parts.push(json(tally.summary().unwrap()));
+    }
+    json(s.figures(js(serde_json::Value::Array(parts))).unwrap())["figures"].clone()
+}
+
+#[wasm_bindgen_test]
+fn the_predicted_density_per_unit_is_the_same_in_any_runs_of_layers() {
+    let (s, _) = two_units([8.0, 8.0, 3.0], 14.0);
+    let n = s.layer_count();
+    let whole = density_in_runs(&s, &[(0, n)]);
+    let d0 = whole["predicted_density"].as_f64().unwrap();
+    let d1 = whole["unit1_predicted_density"].as_f64().unwrap();
+    assert!(
+        (50.0..100.0).contains(&d0) && (50.0..100.0).contains(&d1),
+        "{whole}"
+    );
+    // unit 1's droplets are 1.5 times as wide: the two estimates are of different lattices
+    assert!((d0 - d1).abs() > 1e-6, "{whole}");
+    for runs in [
+        vec![(0, 1), (1, n)],
+        vec![(0, 3), (3, 4), (4, 9), (9, n)],
+        vec![(5, n), (0, 5)],
+    ] {
+        let f = density_in_runs(&s, &runs);
+        for key in ["predicted_density", "unit1_predicted_density"] {
+            let (a, b) = (f[key].as_f64().unwrap(), whole[key].as_f64().unwrap());
+            assert!((a - b).abs() < 1e-9, "{runs:?} {key}: {a} against {b}");
+        }
+    }
+    // a layer analysed alone (not in a tally's run) leaves no density
+    let mut tally = Tally::new();
+    tally.add_layer(&mut s.slice_layer(2).unwrap());
+    s.finish_slabs(&mut tally);
+    let f = json(
+        s.figures(js(serde_json::json!([json(tally.summary().unwrap())])))
+            .unwrap(),
+    );
+    assert!(f["figures"]["predicted_density"].is_null(), "{f}");
 }

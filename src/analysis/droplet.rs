@@ -3,7 +3,7 @@
 
 use crate::base::geom::{Point, line_droplets};
 use crate::base::settings::{Footprint, Settings};
-use crate::slicing::plan::{LayerPlan, MoveKind};
+use crate::slicing::plan::{LayerPlan, Move, MoveKind, Role};
 use std::f64::consts::PI;
 
 /// Footprint diameter D of a droplet, in mm.
@@ -25,10 +25,25 @@ pub fn spheroid_half_height(s: &Settings) -> f64 {
 /// Every droplet centre of a layer's part (each droplet of a `G25` line too), in print order:
 /// unit 0's droplets (support, printed by unit 1, is not the part the analysis measures).
 pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
-    let mut out = Vec::with_capacity(plan.counts.unit0() as usize);
+    centres_where(plan, b, plan.counts.unit0() as usize, |m| m.unit == 0)
+}
+
+/// Every droplet centre unit 1 prints for its parts in a layer (a second material, droplets
+/// of B₁ = `plan.unit1_width`; not the support), in print order.
+pub fn unit1_part_centres(plan: &LayerPlan) -> Vec<Point> {
+    let n = plan.counts.unit1.saturating_sub(plan.counts.support) as usize;
+    centres_where(plan, plan.unit1_width, n, |m| {
+        m.unit == 1 && m.role != Role::Support
+    })
+}
+
+/// The droplet centres of the moves `keep` takes (`b`: their droplet width, `n`: about how
+/// many there are).
+fn centres_where(plan: &LayerPlan, b: f64, n: usize, keep: impl Fn(&Move) -> bool) -> Vec<Point> {
+    let mut out = Vec::with_capacity(n);
     let mut at = Point::ZERO;
     for m in &plan.moves {
-        if m.unit != 0 {
+        if !keep(m) {
             at = m.to;
             continue;
         }

@@ -66,9 +66,10 @@ mod droplet;
 mod estimate3d;
 mod raster;
 mod report;
+mod slabs;
 
 pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_voids};
-pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
+pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres};
 #[cfg(any(test, feature = "reference"))]
 pub use estimate3d::slab_voids_reference;
 pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
@@ -77,5 +78,6 @@ pub use raster::{
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,
 };
 pub use report::{
-    AnalysedLayer, AnalysisGrid, JobAnalysis, LayerStage, Model, PartAnalysis, Report,
+    AnalysedLayer, AnalysisGrid, JobAnalysis, LayerStage, Model, PartAnalysis, Report, UnitDensity,
 };
+pub use slabs::{LayerMaps, SlabFigures, SlabRun, UnitRegions};

@@ -1,15 +1,19 @@
 //! The job's report: part figures, the analysis model, and the per-layer stage the slicing
 //! workers run with its ordered half ([`JobAnalysis`], a [`crate::slicing::sink::LayerSink`]).
 
-use super::droplet::{droplet_centres, footprint_diameter, spheroid_half_height};
+use super::droplet::{
+    droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres,
+};
 use super::estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
-use crate::base::geom::{DVec2, Point, Shapes};
+use super::slabs::{self, LayerMaps, SlabFigures, SlabRun, Slabs, UnitRegions};
+use crate::base::geom::{DVec2, Point, Shapes, region_area};
 use crate::base::settings::Settings;
 use crate::slicing::plan::LayerPlan;
+use crate::slicing::plan::unit1_part_settings;
 use serde::Serialize;
-use std::collections::{BTreeMap, VecDeque};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
 
 /// Part-level figures. Areas in mm² summed over layers; volumes in mm³.
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
@@ -48,11 +52,22 @@ pub struct PartAnalysis {
     pub max_unsupported_area: f64,
     #[serde(default)]
     pub max_unsupported_area_layer: Option<usize>,
+    /// The 3D estimate of unit 1's parts (a second material, droplets of B₁): its volume,
+    /// void volume and predicted density; `None` in a job without unit-1 parts (the fields
+    /// above are unit 0's; the support is not a part and is not measured).
+    #[serde(default)]
+    pub unit1: Option<UnitDensity>,
 }
 
 impl PartAnalysis {
-    /// Adds one layer's figures (its 3D slab: `slab_volume`, `slab_void`).
-    pub fn add(&mut self, l: &LayerAnalysis, slab_volume: f64, slab_void: f64) {
+    /// Adds one layer's figures and its 3D slab's.
+    pub fn add(&mut self, l: &LayerAnalysis, slab: SlabFigures) {
+        self.add_2d(l);
+        self.add_slab(slab);
+    }
+
+    /// Adds one layer's 2D figures.
+    pub fn add_2d(&mut self, l: &LayerAnalysis) {
         self.layers += 1;
         self.droplets += l.droplets;
         let covered = self.coverage * self.region_area + l.coverage * l.region_area;
@@ -80,21 +95,49 @@ impl PartAnalysis {
             self.max_unsupported_area = l.unsupported_area;
             self.max_unsupported_area_layer = Some(l.index);
         }
-        self.volume += slab_volume;
-        self.void_volume += slab_void;
+    }
+
+    /// Adds a slab's 3D figures (of any layer, in any order).
+    pub fn add_slab(&mut self, f: SlabFigures) {
+        self.volume += f.volume;
+        self.void_volume += f.void_volume;
+        if let Some((volume, void_volume)) = f.unit1 {
+            let u = self.unit1.get_or_insert_default();
+            u.volume += volume;
+            u.void_volume += void_volume;
+        }
         self.update_fraction();
     }
 
-    /// `void_fraction` and `predicted_density` from the volumes.
+    /// `void_fraction` and `predicted_density` from the volumes (unit 1's too).
     pub fn update_fraction(&mut self) {
-        let some = self.volume > 0.0;
-        self.void_fraction = if some {
-            self.void_volume / self.volume
-        } else {
-            0.0
-        };
-        self.predicted_density = some.then_some(100.0 * (1.0 - self.void_fraction));
+        (self.void_fraction, self.predicted_density) = density(self.volume, self.void_volume);
+        if let Some(u) = &mut self.unit1 {
+            (u.void_fraction, u.predicted_density) = density(u.volume, u.void_volume);
+        }
     }
+}
+
+/// (void fraction, predicted density %) of a volume and its void volume; no density without
+/// a volume.
+fn density(volume: f64, void_volume: f64) -> (f64, Option<f64>) {
+    let some = volume > 0.0;
+    let fraction = if some { void_volume / volume } else { 0.0 };
+    (fraction, some.then_some(100.0 * (1.0 - fraction)))
+}
+
+/// The 3D estimate of the parts one unit prints: as [`PartAnalysis`] holds it for unit 0.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct UnitDensity {
+    /// The parts' volume, mm³.
+    pub volume: f64,
+    /// Volume no droplet spheroid fills, mm³.
+    pub void_volume: f64,
+    /// void_volume / volume.
+    pub void_fraction: f64,
+    /// 100 × (1 − void_fraction), %; `None` without a volume.
+    pub predicted_density: Option<f64>,
 }
 
 /// The whole report of a job: settings, model, part figures and every layer's figures.
@@ -140,28 +183,34 @@ impl Model {
 
 /// The per-layer half of the job analysis, for the workers that plan the layers (see
 /// [`crate::write_gcode_with`]): [`analyse`](Self::analyse) gives a layer's 2D figures and its
-/// spheroid map; [`JobAnalysis`] takes them in layer order and adds the 3D estimate, so no
-/// layer is planned twice.
+/// spheroid maps; [`JobAnalysis`] takes them in layer order and adds the 3D estimate, so no
+/// layer is planned twice. In a job with unit-1 parts (a second material), unit 1's parts get
+/// their own 3D estimate (droplets of B₁ on a grid of B₁ / 3); the 2D figures are unit 0's.
 #[derive(Clone, Debug)]
 pub struct LayerStage {
     settings: Settings,
     grid: Grid3,
+    /// Unit 1's part settings and grid, in a job with unit-1 parts.
+    unit1: Option<(Settings, Grid3)>,
 }
 
-/// One layer analysed by a [`LayerStage`]: its 2D figures, and its region and spheroid map
+/// One layer analysed by a [`LayerStage`]: its 2D figures, and its regions and spheroid maps
 /// waiting for its neighbours' maps (none when the workers compute the slabs, [`Slabs`]).
 pub struct AnalysedLayer {
     analysis: LayerAnalysis,
-    own: Option<(Shapes, HeightMap)>,
+    own: Option<(UnitRegions, LayerMaps)>,
 }
 
 /// What a job's analysis needs of the job besides its settings: where the part lies (the 3D
-/// grid is fixed to it), how many layers it has, and the model's name for the report.
+/// grid is fixed to it), how many layers it has, whether unit 1 prints parts, and the model's
+/// name for the report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AnalysisGrid {
     /// The least x and y of the placed part's bounding box, mm.
     pub min: Point,
     pub layers: usize,
+    /// Whether the job has unit-1 parts (a second material), measured on their own.
+    pub unit1_parts: bool,
     pub file_name: String,
 }
 
@@ -178,160 +227,147 @@ impl AnalysisGrid {
 
 impl LayerStage {
     pub fn new(grid: &AnalysisGrid, settings: &Settings) -> LayerStage {
+        let unit1 = grid.unit1_parts.then(|| {
+            let s1 = unit1_part_settings(settings);
+            let g1 = grid.grid3(&s1);
+            (s1, g1)
+        });
         LayerStage {
             settings: settings.clone(),
             grid: grid.grid3(settings),
+            unit1,
         }
     }
 
-    /// Analyses layer `plan.index` against its `region`, in `raster`'s memory (one raster per
-    /// worker, reused from layer to layer).
+    /// The settings the stage analyses unit 0 with.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Analyses layer `plan.index` against its `region` (unit 0's), in `raster`'s memory (one
+    /// raster per worker, reused from layer to layer).
     pub fn analyse(&self, raster: &mut Raster, region: &Shapes, plan: &LayerPlan) -> AnalysedLayer {
-        let (analysis, map) = self.analyse_2d(raster, region, plan);
+        let (analysis, maps) = self.analyse_2d(raster, region, plan);
         AnalysedLayer {
             analysis,
-            own: Some((region.clone(), map)),
+            own: Some((self.regions(region, plan), maps)),
         }
     }
 
-    /// The layer's 2D figures and its spheroid map.
-    fn analyse_2d(
+    /// The regions of the layer the units print as parts (`region`: unit 0's).
+    pub fn regions(&self, region: &Shapes, plan: &LayerPlan) -> UnitRegions {
+        UnitRegions {
+            unit0: region.clone(),
+            unit1: if self.unit1.is_some() {
+                plan.unit1_region.clone()
+            } else {
+                Shapes::new()
+            },
+        }
+    }
+
+    /// The layer's 2D figures and its spheroid maps.
+    pub(super) fn analyse_2d(
         &self,
         raster: &mut Raster,
         region: &Shapes,
         plan: &LayerPlan,
-    ) -> (LayerAnalysis, HeightMap) {
+    ) -> (LayerAnalysis, LayerMaps) {
         let s = &self.settings;
         let centres = droplet_centres(plan, s.droplet_width());
         raster.rebuild(plan.index, plan.z, &centres, region, s);
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
-        let map = HeightMap::new(&centres, &self.grid, footprint_diameter(s));
-        (analysis, map)
+        let unit0 = HeightMap::new(&centres, &self.grid, footprint_diameter(s));
+        (analysis, self.with_unit1(unit0, plan))
     }
 
-    /// Slab `i`'s 3D estimate: (its exact volume, its void volume), the void share sampled on
-    /// the grid.
-    fn slab(
+    /// A layer's spheroid maps given unit 0's.
+    fn with_unit1(&self, unit0: HeightMap, plan: &LayerPlan) -> LayerMaps {
+        let unit1 = self
+            .unit1
+            .as_ref()
+            .map(|(s1, g1)| HeightMap::new(&unit1_part_centres(plan), g1, footprint_diameter(s1)));
+        LayerMaps { unit0, unit1 }
+    }
+
+    /// A layer's spheroid maps alone (a layer next to a run of analysed layers, whose own
+    /// figures are not wanted: [`SlabRun::finish`]).
+    pub fn maps(&self, plan: &LayerPlan) -> LayerMaps {
+        let s = &self.settings;
+        let centres = droplet_centres(plan, s.droplet_width());
+        let unit0 = HeightMap::new(&centres, &self.grid, footprint_diameter(s));
+        self.with_unit1(unit0, plan)
+    }
+
+    /// Slab `i`'s 3D estimate: per unit, its exact volume and its void volume (the void share
+    /// sampled on the grid).
+    pub(super) fn slab(
         &self,
         analysis: &LayerAnalysis,
-        region: &Shapes,
-        maps: [Option<&HeightMap>; 3],
-    ) -> (f64, f64) {
+        regions: &UnitRegions,
+        maps: [Option<&LayerMaps>; 3],
+    ) -> SlabFigures {
         let s = &self.settings;
-        let Some(this) = maps[1] else {
-            return (analysis.region_area * s.layer_height, 0.0);
-        };
-        let (vol, void) = slab_voids(region, &self.grid, maps[0], this, maps[2], s);
-        let exact = analysis.region_area * s.layer_height;
-        let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
-        (exact, void)
-    }
-}
-
-/// The slabs' 3D estimate in the slicing workers (natively, with [`crate::write_gcode_with`]):
-/// each worker publishes its layer's region and spheroid map here, and the worker that
-/// publishes the last of the three maps a slab needs (layers i − 1, i, i + 1) computes it,
-/// so the writing thread only adds the figures up. A map is dropped once its three slabs are
-/// done; the workers run at most a window of layers ahead of the writing thread, so only
-/// that many maps are held.
-#[derive(Default)]
-pub struct Slabs {
-    n: usize,
-    maps: Vec<Option<Arc<HeightMap>>>,
-    /// Each layer's region and 2D figures, until its slab is done.
-    layers: Vec<Option<(Shapes, LayerAnalysis)>>,
-    claimed: Vec<bool>,
-    /// Slabs not yet done that use each map.
-    uses: Vec<u8>,
-    /// Slabs done and not yet taken: layer → (volume, void volume).
-    done: BTreeMap<usize, (f64, f64)>,
-}
-
-/// What a worker claims: a slab, its layer's region and figures and the three maps.
-type Claim = (usize, Shapes, LayerAnalysis, [Option<Arc<HeightMap>>; 3]);
-
-impl Slabs {
-    fn new(n: usize) -> Slabs {
-        Slabs {
-            n,
-            maps: (0..n).map(|_| None).collect(),
-            layers: (0..n).map(|_| None).collect(),
-            claimed: vec![false; n],
-            uses: (0..n)
-                .map(|k| (k.saturating_sub(1)..(k + 2).min(n)).len() as u8)
-                .collect(),
-            done: BTreeMap::new(),
-        }
-    }
-
-    /// The layers of slab `j` (those in the job).
-    fn around(&self, j: usize) -> std::ops::Range<usize> {
-        j.saturating_sub(1)..(j + 2).min(self.n)
-    }
-
-    /// Publishes layer `i`; returns the slabs it completes, claimed for the caller.
-    fn publish(
-        &mut self,
-        i: usize,
-        region: Shapes,
-        analysis: LayerAnalysis,
-        map: HeightMap,
-    ) -> Vec<Claim> {
-        if i >= self.n {
-            return Vec::new();
-        }
-        self.maps[i] = Some(Arc::new(map));
-        self.layers[i] = Some((region, analysis));
-        let mut claims = Vec::new();
-        for j in self.around(i) {
-            let ready = !self.claimed[j] && self.around(j).all(|k| self.maps[k].is_some());
-            if !ready {
-                continue;
-            }
-            let Some((region, analysis)) = self.layers[j].take() else {
-                continue;
+        let (volume, void_volume) = slab_of(
+            analysis.region_area,
+            &regions.unit0,
+            &self.grid,
+            maps.map(|m| m.map(|m| &m.unit0)),
+            s,
+        );
+        let unit1 = self.unit1.as_ref().map(|(s1, g1)| {
+            let area = if regions.unit1.is_empty() {
+                0.0
+            } else {
+                region_area(&regions.unit1)
             };
-            self.claimed[j] = true;
-            let map =
-                |k: Option<usize>| k.filter(|&k| k < self.n).and_then(|k| self.maps[k].clone());
-            claims.push((
-                j,
-                region,
-                analysis,
-                [map(j.checked_sub(1)), map(Some(j)), map(Some(j + 1))],
-            ));
-        }
-        claims
-    }
-
-    /// Slab `j` is done: keeps its figures, drops the maps no slab needs any more.
-    fn complete(&mut self, j: usize, figures: (f64, f64)) {
-        self.done.insert(j, figures);
-        for k in self.around(j) {
-            self.uses[k] = self.uses[k].saturating_sub(1);
-            if self.uses[k] == 0 {
-                self.maps[k] = None;
-            }
+            slab_of(
+                area,
+                &regions.unit1,
+                g1,
+                maps.map(|m| m.and_then(|m| m.unit1.as_ref())),
+                s1,
+            )
+        });
+        SlabFigures {
+            volume,
+            void_volume,
+            unit1,
         }
     }
 }
 
-fn lock(m: &Mutex<Slabs>) -> MutexGuard<'_, Slabs> {
-    m.lock().unwrap_or_else(|p| p.into_inner())
+/// A slab's (exact volume, void volume): `area` × H, and the void share of the region sampled
+/// on `grid` between the maps of the layers below, of its own and above.
+fn slab_of(
+    area: f64,
+    region: &Shapes,
+    grid: &Grid3,
+    maps: [Option<&HeightMap>; 3],
+    s: &Settings,
+) -> (f64, f64) {
+    let exact = area * s.layer_height;
+    let Some(this) = maps[1] else {
+        return (exact, 0.0);
+    };
+    if region.is_empty() {
+        return (exact, 0.0);
+    }
+    let (vol, void) = slab_voids(region, grid, maps[0], this, maps[2], s);
+    let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
+    (exact, void)
 }
 
 /// The ordered half of the job analysis: takes every layer's [`AnalysedLayer`] in ascending
-/// order, adds each slab's 3D estimate once its neighbours are in (computing it here, or
-/// taking it from the workers, [`Slabs`]), and gives the [`Report`]. Keeps two layers' maps
-/// at a time when it computes the slabs itself.
+/// order, adds each slab's 3D estimate once its neighbours are in (computing it here with a
+/// [`SlabRun`], or taking it from the workers, [`Slabs`]), and gives the [`Report`].
 pub struct JobAnalysis {
-    stage: LayerStage,
+    stage: Arc<LayerStage>,
     file_name: String,
     part: PartAnalysis,
     layers: Vec<LayerAnalysis>,
-    below: Option<HeightMap>,
-    current: Option<AnalysedLayer>,
+    run: SlabRun,
     /// The slabs the workers compute, and the layers waiting for theirs, in order.
     slabs: Arc<Mutex<Slabs>>,
     waiting: VecDeque<LayerAnalysis>,
@@ -340,13 +376,13 @@ pub struct JobAnalysis {
 impl JobAnalysis {
     /// The analysis of a job of `grid.layers` layers, sliced with `settings`.
     pub fn new(grid: &AnalysisGrid, settings: &Settings) -> JobAnalysis {
+        let stage = Arc::new(LayerStage::new(grid, settings));
         JobAnalysis {
-            stage: LayerStage::new(grid, settings),
+            run: SlabRun::new(stage.clone()),
+            stage,
             file_name: grid.file_name.clone(),
             part: PartAnalysis::default(),
             layers: Vec::with_capacity(grid.layers),
-            below: None,
-            current: None,
             slabs: Arc::new(Mutex::new(Slabs::new(grid.layers))),
             waiting: VecDeque::new(),
         }
@@ -354,16 +390,19 @@ impl JobAnalysis {
 
     /// The stage for the workers.
     pub fn stage(&self) -> LayerStage {
-        self.stage.clone()
+        (*self.stage).clone()
     }
 
     /// The next layer (layers must come in ascending order, from 0).
     pub fn push(&mut self, layer: AnalysedLayer) {
-        match &layer.own {
-            Some((_, map)) => {
-                self.close(Some(map));
-                self.below = self.current.take().and_then(|c| c.own.map(|o| o.1));
-                self.current = Some(layer);
+        match layer.own {
+            Some((regions, maps)) => {
+                let i = self.layers.len();
+                self.part.add_2d(&layer.analysis);
+                self.layers.push(layer.analysis.clone());
+                if let Some(f) = self.run.push(i, layer.analysis, regions, maps) {
+                    self.part.add_slab(f);
+                }
             }
             // Its slab comes from the workers.
             None => {
@@ -378,7 +417,7 @@ impl JobAnalysis {
     /// leaves, is computed here from the maps there are).
     fn take_slabs(&mut self, all: bool) {
         let slabs = self.slabs.clone();
-        let mut board = lock(&slabs);
+        let mut board = slabs::lock(&slabs);
         while let Some(analysis) = self.waiting.front() {
             let j = self.layers.len();
             let figures = match board.done.remove(&j) {
@@ -386,45 +425,33 @@ impl JobAnalysis {
                 None if all => {
                     let map = |k: usize| board.maps.get(k).cloned().flatten();
                     let maps = [j.checked_sub(1).and_then(map), map(j), map(j + 1)];
-                    let region = board.layers.get_mut(j).and_then(Option::take);
-                    let region = region.map(|r| r.0).unwrap_or_default();
+                    let regions = board.layers.get_mut(j).and_then(Option::take);
+                    let regions = regions.map(|r| r.0).unwrap_or_default();
                     self.stage.slab(
                         analysis,
-                        &region,
+                        &regions,
                         [maps[0].as_deref(), maps[1].as_deref(), maps[2].as_deref()],
                     )
                 }
                 None => break,
             };
             let analysis = self.waiting.pop_front().expect("a waiting layer");
-            self.part.add(&analysis, figures.0, figures.1);
+            self.part.add(&analysis, figures);
             self.layers.push(analysis);
         }
     }
 
-    /// The 3D estimate of the current layer, with `above` (the next layer's map, if any).
-    fn close(&mut self, above: Option<&HeightMap>) {
-        let Some(cur) = &self.current else { return };
-        let Some((region, map)) = &cur.own else {
-            return;
-        };
-        let (exact, void) = self.stage.slab(
-            &cur.analysis,
-            region,
-            [self.below.as_ref(), Some(map), above],
-        );
-        self.part.add(&cur.analysis, exact, void);
-        self.layers.push(cur.analysis.clone());
-    }
-
     /// The report, after the last layer.
     pub fn finish(mut self) -> Report {
-        self.close(None);
+        let run = std::mem::replace(&mut self.run, SlabRun::new(self.stage.clone()));
+        if run.span().is_some() {
+            self.part.add_slab(run.finish(None, None));
+        }
         self.take_slabs(true);
         Report {
             file_name: self.file_name,
             model: Model::new(&self.stage.settings),
-            settings: self.stage.settings,
+            settings: self.stage.settings.clone(),
             part: self.part,
             layers: self.layers,
         }
@@ -435,11 +462,11 @@ impl JobAnalysis {
 /// it plans in its own [`Raster`] and computes the slabs its layer completes ([`Slabs`]); the
 /// layers are pushed in order.
 impl crate::slicing::sink::LayerSink for JobAnalysis {
-    type State = (Raster, LayerStage, Arc<Mutex<Slabs>>);
+    type State = (Raster, Arc<LayerStage>, Arc<Mutex<Slabs>>);
     type Out = AnalysedLayer;
 
     fn init(&self) -> Self::State {
-        (Raster::empty(), self.stage(), self.slabs.clone())
+        (Raster::empty(), self.stage.clone(), self.slabs.clone())
     }
 
     fn per_layer(
@@ -448,12 +475,13 @@ impl crate::slicing::sink::LayerSink for JobAnalysis {
         region: &Shapes,
         plan: &LayerPlan,
     ) -> AnalysedLayer {
-        let (analysis, map) = stage.analyse_2d(raster, region, plan);
-        let claims = lock(slabs).publish(i, region.clone(), analysis.clone(), map);
-        for (j, region, analysis, maps) in claims {
+        let (analysis, maps) = stage.analyse_2d(raster, region, plan);
+        let regions = stage.regions(region, plan);
+        let claims = slabs::lock(slabs).publish(i, regions, analysis.clone(), maps);
+        for (j, regions, analysis, maps) in claims {
             let maps = [maps[0].as_deref(), maps[1].as_deref(), maps[2].as_deref()];
-            let figures = stage.slab(&analysis, &region, maps);
-            lock(slabs).complete(j, figures);
+            let figures = stage.slab(&analysis, &regions, maps);
+            slabs::lock(slabs).complete(j, figures);
         }
         AnalysedLayer {
             analysis,

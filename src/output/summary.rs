@@ -129,6 +129,9 @@ pub struct Figures {
     /// without the 3D estimate. A geometric estimate from the droplet model, not a measured
     /// density.
     pub predicted_density: Option<f64>,
+    /// The same of unit 1's parts (a second material); `None` without them or without the 3D
+    /// estimate.
+    pub unit1_predicted_density: Option<f64>,
     /// What slicing repaired, in plain language.
     pub repairs: Vec<String>,
 }
@@ -163,7 +166,13 @@ impl Summary {
     /// Adds one layer's void analysis (a layer may be analysed without being counted again,
     /// e.g. when the analysis is made after the slice).
     pub fn add_analysis(&mut self, layer: &LayerAnalysis) {
-        self.analysis.add(layer, 0.0, 0.0);
+        self.analysis.add_2d(layer);
+    }
+
+    /// Adds a slab's 3D figures (the page's workers compute them for their runs of layers,
+    /// [`crate::analysis::SlabRun`]).
+    pub fn add_slab(&mut self, f: &crate::analysis::SlabFigures) {
+        self.analysis.add_slab(*f);
     }
 
     /// Adds the layers of another summary (disjoint from this one's).
@@ -246,6 +255,7 @@ impl Summary {
                 _ => None,
             },
             predicted_density: a.predicted_density,
+            unit1_predicted_density: a.unit1.and_then(|u| u.predicted_density),
             repairs: self.repairs(),
         }
     }
@@ -324,6 +334,11 @@ impl PartAnalysis {
         );
         self.volume += o.volume;
         self.void_volume += o.void_volume;
+        if let Some(theirs) = &o.unit1 {
+            let u = self.unit1.get_or_insert_default();
+            u.volume += theirs.volume;
+            u.void_volume += theirs.void_volume;
+        }
         self.update_fraction();
     }
 }

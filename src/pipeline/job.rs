@@ -78,6 +78,7 @@ impl Job {
         crate::analysis::AnalysisGrid {
             min: geom::DVec2::new(min[0], min[1]),
             layers: self.layer_count(),
+            unit1_parts: !self.groups.is_empty(),
             file_name: self.info.file_name.clone(),
         }
     }
@@ -111,6 +112,15 @@ impl Job {
             return self.supported_plans()[i].clone();
         }
         self.plan_layer_with(i, self.section(i), None)
+    }
+
+    /// Layer `i`'s plan for the analysis of the layers next to it: its moves and unit 1's
+    /// part region, without the overhang figure (which needs the section below).
+    pub fn plan_for_analysis(&self, i: usize) -> LayerPlan {
+        if self.settings.support == settings::Support::Unit1 {
+            return self.supported_plans()[i].0.clone();
+        }
+        self.plan_parts(i, &self.section(i)).0
     }
 
     /// Whether planning a layer needs the section of the layer below (for the overhang
@@ -169,6 +179,7 @@ impl Job {
                     plan::Role::Support,
                     &self.settings,
                 );
+                plan.unit1_region = r1;
                 (plan, r0)
             }
         }

@@ -147,6 +147,7 @@ where
                             stages::time(Stage::Sink, || K::per_layer(&mut state, i, &region, &p));
                         let units = (p.first_unit(), p.moves.last().map(|m| m.unit));
                         p.moves = Vec::new();
+                        p.unit1_region = geom::Shapes::new();
                         (text, p, extra, units.0, units.1)
                     }))
                     .map_err(|e| {

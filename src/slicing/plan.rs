@@ -99,6 +99,9 @@ pub struct LayerPlan {
     pub unsupported_area: f64,
     /// Droplet width B₁ of the unit-1 moves (0 when there are none).
     pub unit1_width: f64,
+    /// The region unit 1 prints as parts (a second material) in this layer; empty in a job
+    /// without unit-1 parts. The analysis measures it as it measures unit 0's.
+    pub unit1_region: Shapes,
 }
 
 impl LayerPlan {

@@ -21,9 +21,11 @@
 mod cut;
 mod models;
 pub mod reader;
+mod tally;
 
 pub use models::{Models, check_profile};
 use models::{job_of, read_file};
+pub use tally::Tally;
 
 use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
@@ -247,11 +249,12 @@ impl Session {
     fn with(job: Job) -> Session {
         let settings = job.settings().clone();
         Session {
-            job,
-            settings,
             unit_after: std::cell::Cell::new(None),
             last_section: std::cell::RefCell::new(None),
             raster: std::cell::RefCell::new(analysis::Raster::empty()),
+            stage: std::sync::Arc::new(analysis::LayerStage::new(&job.analysis_grid(), &settings)),
+            job,
+            settings,
         }
     }
 
@@ -306,6 +309,8 @@ pub struct Session {
     last_section: std::cell::RefCell<Option<(usize, crate::base::geom::Shapes)>>,
     /// The raster every analysed layer is rebuilt into (its memory kept between layers).
     raster: std::cell::RefCell<analysis::Raster>,
+    /// The 3D estimate's stage (its grids are the job's).
+    pub(crate) stage: std::sync::Arc<analysis::LayerStage>,
 }
 
 #[wasm_bindgen]
@@ -398,7 +403,8 @@ impl Session {
     }
 
     /// [`Session::slice_layer`] plus the void analysis of the same plan (no second planning):
-    /// `analysis` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]). About 2–3
+    /// `analysis` and the coverage mask (cells of B / [`MASK_CELLS_PER_B`]), and what the 3D
+    /// estimate needs (a [`Tally`] takes it: [`Session::finish_slabs`]). About 2–3
     /// times the work of planning the layer.
     pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
@@ -412,6 +418,13 @@ impl Session {
             cell,
         );
         let mut r = LayerResult::new(&plan, &self.settings, text);
+        r.slab = Some(Box::new(tally::SlabInput {
+            index: i,
+            analysis: a.clone(),
+            regions: self.stage.regions(&region, &plan),
+            maps: stages::time(Stage::Sink, || self.stage.maps(&plan)),
+            stage: self.stage.clone(),
+        }));
         r.analysis = Some(a);
         r.mask = Some(mask);
         Ok(r)
@@ -463,42 +476,6 @@ impl Session {
     }
 }
 
-/// A unit's summary, built layer by layer in the worker.
-#[wasm_bindgen]
-#[derive(Default)]
-pub struct Tally {
-    summary: Summary,
-}
-
-#[wasm_bindgen]
-impl Tally {
-    #[wasm_bindgen(constructor)]
-    pub fn new() -> Tally {
-        Tally::default()
-    }
-
-    /// Adds a sliced layer (its counts, travel and repairs, and its analysis if it has one).
-    pub fn add_layer(&mut self, layer: &LayerResult) {
-        self.summary.merge(&layer.summary);
-        if let Some(a) = &layer.analysis {
-            self.summary.add_analysis(a);
-        }
-    }
-
-    /// Adds only a layer's analysis (a layer analysed after the slice that counted it).
-    pub fn add_analysis(&mut self, layer: &LayerResult) {
-        if let Some(a) = &layer.analysis {
-            self.summary.add_analysis(a);
-        }
-    }
-
-    /// The summary so far (`Summary`).
-    #[wasm_bindgen(unchecked_return_type = "Summary")]
-    pub fn summary(&self) -> Result<JsValue, JsValue> {
-        to_js(&self.summary, "a summary")
-    }
-}
-
 /// One planned layer, ready to be posted to the page.
 #[wasm_bindgen]
 pub struct LayerResult {
@@ -508,11 +485,13 @@ pub struct LayerResult {
     travel_mm: f64,
     seconds: f64,
     unsupported_area: f64,
-    summary: Summary,
+    pub(crate) summary: Summary,
     gcode: String,
     preview: PreviewLayer,
     analysis: Option<LayerAnalysis>,
     mask: Option<CoverageMask>,
+    /// What the 3D estimate needs of an analysed layer, until a [`Tally`] takes it.
+    slab: Option<Box<tally::SlabInput>>,
 }
 
 impl LayerResult {
@@ -531,6 +510,7 @@ impl LayerResult {
             }),
             analysis: None,
             mask: None,
+            slab: None,
         }
     }
 }

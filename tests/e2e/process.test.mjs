@@ -1,12 +1,16 @@
 // The process engineer's tools in the page (issue 26): Orient per part (the core's candidates,
-// one applied and undone), profiles (save, export, delete, import again; a bad file refused)
-// and the chamber's height in the 3D view.
+// one applied and undone), profiles (save, export, delete, import again; a bad file refused),
+// the chamber's height in the 3D view, and the predicted density per unit against the CLI.
+// Needs dist/ (scripts/build.sh) and target/release/dropslice.
 import assert from "node:assert/strict";
+import { execFileSync } from "node:child_process";
 import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { after, before, test } from "node:test";
-import { open3d, openPage, pick, shared, start, stop, waitDone } from "./helpers.mjs";
+import { open3d, openPage, pick, repo, shared, start, stop, waitDone } from "./helpers.mjs";
+
+const cli = join(repo, "target/release/dropslice");
 
 let env;
 const dir = mkdtempSync(join(tmpdir(), "dropslice-process-"));
@@ -149,4 +153,36 @@ test("the 3D view draws the chamber's height", async () => {
   await page.waitForFunction(() => window.dropslice.view3d().chamber === 120, null, { timeout: 10_000 });
   assert.deepEqual(errors, []);
   await page.context().close();
+});
+
+test("the predicted density per unit in the statistics is the command line's", async () => {
+  // a two-material job: the cube in unit 0 and again in unit 1 (B₁ = 1.5 H)
+  const job = { settings: { part_spacing: 5, unit1_droplet_aspect: 1.5 }, parts: [{ file: "cube.stl" }, { file: "cube.stl", unit: 1 }] };
+  const jobFile = join(dir, "two-units.json");
+  const cubeFile = join(dir, "cube.stl");
+  writeFileSync(jobFile, JSON.stringify(job));
+  writeFileSync(cubeFile, readFileSync(join(shared, "models/cube_20mm_ascii.stl")));
+  const report = join(dir, "two-units.report.json");
+  execFileSync(cli, [jobFile, "-o", join(dir, "two-units.gco"), "--report", report, "-q"]);
+  const part = JSON.parse(readFileSync(report, "utf8")).part;
+  const expected = [`${part.predicted_density.toFixed(1)} %`, `${part.unit1.predicted_density.toFixed(1)} %`];
+
+  const { page, errors } = await openPage(env.browser, env.url);
+  await waitDone(page, 60_000);
+  assert.equal(await page.locator("#stat-density").innerText(), "–", "no density without the 3D analysis");
+  assert.equal(await page.isVisible("#stat-density1"), false, "no unit-1 row in a job without unit-1 parts");
+  await pick(page, [jobFile, cubeFile]);
+  await waitDone(page, 60_000);
+  await page.check("#opt-voids");
+  await page.waitForFunction(() => {
+    const st = window.dropslice.status();
+    return st.state === "done" && st.analysed === st.layers;
+  }, null, { timeout: 120_000, polling: 100 });
+  const shown = () => page.evaluate(() => ["stat-density", "stat-density1"].map((id) => document.getElementById(id).textContent));
+  await page.waitForFunction((want) => ["stat-density", "stat-density1"].every((id, k) => document.getElementById(id).textContent === want[k]), expected, { timeout: 10_000 })
+    .catch(async () => assert.fail(`the page shows ${JSON.stringify(await shown())}, the command line ${JSON.stringify(expected)}`));
+  assert.equal(await page.isVisible("#stat-density1-label"), true);
+  assert.match(await page.getAttribute("#stat-density", "title"), /not a measured density/);
+  assert.deepEqual(errors, []);
+  await page.close();
 });

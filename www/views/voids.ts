@@ -6,6 +6,8 @@ import { $, nf, setText } from "./dom";
 const pct = (x: number) => `${(x * 100).toFixed(1)} %`;
 const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
 
+const finite = (x: number | null | undefined): number | null => (x !== null && x !== undefined && Number.isFinite(x) ? x : null);
+
 export function writeVoids(s: Slice | null, current: number): void {
   const a = s?.analysis[current];
   setText("stat-coverage", a ? pct(a.coverage) : "–");
@@ -15,11 +17,19 @@ export function writeVoids(s: Slice | null, current: number): void {
   const partial = s && s.analysed < s.layers ? " so far" : "";
   const coverage = s?.figures.partCoverage ?? null;
   setText("stat-part-coverage", coverage !== null ? pct(coverage) + partial : "–");
-  // the core's 3D void estimate only (the page never makes up a density of its own)
-  const density = s?.figures.core?.predicted_density ?? null;
-  setText("stat-density", density !== null && Number.isFinite(density) ? `${density.toFixed(1)} %${partial}` : "–");
+  // the core's 3D void estimate only (the page never makes up a density of its own), per unit
+  // that prints parts
+  const core = s?.figures.core;
+  const d0 = finite(core?.predicted_density);
+  const d1 = finite(core?.unit1_predicted_density);
+  const dens = (d: number | null) => (d !== null ? `${d.toFixed(1)} %${partial}` : "–");
+  setText("stat-density", dens(d0));
+  setText("stat-density1", dens(d1));
+  $("stat-density1").hidden = $("stat-density1-label").hidden = d1 === null;
   $("stat-density").title =
-    density !== null ? "100 % minus the 3D void fraction of the analysed layers: a geometric estimate from the droplet model, not a measured density" : "Needs the 3D void analysis (the command line's --report gives it); the page's layer analysis does not estimate it";
+    d0 !== null
+      ? "100 % minus the 3D void fraction of the analysed layers (each slab with the droplet spheroids of the layers below and above), of unit 0's parts: a geometric estimate from the droplet model, not a measured density"
+      : "Turn on Voids: the 3D void analysis estimates it";
   const worst = s?.figures.worst;
   setText("stat-worst", worst ? `${nf.format(worst.index + 1)} · ${mm2(worst.area)}` : "–");
   ($("btn-worst") as HTMLButtonElement).disabled = !worst;

@@ -156,6 +156,8 @@ async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
       since = performance.now();
       if (session !== s) throw internal("the model was replaced during slicing");
     }
+    // the 3D estimate's slabs at the unit's ends (the layers next to it are planned again)
+    if (req.analyse) clock.time("core: the unit's end slabs", () => s.finish_slabs(parts.tally));
     const unit: SliceUnit = { from, to, summary: parts.tally.summary() };
     if (counted) unit.gcode = clock.time("worker: blob", () => new Blob(parts.gcode as BlobPart[], { type: "text/plain" }));
     answer("slice", id, unit);

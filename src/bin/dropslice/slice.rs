@@ -308,7 +308,10 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             100.0 * report.part.coverage,
             path.display()
         );
-        density = report.part.predicted_density;
+        density = Some((
+            report.part.predicted_density,
+            report.part.unit1.and_then(|u| u.predicted_density),
+        ));
         report_done = Some(staged);
     }
     // Everything is written: only now are the files put in place.
@@ -338,10 +341,8 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             t0.elapsed().as_secs_f64()
         );
         eprintln!("dropslice: {}", overhang_line(&f));
-        if let Some(d) = density {
-            eprintln!(
-                "dropslice: predicted density {d:.1} % (100 % − the 3D void fraction: a geometric estimate from the droplet model, not a measured density)"
-            );
+        if let Some(line) = density.and_then(|(d0, d1)| density_line(d0, d1)) {
+            eprintln!("dropslice: {line}");
         }
         if f.unit1_droplets > 0 {
             eprintln!(
@@ -356,6 +357,21 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
         }
     }
     Ok(())
+}
+
+/// The summary's predicted density, per unit that prints parts (`None` without a figure).
+fn density_line(unit0: Option<f64>, unit1: Option<f64>) -> Option<String> {
+    const WHAT: &str = "100 % − the 3D void fraction: a geometric estimate from the droplet model, not a measured density";
+    Some(match (unit0, unit1) {
+        (Some(d0), Some(d1)) => {
+            format!(
+                "predicted density: unit 0's parts {d0:.1} %, unit 1's parts {d1:.1} % ({WHAT})"
+            )
+        }
+        (Some(d), None) => format!("predicted density {d:.1} % ({WHAT})"),
+        (None, Some(d)) => format!("predicted density: unit 1's parts {d:.1} % ({WHAT})"),
+        (None, None) => return None,
+    })
 }
 
 /// The job to slice and its name for the summary: one model ([`Job::new`], as always),
