@@ -44,7 +44,7 @@ pub fn coord(x: f64) -> String {
 pub fn push_coord(out: &mut String, x: f64) {
     const _: () = assert!(OUTPUT_DECIMALS == 4, "push_coord writes 4 digits");
     let t = x * OUTPUT_SCALE;
-    if !(t.abs() < 1e15) {
+    if !t.is_finite() || t.abs() >= 1e15 {
         let _ = write!(out, "{x:.OUTPUT_DECIMALS$}");
         return;
     }
