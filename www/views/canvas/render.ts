@@ -89,6 +89,17 @@ interface StampPass {
   want: number;
 }
 
+/** A resumable piece of the square painting: `run(from, deadline)` works from item `from` on
+ *  until `deadline` (checked every 4,096 items) and returns the item to go on from (`count`:
+ *  done). */
+interface Step {
+  count: number;
+  run: (from: number, deadline: number) => number;
+}
+
+/** Whether a loop at item `i` (begun at `from`) has used its time. */
+const late = (i: number, from: number, deadline: number) => (i & 4095) === 0 && i > from && performance.now() > deadline;
+
 export class Renderer extends PanZoomCanvas implements LayerCanvas {
   current: LayerData | null = null;
   below: LayerData | null = null;
@@ -171,6 +182,8 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
   /** The time the current draw may spend stamping (ms): a frame's draw has FRAME_BUDGET_MS,
    *  a direct `draw()` (the tests, a PNG export) all it needs. */
   private budget = Infinity;
+  /** The square painting under way (zoomed far out), as `stamping`. */
+  private pixeling: { key: unknown[]; steps: Step[]; step: number; next: number } | null = null;
 
   protected frameDraw(): void {
     this.budget = FRAME_BUDGET_MS;
@@ -239,6 +252,7 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
     let job = this.stamping;
     if (!job || job.key.length !== key.length || job.key.some((v, i) => v !== key[i])) {
       this.pixelBuffer();
+      this.pixeling = null; // the buffer is this picture's now
       job = this.stamping = { key, passes: this.stampPasses(k, ox, oy, below, marks), pass: 0, next: 0 };
     }
     const deadline = performance.now() + this.budget;
@@ -282,46 +296,89 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
     return passes;
   }
 
-  /** Zoomed far out: droplets as squares of ceil(B) device pixels, written into a buffer. */
+  /** Zoomed far out: droplets as squares of ceil(B) device pixels, written into the pixel
+   *  buffer: the layer below, the current layer's colour classes in CLASS_ORDER, the overhang
+   *  marks (squares 2 px wider) over them. Within a frame's budget, as the stamping: the 1M
+   *  torus' layers (about 140,000 droplets each, with the layer below) took 40–60 ms in one
+   *  frame. */
   private drawPixels(ctx: CanvasRenderingContext2D, k: number): void {
     const W = this.canvas.width;
     const H = this.canvas.height;
-    this.pixelBuffer();
-    this.stamping = null; // the buffer is this picture's now
-    this.discs!.touchAll();
+    const marks = this.marks();
+    const below = this.showBelow ? this.below : null;
+    const { cx, cy } = this.view;
+    const key = [this.current, below, marks, k, cx, cy, W, H, this.dropletWidth];
+    let job = this.pixeling;
+    if (!job || job.key.length !== key.length || job.key.some((v, i) => v !== key[i])) {
+      this.pixelBuffer();
+      this.stamping = null; // the buffer is this picture's now
+      this.discs!.touchAll();
+      job = this.pixeling = { key, steps: this.pixelSteps(k, below, marks), step: 0, next: 0 };
+    }
+    const deadline = performance.now() + this.budget;
+    while (job.step < job.steps.length) {
+      const st = job.steps[job.step];
+      job.next = st.run(job.next, deadline);
+      if (job.next < st.count) break;
+      job.step++;
+      job.next = 0;
+    }
+    this.blit(ctx);
+    if (job.step < job.steps.length) this.request();
+  }
+
+  /** The square painting's steps: the layer below; the current layer's colour classes
+   *  (computed once, in a step of their own), one step per class; the overhang marks. */
+  private pixelSteps(k: number, below: LayerData | null, marks: Uint8Array | null): Step[] {
+    const W = this.canvas.width;
+    const H = this.canvas.height;
     const buf = this.discs!.pixels;
     const size = Math.max(1, Math.ceil(this.dropletWidth * k));
     const { cx, cy } = this.view;
     const ox = W / 2 - cx * k - size / 2;
     const oy = H / 2 + cy * k - size / 2;
-    const square = (x: number, y: number, n: number, color: number) => {
-      const ix = Math.round(x * k + ox - (n - size) / 2);
-      const iy = Math.round(-y * k + oy - (n - size) / 2);
-      if (ix < 0 || iy < 0 || ix + n > W || iy + n > H) return;
-      for (let r = 0; r < n; r++) {
-        const row = (iy + r) * W + ix;
-        for (let c = 0; c < n; c++) buf[row + c] = color;
-      }
-    };
-    /** `cls` < 0: every droplet in `color`; else only that colour class. */
-    const plot = (layer: LayerData, cls: number, color: number) => {
-      const d = layer.droplets;
-      const roles = layer.roles;
-      const units = layer.units;
-      for (let i = 0; i < roles.length; i++) {
-        if (cls >= 0 && dropletClass(roles[i], units?.[i] ?? 0) !== cls) continue;
-        square(d[2 * i], d[2 * i + 1], size, color);
-      }
-    };
-    if (this.showBelow && this.below) plot(this.below, -1, pixel(BELOW_COLOR));
-    if (this.current) for (const cls of CLASS_ORDER) plot(this.current, cls, pixel(CLASS_COLORS[cls]));
-    const marks = this.overhangs;
-    if (this.current && marks && marks.length === this.current.roles.length) {
-      const d = this.current.droplets;
-      const color = pixel(OVERHANG_COLOR);
-      for (let i = 0; i < marks.length; i++) if (marks[i]) square(d[2 * i], d[2 * i + 1], size + 2, color);
+    /** Squares of `n` px (centred as the droplets' `size`), in `color`, of the droplets of
+     *  `layer` whose `pick` is `want` (every one without `pick`). */
+    const paint = (layer: LayerData, n: number, color: number, pick: Uint8Array | null, want: number): Step => ({
+      count: layer.roles.length,
+      run: (from, deadline) => {
+        const d = layer.droplets;
+        const count = layer.roles.length;
+        const shift = (n - size) / 2;
+        for (let i = from; i < count; i++) {
+          if (late(i, from, deadline)) return i;
+          if (pick && pick[i] !== want) continue;
+          const ix = Math.round(d[2 * i] * k + ox - shift);
+          const iy = Math.round(-d[2 * i + 1] * k + oy - shift);
+          if (ix < 0 || iy < 0 || ix + n > W || iy + n > H) continue;
+          for (let r = 0; r < n; r++) {
+            const row = (iy + r) * W + ix;
+            for (let c = 0; c < n; c++) buf[row + c] = color;
+          }
+        }
+        return count;
+      },
+    });
+    const steps: Step[] = [];
+    if (below) steps.push(paint(below, size, pixel(BELOW_COLOR), null, 0));
+    const cur = this.current;
+    if (cur) {
+      const n = cur.roles.length;
+      const cls = new Uint8Array(n);
+      steps.push({
+        count: n,
+        run: (from, deadline) => {
+          for (let i = from; i < n; i++) {
+            if (late(i, from, deadline)) return i;
+            cls[i] = dropletClass(cur.roles[i], cur.units?.[i] ?? 0);
+          }
+          return n;
+        },
+      });
+      for (const c of CLASS_ORDER) steps.push(paint(cur, size, pixel(CLASS_COLORS[c]), cls, c));
+      if (marks) steps.push(paint(cur, size + 2, pixel(OVERHANG_COLOR), marks, 1));
     }
-    this.blit(ctx);
+    return steps;
   }
 
   private drawDroplets(ctx: CanvasRenderingContext2D, layer: LayerData, _k: number, vis: Bounds, faint: boolean): void {
