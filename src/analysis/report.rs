@@ -239,11 +239,6 @@ impl LayerStage {
         }
     }
 
-    /// The settings the stage analyses unit 0 with.
-    pub fn settings(&self) -> &Settings {
-        &self.settings
-    }
-
     /// Analyses layer `plan.index` against its `region` (unit 0's), in `raster`'s memory (one
     /// raster per worker, reused from layer to layer).
     pub fn analyse(&self, raster: &mut Raster, region: &Shapes, plan: &LayerPlan) -> AnalysedLayer {

@@ -86,11 +86,6 @@ impl SlabRun {
         }
     }
 
-    /// The stage the run computes with.
-    pub fn stage(&self) -> &LayerStage {
-        &self.stage
-    }
-
     /// The run's layers [first, last + 1), once one is pushed.
     pub fn span(&self) -> Option<(usize, usize)> {
         Some((self.first?, self.last.as_ref()?.index + 1))
