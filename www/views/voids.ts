@@ -29,7 +29,9 @@ export function writeVoids(s: Slice | null, current: number): void {
   $("stat-density").title =
     d0 !== null
       ? "100 % minus the 3D void fraction of the analysed layers (each slab with the droplet spheroids of the layers below and above), of unit 0's parts: a geometric estimate from the droplet model, not a measured density"
-      : "Turn on Voids: the 3D void analysis estimates it";
+      : d1 !== null
+        ? "The job has no parts of unit 0"
+        : "Turn on Voids: the 3D void analysis estimates it";
   const worst = s?.figures.worst;
   setText("stat-worst", worst ? `${nf.format(worst.index + 1)} · ${mm2(worst.area)}` : "–");
   ($("btn-worst") as HTMLButtonElement).disabled = !worst;
