@@ -341,8 +341,15 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             t0.elapsed().as_secs_f64()
         );
         eprintln!("dropslice: {}", overhang_line(&f));
-        if let Some(line) = density.and_then(|(d0, d1)| density_line(d0, d1)) {
-            eprintln!("dropslice: {line}");
+        match density {
+            Some((d0, d1)) => {
+                if let Some(line) = density_line(d0, d1) {
+                    eprintln!("dropslice: {line}");
+                }
+            }
+            None => eprintln!(
+                "dropslice: predicted density: not estimated (--report FILE.json runs the 3D void analysis, about 3 times the slicing's time)"
+            ),
         }
         if f.unit1_droplets > 0 {
             eprintln!(
