@@ -201,12 +201,14 @@ fn the_cli_prints_the_librarys_figures() {
     let text = String::from_utf8_lossy(&run.stderr);
     let (job, layers) = layer_summaries("cube_20mm_ascii.stl", Settings::default());
     let f = Summary::merged(&layers).figures(job.settings());
-    let line = text.lines().find(|l| l.contains(" layers, ")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| l.contains(" layers, ")).unwrap();
+    let line = lines[at];
     // The overhang line follows it: a cube has none.
     assert_eq!(f.worst_overhang, None);
     assert_eq!(
-        text.lines().last().unwrap(),
-        "dropslice: no overhangs (every layer rests on the one below)"
+        lines.get(at + 1).copied(),
+        Some("dropslice: no overhangs (every layer rests on the one below)")
     );
     // Each figure is read back from the line (not rebuilt with the CLI's format): the number
     // written before its unit, to the places the line shows.
