@@ -273,12 +273,12 @@ impl LayerStage {
         raster.rebuild(plan.index, plan.z, &centres, region, s);
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
-        let unit0 = HeightMap::new(&centres, &self.grid, footprint_diameter(s));
-        (analysis, self.with_unit1(unit0, plan))
+        (analysis, self.maps_with(&centres, plan))
     }
 
-    /// A layer's spheroid maps given unit 0's.
-    fn with_unit1(&self, unit0: HeightMap, plan: &LayerPlan) -> LayerMaps {
+    /// A layer's spheroid maps given unit 0's droplet centres.
+    fn maps_with(&self, centres: &[Point], plan: &LayerPlan) -> LayerMaps {
+        let unit0 = HeightMap::new(centres, &self.grid, footprint_diameter(&self.settings));
         let unit1 = self
             .unit1
             .as_ref()
@@ -289,10 +289,7 @@ impl LayerStage {
     /// A layer's spheroid maps alone (a layer next to a run of analysed layers, whose own
     /// figures are not wanted: [`SlabRun::finish`]).
     pub fn maps(&self, plan: &LayerPlan) -> LayerMaps {
-        let s = &self.settings;
-        let centres = droplet_centres(plan, s.droplet_width());
-        let unit0 = HeightMap::new(&centres, &self.grid, footprint_diameter(s));
-        self.with_unit1(unit0, plan)
+        self.maps_with(&droplet_centres(plan, self.settings.droplet_width()), plan)
     }
 
     /// Slab `i`'s 3D estimate: per unit, its exact volume and its void volume (the void share
