@@ -74,9 +74,14 @@ fn json(v: JsValue) -> serde_json::Value {
     serde_wasm_bindgen::from_value(v).unwrap()
 }
 
-/// A session made as another worker makes it: from `s`'s prepared mesh, `info` and settings.
-fn prepared_copy(s: &Session, info: JsValue, settings: JsValue) -> Result<Session, JsValue> {
-    Session::from_prepared(&s.vertices().to_vec(), &s.facets().to_vec(), info, settings)
+/// A session made as another worker makes it: its own import of the same files (`name`,
+/// bytes; added in the reverse order) prepared for the same job.
+fn worker_copy(files: &[(&str, &[u8])], job: &serde_json::Value) -> Session {
+    let mut models = Models::new();
+    for &(name, bytes) in files.iter().rev() {
+        models.add_bytes(bytes, name).unwrap();
+    }
+    Session::from_models(&models, js(job.clone())).unwrap()
 }
 
 fn defaults() -> JsValue {
@@ -299,12 +304,15 @@ fn nothing_to_print_comes_with_the_figures() {
 }
 
 #[wasm_bindgen_test]
-fn a_session_from_the_prepared_mesh_slices_the_same() {
+fn every_worker_s_own_session_slices_the_same() {
     let stl = two_boxes_stl(10.0, 6.0, 2.0, 3.0, 2.0);
-    let settings = serde_json::json!({"layer_height": 0.25, "rotate_z": 30});
-    let first = Session::new(stl.as_bytes(), "two.stl", js(settings.clone())).unwrap();
-    let info = first.info().unwrap();
-    let other = prepared_copy(&first, info, js(settings.clone())).unwrap();
+    let job = serde_json::json!({
+        "settings": {"layer_height": 0.25},
+        "parts": [{"file": "two.stl", "rotate_z": 30}]
+    });
+    let files: [(&str, &[u8]); 1] = [("two.stl", stl.as_bytes())];
+    let first = worker_copy(&files, &job);
+    let other = worker_copy(&files, &job);
     assert_eq!(other.layer_count(), first.layer_count());
     assert_eq!(json(other.info().unwrap()), json(first.info().unwrap()));
     assert_eq!(
@@ -333,12 +341,6 @@ fn a_session_from_the_prepared_mesh_slices_the_same() {
     let sa = json(a.summary().unwrap());
     let merged = json(merge_summaries(js(serde_json::json!([sa]))).unwrap());
     assert_eq!(merged["counts"], sa["counts"]);
-    // other settings than the prepared mesh was made with are refused
-    let other_settings = js(serde_json::json!({"layer_height": 0.1}));
-    throws(
-        prepared_copy(&first, first.info().unwrap(), other_settings),
-        "internal",
-    );
 }
 
 #[wasm_bindgen_test]
@@ -519,13 +521,14 @@ fn models_give_infos_layouts_and_a_merged_session() {
     );
     assert_eq!(inst[1]["copy"], 0);
     assert_eq!(inst[2]["copy"], 1);
-    // The merged session slices all three; its prepared mesh goes to another worker as usual.
+    // The merged session slices all three, as another worker's own import of the files does.
     let s = Session::from_models(&models, js(job.clone())).unwrap();
     let info = json(s.info().unwrap());
     assert_eq!(info["instances"].as_array().unwrap().len(), 3);
     assert_eq!(info["layers"], 15);
     assert_eq!(info["bounds"], layout["bounds"]);
-    let other = prepared_copy(&s, s.info().unwrap(), js(job["settings"].clone())).unwrap();
+    let (a, b) = (box_stl(20.0, 10.0, 2.0), box_stl(5.0, 5.0, 3.0));
+    let other = worker_copy(&[("a.stl", a.as_bytes()), ("b.stl", b.as_bytes())], &job);
     for i in [0, 7, 14] {
         assert_eq!(
             s.slice_layer(i).unwrap().gcode().to_vec(),
@@ -583,10 +586,11 @@ fn two_units(b: [f64; 3], b_x: f64) -> (Session, serde_json::Value) {
 }
 
 #[wasm_bindgen_test]
-fn a_job_with_a_unit_1_part_is_handed_on_with_its_units() {
+fn a_job_with_a_unit_1_part_slices_the_same_in_every_worker() {
     // b overlaps a by 4 mm in x; a is listed first and keeps the overlap.
     let (s, job) = two_units([10.0, 10.0, 3.0], 6.0);
-    let other = prepared_copy(&s, s.info().unwrap(), js(job["settings"].clone())).unwrap();
+    let (a, b) = (box_stl(10.0, 10.0, 2.0), box_stl(10.0, 10.0, 3.0));
+    let other = worker_copy(&[("a.stl", a.as_bytes()), ("b.stl", b.as_bytes())], &job);
     assert_eq!(json(other.info().unwrap()), json(s.info().unwrap()));
     assert_eq!(
         other.header(JsValue::NULL).unwrap(),

@@ -10,7 +10,7 @@ import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
 import { showError } from "./flows/errors";
-import { addParts, applyOrientation, arrangeAll, duplicatePart, editParts, layFlat, movePart, orientations, relayout, removePart, saveJob, selectPart } from "./flows/job";
+import { addParts, applyOrientation, arrangeAll, duplicatePart, editParts, ensureMeshes, layFlat, movePart, orientations, relayout, removePart, saveJob, selectPart } from "./flows/job";
 import { deleteProfile, exportProfile, importProfile, renameProfile, saveProfile, showProfiles, useProfile } from "./flows/profiles";
 import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
 import { fit, setShowOverhangs, show } from "./flows/layer";
@@ -78,6 +78,7 @@ const actions: Actions = {
   unitFix: (factor) => fixUnits(page, factor),
   calibrate: (request) => page.pool.calibrate(request),
   overhangFace: (settings) => page.pool.overhangFace(settings),
+  meshes: () => void ensureMeshes(page),
   setCutLine: (line, refit) => setCutLine(page, line, refit),
   updateCut: () => updateCut(page),
   cutLine: () => cutStatus(page).line,

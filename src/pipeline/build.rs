@@ -245,55 +245,7 @@ impl Job {
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
 
-    /// A job from a mesh another [`Job`] prepared (its [`Job::mesh`] and [`Job::info`], with
-    /// the same settings): no import, checks or repair, only the facet index. Slices exactly
-    /// as that job does.
-    pub fn from_prepared(mesh: Mesh, info: JobInfo, settings: Settings) -> Result<Job, Error> {
-        settings.validate()?;
-        let zs = slice::layer_heights(
-            info.bounds.size()[2],
-            settings.layer_height,
-            settings.slice_plane,
-        );
-        let bad = |what: String| Error::Internal(format!("prepared mesh: {what}"));
-        if zs.len() != info.layers {
-            return Err(bad(format!(
-                "{} layers, but the settings give {} (prepared with other settings?)",
-                info.layers,
-                zs.len()
-            )));
-        }
-        if info.mesh.facets != mesh.facets.len() {
-            return Err(bad(format!(
-                "{} facets, but the info says {}",
-                mesh.facets.len(),
-                info.mesh.facets
-            )));
-        }
-        let n = mesh.vertices.len();
-        if mesh.facets.iter().flatten().any(|&v| v as usize >= n) {
-            return Err(bad("a facet refers to a vertex that does not exist".into()));
-        }
-        if !info.groups.is_empty() {
-            let total = info
-                .groups
-                .iter()
-                .try_fold(0usize, |t, g| t.checked_add(g.facets));
-            if total != Some(mesh.facets.len())
-                || info.groups.len() > job::MAX_INSTANCES
-                || info.groups.iter().any(|g| g.unit > 1)
-            {
-                return Err(bad(
-                    "the facet groups do not cover the facets, or name a unit other than 0 or 1"
-                        .into(),
-                ));
-            }
-        }
-        let buckets = FacetBuckets::new(&mesh, &zs);
-        Ok(Job::assemble(settings, mesh, buckets, zs, info))
-    }
-
-    /// The common tail of [`Job::new`] and [`Job::from_prepared`].
+    /// The common tail of [`Job::new`] and [`Job::from_models`].
     fn assemble(
         settings: Settings,
         mesh: Mesh,

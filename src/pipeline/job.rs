@@ -54,7 +54,7 @@ impl Job {
         0
     }
 
-    /// The placed, repaired mesh that is sliced (for [`Job::from_prepared`]).
+    /// The placed, repaired mesh that is sliced.
     pub fn mesh(&self) -> &Mesh {
         &self.mesh
     }

@@ -12,9 +12,8 @@
 //! console, and the worker turns the trap that follows into an error message.
 //!
 //! The model comes in as a `File` read in the worker ([`Session::from_file`], `FileReaderSync`),
-//! so the page's thread never copies its bytes; one worker prepares the job and hands the
-//! prepared mesh ([`Session::vertices`], [`Session::facets`], [`Session::info`]) to the others
-//! ([`Session::from_prepared`]), which skip the import.
+//! so the page's thread never copies its bytes. Every worker prepares the job from its own
+//! import of the files ([`Session::from_models`]), all at the same time.
 //!
 //! The core knows nothing of wasm; this file only converts.
 
@@ -31,14 +30,13 @@ use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
 use crate::base::stages::{self, Stage};
-use crate::model::mesh::Mesh;
 use crate::model::spec as job;
 use crate::output::gcode;
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{self, Figures, Summary};
 use crate::slicing::plan::{Counts, LayerPlan};
-use crate::{Job, JobInfo};
-use js_sys::{Float32Array, Float64Array, Uint8Array, Uint32Array};
+use crate::Job;
+use js_sys::{Float32Array, Float64Array, Uint8Array};
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
@@ -336,52 +334,12 @@ impl Session {
 
     /// The build job `job` (`{settings, parts}`, as in a job file) of the files in `models`:
     /// every instance placed as [`Models::layout`] says and merged into one mesh; its settings
-    /// are `job.settings`. Other workers get it through `vertices()`, `facets()`, `info()` and
-    /// [`Session::from_prepared`] (with the same settings) as for one file.
+    /// are `job.settings`. The same files and job give the same session in every worker.
     pub fn from_models(models: &Models, job: JsValue) -> Result<Session, JsValue> {
         let spec = job_of(job)?;
         let job = stages::time(Stage::Prepare, || Job::from_models(&models.models, &spec))
             .map_err(js_error)?;
         Ok(Session::with(job))
-    }
-
-    /// A session from the prepared mesh of another worker's session (its `vertices`, `facets`
-    /// and `info`, made with the same settings): no import, only the facet index.
-    pub fn from_prepared(
-        vertices: &[f64],
-        facets: &[u32],
-        #[wasm_bindgen(unchecked_param_type = "JobInfo")] info: JsValue,
-        settings: JsValue,
-    ) -> Result<Session, JsValue> {
-        let settings = settings_of(settings)?;
-        let info: JobInfo = from_js(info, "job info")?;
-        if !vertices.len().is_multiple_of(3) || !facets.len().is_multiple_of(3) {
-            return Err(js_error(Error::Internal(
-                "prepared mesh: arrays are not triples".into(),
-            )));
-        }
-        let mesh = Mesh {
-            vertices: vertices
-                .chunks_exact(3)
-                .map(|v| [v[0], v[1], v[2]])
-                .collect(),
-            facets: facets.chunks_exact(3).map(|f| [f[0], f[1], f[2]]).collect(),
-        };
-        let job = stages::time(Stage::Prepare, || Job::from_prepared(mesh, info, settings))
-            .map_err(js_error)?;
-        Ok(Session::with(job))
-    }
-
-    /// The prepared mesh's vertices, x,y,z per vertex, mm (a copy; transfer its buffer).
-    pub fn vertices(&self) -> Float64Array {
-        let v: &[[f64; 3]] = &self.job.mesh().vertices;
-        Float64Array::from(v.as_flattened())
-    }
-
-    /// The prepared mesh's facets, three vertex indices each (a copy; transfer its buffer).
-    pub fn facets(&self) -> Uint32Array {
-        let f: &[[u32; 3]] = &self.job.mesh().facets;
-        Uint32Array::from(f.as_flattened())
     }
 
     /// Number of layers.

@@ -1,9 +1,9 @@
 // The worker pool: one worker per core (hardwareConcurrency, 1 … 8), each with its own wasm
 // instance. The first worker is the job worker: it holds the job's files (`Models`: added as
 // Files, read and imported there), answers layout, display meshes and lay-flat, and prepares a
-// slice (`Session.from_models`: place, merge, weld, checks, repair), returning the prepared
-// mesh as transferable arrays; the other workers build their session from that (no import work
-// repeated). The pool remembers which Files the job worker holds and adds them again to a
+// slice (`Session.from_models`: place, merge, weld, checks, repair); the other workers read and
+// prepare the same Files for themselves at the same time and keep only the prepared job (a
+// worker waiting for the job worker's mesh idled through its whole preparation). The pool remembers which Files the job worker holds and adds them again to a
 // fresh worker (after a cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
 // flight, so it never waits for the page between units). Layers come back in batches ("layers" replies,
@@ -123,8 +123,8 @@ class WorkerHandle {
   }
 }
 
-/** One worker per core, 1 … [[MAX_WORKERS]]: preparing the job is done once, not per worker,
- *  so every worker slices from the start. */
+/** One worker per core, 1 … [[MAX_WORKERS]]: every worker prepares the job at the same time
+ *  (see [[openAll]]), so all of them slice from the start. */
 export function defaultPoolSize(): number {
   const n = navigator.hardwareConcurrency || 1;
   return Math.max(1, Math.min(n, MAX_WORKERS));
@@ -194,10 +194,11 @@ async function addTo(h: WorkerHandle, files: JobFileRef[], hasher: WorkerHandle 
   }
 }
 
-/** Opens a job: the job worker gets its files and prepares it; the others take the prepared
- *  mesh. `ready(h, r)` runs for each worker as soon as it holds the job (for the first one
- *  before the others are asked). If the first worker refuses the job, no worker is touched and
- *  every one keeps its previous model. */
+/** Opens a job in every worker at once: the job worker prepares it from the files it holds,
+ *  every other worker reads and prepares the same files itself meanwhile (no worker waits for
+ *  another's mesh). `ready(h, r)` runs for each worker once it holds the job, for the job
+ *  worker first. The core refuses a job alike in every worker (each keeps its previous model
+ *  then); the job worker's refusal is the one reported. */
 async function openAll(
   handles: WorkerHandle[],
   files: JobFileRef[],
@@ -205,26 +206,27 @@ async function openAll(
   ready: (h: WorkerHandle, r: OpenResult) => Promise<void>,
 ): Promise<OpenResult> {
   const [first, ...others] = handles;
-  await syncModels(first, files);
-  const r = await first.call("open_job", { job, prepare: others.length > 0 });
+  const opening = others.map((h) => h.call("open_files", { files, job }).then((o) => ({ h, o })));
+  for (const p of opening) p.catch(() => {}); // awaited below, after the job worker's answer
+  let r: OpenResult;
+  try {
+    await syncModels(first, files);
+    r = await first.call("open_job", { job });
+  } catch (e) {
+    // a worker that took the job all the same no longer holds the page's model
+    await Promise.all(opening.map((p) => p.then(({ h }) => (h.hasModel = false), () => {})));
+    throw e;
+  }
   for (const h of handles) h.hasModel = false;
   first.hasModel = true;
-  const prepared = r.prepared;
-  delete r.prepared;
-  const settings = job.settings;
   const work = [ready(first, r)];
-  if (prepared && others.length > 0) {
-    others.forEach((h, k) => {
-      // each worker gets its own copy; the last one takes the buffers themselves
-      const last = k === others.length - 1;
-      const transfer = last ? [prepared.vertices.buffer, prepared.facets.buffer] : [];
-      work.push(
-        h.call("adopt", { prepared, settings }, undefined, transfer).then(async (o) => {
-          h.hasModel = true;
-          await ready(h, o);
-        }),
-      );
-    });
+  for (const p of opening) {
+    work.push(
+      p.then(async ({ h, o }) => {
+        h.hasModel = true;
+        await ready(h, o);
+      }),
+    );
   }
   await Promise.all(work);
   return r;

@@ -141,21 +141,11 @@ export interface InitResult {
   defaults: Settings;
 }
 
-/** A job one worker prepared (parsed, welded, checked, repaired, placed) for the others:
- *  vertices x,y,z (mm) and facets (three vertex indices each), transferable. */
-export interface PreparedMesh {
-  vertices: Float64Array;
-  facets: Uint32Array;
-  info: JobInfo;
-}
-
 export interface OpenResult {
   layers: number;
   info: JobInfo;
   /** SHA-256 of the file, hex (when asked for). */
   sha256?: string;
-  /** The prepared mesh (when asked for). */
-  prepared?: PreparedMesh;
 }
 
 export interface GcodeParseResult {
@@ -172,8 +162,6 @@ export interface GcodeParseResult {
 /** Every request a worker answers: what it is sent and what it replies. */
 export interface Calls {
   init: { data: null; result: InitResult };
-  /** Takes the job another worker prepared. */
-  adopt: { data: { prepared: PreparedMesh; settings: Settings }; result: OpenResult };
   slice: { data: { from: number; to: number; analyse?: boolean; gcode?: boolean }; result: SliceUnit };
   preview: { data: { index: number; analyse?: boolean }; result: LayerData };
   header: { data: { summary: Summary | null }; result: string };
@@ -197,8 +185,12 @@ export interface Calls {
   orient: { data: { job: JobFile; part: number }; result: Orientations };
   /** A profile's JSON text checked by the core (`check_profile`); needs no model. */
   check_profile: { data: { text: string }; result: Profile };
-  /** Prepares the job `job` of the files added (Session.from_models); like "open". */
-  open_job: { data: { job: JobFile; prepare?: boolean }; result: OpenResult };
+  /** Prepares the job `job` of the files added (Session.from_models). */
+  open_job: { data: { job: JobFile }; result: OpenResult };
+  /** A worker that does not hold the job's files (not the job worker) reads and imports
+   *  `files` itself, prepares `job` from them and keeps only the prepared job: every worker
+   *  prepares at the same time instead of waiting for the job worker's mesh. */
+  open_files: { data: { files: { name: string; file: File }[]; job: JobFile }; result: OpenResult };
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
    *  within the rule (src/wasm/mod.rs `unsupported_droplets`); `below` null for the first layer. */
   unsupported: { data: UnsupportedRequest; result: Uint8Array };

@@ -247,10 +247,13 @@ export function movePart(page: Page, id: number, copy: number, dx: number, dy: n
 }
 
 /** Fetches the display meshes the 3D view lacks: the job's budget shared by its instances
- *  (parts of many copies are drawn coarser); a mesh far off its share is fetched again. */
+ *  (parts of many copies are drawn coarser); a mesh far off its share is fetched again. Only
+ *  while the 3D view is shown (it asks when it is opened): the job worker makes them, and a
+ *  mesh asked for with a new job would delay that worker's preparation of the slice (0.7 s
+ *  for a part of a million facets). */
 export async function ensureMeshes(page: Page): Promise<void> {
   const job = page.store.job;
-  if (!job) return;
+  if (!job || !page.view3d.active) return;
   const budget = Math.max(2000, Math.floor(DISPLAY_BUDGET / Math.max(1, job.instances)));
   const want = job.parts.filter((p) => !p.mesh || p.mesh.budget > 2 * budget || (p.mesh.budget < budget / 2 && p.mesh.positions.length / 9 >= p.mesh.budget * 0.8));
   // parts of the same file and item share one mesh

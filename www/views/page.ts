@@ -70,6 +70,8 @@ export interface Actions {
   unitFix(factor: number): void;
   /** The droplet calibration for a mass and a density (a worker computes it). */
   calibrate(request: CalibrateRequest): Promise<Calibration>;
+  /** The display meshes the 3D view lacks are fetched (only while it is shown). */
+  meshes(): void;
   /** The 3D tint's threshold (the face normal's z) for `settings`. */
   overhangFace(settings: Settings): Promise<number>;
   /** The cut line set (null: no cut); `refit` fits the cut's canvas to it. */

@@ -2,9 +2,9 @@
 // job worker (the pool's first) the job's `Models` (its imported files). Answers the requests
 // of core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred). The
 // model files arrive as Files and are read here (by the core, with FileReaderSync), never on
-// the page's thread; the worker that prepares a job hands the prepared mesh to the others
-// ("adopt"). Everything from the core is a typed value; its
-// errors are thrown as `{kind, message, setting?}` and passed on as they are.
+// the page's thread; the other workers read and prepare the same files for themselves at the
+// same time ("open_files"), keeping only the prepared job. Everything from the core is a typed
+// value; its errors are thrown as `{kind, message, setting?}` and passed on as they are.
 
 import init, { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
@@ -235,20 +235,20 @@ async function handle(req: Request): Promise<void> {
     case "open_job": {
       await load();
       // the old session stays usable if the job is refused
-      const result = adopt(Session.from_models(needModels(), req.data.job));
-      const transfer: Transferable[] = [];
-      if (req.data.prepare) {
-        const s = need();
-        result.prepared = clock.time("worker: prepared mesh out", () => ({ vertices: s.vertices(), facets: s.facets(), info: result.info }));
-        transfer.push(result.prepared.vertices.buffer, result.prepared.facets.buffer);
-      }
-      answer(req.kind, req.id, result, transfer);
+      answer(req.kind, req.id, adopt(Session.from_models(needModels(), req.data.job)));
       return;
     }
-    case "adopt": {
+    case "open_files": {
       await load();
-      const { prepared, settings } = req.data;
-      answer(req.kind, req.id, adopt(Session.from_prepared(prepared.vertices, prepared.facets, prepared.info, settings)));
+      // the files are imported for this job only: the session keeps what it slices, the
+      // imported files are dropped (the job worker keeps them for layout and edits)
+      const own = new Models();
+      try {
+        for (const { name, file } of req.data.files) clock.time("worker: file read and parsed", () => own.add(file, name));
+        answer(req.kind, req.id, adopt(Session.from_models(own, req.data.job)));
+      } finally {
+        own.free();
+      }
       return;
     }
     case "slice": {
@@ -351,8 +351,8 @@ function describe(e: unknown): ErrorValue {
 }
 
 // The module is compiled and instantiated as soon as the worker starts, not at its first
-// request: a worker that adopts a prepared mesh would otherwise compile it only then, on the
-// slice's path. A failure is reported to the first request that needs the core.
+// request: a worker asked to open a job (often its first request, after a cancel) would
+// otherwise compile it only then, on the slice's path. A failure is reported to the first request that needs the core.
 load().catch(() => {});
 
 scope.onmessage = (ev: MessageEvent<Request>) => {

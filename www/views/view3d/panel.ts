@@ -141,11 +141,14 @@ export class View3DPanel implements View3DView {
 
   /** Layer canvas or 3D view. */
   setActive(on: boolean): void {
+    const shown = on && !this.active;
     this.active = on;
     $("canvas-wrap").dataset.mode = on ? "3d" : "layer";
     $("mode-layer").setAttribute("aria-pressed", String(!on));
     $("mode-3d").setAttribute("aria-pressed", String(on));
     this.container.hidden = !on;
+    // the parts' display meshes are fetched only while the view is shown
+    if (shown) this.page?.actions.meshes();
     if (on && !this.loading) {
       this.loading = true;
       import("./view3d").then(
