@@ -71,7 +71,9 @@ test("four models that do not fit: no code of the previous job can be downloaded
   assert.match(await page.locator("#undo-note").innerText(), /replaced the previous job/);
   await key(page, "Control+z");
   await page.waitForFunction(() => /sample/.test(window.dropslice.job().name));
-  assert.deepEqual((await job(page)).parts, before.parts);
+  // the same parts (their display meshes aside: the 3D view shown meanwhile fetched one)
+  const specs = (parts) => parts.map(({ mesh, ...spec }) => spec);
+  assert.deepEqual(specs((await job(page)).parts), specs(before.parts));
   assert.equal(await disabled(page, "btn-download"), true, "its slice was dropped: slice again first");
   assert.equal(await disabled(page, "btn-slice"), false);
   assert.deepEqual(errors, []);
