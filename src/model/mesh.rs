@@ -4,7 +4,7 @@
 
 use crate::base::geom::{DMat3, DVec3, sin_cos_deg};
 use crate::base::settings::Settings;
-use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
+use rustc_hash::FxHashMap as HashMap;
 
 /// A welded triangle mesh in millimetres.
 #[derive(Clone, Debug, Default)]
@@ -148,21 +148,59 @@ impl Mesh {
     /// [`remove_duplicate_facets`](Self::remove_duplicate_facets), returning which of the
     /// facets before were kept (the others keep their order).
     pub fn remove_duplicate_facets_kept(&mut self) -> Vec<bool> {
-        let before = self.facets.len();
-        let mut seen = HashSet::with_capacity_and_hasher(before, Default::default());
-        let kept: Vec<bool> = self
+        // Each facet as the cyclic rotation starting at its smallest vertex id; two facets are
+        // equal exactly when these are. The facets are bucketed by that smallest vertex (in
+        // their order), and within a bucket a facet is a repeat when an earlier one equals it:
+        // a few sequential passes instead of a hash set of every facet.
+        let canon: Vec<[u32; 3]> = self
             .facets
             .iter()
             .map(|f| {
-                // The cyclic rotation starting at the smallest vertex id.
-                let k = f
-                    .iter()
-                    .enumerate()
-                    .min_by_key(|(_, v)| **v)
-                    .map_or(0, |(k, _)| k);
-                seen.insert([f[k], f[(k + 1) % 3], f[(k + 2) % 3]])
+                let k = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+                [f[k], f[(k + 1) % 3], f[(k + 2) % 3]]
             })
             .collect();
+        let n = self
+            .vertices
+            .len()
+            .max(canon.iter().map(|c| c[0] as usize + 1).max().unwrap_or(0));
+        let mut start = vec![0u32; n + 1];
+        for c in &canon {
+            start[c[0] as usize + 1] += 1;
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        let mut order = vec![0u32; canon.len()];
+        for (i, c) in canon.iter().enumerate() {
+            let at = &mut next[c[0] as usize];
+            order[*at as usize] = i as u32;
+            *at += 1;
+        }
+        let mut kept = vec![true; canon.len()];
+        for v in 0..n {
+            let bucket = &mut order[start[v] as usize..start[v + 1] as usize];
+            if bucket.len() < 2 {
+                continue;
+            }
+            if bucket.len() > 16 {
+                // in facet order within equal keys (a stable sort), so the first is kept
+                bucket.sort_by_key(|&i| (canon[i as usize][1], canon[i as usize][2]));
+                for j in 1..bucket.len() {
+                    if canon[bucket[j] as usize] == canon[bucket[j - 1] as usize] {
+                        kept[bucket[j] as usize] = false;
+                    }
+                }
+                continue;
+            }
+            for j in 1..bucket.len() {
+                let c = canon[bucket[j] as usize];
+                if bucket[..j].iter().any(|&k| canon[k as usize] == c) {
+                    kept[bucket[j] as usize] = false;
+                }
+            }
+        }
         let mut it = kept.iter();
         self.facets.retain(|_| *it.next().unwrap_or(&true));
         kept

@@ -483,11 +483,14 @@ impl Mesh {
             start[k + 1] += start[k];
         }
         let mut next = start.clone();
-        let mut around = vec![0u32; 3 * nf];
+        // Each facet around a vertex with its vertices after and before that one, so the
+        // scan of a vertex's facets reads one run of memory and never the facets themselves.
+        let mut around = vec![[0u32; 3]; 3 * nf];
         for (fi, f) in self.facets.iter().enumerate() {
-            for &v in f {
-                around[next[v as usize] as usize] = fi as u32;
-                next[v as usize] += 1;
+            for k in 0..3 {
+                let v = f[k] as usize;
+                around[next[v] as usize] = [fi as u32, f[(k + 1) % 3], f[(k + 2) % 3]];
+                next[v] += 1;
             }
         }
         drop(next);
@@ -504,17 +507,16 @@ impl Mesh {
         for (fi, f) in self.facets.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (f[k], f[(k + 1) % 3]);
-                // The other facets with the edge a–b, and whether they run b→a.
+                // The other facets with the edge a–b, and whether they run b→a (b just
+                // before a).
                 let (mut others, mut opposite, mut other) = (0, true, 0u32);
-                for &g in &around[start[a as usize] as usize..start[a as usize + 1] as usize] {
-                    if g as usize == fi {
-                        continue;
-                    }
-                    let h = self.facets[g as usize];
-                    if let Some(j) = h.iter().position(|&v| v == b) {
+                for &[g, after, before] in
+                    &around[start[a as usize] as usize..start[a as usize + 1] as usize]
+                {
+                    if g as usize != fi && (after == b || before == b) {
                         others += 1;
                         other = g;
-                        opposite &= h[(j + 1) % 3] == a;
+                        opposite &= before == b;
                     }
                 }
                 if others == 1 && opposite {

@@ -26,6 +26,7 @@ pub use models::{Models, check_profile};
 use models::{job_of, read_file};
 pub use tally::Tally;
 
+use crate::Job;
 use crate::analysis::{self, CoverageMask, LayerAnalysis, MaskTile};
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
@@ -35,7 +36,6 @@ use crate::output::gcode;
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{self, Figures, Summary};
 use crate::slicing::plan::{Counts, LayerPlan};
-use crate::Job;
 use js_sys::{Float32Array, Float64Array, Uint8Array};
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
