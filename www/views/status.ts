@@ -14,8 +14,14 @@ export function progress(fraction: number | null, label = "Slicing…"): void {
   }
   p.hidden = false;
   const pct = Math.floor(fraction * 100);
-  $("progress-label").textContent = label;
-  $("progress-pct").textContent = `${pct} %`;
+  // only what changed: a text written again (even the same) costs the page a layout, and
+  // the bar moves every frame while slicing
+  setText($("progress-label"), label);
+  setText($("progress-pct"), `${pct} %`);
   $("progress-fill").style.transform = `scaleX(${pct / 100})`;
   p.dataset.percent = String(pct);
+}
+
+function setText(e: HTMLElement, text: string): void {
+  if (e.textContent !== text) e.textContent = text;
 }
