@@ -35,6 +35,9 @@ export interface PendingJob {
   link?: ShareState;
 }
 
+/** No droplets (the box's pass skipped). */
+const EMPTY_XY = new Float32Array(0);
+
 /** Everything known about one slice (or one opened .gco file). */
 export class Slice {
   layers = 0;
@@ -56,6 +59,7 @@ export class Slice {
   cacheBytes = 0;
   done = 0;
   complete = false;
+  /** The droplets' box, of a slice without the core's bounds (a .gco file). */
   bbox: Bounds = { minX: Infinity, minY: Infinity, maxX: -Infinity, maxY: -Infinity };
   /** Droplets, travel, estimates, coverage, worst layer, repairs: the core's (figures.ts). */
   figures = new Figures();
@@ -95,7 +99,9 @@ export class Slice {
       if (l.seconds !== undefined) this.layerSeconds[l.index] = l.seconds;
       if (l.unsupportedArea !== undefined) this.unsupportedArea[l.index] = l.unsupportedArea;
       if (this.source === "gco") this.figures.addReadLayer(l);
-      const d = l.droplets;
+      // the droplets' box stands in for the core's bounds (a .gco file has none); a pass over
+      // every droplet on the page's thread is not spent where the bounds are known
+      const d = this.info.bounds ? EMPTY_XY : l.droplets;
       const b = this.bbox;
       for (let i = 0; i < d.length; i += 2) {
         const x = d[i];
