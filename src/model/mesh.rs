@@ -2,7 +2,7 @@
 //! transforms (SPEC.md: rotate, scale, bounding box minimum to the origin, placement) and its
 //! diagnostics (open and non-manifold edges). Its shells and their orientation: [`crate::model::shells`].
 
-use crate::base::geom::{DMat3, DVec3, sin_cos_deg};
+use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
 use crate::base::settings::Settings;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -32,8 +32,8 @@ impl Bounds {
     /// Grown to hold the box `lo`..`hi`.
     pub fn grow(&mut self, lo: [f64; 3], hi: [f64; 3]) {
         for k in 0..3 {
-            self.min[k] = self.min[k].min(lo[k]);
-            self.max[k] = self.max[k].max(hi[k]);
+            self.min[k] = lesser(self.min[k], lo[k]);
+            self.max[k] = greater(self.max[k], hi[k]);
         }
     }
 

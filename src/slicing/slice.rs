@@ -18,7 +18,8 @@
 //!   and CuraEngine do.
 
 use crate::base::geom::{
-    Contour, DVec2, Point, Shapes, dist, shapes_from_overlay, signed_area, to_overlay,
+    Contour, DVec2, Point, Shapes, dist, greater, lesser, shapes_from_overlay, signed_area,
+    to_overlay,
 };
 use crate::base::settings::SlicePlane;
 use crate::model::mesh::{Mesh, edge_key};
@@ -76,8 +77,8 @@ impl FacetBuckets {
             .iter()
             .map(|f| {
                 let z = f.map(|i| mesh.vertices[i as usize][2]);
-                let lo = z[0].min(z[1]).min(z[2]);
-                let hi = z[0].max(z[1]).max(z[2]);
+                let lo = lesser(lesser(z[0], z[1]), z[2]);
+                let hi = greater(greater(z[0], z[1]), z[2]);
                 let a = zs.partition_point(|&p| p <= lo) as u32;
                 let b = zs.partition_point(|&p| p <= hi) as u32;
                 (lo, a, b.max(a))
