@@ -3,8 +3,9 @@
 // Files, read and imported there), answers layout, display meshes and lay-flat, and prepares a
 // slice (`Session.from_models`: place, merge, weld, checks, repair); the other workers read and
 // prepare the same Files for themselves at the same time and keep only the prepared job (a
-// worker waiting for the job worker's mesh idled through its whole preparation). The pool remembers which Files the job worker holds and adds them again to a
-// fresh worker (after a cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
+// worker waiting for the job worker's mesh idled through its whole preparation). The pool
+// remembers which Files the job worker holds and adds them again to a fresh worker (after a
+// cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
 // flight, so it never waits for the page between units). Layers come back in batches ("layers" replies,
 // buffers transferred) and are stored by index, so the page sees them in layer order however
@@ -206,18 +207,15 @@ async function openAll(
   ready: (h: WorkerHandle, r: OpenResult) => Promise<void>,
 ): Promise<OpenResult> {
   const [first, ...others] = handles;
+  // The others answer nothing of the slice shown from now on: a request queued behind their
+  // opening would be answered by the new job before the page knows of it. The job worker
+  // answers the page's requests in order: after its answer to `open_job` (the page has the
+  // new job then), or from its previous model if it refuses the job.
+  for (const h of others) h.hasModel = false;
   const opening = others.map((h) => h.call("open_files", { files, job }).then((o) => ({ h, o })));
   for (const p of opening) p.catch(() => {}); // awaited below, after the job worker's answer
-  let r: OpenResult;
-  try {
-    await syncModels(first, files);
-    r = await first.call("open_job", { job });
-  } catch (e) {
-    // a worker that took the job all the same no longer holds the page's model
-    await Promise.all(opening.map((p) => p.then(({ h }) => (h.hasModel = false), () => {})));
-    throw e;
-  }
-  for (const h of handles) h.hasModel = false;
+  await syncModels(first, files);
+  const r = await first.call("open_job", { job });
   first.hasModel = true;
   const work = [ready(first, r)];
   for (const p of opening) {
