@@ -239,6 +239,20 @@ pub(crate) fn square(x0: f64, y0: f64, a: f64) -> Shapes {
     vec![Shape::new(outer, vec![])]
 }
 
+/// The smaller of two numbers that are not NaN, by one comparison: `f64::min` is a call into
+/// the maths library in WebAssembly (its NaN rule), which the per-vertex loops of the mesh
+/// preparation felt.
+#[inline(always)]
+pub fn lesser(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// The larger of two numbers that are not NaN (see [`lesser`]).
+#[inline(always)]
+pub fn greater(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -274,18 +288,4 @@ mod tests {
         let s = vec![Shape::new(sq(4.0), vec![hole])];
         assert_eq!(region_area(&s), 15.0);
     }
-}
-
-/// The smaller of two numbers that are not NaN, by one comparison: `f64::min` is a call into
-/// the maths library in WebAssembly (its NaN rule), which the per-vertex loops of the mesh
-/// preparation felt.
-#[inline(always)]
-pub fn lesser(a: f64, b: f64) -> f64 {
-    if b < a { b } else { a }
-}
-
-/// The larger of two numbers that are not NaN (see [`lesser`]).
-#[inline(always)]
-pub fn greater(a: f64, b: f64) -> f64 {
-    if b > a { b } else { a }
 }
