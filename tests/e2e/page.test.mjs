@@ -52,6 +52,15 @@ test("3DBenchy: progress reaches 100 %, the slider changes the canvas", async ()
   const t0 = Date.now();
   await pick(page, benchy);
   await page.waitForFunction(() => document.body.dataset.state === "slicing");
+  // the progress box (with Cancel) lies clear of the view tools above the canvas
+  const boxes = await page.evaluate(() => [document.getElementById("progress"), document.querySelector(".view-tools")].map((e) => {
+    const r = e.getBoundingClientRect();
+    return { left: r.left, right: r.right, top: r.top, bottom: r.bottom, shown: !e.hidden && r.width > 0 };
+  }));
+  const [bar, tools] = boxes;
+  assert.ok(bar.shown && tools.shown, `both shown: ${JSON.stringify(boxes)}`);
+  const overlap = bar.left < tools.right && tools.left < bar.right && bar.top < tools.bottom && tools.top < bar.bottom;
+  assert.ok(!overlap, `the progress box clear of the view tools: ${JSON.stringify(boxes)}`);
   const s = await waitDone(page, 240_000);
   console.log(`# 3DBenchy sliced in the page in ${s.seconds.toFixed(2)} s (file chosen -> G-code ready; ${((Date.now() - t0) / 1000).toFixed(1)} s as the test saw it) with ${s.workers} worker(s)`);
   assert.ok(s.seconds > 0, "the page timed its slice");

@@ -27,10 +27,14 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   assert.equal(s.layers, 240);
 
   assert.equal(await page.evaluate(() => window.dropslice.view3d()), null, "no WebGL context before the tab is opened");
+  // the display mesh is made only for the 3D view shown (the job worker made it ahead of the
+  // slice's preparation before)
+  assert.equal(await page.evaluate(() => window.dropslice.job().parts[0].mesh), 0, "no display mesh while the 3D view is hidden");
   const chunk = (u) => /\/view3d-[0-9A-Z]+\.js$/.test(u);
   assert.equal((await page.evaluate(() => performance.getEntriesByType("resource").map((e) => e.name))).filter(chunk).length, 0, "the 3D view's code is not loaded before the tab is opened");
   await open3d(page);
   assert.equal((await page.evaluate(() => performance.getEntriesByType("resource").map((e) => e.name))).filter(chunk).length, 1, "the 3D view's code is loaded once the tab is opened");
+  await page.waitForFunction(() => window.dropslice.job().parts[0].mesh > 0, null, { timeout: 30_000 });
   assert.equal(await page.isVisible("#view3d canvas"), true);
   assert.equal(await page.isVisible("#legend3d"), true);
   assert.equal(await page.isVisible("#legend"), false);
