@@ -1,7 +1,9 @@
 // CPU seconds of the page's per-layer work in the core, on one thread in Node (no browser, no
 // other worker): every layer of MODEL sliced (`slice_layer`) and sliced with analysis
 // (`slice_layer_analysed`, reading the analysis and the mask out as the worker does), runs
-// alternated, best of RUNS. Usage: node scripts/wasm_layer_time.mjs [RUNS] [MODEL.stl] [PKG_DIR]
+// alternated, best of RUNS; and each pass' preparation (`new Session`, wall ms), the first of
+// which is the first after the module loaded, as in a page just opened (docs/performance.md:
+// about twice the later ones). Usage: node scripts/wasm_layer_time.mjs [RUNS] [MODEL.stl] [PKG_DIR]
 // (PKG_DIR: the wasm-bindgen output to time, www/pkg by default; `bash scripts/build.sh` first).
 import { readFileSync } from "node:fs";
 import { resolve, dirname, join } from "node:path";
@@ -19,8 +21,12 @@ const cpu = () => {
   return (u.user + u.system) / 1e6;
 };
 
+const prepared = [];
+
 function pass(analyse) {
+  const p0 = performance.now();
   const s = new core.Session(stl, model.split("/").pop(), core.default_settings());
+  prepared.push(performance.now() - p0);
   const t0 = cpu();
   let sink = 0;
   for (let i = 0; i < s.layer_count(); i++) {
@@ -46,4 +52,5 @@ for (let k = 0; k < runs; k++) {
   best.analysed = Math.min(best.analysed, b);
   console.log(`run ${k}: sliced ${a.toFixed(2)} s, sliced + analysed ${b.toFixed(2)} s (CPU)`);
 }
+console.log(`prepared (ms, in order; the first after the module loaded): ${prepared.map((t) => t.toFixed(0)).join(", ")}`);
 console.log(`best: sliced ${best.plain.toFixed(2)} s, sliced + analysed ${best.analysed.toFixed(2)} s, analysis ${(best.analysed - best.plain).toFixed(2)} s (CPU, one thread)`);

@@ -35,8 +35,17 @@ export interface PendingJob {
   link?: ShareState;
 }
 
-/** No droplets (the box's pass skipped). */
-const EMPTY_XY = new Float32Array(0);
+/** Grows `b` to hold the points `d` (x, y pairs). */
+function growBox(b: Bounds, d: Float32Array): void {
+  for (let i = 0; i < d.length; i += 2) {
+    const x = d[i];
+    const y = d[i + 1];
+    if (x < b.minX) b.minX = x;
+    if (x > b.maxX) b.maxX = x;
+    if (y < b.minY) b.minY = y;
+    if (y > b.maxY) b.maxY = y;
+  }
+}
 
 /** Everything known about one slice (or one opened .gco file). */
 export class Slice {
@@ -99,18 +108,9 @@ export class Slice {
       if (l.seconds !== undefined) this.layerSeconds[l.index] = l.seconds;
       if (l.unsupportedArea !== undefined) this.unsupportedArea[l.index] = l.unsupportedArea;
       if (this.source === "gco") this.figures.addReadLayer(l);
-      // the droplets' box stands in for the core's bounds (a .gco file has none); a pass over
-      // every droplet on the page's thread is not spent where the bounds are known
-      const d = this.info.bounds ? EMPTY_XY : l.droplets;
-      const b = this.bbox;
-      for (let i = 0; i < d.length; i += 2) {
-        const x = d[i];
-        const y = d[i + 1];
-        if (x < b.minX) b.minX = x;
-        if (x > b.maxX) b.maxX = x;
-        if (y < b.minY) b.minY = y;
-        if (y > b.maxY) b.maxY = y;
-      }
+      // the droplets' box stands in for the core's bounds, which a .gco file has not (a pass
+      // over every droplet on the page's thread, not spent where the bounds are known)
+      if (!this.info.bounds) growBox(this.bbox, l.droplets);
     }
     const a = l.analysis;
     if (a && this.analysis[l.index] === undefined) this.analysis[l.index] = a;

@@ -1,6 +1,6 @@
 // The page's state for styles and tests (body[data-state]) and the progress bar.
 
-import { $ } from "./dom";
+import { $, setText } from "./dom";
 
 export function setState(state: "loading" | "reading" | "idle" | "slicing" | "done" | "error" | "cancelled"): void {
   document.body.dataset.state = state;
@@ -14,14 +14,10 @@ export function progress(fraction: number | null, label = "Slicing…"): void {
   }
   p.hidden = false;
   const pct = Math.floor(fraction * 100);
-  // only what changed: a text written again (even the same) costs the page a layout, and
-  // the bar moves every frame while slicing
-  setText($("progress-label"), label);
-  setText($("progress-pct"), `${pct} %`);
+  // only what changed (setText): the bar moves every frame while slicing
+  setText("progress-label", label);
+  setText("progress-pct", `${pct} %`);
   $("progress-fill").style.transform = `scaleX(${pct / 100})`;
   p.dataset.percent = String(pct);
 }
 
-function setText(e: HTMLElement, text: string): void {
-  if (e.textContent !== text) e.textContent = text;
-}

@@ -89,9 +89,9 @@ interface StampPass {
   want: number;
 }
 
-/** A resumable piece of the square painting: `run(from, deadline)` works from item `from` on
- *  until `deadline` (checked every 4,096 items) and returns the item to go on from (`count`:
- *  done). */
+/** A resumable piece of a picture painted into the pixel buffer (a stamping pass, a square
+ *  painting step): `run(from, deadline)` works from item `from` on until `deadline` and
+ *  returns the item to go on from (`count`: done). */
 interface Step {
   count: number;
   run: (from: number, deadline: number) => number;
@@ -176,14 +176,13 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
   private scratch: OffscreenCanvas | null = null;
   private discs: DiscBuffer | null = null;
   private stamps: DiscStamps[] = [];
-  /** The stamping under way: what it draws (compared item by item), its passes (one colour
-   *  each), and where it stands. */
-  private stamping: { key: unknown[]; passes: StampPass[]; pass: number; next: number } | null = null;
-  /** The time the current draw may spend stamping (ms): a frame's draw has FRAME_BUDGET_MS,
+  /** The picture being painted into the pixel buffer (discs or, zoomed far out, squares): what
+   *  it draws (compared item by item, the kind of painting first), its steps, and where it
+   *  stands. */
+  private painting: { key: unknown[]; steps: Step[]; step: number; next: number } | null = null;
+  /** The time the current draw may spend painting (ms): a frame's draw has FRAME_BUDGET_MS,
    *  a direct `draw()` (the tests, a PNG export) all it needs. */
   private budget = Infinity;
-  /** The square painting under way (zoomed far out), as `stamping`. */
-  private pixeling: { key: unknown[]; steps: Step[]; step: number; next: number } | null = null;
 
   protected frameDraw(): void {
     this.budget = FRAME_BUDGET_MS;
@@ -248,28 +247,33 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
     const oy = H / 2 + cy * k;
     const marks = this.marks();
     const below = this.showBelow ? this.below : null;
-    const key = [this.current, below, marks, k, ox, oy, W, H, this.dropletWidth];
-    let job = this.stamping;
+    const key = ["discs", this.current, below, marks, k, ox, oy, W, H, this.dropletWidth];
+    this.paint(ctx, key, () => this.stampPasses(k, ox, oy, below, marks));
+  }
+
+  /** Paints the picture `key` within the draw's budget: its steps (`steps()`, made when the
+   *  picture changes, in a fresh buffer) go on from where the last frame left them; what is
+   *  painted so far is shown, and the next frame is asked for while steps are left. */
+  private paint(ctx: CanvasRenderingContext2D, key: unknown[], steps: () => Step[]): void {
+    let job = this.painting;
     if (!job || job.key.length !== key.length || job.key.some((v, i) => v !== key[i])) {
       this.pixelBuffer();
-      this.pixeling = null; // the buffer is this picture's now
-      job = this.stamping = { key, passes: this.stampPasses(k, ox, oy, below, marks), pass: 0, next: 0 };
+      job = this.painting = { key, steps: steps(), step: 0, next: 0 };
     }
     const deadline = performance.now() + this.budget;
-    const buf = this.discs!;
-    while (job.pass < job.passes.length) {
-      const p = job.passes[job.pass];
-      job.next = buf.paint(p.stamps, p.color, p.at, p.count, p.pick, p.want, job.next, deadline);
-      if (job.next < p.count) break;
-      job.pass++;
+    while (job.step < job.steps.length) {
+      const st = job.steps[job.step];
+      job.next = st.run(job.next, deadline);
+      if (job.next < st.count) break;
+      job.step++;
       job.next = 0;
     }
     this.blit(ctx);
-    if (job.pass < job.passes.length) this.request();
+    if (job.step < job.steps.length) this.request();
   }
 
   /** The stamping's passes: the layer below, the colour classes, the overhang marks. */
-  private stampPasses(k: number, ox: number, oy: number, below: LayerData | null, marks: Uint8Array | null): StampPass[] {
+  private stampPasses(k: number, ox: number, oy: number, below: LayerData | null, marks: Uint8Array | null): Step[] {
     const drop = this.stampsFor(this.dropletWidth * k);
     /** The layer's droplets in device px (x, y pairs). */
     const place = (layer: LayerData): Float64Array => {
@@ -293,7 +297,8 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
       for (const c of CLASS_ORDER) passes.push({ stamps: drop, color: rgb(CLASS_COLORS[c]), at, count: n, pick: cls, want: c });
       if (marks) passes.push({ stamps: this.stampsFor(this.dropletWidth * k * OVERHANG_DIAMETER), color: rgb(OVERHANG_COLOR), at, count: n, pick: marks, want: 1 });
     }
-    return passes;
+    const buf = this.discs!;
+    return passes.map((p) => ({ count: p.count, run: (from, deadline) => buf.paint(p.stamps, p.color, p.at, p.count, p.pick, p.want, from, deadline) }));
   }
 
   /** Zoomed far out: droplets as squares of ceil(B) device pixels, written into the pixel
@@ -307,24 +312,11 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
     const marks = this.marks();
     const below = this.showBelow ? this.below : null;
     const { cx, cy } = this.view;
-    const key = [this.current, below, marks, k, cx, cy, W, H, this.dropletWidth];
-    let job = this.pixeling;
-    if (!job || job.key.length !== key.length || job.key.some((v, i) => v !== key[i])) {
-      this.pixelBuffer();
-      this.stamping = null; // the buffer is this picture's now
+    const key = ["squares", this.current, below, marks, k, cx, cy, W, H, this.dropletWidth];
+    this.paint(ctx, key, () => {
       this.discs!.touchAll();
-      job = this.pixeling = { key, steps: this.pixelSteps(k, below, marks), step: 0, next: 0 };
-    }
-    const deadline = performance.now() + this.budget;
-    while (job.step < job.steps.length) {
-      const st = job.steps[job.step];
-      job.next = st.run(job.next, deadline);
-      if (job.next < st.count) break;
-      job.step++;
-      job.next = 0;
-    }
-    this.blit(ctx);
-    if (job.step < job.steps.length) this.request();
+      return this.pixelSteps(k, below, marks);
+    });
   }
 
   /** The square painting's steps: the layer below; the current layer's colour classes
