@@ -105,11 +105,7 @@ impl Mesh {
     }
 
     pub fn bounds(&self) -> Bounds {
-        let mut b = Bounds::EMPTY;
-        for v in &self.vertices {
-            b.grow(*v, *v);
-        }
-        b
+        bounds_of(&self.vertices)
     }
 
     /// Applies SPEC.md's transforms: rotate about x, y, z (in that order), scale, move the
@@ -121,18 +117,7 @@ impl Mesh {
 
     /// [`Mesh::transform`] with the values of a [`Placement`] (a build job's part).
     pub fn place(&mut self, p: &Placement) {
-        let r = rotation(p.rotate);
-        let scale = DVec3::from(p.scale);
-        for v in &mut self.vertices {
-            *v = (r * DVec3::from(*v) * scale).to_array();
-        }
-        let b = self.bounds();
-        let place = rot(2, p.place_angle);
-        let min = DVec3::from(b.min);
-        for v in &mut self.vertices {
-            let q = place * (DVec3::from(*v) - min);
-            *v = [q.x + p.place[0], q.y + p.place[1], q.z];
-        }
+        place_vertices(&mut self.vertices, p);
     }
 
     /// Drops facets that repeat another facet with the same orientation (the same three
@@ -364,6 +349,33 @@ impl Mesh {
             cavity_shells: 0,
             unchecked_shells: 0,
         }
+    }
+}
+
+/// The box of `vertices` ([`Bounds::EMPTY`] for none).
+fn bounds_of(vertices: &[[f64; 3]]) -> Bounds {
+    let mut b = Bounds::EMPTY;
+    for v in vertices {
+        b.grow(*v, *v);
+    }
+    b
+}
+
+/// [`Mesh::place`] on the vertices of one mesh (the box moved to the origin is theirs), where
+/// they lie: a build job places each instance's vertices after copying them into the merged
+/// mesh, with no placed copy between.
+pub fn place_vertices(vertices: &mut [[f64; 3]], p: &Placement) {
+    let r = rotation(p.rotate);
+    let scale = DVec3::from(p.scale);
+    for v in vertices.iter_mut() {
+        *v = (r * DVec3::from(*v) * scale).to_array();
+    }
+    let b = bounds_of(vertices);
+    let place = rot(2, p.place_angle);
+    let min = DVec3::from(b.min);
+    for v in vertices.iter_mut() {
+        let q = place * (DVec3::from(*v) - min);
+        *v = [q.x + p.place[0], q.y + p.place[1], q.z];
     }
 }
 

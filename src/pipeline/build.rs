@@ -8,7 +8,7 @@ use crate::base::parallel::both;
 use crate::base::settings::Settings;
 use crate::model::import;
 use crate::model::layout::{Frame, Instance, at_part, place_instances};
-use crate::model::mesh::{Mesh, MeshStats};
+use crate::model::mesh::{self, Mesh, MeshStats};
 use crate::model::models::{Model, models_of};
 use crate::model::prepare::{
     FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_chamber, check_height,
@@ -106,31 +106,43 @@ impl Job {
             frames.push(frame);
         }
         let layout = place_instances(&by_part, spec, &frames)?;
-        let vertices: usize = layout
-            .instances
-            .iter()
-            .map(|x| welded[x.part].vertices.len())
-            .sum();
-        let mut mesh = Mesh {
-            vertices: Vec::with_capacity(vertices),
-            facets: Vec::with_capacity(facets),
-        };
         // The instances run by run (a job of unit 0 alone: one run, in the layout's order).
         let mut order: Vec<&Instance> = layout.instances.iter().collect();
         order.sort_by_key(|inst| run_of[inst.part]);
+        // Each instance's vertices are placed where they land in the merged mesh; a job of
+        // one instance takes its part's welded mesh as it is: no copy of the mesh, which on a
+        // million facets is 24 MB a copy (a page worker's memory never shrinks).
+        let mut mesh = if let [only] = order[..] {
+            std::mem::take(&mut welded[only.part])
+        } else {
+            let vertices: usize = order.iter().map(|x| welded[x.part].vertices.len()).sum();
+            Mesh {
+                vertices: Vec::with_capacity(vertices),
+                facets: Vec::with_capacity(facets),
+            }
+        };
+        let merged = order.len() > 1;
         let mut groups: Vec<FacetGroup> = Vec::new();
         for inst in order {
-            let mut m = welded[inst.part].clone();
-            m.place(&spec.parts[inst.part].placement(inst.shift, &settings));
-            let base = mesh.vertices.len() as u32;
-            mesh.vertices.extend_from_slice(&m.vertices);
-            mesh.facets
-                .extend(m.facets.iter().map(|f| f.map(|v| v + base)));
+            let part = &welded[inst.part];
+            let base = if merged { mesh.vertices.len() } else { 0 };
+            if merged {
+                mesh.vertices.extend_from_slice(&part.vertices);
+                mesh.facets
+                    .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
+            }
+            let placement = spec.parts[inst.part].placement(inst.shift, &settings);
+            mesh::place_vertices(&mut mesh.vertices[base..], &placement);
+            let facets = if merged {
+                part.facets.len()
+            } else {
+                mesh.facets.len()
+            };
             // Runs are numbered from 0 in order: run r is the (r + 1)-th group.
             match groups.get_mut(run_of[inst.part]) {
-                Some(g) => g.facets += m.facets.len(),
+                Some(g) => g.facets += facets,
                 None => groups.push(FacetGroup {
-                    facets: m.facets.len(),
+                    facets,
                     unit: spec.parts[inst.part].unit,
                 }),
             }
