@@ -1086,3 +1086,92 @@ fn obj_unicode_whitespace_is_counted_as_tobj_splits() {
     assert!(m.contains("20000001 triangles"), "{m}");
     eprintln!("refused in {:?}", t0.elapsed());
 }
+
+/// The weld of one pass, written plainly: a vertex per distinct corner (bit-identical float32
+/// coordinates, −0 = +0), numbered by its first corner; facets with a repeated vertex dropped.
+fn weld_oracle(tris: &[Tri]) -> (Vec<P3>, Vec<[u32; 3]>, usize) {
+    let mut ids = std::collections::HashMap::new();
+    let (mut vertices, mut facets, mut degenerate) = (Vec::new(), Vec::new(), 0);
+    for t in tris {
+        let f = t.map(|p| {
+            let key = p.map(|c| (c + 0.0).to_bits());
+            *ids.entry(key).or_insert_with(|| {
+                vertices.push(p.map(f64::from));
+                vertices.len() as u32 - 1
+            })
+        });
+        if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
+            degenerate += 1;
+        } else {
+            facets.push(f);
+        }
+    }
+    (vertices, facets, degenerate)
+}
+
+// The weld in parts (on all cores natively) numbers vertices and keeps facets as one pass does,
+// whatever the number of parts: on shared models and on a soup with ±0, collapsed facets and
+// corners shared across the parts' borders.
+#[test]
+fn weld_in_parts_is_the_one_pass_weld() {
+    use dropslice::model::mesh::Mesh;
+    let mut soups: Vec<(String, Vec<Tri>)> = [
+        "3DBenchy.stl",
+        "esca_nonmanifold.stl",
+        "cube_20mm_ascii.stl",
+    ]
+    .iter()
+    .map(|name| {
+        let bytes = std::fs::read(common::shared_dir().join("models").join(name)).unwrap();
+        (name.to_string(), import::stl::parse(&bytes).unwrap().0)
+    })
+    .collect();
+    // 2,000 facets over 60 corners drawn by a fixed sequence: every corner recurs in every
+    // part, some facets collapse, and 0 is written as +0 and −0.
+    let corner = |i: u64| -> [f32; 3] {
+        let c = i % 60;
+        let z = if c.is_multiple_of(7) {
+            if i.is_multiple_of(2) { 0.0 } else { -0.0 }
+        } else {
+            c as f32 * 0.25
+        };
+        [(c % 5) as f32 - 2.0, (c / 5 % 4) as f32, z]
+    };
+    let mut x = 12345u64;
+    let mut next = || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        x >> 33
+    };
+    let soup: Vec<Tri> = (0..2000)
+        .map(|_| [corner(next()), corner(next()), corner(next())])
+        .collect();
+    soups.push(("crafted soup".into(), soup));
+    for (name, tris) in &soups {
+        let (vertices, facets, degenerate) = weld_oracle(tris);
+        if name == "crafted soup" {
+            let zeros = |sign: bool| {
+                tris.iter()
+                    .flatten()
+                    .any(|p| p[2] == 0.0 && p[2].is_sign_negative() == sign)
+            };
+            assert!(
+                degenerate > 0 && zeros(true) && zeros(false),
+                "the soup collapses facets and holds ±0"
+            );
+        }
+        for parts in 1..=5 {
+            let (m, d) = Mesh::weld_in(tris, parts);
+            assert_eq!(m.vertices, vertices, "{name}, {parts} parts: vertices");
+            assert_eq!(m.facets, facets, "{name}, {parts} parts: facets");
+            assert_eq!(d, degenerate, "{name}, {parts} parts: collapsed facets");
+        }
+        let (m, d) = Mesh::weld(tris);
+        assert_eq!(
+            (m.vertices, m.facets, d),
+            (vertices, facets, degenerate),
+            "{name}: Mesh::weld"
+        );
+    }
+}
