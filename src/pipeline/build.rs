@@ -202,15 +202,35 @@ impl Job {
         // One droplet estimate for the whole job: every unit and the support.
         let unit1 = budget::Unit1Parts::of(&mesh, &groups);
         let open = shells.open > 0;
-        let overhangs = if open || settings.support == crate::base::settings::Support::Off {
-            budget::Overhangs::default()
-        } else {
-            let h = settings.layer_height;
-            budget::Overhangs::of(
-                &mesh,
-                &slice::layer_heights(size[2], h, settings.slice_plane),
-            )
-        };
+        let support = !open && settings.support != crate::base::settings::Support::Off;
+        let zs = plane_heights(&size, &settings);
+        // The support's overhang figures for the estimate beside the statistics and the facet
+        // index (the job is checked before the index is used).
+        let (overhangs, repaired) = both(
+            || {
+                if support {
+                    let h = settings.layer_height;
+                    budget::Overhangs::of(
+                        &mesh,
+                        &slice::layer_heights(size[2], h, settings.slice_plane),
+                    )
+                } else {
+                    budget::Overhangs::default()
+                }
+            },
+            || {
+                let zs = zs.as_ref().ok()?;
+                Some(repair(
+                    &mesh,
+                    zs,
+                    &shells,
+                    weld,
+                    duplicates,
+                    input.facets_in_file,
+                    input.degenerate,
+                ))
+            },
+        );
         let mut estimate = budget::Estimate::new(
             volume,
             unit1,
@@ -221,16 +241,10 @@ impl Job {
             &settings,
         );
         estimate.check(&settings)?;
-        let zs = plane_heights(&size, &settings)?;
-        let (mesh, buckets, stats) = repair(
-            mesh,
-            &zs,
-            &shells,
-            weld,
-            duplicates,
-            input.facets_in_file,
-            input.degenerate,
-        );
+        let zs = zs?;
+        let (buckets, stats) = repaired.ok_or_else(|| {
+            Error::Internal("the facet index was not built though the layers are known".into())
+        })?;
         if shells.open > 0 {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
@@ -310,18 +324,18 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
 
 /// Mesh statistics and index: the facet index per layer and what the repair did.
 fn repair(
-    mesh: Mesh,
+    mesh: &Mesh,
     zs: &[f64],
     shells: &ShellOrientation,
     (welded, dropped): (usize, usize),
     duplicates: usize,
     facets_in_file: usize,
     degenerate: usize,
-) -> (Mesh, FacetBuckets, MeshStats) {
+) -> (FacetBuckets, MeshStats) {
     // The statistics and the facet index are independent: build them side by side.
     let (stats, buckets) = both(
         || mesh.stats(facets_in_file, degenerate + dropped),
-        || FacetBuckets::new(&mesh, zs),
+        || FacetBuckets::new(mesh, zs),
     );
     let stats = MeshStats {
         duplicate_facets: duplicates,
@@ -332,7 +346,7 @@ fn repair(
         unchecked_shells: shells.unchecked,
         ..stats
     };
-    (mesh, buckets, stats)
+    (buckets, stats)
 }
 
 /// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
