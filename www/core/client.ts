@@ -164,40 +164,46 @@ export interface JobFileRef {
   file: File;
 }
 
-/** Makes the job worker `h` hold exactly `files` (adds the ones it lacks or holds as another
- *  File, removes the others). */
+/** Makes worker `h` hold exactly `files` (adds the ones it lacks or holds as another File,
+ *  removes the others). A worker answers its requests in order, so a file whose import was
+ *  sent already counts as held. */
 async function syncModels(h: WorkerHandle, files: JobFileRef[]): Promise<void> {
   const wanted = new Map(files.map((f) => [f.name, f.file]));
   const gone = [...h.models.keys()].filter((n) => !wanted.has(n));
-  if (gone.length) {
-    for (const n of gone) h.models.delete(n);
-    await h.call("models_remove", { names: gone });
-  }
+  for (const n of gone) h.models.delete(n);
+  // both requests at once: the worker answers them in order
+  const removed = gone.length ? h.call("models_remove", { names: gone }) : null;
+  removed?.catch(() => {}); // awaited below
   const missing = files.filter((f) => h.models.get(f.name) !== f.file);
   if (missing.length) await addTo(h, missing, null);
+  await removed;
 }
 
-/** Adds `files` to `h`'s Models and records them; on a refusal the names are forgotten (the
- *  worker may have replaced some of them before refusing one). Their SHA-256 comes from
- *  `hasher`: another worker hashes while `h` reads and imports (in `h` the hash would wait for
- *  the import: its thread is busy); `h` itself hashes after reading; `null`: no hash. */
+/** Adds `files` to `h`'s Models. Their SHA-256 comes from `hasher`: another worker hashes
+ *  while `h` reads and imports (in `h` the hash would wait for the import: its thread is busy);
+ *  `h` itself hashes after reading; `null`: no hash. The files count as held from the request
+ *  on (see [[syncModels]]); on a refusal the names are forgotten (the worker may have replaced
+ *  some of them before refusing one). */
 async function addTo(h: WorkerHandle, files: JobFileRef[], hasher: WorkerHandle | null): Promise<ResultOf<"models_add">> {
+  for (const f of files) h.models.set(f.name, f.file);
   try {
     const aside = hasher && hasher !== h ? Promise.all(files.map((f) => hasher.call("hash", { file: f.file }))) : null;
     aside?.catch(() => {}); // awaited below; a refusal of the import must not leave it unhandled
     const r = await h.call("models_add", { files, hash: hasher === h });
     const sha256 = aside ? await aside : r.sha256;
-    for (const f of files) h.models.set(f.name, f.file);
     return { infos: r.infos, sha256 };
   } catch (e) {
-    for (const f of files) h.models.delete(f.name);
+    for (const f of files) if (h.models.get(f.name) === f.file) h.models.delete(f.name);
     throw e;
   }
 }
 
-/** Opens a job in every worker at once: the job worker prepares it from the files it holds,
- *  every other worker reads and prepares the same files itself meanwhile (no worker waits for
- *  another's mesh). `ready(h, r)` runs for each worker once it holds the job, for the job
+/** Opens a job in every worker at once: each prepares it from the job's files in its own
+ *  `Models`. The job worker imported them when they were added; another worker imports the
+ *  files it lacks first (on a job's first opening: on 2 cores, importing them beside the job
+ *  worker's import delayed the job worker more than it saved) and keeps them, so the job
+ *  opened again (settings changed) is prepared without reading any file. No worker waits for
+ *  another's mesh. `ready(h, r)` runs for each worker once it holds the job, for the job
  *  worker first. The core refuses a job alike in every worker (each keeps its previous model
  *  then); the job worker's refusal is the one reported. */
 async function openAll(
@@ -212,7 +218,10 @@ async function openAll(
   // answers the page's requests in order: after its answer to `open_job` (the page has the
   // new job then), or from its previous model if it refuses the job.
   for (const h of others) h.hasModel = false;
-  const opening = others.map((h) => h.call("open_files", { files, job }).then((o) => ({ h, o })));
+  const opening = others.map(async (h) => {
+    await syncModels(h, files);
+    return { h, o: await h.call("open_job", { job }) };
+  });
   for (const p of opening) p.catch(() => {}); // awaited below, after the job worker's answer
   await syncModels(first, files);
   const r = await first.call("open_job", { job });

@@ -171,7 +171,7 @@ export interface Calls {
   hash: { data: { file: Blob }; result: string };
   parse_gcode: { data: { file: Blob }; result: GcodeParseResult };
   crash: { data: null; result: void };
-  /** Build jobs (the job worker's `Models`, src/wasm/mod.rs): files added under their job names
+  /** Build jobs (each worker's `Models`, src/wasm/mod.rs): files added under their job names
    *  (a name already there is replaced), with their info and SHA-256. */
   /** `hash: false`: no SHA-256 here (`sha256` empty; the pool has another worker hash the
    *  files meanwhile, or needs no hash). */
@@ -185,12 +185,9 @@ export interface Calls {
   orient: { data: { job: JobFile; part: number }; result: Orientations };
   /** A profile's JSON text checked by the core (`check_profile`); needs no model. */
   check_profile: { data: { text: string }; result: Profile };
-  /** Prepares the job `job` of the files added (Session.from_models). */
+  /** Prepares the job `job` of the files added (Session.from_models), in every worker at
+   *  once. */
   open_job: { data: { job: JobFile }; result: OpenResult };
-  /** A worker that does not hold the job's files (not the job worker) reads and imports
-   *  `files` itself, prepares `job` from them and keeps only the prepared job: every worker
-   *  prepares at the same time instead of waiting for the job worker's mesh. */
-  open_files: { data: { files: { name: string; file: File }[]; job: JobFile }; result: OpenResult };
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
    *  within the rule (src/wasm/mod.rs `unsupported_droplets`); `below` null for the first layer. */
   unsupported: { data: UnsupportedRequest; result: Uint8Array };

@@ -1,10 +1,10 @@
-// One worker = one wasm instance = at most one Session (one prepared slicing job), and in the
-// job worker (the pool's first) the job's `Models` (its imported files). Answers the requests
-// of core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred). The
-// model files arrive as Files and are read here (by the core, with FileReaderSync), never on
-// the page's thread; the other workers read and prepare the same files for themselves at the
-// same time ("open_files"), keeping only the prepared job. Everything from the core is a typed
-// value; its errors are thrown as `{kind, message, setting?}` and passed on as they are.
+// One worker = one wasm instance = at most one Session (one prepared slicing job) and the
+// job's `Models` (its imported files, from which it prepares the job; the job worker, the
+// pool's first, also answers the layout and the 3D view's requests). Answers the requests of
+// core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred).
+// The model files arrive as Files and are read here (by the core, with FileReaderSync), never
+// on the page's thread. Everything from the core is a typed value; its errors are thrown as
+// `{kind, message, setting?}` and passed on as they are.
 
 import init, { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
@@ -43,7 +43,7 @@ const clock = publish(
 let wasm: Promise<InitOutput> | null = null;
 let memory: WebAssembly.Memory | null = null;
 let session: Session | null = null;
-/** The job's files (only the job worker gets any). */
+/** The job's files (every worker holds them once it opened the job). */
 let models: Models | null = null;
 let lastPanic = "";
 let broken = false;
@@ -236,19 +236,6 @@ async function handle(req: Request): Promise<void> {
       await load();
       // the old session stays usable if the job is refused
       answer(req.kind, req.id, adopt(Session.from_models(needModels(), req.data.job)));
-      return;
-    }
-    case "open_files": {
-      await load();
-      // the files are imported for this job only: the session keeps what it slices, the
-      // imported files are dropped (the job worker keeps them for layout and edits)
-      const own = new Models();
-      try {
-        for (const { name, file } of req.data.files) clock.time("worker: file read and parsed", () => own.add(file, name));
-        answer(req.kind, req.id, adopt(Session.from_models(own, req.data.job)));
-      } finally {
-        own.free();
-      }
       return;
     }
     case "slice": {
