@@ -1109,11 +1109,10 @@ fn weld_oracle(tris: &[Tri]) -> (Vec<P3>, Vec<[u32; 3]>, usize) {
     (vertices, facets, degenerate)
 }
 
-// The weld in parts (on all cores natively) numbers vertices and keeps facets as one pass does,
-// whatever the number of parts: on shared models and on a soup with ±0, collapsed facets and
-// corners shared across the parts' borders.
+// The weld numbers vertices by their first corner and drops collapsed facets, as a plain
+// one-pass weld does: on shared models and on a soup with ±0 and collapsed facets.
 #[test]
-fn weld_in_parts_is_the_one_pass_weld() {
+fn weld_is_the_plain_one_pass_weld() {
     use dropslice::model::mesh::Mesh;
     let mut soups: Vec<(String, Vec<Tri>)> = [
         "3DBenchy.stl",
@@ -1126,8 +1125,8 @@ fn weld_in_parts_is_the_one_pass_weld() {
         (name.to_string(), import::stl::parse(&bytes).unwrap().0)
     })
     .collect();
-    // 2,000 facets over 60 corners drawn by a fixed sequence: every corner recurs in every
-    // part, some facets collapse, and 0 is written as +0 and −0.
+    // 2,000 facets over 60 corners drawn by a fixed sequence: corners recur, some facets
+    // collapse, and 0 is written as +0 and −0.
     let corner = |i: u64| -> [f32; 3] {
         let c = i % 60;
         let z = if c.is_multiple_of(7) {
@@ -1160,12 +1159,6 @@ fn weld_in_parts_is_the_one_pass_weld() {
                 degenerate > 0 && zeros(true) && zeros(false),
                 "the soup collapses facets and holds ±0"
             );
-        }
-        for parts in 1..=5 {
-            let (m, d) = Mesh::weld_in(tris, parts);
-            assert_eq!(m.vertices, vertices, "{name}, {parts} parts: vertices");
-            assert_eq!(m.facets, facets, "{name}, {parts} parts: facets");
-            assert_eq!(d, degenerate, "{name}, {parts} parts: collapsed facets");
         }
         let (m, d) = Mesh::weld(tris);
         assert_eq!(

@@ -13,18 +13,6 @@ pub fn par_map<R: Send>(n: usize, f: &(dyn Fn(usize) -> R + Sync)) -> Vec<R> {
     (0..n).map(f).collect()
 }
 
-/// How many threads [`par_map`] runs on (1 on wasm32).
-pub fn threads() -> usize {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        rayon::current_num_threads()
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
-        1
-    }
-}
-
 /// Runs two computations, on two threads natively (wasm workers are single-threaded).
 pub fn both<A: Send, B: Send>(
     a: impl FnOnce() -> A + Send,

@@ -6,10 +6,6 @@ use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
 use crate::base::settings::Settings;
 use rustc_hash::FxHashMap as HashMap;
 
-/// Files with at least this many triangles are welded in parts on all cores ([`Mesh::weld`]):
-/// below it the merge costs more than the parts save.
-pub const WELD_SPLIT_MIN: usize = 100_000;
-
 /// A welded triangle mesh in millimetres.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
@@ -84,74 +80,28 @@ pub struct MeshStats {
 
 impl Mesh {
     /// Welds corners whose float32 coordinates are bit-identical (−0 = +0) and drops facets
-    /// that collapse to a line or a point. Vertices are numbered in the order of their first
-    /// corner in `tris`. Natively, files of [`WELD_SPLIT_MIN`] triangles or more are welded
-    /// in parts on all cores ([`weld_in`](Self::weld_in)), with the same result.
+    /// that collapse to a line or a point.
     pub fn weld(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
-        let parts = if tris.len() >= WELD_SPLIT_MIN {
-            crate::base::parallel::threads()
-        } else {
-            1
-        };
-        Mesh::weld_in(tris, parts)
-    }
-
-    /// [`weld`](Self::weld) with the triangles in `parts` runs of consecutive triangles, each
-    /// welded on its own (on all cores natively), then merged in order: every part's new
-    /// vertices, in its own order, after the vertices of the parts before it. A vertex's first
-    /// corner in `tris` lies in the first part that has it, where it is first, so the numbers
-    /// are those of a single pass for any `parts`.
-    pub fn weld_in(tris: &[[[f32; 3]; 3]], parts: usize) -> (Mesh, usize) {
-        let key = |p: &[f32; 3]| p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() });
-        // One part: its map, its vertices (in order of their first corner) and corners.
-        let weld_part = |tris: &[[[f32; 3]; 3]]| {
-            let mut index: HashMap<[u32; 3], u32> =
-                HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
-            let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
-            let mut corners = Vec::with_capacity(tris.len());
-            for t in tris {
-                corners.push(t.map(|p| {
-                    *index.entry(key(&p)).or_insert_with(|| {
-                        vertices.push(p);
-                        (vertices.len() - 1) as u32
-                    })
-                }));
-            }
-            (index, vertices, corners)
-        };
-        let parts = parts.clamp(1, tris.len().max(1));
-        let size = tris.len().div_ceil(parts).max(1);
-        let mut welded = crate::base::parallel::par_map(parts, &|k| {
-            weld_part(&tris[(k * size).min(tris.len())..((k + 1) * size).min(tris.len())])
-        })
-        .into_iter();
-        let (mut index, first, mut corners) = welded.next().unwrap_or_default();
-        let mut vertices: Vec<[f64; 3]> = first.iter().map(|p| p.map(f64::from)).collect();
-        drop(first);
-        for (_, local, part_corners) in welded {
-            // The part's vertex numbers in the whole mesh.
-            let global: Vec<u32> = local
-                .iter()
-                .map(|p| {
-                    *index.entry(key(p)).or_insert_with(|| {
-                        vertices.push(p.map(f64::from));
-                        (vertices.len() - 1) as u32
-                    })
+        let mut index: HashMap<[u32; 3], u32> =
+            HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
+        let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
+        let mut facets = Vec::with_capacity(tris.len());
+        let mut degenerate = 0;
+        for t in tris {
+            let ids = t.map(|p| {
+                let key = p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() });
+                *index.entry(key).or_insert_with(|| {
+                    vertices.push(p.map(f64::from));
+                    (vertices.len() - 1) as u32
                 })
-                .collect();
-            corners.extend(part_corners.iter().map(|c| c.map(|v| global[v as usize])));
+            });
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                degenerate += 1;
+            } else {
+                facets.push(ids);
+            }
         }
-        drop(index);
-        let before = corners.len();
-        corners.retain(|ids| ids[0] != ids[1] && ids[1] != ids[2] && ids[0] != ids[2]);
-        let degenerate = before - corners.len();
-        (
-            Mesh {
-                vertices,
-                facets: corners,
-            },
-            degenerate,
-        )
+        (Mesh { vertices, facets }, degenerate)
     }
 
     pub fn bounds(&self) -> Bounds {
