@@ -133,16 +133,16 @@ impl Job {
             }
             let placement = spec.parts[inst.part].placement(inst.shift, &settings);
             mesh::place_vertices(&mut mesh.vertices[base..], &placement);
-            let facets = if merged {
+            let count = if merged {
                 part.facets.len()
             } else {
                 mesh.facets.len()
             };
             // Runs are numbered from 0 in order: run r is the (r + 1)-th group.
             match groups.get_mut(run_of[inst.part]) {
-                Some(g) => g.facets += facets,
+                Some(g) => g.facets += count,
                 None => groups.push(FacetGroup {
-                    facets,
+                    facets: count,
                     unit: spec.parts[inst.part].unit,
                 }),
             }
