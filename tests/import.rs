@@ -1168,3 +1168,70 @@ fn weld_is_the_plain_one_pass_weld() {
         );
     }
 }
+
+// The mesh statistics' edge counts (open, non-manifold, misoriented) against a plain count of
+// every undirected edge's uses: shared models (one of them non-manifold), a bunny with holes
+// cut (damaged copies), and a crafted soup with all three kinds.
+#[test]
+fn edge_counts_are_those_of_a_plain_count() {
+    use dropslice::model::mesh::Mesh;
+    let count = |m: &Mesh| {
+        let mut uses: std::collections::HashMap<(u32, u32), Vec<bool>> = Default::default();
+        for f in &m.facets {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                uses.entry((a.min(b), a.max(b))).or_default().push(a < b);
+            }
+        }
+        let open = uses.values().filter(|u| u.len() == 1).count();
+        let nonmanifold = uses.values().filter(|u| u.len() > 2).count();
+        let misoriented = uses
+            .values()
+            .filter(|u| u.len() == 2 && u[0] == u[1])
+            .count();
+        (open, nonmanifold, misoriented)
+    };
+    let mut meshes: Vec<(String, Mesh)> = [
+        "3DBenchy.stl",
+        "esca_nonmanifold.stl",
+        "stanford_bunny.stl",
+        "spikey_top_solid_header.stl",
+    ]
+    .iter()
+    .map(|name| {
+        let bytes = std::fs::read(common::shared_dir().join("models").join(name)).unwrap();
+        (
+            name.to_string(),
+            Mesh::weld(&import::stl::parse(&bytes).unwrap().0).0,
+        )
+    })
+    .collect();
+    // The bunny with every 7th facet gone (holes), every 11th reversed (misoriented edges)
+    // and every 13th repeated reversed (edges of three and four facets).
+    let mut damaged = meshes[2].1.clone();
+    let facets = std::mem::take(&mut damaged.facets);
+    for (i, f) in facets.into_iter().enumerate() {
+        if i % 7 == 0 {
+            continue;
+        }
+        damaged
+            .facets
+            .push(if i % 11 == 0 { [f[0], f[2], f[1]] } else { f });
+        if i % 13 == 0 {
+            damaged.facets.push([f[2], f[1], f[0]]);
+        }
+    }
+    meshes.push(("damaged bunny".into(), damaged));
+    for (name, m) in &meshes {
+        let s = m.stats(m.facets.len(), 0);
+        let want = count(m);
+        assert_eq!(
+            (s.open_edges, s.nonmanifold_edges, s.misoriented_edges),
+            want,
+            "{name}"
+        );
+        if name == "damaged bunny" {
+            assert!(want.0 > 0 && want.1 > 0 && want.2 > 0, "{want:?}");
+        }
+    }
+}

@@ -307,30 +307,7 @@ impl Mesh {
 
     /// Edge statistics and signed volume.
     pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
-        // Directed edges, sorted by their undirected key.
-        // Directed edges as (undirected key << 1 | direction), sorted: 8 bytes an edge, which
-        // matters at millions of facets. Vertex ids stay below 2^31 (at most 3 per facet, and
-        // files over 20 million facets are refused), so the shift loses nothing.
-        let mut edges: Vec<u64> = Vec::with_capacity(self.facets.len() * 3);
-        for f in &self.facets {
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                edges.push(edge_key(a, b) << 1 | u64::from(a < b));
-            }
-        }
-        edges.sort_unstable();
-        let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
-        for group in edges.chunk_by(|x, y| x >> 1 == y >> 1) {
-            match group.len() {
-                1 => open += 1,
-                2 => {
-                    if group[0] & 1 == group[1] & 1 {
-                        misoriented += 1
-                    }
-                }
-                _ => nonmanifold += 1,
-            }
-        }
+        let (open, nonmanifold, misoriented) = self.edge_counts();
         let signed_volume = self.signed_volume();
         MeshStats {
             facets_in_file,
@@ -376,6 +353,56 @@ pub fn place_vertices(vertices: &mut [[f64; 3]], p: &Placement) {
     for v in vertices.iter_mut() {
         let q = place * (DVec3::from(*v) - min);
         *v = [q.x + p.place[0], q.y + p.place[1], q.z];
+    }
+}
+
+impl Mesh {
+    /// The undirected edges used by one facet, by more than two, and by two running along it
+    /// the same way. Every facet's edges are filed under their lower vertex (compressed rows,
+    /// 4 bytes an edge: the other vertex and the direction), and each vertex's few are sorted
+    /// and grouped: no sort of all edges, and each row read once.
+    fn edge_counts(&self) -> (usize, usize, usize) {
+        let n = self.vertices.len();
+        let mut start = vec![0u32; n + 1];
+        for f in &self.facets {
+            for k in 0..3 {
+                start[f[k].min(f[(k + 1) % 3]) as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            start[v + 1] += start[v];
+        }
+        let mut next = start.clone();
+        // The other vertex << 1 | whether the edge runs from the lower vertex. Vertex ids
+        // stay below 2^31 (at most 3 per facet, and files over 20 million facets are
+        // refused), so the shift loses nothing.
+        let mut rows = vec![0u32; start[n] as usize];
+        for f in &self.facets {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                let lo = a.min(b) as usize;
+                rows[next[lo] as usize] = a.max(b) << 1 | u32::from(a < b);
+                next[lo] += 1;
+            }
+        }
+        drop(next);
+        let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
+        for v in 0..n {
+            let row = &mut rows[start[v] as usize..start[v + 1] as usize];
+            row.sort_unstable();
+            for group in row.chunk_by(|x, y| x >> 1 == y >> 1) {
+                match group.len() {
+                    1 => open += 1,
+                    2 => {
+                        if group[0] & 1 == group[1] & 1 {
+                            misoriented += 1
+                        }
+                    }
+                    _ => nonmanifold += 1,
+                }
+            }
+        }
+        (open, nonmanifold, misoriented)
     }
 }
 

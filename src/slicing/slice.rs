@@ -96,13 +96,32 @@ impl FacetBuckets {
         let offsets = counts.clone();
         let mut fill = counts;
         let mut facets = vec![0u32; *offsets.last().unwrap_or(&0) as usize];
-        // Lowest z first, ties in file order.
-        let mut order: Vec<(f64, u32)> = spans
-            .iter()
-            .enumerate()
-            .map(|(f, s)| (s.0, f as u32))
-            .collect();
-        order.sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+        // Lowest z first, ties in file order. A facet's first plane never decreases with its
+        // lowest z, so the facets are put in runs by their first plane (a counting sort that
+        // keeps file order), and only each run is sorted by lowest z: small sorts instead of
+        // one of every facet (those crossing no plane are left out).
+        let mut run = vec![0u32; zs.len() + 1];
+        for &(_, a, b) in &spans {
+            if a < b {
+                run[a as usize + 1] += 1;
+            }
+        }
+        for i in 1..run.len() {
+            run[i] += run[i - 1];
+        }
+        let mut order: Vec<(f64, u32)> = vec![(0.0, 0); *run.last().unwrap_or(&0) as usize];
+        let mut at = run.clone();
+        for (f, &(lo, a, b)) in spans.iter().enumerate() {
+            if a < b {
+                order[at[a as usize] as usize] = (lo, f as u32);
+                at[a as usize] += 1;
+            }
+        }
+        drop(at);
+        for w in run.windows(2) {
+            order[w[0] as usize..w[1] as usize]
+                .sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+        }
         for (_, f) in order {
             let (_, a, b) = spans[f as usize];
             for i in a..b {
@@ -499,5 +518,49 @@ mod tests {
         let zs = layer_heights(20.0, 0.2, SlicePlane::Top);
         assert_eq!(zs.len(), 100);
         assert_eq!(*zs.last().unwrap(), 20.0);
+    }
+
+    // Each layer's facets are those crossing its plane, lowest z first and ties in file order,
+    // as one sort of every facet gives them: facets whose lowest corners tie (many at one z,
+    // ±0), lie exactly on a plane, span several planes or none.
+    #[test]
+    fn buckets_are_every_crossing_facet_by_lowest_z() {
+        let zs = layer_heights(3.0, 0.5, SlicePlane::Middle);
+        let mut vertices = Vec::new();
+        let mut facets = Vec::new();
+        let mut x = 7u64;
+        for i in 0..600u32 {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            // lowest z on a coarse grid of 0.25 (on planes, between them, ties), −0 for some
+            let lo = match i % 9 {
+                0 => -0.0,
+                1 => 0.0,
+                _ => ((x >> 40) % 13) as f64 * 0.25,
+            };
+            let span = ((x >> 20) % 7) as f64 * 0.3;
+            let base = vertices.len() as u32;
+            vertices.extend([
+                [0.0, 0.0, lo + span],
+                [1.0, 0.0, lo],
+                [0.0, 1.0, lo + span / 2.0],
+            ]);
+            facets.push([base, base + 1, base + 2]);
+        }
+        let mesh = Mesh { vertices, facets };
+        let b = FacetBuckets::new(&mesh, &zs);
+        for (i, &z) in zs.iter().enumerate() {
+            let mut want: Vec<(f64, u32)> = (0..mesh.facets.len() as u32)
+                .filter_map(|f| {
+                    let c = mesh.facets[f as usize].map(|v| mesh.vertices[v as usize][2]);
+                    let (lo, hi) = (c[0].min(c[1]).min(c[2]), c[0].max(c[1]).max(c[2]));
+                    (lo < z && z <= hi).then_some((lo, f))
+                })
+                .collect();
+            want.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+            let want: Vec<u32> = want.into_iter().map(|(_, f)| f).collect();
+            assert_eq!(b.layer(i), &want[..], "layer {i} at z = {z}");
+        }
     }
 }
