@@ -198,6 +198,17 @@ async function addTo(h: WorkerHandle, files: JobFileRef[], hasher: WorkerHandle 
   }
 }
 
+/** Makes `h` hold `files` and opens `job` there: all its requests posted at once (it answers
+ *  them in order; a round trip through the page's busy thread between them cost a worker
+ *  tens of ms). A refusal of the files is reported before the job's. */
+async function syncThenOpen(h: WorkerHandle, files: JobFileRef[], job: JobFile): Promise<OpenResult> {
+  const synced = syncModels(h, files);
+  const opened = h.call("open_job", { job });
+  opened.catch(() => {}); // awaited below, after the files
+  await synced;
+  return opened;
+}
+
 /** Opens a job in every worker at once: each prepares it from the job's files in its own
  *  `Models`. The job worker imported them when they were added; another worker imports the
  *  files it lacks first (on a job's first opening: on 2 cores, importing them beside the job
@@ -218,13 +229,9 @@ async function openAll(
   // answers the page's requests in order: after its answer to `open_job` (the page has the
   // new job then), or from its previous model if it refuses the job.
   for (const h of others) h.hasModel = false;
-  const opening = others.map(async (h) => {
-    await syncModels(h, files);
-    return { h, o: await h.call("open_job", { job }) };
-  });
+  const opening = others.map(async (h) => ({ h, o: await syncThenOpen(h, files, job) }));
   for (const p of opening) p.catch(() => {}); // awaited below, after the job worker's answer
-  await syncModels(first, files);
-  const r = await first.call("open_job", { job });
+  const r = await syncThenOpen(first, files, job);
   first.hasModel = true;
   const work = [ready(first, r)];
   for (const p of opening) {
