@@ -195,15 +195,23 @@ async function handle(req: Request): Promise<void> {
       const infos: ModelInfo[] = [];
       const sha256: string[] = [];
       const hashing = req.data.hash ?? true;
-      for (const { name, file } of req.data.files) {
-        const hash = hashing ? sha256Of(file) : null;
-        const m = models;
-        infos.push(clock.time("worker: file read and parsed", () => m.add(file, name)));
-        if (hash) {
-          const t0 = performance.now();
-          sha256.push(await hash);
-          clock.since("worker: waiting for SHA-256", t0);
+      const m = models;
+      try {
+        for (const { name, file } of req.data.files) {
+          const hash = hashing ? sha256Of(file) : null;
+          infos.push(clock.time("worker: file read and parsed", () => m.add(file, name)));
+          if (hash) {
+            const t0 = performance.now();
+            sha256.push(await hash);
+            clock.since("worker: waiting for SHA-256", t0);
+          }
         }
+      } catch (e) {
+        // None of the files asked for stays (an earlier file of that name neither): a job
+        // opened right after (its request is already queued) finds them missing and is
+        // refused, instead of being prepared from what the worker held before.
+        for (const { name } of req.data.files) m.remove(name);
+        throw e;
       }
       answer(req.kind, req.id, { infos, sha256 });
       return;
