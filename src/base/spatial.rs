@@ -150,6 +150,15 @@ impl<'a> EdgeIndex<'a> {
             for x in x0..=x1 {
                 let c = (y * self.nx + x) as usize;
                 for &e in &self.items[self.offsets[c] as usize..self.offsets[c + 1] as usize] {
+                    // An edge whose box lies farther than r from p lies farther than r too.
+                    let (a, b) = self.edges[e as usize];
+                    if p[0] + r < a[0].min(b[0])
+                        || p[0] - r > a[0].max(b[0])
+                        || p[1] + r < a[1].min(b[1])
+                        || p[1] - r > a[1].max(b[1])
+                    {
+                        continue;
+                    }
                     if hit(e as usize) {
                         return true;
                     }
