@@ -327,6 +327,37 @@ impl Mesh {
             unchecked_shells: 0,
         }
     }
+
+    /// The undirected edges used by one facet, by more than two, and by two running along it
+    /// the same way. Every facet's edges are filed under their lower vertex ([`CompressedRows`],
+    /// 4 bytes an edge: the other vertex and the direction), and each vertex's few are sorted
+    /// and grouped: no sort of all edges, and each row read once.
+    fn edge_counts(&self) -> (usize, usize, usize) {
+        // The other vertex << 1 | whether the edge runs from the lower vertex. Vertex ids
+        // stay below 2^31 (at most 3 per facet, and files over 20 million facets are
+        // refused), so the shift loses nothing.
+        let mut rows = CompressedRows::per_corner(self, |_, f, k| {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            (a.min(b), a.max(b) << 1 | u32::from(a < b))
+        });
+        let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
+        for v in 0..self.vertices.len() {
+            let row = rows.row_mut(v);
+            row.sort_unstable();
+            for group in row.chunk_by(|x, y| x >> 1 == y >> 1) {
+                match group.len() {
+                    1 => open += 1,
+                    2 => {
+                        if group[0] & 1 == group[1] & 1 {
+                            misoriented += 1
+                        }
+                    }
+                    _ => nonmanifold += 1,
+                }
+            }
+        }
+        (open, nonmanifold, misoriented)
+    }
 }
 
 /// The box of `vertices` ([`Bounds::EMPTY`] for none).
@@ -356,53 +387,52 @@ pub fn place_vertices(vertices: &mut [[f64; 3]], p: &Placement) {
     }
 }
 
-impl Mesh {
-    /// The undirected edges used by one facet, by more than two, and by two running along it
-    /// the same way. Every facet's edges are filed under their lower vertex (compressed rows,
-    /// 4 bytes an edge: the other vertex and the direction), and each vertex's few are sorted
-    /// and grouped: no sort of all edges, and each row read once.
-    fn edge_counts(&self) -> (usize, usize, usize) {
-        let n = self.vertices.len();
+/// Items filed under rows 0..n, each row's items one run of memory in the order given (the
+/// compressed rows of a sparse matrix): a mesh's per-vertex lists without a `Vec` per vertex.
+pub(crate) struct CompressedRows<T> {
+    start: Vec<u32>,
+    items: Vec<T>,
+}
+
+impl<T: Copy + Default> CompressedRows<T> {
+    /// Three items per facet of `mesh`, filed under vertex rows: `item(facet, its vertices, k)`
+    /// for k = 0, 1, 2 gives (row, item). It is called twice per item (once to count the rows,
+    /// once to fill them): plain loops, which run faster than a flattened iterator walked
+    /// twice. At most `u32::MAX` items.
+    pub(crate) fn per_corner(
+        mesh: &Mesh,
+        item: impl Fn(u32, &[u32; 3], usize) -> (u32, T),
+    ) -> Self {
+        let n = mesh.vertices.len();
         let mut start = vec![0u32; n + 1];
-        for f in &self.facets {
+        for (fi, f) in mesh.facets.iter().enumerate() {
             for k in 0..3 {
-                start[f[k].min(f[(k + 1) % 3]) as usize + 1] += 1;
+                start[item(fi as u32, f, k).0 as usize + 1] += 1;
             }
         }
-        for v in 0..n {
-            start[v + 1] += start[v];
+        for r in 0..n {
+            start[r + 1] += start[r];
         }
         let mut next = start.clone();
-        // The other vertex << 1 | whether the edge runs from the lower vertex. Vertex ids
-        // stay below 2^31 (at most 3 per facet, and files over 20 million facets are
-        // refused), so the shift loses nothing.
-        let mut rows = vec![0u32; start[n] as usize];
-        for f in &self.facets {
+        let mut items = vec![T::default(); start[n] as usize];
+        for (fi, f) in mesh.facets.iter().enumerate() {
             for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                let lo = a.min(b) as usize;
-                rows[next[lo] as usize] = a.max(b) << 1 | u32::from(a < b);
-                next[lo] += 1;
+                let (r, x) = item(fi as u32, f, k);
+                items[next[r as usize] as usize] = x;
+                next[r as usize] += 1;
             }
         }
-        drop(next);
-        let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
-        for v in 0..n {
-            let row = &mut rows[start[v] as usize..start[v + 1] as usize];
-            row.sort_unstable();
-            for group in row.chunk_by(|x, y| x >> 1 == y >> 1) {
-                match group.len() {
-                    1 => open += 1,
-                    2 => {
-                        if group[0] & 1 == group[1] & 1 {
-                            misoriented += 1
-                        }
-                    }
-                    _ => nonmanifold += 1,
-                }
-            }
-        }
-        (open, nonmanifold, misoriented)
+        CompressedRows { start, items }
+    }
+
+    /// Row `r`'s items.
+    pub(crate) fn row(&self, r: usize) -> &[T] {
+        &self.items[self.start[r] as usize..self.start[r + 1] as usize]
+    }
+
+    /// Row `r`'s items, to reorder in place.
+    pub(crate) fn row_mut(&mut self, r: usize) -> &mut [T] {
+        &mut self.items[self.start[r] as usize..self.start[r + 1] as usize]
     }
 }
 

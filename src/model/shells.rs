@@ -3,7 +3,7 @@
 //! inside-out shells turned outward unless they lie inside another shell (cavities), decided
 //! by winding numbers and a grid of the shells' bounding boxes (`BoxIndex`).
 
-use crate::model::mesh::Mesh;
+use crate::model::mesh::{CompressedRows, Mesh};
 
 /// The shells of a mesh ([`Mesh::shells`]), for [`Mesh::orient`].
 #[derive(Clone, Debug, Default)]
@@ -472,28 +472,11 @@ impl Mesh {
     /// + corner: the edge from that corner to the next); and how many edges only one facet has.
     fn edge_shells(&self) -> (Vec<u32>, Vec<bool>, Vec<u32>, usize) {
         let nf = self.facets.len();
-        // Facets around each vertex (compressed rows).
-        let mut start = vec![0u32; self.vertices.len() + 1];
-        for f in &self.facets {
-            for &v in f {
-                start[v as usize + 1] += 1;
-            }
-        }
-        for k in 0..self.vertices.len() {
-            start[k + 1] += start[k];
-        }
-        let mut next = start.clone();
         // Each facet around a vertex with its vertices after and before that one, so the
         // scan of a vertex's facets reads one run of memory and never the facets themselves.
-        let mut around = vec![[0u32; 3]; 3 * nf];
-        for (fi, f) in self.facets.iter().enumerate() {
-            for k in 0..3 {
-                let v = f[k] as usize;
-                around[next[v] as usize] = [fi as u32, f[(k + 1) % 3], f[(k + 2) % 3]];
-                next[v] += 1;
-            }
-        }
-        drop(next);
+        let around = CompressedRows::per_corner(self, |fi, f, k| {
+            (f[k], [fi, f[(k + 1) % 3], f[(k + 2) % 3]])
+        });
         let mut parent: Vec<u32> = (0..nf as u32).collect();
         fn find(p: &mut [u32], mut x: u32) -> u32 {
             while p[x as usize] != x {
@@ -510,9 +493,7 @@ impl Mesh {
                 // The other facets with the edge a–b, and whether they run b→a (b just
                 // before a).
                 let (mut others, mut opposite, mut other) = (0, true, 0u32);
-                for &[g, after, before] in
-                    &around[start[a as usize] as usize..start[a as usize + 1] as usize]
-                {
+                for &[g, after, before] in around.row(a as usize) {
                     if g as usize != fi && (after == b || before == b) {
                         others += 1;
                         other = g;

@@ -112,41 +112,41 @@ impl Job {
         // Each instance's vertices are placed where they land in the merged mesh; a job of
         // one instance takes its part's welded mesh as it is: no copy of the mesh, which on a
         // million facets is 24 MB a copy (a page worker's memory never shrinks).
-        let mut mesh = if let [only] = order[..] {
-            std::mem::take(&mut welded[only.part])
-        } else {
-            let vertices: usize = order.iter().map(|x| welded[x.part].vertices.len()).sum();
-            Mesh {
-                vertices: Vec::with_capacity(vertices),
-                facets: Vec::with_capacity(facets),
-            }
-        };
-        let merged = order.len() > 1;
         let mut groups: Vec<FacetGroup> = Vec::new();
-        for inst in order {
-            let part = &welded[inst.part];
-            let base = if merged { mesh.vertices.len() } else { 0 };
-            if merged {
-                mesh.vertices.extend_from_slice(&part.vertices);
-                mesh.facets
-                    .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
-            }
-            let placement = spec.parts[inst.part].placement(inst.shift, &settings);
-            mesh::place_vertices(&mut mesh.vertices[base..], &placement);
-            let count = if merged {
-                part.facets.len()
-            } else {
-                mesh.facets.len()
-            };
+        let mut add_to_run = |part: usize, count: usize| {
             // Runs are numbered from 0 in order: run r is the (r + 1)-th group.
-            match groups.get_mut(run_of[inst.part]) {
+            match groups.get_mut(run_of[part]) {
                 Some(g) => g.facets += count,
                 None => groups.push(FacetGroup {
                     facets: count,
-                    unit: spec.parts[inst.part].unit,
+                    unit: spec.parts[part].unit,
                 }),
             }
-        }
+        };
+        let mesh = if let [only] = order[..] {
+            let mut mesh = std::mem::take(&mut welded[only.part]);
+            let placement = spec.parts[only.part].placement(only.shift, &settings);
+            mesh::place_vertices(&mut mesh.vertices, &placement);
+            add_to_run(only.part, mesh.facets.len());
+            mesh
+        } else {
+            let vertices: usize = order.iter().map(|x| welded[x.part].vertices.len()).sum();
+            let mut mesh = Mesh {
+                vertices: Vec::with_capacity(vertices),
+                facets: Vec::with_capacity(facets),
+            };
+            for inst in order {
+                let part = &welded[inst.part];
+                let base = mesh.vertices.len();
+                mesh.vertices.extend_from_slice(&part.vertices);
+                mesh.facets
+                    .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
+                let placement = spec.parts[inst.part].placement(inst.shift, &settings);
+                mesh::place_vertices(&mut mesh.vertices[base..], &placement);
+                add_to_run(inst.part, part.facets.len());
+            }
+            mesh
+        };
         drop(welded);
         if groups.iter().all(|g| g.unit == 0) {
             groups.clear();
