@@ -2,6 +2,14 @@
 
 use crate::base::geom::{Point, segment_distance2};
 
+/// `x.floor() as i64`, exactly (NaN → 0, saturating beyond the range), without a call to libm's
+/// `floor` (the baseline x86-64 target has no rounding instruction): the grids' cell numbers.
+#[inline]
+pub fn floor_i64(x: f64) -> i64 {
+    let i = x as i64;
+    i.saturating_sub(i64::from((i as f64) > x))
+}
+
 /// Calls `f(x, y)` for the cells at Chebyshev distance exactly `r` from (cx, cy) that lie inside an
 /// `nx` × `ny` grid: the ring searched in step `r` of a nearest-neighbour search.
 pub fn each_ring_cell(cx: i64, cy: i64, r: i64, nx: i64, ny: i64, mut f: impl FnMut(i64, i64)) {
@@ -62,12 +70,12 @@ impl<'a> EdgeIndex<'a> {
         }
         let spread = ((max[0] - min[0]) * (max[1] - min[1]) / edges.len().max(1) as f64).sqrt();
         let cell = cell.max(spread);
-        let nx = ((max[0] - min[0]) / cell).floor() as i64 + 1;
-        let ny = ((max[1] - min[1]) / cell).floor() as i64 + 1;
+        let nx = floor_i64((max[0] - min[0]) / cell) + 1;
+        let ny = floor_i64((max[1] - min[1]) / cell) + 1;
         let cell_of = |p: Point| {
             (
-                (((p[0] - min[0]) / cell).floor() as i64).clamp(0, nx - 1),
-                (((p[1] - min[1]) / cell).floor() as i64).clamp(0, ny - 1),
+                floor_i64((p[0] - min[0]) / cell).clamp(0, nx - 1),
+                floor_i64((p[1] - min[1]) / cell).clamp(0, ny - 1),
             )
         };
         let mut counts = vec![0u32; (nx * ny) as usize + 1];
@@ -109,8 +117,8 @@ impl<'a> EdgeIndex<'a> {
         if self.edges.is_empty() {
             return 0.0;
         }
-        let cx = ((p[0] - self.min[0]) / self.cell).floor() as i64;
-        let cy = ((p[1] - self.min[1]) / self.cell).floor() as i64;
+        let cx = floor_i64((p[0] - self.min[0]) / self.cell);
+        let cy = floor_i64((p[1] - self.min[1]) / self.cell);
         let mut best = f64::INFINITY;
         let max_r = self.nx.max(self.ny) + cx.abs().max(cy.abs());
         for r in 0..=max_r {
@@ -136,8 +144,7 @@ impl<'a> EdgeIndex<'a> {
         if self.edges.is_empty() {
             return false;
         }
-        let cell =
-            |v: f64, min: f64, n: i64| (((v - min) / self.cell).floor() as i64).clamp(0, n - 1);
+        let cell = |v: f64, min: f64, n: i64| floor_i64((v - min) / self.cell).clamp(0, n - 1);
         let (x0, x1) = (
             cell(p[0] - r, self.min[0], self.nx),
             cell(p[0] + r, self.min[0], self.nx),
@@ -483,6 +490,46 @@ impl Tiles {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn floor_i64_is_floor_as_i64() {
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            -1.0 - f64::EPSILON,
+            1.0 - f64::EPSILON / 2.0,
+            -(1.0 - f64::EPSILON / 2.0),
+            4503599627370495.5,
+            -4503599627370495.5,
+            9.3e18,
+            -9.3e18,
+            i64::MIN as f64,
+            1e300,
+            -1e300,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        // Pseudo-random values of every scale (a fixed sequence: repeatable).
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..100_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let unit = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let x = (unit - 0.5) * 10f64.powi((state % 40) as i32 - 20);
+            xs.extend([x, x.floor(), x.ceil()]);
+        }
+        for x in xs {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x:e}");
+        }
+    }
 
     #[test]
     fn tiles_store_only_what_was_marked() {

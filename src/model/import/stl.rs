@@ -139,14 +139,16 @@ fn binary_count(bytes: &[u8]) -> Option<usize> {
 }
 
 fn parse_binary(bytes: &[u8], n: usize) -> Triangles {
-    let f = |b: &[u8], o: usize| f32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
     bytes[84..]
         .chunks_exact(50)
         .take(n)
         .map(|rec| {
+            // A record as an array: the offsets below are checked when compiled, not per byte.
+            let rec: &[u8; 50] = rec.try_into().expect("chunks of 50 bytes");
+            let f = |o: usize| f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]);
             let v = |k: usize| {
                 let o = 12 + 12 * k;
-                [f(rec, o), f(rec, o + 4), f(rec, o + 8)]
+                [f(o), f(o + 4), f(o + 8)]
             };
             [v(0), v(1), v(2)]
         })
