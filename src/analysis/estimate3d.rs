@@ -5,7 +5,7 @@ use super::droplet::spheroid_half_height;
 use super::raster::region_spans;
 use crate::base::geom::{Point, Shapes, all_contours};
 use crate::base::settings::Settings;
-use crate::base::spatial::{Segment, Spot, Tiles};
+use crate::base::spatial::{Segment, Spot, Tiles, floor_i64};
 
 #[cfg(any(test, feature = "reference"))]
 mod reference;
@@ -67,19 +67,6 @@ impl<'a> MapRow<'a> {
             }
         }
         (ix, &[], i64::MAX)
-    }
-}
-
-/// ⌊t⌋ as an integer, as `t.floor() as i64` gives it (saturating; 0 for NaN) but without a
-/// call to libm's `floor` (the baseline x86-64 target has no rounding instruction): this was
-/// a fifth of the height maps' time.
-#[inline]
-fn floor_i64(t: f64) -> i64 {
-    let i = t as i64;
-    if (i as f64) > t {
-        i.saturating_sub(1)
-    } else {
-        i
     }
 }
 

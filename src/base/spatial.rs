@@ -3,7 +3,10 @@
 use crate::base::geom::{Point, segment_distance2};
 
 /// `x.floor() as i64`, exactly (NaN → 0, saturating beyond the range), without a call to libm's
-/// `floor` (the baseline x86-64 target has no rounding instruction): the grids' cell numbers.
+/// `floor` (the baseline x86-64 target has no rounding instruction): the cell numbers of the
+/// grids here and of the 3D estimate's height maps. (The support's droplet grids have a
+/// cheaper one for |x| < 2⁵¹, `support::droplets::grid::floor`, which their per-droplet loops
+/// need: this one there cost their fill a fifth more instructions.)
 #[inline]
 pub fn floor_i64(x: f64) -> i64 {
     let i = x as i64;
@@ -504,6 +507,10 @@ mod tests {
             1.0 - f64::EPSILON / 2.0,
             -(1.0 - f64::EPSILON / 2.0),
             4503599627370495.5,
+            2_251_799_813_685_247.0,
+            -2_251_799_813_685_247.5,
+            123_456.789,
+            -1e-300,
             -4503599627370495.5,
             9.3e18,
             -9.3e18,
