@@ -60,8 +60,6 @@ pub fn all_contours(region: &Shapes) -> impl Iterator<Item = &Contour> {
 pub const OUTPUT_DECIMALS: usize = 4;
 /// 10^[`OUTPUT_DECIMALS`]: a position in output units is `(v * OUTPUT_SCALE).round()`.
 pub const OUTPUT_SCALE: f64 = 10_000.0;
-/// [`OUTPUT_SCALE`] as an integer.
-pub const OUTPUT_SCALE_INT: u64 = 10_000;
 
 /// `p` rounded to the output precision, as written in the code.
 pub fn round_output(p: Point) -> Point {
