@@ -263,6 +263,53 @@ test("a job link too big to embed asks for its files, says which are missing, an
   await other.context.close();
 });
 
+test("a worker's refused import leaves none of the files asked for: the job queued behind it is refused, not prepared from the earlier file", async () => {
+  // The page posts a worker's import and the job's opening together (client.ts syncThenOpen),
+  // so the opening must not find an earlier file of the same name when the import failed.
+  // (With the worker's clean-up after a refusal taken out, the job is prepared and this fails.)
+  const { page } = main;
+  const spec = { settings: {}, parts: [{ file: "cube_20mm_ascii.stl" }] };
+  const r = await page.evaluate(
+    async ({ spec, cubeText }) => {
+      const w = new Worker(new URL("worker.js", location.href), { type: "module" });
+      const pending = new Map();
+      w.onmessage = (ev) => {
+        const m = ev.data;
+        if (m.kind === "result" || m.kind === "error") pending.get(m.id)?.(m);
+      };
+      let id = 0;
+      const call = (kind, data) =>
+        new Promise((resolve) => {
+          pending.set(++id, resolve);
+          w.postMessage({ id, kind, data });
+        });
+      const name = spec.parts[0].file;
+      const good = new File([cubeText], name);
+      // a binary STL header announcing 117 million facets in 300 bytes
+      const bad = new File([new Uint8Array(300).fill(7)], "bad.stl");
+      try {
+        const added = await call("models_add", { files: [{ name, file: good }], hash: false });
+        const opened = await call("open_job", { job: spec });
+        // as syncThenOpen posts them: at once, the opening queued behind the import
+        const [refused, reopened] = await Promise.all([
+          call("models_add", { files: [{ name, file: good }, { name: "bad.stl", file: bad }], hash: false }),
+          call("open_job", { job: spec }),
+        ]);
+        return { added: added.kind, opened: opened.kind, openedWhy: opened.data?.message, refused: refused.kind, refusal: refused.data?.message, reopened: reopened.kind, why: reopened.data?.message };
+      } finally {
+        w.terminate();
+      }
+    },
+    { spec, cubeText: readFileSync(cube, "utf8") },
+  );
+  assert.equal(r.added, "result");
+  assert.equal(r.opened, "result", `the job opens from the file while the worker holds it: ${r.openedWhy}`);
+  assert.equal(r.refused, "error");
+  assert.match(r.refusal, /not an STL file/);
+  assert.equal(r.reopened, "error", "the job must not be prepared from the file held before the refused import");
+  assert.match(r.why, new RegExp(spec.parts[0].file.replace(/[.]/g, "\\.")));
+});
+
 test("a part of 1,000,000 facets: the 3D view draws a decimated copy (at most 300,000 triangles)", async () => {
   const big = await openPage(env.browser, env.url);
   const { page, errors } = big;
