@@ -9,3 +9,5 @@ pub mod parallel;
 pub mod settings;
 pub mod spatial;
 pub mod stages;
+#[cfg(test)]
+pub(crate) mod testing;

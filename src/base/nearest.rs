@@ -210,13 +210,7 @@ pub fn nearest_walk(starts: &[Point], from: Point, end: impl Fn(usize) -> Point)
 mod tests {
     use super::*;
 
-    /// A small deterministic generator (xorshift), for random inputs.
-    fn random(seed: &mut u64) -> f64 {
-        *seed ^= *seed << 13;
-        *seed ^= *seed >> 7;
-        *seed ^= *seed << 17;
-        (*seed >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::base::testing::random;
 
     /// The list walk of [`nearest_walk`]'s description, step by step.
     fn list_walk(starts: &[Point], from: Point, end: impl Fn(usize) -> Point) -> Vec<usize> {

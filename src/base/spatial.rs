@@ -496,44 +496,7 @@ mod tests {
 
     #[test]
     fn floor_i64_is_floor_as_i64() {
-        let mut xs = vec![
-            0.0,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            -1.0 - f64::EPSILON,
-            1.0 - f64::EPSILON / 2.0,
-            -(1.0 - f64::EPSILON / 2.0),
-            4503599627370495.5,
-            2_251_799_813_685_247.0,
-            -2_251_799_813_685_247.5,
-            123_456.789,
-            -1e-300,
-            -4503599627370495.5,
-            9.3e18,
-            -9.3e18,
-            i64::MIN as f64,
-            1e300,
-            -1e300,
-            f64::MIN_POSITIVE,
-            -f64::MIN_POSITIVE,
-            f64::NAN,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        // Pseudo-random values of every scale (a fixed sequence: repeatable).
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        for _ in 0..100_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let unit = (state >> 11) as f64 / (1u64 << 53) as f64;
-            let x = (unit - 0.5) * 10f64.powi((state % 40) as i32 - 20);
-            xs.extend([x, x.floor(), x.ceil()]);
-        }
-        for x in xs {
+        for x in crate::base::testing::floor_cases() {
             assert_eq!(floor_i64(x), x.floor() as i64, "{x:e}");
         }
     }

@@ -301,10 +301,7 @@ mod tests {
         // Pseudo-random values of every scale (a fixed sequence: the test is repeatable).
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
         for _ in 0..200_000 {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let unit = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let unit = crate::base::testing::random(&mut state);
             let scale = 10f64.powi((state % 14) as i32 - 5);
             let x = (unit - 0.5) * scale;
             xs.extend([x, (x * 1e4).round() / 1e4, ((x * 1e4).floor() + 0.5) / 1e4]);

@@ -151,13 +151,7 @@ mod tests {
         }
     }
 
-    /// A small deterministic generator (xorshift), for random inputs.
-    fn random(seed: &mut u64) -> f64 {
-        *seed ^= *seed << 13;
-        *seed ^= *seed >> 7;
-        *seed ^= *seed << 17;
-        (*seed >> 11) as f64 / (1u64 << 53) as f64
-    }
+    use crate::base::testing::random;
 
     #[test]
     fn greedy_takes_the_nearest_end_as_a_scan_of_every_end_does() {

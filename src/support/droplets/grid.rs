@@ -236,37 +236,12 @@ mod tests {
 
     #[test]
     fn floor_is_the_floor() {
-        for x in [
-            0.0,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            1.5,
-            -1.5,
-            2.5,
-            -2.5,
-            0.999_999_999,
-            -1e-300,
-            1e-300,
-            123_456.789,
-            -123_456.789,
-            2_251_799_813_685_247.0,
-            -2_251_799_813_685_247.5,
-            f64::EPSILON,
-            1.0 - f64::EPSILON / 2.0,
-            -(1.0 - f64::EPSILON / 2.0),
-        ] {
-            assert_eq!(floor(x), x.floor() as i64, "{x}");
-        }
-        let mut v = 0x9e37_79b9_7f4a_7c15_u64;
-        for _ in 0..100_000 {
-            v ^= v << 13;
-            v ^= v >> 7;
-            v ^= v << 17;
-            let x = ((v >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e6;
-            assert_eq!(floor(x), x.floor() as i64, "{x}");
+        // its range: |x| < 2⁵¹
+        for x in crate::base::testing::floor_cases()
+            .into_iter()
+            .filter(|x| x.abs() < 2_251_799_813_685_248.0)
+        {
+            assert_eq!(floor(x), x.floor() as i64, "{x:e}");
         }
     }
 
@@ -275,12 +250,7 @@ mod tests {
         // Droplets of two widths in clusters and a sparse spread, queries inside and outside
         // the grid and right at the reach: the grid answers "is there one" as a full scan.
         let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut random = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut random = || crate::base::testing::random(&mut seed);
         let (b, b1, limit) = (0.208, 0.15, 0.104);
         let reach = |w: f64| w / 2.0 + limit;
         let (mut found, mut missed) = (0, 0);
