@@ -133,6 +133,20 @@ impl Mesh {
     /// [`remove_duplicate_facets`](Self::remove_duplicate_facets), returning which of the
     /// facets before were kept (the others keep their order).
     pub fn remove_duplicate_facets_kept(&mut self) -> Vec<bool> {
+        let kept = self.unrepeated_facets();
+        self.keep_facets(&kept);
+        kept
+    }
+
+    /// Keeps the facets `kept` marks (from [`Mesh::unrepeated_facets`]), in their order.
+    pub fn keep_facets(&mut self, kept: &[bool]) {
+        let mut it = kept.iter();
+        self.facets.retain(|_| *it.next().unwrap_or(&true));
+    }
+
+    /// Per facet, whether [`remove_duplicate_facets`](Self::remove_duplicate_facets) keeps it:
+    /// false for a repeat of an earlier facet. Reads the mesh only.
+    pub fn unrepeated_facets(&self) -> Vec<bool> {
         // Each facet as the cyclic rotation starting at its smallest vertex id; two facets are
         // equal exactly when these are. The facets are bucketed by that smallest vertex (in
         // their order), and within a bucket a facet is a repeat when an earlier one equals it:
@@ -186,8 +200,6 @@ impl Mesh {
                 }
             }
         }
-        let mut it = kept.iter();
-        self.facets.retain(|_| *it.next().unwrap_or(&true));
         kept
     }
 

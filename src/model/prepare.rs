@@ -216,10 +216,14 @@ pub(crate) fn check_volume(
 }
 
 /// Cracks between near-coincident corners: when the exact weld left open edges, a tolerance
-/// weld, kept if it leaves fewer. Returns the shells of the mesh as it is then, and how many
-/// vertices were merged and facets dropped.
-pub(crate) fn close_cracks(mesh: &mut Mesh, groups: &mut [FacetGroup]) -> (Shells, (usize, usize)) {
-    let shells = mesh.shells();
+/// weld, kept if it leaves fewer. `shells` are the mesh's ([`Mesh::shells`]). Returns the
+/// shells of the mesh as it is then, and how many vertices were merged and facets dropped
+/// (both 0: the mesh is unchanged).
+pub(crate) fn close_cracks(
+    mesh: &mut Mesh,
+    shells: Shells,
+    groups: &mut [FacetGroup],
+) -> (Shells, (usize, usize)) {
     if shells.open_edges == 0 {
         return (shells, (0, 0));
     }

@@ -238,6 +238,15 @@ impl Mesh {
     /// a grid of the shells' boxes. Index look-ups, box tests and facet evaluations together
     /// stay under [`ENCLOSURE_BUDGET`].
     pub fn orient(&mut self, shells: &Shells) -> ShellOrientation {
+        let (out, flip) = self.orientation(shells);
+        self.turn(shells, &flip);
+        out
+    }
+
+    /// What [`Mesh::orient`] finds, without turning anything: the figures, and per shell
+    /// whether to turn it (empty when none is turned; [`Mesh::turn`] turns them). Reads the
+    /// mesh only, so other work on the mesh as it is may run beside it.
+    pub fn orientation(&self, shells: &Shells) -> (ShellOrientation, Vec<bool>) {
         let mut out = ShellOrientation::default();
         let Shells {
             facet_shell,
@@ -246,7 +255,7 @@ impl Mesh {
             ..
         } = shells;
         if self.facets.is_empty() || facet_shell.len() != self.facets.len() {
-            return out;
+            return (out, Vec::new());
         }
         let n = closed.len();
         out.closed = closed.iter().filter(|&&c| c).count();
@@ -296,7 +305,7 @@ impl Mesh {
         let queries: Vec<usize> = (0..n).filter(|&s| inverted(s)).collect();
         if queries.is_empty() {
             out.closed_volume = (0..n).filter(|&s| closed[s]).map(|s| volume[s].abs()).sum();
-            return out;
+            return (out, Vec::new());
         }
         let (start, grouped) = group_by_shell(facet_shell, n);
         // Shells that may enclose another: every closed one, and open ones of 2 facets or more.
@@ -342,15 +351,24 @@ impl Mesh {
                 }
             }
         }
-        if out.flipped + out.flipped_open > 0 {
-            for (fi, f) in self.facets.iter_mut().enumerate() {
-                if flip[facet_shell[fi] as usize] {
-                    f.swap(1, 2);
-                }
-            }
+        if out.flipped + out.flipped_open == 0 {
+            flip.clear();
         }
         out.closed_volume = (0..n).filter(|&s| closed[s]).map(|s| volume[s].abs()).sum();
-        out
+        (out, flip)
+    }
+
+    /// Turns the shells `flip` marks (from [`Mesh::orientation`] of the same `shells`): each
+    /// of their facets reversed. Nothing to do for an empty `flip`.
+    pub fn turn(&mut self, shells: &Shells, flip: &[bool]) {
+        if flip.is_empty() {
+            return;
+        }
+        for (fi, f) in self.facets.iter_mut().enumerate() {
+            if flip[shells.facet_shell[fi] as usize] {
+                f.swap(1, 2);
+            }
+        }
     }
 
     /// Bounding boxes, first facet and facet count of the `n` shells.

@@ -192,20 +192,47 @@ impl Job {
         // meant it (inside-out shells turned outward, cavities kept), so the volume below
         // counts what will be printed: shells of opposite orientation can no longer cancel.
         let mut groups = input.groups;
-        let kept = mesh.remove_duplicate_facets_kept();
+        let zs = plane_heights(&size, &settings);
+        // The facet index beside the repeated facets and the shells, and the statistics
+        // beside the shells' orientation: each reads the mesh as it is then, which the steps
+        // beside it leave as it is on a sound mesh (the index needs only the vertices and the
+        // facets' numbers, which turning a shell keeps). Where facets are dropped, the cracks
+        // closed or a shell is turned, they are made again from the changed mesh (the job is
+        // checked before the index is used).
+        let ((kept, mesh_shells), index) = both(
+            || {
+                let kept = mesh.unrepeated_facets();
+                let shells = kept.iter().all(|&k| k).then(|| mesh.shells());
+                (kept, shells)
+            },
+            || zs.as_ref().ok().map(|zs| FacetBuckets::new(&mesh, zs)),
+        );
         let duplicates = kept.iter().filter(|&&k| !k).count();
-        keep_groups(&mut groups, &kept);
-        let (mesh_shells, weld) = close_cracks(&mut mesh, &mut groups);
-        let shells = mesh.orient(&mesh_shells);
+        let (mesh_shells, index) = match mesh_shells {
+            Some(shells) => (shells, index),
+            None => {
+                mesh.keep_facets(&kept);
+                keep_groups(&mut groups, &kept);
+                (mesh.shells(), None)
+            }
+        };
+        let (mesh_shells, weld) = close_cracks(&mut mesh, mesh_shells, &mut groups);
+        let index = index.filter(|_| weld == (0, 0));
+        let dropped = input.degenerate + weld.1;
+        let ((shells, flip), stats) = both(
+            || mesh.orientation(&mesh_shells),
+            || mesh.stats(input.facets_in_file, dropped),
+        );
+        let stats = (flip.is_empty()).then_some(stats);
+        mesh.turn(&mesh_shells, &flip);
         drop(mesh_shells);
         let volume = check_volume(&mesh, &shells, &size)?;
         // One droplet estimate for the whole job: every unit and the support.
         let unit1 = budget::Unit1Parts::of(&mesh, &groups);
         let open = shells.open > 0;
         let support = !open && settings.support != crate::base::settings::Support::Off;
-        let zs = plane_heights(&size, &settings);
-        // The support's overhang figures for the estimate beside the statistics and the facet
-        // index (the job is checked before the index is used).
+        // The support's overhang figures for the estimate beside what is left of the
+        // statistics and the facet index.
         let (overhangs, repaired) = both(
             || {
                 if support {
@@ -220,15 +247,11 @@ impl Job {
             },
             || {
                 let zs = zs.as_ref().ok()?;
-                Some(repair(
-                    &mesh,
-                    zs,
-                    &shells,
-                    weld,
-                    duplicates,
-                    input.facets_in_file,
-                    input.degenerate,
-                ))
+                let (stats, buckets) = both(
+                    || stats.unwrap_or_else(|| mesh.stats(input.facets_in_file, dropped)),
+                    || index.unwrap_or_else(|| FacetBuckets::new(&mesh, zs)),
+                );
+                Some((buckets, repaired(stats, &shells, weld, duplicates)))
             },
         );
         let mut estimate = budget::Estimate::new(
@@ -322,22 +345,14 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
     Ok(zs)
 }
 
-/// Mesh statistics and index: the facet index per layer and what the repair did.
-fn repair(
-    mesh: &Mesh,
-    zs: &[f64],
+/// The mesh statistics with what the repair did.
+fn repaired(
+    stats: MeshStats,
     shells: &ShellOrientation,
-    (welded, dropped): (usize, usize),
+    (welded, _): (usize, usize),
     duplicates: usize,
-    facets_in_file: usize,
-    degenerate: usize,
-) -> (FacetBuckets, MeshStats) {
-    // The statistics and the facet index are independent: build them side by side.
-    let (stats, buckets) = both(
-        || mesh.stats(facets_in_file, degenerate + dropped),
-        || FacetBuckets::new(mesh, zs),
-    );
-    let stats = MeshStats {
+) -> MeshStats {
+    MeshStats {
         duplicate_facets: duplicates,
         tolerance_welded: welded,
         flipped_shells: shells.flipped,
@@ -345,8 +360,7 @@ fn repair(
         cavity_shells: shells.cavities,
         unchecked_shells: shells.unchecked,
         ..stats
-    };
-    (buckets, stats)
+    }
 }
 
 /// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
@@ -380,4 +394,127 @@ fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f6
         })
         .sum();
     total / samples as f64 * n as f64 * h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type Tri = [[f32; 3]; 3];
+
+    /// A closed box of 12 facets, outward, corner `o`, size `s`.
+    fn cube(o: [f32; 3], s: f32) -> Vec<Tri> {
+        let p = |i: usize| {
+            let b = [i & 1, (i >> 1) & 1, (i >> 2) & 1];
+            [0, 1, 2].map(|k| o[k] + s * b[k] as f32)
+        };
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        quads
+            .iter()
+            .flat_map(|q| [[p(q[0]), p(q[1]), p(q[2])], [p(q[0]), p(q[2]), p(q[3])]])
+            .collect()
+    }
+
+    fn stl(tris: &[Tri]) -> Vec<u8> {
+        let mut b = vec![0u8; 80];
+        b.extend((tris.len() as u32).to_le_bytes());
+        for t in tris {
+            b.extend([0u8; 12]);
+            for v in t {
+                for c in v {
+                    b.extend(c.to_le_bytes());
+                }
+            }
+            b.extend([0u8; 2]);
+        }
+        b
+    }
+
+    /// The statistics and the facet index are made beside the steps that may change the mesh
+    /// (repeated facets dropped, cracks closed, shells turned) and made again where one did:
+    /// on every kind of damage they equal what the final mesh gives.
+    #[test]
+    fn the_index_and_statistics_made_beside_the_repair_are_those_of_the_repaired_mesh() {
+        let sound = [cube([0.0; 3], 10.0), cube([20.0, 0.0, 0.0], 6.0)].concat();
+        let inside_out = |t: &Tri| [t[0], t[2], t[1]];
+        // Each case with what the repair must have done: (repeats dropped, vertices merged,
+        // shells turned).
+        let mut damaged: Vec<(&str, Vec<Tri>, [bool; 3])> =
+            vec![("sound", sound.clone(), [false; 3])];
+        let mut repeated = sound.clone();
+        repeated.extend_from_slice(&sound[3..7]);
+        damaged.push(("repeated facets", repeated, [true, false, false]));
+        let mut turned = sound.clone();
+        for t in &mut turned[12..] {
+            *t = inside_out(t);
+        }
+        damaged.push(("one shell inside out", turned, [false, false, true]));
+        // A crack: one corner of the second box moved by less than the tolerance weld's
+        // distance in the facets that hold it, but not in the others.
+        let mut cracked = sound.clone();
+        let corner = cracked[12][0];
+        for t in cracked[12..18].iter_mut() {
+            for v in t.iter_mut().filter(|v| **v == corner) {
+                v[0] += 2e-5;
+            }
+        }
+        // and a sliver first whose two close corners the tolerance weld merges: it is dropped,
+        // so every later facet's number changes.
+        let a = sound[0][0];
+        cracked.insert(0, [a, [a[0] + 2e-5, a[1], a[2]], sound[0][1]]);
+        damaged.push(("a crack", cracked, [false, true, false]));
+        let mut all = sound.clone();
+        all.extend_from_slice(&sound[0..2]);
+        for t in &mut all[12..24] {
+            *t = inside_out(t);
+        }
+        all[5][1][1] += 3e-5;
+        damaged.push(("all at once", all, [true; 3]));
+        for (what, tris, repairs) in damaged {
+            let job = Job::new(&stl(&tris), "x.stl", Settings::default()).expect(what);
+            let info = job.info();
+            let m = &info.mesh;
+            let done = [
+                m.duplicate_facets > 0,
+                m.tolerance_welded > 0,
+                m.flipped_shells > 0,
+            ];
+            assert_eq!(done, repairs, "{what}: {m:?}");
+            let fresh = job
+                .mesh
+                .stats(info.mesh.facets_in_file, info.mesh.degenerate_facets);
+            let got = &info.mesh;
+            assert_eq!(
+                (
+                    got.facets,
+                    got.vertices,
+                    got.open_edges,
+                    got.nonmanifold_edges
+                ),
+                (
+                    fresh.facets,
+                    fresh.vertices,
+                    fresh.open_edges,
+                    fresh.nonmanifold_edges
+                ),
+                "{what}"
+            );
+            assert_eq!(
+                (got.misoriented_edges, got.signed_volume, got.bodies),
+                (fresh.misoriented_edges, fresh.signed_volume, fresh.bodies),
+                "{what}"
+            );
+            let index = FacetBuckets::new(&job.mesh, &job.zs);
+            for i in 0..job.zs.len() {
+                assert_eq!(job.buckets.layer(i), index.layer(i), "{what}: layer {i}");
+            }
+        }
+    }
 }
