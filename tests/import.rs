@@ -1147,9 +1147,29 @@ fn weld_is_the_plain_one_pass_weld() {
         .map(|_| [corner(next()), corner(next()), corner(next())])
         .collect();
     soups.push(("crafted soup".into(), soup));
+    // A larger soup (welded in two halves side by side, Mesh::weld from 50,000 to 2M facets), whose
+    // corners come from a set that grows along it, so some vertices first appear in each half.
+    let wide = |c: u64, i: u64| -> [f32; 3] {
+        let z = if c.is_multiple_of(7) {
+            if i.is_multiple_of(2) { 0.0 } else { -0.0 }
+        } else {
+            (c % 13) as f32 * 0.25
+        };
+        [(c % 37) as f32 - 18.0, (c / 37) as f32 * 0.5, z]
+    };
+    let large: Vec<Tri> = (0..120_000u64)
+        .map(|j| {
+            let range = 60 + j / 50;
+            [0, 1, 2].map(|_| {
+                let i = next();
+                wide(i % range, i)
+            })
+        })
+        .collect();
+    soups.push(("crafted soup, large".into(), large));
     for (name, tris) in &soups {
         let (vertices, facets, degenerate) = weld_oracle(tris);
-        if name == "crafted soup" {
+        if name.starts_with("crafted soup") {
             let zeros = |sign: bool| {
                 tris.iter()
                     .flatten()

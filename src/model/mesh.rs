@@ -82,6 +82,14 @@ impl Mesh {
     /// Welds corners whose float32 coordinates are bit-identical (−0 = +0) and drops facets
     /// that collapse to a line or a point.
     pub fn weld(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
+        if cfg!(not(target_arch = "wasm32")) && WELD_HALVES.contains(&tris.len()) {
+            return Self::weld_in_halves(tris);
+        }
+        Self::weld_in_one(tris)
+    }
+
+    /// [`Mesh::weld`] in one pass: each corner looked up in one map of every vertex so far.
+    fn weld_in_one(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
         let mut index: HashMap<[u32; 3], u32> =
             HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
         let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
@@ -89,8 +97,7 @@ impl Mesh {
         let mut degenerate = 0;
         for t in tris {
             let ids = t.map(|p| {
-                let key = p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() });
-                *index.entry(key).or_insert_with(|| {
+                *index.entry(weld_key(p)).or_insert_with(|| {
                     vertices.push(p.map(f64::from));
                     (vertices.len() - 1) as u32
                 })
@@ -101,6 +108,43 @@ impl Mesh {
                 facets.push(ids);
             }
         }
+        (Mesh { vertices, facets }, degenerate)
+    }
+
+    /// [`Mesh::weld`] as two halves of the facets welded side by side, each into a map of its
+    /// own, then joined: a vertex of the second half that the first has takes its number, the
+    /// others follow in the order they were first met. That is the one pass' numbering,
+    /// vertex for vertex and facet for facet.
+    fn weld_in_halves(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
+        let (first, second) = tris.split_at(tris.len() / 2);
+        let ((index, mut vertices, mut facets), (later_index, later, later_ids)) =
+            crate::base::parallel::both(
+                // the first half's lists take the whole mesh (no copy when they grow)
+                || weld_local(first, tris.len(), tris.len() / 2 + 16),
+                || weld_local(second, second.len(), second.len() / 2 + 16),
+            );
+        drop(later_index);
+        // (f32 → f64 → f32 is exact: the key of the corner as read)
+        let joined: Vec<u32> = later
+            .iter()
+            .map(|p| match index.get(&weld_key(p.map(|c| c as f32))) {
+                Some(&v) => v,
+                None => {
+                    vertices.push(*p);
+                    (vertices.len() - 1) as u32
+                }
+            })
+            .collect();
+        drop((index, later));
+        let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
+        facets.retain(distinct);
+        facets.extend(
+            later_ids
+                .iter()
+                .map(|f| f.map(|v| joined[v as usize]))
+                .filter(distinct),
+        );
+        let degenerate = tris.len() - facets.len();
         (Mesh { vertices, facets }, degenerate)
     }
 
@@ -370,6 +414,42 @@ impl Mesh {
         }
         (open, nonmanifold, misoriented)
     }
+}
+
+/// Files of this many facets are welded in two halves side by side ([`Mesh::weld`]; natively).
+/// Below, the join costs more than the halves save; above, memory decides: the halves' two
+/// maps and lists take up to twice the one pass' (where each half meets nearly every vertex,
+/// as in a file that lists every quad's first triangles before their second ones: +80 MB on
+/// 4M facets, over the largest files' memory target).
+const WELD_HALVES: std::ops::RangeInclusive<usize> = 50_000..=2_000_000;
+
+/// A corner's weld key: its coordinates' bits, −0 as +0.
+fn weld_key(p: [f32; 3]) -> [u32; 3] {
+    p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() })
+}
+
+/// One half of [`Mesh::weld_in_halves`]: the map of its vertices, the vertices in the order
+/// first met, and every facet's vertex numbers (collapsed ones too); the two lists with room
+/// for `vertices` and `facets`.
+#[allow(clippy::type_complexity)]
+fn weld_local(
+    tris: &[[[f32; 3]; 3]],
+    facets: usize,
+    vertices: usize,
+) -> (HashMap<[u32; 3], u32>, Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let mut index: HashMap<[u32; 3], u32> =
+        HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
+    let mut points = Vec::with_capacity(vertices);
+    let mut ids = Vec::with_capacity(facets);
+    ids.extend(tris.iter().map(|t| {
+        t.map(|p| {
+            *index.entry(weld_key(p)).or_insert_with(|| {
+                points.push(p.map(f64::from));
+                (points.len() - 1) as u32
+            })
+        })
+    }));
+    (index, points, ids)
 }
 
 /// The box of `vertices` ([`Bounds::EMPTY`] for none).
