@@ -180,3 +180,82 @@ fn diagnostics_in_summary_header_and_footer() {
     );
     let _ = std::fs::remove_file(&path);
 }
+
+/// `Job::new` builds the facet index beside the repeated-facet check and the shells, and the
+/// statistics beside the shells' orientation, and makes them again where such a step changed
+/// the mesh (facets dropped, cracks closed, a shell turned): on every kind of damage they are
+/// those of the final mesh.
+#[test]
+fn the_index_and_statistics_made_beside_the_repair_are_those_of_the_repaired_mesh() {
+    use dropslice::slicing::slice::{FacetBuckets, section_loops};
+    let sound = [
+        common::cuboid([0.0; 3], [10.0; 3]),
+        common::cuboid([20.0, 0.0, 0.0], [26.0, 6.0, 6.0]),
+    ]
+    .concat();
+    let inside_out = |t: &Tri| [t[0], t[2], t[1]];
+    // Each case with what the repair must have done: (repeats dropped, vertices merged,
+    // shells turned).
+    let mut damaged: Vec<(&str, Vec<Tri>, [bool; 3])> = vec![("sound", sound.clone(), [false; 3])];
+    let mut repeated = sound.clone();
+    repeated.extend_from_slice(&sound[3..7]);
+    damaged.push(("repeated facets", repeated, [true, false, false]));
+    let mut turned = sound.clone();
+    for t in &mut turned[12..] {
+        *t = inside_out(t);
+    }
+    damaged.push(("one shell inside out", turned, [false, false, true]));
+    // A crack: one corner of the second box moved by less than the tolerance weld's distance
+    // in some of the facets that hold it; and a sliver first whose two close corners that weld
+    // merges, so it is dropped and every later facet's number changes.
+    let mut cracked = sound.clone();
+    let corner = cracked[12][0];
+    for t in cracked[12..18].iter_mut() {
+        for v in t.iter_mut().filter(|v| **v == corner) {
+            v[0] += 2e-5;
+        }
+    }
+    let a = sound[0][0];
+    cracked.insert(0, [a, [a[0] + 2e-5, a[1], a[2]], sound[0][1]]);
+    damaged.push(("a crack", cracked, [false, true, false]));
+    let mut all = sound.clone();
+    all.extend_from_slice(&sound[0..2]);
+    for t in &mut all[12..24] {
+        *t = inside_out(t);
+    }
+    all[5][1][1] += 3e-5;
+    damaged.push(("all at once", all, [true; 3]));
+    for (what, tris, repairs) in damaged {
+        let job = Job::new(&binary(&tris), "x.stl", Settings::default()).expect(what);
+        let m = &job.info().mesh;
+        let done = [
+            m.duplicate_facets > 0,
+            m.tolerance_welded > 0,
+            m.flipped_shells > 0,
+        ];
+        assert_eq!(done, repairs, "{what}: {m:?}");
+        let fresh = job.mesh().stats(m.facets_in_file, m.degenerate_facets);
+        assert_eq!(
+            (m.facets, m.vertices, m.open_edges, m.nonmanifold_edges),
+            (
+                fresh.facets,
+                fresh.vertices,
+                fresh.open_edges,
+                fresh.nonmanifold_edges
+            ),
+            "{what}"
+        );
+        assert_eq!(
+            (m.misoriented_edges, m.signed_volume, m.bodies),
+            (fresh.misoriented_edges, fresh.signed_volume, fresh.bodies),
+            "{what}"
+        );
+        // Every layer's loops as sliced through a facet index of the final mesh.
+        let zs: Vec<f64> = (0..job.layer_count()).map(|i| job.plane_z(i)).collect();
+        let index = FacetBuckets::new(job.mesh(), &zs);
+        for (i, &z) in zs.iter().enumerate() {
+            let fresh = section_loops(job.mesh(), index.layer(i), z).0;
+            assert_eq!(job.section_loops(i), fresh, "{what}: layer {i}");
+        }
+    }
+}
