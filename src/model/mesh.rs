@@ -90,24 +90,9 @@ impl Mesh {
 
     /// [`Mesh::weld`] in one pass: each corner looked up in one map of every vertex so far.
     fn weld_in_one(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
-        let mut index: HashMap<[u32; 3], u32> =
-            HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
-        let mut vertices = Vec::with_capacity(tris.len() / 2 + 16);
-        let mut facets = Vec::with_capacity(tris.len());
-        let mut degenerate = 0;
-        for t in tris {
-            let ids = t.map(|p| {
-                *index.entry(weld_key(p)).or_insert_with(|| {
-                    vertices.push(p.map(f64::from));
-                    (vertices.len() - 1) as u32
-                })
-            });
-            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
-                degenerate += 1;
-            } else {
-                facets.push(ids);
-            }
-        }
+        let (_, vertices, mut facets) = weld_local(tris, tris.len(), tris.len() / 2 + 16);
+        facets.retain(distinct);
+        let degenerate = tris.len() - facets.len();
         (Mesh { vertices, facets }, degenerate)
     }
 
@@ -136,7 +121,6 @@ impl Mesh {
             })
             .collect();
         drop((index, later));
-        let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
         facets.retain(distinct);
         facets.extend(
             later_ids
@@ -428,9 +412,14 @@ fn weld_key(p: [f32; 3]) -> [u32; 3] {
     p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() })
 }
 
-/// One half of [`Mesh::weld_in_halves`]: the map of its vertices, the vertices in the order
-/// first met, and every facet's vertex numbers (collapsed ones too); the two lists with room
-/// for `vertices` and `facets`.
+/// Whether a welded facet's three vertices differ (it did not collapse).
+fn distinct(f: &[u32; 3]) -> bool {
+    f[0] != f[1] && f[1] != f[2] && f[0] != f[2]
+}
+
+/// The weld of `tris` ([`Mesh::weld_in_one`], or one half of [`Mesh::weld_in_halves`]): the
+/// map of its vertices, the vertices in the order first met, and every facet's vertex numbers
+/// (collapsed ones too); the two lists with room for `vertices` and `facets`.
 #[allow(clippy::type_complexity)]
 fn weld_local(
     tris: &[[[f32; 3]; 3]],
