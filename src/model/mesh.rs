@@ -3,6 +3,7 @@
 //! diagnostics (open and non-manifold edges). Its shells and their orientation: [`crate::model::shells`].
 
 use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
+use crate::base::parallel::in_runs;
 use crate::base::settings::Settings;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -179,55 +180,52 @@ impl Mesh {
         // equal exactly when these are. The facets are bucketed by that smallest vertex (in
         // their order), and within a bucket a facet is a repeat when an earlier one equals it:
         // a few sequential passes instead of a hash set of every facet.
-        let canon: Vec<[u32; 3]> = self
-            .facets
-            .iter()
-            .map(|f| {
+        // (Each pass in runs: [`in_runs`].)
+        let mut canon: Vec<[u32; 3]> = Vec::with_capacity(self.facets.len());
+        in_runs(self.facets.len(), &mut |r| {
+            canon.extend(self.facets[r].iter().map(|f| {
                 let k = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
                 [f[k], f[(k + 1) % 3], f[(k + 2) % 3]]
-            })
-            .collect();
+            }))
+        });
         let n = self
             .vertices
             .len()
             .max(canon.iter().map(|c| c[0] as usize + 1).max().unwrap_or(0));
         let mut start = vec![0u32; n + 1];
-        for c in &canon {
-            start[c[0] as usize + 1] += 1;
-        }
-        for v in 0..n {
-            start[v + 1] += start[v];
-        }
+        in_runs(canon.len(), &mut |r| {
+            // (slices of their own: their bounds stay in registers through the stores)
+            let start = &mut start[..];
+            for c in &canon[r] {
+                start[c[0] as usize + 1] += 1;
+            }
+        });
+        in_runs(n, &mut |r| {
+            for v in r {
+                start[v + 1] += start[v];
+            }
+        });
         let mut next = start.clone();
         let mut order = vec![0u32; canon.len()];
-        for (i, c) in canon.iter().enumerate() {
-            let at = &mut next[c[0] as usize];
-            order[*at as usize] = i as u32;
-            *at += 1;
-        }
+        in_runs(canon.len(), &mut |r| {
+            let (order, next) = (&mut order[..], &mut next[..]);
+            for (i, c) in r.clone().zip(&canon[r]) {
+                let at = &mut next[c[0] as usize];
+                order[*at as usize] = i as u32;
+                *at += 1;
+            }
+        });
         let mut kept = vec![true; canon.len()];
-        for v in 0..n {
-            let bucket = &mut order[start[v] as usize..start[v + 1] as usize];
-            if bucket.len() < 2 {
-                continue;
+        in_runs(n, &mut |r| {
+            let (order, kept) = (&mut order[..], &mut kept[..]);
+            for v in r {
+                repeats_in(
+                    &mut order[start[v] as usize..start[v + 1] as usize],
+                    &canon,
+                    kept,
+                );
             }
-            if bucket.len() > 16 {
-                // in facet order within equal keys (a stable sort), so the first is kept
-                bucket.sort_by_key(|&i| (canon[i as usize][1], canon[i as usize][2]));
-                for j in 1..bucket.len() {
-                    if canon[bucket[j] as usize] == canon[bucket[j - 1] as usize] {
-                        kept[bucket[j] as usize] = false;
-                    }
-                }
-                continue;
-            }
-            for j in 1..bucket.len() {
-                let c = canon[bucket[j] as usize];
-                if bucket[..j].iter().any(|&k| canon[k as usize] == c) {
-                    kept[bucket[j] as usize] = false;
-                }
-            }
-        }
+        });
         kept
     }
 
@@ -299,23 +297,28 @@ impl Mesh {
     pub fn bodies(&self) -> usize {
         let root = self.vertex_components();
         let mut used = vec![false; self.vertices.len()];
-        for f in &self.facets {
-            used[root[f[0] as usize] as usize] = true;
-        }
+        in_runs(self.facets.len(), &mut |r| {
+            let used = &mut used[..];
+            for f in &self.facets[r] {
+                used[root[f[0] as usize] as usize] = true;
+            }
+        });
         used.iter().filter(|&&u| u).count()
     }
 
     /// Volume enclosed by the facets, signed by their orientation (negative: inside out).
     pub fn signed_volume(&self) -> f64 {
-        self.facets
-            .iter()
-            .map(|f| {
+        // The sum in facet order from −0.0, as `Iterator::sum` adds (in runs: [`in_runs`]).
+        let mut sum = -0.0;
+        in_runs(self.facets.len(), &mut |r| {
+            for f in &self.facets[r] {
                 let [a, b, c] = f.map(|i| self.vertices[i as usize]);
-                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                sum += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
                     + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                    / 6.0
-            })
-            .sum()
+                    / 6.0;
+            }
+        });
+        sum
     }
 
     /// The connected piece (a root vertex id) of every vertex; facets sharing a vertex are in
@@ -329,19 +332,25 @@ impl Mesh {
             }
             x
         }
-        for f in &self.facets {
-            let a = find(&mut parent, f[0]);
-            for &v in &f[1..] {
-                let b = find(&mut parent, v);
-                if a != b {
-                    parent[b as usize] = a;
+        in_runs(self.facets.len(), &mut |r| {
+            let parent = &mut parent[..];
+            for f in &self.facets[r] {
+                let a = find(parent, f[0]);
+                for &v in &f[1..] {
+                    let b = find(parent, v);
+                    if a != b {
+                        parent[b as usize] = a;
+                    }
                 }
             }
-        }
-        for v in 0..parent.len() as u32 {
-            let r = find(&mut parent, v);
-            parent[v as usize] = r;
-        }
+        });
+        in_runs(parent.len(), &mut |r| {
+            let parent = &mut parent[..];
+            for v in r {
+                let root = find(parent, v as u32);
+                parent[v] = root;
+            }
+        });
         parent
     }
 
@@ -381,21 +390,23 @@ impl Mesh {
             (a.min(b), a.max(b) << 1 | u32::from(a < b))
         });
         let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
-        for v in 0..self.vertices.len() {
-            let row = rows.row_mut(v);
-            row.sort_unstable();
-            for group in row.chunk_by(|x, y| x >> 1 == y >> 1) {
-                match group.len() {
-                    1 => open += 1,
-                    2 => {
-                        if group[0] & 1 == group[1] & 1 {
-                            misoriented += 1
+        in_runs(self.vertices.len(), &mut |r| {
+            for v in r {
+                let row = rows.row_mut(v);
+                row.sort_unstable();
+                for group in row.chunk_by(|x, y| x >> 1 == y >> 1) {
+                    match group.len() {
+                        1 => open += 1,
+                        2 => {
+                            if group[0] & 1 == group[1] & 1 {
+                                misoriented += 1
+                            }
                         }
+                        _ => nonmanifold += 1,
                     }
-                    _ => nonmanifold += 1,
                 }
             }
-        }
+        });
         (open, nonmanifold, misoriented)
     }
 }
@@ -430,23 +441,52 @@ fn weld_local(
         HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
     let mut points = Vec::with_capacity(vertices);
     let mut ids = Vec::with_capacity(facets);
-    ids.extend(tris.iter().map(|t| {
-        t.map(|p| {
-            *index.entry(weld_key(p)).or_insert_with(|| {
-                points.push(p.map(f64::from));
-                (points.len() - 1) as u32
+    // In runs of triangles ([`in_runs`]: the page's engine compiles the later runs well).
+    in_runs(tris.len(), &mut |r| {
+        ids.extend(tris[r].iter().map(|t| {
+            t.map(|p| {
+                *index.entry(weld_key(p)).or_insert_with(|| {
+                    points.push(p.map(f64::from));
+                    (points.len() - 1) as u32
+                })
             })
-        })
-    }));
+        }))
+    });
     (index, points, ids)
+}
+
+/// Marks in `kept` every facet of `bucket` (facet numbers with one smallest vertex, in facet
+/// order) that repeats an earlier one of it ([`Mesh::unrepeated_facets`]).
+fn repeats_in(bucket: &mut [u32], canon: &[[u32; 3]], kept: &mut [bool]) {
+    if bucket.len() < 2 {
+        return;
+    }
+    if bucket.len() > 16 {
+        // in facet order within equal keys (a stable sort), so the first is kept
+        bucket.sort_by_key(|&i| (canon[i as usize][1], canon[i as usize][2]));
+        for j in 1..bucket.len() {
+            if canon[bucket[j] as usize] == canon[bucket[j - 1] as usize] {
+                kept[bucket[j] as usize] = false;
+            }
+        }
+        return;
+    }
+    for j in 1..bucket.len() {
+        let c = canon[bucket[j] as usize];
+        if bucket[..j].iter().any(|&k| canon[k as usize] == c) {
+            kept[bucket[j] as usize] = false;
+        }
+    }
 }
 
 /// The box of `vertices` ([`Bounds::EMPTY`] for none).
 fn bounds_of(vertices: &[[f64; 3]]) -> Bounds {
     let mut b = Bounds::EMPTY;
-    for v in vertices {
-        b.grow(*v, *v);
-    }
+    in_runs(vertices.len(), &mut |r| {
+        for v in &vertices[r] {
+            b.grow(*v, *v);
+        }
+    });
     b
 }
 
@@ -484,25 +524,37 @@ impl<T: Copy + Default> CompressedRows<T> {
         mesh: &Mesh,
         item: impl Fn(u32, &[u32; 3], usize) -> (u32, T),
     ) -> Self {
+        // Each pass in runs of facets ([`in_runs`]: the page's engine compiles the later runs
+        // well).
         let n = mesh.vertices.len();
+        let facets = &mesh.facets;
         let mut start = vec![0u32; n + 1];
-        for (fi, f) in mesh.facets.iter().enumerate() {
-            for k in 0..3 {
-                start[item(fi as u32, f, k).0 as usize + 1] += 1;
+        in_runs(facets.len(), &mut |run| {
+            // (a slice of its own: its bounds stay in registers through the stores)
+            let start = &mut start[..];
+            for (fi, f) in run.clone().zip(&facets[run]) {
+                for k in 0..3 {
+                    start[item(fi as u32, f, k).0 as usize + 1] += 1;
+                }
             }
-        }
-        for r in 0..n {
-            start[r + 1] += start[r];
-        }
+        });
+        in_runs(n, &mut |run| {
+            for r in run {
+                start[r + 1] += start[r];
+            }
+        });
         let mut next = start.clone();
         let mut items = vec![T::default(); start[n] as usize];
-        for (fi, f) in mesh.facets.iter().enumerate() {
-            for k in 0..3 {
-                let (r, x) = item(fi as u32, f, k);
-                items[next[r as usize] as usize] = x;
-                next[r as usize] += 1;
+        in_runs(facets.len(), &mut |run| {
+            let (items, next) = (&mut items[..], &mut next[..]);
+            for (fi, f) in run.clone().zip(&facets[run]) {
+                for k in 0..3 {
+                    let (r, x) = item(fi as u32, f, k);
+                    items[next[r as usize] as usize] = x;
+                    next[r as usize] += 1;
+                }
             }
-        }
+        });
         CompressedRows { start, items }
     }
 

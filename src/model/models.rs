@@ -114,9 +114,11 @@ pub struct ItemInfo {
 /// The bounding box of triangles.
 pub fn bounds_of(tris: &[[[f32; 3]; 3]]) -> Bounds {
     let mut b = Bounds::EMPTY;
-    for p in corners(tris) {
-        b.grow(p, p);
-    }
+    crate::base::parallel::in_runs(tris.len(), &mut |r| {
+        for p in corners(&tris[r]) {
+            b.grow(p, p);
+        }
+    });
     b
 }
 

@@ -3,6 +3,7 @@
 //! inside-out shells turned outward unless they lie inside another shell (cavities), decided
 //! by winding numbers and a grid of the shells' bounding boxes (`BoxIndex`).
 
+use crate::base::parallel::in_runs;
 use crate::model::mesh::{CompressedRows, Mesh};
 
 /// The shells of a mesh ([`Mesh::shells`]), for [`Mesh::orient`].
@@ -278,12 +279,15 @@ impl Mesh {
         };
         // Volumes, each about its shell's centre (for precision), caps included.
         let mut volume = vec![0.0f64; n];
-        for (fi, f) in self.facets.iter().enumerate() {
-            let s = facet_shell[fi] as usize;
-            let o = centre(s);
-            let [p, q, r] = f.map(|i| sub(self.vertices[i as usize], o));
-            volume[s] += dot(p, cross(q, r)) / 6.0;
-        }
+        in_runs(self.facets.len(), &mut |run| {
+            let volume = &mut volume[..];
+            for (fi, f) in run.clone().zip(&self.facets[run]) {
+                let s = facet_shell[fi] as usize;
+                let o = centre(s);
+                let [p, q, r] = f.map(|i| sub(self.vertices[i as usize], o));
+                volume[s] += dot(p, cross(q, r)) / 6.0;
+            }
+        });
         for (s, v) in volume.iter_mut().enumerate() {
             let o = centre(s);
             for t in caps_of(s) {
@@ -379,19 +383,22 @@ impl Mesh {
             first_facet: vec![u32::MAX; n],
             facet_count: vec![0u32; n],
         };
-        for (fi, f) in self.facets.iter().enumerate() {
-            let s = facet_shell[fi] as usize;
-            for v in f.map(|i| self.vertices[i as usize]) {
-                for (k, c) in v.into_iter().enumerate() {
-                    b.bmin[s][k] = b.bmin[s][k].min(c);
-                    b.bmax[s][k] = b.bmax[s][k].max(c);
+        // In runs of facets ([`in_runs`]).
+        in_runs(self.facets.len(), &mut |r| {
+            for (fi, f) in r.clone().zip(&self.facets[r]) {
+                let s = facet_shell[fi] as usize;
+                for v in f.map(|i| self.vertices[i as usize]) {
+                    for (k, c) in v.into_iter().enumerate() {
+                        b.bmin[s][k] = b.bmin[s][k].min(c);
+                        b.bmax[s][k] = b.bmax[s][k].max(c);
+                    }
                 }
+                if b.first_facet[s] == u32::MAX {
+                    b.first_facet[s] = fi as u32;
+                }
+                b.facet_count[s] += 1;
             }
-            if b.first_facet[s] == u32::MAX {
-                b.first_facet[s] = fi as u32;
-            }
-            b.facet_count[s] += 1;
-        }
+        });
         b
     }
 
@@ -505,43 +512,51 @@ impl Mesh {
         }
         let mut bad: Vec<u32> = Vec::new();
         let mut open_edges = 0;
-        for (fi, f) in self.facets.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                // The other facets with the edge a–b, and whether they run b→a (b just
-                // before a).
-                let (mut others, mut opposite, mut other) = (0, true, 0u32);
-                for &[g, after, before] in around.row(a as usize) {
-                    if g as usize != fi && (after == b || before == b) {
-                        others += 1;
-                        other = g;
-                        opposite &= before == b;
+        // In runs of facets ([`in_runs`]: the page's engine compiles the later runs well).
+        let facets = &self.facets;
+        in_runs(nf, &mut |run| {
+            // (a slice of its own: its bounds stay in registers through the stores)
+            let parent = &mut parent[..];
+            for (fi, f) in run.clone().zip(&facets[run]) {
+                for k in 0..3 {
+                    let (a, b) = (f[k], f[(k + 1) % 3]);
+                    // The other facets with the edge a–b, and whether they run b→a (b just
+                    // before a).
+                    let (mut others, mut opposite, mut other) = (0, true, 0u32);
+                    for &[g, after, before] in around.row(a as usize) {
+                        if g as usize != fi && (after == b || before == b) {
+                            others += 1;
+                            other = g;
+                            opposite &= before == b;
+                        }
                     }
-                }
-                if others == 1 && opposite {
-                    let (x, y) = (find(&mut parent, fi as u32), find(&mut parent, other));
-                    if x != y {
-                        parent[y as usize] = x;
+                    if others == 1 && opposite {
+                        let (x, y) = (find(parent, fi as u32), find(parent, other));
+                        if x != y {
+                            parent[y as usize] = x;
+                        }
+                    } else {
+                        open_edges += usize::from(others == 0);
+                        bad.push(3 * fi as u32 + k as u32);
                     }
-                } else {
-                    open_edges += usize::from(others == 0);
-                    bad.push(3 * fi as u32 + k as u32);
                 }
             }
-        }
+        });
         drop(around);
         let mut id = vec![u32::MAX; nf];
         let mut shells = 0u32;
-        let facet_shell: Vec<u32> = (0..nf as u32)
-            .map(|fi| {
-                let r = find(&mut parent, fi) as usize;
+        let mut facet_shell: Vec<u32> = Vec::with_capacity(nf);
+        in_runs(nf, &mut |run| {
+            let (parent, id) = (&mut parent[..], &mut id[..]);
+            facet_shell.extend(run.map(|fi| {
+                let r = find(parent, fi as u32) as usize;
                 if id[r] == u32::MAX {
                     id[r] = shells;
                     shells += 1;
                 }
                 id[r]
-            })
-            .collect();
+            }))
+        });
         let mut closed = vec![true; shells as usize];
         for &e in &bad {
             closed[facet_shell[(e / 3) as usize] as usize] = false;

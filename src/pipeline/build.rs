@@ -295,7 +295,7 @@ impl Job {
     }
 
     /// The common tail of [`Job::new`] and [`Job::from_models`].
-    fn assemble(
+    pub(super) fn assemble(
         settings: Settings,
         mesh: Mesh,
         buckets: FacetBuckets,

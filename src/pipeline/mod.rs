@@ -3,6 +3,7 @@
 
 mod budget;
 mod build;
+mod handoff;
 mod job;
 mod supported;
 #[cfg(not(target_arch = "wasm32"))]

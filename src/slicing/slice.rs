@@ -21,6 +21,7 @@ use crate::base::geom::{
     Contour, DVec2, Point, Shapes, dist, greater, lesser, shapes_from_overlay, signed_area,
     to_overlay,
 };
+use crate::base::parallel::in_runs;
 use crate::base::settings::SlicePlane;
 use crate::model::mesh::{Mesh, edge_key};
 use i_overlay::core::fill_rule::FillRule;
@@ -71,25 +72,37 @@ pub struct FacetBuckets {
 
 impl FacetBuckets {
     pub fn new(mesh: &Mesh, zs: &[f64]) -> FacetBuckets {
+        // Every pass over the facets runs in runs of them (`in_runs`: the page's engine
+        // compiles the later runs well).
+        let nf = mesh.facets.len();
         // Per facet: its lowest z and the planes it crosses (lo < z <= hi).
-        let spans: Vec<(f64, u32, u32)> = mesh
-            .facets
-            .iter()
-            .map(|f| {
+        let mut spans: Vec<(f64, u32, u32)> = Vec::with_capacity(nf);
+        in_runs(nf, &mut |r| {
+            spans.extend(mesh.facets[r].iter().map(|f| {
                 let z = f.map(|i| mesh.vertices[i as usize][2]);
                 let lo = lesser(lesser(z[0], z[1]), z[2]);
                 let hi = greater(greater(z[0], z[1]), z[2]);
                 let a = zs.partition_point(|&p| p <= lo) as u32;
                 let b = zs.partition_point(|&p| p <= hi) as u32;
                 (lo, a, b.max(a))
-            })
-            .collect();
+            }))
+        });
         let mut counts = vec![0u32; zs.len() + 1];
-        for &(_, a, b) in &spans {
-            for i in a..b {
-                counts[i as usize + 1] += 1;
+        // The facets by their first plane (a counting sort that keeps file order; those
+        // crossing no plane are left out), counted beside the rows.
+        let mut run = vec![0u32; zs.len() + 1];
+        in_runs(nf, &mut |r| {
+            // (slices of their own: their bounds stay in registers through the stores)
+            let (counts, run) = (&mut counts[..], &mut run[..]);
+            for &(_, a, b) in &spans[r] {
+                for i in a..b {
+                    counts[i as usize + 1] += 1;
+                }
+                if a < b {
+                    run[a as usize + 1] += 1;
+                }
             }
-        }
+        });
         for i in 1..counts.len() {
             counts[i] += counts[i - 1];
         }
@@ -97,43 +110,71 @@ impl FacetBuckets {
         let mut fill = counts;
         let mut facets = vec![0u32; *offsets.last().unwrap_or(&0) as usize];
         // Lowest z first, ties in file order. A facet's first plane never decreases with its
-        // lowest z, so the facets are put in runs by their first plane (a counting sort that
-        // keeps file order), and only each run is sorted by lowest z: small sorts instead of
-        // one of every facet (those crossing no plane are left out).
-        let mut run = vec![0u32; zs.len() + 1];
-        for &(_, a, b) in &spans {
-            if a < b {
-                run[a as usize + 1] += 1;
-            }
-        }
+        // lowest z, so the facets are put in runs by their first plane, and only each run is
+        // sorted by lowest z: small sorts instead of one of every facet.
         for i in 1..run.len() {
             run[i] += run[i - 1];
         }
         let mut order: Vec<(f64, u32)> = vec![(0.0, 0); *run.last().unwrap_or(&0) as usize];
         let mut at = run.clone();
-        for (f, &(lo, a, b)) in spans.iter().enumerate() {
-            if a < b {
-                order[at[a as usize] as usize] = (lo, f as u32);
-                at[a as usize] += 1;
+        in_runs(nf, &mut |r| {
+            let (order, at) = (&mut order[..], &mut at[..]);
+            for (f, &(lo, a, b)) in spans[r.clone()].iter().enumerate() {
+                if a < b {
+                    order[at[a as usize] as usize] = (lo, (r.start + f) as u32);
+                    at[a as usize] += 1;
+                }
             }
-        }
+        });
         drop(at);
         for w in run.windows(2) {
             order[w[0] as usize..w[1] as usize]
                 .sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
         }
-        for (_, f) in order {
-            let (_, a, b) = spans[f as usize];
-            for i in a..b {
-                facets[fill[i as usize] as usize] = f;
-                fill[i as usize] += 1;
+        in_runs(order.len(), &mut |r| {
+            let (facets, fill) = (&mut facets[..], &mut fill[..]);
+            for &(_, f) in &order[r] {
+                let (_, a, b) = spans[f as usize];
+                for i in a..b {
+                    facets[fill[i as usize] as usize] = f;
+                    fill[i as usize] += 1;
+                }
             }
-        }
+        });
         FacetBuckets { offsets, facets }
     }
 
     pub fn layer(&self, i: usize) -> &[u32] {
         &self.facets[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// The rows as stored: one offset per layer and one past the last, then every layer's
+    /// facets one after the other (for [`FacetBuckets::from_rows`]).
+    pub(crate) fn rows(&self) -> (&[u32], &[u32]) {
+        (&self.offsets, &self.facets)
+    }
+
+    /// The index [`FacetBuckets::rows`] gave, checked for `layers` layers of a mesh of
+    /// `facets` facets: offsets from 0, never falling, ending at the last facet listed; every
+    /// facet number below `facets`.
+    pub(crate) fn from_rows(
+        offsets: Vec<u32>,
+        listed: Vec<u32>,
+        layers: usize,
+        facets: usize,
+    ) -> Result<FacetBuckets, String> {
+        let sound = offsets.len() == layers + 1
+            && offsets[0] == 0
+            && offsets.windows(2).all(|w| w[0] <= w[1])
+            && offsets[layers] as usize == listed.len()
+            && listed.iter().all(|&f| (f as usize) < facets);
+        if !sound {
+            return Err("the facet index does not fit the layers and the mesh".into());
+        }
+        Ok(FacetBuckets {
+            offsets,
+            facets: listed,
+        })
     }
 }
 

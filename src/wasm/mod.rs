@@ -342,6 +342,19 @@ impl Session {
         Ok(Session::with(job))
     }
 
+    /// The prepared job as bytes ([`Job::to_bytes`]), for [`Session::from_prepared`] in the
+    /// page's other workers: they take this worker's preparation instead of repeating it.
+    pub fn prepared(&self) -> Vec<u8> {
+        stages::time(Stage::Prepare, || self.job.to_bytes())
+    }
+
+    /// The job another worker prepared ([`Session::prepared`]). Throws `{kind: "internal",
+    /// message}` if the bytes are damaged.
+    pub fn from_prepared(bytes: &[u8]) -> Result<Session, JsValue> {
+        let job = stages::time(Stage::Prepare, || Job::from_bytes(bytes)).map_err(js_error)?;
+        Ok(Session::with(job))
+    }
+
     /// Number of layers.
     pub fn layer_count(&self) -> usize {
         self.job.layer_count()

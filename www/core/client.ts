@@ -198,25 +198,26 @@ async function addTo(h: WorkerHandle, files: JobFileRef[], hasher: WorkerHandle 
   }
 }
 
-/** Makes `h` hold `files` and opens `job` there: all its requests posted at once (it answers
- *  them in order; a round trip through the page's busy thread between them cost a worker
- *  tens of ms). A refusal of the files is reported before the job's. */
-async function syncThenOpen(h: WorkerHandle, files: JobFileRef[], job: JobFile): Promise<OpenResult> {
+/** Makes `h` hold `files` and opens `job` there (`share`: copies of the prepared job for
+ *  other workers, see [[openAll]]): all its requests posted at once (it answers them in order;
+ *  a round trip through the page's busy thread between them cost a worker tens of ms). A
+ *  refusal of the files is reported before the job's. */
+async function syncThenOpen(h: WorkerHandle, files: JobFileRef[], job: JobFile, share: number): Promise<ResultOf<"open_job">> {
   const synced = syncModels(h, files);
-  const opened = h.call("open_job", { job });
+  const opened = h.call("open_job", { job, share });
   opened.catch(() => {}); // awaited below, after the files
   await synced;
   return opened;
 }
 
-/** Opens a job in every worker at once: each prepares it from the job's files in its own
- *  `Models`. The job worker imported them when they were added; another worker imports the
- *  files it lacks first (on a job's first opening: on 2 cores, importing them beside the job
- *  worker's import delayed the job worker more than it saved) and keeps them, so the job
- *  opened again (settings changed) is prepared without reading any file. No worker waits for
- *  another's mesh. `ready(h, r)` runs for each worker once it holds the job, for the job
- *  worker first. The core refuses a job alike in every worker (each keeps its previous model
- *  then); the job worker's refusal is the one reported. */
+/** Opens a job in every worker: the job worker prepares it from the job's files (imported
+ *  when they were added) and hands the prepared job as bytes to the others, which take it
+ *  without reading a file or preparing anything (`adopt_job`; on 2 cores every worker
+ *  preparing the job itself made the job worker's preparation slower by what the other's cost,
+ *  and computed everything twice). `ready(h, r)` runs for each worker once it holds the job,
+ *  for the job worker first. If the job worker refuses the job, no worker opens it (each keeps
+ *  its previous model, the others no longer answer for it); the job worker's refusal is the one
+ *  reported. */
 async function openAll(
   handles: WorkerHandle[],
   files: JobFileRef[],
@@ -229,19 +230,18 @@ async function openAll(
   // answers the page's requests in order: after its answer to `open_job` (the page has the
   // new job then), or from its previous model if it refuses the job.
   for (const h of others) h.hasModel = false;
-  const opening = others.map(async (h) => ({ h, o: await syncThenOpen(h, files, job) }));
-  for (const p of opening) p.catch(() => {}); // awaited below, after the job worker's answer
-  const r = await syncThenOpen(first, files, job);
+  const { prepared = [], ...r } = await syncThenOpen(first, files, job, others.length);
   first.hasModel = true;
+  if (prepared.length < others.length) throw new SliceError("internal", "the job worker handed over too few copies of the job");
+  // the others' requests go out before the job worker's first units
+  const adopted = others.map(async (h, k) => {
+    const o = await h.call("adopt_job", { prepared: prepared[k] }, undefined, [prepared[k].buffer]);
+    h.hasModel = true;
+    return { h, o };
+  });
+  for (const p of adopted) p.catch(() => {}); // awaited below
   const work = [ready(first, r)];
-  for (const p of opening) {
-    work.push(
-      p.then(async ({ h, o }) => {
-        h.hasModel = true;
-        await ready(h, o);
-      }),
-    );
-  }
+  for (const p of adopted) work.push(p.then(({ h, o }) => ready(h, o)));
   await Promise.all(work);
   return r;
 }

@@ -185,9 +185,13 @@ export interface Calls {
   orient: { data: { job: JobFile; part: number }; result: Orientations };
   /** A profile's JSON text checked by the core (`check_profile`); needs no model. */
   check_profile: { data: { text: string }; result: Profile };
-  /** Prepares the job `job` of the files added (Session.from_models), in every worker at
-   *  once. */
-  open_job: { data: { job: JobFile }; result: OpenResult };
+  /** Prepares the job `job` of the files added (Session.from_models), in the job worker;
+   *  with `share: n`, also n copies of the prepared job as bytes (`Session.prepared`), one for
+   *  each other worker's `adopt_job`. */
+  open_job: { data: { job: JobFile; share?: number }; result: OpenResult & { prepared?: Uint8Array[] } };
+  /** Takes the job the job worker prepared (`Session.from_prepared`): no file is read, nothing
+   *  prepared again. */
+  adopt_job: { data: { prepared: Uint8Array }; result: OpenResult };
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
    *  within the rule (src/wasm/mod.rs `unsupported_droplets`); `below` null for the first layer. */
   unsupported: { data: UnsupportedRequest; result: Uint8Array };

@@ -243,7 +243,22 @@ async function handle(req: Request): Promise<void> {
     case "open_job": {
       await load();
       // the old session stays usable if the job is refused
-      answer(req.kind, req.id, adopt(Session.from_models(needModels(), req.data.job)));
+      const s = Session.from_models(needModels(), req.data.job);
+      const opened = adopt(s);
+      const n = req.data.share ?? 0;
+      if (n < 1) {
+        answer(req.kind, req.id, opened);
+        return;
+      }
+      // one copy per other worker, made here rather than on the page's thread; all transferred
+      const prepared = [clock.time("core: the prepared job as bytes", () => s.prepared())];
+      for (let k = 1; k < n; k++) prepared.push(prepared[0].slice());
+      answer(req.kind, req.id, { ...opened, prepared }, prepared.map((p) => p.buffer));
+      return;
+    }
+    case "adopt_job": {
+      await load();
+      answer(req.kind, req.id, adopt(Session.from_prepared(req.data.prepared)));
       return;
     }
     case "slice": {

@@ -1,0 +1,216 @@
+//! A prepared job as bytes, so that the page's other workers take the job worker's mesh
+//! preparation instead of repeating it (docs/architecture.md, "The page's workers").
+//!
+//! [`Job::to_bytes`] writes the settings and the job's info (JSON), the repaired mesh, the
+//! plane heights and the facet index (little-endian arrays); [`Job::from_bytes`] reads them
+//! back into a job that plans every layer as the original does. The bytes never leave the
+//! page, but they cross a message between workers: every length is checked against what is
+//! left before anything is allocated, every number and index is checked, so damaged bytes are
+//! refused with a message, never a panic or a job that slices wrongly.
+
+use super::Job;
+use crate::base::error::Error;
+use crate::base::parallel::in_runs;
+use crate::base::settings::Settings;
+use crate::model::mesh::Mesh;
+use crate::model::prepare::JobInfo;
+use crate::slicing::slice::FacetBuckets;
+
+/// The first bytes: the format and its version.
+const MAGIC: &[u8; 8] = b"DSJOB\0\0\x01";
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Meta {
+    settings: Settings,
+    info: JobInfo,
+    /// Each instance's final move (not in the info's JSON, which the page also gets).
+    shifts: Vec<[f64; 2]>,
+}
+
+impl Job {
+    /// The prepared job as bytes for [`Job::from_bytes`] (about 24 B per vertex, 12 B per
+    /// facet and 4 B per facet and layer it crosses).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let meta = serde_json::to_vec(&Meta {
+            settings: self.settings.clone(),
+            info: self.info.clone(),
+            shifts: self.info.instances.iter().map(|i| i.shift).collect(),
+        })
+        .expect("settings and job info serialise");
+        let (offsets, bucket_facets) = self.buckets.rows();
+        let size = MAGIC.len()
+            + 6 * 8
+            + meta.len()
+            + self.mesh.vertices.len() * 24
+            + self.mesh.facets.len() * 12
+            + self.zs.len() * 8
+            + (offsets.len() + bucket_facets.len()) * 4;
+        let mut out = Vec::with_capacity(size);
+        out.extend_from_slice(MAGIC);
+        let count = |out: &mut Vec<u8>, n: usize| out.extend_from_slice(&(n as u64).to_le_bytes());
+        count(&mut out, meta.len());
+        out.extend_from_slice(&meta);
+        count(&mut out, self.mesh.vertices.len());
+        put(
+            &mut out,
+            self.mesh.vertices.as_flattened(),
+            f64::to_le_bytes,
+        );
+        count(&mut out, self.mesh.facets.len());
+        put(&mut out, self.mesh.facets.as_flattened(), u32::to_le_bytes);
+        count(&mut out, self.zs.len());
+        put(&mut out, &self.zs, f64::to_le_bytes);
+        for row in [offsets, bucket_facets] {
+            count(&mut out, row.len());
+            put(&mut out, row, u32::to_le_bytes);
+        }
+        debug_assert_eq!(out.len(), size);
+        out
+    }
+
+    /// The job [`Job::to_bytes`] wrote. Bytes that are not such a job (truncated, of another
+    /// version, with a number out of range or an index past its array) are refused as an
+    /// internal error: they only ever come from another worker of the same page.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Job, Error> {
+        read(bytes).map_err(|e| {
+            Error::Internal(format!(
+                "the prepared job handed over is damaged: {e}; slice again"
+            ))
+        })
+    }
+}
+
+fn read(bytes: &[u8]) -> Result<Job, String> {
+    let mut r = Reader { bytes, at: 0 };
+    if r.take(MAGIC.len())? != MAGIC {
+        return Err("not a prepared job of this version".into());
+    }
+    let n = r.count(1)?;
+    let meta: Meta =
+        serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+    meta.settings.validate().map_err(|e| e.to_string())?;
+    let n = r.count(24)?;
+    let vertices: Vec<[f64; 3]> = get(r.take(n * 24)?, |c: [u8; 24]| {
+        std::array::from_fn(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap()))
+    });
+    // Every vertex within the job's box (grown by 1 mm: the box is measured before the repair
+    // closes cracks), so the work of every layer stays what the job worker's was.
+    let (lo, hi) = (meta.info.bounds.min, meta.info.bounds.max);
+    let boxed = |v: &[f64; 3]| (0..3).all(|k| v[k] >= lo[k] - 1.0 && v[k] <= hi[k] + 1.0);
+    if !vertices.iter().all(boxed) {
+        return Err("a vertex lies outside the job's box".into());
+    }
+    let n = r.count(12)?;
+    let facets: Vec<[u32; 3]> = get(r.take(n * 12)?, |c: [u8; 12]| {
+        std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
+    });
+    if facets
+        .iter()
+        .flatten()
+        .any(|&i| i as usize >= vertices.len())
+    {
+        return Err("a facet names a vertex past the last".into());
+    }
+    let n = r.count(8)?;
+    let zs: Vec<f64> = get(r.take(n * 8)?, f64::from_le_bytes);
+    if zs.is_empty() || !zs.iter().all(|z| z.is_finite()) || zs.windows(2).any(|w| w[0] >= w[1]) {
+        return Err("the plane heights are not finite and rising".into());
+    }
+    // Plane heights are above the part's lowest point.
+    if zs[0] < 0.0 || zs[zs.len() - 1] > hi[2] - lo[2] + 1.0 {
+        return Err("a plane lies outside the job's box".into());
+    }
+    if meta.info.layers != zs.len() {
+        return Err("the layer count differs from the plane heights'".into());
+    }
+    let grouped: usize = meta.info.groups.iter().map(|g| g.facets).sum();
+    if !meta.info.groups.is_empty() && grouped != facets.len() {
+        return Err("the units' facet runs do not cover the mesh".into());
+    }
+    let mut rows = [Vec::new(), Vec::new()];
+    for row in &mut rows {
+        let n = r.count(4)?;
+        *row = get(r.take(n * 4)?, u32::from_le_bytes);
+    }
+    if r.at != bytes.len() {
+        return Err("bytes follow the facet index".into());
+    }
+    let [offsets, bucket_facets] = rows;
+    let buckets = FacetBuckets::from_rows(offsets, bucket_facets, zs.len(), facets.len())?;
+    let Meta {
+        settings,
+        mut info,
+        shifts,
+    } = meta;
+    if shifts.len() != info.instances.len() {
+        return Err("the instances' moves do not match the instances".into());
+    }
+    for (i, s) in info.instances.iter_mut().zip(shifts) {
+        i.shift = s;
+    }
+    Ok(Job::assemble(
+        settings,
+        Mesh { vertices, facets },
+        buckets,
+        zs,
+        info,
+    ))
+}
+
+/// Appends `items` in the bytes `le` gives each (in runs: [`in_runs`]).
+fn put<T: Copy, const N: usize>(out: &mut Vec<u8>, items: &[T], le: fn(T) -> [u8; N]) {
+    let at = out.len();
+    out.resize(at + N * items.len(), 0);
+    let dst = &mut out[at..];
+    in_runs(items.len(), &mut |r| {
+        for (c, &x) in dst[N * r.start..N * r.end]
+            .chunks_exact_mut(N)
+            .zip(&items[r])
+        {
+            c.copy_from_slice(&le(x));
+        }
+    });
+}
+
+/// The items of `bytes`, `N` bytes each, as `from` reads them (in runs: [`in_runs`]).
+fn get<T, const N: usize>(bytes: &[u8], from: impl Fn([u8; N]) -> T) -> Vec<T> {
+    let n = bytes.len() / N;
+    let mut out = Vec::with_capacity(n);
+    in_runs(n, &mut |r| {
+        out.extend(
+            bytes[N * r.start..N * r.end]
+                .chunks_exact(N)
+                .map(|c| from(c.try_into().expect("N bytes"))),
+        )
+    });
+    out
+}
+
+/// Reads the bytes in order; every length is checked against what is left.
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        let end = self
+            .at
+            .checked_add(n)
+            .filter(|&e| e <= self.bytes.len())
+            .ok_or("it ends early")?;
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+
+    /// A count of items of `size` bytes each that the bytes left can hold.
+    fn count(&mut self, size: usize) -> Result<usize, String> {
+        let n = u64::from_le_bytes(self.take(8)?.try_into().unwrap());
+        let left = (self.bytes.len() - self.at) as u64;
+        if n > left / size as u64 {
+            return Err("a length runs past its end".into());
+        }
+        Ok(n as usize)
+    }
+}

@@ -1,0 +1,172 @@
+//! The prepared job handed from the page's job worker to the others (src/pipeline/handoff.rs):
+//! a job read back from its bytes writes the same G-code as the job itself (a plain STL, a
+//! 3MF build, an OBJ, a build job with a unit-1 part and support on), has the same info and
+//! settings, and damaged bytes are refused with a message, never a panic.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
+
+mod common;
+
+use common::Rng;
+use dropslice::model::models::Model;
+use dropslice::model::spec::JobSpec;
+use dropslice::{Job, Settings};
+
+fn gcode(job: &Job) -> Vec<u8> {
+    let mut out = Vec::new();
+    dropslice::pipeline::write_gcode(job, &mut out, |_, _| {}).unwrap();
+    out
+}
+
+/// `job` and the job read back from its bytes agree in everything the page uses.
+fn assert_same(job: &Job, what: &str) {
+    let bytes = job.to_bytes();
+    let back = Job::from_bytes(&bytes).unwrap_or_else(|e| panic!("{what}: {e}"));
+    assert_eq!(back.settings(), job.settings(), "{what}: settings");
+    assert_eq!(back.info(), job.info(), "{what}: info");
+    assert_eq!(back.layer_count(), job.layer_count(), "{what}: layers");
+    assert_eq!(
+        back.mesh().vertices,
+        job.mesh().vertices,
+        "{what}: vertices"
+    );
+    assert_eq!(back.mesh().facets, job.mesh().facets, "{what}: facets");
+    assert_eq!(back.header(None), job.header(None), "{what}: header");
+    assert!(gcode(&back) == gcode(job), "{what}: the G-code differs");
+    // Written again, the same bytes.
+    assert!(
+        back.to_bytes() == bytes,
+        "{what}: written again, other bytes"
+    );
+}
+
+#[test]
+fn a_job_read_back_from_its_bytes_slices_as_the_job_itself() {
+    for (file, sets) in [
+        ("3DBenchy.stl", vec![]),
+        (
+            "3DBenchy.stl",
+            vec![("support", "unit1"), ("stagger", "true")],
+        ),
+        ("M3x10_screw.stl", vec![("layer_height", "0.1")]),
+    ] {
+        let mut s = Settings::default();
+        for (k, v) in &sets {
+            s.set(k, v).unwrap();
+        }
+        let job = Job::new(&common::model_bytes(file), file, s).unwrap();
+        assert_same(&job, &format!("{file} {sets:?}"));
+    }
+    for file in std::fs::read_dir(common::shared_dir().join("models")).unwrap() {
+        let path = file.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !(name.ends_with(".3mf") || name.ends_with(".obj")) {
+            continue;
+        }
+        let bytes = std::fs::read(&path).unwrap();
+        if let Ok(job) = Job::new(&bytes, &name, Settings::default()) {
+            assert_same(&job, &name);
+        }
+    }
+}
+
+#[test]
+fn a_build_job_with_a_unit_1_part_and_support_reads_back_alike() {
+    let benchy = Model::read(&common::model_bytes("3DBenchy.stl"), "boat.stl").unwrap();
+    let screw = Model::read(&common::model_bytes("M3x10_screw.stl"), "screw.stl").unwrap();
+    let spec = JobSpec::from_json(
+        r#"{"settings": {"support": "unit1", "unit1_droplet_aspect": 1.6},
+            "parts": [{"file": "boat.stl"}, {"file": "screw.stl", "unit": 1, "copies": 2}]}"#,
+    )
+    .unwrap();
+    let job = Job::from_models(&[benchy, screw], &spec).unwrap();
+    assert!(job.has_unit1_parts());
+    assert!(!job.info().groups.is_empty());
+    assert_same(&job, "boat and two unit-1 screws");
+}
+
+fn small_job() -> Job {
+    Job::new(
+        &common::model_bytes("M3x10_screw.stl"),
+        "screw.stl",
+        Settings::default(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn damaged_bytes_are_refused_with_a_message() {
+    let bytes = small_job().to_bytes();
+    let refused = |b: &[u8], what: &str| {
+        let e = Job::from_bytes(b)
+            .err()
+            .unwrap_or_else(|| panic!("{what}: taken"));
+        assert_eq!(e.kind(), "internal", "{what}");
+        assert!(e.to_string().contains("prepared job"), "{what}: {e}");
+    };
+    // Every length cut short (steps of 7 bytes, and the last few).
+    for n in (0..bytes.len())
+        .step_by(7)
+        .chain(bytes.len() - 9..bytes.len())
+    {
+        refused(&bytes[..n], &format!("cut to {n} bytes"));
+    }
+    let mut longer = bytes.clone();
+    longer.push(0);
+    refused(&longer, "a byte more");
+    let mut other = bytes.clone();
+    other[7] = 2;
+    refused(&other, "another version");
+    // A length that claims more than there is (the settings' JSON length, first after the
+    // 8-byte header): refused before anything is allocated.
+    let mut huge = bytes.clone();
+    huge[8..16].copy_from_slice(&u64::MAX.to_le_bytes());
+    refused(&huge, "a huge length");
+    // The layout after the settings: vertices, facets, planes, offsets, listed facets.
+    let meta = u64::from_le_bytes(bytes[8..16].try_into().unwrap()) as usize;
+    let at_vertices = 16 + meta;
+    let nv = u64::from_le_bytes(bytes[at_vertices..at_vertices + 8].try_into().unwrap()) as usize;
+    let at_facets = at_vertices + 8 + 24 * nv;
+    let nf = u64::from_le_bytes(bytes[at_facets..at_facets + 8].try_into().unwrap()) as usize;
+    let mut nan = bytes.clone();
+    nan[at_vertices + 8..at_vertices + 16].copy_from_slice(&f64::NAN.to_le_bytes());
+    refused(&nan, "a NaN vertex");
+    let mut past = bytes.clone();
+    past[at_facets + 8..at_facets + 12].copy_from_slice(&(nv as u32).to_le_bytes());
+    refused(&past, "a facet past the last vertex");
+    let at_planes = at_facets + 8 + 12 * nf;
+    let nz = u64::from_le_bytes(bytes[at_planes..at_planes + 8].try_into().unwrap()) as usize;
+    let mut falling = bytes.clone();
+    let z1 = bytes[at_planes + 16..at_planes + 24].to_vec();
+    falling[at_planes + 8..at_planes + 16].copy_from_slice(&z1);
+    refused(&falling, "two planes at one height");
+    let at_offsets = at_planes + 8 + 8 * nz;
+    let mut shifted = bytes.clone();
+    shifted[at_offsets + 8..at_offsets + 12].copy_from_slice(&1u32.to_le_bytes());
+    refused(&shifted, "offsets not from 0");
+    let at_listed = at_offsets + 8 + 4 * (nz + 1);
+    let mut stray = bytes.clone();
+    stray[at_listed + 8..at_listed + 12].copy_from_slice(&(nf as u32).to_le_bytes());
+    refused(&stray, "a listed facet past the last");
+    let mut settings = bytes.clone();
+    let text = String::from_utf8(bytes[16..at_vertices].to_vec()).unwrap();
+    let at = 16 + text.find("\"layer_height\":").unwrap() + "\"layer_height\":".len();
+    settings[at] = b'-';
+    refused(&settings, "a negative layer height");
+}
+
+#[test]
+fn random_damage_never_panics() {
+    let bytes = small_job().to_bytes();
+    let mut rng = Rng::new(25);
+    for _ in 0..300 {
+        let mut b = bytes.clone();
+        for _ in 0..1 + rng.below(4) {
+            let at = rng.below(b.len() as u64) as usize;
+            b[at] = rng.below(256) as u8;
+        }
+        // Taken or refused; a job taken plans its layers.
+        if let Ok(job) = Job::from_bytes(&b) {
+            let _ = gcode(&job);
+        }
+    }
+}
