@@ -5,6 +5,7 @@
 
 use crate::base::error::Error;
 use crate::base::geom::{DMat3, DVec3};
+use crate::base::parallel::in_runs;
 use crate::model::mesh::{Bounds, Placement, rot, rotation};
 use crate::model::models::{Model, corners, models_of};
 use crate::model::spec::{JobSpec, PartSpec, clean_name};
@@ -24,29 +25,37 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// The frame of `points` (every vertex of the part) under `p` (its `place` is not used).
-    /// The same arithmetic as [`crate::model::mesh::Mesh::place`], so `qmin + place` is exactly the
-    /// placed mesh's bounding box.
-    pub fn of<I: Iterator<Item = [f64; 3]> + Clone>(points: I, p: &Placement) -> Option<Frame> {
+    /// The frame of the part's points under `p` (its `place` is not used): `corners(item)` of
+    /// every item in order (a vertex, or a triangle's three corners). The same arithmetic as
+    /// [`crate::model::mesh::Mesh::place`], so `qmin + place` is exactly the placed mesh's
+    /// bounding box. Each pass runs in runs of items ([`in_runs`]: the page's engine compiles
+    /// the later runs well).
+    pub fn of<T, const K: usize>(
+        items: &[T],
+        corners: impl Fn(&T) -> [[f64; 3]; K],
+        p: &Placement,
+    ) -> Option<Frame> {
+        if items.is_empty() || K == 0 {
+            return None;
+        }
         let r = rotation(p.rotate);
         let scale = DVec3::from(p.scale);
         let step1 = |v: [f64; 3]| r * DVec3::from(v) * scale;
         let mut min1 = DVec3::INFINITY;
-        let mut any = false;
-        for v in points.clone() {
-            min1 = min1.min(step1(v));
-            any = true;
-        }
-        if !any {
-            return None;
-        }
+        in_runs(items.len(), &mut |run| {
+            for v in items[run].iter().flat_map(&corners) {
+                min1 = min1.min(step1(v));
+            }
+        });
         let angle = rot(2, p.place_angle);
         let (mut qmin, mut qmax) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        for v in points {
-            let q = angle * (step1(v) - min1);
-            qmin = qmin.min(q);
-            qmax = qmax.max(q);
-        }
+        in_runs(items.len(), &mut |run| {
+            for v in items[run].iter().flat_map(&corners) {
+                let q = angle * (step1(v) - min1);
+                qmin = qmin.min(q);
+                qmax = qmax.max(q);
+            }
+        });
         Some(Frame {
             rotation: r,
             scale,
@@ -389,8 +398,12 @@ pub fn layout(models: &[Model], spec: &JobSpec) -> Result<Layout, Error> {
         .enumerate()
         .map(|(i, (p, m))| {
             let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
-            Frame::of(corners(&tris), &p.placement([0.0, 0.0], &spec.settings))
-                .ok_or_else(|| Error::Job(format!("parts[{i}]: the part has no triangles")))
+            Frame::of(
+                &tris,
+                |t| t.map(|c| c.map(f64::from)),
+                &p.placement([0.0, 0.0], &spec.settings),
+            )
+            .ok_or_else(|| Error::Job(format!("parts[{i}]: the part has no triangles")))
         })
         .collect::<Result<Vec<_>, _>>()?;
     place_instances(&by_part, spec, &frames)

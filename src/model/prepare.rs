@@ -121,7 +121,7 @@ pub(crate) fn import(
     let facets_in_file = tris.len();
     drop(tris);
     let placement = mesh::Placement::of_settings(settings).compensated(settings.shrink_factors(0));
-    let frame = Frame::of(mesh.vertices.iter().copied(), &placement)
+    let frame = Frame::of(&mesh.vertices, |v| [*v], &placement)
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;
     let name = job::clean_name(&import::stem(file_name));

@@ -90,7 +90,8 @@ impl Job {
                 )));
             }
             let frame = Frame::of(
-                mesh.vertices.iter().copied(),
+                &mesh.vertices,
+                |v| [*v],
                 &p.placement([0.0, 0.0], &settings),
             );
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
