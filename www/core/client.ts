@@ -1,9 +1,9 @@
 // The worker pool: one worker per core (hardwareConcurrency, 1 … 8), each with its own wasm
 // instance. The first worker is the job worker: it holds the job's files (`Models`: added as
 // Files, read and imported there), answers layout, display meshes and lay-flat, and prepares a
-// slice (`Session.from_models`: place, merge, weld, checks, repair); the other workers read and
-// prepare the same Files for themselves at the same time and keep only the prepared job (a
-// worker waiting for the job worker's mesh idled through its whole preparation). The pool
+// slice (`Session.from_models`: place, merge, weld, checks, repair); the other workers hold no
+// files: they take the job worker's prepared job as bytes (`adopt_job`), so nothing is read or
+// prepared twice (see [[openAll]]). The pool
 // remembers which Files the job worker holds and adds them again to a fresh worker (after a
 // cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in

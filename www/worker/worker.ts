@@ -1,6 +1,7 @@
-// One worker = one wasm instance = at most one Session (one prepared slicing job) and the
-// job's `Models` (its imported files, from which it prepares the job; the job worker, the
-// pool's first, also answers the layout and the 3D view's requests). Answers the requests of
+// One worker = one wasm instance = at most one Session (one prepared slicing job). The job
+// worker, the pool's first, also holds the job's `Models` (its imported files), prepares the
+// job from them, hands it to the other workers as bytes (`open_job` with `share`; they
+// `adopt_job` it) and answers the layout and the 3D view's requests. Answers the requests of
 // core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred).
 // The model files arrive as Files and are read here (by the core, with FileReaderSync), never
 // on the page's thread. Everything from the core is a typed value; its errors are thrown as
@@ -43,7 +44,7 @@ const clock = publish(
 let wasm: Promise<InitOutput> | null = null;
 let memory: WebAssembly.Memory | null = null;
 let session: Session | null = null;
-/** The job's files (every worker holds them once it opened the job). */
+/** The job's files (the job worker's; the others take the prepared job instead). */
 let models: Models | null = null;
 let lastPanic = "";
 let broken = false;
