@@ -97,18 +97,16 @@ fn read(bytes: &[u8]) -> Result<Job, String> {
     // closes cracks), so the work of every layer stays what the job worker's was.
     let (lo, hi) = (meta.info.bounds.min, meta.info.bounds.max);
     let boxed = |v: &[f64; 3]| (0..3).all(|k| v[k] >= lo[k] - 1.0 && v[k] <= hi[k] + 1.0);
-    if !vertices.iter().all(boxed) {
+    if !all(&vertices, boxed) {
         return Err("a vertex lies outside the job's box".into());
     }
     let n = r.count(12)?;
     let facets: Vec<[u32; 3]> = get(r.take(n * 12)?, |c: [u8; 12]| {
         std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
     });
-    if facets
-        .iter()
-        .flatten()
-        .any(|&i| i as usize >= vertices.len())
-    {
+    if !all(&facets, |f| {
+        f.iter().all(|&i| (i as usize) < vertices.len())
+    }) {
         return Err("a facet names a vertex past the last".into());
     }
     let n = r.count(8)?;
@@ -184,6 +182,13 @@ fn get<T, const N: usize>(bytes: &[u8], from: impl Fn([u8; N]) -> T) -> Vec<T> {
         )
     });
     out
+}
+
+/// Whether `ok` holds for every item (in runs: [`in_runs`]).
+fn all<T>(items: &[T], ok: impl Fn(&T) -> bool) -> bool {
+    let mut all = true;
+    in_runs(items.len(), &mut |r| all = all && items[r].iter().all(&ok));
+    all
 }
 
 /// Reads the bytes in order; every length is checked against what is left.

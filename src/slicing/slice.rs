@@ -167,7 +167,14 @@ impl FacetBuckets {
             && offsets[0] == 0
             && offsets.windows(2).all(|w| w[0] <= w[1])
             && offsets[layers] as usize == listed.len()
-            && listed.iter().all(|&f| (f as usize) < facets);
+            && {
+                // (in runs: [`in_runs`])
+                let mut fit = true;
+                in_runs(listed.len(), &mut |r| {
+                    fit = fit && listed[r].iter().all(|&f| (f as usize) < facets)
+                });
+                fit
+            };
         if !sound {
             return Err("the facet index does not fit the layers and the mesh".into());
         }
