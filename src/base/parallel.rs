@@ -49,3 +49,24 @@ pub fn in_runs(n: usize, f: &mut dyn FnMut(std::ops::Range<usize>)) {
         at = end;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_cover_every_index_once_in_order_and_none_is_longer_than_a_run() {
+        for n in [0, 1, RUN - 1, RUN, RUN + 1, 3 * RUN + 5] {
+            let mut seen = Vec::new();
+            let mut longest = 0;
+            in_runs(n, &mut |r| {
+                longest = longest.max(r.len());
+                assert!(!r.is_empty(), "an empty run for n = {n}");
+                seen.extend(r);
+            });
+            assert_eq!(seen, (0..n).collect::<Vec<_>>(), "n = {n}");
+            assert!(longest <= RUN);
+            assert_eq!(longest, n.min(RUN));
+        }
+    }
+}
