@@ -245,16 +245,22 @@ async function handle(req: Request): Promise<void> {
       await load();
       // the old session stays usable if the job is refused
       const s = Session.from_models(needModels(), req.data.job);
-      const opened = adopt(s);
-      const n = req.data.share ?? 0;
-      if (n < 1) {
-        answer(req.kind, req.id, opened);
-        return;
+      // one copy of the prepared job per other worker (at most the pool's), made here rather
+      // than on the page's thread, all transferred; made before the session is taken, so a
+      // failure keeps the old one
+      const asked = req.data.share ?? 0;
+      const n = Number.isFinite(asked) ? Math.min(Math.max(0, Math.floor(asked)), 8) : 0;
+      const prepared: Uint8Array[] = [];
+      try {
+        if (n > 0) prepared.push(clock.time("core: the prepared job as bytes", () => s.prepared()));
+        for (let k = 1; k < n; k++) prepared.push(prepared[0].slice());
+      } catch (e) {
+        s.free();
+        throw e;
       }
-      // one copy per other worker, made here rather than on the page's thread; all transferred
-      const prepared = [clock.time("core: the prepared job as bytes", () => s.prepared())];
-      for (let k = 1; k < n; k++) prepared.push(prepared[0].slice());
-      answer(req.kind, req.id, { ...opened, prepared }, prepared.map((p) => p.buffer));
+      const opened = adopt(s);
+      if (n < 1) answer(req.kind, req.id, opened);
+      else answer(req.kind, req.id, { ...opened, prepared }, prepared.map((p) => p.buffer));
       return;
     }
     case "adopt_job": {
