@@ -5,6 +5,7 @@
 use super::{LayerResult, Session, to_js};
 use crate::analysis::{LayerAnalysis, LayerMaps, LayerStage, SlabRun, UnitRegions};
 use crate::output::summary::Summary;
+use js_sys::Uint8Array;
 use std::sync::Arc;
 use wasm_bindgen::prelude::*;
 
@@ -17,11 +18,13 @@ pub(crate) struct SlabInput {
     pub stage: Arc<LayerStage>,
 }
 
-/// A unit's summary, built layer by layer in the worker.
+/// A unit's summary and G-code, built layer by layer in the worker.
 #[wasm_bindgen]
 #[derive(Default)]
 pub struct Tally {
     summary: Summary,
+    /// The G-code of the layers added, in the order added.
+    gcode: Vec<u8>,
     /// The 3D estimate of the analysed layers so far (they come in order).
     run: Option<SlabRun>,
 }
@@ -33,10 +36,21 @@ impl Tally {
         Tally::default()
     }
 
-    /// Adds a sliced layer (its counts, travel and repairs, and its analysis if it has one).
+    /// Adds a sliced layer (its counts, travel and repairs, its G-code, and its analysis if it
+    /// has one).
     pub fn add_layer(&mut self, layer: &mut LayerResult) {
         self.summary.merge(&layer.summary);
+        self.gcode.extend_from_slice(layer.gcode.as_bytes());
         self.add_analysis(layer);
+    }
+
+    /// The G-code of the layers added, as a view of the module's memory: for a `Blob` made at
+    /// once (it copies the bytes), with no call into the module between (a call may move the
+    /// memory and the view with it). One copy per unit instead of one array per layer, which
+    /// cost the page's engine more per array than per byte.
+    pub fn gcode_view(&self) -> Uint8Array {
+        // SAFETY: the view is read by the caller before anything else runs in the module.
+        unsafe { Uint8Array::view(&self.gcode) }
     }
 
     /// Adds only a layer's analysis (a layer analysed after the slice that counted it), and

@@ -94,15 +94,14 @@ function yieldToQueue(): Promise<void> {
   });
 }
 
-function layerOf(s: Session, index: number, unit: { gcode: Uint8Array[]; tally: Tally } | null, analyse = false, counted = true): LayerData {
+function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analyse = false, counted = true): LayerData {
   const r = clock.time("core: a layer (all its stages)", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index)));
   const t0 = performance.now();
   try {
     if (unit) {
-      if (counted) {
-        unit.gcode.push(r.gcode);
-        unit.tally.add_layer(r);
-      } else unit.tally.add_analysis(r);
+      // the tally keeps the layer's G-code too (the unit's Blob is made from it at once)
+      if (counted) unit.tally.add_layer(r);
+      else unit.tally.add_analysis(r);
     }
     const layer: LayerData = {
       index: r.index,
@@ -141,7 +140,7 @@ async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
   const s = need();
   const { from, to } = req;
   const counted = req.gcode ?? true;
-  const parts = { gcode: [] as Uint8Array[], tally: new Tally() };
+  const parts = { tally: new Tally() };
   let batch: LayerData[] = [];
   let since = performance.now();
   try {
@@ -160,7 +159,8 @@ async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
     // the 3D estimate's slabs at the unit's ends (the layers next to it are planned again)
     if (req.analyse) clock.time("core: the unit's end slabs", () => s.finish_slabs(parts.tally));
     const unit: SliceUnit = { from, to, summary: parts.tally.summary() };
-    if (counted) unit.gcode = clock.time("worker: blob", () => new Blob(parts.gcode as BlobPart[], { type: "text/plain" }));
+    // the Blob copies the view of the module's memory at once (no call into the module between)
+    if (counted) unit.gcode = clock.time("worker: blob", () => new Blob([parts.tally.gcode_view()] as BlobPart[], { type: "text/plain" }));
     answer("slice", id, unit);
   } finally {
     parts.tally.free();
