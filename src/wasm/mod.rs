@@ -344,8 +344,9 @@ impl Session {
 
     /// The prepared job as bytes ([`Job::to_bytes`]), for [`Session::from_prepared`] in the
     /// page's other workers: they take this worker's preparation instead of repeating it.
+    /// (Not counted as `Prepare`: the worker times it on its own line of the profile.)
     pub fn prepared(&self) -> Vec<u8> {
-        stages::time(Stage::Prepare, || self.job.to_bytes())
+        self.job.to_bytes()
     }
 
     /// The job another worker prepared ([`Session::prepared`]). Throws `{kind: "internal",
