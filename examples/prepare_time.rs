@@ -1,5 +1,6 @@
 //! Time of `Job::new` (import, shells, checks, repair, facet index) on a model, median of 7.
-//! Usage: cargo run --release --example prepare_time -- MODEL.stl
+//! Usage: cargo run --release --example prepare_time -- MODEL.stl (`SUPPORT=1`: with
+//! `support = unit1`, whose droplet estimate also reads the down-facing facets)
 // Native tools: on wasm32 (`wasm-pack test` builds every target) the example is empty.
 #![cfg_attr(target_arch = "wasm32", no_main)]
 #![cfg(not(target_arch = "wasm32"))]
@@ -11,10 +12,14 @@ fn main() {
         .nth(1)
         .expect("usage: prepare_time MODEL.stl");
     let bytes = std::fs::read(&path).expect("read the model");
+    let mut settings = Settings::default();
+    if std::env::var("SUPPORT").is_ok_and(|v| v == "1") {
+        settings.set("support", "unit1").expect("support setting");
+    }
     let mut times: Vec<f64> = (0..7)
         .map(|_| {
             let t = Instant::now();
-            let job = Job::new(&bytes, &path, Settings::default()).expect("job");
+            let job = Job::new(&bytes, &path, settings.clone()).expect("job");
             std::hint::black_box(job.layer_count());
             t.elapsed().as_secs_f64() * 1000.0
         })

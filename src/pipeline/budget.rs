@@ -72,7 +72,6 @@ impl Unit1Parts {
 
 /// An edge's first two down-facing facets (with whether each uses it from the lower vertex
 /// index) and how many use it.
-type EdgeUsers = ([(u32, bool); 2], u32);
 
 /// The down-facing facets of a closed mesh (outward normals), summed over the layers for the
 /// support's bound ([`Overhangs::droplets`]).
@@ -94,7 +93,8 @@ type EdgeUsers = ([(u32, bool); 2], u32);
 /// lie on both sides of its projection, so the edge is no boundary of U(n) while both count:
 /// P ≤ Σ over edges of the length × the facets using it that count without their partner.
 /// C is at most the pieces of U(n) joined through shared edges (union–find, the facets added
-/// from the highest N down). Summed over the layers: O(facets) with a hash map of edges.
+/// from the highest N down). Summed over the layers: O(facets), the edges grouped by a counting
+/// sort on their lower vertex.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Overhangs {
     /// Σₙ A(n) (mm²·layers).
@@ -108,9 +108,8 @@ pub struct Overhangs {
 impl Overhangs {
     /// The down-facing facets of `mesh` (oriented outward), sliced at the planes `zs`.
     pub fn of(mesh: &Mesh, zs: &[f64]) -> Overhangs {
-        // Fx hashing: the edges' order does not matter to the figures but for the last bits
-        // of the perimeter's sum (which the default hasher's random seed varied from run to run).
-        use rustc_hash::FxHashMap as HashMap;
+        // The edges are visited in a fixed order (by their vertices), so the perimeter's sum
+        // is the same to the last bit in every run.
         let count = |top: f64| zs.partition_point(|&z| z <= top) as u32;
         let mut o = Overhangs::default();
         // Each down-facing facet that counts for some layer: its corners and N.
@@ -128,21 +127,6 @@ impl Overhangs {
                 down.push((*f, n));
             }
         }
-        // Each edge's facets (the first two, with the direction they use it in) and count.
-        let mut edges: HashMap<(u32, u32), EdgeUsers> =
-            HashMap::with_capacity_and_hasher(down.len() * 3 / 2, Default::default());
-        for (k, (f, _)) in down.iter().enumerate() {
-            for j in 0..3 {
-                let (p, q) = (f[j], f[(j + 1) % 3]);
-                let e = edges
-                    .entry((p.min(q), p.max(q)))
-                    .or_insert(([(0, false); 2], 0));
-                if e.1 < 2 {
-                    e.0[e.1 as usize] = (k as u32, p < q);
-                }
-                e.1 += 1;
-            }
-        }
         let top = down.iter().map(|d| d.1).max().unwrap_or(0) as usize;
         // Pairs of facets sharing an edge, by the layer count both reach.
         let mut joins: Vec<Vec<(u32, u32)>> = vec![Vec::new(); top + 1];
@@ -150,24 +134,69 @@ impl Overhangs {
         for &(_, n) in &down {
             fresh[n as usize] += 1;
         }
-        for (&(p, q), &(users, used)) in &edges {
-            let len = match (mesh.vertices.get(p as usize), mesh.vertices.get(q as usize)) {
-                (Some(a), Some(b)) => (b[0] - a[0]).hypot(b[1] - a[1]),
-                _ => 0.0,
-            };
-            let n = |u: (u32, bool)| down[u.0 as usize].1;
-            if used == 2 && users[0].1 != users[1].1 {
-                o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;
-            } else {
-                let stored: u32 = users[..used.min(2) as usize].iter().map(|&u| n(u)).sum();
-                o.perimeter += len * (stored as f64 + used.saturating_sub(2) as f64 * top as f64);
-            }
-            if used >= 2 {
-                let level = n(users[0]).min(n(users[1]));
-                joins[level as usize].push((users[0].0, users[1].0));
+        // Each edge's facets, with the direction they use it in, grouped by the edge's lower
+        // vertex (a counting sort: a hash map's random reads took most of the time), then by
+        // its other vertex, in the order of the facets.
+        let sides = |f: &[u32; 3]| [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])];
+        let nv = mesh.vertices.len();
+        let mut first = vec![0u32; nv + 1];
+        for (f, _) in &down {
+            for (p, q) in sides(f) {
+                if let Some(c) = first.get_mut(p.min(q) as usize + 1) {
+                    *c += 1;
+                }
             }
         }
-        drop(edges);
+        let mut sum = 0;
+        for c in first.iter_mut() {
+            sum += *c;
+            *c = sum;
+        }
+        let mut fill = first.clone();
+        // (the other vertex, the facet, whether the facet runs from the lower vertex to it)
+        let mut uses = vec![(0u32, 0u32, false); sum as usize];
+        for (k, (f, _)) in down.iter().enumerate() {
+            for (p, q) in sides(f) {
+                if let Some(at) = fill.get_mut(p.min(q) as usize) {
+                    uses[*at as usize] = (p.max(q), k as u32, p < q);
+                    *at += 1;
+                }
+            }
+        }
+        drop(fill);
+        for p in 0..nv {
+            let around = &mut uses[first[p] as usize..first[p + 1] as usize];
+            // Few edges per vertex: an insertion sort, stable (the facets' order kept).
+            for i in 1..around.len() {
+                let mut j = i;
+                while j > 0 && around[j - 1].0 > around[j].0 {
+                    around.swap(j - 1, j);
+                    j -= 1;
+                }
+            }
+            for edge in around.chunk_by(|a, b| a.0 == b.0) {
+                let q = edge[0].0;
+                let used = edge.len();
+                let users = [edge[0], edge[used.min(2) - 1]].map(|u| (u.1, u.2));
+                let len = match (mesh.vertices.get(p), mesh.vertices.get(q as usize)) {
+                    (Some(a), Some(b)) => (b[0] - a[0]).hypot(b[1] - a[1]),
+                    _ => 0.0,
+                };
+                let n = |u: (u32, bool)| down[u.0 as usize].1;
+                if used == 2 && users[0].1 != users[1].1 {
+                    o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;
+                } else {
+                    let stored: u32 = users[..used.min(2)].iter().map(|&u| n(u)).sum();
+                    o.perimeter +=
+                        len * (stored as f64 + used.saturating_sub(2) as f64 * top as f64);
+                }
+                if used >= 2 {
+                    let level = n(users[0]).min(n(users[1]));
+                    joins[level as usize].push((users[0].0, users[1].0));
+                }
+            }
+        }
+        drop(uses);
         let mut parent: Vec<u32> = (0..down.len() as u32).collect();
         fn root(parent: &mut [u32], mut i: u32) -> u32 {
             while parent[i as usize] != i {
@@ -511,6 +540,144 @@ mod tests {
         // The bound holds the hatch of that column: 400 mm² × 50 layers of B₁ = B.
         let b1 = s.unit1_droplet_width();
         assert!(o.droplets(&s) >= 400.0 * n / (b1 * b1));
+    }
+
+    /// [`Overhangs::of`] as it was written first, the edges in a map: the figures the
+    /// counting sort must give.
+    fn of_by_map(mesh: &Mesh, zs: &[f64]) -> Overhangs {
+        let count = |top: f64| zs.partition_point(|&z| z <= top) as u32;
+        let mut o = Overhangs::default();
+        let mut down: Vec<([u32; 3], u32)> = Vec::new();
+        for f in &mesh.facets {
+            let [a, b, c] = f.map(|i| mesh.vertices[i as usize]);
+            let twice = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            let n = count(a[2].max(b[2]).max(c[2]));
+            if twice < 0.0 && n > 0 {
+                o.area += -0.5 * twice * n as f64;
+                down.push((*f, n));
+            }
+        }
+        let mut edges = std::collections::BTreeMap::<(u32, u32), ([(u32, bool); 2], u32)>::new();
+        for (k, (f, _)) in down.iter().enumerate() {
+            for j in 0..3 {
+                let (p, q) = (f[j], f[(j + 1) % 3]);
+                let e = edges
+                    .entry((p.min(q), p.max(q)))
+                    .or_insert(([(0, false); 2], 0));
+                if e.1 < 2 {
+                    e.0[e.1 as usize] = (k as u32, p < q);
+                }
+                e.1 += 1;
+            }
+        }
+        let top = down.iter().map(|d| d.1).max().unwrap_or(0) as usize;
+        let mut joins: Vec<Vec<(u32, u32)>> = vec![Vec::new(); top + 1];
+        let mut fresh = vec![0u32; top + 1];
+        for &(_, n) in &down {
+            fresh[n as usize] += 1;
+        }
+        for (&(p, q), &(users, used)) in &edges {
+            let (a, b) = (mesh.vertices[p as usize], mesh.vertices[q as usize]);
+            let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = |u: (u32, bool)| down[u.0 as usize].1;
+            if used == 2 && users[0].1 != users[1].1 {
+                o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;
+            } else {
+                let stored: u32 = users[..used.min(2) as usize].iter().map(|&u| n(u)).sum();
+                o.perimeter += len * (stored as f64 + used.saturating_sub(2) as f64 * top as f64);
+            }
+            if used >= 2 {
+                let level = n(users[0]).min(n(users[1]));
+                joins[level as usize].push((users[0].0, users[1].0));
+            }
+        }
+        // Pieces: the facets joined through their shared edges, from the highest N down.
+        let mut parent: Vec<usize> = (0..down.len()).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                i = parent[i];
+            }
+            i
+        }
+        let mut pieces = 0i64;
+        for level in (1..=top).rev() {
+            pieces += fresh[level] as i64;
+            for &(a, b) in &joins[level] {
+                let (ra, rb) = (root(&mut parent, a as usize), root(&mut parent, b as usize));
+                if ra != rb {
+                    parent[ra] = rb;
+                    pieces -= 1;
+                }
+            }
+            o.pieces += pieces as f64;
+        }
+        o
+    }
+
+    /// A closed sphere of `rings` × `rings` quads around `c`, facets facing out.
+    fn sphere(c: [f64; 3], r: f64, rings: u32) -> Mesh {
+        let mut vertices = vec![[c[0], c[1], c[2] - r], [c[0], c[1], c[2] + r]];
+        for i in 1..rings {
+            let t = std::f64::consts::PI * i as f64 / rings as f64;
+            for j in 0..rings {
+                let a = std::f64::consts::TAU * j as f64 / rings as f64;
+                let (st, ct) = t.sin_cos();
+                vertices.push([
+                    c[0] + r * st * a.cos(),
+                    c[1] + r * st * a.sin(),
+                    c[2] - r * ct,
+                ]);
+            }
+        }
+        let at = |i: u32, j: u32| 2 + (i - 1) * rings + j % rings;
+        let mut facets = Vec::new();
+        for j in 0..rings {
+            facets.push([0, at(1, j + 1), at(1, j)]);
+            facets.push([1, at(rings - 1, j), at(rings - 1, j + 1)]);
+            for i in 1..rings - 1 {
+                facets.push([at(i, j), at(i, j + 1), at(i + 1, j + 1)]);
+                facets.push([at(i, j), at(i + 1, j + 1), at(i + 1, j)]);
+            }
+        }
+        Mesh { vertices, facets }
+    }
+
+    #[test]
+    fn the_edges_grouped_by_vertex_give_the_figures_of_a_map() {
+        let s = Settings::default();
+        let zs = zs(&s);
+        let same = |m: &Mesh| {
+            let (o, r) = (Overhangs::of(m, &zs), of_by_map(m, &zs));
+            assert_eq!((o.area, o.pieces), (r.area, r.pieces), "{o:?} {r:?}");
+            assert!(
+                (o.perimeter - r.perimeter).abs() <= 1e-9 * r.perimeter,
+                "{o:?} {r:?}"
+            );
+            o
+        };
+        // Closed and oriented: a lifted sphere is one piece per layer under its lower half.
+        let ball = sphere([10.0, 10.0, 10.0], 6.0, 24);
+        let o = same(&ball);
+        assert!(o.area > 0.0 && o.perimeter > 0.0 && o.pieces > 0.0, "{o:?}");
+        // A facet turned (an edge used twice in one direction), two balls sharing vertices
+        // (edges of more than two facets) and a lifted box beside a ball.
+        let mut turned = ball.clone();
+        turned.facets[3].swap(1, 2);
+        same(&turned);
+        let mut twice = ball.clone();
+        let shift = twice.facets.clone();
+        twice
+            .facets
+            .extend(shift.iter().map(|f| [f[0], f[2], f[1]]));
+        twice.facets.extend(shift);
+        same(&twice);
+        let mut both = cuboid([0.0, 0.0, 12.0], [5.0, 5.0, 15.0]);
+        let base = both.vertices.len() as u32;
+        both.vertices.extend(&ball.vertices);
+        both.facets
+            .extend(ball.facets.iter().map(|f| f.map(|i| i + base)));
+        let o = same(&both);
+        assert!(o.pieces > same(&ball).pieces);
     }
 
     #[test]
