@@ -70,9 +70,6 @@ impl Unit1Parts {
     }
 }
 
-/// An edge's first two down-facing facets (with whether each uses it from the lower vertex
-/// index) and how many use it.
-
 /// The down-facing facets of a closed mesh (outward normals), summed over the layers for the
 /// support's bound ([`Overhangs::droplets`]).
 ///
