@@ -133,15 +133,14 @@ impl Overhangs {
         }
         // Each edge's facets, with the direction they use it in, grouped by the edge's lower
         // vertex (a counting sort: a hash map's random reads took most of the time), then by
-        // its other vertex, in the order of the facets.
+        // its other vertex, in the order of the facets. Every corner of `down` is a vertex of
+        // the mesh (checked above).
         let sides = |f: &[u32; 3]| [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])];
         let nv = mesh.vertices.len();
         let mut first = vec![0u32; nv + 1];
         for (f, _) in &down {
             for (p, q) in sides(f) {
-                if let Some(c) = first.get_mut(p.min(q) as usize + 1) {
-                    *c += 1;
-                }
+                first[p.min(q) as usize + 1] += 1;
             }
         }
         let mut sum = 0;
@@ -154,31 +153,22 @@ impl Overhangs {
         let mut uses = vec![(0u32, 0u32, false); sum as usize];
         for (k, (f, _)) in down.iter().enumerate() {
             for (p, q) in sides(f) {
-                if let Some(at) = fill.get_mut(p.min(q) as usize) {
-                    uses[*at as usize] = (p.max(q), k as u32, p < q);
-                    *at += 1;
-                }
+                let at = &mut fill[p.min(q) as usize];
+                uses[*at as usize] = (p.max(q), k as u32, p < q);
+                *at += 1;
             }
         }
         drop(fill);
         for p in 0..nv {
             let around = &mut uses[first[p] as usize..first[p + 1] as usize];
-            // Few edges per vertex: an insertion sort, stable (the facets' order kept).
-            for i in 1..around.len() {
-                let mut j = i;
-                while j > 0 && around[j - 1].0 > around[j].0 {
-                    around.swap(j - 1, j);
-                    j -= 1;
-                }
-            }
+            // Stable (the facets' order kept); O(k log k) however many facets share a vertex.
+            around.sort_by_key(|u| u.0);
             for edge in around.chunk_by(|a, b| a.0 == b.0) {
-                let q = edge[0].0;
                 let used = edge.len();
+                // The first two users (the first twice when it is alone: only it is read then).
                 let users = [edge[0], edge[used.min(2) - 1]].map(|u| (u.1, u.2));
-                let len = match (mesh.vertices.get(p), mesh.vertices.get(q as usize)) {
-                    (Some(a), Some(b)) => (b[0] - a[0]).hypot(b[1] - a[1]),
-                    _ => 0.0,
-                };
+                let (a, b) = (mesh.vertices[p], mesh.vertices[edge[0].0 as usize]);
+                let len = (b[0] - a[0]).hypot(b[1] - a[1]);
                 let n = |u: (u32, bool)| down[u.0 as usize].1;
                 if used == 2 && users[0].1 != users[1].1 {
                     o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;

@@ -189,6 +189,33 @@ fn the_edges_grouped_by_vertex_give_the_figures_of_a_map() {
 }
 
 #[test]
+fn a_vertex_shared_by_many_facets_is_grouped_as_a_map_does() {
+    // A lifted cone of 30,000 facets facing down from one apex (and a cap): one vertex with
+    // 30,000 edges (sorted per vertex; an insertion sort would take quadratic time there).
+    let k = 30_000u32;
+    let mut vertices = vec![[10.0, 10.0, 5.0], [10.0, 10.0, 12.0]];
+    for j in 0..k {
+        let a = std::f64::consts::TAU * j as f64 / k as f64;
+        vertices.push([10.0 + 8.0 * a.cos(), 10.0 + 8.0 * a.sin(), 12.0]);
+    }
+    let rim = |j: u32| 2 + j % k;
+    let mut facets = Vec::new();
+    for j in 0..k {
+        facets.push([0, rim(j + 1), rim(j)]);
+        facets.push([1, rim(j), rim(j + 1)]);
+    }
+    let cone = Mesh { vertices, facets };
+    let zs = zs(&Settings::default());
+    let (o, r) = (Overhangs::of(&cone, &zs), of_by_map(&cone, &zs));
+    assert_eq!((o.area, o.pieces), (r.area, r.pieces), "{o:?} {r:?}");
+    assert!(
+        (o.perimeter - r.perimeter).abs() <= 1e-9 * r.perimeter,
+        "{o:?} {r:?}"
+    );
+    assert!(o.area > 0.0 && o.pieces > 0.0, "{o:?}");
+}
+
+#[test]
 fn each_unit_and_the_support_count_with_their_own_droplets() {
     let size = [20.0, 20.0, 20.0];
     let s = Settings::default();
