@@ -200,6 +200,8 @@ export class Store {
   readonly previewRequests = new Set<number>();
   /** The redraw waiting while the workers run (flows/slice.ts whileBusy). */
   busyRedraw: { gen: number; update: () => void } | null = null;
+  /** When the last of those redraws ran (performance.now()). */
+  busyRedrawAt = -Infinity;
 
   constructor(readonly cacheBudget: number) {}
 

@@ -34,37 +34,29 @@ export interface Target {
  *  redraw costs style, layout and paint, and with few cores that time is taken from slicing. */
 const BUSY_REDRAW_MS = 150;
 
-/** Runs `update` within [[BUSY_REDRAW_MS]], once for all calls until then, unless the run `gen`
- *  has ended by then (the page is then drawn by whatever ended it). */
-let frameWork: (() => void) | null = null;
-
-/** Runs `work` in the next animation frame; a later call before it replaces it. */
-function inNextFrame(work: () => void): void {
-  const pending = frameWork !== null;
-  frameWork = work;
-  if (pending) return;
-  requestAnimationFrame(() => {
-    const w = frameWork;
-    frameWork = null;
-    w?.();
-  });
-}
-
+/** Runs `update` at once when the last such redraw is [[BUSY_REDRAW_MS]] old (the first
+ *  layer moves the bar at once, however fast the slice), else once at the end of that
+ *  interval for all calls until then, unless the run `gen` has ended by then (the page is
+ *  then drawn by whatever ended it). */
 function whileBusy(page: Page, gen: number, update: () => void): void {
   const store = page.store;
   const pending = store.busyRedraw !== null;
   store.busyRedraw = { gen, update };
   if (pending) return;
-  setTimeout(() => {
+  const run = () => {
     const r = store.busyRedraw;
     store.busyRedraw = null;
     if (r && r.gen === store.generation && store.busy) {
+      store.busyRedrawAt = performance.now();
       r.update();
-      // the figures' layout now, in this timer's task, not in the next frame's (where it
-      // joined the canvas' draw, the paint and the commit in one task of 40–60 ms)
+      // the layout now, in this task, not in the next frame's (where it joined the canvas'
+      // draw, the paint and the commit in one task of 40–60 ms)
       void document.documentElement.offsetHeight;
     }
-  }, BUSY_REDRAW_MS);
+  };
+  const wait = store.busyRedrawAt + BUSY_REDRAW_MS - performance.now();
+  if (wait <= 0) run();
+  else setTimeout(run, wait);
 }
 
 function settingsProblem(page: Page): boolean {
@@ -121,8 +113,13 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
   progress(0, `Reading ${name}…`);
   updateButtons(page);
   try {
+    // the bar and the figures in one throttled redraw (one layout and paint for both)
+    const redraw = () => {
+      if (s.done < s.layers) progress(s.done / Math.max(1, s.layers));
+      writeStats(page);
+    };
     const figuresChanged = () => {
-      if (store.slice === s && gen === store.generation) whileBusy(page, gen, () => writeStats(page));
+      if (store.slice === s && gen === store.generation) whileBusy(page, gen, redraw);
     };
     await pool.slice(refs, sliced.file, {
       opened: (r) => {
@@ -154,13 +151,9 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
         // the layer shown and the one below it: drawn once both have arrived (a draw costs)
         const arrived = (k: number) => k < 0 || s.counts[k] !== undefined;
         if ((l.index === current || l.index === current - 1) && arrived(current) && arrived(current - 1)) show(page, current);
-        // the last layer shows 100 % at once; before it the figures are redrawn now and then
+        // the last layer shows 100 % at once; before it the bar and figures now and then
         if (s.done === s.layers) progress(1);
-        else {
-          // the bar is cheap: once a frame; the figures cost: now and then
-          inNextFrame(() => gen === store.generation && s.done < s.layers && progress(s.done / Math.max(1, s.layers)));
-          whileBusy(page, gen, () => writeStats(page));
-        }
+        else whileBusy(page, gen, redraw);
       },
       unit: (u) => {
         if (gen !== store.generation) return;
@@ -216,8 +209,13 @@ export async function analyseVoids(page: Page, s: Slice): Promise<void> {
   // every layer is analysed again: what an earlier, cancelled pass analysed is dropped
   s.figures.restartAnalysis();
   let arrived = 0;
+  // the bar and the figures in one throttled redraw, whichever asked for it
+  const redraw = () => {
+    progress(arrived / Math.max(1, s.layers), label);
+    writeStats(page);
+  };
   const figuresChanged = () => {
-    if (store.slice === s && gen === store.generation) whileBusy(page, gen, () => writeStats(page));
+    if (store.slice === s && gen === store.generation) whileBusy(page, gen, redraw);
   };
   try {
     await pool.analyse(
@@ -227,10 +225,7 @@ export async function analyseVoids(page: Page, s: Slice): Promise<void> {
         s.put(l, store.current);
         arrived++;
         if (l.index === store.current) show(page, store.current);
-        whileBusy(page, gen, () => {
-          progress(arrived / Math.max(1, s.layers), label);
-          writeStats(page);
-        });
+        whileBusy(page, gen, redraw);
       },
       (u) => {
         if (gen !== store.generation) return;
