@@ -495,6 +495,77 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_index_offers_every_edge_within_reach_and_finds_the_nearest_as_a_scan_does() {
+        // Edges short and long (across many cells), points, axis-parallel; queries inside,
+        // outside and at the edges: every edge within r of p is offered, "any edge closer
+        // than r" and the nearest edge's distance are what a scan of every edge says.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut random = || crate::base::testing::random(&mut seed);
+        for case in 0..40 {
+            let n = 1 + case * 13 % 300;
+            let scale = if case % 3 == 0 { 1.0 } else { 30.0 };
+            let edges: Vec<(Point, Point)> = (0..n)
+                .map(|k| {
+                    let a = Point::new(random() * scale, random() * scale);
+                    let b = match k % 5 {
+                        0 => a,
+                        1 => Point::new(a.x + random() * scale, a.y),
+                        2 => Point::new(random() * scale, random() * scale),
+                        _ => a + Point::new(random() - 0.5, random() - 0.5) * 0.4,
+                    };
+                    (a, b)
+                })
+                .collect();
+            let r: f64 = [0.01, 0.1, 0.5, 2.0][case % 4];
+            let index = EdgeIndex::new(&edges, r.max(1e-3));
+            for q in 0..200 {
+                let p = if q % 4 == 0 {
+                    let (a, b) = edges[q % n];
+                    let t = random();
+                    a + (b - a) * t + Point::new(random() - 0.5, random() - 0.5) * 2.0 * r
+                } else {
+                    Point::new(
+                        random() * 1.4 * scale - 0.2 * scale,
+                        random() * 1.4 * scale - 0.2 * scale,
+                    )
+                };
+                let mut offered = vec![false; n];
+                assert!(!index.any_near(p, r, |e| {
+                    offered[e] = true;
+                    false
+                }));
+                for (e, &(a, b)) in edges.iter().enumerate() {
+                    if segment_distance2(p, a, b) <= r * r {
+                        assert!(
+                            offered[e],
+                            "case {case}: edge {e} within {r} of {p} not offered"
+                        );
+                    }
+                }
+                let scan = edges
+                    .iter()
+                    .any(|&(a, b)| segment_distance2(p, a, b) < r * r);
+                let got = index.any_near(p, r, |e| {
+                    let (a, b) = edges[e];
+                    segment_distance2(p, a, b) < r * r
+                });
+                assert_eq!(got, scan, "case {case} at {p}");
+                // and the distance to the nearest edge, as the scan finds it
+                let nearest = edges
+                    .iter()
+                    .map(|&(a, b)| segment_distance2(p, a, b))
+                    .fold(f64::INFINITY, f64::min)
+                    .sqrt();
+                let d = index.distance(p, 0.0);
+                assert!(
+                    (d - nearest).abs() <= 1e-12 * nearest.max(1.0),
+                    "case {case} at {p}: {d} {nearest}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn floor_i64_is_floor_as_i64() {
         for x in crate::base::testing::floor_cases() {
             assert_eq!(floor_i64(x), x.floor() as i64, "{x:e}");
