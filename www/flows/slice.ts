@@ -34,8 +34,8 @@ export interface Target {
  *  redraw costs style, layout and paint, and with few cores that time is taken from slicing. */
 const BUSY_REDRAW_MS = 150;
 
-/** Runs `update` at once when the last such redraw is [[BUSY_REDRAW_MS]] old (the first
- *  layer moves the bar at once, however fast the slice), else once at the end of that
+/** Runs `update` in the next task when the last such redraw is [[BUSY_REDRAW_MS]] old (the
+ *  first layer moves the bar at once, however fast the slice), else once at the end of that
  *  interval for all calls until then, unless the run `gen` has ended by then (the page is
  *  then drawn by whatever ended it). */
 function whileBusy(page: Page, gen: number, update: () => void): void {
@@ -54,9 +54,8 @@ function whileBusy(page: Page, gen: number, update: () => void): void {
       void document.documentElement.offsetHeight;
     }
   };
-  const wait = store.busyRedrawAt + BUSY_REDRAW_MS - performance.now();
-  if (wait <= 0) run();
-  else setTimeout(run, wait);
+  // in a task of its own, not in the worker's message (a longer task for the page's thread)
+  setTimeout(run, Math.max(0, store.busyRedrawAt + BUSY_REDRAW_MS - performance.now()));
 }
 
 function settingsProblem(page: Page): boolean {
