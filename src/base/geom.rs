@@ -150,6 +150,52 @@ pub fn line_droplets(from: Point, to: Point, b: f64) -> impl Iterator<Item = Poi
     })
 }
 
+/// The droplets of [`line_droplets`] that lie in the box `lo`..=`hi` (both ends included), in
+/// their order: the same points, but only those near the box are computed (a long line
+/// crossing a small box costs a few, not all of its droplets).
+pub fn line_droplets_in(
+    from: Point,
+    to: Point,
+    b: f64,
+    lo: Point,
+    hi: Point,
+) -> impl Iterator<Item = Point> {
+    let l = dist(from, to);
+    let count = line_droplet_count(l, b);
+    // The line's parameter range within the box, s ∈ [s0, s1] (empty when s0 > s1).
+    let (mut s0, mut s1) = (0.0f64, 1.0f64);
+    for k in 0..2 {
+        let d = to[k] - from[k];
+        if d != 0.0 {
+            let (a, e) = ((lo[k] - from[k]) / d, (hi[k] - from[k]) / d);
+            s0 = s0.max(a.min(e));
+            s1 = s1.min(a.max(e));
+        } else if from[k] < lo[k] || from[k] > hi[k] {
+            s1 = -1.0;
+        }
+    }
+    // Droplet j lies at s = j·b/l: its indices, one more on each side for the rounding, and
+    // every point still checked against the box.
+    let js = if l.is_nan() || l <= 0.0 {
+        0..count
+    } else if s0.partial_cmp(&s1).is_none_or(|o| o.is_gt()) {
+        0..0
+    } else {
+        let k = l / b;
+        let j0 = ((s0 * k).floor() - 1.0).max(0.0) as u64;
+        let j1 = ((s1 * k).ceil() + 2.0).max(0.0) as u64;
+        j0.min(count)..j1.min(count)
+    };
+    js.filter_map(move |j| {
+        let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
+        let p = DVec2::new(
+            from[0] + t * (to[0] - from[0]),
+            from[1] + t * (to[1] - from[1]),
+        );
+        (p.cmpge(lo).all() && p.cmple(hi).all()).then_some(p)
+    })
+}
+
 /// Loops in the boolean engine's point type.
 pub fn to_overlay<'a>(contours: impl IntoIterator<Item = &'a Contour>) -> Vec<Vec<[f64; 2]>> {
     contours
@@ -254,6 +300,35 @@ pub fn greater(a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_lines_droplets_in_a_box_are_those_of_the_whole_line_in_it() {
+        // Lines long and short, axis-parallel and of no length; boxes around, across, at an
+        // end and beside them: the same points in the same order as the whole line filtered.
+        let mut seed = 0x5851_f42d_4c95_7f2du64;
+        let mut random = || crate::base::testing::random(&mut seed);
+        let mut kept = 0;
+        for case in 0..2000 {
+            let from = DVec2::new(random() * 40.0, random() * 40.0);
+            let to = match case % 5 {
+                0 => from,
+                1 => DVec2::new(random() * 40.0, from.y),
+                2 => DVec2::new(from.x, random() * 40.0),
+                _ => DVec2::new(random() * 40.0, random() * 40.0),
+            };
+            let b = [0.2, 0.208, 0.5, 3.0][case % 4];
+            let c = from + (to - from) * (random() * 1.4 - 0.2);
+            let half = DVec2::new(random(), random()) * [0.0, 0.3, 2.0, 30.0][case / 4 % 4];
+            let (lo, hi) = (c - half, c + half);
+            let whole: Vec<Point> = line_droplets(from, to, b)
+                .filter(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+                .collect();
+            let part: Vec<Point> = line_droplets_in(from, to, b, lo, hi).collect();
+            assert_eq!(part, whole, "case {case}: {from} {to} {b} {lo} {hi}");
+            kept += whole.len();
+        }
+        assert!(kept > 5000, "{kept}");
+    }
 
     #[test]
     fn right_angles_are_exact() {

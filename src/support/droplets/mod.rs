@@ -8,7 +8,9 @@
 //! than the limit but the droplets below sit B/2 inside that edge. The pass works on droplet
 //! centres only (hash grids of the layers' droplets), so it is cheap.
 
-use crate::base::geom::{DVec2, Point, Shapes, dist, round_output};
+use crate::base::geom::{
+    DVec2, Point, Shapes, dist, line_droplets, line_droplets_in, round_output,
+};
 use crate::base::settings::Settings;
 use crate::slicing::plan::{Move, MoveKind};
 use gaps::inside;
@@ -48,18 +50,15 @@ pub fn droplets_of(
         let w = if m.unit == 1 { b1 } else { b };
         match m.kind {
             MoveKind::Droplet if inside(m.to) => out.push((m.to, w)),
-            MoveKind::Line => {
-                let meets = within.is_none_or(|(lo, hi)| {
-                    at.min(m.to).cmple(hi).all() && at.max(m.to).cmpge(lo).all()
-                });
-                if meets {
-                    out.extend(
-                        crate::base::geom::line_droplets(at, m.to, w)
-                            .filter(|&p| inside(p))
-                            .map(|p| (p, w)),
-                    );
+            MoveKind::Line => match within {
+                None => out.extend(line_droplets(at, m.to, w).map(|p| (p, w))),
+                // only the droplets near the box are computed (a long line, a small box)
+                Some((lo, hi)) => {
+                    if at.min(m.to).cmple(hi).all() && at.max(m.to).cmpge(lo).all() {
+                        out.extend(line_droplets_in(at, m.to, w, lo, hi).map(|p| (p, w)));
+                    }
                 }
-            }
+            },
             _ => {}
         }
         at = m.to;
@@ -225,28 +224,33 @@ fn unsupported_added(
 ) {
     let reach = |w: f64| rule.reach(w);
     let adds: Vec<Droplet> = added.iter().map(|&p| (p, rule.b1)).collect();
-    let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
-    for (p, _) in &adds {
-        lo = lo.min(*p);
-        hi = hi.max(*p);
-    }
-    let (lo, hi) = (lo - DVec2::splat(rule.cell), hi + DVec2::splat(rule.cell));
-    buf.clear();
-    droplets(i - 1, Some((lo, hi)), buf);
-    let mut held = vec![false; adds.len()];
-    if adds.len() > 16 {
-        let below = Below::new(rule.b, rule.b1, reach, buf);
-        for (h, &(p, _)) in held.iter_mut().zip(&adds) {
-            *h = below.find_within(p, reach).is_some();
-        }
+    let cell = DVec2::splat(rule.cell);
+    let held: Vec<bool> = if adds.len() <= 16 {
+        // Few: each asks for the droplets in its own box (a line crossing it gives only the
+        // droplets near the box), not the box of all of them, which may span the layer.
+        adds.iter()
+            .map(|&(p, _)| {
+                buf.clear();
+                droplets(i - 1, Some((p - cell, p + cell)), buf);
+                buf.iter().any(|&(q, w)| {
+                    let r = reach(w);
+                    (p - q).length_squared() <= r * r
+                })
+            })
+            .collect()
     } else {
-        for &(q, w) in buf.iter() {
-            let r = reach(w);
-            for (h, &(p, _)) in held.iter_mut().zip(&adds) {
-                *h = *h || (p - q).length_squared() <= r * r;
-            }
+        let (mut lo, mut hi) = (DVec2::INFINITY, DVec2::NEG_INFINITY);
+        for (p, _) in &adds {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
         }
-    }
+        buf.clear();
+        droplets(i - 1, Some((lo - cell, hi + cell)), buf);
+        let below = Below::new(rule.b, rule.b1, reach, buf);
+        adds.iter()
+            .map(|&(p, _)| below.find_within(p, reach).is_some())
+            .collect()
+    };
     todo.extend(
         adds.iter()
             .zip(&held)
