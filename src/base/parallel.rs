@@ -13,6 +13,31 @@ pub fn par_map<R: Send>(n: usize, f: &(dyn Fn(usize) -> R + Sync)) -> Vec<R> {
     (0..n).map(f).collect()
 }
 
+/// `f(i, item)` for every item of `items` (taken by value) on all cores natively, in order on
+/// wasm32; the results in the items' order.
+pub fn par_map_owned<T: Send, R: Send>(
+    items: Vec<T>,
+    f: &(dyn Fn(usize, T) -> R + Sync),
+) -> Vec<R> {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use rayon::prelude::*;
+        items
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, t)| f(i, t))
+            .collect()
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        items
+            .into_iter()
+            .enumerate()
+            .map(|(i, t)| f(i, t))
+            .collect()
+    }
+}
+
 /// Runs two computations, on two threads natively (wasm workers are single-threaded).
 pub fn both<A: Send, B: Send>(
     a: impl FnOnce() -> A + Send,
@@ -53,6 +78,17 @@ pub fn in_runs(n: usize, f: &mut dyn FnMut(std::ops::Range<usize>)) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn owned_items_are_mapped_once_each_in_their_order() {
+        let items: Vec<String> = (0..1000).map(|i| format!("item {i}")).collect();
+        let out = par_map_owned(items, &|i, s| (i, s.len(), s));
+        assert_eq!(out.len(), 1000);
+        for (k, (i, len, s)) in out.into_iter().enumerate() {
+            assert_eq!((i, s.clone()), (k, format!("item {k}")));
+            assert_eq!(len, s.len());
+        }
+    }
 
     #[test]
     fn runs_cover_every_index_once_in_order_and_none_is_longer_than_a_run() {

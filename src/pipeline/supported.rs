@@ -2,7 +2,7 @@
 //! once per job because the droplet-level pass needs all layers' droplets.
 
 use crate::base::geom;
-use crate::base::parallel::{both, par_map};
+use crate::base::parallel::{both, par_map, par_map_owned};
 use crate::base::stages::{self, Stage};
 use crate::pipeline::Job;
 use crate::slicing::plan::{self, LayerPlan};
@@ -74,26 +74,23 @@ impl Job {
                     s,
                 )
             });
-            let plans = planned
-                .into_iter()
-                .enumerate()
-                .map(|(i, (mut p, region, mut moves))| {
-                    if !extra[i].is_empty() {
-                        let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
-                        let none = geom::Shapes::new();
-                        moves.extend(support::moves::support_moves(
-                            &[],
-                            &none,
-                            &extra[i],
-                            i,
-                            s,
-                            start,
-                        ));
-                    }
-                    plan::add_unit1(&mut p, moves, s);
-                    (p, region)
-                })
-                .collect();
+            // Each layer's added droplets and unit 1's moves into its plan (on all cores).
+            let plans = par_map_owned(planned, &|i, (mut p, region, mut moves)| {
+                if !extra[i].is_empty() {
+                    let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+                    let none = geom::Shapes::new();
+                    moves.extend(support::moves::support_moves(
+                        &[],
+                        &none,
+                        &extra[i],
+                        i,
+                        s,
+                        start,
+                    ));
+                }
+                plan::add_unit1(&mut p, moves, s);
+                (p, region)
+            });
             SupportedPlans {
                 layers: plans,
                 figures,
