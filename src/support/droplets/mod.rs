@@ -212,8 +212,10 @@ fn unsupported_by_planned(droplets: LayerDroplets, n: usize, rule: &Rule) -> Vec
 }
 
 /// Appends to `todo` the droplets `added` to layer i that layer i − 1's planned droplets leave
-/// unsupported. They are few, so only that layer's droplets within reach of their box are
-/// listed (into `buf`), and scanned once (a grid only for many).
+/// unsupported. They are few: each asks for that layer's droplets within reach of itself
+/// (listed into `buf`; a walk of the layer's moves each, cheaper than listing and scanning the
+/// droplets of the box of all of them, which may span the layer); more than 16 list the
+/// droplets of their common box once, in a grid.
 fn unsupported_added(
     droplets: LayerDroplets,
     i: usize,
