@@ -14,7 +14,7 @@ export function progress(fraction: number | null, label = "Slicing…"): void {
   }
   p.hidden = false;
   const pct = Math.floor(fraction * 100);
-  // only what changed (setText): the bar moves every frame while slicing
+  // only what changed (setText): the bar moves every 150 ms while slicing
   setText("progress-label", label);
   setText("progress-pct", `${pct} %`);
   $("progress-fill").style.transform = `scaleX(${pct / 100})`;
