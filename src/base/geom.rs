@@ -141,13 +141,18 @@ pub fn line_droplet_count_f64(length: f64, b: f64) -> f64 {
 /// ([`line_droplet_count`] of them).
 pub fn line_droplets(from: Point, to: Point, b: f64) -> impl Iterator<Item = Point> {
     let l = dist(from, to);
-    (0..line_droplet_count(l, b)).map(move |j| {
-        let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
-        DVec2::new(
-            from[0] + t * (to[0] - from[0]),
-            from[1] + t * (to[1] - from[1]),
-        )
-    })
+    (0..line_droplet_count(l, b)).map(move |j| line_droplet(from, to, l, b, j))
+}
+
+/// Droplet `j` of the line from `from` to `to` of length `l`: the one point of it that
+/// [`line_droplets`] and [`line_droplets_in`] both compute.
+#[inline]
+fn line_droplet(from: Point, to: Point, l: f64, b: f64, j: u64) -> Point {
+    let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
+    DVec2::new(
+        from[0] + t * (to[0] - from[0]),
+        from[1] + t * (to[1] - from[1]),
+    )
 }
 
 /// The droplets of [`line_droplets`] that lie in the box `lo`..=`hi` (both ends included), in
@@ -186,14 +191,8 @@ pub fn line_droplets_in(
         let j1 = ((s1 * k).ceil() + 2.0).max(0.0) as u64;
         j0.min(count)..j1.min(count)
     };
-    js.filter_map(move |j| {
-        let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
-        let p = DVec2::new(
-            from[0] + t * (to[0] - from[0]),
-            from[1] + t * (to[1] - from[1]),
-        );
-        (p.cmpge(lo).all() && p.cmple(hi).all()).then_some(p)
-    })
+    js.map(move |j| line_droplet(from, to, l, b, j))
+        .filter(move |p| p.cmpge(lo).all() && p.cmple(hi).all())
 }
 
 /// Loops in the boolean engine's point type.
