@@ -13,6 +13,18 @@ const repo = resolve(dirname(fileURLToPath(import.meta.url)), "..");
 const { start, openPage, waitSettled } = await import(join(repo, "tests/e2e/helpers.mjs"));
 const model = process.argv[2] || join(repo, "../shared/models/3DBenchy.stl");
 const runs = Number(process.argv[3] ?? 2);
+// PAUSE_MS: wait this long after the sample part settles before choosing the file (as a user
+// takes a while to), printing the CPU of that pause.
+const pause = Number(process.env.PAUSE_MS ?? 0);
+
+/** The CPU (ms) every thread used from `before` to `after` (`cpuByThread`), summed and the largest. */
+function summary(before, after) {
+  const rows = Object.entries(after)
+    .map(([k, v]) => [k, (v - (before[k] ?? 0)) * 10])
+    .filter(([, v]) => v > 0)
+    .sort((a, b) => b[1] - a[1]);
+  return `${rows.reduce((a, [, v]) => a + v, 0)} ms in all; ${rows.slice(0, 8).map(([k, v]) => `${k} ${v}`).join(", ")}`;
+}
 
 /** CPU ticks (1/100 s) of every Chromium thread, by process type and thread name. */
 function cpuByThread() {
@@ -69,6 +81,11 @@ try {
       });
       await page.reload();
       await waitSettled(page); // the sample part
+      if (pause > 0) {
+        const quiet = cpuByThread();
+        await new Promise((r) => setTimeout(r, pause));
+        console.log(`  CPU in the ${pause} ms pause after the sample part: ${summary(quiet, cpuByThread())}`);
+      }
       await page.evaluate(() => (window.__timeline = []));
       const before = cpuByThread();
       await page.setInputFiles("#file-input", model);
@@ -81,11 +98,7 @@ try {
         if (kind === "figures") continue;
         console.log(`  ${(t - t0).toFixed(0).padStart(6)}  worker ${w + 1} ${dir} ${kind} #${id}${from !== "" ? ` from ${from}` : ""}`);
       }
-      const rows = Object.entries(after)
-        .map(([k, v]) => [k, (v - (before[k] ?? 0)) * 10])
-        .filter(([, v]) => v > 0)
-        .sort((a, b) => b[1] - a[1]);
-      console.log(`  CPU while slicing: ${rows.reduce((a, [, v]) => a + v, 0)} ms in all; ${rows.slice(0, 8).map(([k, v]) => `${k} ${v}`).join(", ")}`);
+      console.log(`  CPU while slicing: ${summary(before, after)}`);
     } finally {
       await context.close();
     }

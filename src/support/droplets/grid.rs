@@ -187,7 +187,8 @@ pub(super) fn floor(x: f64) -> i64 {
     const SHIFT: f64 = 6_755_399_441_055_744.0;
     let y = x + SHIFT;
     let t = (y.to_bits() as i64).wrapping_sub(SHIFT.to_bits() as i64);
-    if y - SHIFT > x { t - 1 } else { t }
+    // Without a branch: which way it goes is as often one as the other.
+    t - (y - SHIFT > x) as i64
 }
 
 /// Droplets added to a layer, in a hash grid (few).
