@@ -207,7 +207,6 @@ pub struct Raster {
 #[derive(Default)]
 struct Scratch {
     runs: Vec<(u32, u32, u32, u32)>,
-    bnd: Vec<bool>,
     parent: Vec<u32>,
     cells: Vec<u64>,
     root: Vec<u32>,

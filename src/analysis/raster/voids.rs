@@ -1,7 +1,7 @@
 //! The layer's figures: cells counted and voids labelled in one pass over the rows, and the
 //! boundary deviation.
 
-use super::{Grid, LayerAnalysis, MIN_PASSAGE_COLS, Raster, Scratch, Void};
+use super::{Grid, LayerAnalysis, MIN_PASSAGE_COLS, Raster, Void};
 use crate::base::geom::{DVec2, Point, dist};
 use crate::base::spatial::{EdgeIndex, Row};
 
@@ -190,8 +190,8 @@ impl Raster {
     }
 
     /// The void runs of row `k` (laid out as `row`) appended to `runs` as (row, start, end,
-    /// `NO_LABEL`), and to `bnd` whether each touches a region cell with a neighbour (left,
-    /// right, above, below) outside the region: the runs of [`runs`](Self::runs) with the
+    /// touches), touches 1 when the run touches a region cell with a neighbour (left, right,
+    /// above, below) outside the region, else 0: the runs of [`runs`](Self::runs) with the
     /// boundary test of the reference's `edge_row`, in one pass over the words. A run
     /// touches the edge when adding its edge cells to the void bits carries out of it: the
     /// row's void words plus their edge cells, added as one long number, set the bit just
@@ -203,7 +203,6 @@ impl Raster {
         row: &Row,
         k: usize,
         runs: &mut Vec<(u32, u32, u32, u32)>,
-        bnd: &mut Vec<bool>,
         (up_buf, down_buf): &mut (Vec<u64>, Vec<u64>),
         counts: &mut [u64; 3],
     ) -> bool {
@@ -225,9 +224,8 @@ impl Raster {
             let shift = (64 * seg.shift()) as u32;
             // The last word's top void bit, and the carry of the addition.
             let (mut carry, mut touch) = (0u64, false);
-            // Starts are pushed as they come, ends fill the runs in order (`open` the first
-            // run without its end).
-            let mut open = runs.len();
+            // Where the run open at the last word's top starts.
+            let mut open = 0u32;
             for w in a..e {
                 let (r, dr) = (bits[w], drops[w]);
                 counts[0] += r.count_ones() as u64;
@@ -248,24 +246,29 @@ impl Raster {
                 let mut starts = v & !prev;
                 let mut ends = !v & prev;
                 let base = (w * 64) as u32 + shift;
-                while starts != 0 {
-                    runs.push((k, base + starts.trailing_zeros(), 0, NO_LABEL));
-                    starts &= starts - 1;
+                // Each run is pushed whole at its end: the run open from the words before
+                // ends first, then each end closes the lowest start left; a start left over
+                // opens the run that goes on into the next word.
+                if carry != 0 && ends != 0 {
+                    let t = ends.trailing_zeros();
+                    runs.push((k, open, base + t, ((touched >> t) & 1) as u32));
+                    ends &= ends - 1;
                 }
                 while ends != 0 {
                     let t = ends.trailing_zeros();
-                    runs[open].2 = base + t;
-                    // Runs end in order: `bnd` has an entry per run ended.
-                    bnd.push((touched >> t) & 1 != 0);
-                    open += 1;
+                    let s = base + starts.trailing_zeros();
+                    runs.push((k, s, base + t, ((touched >> t) & 1) as u32));
+                    starts &= starts - 1;
                     ends &= ends - 1;
+                }
+                if starts != 0 {
+                    open = base + starts.trailing_zeros();
                 }
                 carry = v >> 63;
             }
             // The segment's next word is not stored (zero) or beyond the row's bits.
             if carry != 0 {
-                runs[open].2 = (e * 64) as u32 + shift;
-                bnd.push(touch);
+                runs.push((k, open, (e * 64) as u32 + shift, touch as u32));
             }
         }
         over != 0
@@ -317,18 +320,16 @@ impl Raster {
         // A label's cells, with the boundary flag in the top bit.
         const TOP: u64 = 1 << 63;
         let g = self.grid;
-        let mut scratch = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
-        let Scratch {
-            runs,
-            bnd,
-            parent,
-            cells,
-            root,
-            around,
-        } = &mut *scratch;
-        // (row, start, end, label)
+        let mut guard = self.scratch.lock().unwrap_or_else(|e| e.into_inner());
+        let scratch = &mut *guard;
+        // The buffers as locals while labelling (not reached through the lock's guard).
+        let mut runs = std::mem::take(&mut scratch.runs);
+        let mut parent = std::mem::take(&mut scratch.parent);
+        let mut cells = std::mem::take(&mut scratch.cells);
+        let mut root = std::mem::take(&mut scratch.root);
+        let around = &mut scratch.around;
+        // (row, start, end, label; the touch flag of `void_runs` until labelled)
         runs.clear();
-        bnd.clear();
         cells.clear();
         parent.clear();
         let mut prev = 0..0;
@@ -339,48 +340,50 @@ impl Raster {
             }
             next_k = k + 1;
             let first = runs.len();
-            if self.void_runs(&row, k, runs, bnd, around, counts) {
+            if self.void_runs(&row, k, &mut runs, around, counts) {
                 over_rows.push(k);
             }
-            if runs.len() == first {
-                prev = first..first;
-                continue;
-            }
-            let (mut i, mut j) = (prev.start, first);
-            while i < prev.end && j < runs.len() {
-                let (_, s1, e1, l1) = runs[i];
-                let (_, s2, e2, l2) = runs[j];
-                let joined = e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS;
-                // One branch, taken rarely (`joined &&` would branch on `joined`, which
-                // is as often true as not).
-                if joined & (l2 != NO_LABEL) {
-                    // A second run above: rare.
-                    let (a, b) = (find(parent, l1 as usize), find(parent, l2 as usize));
-                    if a != b {
-                        // The earlier label stays the root: roots in order of their
-                        // component's first run, as the reference numbers them.
-                        let (lo, hi) = (a.min(b), a.max(b));
-                        parent[hi] = lo as u32;
-                        let h = cells[hi];
-                        cells[lo] = (cells[lo] + (h & !TOP)) | (h & TOP);
-                    }
+            // Each run takes the label of the first run above it joins (a new label when
+            // none); the others it joins are united with it. Runs above that end before a
+            // run could overlap it by the passage are passed once (nor can they join a later
+            // run); those starting after it could overlap end the search.
+            let (head, row_runs) = runs.split_at_mut(first);
+            let above = &head[prev.clone()];
+            let mut i = 0;
+            for run in row_runs {
+                let (_, s2, e2, touches) = *run;
+                while i < above.len() && above[i].2 < s2 + MIN_PASSAGE_COLS {
+                    i += 1;
                 }
-                // Without branches on the data: the first run above gives its label.
-                runs[j].3 = if joined && l2 == NO_LABEL { l1 } else { l2 };
-                let step = (e1 < e2) as usize;
-                i += step;
-                j += 1 - step;
-            }
-            for (run, &b) in runs[first..].iter_mut().zip(&bnd[first..]) {
-                let l = if run.3 == NO_LABEL {
-                    parent.push(cells.len() as u32);
+                let mut label = NO_LABEL;
+                let mut t = i;
+                while t < above.len() && above[t].1 + MIN_PASSAGE_COLS <= e2 {
+                    let (_, s1, e1, l1) = above[t];
+                    if e1.min(e2) >= s1.max(s2) + MIN_PASSAGE_COLS {
+                        let a = find(&mut parent, l1 as usize) as u32;
+                        if label == NO_LABEL {
+                            label = a;
+                        } else if a != label {
+                            // A second run above: rare. The earlier label stays the root:
+                            // roots in order of their component's first run, as the
+                            // reference numbers them.
+                            let (lo, hi) = (a.min(label) as usize, a.max(label) as usize);
+                            parent[hi] = lo as u32;
+                            let h = cells[hi];
+                            cells[lo] = (cells[lo] + (h & !TOP)) | (h & TOP);
+                            label = lo as u32;
+                        }
+                    }
+                    t += 1;
+                }
+                if label == NO_LABEL {
+                    label = cells.len() as u32;
+                    parent.push(label);
                     cells.push(0);
-                    cells.len() - 1
-                } else {
-                    find(parent, run.3 as usize)
-                };
-                run.3 = l as u32;
-                cells[l] = (cells[l] + (run.2 - run.1) as u64) | ((b as u64) << 63);
+                }
+                let l = label as usize;
+                cells[l] = (cells[l] + (e2 - s2) as u64) | ((touches as u64) << 63);
+                run.3 = label;
             }
             prev = first..runs.len();
         }
@@ -412,16 +415,24 @@ impl Raster {
         let mut dev_in = Deviation::default();
         let mut acc = Acc::default();
         let big = largest.map_or(u32::MAX, |(l, _)| l as u32);
+        // Per label what its runs need, from its root (one look-up per run below): 1 a
+        // probe (the void reaches the boundary), 2 the largest's sums.
+        for r in root.iter_mut() {
+            let reaches = cells[*r as usize] & TOP != 0;
+            *r = reaches as u32 | ((*r == big) as u32) << 1;
+        }
         for &(k, s, e, l) in runs.iter() {
-            let r = root[l as usize];
-            if cells[r as usize] & TOP != 0 {
+            let need = root[l as usize];
+            if need & 1 != 0 {
                 probe(&g, index, &mut dev_in, k as usize, s, e);
             }
-            if r == big {
+            if need & 2 != 0 {
                 acc.add(k, s, e, false);
             }
         }
         acc.boundary = largest.is_some_and(|(l, _)| cells[l] & TOP != 0);
+        // The buffers back, for the next layer.
+        (scratch.runs, scratch.parent, scratch.cells, scratch.root) = (runs, parent, cells, root);
         Voids {
             count,
             enclosed,
