@@ -4,7 +4,7 @@
 //! 10⁵ loops or hatch segments is ordered in milliseconds instead of minutes.
 
 use crate::base::geom::{DVec2, Point, dist};
-use crate::base::spatial::each_ring_cell;
+use crate::base::spatial::{each_ring_cell, floor_i64};
 
 /// Cells a side of a block of [`NearestGrid`]'s live counts.
 const BLOCK: i64 = 8;
@@ -83,8 +83,9 @@ impl NearestGrid {
     }
 
     fn cell_of(&self, p: Point) -> (i64, i64) {
-        let cx = ((p[0] - self.min[0]) / self.cell).floor() as i64;
-        let cy = ((p[1] - self.min[1]) / self.cell).floor() as i64;
+        // (`floor_i64`: `floor() as i64` without a call to libm per query)
+        let cx = floor_i64((p[0] - self.min[0]) / self.cell);
+        let cy = floor_i64((p[1] - self.min[1]) / self.cell);
         (cx.clamp(0, self.nx - 1), cy.clamp(0, self.ny - 1))
     }
 

@@ -5,6 +5,7 @@
 use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
 use crate::base::parallel::in_runs;
 use crate::base::settings::Settings;
+use crate::base::spatial::floor_i64;
 use rustc_hash::FxHashMap as HashMap;
 
 /// A welded triangle mesh in millimetres.
@@ -239,7 +240,7 @@ impl Mesh {
     /// [`weld_tolerance`](Self::weld_tolerance), also returning which of the facets before
     /// were kept (the others keep their order).
     pub fn weld_tolerance_kept(&mut self, tol: f64) -> (usize, Vec<bool>) {
-        let cell = |p: &[f64; 3]| p.map(|c| (c / tol).floor() as i64);
+        let cell = |p: &[f64; 3]| p.map(|c| floor_i64(c / tol));
         let mut grid: HashMap<[i64; 3], Vec<u32>> =
             HashMap::with_capacity_and_hasher(self.vertices.len(), Default::default());
         let mut remap: Vec<u32> = Vec::with_capacity(self.vertices.len());
