@@ -9,7 +9,8 @@ use std::collections::HashMap;
 /// Droplets of a layer in cells over their bounding box (counts, then the droplets sorted by
 /// cell), cells at least the rule's distance.
 struct Grid {
-    cell: f64,
+    /// 1 / the cell's side: a cell's index by a product, not a division (both per droplet).
+    inv: f64,
     min: Point,
     nx: i64,
     ny: i64,
@@ -22,7 +23,7 @@ struct Grid {
 impl Grid {
     fn new(cell: f64, droplets: &[Droplet]) -> Grid {
         let mut g = Grid {
-            cell,
+            inv: 1.0 / cell,
             min: DVec2::ZERO,
             nx: 0,
             ny: 0,
@@ -55,10 +56,14 @@ impl Grid {
         // About one cell per droplet at most, however large the layer: memory stays
         // proportional to the droplets (larger cells still hold every droplet within reach).
         let spread = ((max.x - min.x) * (max.y - min.y) / count.max(1) as f64).sqrt();
-        self.cell = cell.max(spread);
+        // Cells a hair wider than asked: two points at most `cell` apart then lie in the same
+        // or neighbouring cells whatever the rounding of the differences and products that
+        // place them, so the search of the 3 × 3 cells around a point misses none.
+        self.inv = 1.0 / (cell.max(spread) * (1.0 + 1e-9));
         self.min = min;
-        self.nx = ((max.x - min.x) / self.cell).floor() as i64 + 1;
-        self.ny = ((max.y - min.y) / self.cell).floor() as i64 + 1;
+        // The cell of the greatest coordinates as `key` places it.
+        let (x, y) = self.key(max);
+        (self.nx, self.ny) = (x + 1, y + 1);
         let nx = self.nx;
         self.offsets.clear();
         self.offsets.resize((nx * self.ny) as usize + 1, 0);
@@ -92,8 +97,8 @@ impl Grid {
 
     fn key(&self, p: Point) -> (i64, i64) {
         (
-            floor((p.x - self.min.x) / self.cell),
-            floor((p.y - self.min.y) / self.cell),
+            floor((p.x - self.min.x) * self.inv),
+            floor((p.y - self.min.y) * self.inv),
         )
     }
 
