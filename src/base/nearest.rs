@@ -21,6 +21,8 @@ pub struct NearestGrid {
     live: usize,
     min: Point,
     cell: f64,
+    /// 1 / `cell` (a point's cell by a product, not a division: per query and removal).
+    inv: f64,
     nx: i64,
     ny: i64,
 }
@@ -53,6 +55,7 @@ impl NearestGrid {
             points,
             min,
             cell,
+            inv: 1.0 / cell,
             nx,
             ny,
         };
@@ -83,9 +86,11 @@ impl NearestGrid {
     }
 
     fn cell_of(&self, p: Point) -> (i64, i64) {
-        // (`floor_i64`: `floor() as i64` without a call to libm per query)
-        let cx = floor_i64((p[0] - self.min[0]) / self.cell);
-        let cy = floor_i64((p[1] - self.min[1]) / self.cell);
+        // (`floor_i64`: `floor() as i64` without a call to libm per query.) The product
+        // places a point on a cell's border within rounding of the quotient's choice, far
+        // inside the slack the searches keep.
+        let cx = floor_i64((p[0] - self.min[0]) * self.inv);
+        let cy = floor_i64((p[1] - self.min[1]) * self.inv);
         (cx.clamp(0, self.nx - 1), cy.clamp(0, self.ny - 1))
     }
 
