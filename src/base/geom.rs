@@ -222,7 +222,8 @@ pub fn shapes_from_overlay(shapes: Vec<Vec<Vec<[f64; 2]>>>) -> Shapes {
 
 /// Crosses a region with the lines y = y0 + (k + phase)·step, k in `rows`: calls
 /// `span(k, xa, xb)` for every span of a line inside the region (non-zero rule), in order of
-/// k, then x. `to` maps the region's points first (the hatch turns its lines horizontal).
+/// k, then x; spans have xa < xb (a line touching the region at a point gives none). `to`
+/// maps the region's points first (the hatch turns its lines horizontal).
 pub fn scanline_spans(
     region: &Shapes,
     to: impl Fn(Point) -> Point,
@@ -293,11 +294,13 @@ pub fn scanline_spans(
         hits
     };
     for row in by_line.chunk_by(|a, b| a.0 == b.0) {
-        let mut winding = 0;
-        let mut start = 0.0;
-        for &(k, x, w) in row {
+        let (mut winding, mut start) = (0, 0.0);
+        // Crossings at one x are taken together: whatever their order, a line touching the
+        // region at a point gives no span, and one passing a vertex inside it is not split.
+        for at_x in row.chunk_by(|a, b| a.1 == b.1) {
+            let (k, x) = (at_x[0].0, at_x[0].1);
             let before = winding;
-            winding += w;
+            winding += at_x.iter().map(|h| h.2).sum::<i32>();
             if before == 0 && winding != 0 {
                 start = x;
             } else if before != 0 && winding == 0 {
@@ -423,14 +426,21 @@ mod tests {
         hits.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
         let mut out = Vec::new();
         for row in hits.chunk_by(|a, b| a.0 == b.0) {
-            let (mut winding, mut start) = (0, 0.0);
-            for &(k, x, w) in row {
-                let before = winding;
+            // The winding just right of each crossing's x, spans where it is not zero.
+            let mut winding = 0;
+            let mut start = None;
+            for (i, &(k, x, w)) in row.iter().enumerate() {
                 winding += w;
-                if before == 0 && winding != 0 {
-                    start = x;
-                } else if before != 0 && winding == 0 {
-                    out.push((k, start, x));
+                if row.get(i + 1).is_some_and(|h| h.1 == x) {
+                    continue;
+                }
+                match (start, winding != 0) {
+                    (None, true) => start = Some(x),
+                    (Some(a), false) => {
+                        out.push((k, a, x));
+                        start = None;
+                    }
+                    _ => {}
                 }
             }
         }
@@ -480,5 +490,46 @@ mod tests {
             spans += got.len();
         }
         assert!(spans > 10_000, "{spans}");
+    }
+
+    #[test]
+    fn a_line_through_a_vertex_neither_touches_nor_splits() {
+        // A triangle whose lowest corner lies on the line y = 1: alone, the line touches it
+        // at a point (no span); inside a square, the square's span is not split there.
+        let tri = |p: [f64; 2]| -> Contour {
+            vec![
+                DVec2::new(p[0], p[1]),
+                DVec2::new(p[0] + 1.0, p[1] + 2.0),
+                DVec2::new(p[0] - 1.0, p[1] + 2.0),
+            ]
+        };
+        let square = |a: f64| -> Contour {
+            [[0.0, 0.0], [a, 0.0], [a, a], [0.0, a]]
+                .map(DVec2::from)
+                .into()
+        };
+        let spans = |region: &Shapes| {
+            let mut out = Vec::new();
+            scanline_spans(
+                region,
+                |p| p,
+                0.0,
+                1.0,
+                0.0,
+                0..5,
+                |k, a, b| out.push((k, a, b)),
+            );
+            out
+        };
+        let alone = vec![Shape::new(tri([2.0, 1.0]), vec![])];
+        assert_eq!(spans(&alone), vec![(2, 1.5, 2.5)]);
+        let inside = vec![
+            Shape::new(square(4.0), vec![]),
+            Shape::new(tri([2.0, 1.0]), vec![]),
+        ];
+        assert_eq!(
+            spans(&inside),
+            vec![(0, 0.0, 4.0), (1, 0.0, 4.0), (2, 0.0, 4.0), (3, 0.0, 4.0)]
+        );
     }
 }
