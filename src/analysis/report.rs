@@ -141,13 +141,54 @@ pub struct UnitDensity {
 }
 
 /// The whole report of a job: settings, model, part figures and every layer's figures.
-#[derive(Clone, Debug, Serialize)]
+///
+/// In memory its layers are numbered from 0 (as [`LayerAnalysis::index`]); written
+/// (`Serialize`, the CLI's `--report`) every layer number — `layers[].index`,
+/// `part.largest_void_layer`, `part.max_deviation_layer`, `part.max_unsupported_area_layer` —
+/// counts from 1, as the G-code's layer comments, the summary line and the page do
+/// (docs/quality.md, *The report*).
+#[derive(Clone, Debug)]
 pub struct Report {
     pub file_name: String,
     pub settings: Settings,
     pub model: Model,
     pub part: PartAnalysis,
     pub layers: Vec<LayerAnalysis>,
+}
+
+impl Serialize for Report {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        #[derive(Serialize)]
+        struct Written<'a> {
+            file_name: &'a str,
+            settings: &'a Settings,
+            model: &'a Model,
+            part: PartAnalysis,
+            layers: Vec<LayerAnalysis>,
+        }
+        let from_1 = |l: Option<usize>| l.map(|l| l + 1);
+        let p = &self.part;
+        Written {
+            file_name: &self.file_name,
+            settings: &self.settings,
+            model: &self.model,
+            part: PartAnalysis {
+                largest_void_layer: from_1(p.largest_void_layer),
+                max_deviation_layer: from_1(p.max_deviation_layer),
+                max_unsupported_area_layer: from_1(p.max_unsupported_area_layer),
+                ..p.clone()
+            },
+            layers: self
+                .layers
+                .iter()
+                .map(|l| LayerAnalysis {
+                    index: l.index + 1,
+                    ..l.clone()
+                })
+                .collect(),
+        }
+        .serialize(serializer)
+    }
 }
 
 /// The analysis model as used, for the report.
