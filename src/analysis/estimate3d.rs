@@ -77,6 +77,19 @@ fn ceil_i64(t: f64) -> i64 {
 }
 
 impl HeightMap {
+    /// The most bytes a map of droplets within a `w` × `h` mm box takes on cells of `cell` mm
+    /// (footprint diameter `d`): every tile over the box and its droplets' reach stored, and a
+    /// tile more on each side (a box seldom starts at a tile's edge). For
+    /// [`crate::analysis::AnalysisGrid::layer_bytes`], before anything is allocated.
+    pub fn box_bytes(w: f64, h: f64, cell: f64, d: f64) -> f64 {
+        let side = |l: f64, tile: usize| {
+            let tile = tile as f64;
+            (((l + 2.0 * d) / cell + 2.0) / tile).ceil() * tile + tile
+        };
+        // An f32 per cell.
+        4.0 * side(w, MAP_TILE_COLS) * side(h, MAP_BAND_ROWS)
+    }
+
     /// The map of droplets at `centres` of footprint diameter `d`. Every stored value is the
     /// one `HeightMap::reference` stores (the same expressions, in the same order); the work
     /// saved is around them: each droplet's cells found once, the cells' centres taken from

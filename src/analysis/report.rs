@@ -249,13 +249,86 @@ pub struct AnalysedLayer {
 pub struct AnalysisGrid {
     /// The least x and y of the placed part's bounding box, mm.
     pub min: Point,
+    /// The xy boxes (least, greatest corner) of the job's parts on the plate, mm: every
+    /// layer's region and droplets lie within them. They bound a layer's memory
+    /// ([`layer_bytes`](Self::layer_bytes)).
+    pub boxes: Vec<[Point; 2]>,
     pub layers: usize,
     /// Whether the job has unit-1 parts (a second material), measured on their own.
     pub unit1_parts: bool,
     pub file_name: String,
 }
 
+/// The most memory the analysis of one layer may take, bytes, by its estimate
+/// ([`AnalysisGrid::layer_bytes`]): a job above it is not analysed
+/// ([`AnalysisGrid::check`]). With it the CLI's analysis (two workers, the spheroid maps of
+/// the layers around theirs) stays within a few GB, a page worker's within its 32-bit memory.
+pub const MAX_LAYER_BYTES: f64 = 1e9;
+
+/// Bytes the analysis keeps per droplet of a layer besides the grids: its centre (16), its
+/// place on the raster (24) and its cells on the 3D grid (32).
+const BYTES_PER_DROPLET: f64 = 72.0;
+
+/// Droplets per B² of a layer filled at `fill_density` 1, about: the fill's lattice (1) and
+/// the loops over it where they meet.
+const DROPLETS_PER_B2: f64 = 1.25;
+
 impl AnalysisGrid {
+    /// An estimate of the most memory one layer's analysis takes, bytes, before any of it is
+    /// taken: each part's box as if a layer filled it — the raster's bitmaps over the box
+    /// ([`Raster::box_bytes`], a bound), its droplets' buffers, and its spheroid maps
+    /// ([`HeightMap::box_bytes`], a bound; unit 1's too in a job with unit-1 parts). The
+    /// boxes are grown by the largest shrinkage compensation.
+    pub fn layer_bytes(&self, s: &Settings) -> f64 {
+        let grow = 1.0 / (1.0 - s.shrink_xy.max(s.unit1_shrink_xy).clamp(0.0, 50.0) / 100.0);
+        let b = s.droplet_width();
+        let d = footprint_diameter(s);
+        let per_mm2 = DROPLETS_PER_B2 * s.fill_density.max(1.0) / (b * b);
+        let unit1 = self.unit1_parts.then(|| unit1_part_settings(s));
+        self.boxes
+            .iter()
+            .map(|[lo, hi]| {
+                let w = (hi[0] - lo[0]).max(0.0) * grow;
+                let h = (hi[1] - lo[1]).max(0.0) * grow;
+                let maps = HeightMap::box_bytes(w, h, b / GRID3_PER_B, d)
+                    + unit1.as_ref().map_or(0.0, |s1| {
+                        let d1 = footprint_diameter(s1);
+                        HeightMap::box_bytes(w, h, s1.droplet_width() / GRID3_PER_B, d1)
+                    });
+                Raster::box_bytes(w, h, s) + BYTES_PER_DROPLET * per_mm2 * w * h + maps
+            })
+            .sum()
+    }
+
+    /// Refuses the analysis of a job whose layers would take more than [`MAX_LAYER_BYTES`]
+    /// each ([`layer_bytes`](Self::layer_bytes)): what it would take, what it may take, and
+    /// what to do. The slice is not affected.
+    pub fn check(&self, s: &Settings) -> Result<(), crate::Error> {
+        let bytes = self.layer_bytes(s);
+        if bytes <= MAX_LAYER_BYTES {
+            return Ok(());
+        }
+        let area: f64 = self
+            .boxes
+            .iter()
+            .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0))
+            .sum();
+        let b = s.droplet_width();
+        let gb = |x: f64| crate::base::error::rounded(x / 1e9);
+        let mm = crate::base::error::rounded;
+        Err(crate::Error::Analysis(format!(
+            "a layer of this job would take about {} GB to analyse, more than the {} GB \
+             allowed (a grid of {} × {} mm cells, B/40 × B/10 with B = {} mm, over {} mm² of \
+             parts); analyse a smaller part, or larger droplets (layer_height, droplet_aspect)",
+            gb(bytes),
+            gb(MAX_LAYER_BYTES),
+            mm(b / ROWS_PER_B / COLS_PER_ROW),
+            mm(b / ROWS_PER_B),
+            mm(b),
+            mm(area),
+        )))
+    }
+
     /// The 3D grid of the analysis with settings `s`.
     fn grid3(&self, s: &Settings) -> Grid3 {
         let d = footprint_diameter(s);

@@ -17,6 +17,9 @@ pub enum Error {
     NothingToPrint(String),
     /// Reading or writing a file failed.
     Io(String),
+    /// The void analysis was not made (a layer too large to analyse in bounded memory); the
+    /// slice itself is not affected.
+    Analysis(String),
     /// A bug in dropslice.
     Internal(String),
 }
@@ -30,7 +33,8 @@ impl Error {
         }
     }
 
-    /// A short machine-readable tag: "import", "setting", "job", "nothing_to_print", "io", "internal".
+    /// A short machine-readable tag: "import", "setting", "job", "nothing_to_print", "io",
+    /// "analysis", "internal".
     pub fn kind(&self) -> &'static str {
         match self {
             Error::Import(_) => "import",
@@ -38,6 +42,7 @@ impl Error {
             Error::Job(_) => "job",
             Error::NothingToPrint(_) => "nothing_to_print",
             Error::Io(_) => "io",
+            Error::Analysis(_) => "analysis",
             Error::Internal(_) => "internal",
         }
     }
@@ -99,6 +104,36 @@ pub fn number(x: f64) -> String {
     if s.len() > 24 { format!("{x:e}") } else { s }
 }
 
+/// A number as a message shows it when it need not be exact (a size, an area, a derived
+/// figure): three significant digits, never more than a dozen characters — `0.208`, `1000`,
+/// `2.35e-7`, `5e-324`, `1.8e308` —, whatever the number (a tiny or huge input gives no
+/// 300-digit figure).
+pub fn rounded(x: f64) -> String {
+    if !x.is_finite() || x == 0.0 {
+        // "NaN", "inf", "-inf"; 0 and −0 as "0".
+        return if x == 0.0 { "0".into() } else { format!("{x}") };
+    }
+    let a = x.abs();
+    if (1e-3..1e9).contains(&a) {
+        // Digits after the point for three significant ones; an integer part is kept whole.
+        let digits = (2 - a.log10().floor() as i32).max(0) as usize;
+        trim_zeros(format!("{x:.digits$}"))
+    } else {
+        let s = format!("{x:.2e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        format!("{}e{exponent}", trim_zeros(mantissa.to_string()))
+    }
+}
+
+/// `1.500` → `1.5`, `2.00` → `2`; a number without a point as it is.
+fn trim_zeros(s: String) -> String {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// A message cut to at most [`MAX_MESSAGE_CHARS`] characters.
 pub fn clamp_message(s: &str) -> std::borrow::Cow<'_, str> {
     clamp(s, MAX_MESSAGE_CHARS)
@@ -141,6 +176,7 @@ impl Error {
             Error::Job(m) => write!(f, "bad job: {m}"),
             Error::NothingToPrint(m) => write!(f, "nothing to print: {m}"),
             Error::Io(m) => write!(f, "{m}"),
+            Error::Analysis(m) => write!(f, "no void analysis: {m}"),
             Error::Internal(m) => write!(
                 f,
                 "internal error (a bug in dropslice, please report it): {m}"
@@ -207,5 +243,33 @@ mod tests {
         let shown = long.to_string();
         assert_eq!(shown.chars().count(), MAX_MESSAGE_CHARS + 1);
         assert_eq!(long.report().message, shown);
+    }
+
+    #[test]
+    fn rounded_numbers_have_three_significant_digits() {
+        for (x, want) in [
+            (0.208, "0.208"),
+            (0.2083333, "0.208"),
+            (1000.0, "1000"),
+            (123456.7, "123457"),
+            (2.5, "2.5"),
+            (-3.14159, "-3.14"),
+            (0.0, "0"),
+            (-0.0, "0"),
+            (1e-300, "1e-300"),
+            (5e-324, "4.94e-324"),
+            (2.35e-7, "2.35e-7"),
+            (f64::MAX, "1.8e308"),
+            (1e9, "1e9"),
+            (0.001, "0.001"),
+            (f64::NAN, "NaN"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(rounded(x), want, "{x:e}");
+        }
+        // Never long, whatever the number.
+        for x in [1e-310, 3.7e-200, 1.23456789e250, -9.87e-15, 7.0 / 3.0] {
+            assert!(rounded(x).len() <= 10, "{x:e}: {}", rounded(x));
+        }
     }
 }

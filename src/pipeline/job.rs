@@ -75,8 +75,16 @@ impl Job {
     /// ([`crate::analysis::JobAnalysis::new`]).
     pub fn analysis_grid(&self) -> crate::analysis::AnalysisGrid {
         let min = self.info.bounds.min;
+        let (lo, hi) = (self.info.bounds.min, self.info.bounds.max);
+        let mut boxes: Vec<[geom::Point; 2]> = (self.info.instances.iter())
+            .map(|i| [i.min, i.max].map(|p| geom::DVec2::new(p[0], p[1])))
+            .collect();
+        if boxes.is_empty() {
+            boxes.push([lo, hi].map(|p| geom::DVec2::new(p[0], p[1])));
+        }
         crate::analysis::AnalysisGrid {
             min: geom::DVec2::new(min[0], min[1]),
+            boxes,
             layers: self.layer_count(),
             unit1_parts: !self.groups.is_empty(),
             file_name: self.info.file_name.clone(),

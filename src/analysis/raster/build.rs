@@ -220,7 +220,8 @@ impl Raster {
                 .filter(|sp| k1 < sp.end_row)
             {
                 let shift = 64 * sp.shift;
-                let mut at = 64 * sp.index(k0);
+                // Bit positions in u64: past 2³² bits (512 MB of words) in a 32-bit build.
+                let mut at = 64 * sp.index(k0) as u64;
                 for (slot, &(n, half)) in (sp.slot(k0)..).zip(rows_of) {
                     if n >= 1 {
                         // Within the widest row's columns: ≥ w0 ≥ 0, so the value is above −1
@@ -228,10 +229,10 @@ impl Raster {
                         // baseline x86-64; `as usize` takes a dozen).
                         let c0 = (u - half + 0.5) as i64 as usize - shift;
                         let c1 = c0 + n as usize - 1;
-                        set_range(drop_bits, at + c0, at + c1);
+                        set_range(drop_bits, at + c0 as u64, at + c1 as u64);
                         widen(&mut extent[slot], c0, c1);
                     }
-                    at += 64 * sp.row_len;
+                    at += 64 * sp.row_len as u64;
                 }
                 continue;
             }
@@ -264,6 +265,25 @@ impl Raster {
         self.grid = grid;
     }
 
+    /// The most bytes the bitmaps of a raster take over a `w` × `h` mm box that holds a layer's
+    /// region and droplets (settings `s`): every tile over the box and the grid's margin
+    /// stored, and a tile more on each side (a box seldom starts at a tile's edge); two words
+    /// of 64 columns per stored word place, and a row's extent. For
+    /// [`crate::analysis::AnalysisGrid::layer_bytes`], before anything is allocated.
+    pub fn box_bytes(w: f64, h: f64, s: &Settings) -> f64 {
+        let b = s.droplet_width();
+        let r = footprint_diameter(s) / 2.0;
+        let gy = b / ROWS_PER_B;
+        let gx = gy / COLS_PER_ROW;
+        // The droplets' reach and the grid's margin on both sides.
+        let reach = 2.0 * (r + 3.0 * gy);
+        let band = BAND_ROWS as f64;
+        let rows = (((h + reach) / gy + 2.0) / band).ceil() * band + band;
+        let tile = TILE_WORDS as f64;
+        let words = (((w + reach) / gx / 64.0 + 2.0) / tile).ceil() * tile + tile;
+        rows * (16.0 * words + 8.0)
+    }
+
     /// Words of memory its bitmaps take (for tests of the memory it needs).
     pub fn stored_words(&self) -> usize {
         self.region_bits.len() + self.drop_bits.len()
@@ -294,7 +314,7 @@ fn set_cols(
         return;
     };
     let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
-    let at = 64 * sp.index(k);
-    set_range(bits, at + c0, at + c1);
+    let at = 64 * sp.index(k) as u64;
+    set_range(bits, at + c0 as u64, at + c1 as u64);
     widen(&mut extent[sp.slot(k)], c0, c1);
 }

@@ -263,8 +263,10 @@ impl Grid {
     }
 }
 
-fn set_range(row: &mut [u64], c0: usize, c1: usize) {
-    let (w0, w1) = (c0 >> 6, c1 >> 6);
+/// Sets bits c0..=c1 of `row`. Bit positions are u64: a raster's bits are numbered across
+/// all its stored words, past 2³² in a 32-bit build (the page's wasm) once it holds 512 MB.
+fn set_range(row: &mut [u64], c0: u64, c1: u64) {
+    let (w0, w1) = ((c0 >> 6) as usize, (c1 >> 6) as usize);
     let m0 = !0u64 << (c0 & 63);
     let m1 = !0u64 >> (63 - (c1 & 63));
     if w0 == w1 {
@@ -324,4 +326,33 @@ pub(super) fn region_spans(
         0..ny as i64,
         |k, xa, xb| span(k as usize, xa, xb),
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bit_positions_past_2_to_the_32_set_their_own_words() {
+        // A raster of more than 512 MB numbers its bits past 2³²: a 32-bit build (the page's
+        // wasm) once wrapped them ("slice index starts at 67105945 but ends at 84"). Zeroed
+        // memory the test does not touch is not taken.
+        let words = (1usize << 26) + 4;
+        let mut bits = vec![0u64; words];
+        let base = 64 * (1u64 << 26);
+        assert!(base + 3 > u32::MAX as u64);
+        set_range(&mut bits, base + 3, base + 70);
+        let w = 1 << 26;
+        assert_eq!(bits[w], !0u64 << 3);
+        assert_eq!(bits[w + 1], (1u64 << 7) - 1);
+        assert_eq!(bits[w - 1], 0);
+        assert_eq!(bits[w + 2], 0);
+        assert_eq!(count_range(&bits[w..], 3, 70), 68);
+        // Within one word, and across three.
+        set_range(&mut bits, base + 64 * 2 + 5, base + 64 * 2 + 5);
+        assert_eq!(bits[w + 2], 1 << 5);
+        set_range(&mut bits, base - 2, base + 129);
+        assert_eq!(bits[w - 1], 3 << 62);
+        assert_eq!((bits[w], bits[w + 1], bits[w + 2]), (!0, !0, 3 | 1 << 5));
+    }
 }

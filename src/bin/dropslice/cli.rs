@@ -162,7 +162,8 @@ pub struct SliceArgs {
     ///
     /// The report: coverage, voids, overfill, boundary deviation per layer and for the
     /// part, and the part's 3D void fraction (model: docs/quality.md); the summary line
-    /// shows the latter.
+    /// shows the latter. Layers are numbered from 1. A job whose layers would take more
+    /// than 1 GB each to analyse is sliced without the report (exit code 2).
     #[arg(
         long,
         value_name = "FILE.json",

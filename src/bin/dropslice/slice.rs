@@ -258,10 +258,16 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
     // Progress after the first second: in place on a terminal, a line every 2 s in a log.
     let every_ms = if terminal { 250 } else { 2000 };
     let mut shown = false;
-    // With --report, each layer is analysed by the worker that planned it.
+    // With --report, each layer is analysed by the worker that planned it; a job whose layers
+    // would take too much memory to analyse is sliced without (the refusal comes at the end).
+    let grid = job.analysis_grid();
+    let refused = report
+        .as_ref()
+        .and_then(|_| grid.check(job.settings()).err());
     let mut analysis = report
         .as_ref()
-        .map(|_| JobAnalysis::new(&job.analysis_grid(), job.settings()));
+        .filter(|_| refused.is_none())
+        .map(|_| JobAnalysis::new(&grid, job.settings()));
     let progress = |done: usize, total: usize| {
         let due = last.elapsed().as_millis() >= every_ms || (done == total && shown);
         if quiet || t0.elapsed().as_secs_f64() < 1.0 || !due {
@@ -347,6 +353,7 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
                     eprintln!("dropslice: {line}");
                 }
             }
+            None if refused.is_some() => {}
             None => eprintln!(
                 "dropslice: predicted density: not estimated (--report FILE.json runs the 3D void analysis, about 3 times the slicing's time)"
             ),
@@ -363,7 +370,15 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             );
         }
     }
-    Ok(())
+    match refused {
+        // The code is in place; the report was not written (an older file there is kept).
+        Some(Error::Analysis(m)) => Err(Error::Analysis(format!(
+            "{m}. {} was written, without the report",
+            output.display()
+        ))),
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 /// The summary's predicted density, per unit that prints parts (`None` without a figure).
