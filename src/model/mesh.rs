@@ -424,6 +424,14 @@ fn weld_key(p: [f32; 3]) -> [u32; 3] {
     p.map(|c| if c == 0.0 { 0u32 } else { c.to_bits() })
 }
 
+/// Whether [`Mesh::weld`] keeps a facet of triangle `t`: its three corners are distinct
+/// vertices (corners equal bit for bit, 0 and −0 alike, are one vertex). Counting these
+/// gives the welded mesh's facets without welding.
+pub fn keeps_facet(t: &[[f32; 3]; 3]) -> bool {
+    let [a, b, c] = t.map(weld_key);
+    a != b && b != c && a != c
+}
+
 /// Whether a welded facet's three vertices differ (it did not collapse).
 fn distinct(f: &[u32; 3]) -> bool {
     f[0] != f[1] && f[1] != f[2] && f[0] != f[2]

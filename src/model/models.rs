@@ -4,7 +4,7 @@
 use crate::base::error::Error;
 use crate::model::import::stl::{self, Format};
 use crate::model::import::{self, Part};
-use crate::model::mesh::Bounds;
+use crate::model::mesh::{Bounds, keeps_facet};
 use crate::model::spec::{JobSpec, clean_name};
 use serde::Serialize;
 use std::borrow::Cow;
@@ -186,4 +186,69 @@ pub fn models_of<'a>(models: &'a [Model], spec: &JobSpec) -> Result<Vec<&'a Mode
 /// The corners of a list of triangles as f64 points.
 pub fn corners(tris: &[[[f32; 3]; 3]]) -> impl Iterator<Item = [f64; 3]> + Clone + '_ {
     tris.iter().flatten().map(|p| p.map(f64::from))
+}
+
+/// Most triangles a job holds in all (its parts' welded facets × copies): as many as one file
+/// may hold.
+pub const MAX_JOB_TRIANGLES: usize = import::MAX_TRIANGLES;
+
+/// The refusal of a job of more than [`MAX_JOB_TRIANGLES`] triangles (slicing's and orient's).
+pub fn too_many_triangles() -> Error {
+    Error::Job(format!(
+        "the job has more than {MAX_JOB_TRIANGLES} triangles in all (parts × copies); print fewer copies or simplify the models"
+    ))
+}
+
+/// Refuses, before any work on them, a job whose parts hold more than [`MAX_JOB_TRIANGLES`]
+/// facets in all: each part's facets as [`Mesh::weld`](crate::model::mesh::Mesh::weld) keeps
+/// them (its triangles whose corners differ) × its copies, the count
+/// [`Job::from_models`](crate::pipeline::Job) refuses, found without welding. The triangles
+/// as read bound it from above, so they are only counted when those exceed the bound; then
+/// each file's item once, stopping at the bound.
+pub fn check_job_triangles(models: &[Model], spec: &JobSpec) -> Result<(), Error> {
+    let by_part = models_of(models, spec)?;
+    // (an item that does not exist counts none: the caller's own reading of it says so)
+    fn read(m: &Model, item: Option<usize>) -> &[Part] {
+        match item {
+            Some(i) => m.parts.get(i..=i).unwrap_or(&[]),
+            None => &m.parts,
+        }
+    }
+    let mut upper = 0usize;
+    for (p, m) in spec.parts.iter().zip(&by_part) {
+        let n: usize = read(m, p.item).iter().map(|q| q.triangles.len()).sum();
+        upper = upper.saturating_add(n.saturating_mul(p.copies as usize));
+    }
+    if upper <= MAX_JOB_TRIANGLES {
+        return Ok(());
+    }
+    let mut counted: Vec<(&str, Option<usize>, usize)> = Vec::new();
+    let mut total = 0usize;
+    for (p, m) in spec.parts.iter().zip(&by_part) {
+        let facets = match counted
+            .iter()
+            .find(|(name, item, _)| *name == m.name && *item == p.item)
+        {
+            Some(&(_, _, n)) => n,
+            None => {
+                let mut n = 0usize;
+                for q in read(m, p.item) {
+                    // In chunks on all cores (natively): 20 M triangles are read once.
+                    const CHUNK: usize = 1 << 20;
+                    let chunks: Vec<&[[[f32; 3]; 3]]> = q.triangles.chunks(CHUNK).collect();
+                    let kept = crate::base::parallel::par_map(chunks.len(), &|c| {
+                        chunks[c].iter().filter(|t| keeps_facet(t)).count()
+                    });
+                    n += kept.iter().sum::<usize>();
+                }
+                counted.push((&m.name, p.item, n));
+                n
+            }
+        };
+        total = total.saturating_add(facets.saturating_mul(p.copies as usize));
+        if total > MAX_JOB_TRIANGLES {
+            return Err(too_many_triangles());
+        }
+    }
+    Ok(())
 }

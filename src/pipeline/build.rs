@@ -6,10 +6,11 @@ use crate::base::error::Error;
 use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
-use crate::model::import;
 use crate::model::layout::{Frame, Instance, at_part, place_instances};
 use crate::model::mesh::{self, Mesh, MeshStats};
-use crate::model::models::{Model, models_of};
+use crate::model::models::{
+    MAX_JOB_TRIANGLES, Model, check_job_triangles, models_of, too_many_triangles,
+};
 use crate::model::prepare::{
     FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_chamber, check_height,
     check_volume, close_cracks, import, keep_groups, suggested_scale, warnings,
@@ -64,6 +65,8 @@ impl Job {
         spec.validate()?;
         let settings = spec.settings.clone();
         let by_part = models_of(models, spec)?;
+        // Before any part is welded: a small 3MF may instance millions of triangles per part.
+        check_job_triangles(models, spec)?;
         // Runs of consecutive parts of one unit (SPEC.md: where parts of different units
         // overlap, the part listed first keeps the overlap).
         let mut run_of = Vec::with_capacity(spec.parts.len());
@@ -83,11 +86,8 @@ impl Job {
             let (mesh, dropped) = Mesh::weld(&tris);
             let copies = p.copies as usize;
             facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
-            if facets > import::MAX_TRIANGLES {
-                return Err(Error::Job(format!(
-                    "the job has more than {} triangles in all (parts × copies); print fewer copies or simplify the models",
-                    import::MAX_TRIANGLES
-                )));
+            if facets > MAX_JOB_TRIANGLES {
+                return Err(too_many_triangles());
             }
             let frame = Frame::of(
                 &mesh.vertices,

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 const USAGE: &str = "dropslice [slice] MODEL... [OPTIONS]
        dropslice [slice] JOB.json [OPTIONS]
        dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]
-       dropslice orient MODEL_OR_JOB [--apply] [--set NAME=VALUE]...";
+       dropslice orient MODEL_OR_JOB [--apply] [--profile FILE.json]... [--set NAME=VALUE]...";
 
 const ABOUT: &str =
     "Slices models into droplet machine code (.gco) for droplet-based plastic 3D printing";
@@ -94,9 +94,11 @@ enum Command {
     /// turns) by the overhang rule, from the facets: the projected area of the facets
     /// facing down more steeply than overhang_limit allows; ties go to the lower height.
     /// Prints the chosen rotate_x/y/z and the area before and after. --apply writes them
-    /// into the job file, or for a model a new job file MODEL.job.json beside it.
+    /// into the job file (only those values change: its other text, key order, mode, owner
+    /// and links are kept; a symlink's target is written; a read-only file is refused), or
+    /// for a model a new job file MODEL.job.json beside it.
     #[command(
-        override_usage = "dropslice orient MODEL_OR_JOB [--apply] [--set NAME=VALUE]...",
+        override_usage = "dropslice orient MODEL_OR_JOB [--apply] [--profile FILE.json]... [--set NAME=VALUE]...",
         args_override_self = true,
         display_name = "dropslice",
         verbatim_doc_comment
@@ -117,6 +119,10 @@ pub struct OrientArgs {
     /// for a model also its rotate_* and scale_*)
     #[arg(long, value_name = "NAME=VALUE", allow_hyphen_values = true)]
     pub set: Vec<String>,
+    /// Apply a machine or material profile (JSON; repeatable, in order, before --set), as
+    /// slicing does: a material's droplet_aspect and shrinkage change the rule and the scale
+    #[arg(long, value_name = "FILE.json", allow_hyphen_values = true)]
+    pub profile: Vec<PathBuf>,
 }
 
 /// `dropslice [slice] ...`.

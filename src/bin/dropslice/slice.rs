@@ -151,7 +151,7 @@ impl Args {
 }
 
 /// Reads and checks a profile file (`--profile`); the message names the file.
-fn read_profile(path: &Path) -> Result<Profile, String> {
+pub fn read_profile(path: &Path) -> Result<Profile, String> {
     let shown = path.display();
     let bytes = read_regular(path, MAX_PROFILE_BYTES as u64, "a profile")
         .map_err(|e| format!("the profile: {e}"))?;
