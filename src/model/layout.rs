@@ -6,6 +6,7 @@
 use crate::base::error::Error;
 use crate::base::geom::{DMat3, DVec3};
 use crate::base::parallel::in_runs;
+use crate::model::fit::{self, Misfit};
 use crate::model::mesh::{Bounds, Placement, rot, rotation};
 use crate::model::models::{Model, corners, models_of};
 use crate::model::spec::{JobSpec, PartSpec, clean_name};
@@ -120,6 +121,10 @@ pub struct Layout {
     pub instances: Vec<Instance>,
     pub bounds: Bounds,
     pub warnings: Vec<String>,
+    /// The instances that break the plate rule ([`fit::misfit`]), in the order of `instances`;
+    /// a part larger than the plate once.
+    #[serde(default)]
+    pub misfits: Vec<Misfit>,
 }
 
 /// An axis-aligned rectangle on the plate.
@@ -189,8 +194,10 @@ pub fn arrange(
 }
 
 /// Where every instance of `spec` goes, given each part's [`Frame`] (`frames[i]` for
-/// `spec.parts[i]`). Refuses a job whose arranged instances do not fit the plate (but one
-/// instance alone goes to the origin, with a warning, however large).
+/// `spec.parts[i]`). Refuses a job whose arranged instances do not fit the plate together; an
+/// arranged instance larger than the plate goes to the origin, and every instance that breaks
+/// the plate rule is one of [`Layout::misfits`] (the job is refused for them later, unless
+/// `allow_off_plate`).
 pub fn place_instances(
     models: &[&Model],
     spec: &JobSpec,
@@ -199,11 +206,10 @@ pub fn place_instances(
     let s = &spec.settings;
     let plate = [s.plate_x, s.plate_y];
     let gap = s.part_spacing;
-    let mut warnings = Vec::new();
+    let warnings = Vec::new();
     let mut instances = Vec::new();
     let mut fixed = Vec::new();
     let mut free: Vec<(usize, usize)> = Vec::new();
-    let total: usize = spec.parts.iter().map(|p| p.copies as usize).sum();
     for (i, p) in spec.parts.iter().enumerate() {
         let f = &frames[i];
         for copy in 0..p.copies as usize {
@@ -213,7 +219,6 @@ pub fn place_instances(
                         min: [f.qmin.x + at[0], f.qmin.y + at[1]],
                         max: [f.qmax.x + at[0], f.qmax.y + at[1]],
                     };
-                    warnings.extend(outside_plate(i, models[i], p, &r, plate));
                     fixed.push(r);
                     instances.push(instance(models[i], i, copy, p, f, true, at, [at[0], at[1]]));
                 }
@@ -242,13 +247,12 @@ pub fn place_instances(
         })
         .collect();
     let mut slots = arrange(&fixed, &sizes, plate, gap);
-    if total == 1 && free.len() == 1 && slots[0].is_none() {
-        let [w, d] = sizes[0];
-        warnings.push(format!(
-            "the part ({w:.1} × {d:.1} mm) is larger than the plate ({} × {} mm); it is placed at the origin",
-            plate[0], plate[1]
-        ));
-        slots[0] = Some([0.0, 0.0]);
+    // Larger than the plate: no arrangement can help; at the origin, a misfit.
+    let eps = fit::TOLERANCE_MM;
+    for (slot, [w, d]) in slots.iter_mut().zip(&sizes) {
+        if slot.is_none() && (*w > plate[0] + eps || *d > plate[1] + eps) {
+            *slot = Some([0.0, 0.0]);
+        }
     }
     let missing: Vec<(usize, usize)> = free
         .iter()
@@ -278,38 +282,35 @@ pub fn place_instances(
     for inst in &instances {
         bounds.grow(inst.min, inst.max);
     }
+    let mut misfits: Vec<Misfit> = Vec::new();
+    for inst in &instances {
+        let (p, m) = (&spec.parts[inst.part], models[inst.part]);
+        let Some(f) = fit::misfit(inst, &frames[inst.part], &shown_name(m, p), s) else {
+            continue;
+        };
+        // A part larger than the plate is named once, whatever its copies.
+        if f.kind == fit::MisfitKind::Outside || !misfits.iter().any(|x| x.part == f.part) {
+            misfits.push(f);
+        }
+    }
     Ok(Layout {
         instances,
         bounds,
         warnings,
+        misfits,
     })
 }
 
-/// A warning when the fixed instance `r` of part `i` reaches outside the plate.
-fn outside_plate(
-    i: usize,
-    model: &Model,
-    p: &PartSpec,
-    r: &Rect,
-    plate: [f64; 2],
-) -> Option<String> {
-    let eps = 1e-9 * (1.0 + plate[0].max(plate[1]));
-    let outside = r.min[0] < -eps
-        || r.min[1] < -eps
-        || r.max[0] > plate[0] + eps
-        || r.max[1] > plate[1] + eps;
-    outside.then(|| {
-        format!(
-            "parts[{i}] ({}) reaches outside the plate ({} × {} mm): X{:.1}..{:.1} Y{:.1}..{:.1}",
-            clean_name(&part_label(model, p)),
-            plate[0],
-            plate[1],
-            r.min[0],
-            r.max[0],
-            r.min[1],
-            r.max[1]
-        )
-    })
+/// The part's name as the page lists it: the spec's `name`; a 3MF item's name with its file,
+/// "gear (gears.3mf)"; else the file's name.
+pub fn shown_name(model: &Model, p: &PartSpec) -> String {
+    if let Some(n) = &p.name {
+        return clean_name(n);
+    }
+    match p.item {
+        Some(i) => clean_name(&format!("{} ({})", model.part_name(Some(i)), p.file)),
+        None => clean_name(&p.file),
+    }
 }
 
 /// The refusal of a job whose arranged instances `missing` (part, copy) found no slot.

@@ -1,9 +1,10 @@
 //! The model: files in (STL, OBJ, 3MF: [`import`]), the welded mesh ([`mesh`]) and its shells
 //! ([`shells`]), the job file ([`spec`]), the files a job reads ([`models`]), where its
-//! instances go ([`layout`]), the page's display meshes ([`display`]) and the preparation of
+//! instances go ([`layout`]) and whether they fit the plate ([`fit`]), the page's display meshes ([`display`]) and the preparation of
 //! one file's mesh ([`prepare`]).
 
 pub mod display;
+pub mod fit;
 pub mod import;
 pub mod layout;
 pub mod mesh;

@@ -4,6 +4,7 @@
 
 use crate::base::error::Error;
 use crate::base::settings::Settings;
+use crate::model::fit;
 use crate::model::import::{self, stl};
 use crate::model::layout::{Frame, Instance};
 use crate::model::mesh::{self, Bounds, Mesh, MeshStats};
@@ -90,6 +91,8 @@ pub(crate) struct Imported {
     pub(crate) facets_in_file: usize,
     pub(crate) degenerate: usize,
     pub(crate) instance: Instance,
+    /// The instance against the plate rule ([`fit::misfit`]).
+    pub(crate) misfit: Option<fit::Misfit>,
 }
 
 /// What [`Job::build`] needs besides the mesh.
@@ -100,6 +103,11 @@ pub(crate) struct Input {
     pub(crate) degenerate: usize,
     pub(crate) instances: Vec<Instance>,
     pub(crate) warnings: Vec<String>,
+    /// The instances that break the plate rule: the job is refused for them unless
+    /// `allow_off_plate` allows them (then they are warnings).
+    pub(crate) misfits: Vec<fit::Misfit>,
+    /// How the refusal names the change (the command line's `--set` for one model).
+    pub(crate) hint: fit::Hint,
     /// [`JobInfo::groups`] of the merged mesh (before the repair drops facets).
     pub(crate) groups: Vec<FacetGroup>,
 }
@@ -153,12 +161,14 @@ pub(crate) fn import(
         shift: place,
     };
     mesh.place(&placement);
+    let misfit = fit::misfit(&instance, &frame, &job::clean_name(file_name), settings);
     Ok(Imported {
         mesh,
         format,
         facets_in_file,
         degenerate,
         instance,
+        misfit,
     })
 }
 

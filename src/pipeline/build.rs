@@ -6,6 +6,7 @@ use crate::base::error::Error;
 use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
+use crate::model::fit;
 use crate::model::layout::{Frame, Instance, at_part, place_instances};
 use crate::model::mesh::{self, Mesh, MeshStats};
 use crate::model::models::{
@@ -34,6 +35,7 @@ impl Job {
             facets_in_file,
             degenerate,
             instance,
+            misfit,
         } = import(model_bytes, file_name, &settings)?;
         let input = Input {
             file_name: file_name.to_string(),
@@ -42,6 +44,8 @@ impl Job {
             degenerate,
             instances: vec![instance],
             warnings: Vec::new(),
+            misfits: misfit.into_iter().collect(),
+            hint: fit::Hint::Set,
             groups: Vec::new(),
         };
         Job::build(mesh, input, settings)
@@ -177,6 +181,8 @@ impl Job {
             degenerate,
             instances: layout.instances,
             warnings: layout.warnings,
+            misfits: layout.misfits,
+            hint: fit::Hint::Parts,
             groups,
         };
         Job::build(mesh, input, settings)
@@ -276,8 +282,13 @@ impl Job {
             estimate.unit0_volume = sampled_volume(&mesh, &buckets, &zs, h);
             estimate.check(&settings)?;
         }
+        // The plate rule (after the checks of the job's size and droplets, so those speak first).
+        if let Some(e) = fit::refusal(&input.misfits, &settings, input.hint) {
+            return Err(e);
+        }
         check_chamber(&size, &settings)?;
         let mut all_warnings = input.warnings;
+        all_warnings.extend(input.misfits.into_iter().map(|m| m.message));
         all_warnings.extend(warnings(&stats, &size));
         let info = JobInfo {
             file_name: input.file_name,

@@ -134,6 +134,9 @@ pub struct Settings {
     pub plate_z: f64,
     /// Gap between the bounding boxes of arranged parts (mm).
     pub part_spacing: f64,
+    /// Slice a job with a part larger than the plate or reaching past its edges (refused
+    /// unless set; docs/jobs.md "The plate rule").
+    pub allow_off_plate: bool,
     /// A droplet is supported when the layer below has material within this many B.
     pub overhang_limit: f64,
     /// Support under overhangs, printed by discharge unit 1.
@@ -196,6 +199,7 @@ impl Default for Settings {
             plate_y: 134.0,
             plate_z: 230.0,
             part_spacing: 5.0,
+            allow_off_plate: false,
             overhang_limit: 0.5,
             support: Support::Off,
             support_gap_xy: 0.5,

@@ -376,6 +376,13 @@ pub fn schema() -> Vec<SettingSpec> {
             "Plate",
             "Gap between the bounding boxes of arranged parts",
         ),
+        choice(
+            "allow_off_plate",
+            Kind::Bool,
+            NO_CHOICES,
+            "Plate",
+            "Slice a part larger than the plate or reaching past its edges anyway (off: such a job is refused, with the turn or the scale that fits)",
+        ),
         num(
             "overhang_limit",
             "x B",
