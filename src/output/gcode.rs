@@ -1,8 +1,9 @@
 //! Write code, stage 6 (SPEC.md 4.5, 5.3.6): the header and each [`LayerPlan`] as `.gco` text.
 //! Coordinates have exactly 4 decimals; `G01` travel, `G25` a line of droplets, `G26` one
 //! droplet. The header lists every setting, the input file, the version and a summary; it is
-//! written before any layer, with fixed-width placeholders for the droplet counts that
-//! [`header`] fills in once the slice is done (same length, so a file can be patched in place).
+//! written before any layer, with fixed-width placeholders for the droplet counts and the
+//! figures (print time, travel, volume, mass: [`FIGURE_LINES`]) that [`header`] fills in once
+//! the slice is done (same length, so a file can be patched in place).
 
 use crate::base::geom::{OUTPUT_DECIMALS, OUTPUT_SCALE};
 use crate::base::settings::Settings;
@@ -29,6 +30,97 @@ pub struct HeaderInput<'a> {
 
 /// Width of the droplet count fields in the header.
 const COUNT_WIDTH: usize = 12;
+
+/// Width of a figure's field in the header: [`exact`] writes at most 24 characters.
+const FIGURE_WIDTH: usize = 24;
+
+/// Which figure a header line carries ([`FIGURE_LINES`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FigureField {
+    /// `Figures::print_seconds`, s.
+    PrintSeconds,
+    /// `Figures::travel_mm`, mm.
+    Travel,
+    /// `Figures::volume_mm3` (unit 0), mm³.
+    Volume,
+    /// `Figures::mass_g` (unit 0), g.
+    Mass,
+    /// `Figures::unit0_seconds`, s (two units only).
+    Unit0Seconds,
+    /// `Figures::unit1_seconds`, s (two units only).
+    Unit1Seconds,
+    /// `Figures::unit1_volume_mm3`, mm³ (two units only).
+    Unit1Volume,
+    /// `Figures::unit1_mass_g`, g (two units only).
+    Unit1Mass,
+}
+
+/// The header's figure lines: label (padded as the droplet lines), field, unit, and whether
+/// the line is written only when unit 1 prints (then `volume`/`mass` name unit 0's).
+pub const FIGURE_LINES: [(&str, FigureField, &str, Option<bool>); 10] = [
+    ("print time", FigureField::PrintSeconds, "s", None),
+    (
+        "droplet time unit 0",
+        FigureField::Unit0Seconds,
+        "s",
+        Some(true),
+    ),
+    (
+        "droplet time unit 1",
+        FigureField::Unit1Seconds,
+        "s",
+        Some(true),
+    ),
+    ("travel", FigureField::Travel, "mm", None),
+    ("volume", FigureField::Volume, "mm3", Some(false)),
+    ("mass", FigureField::Mass, "g", Some(false)),
+    ("volume unit 0", FigureField::Volume, "mm3", Some(true)),
+    ("mass unit 0", FigureField::Mass, "g", Some(true)),
+    ("volume unit 1", FigureField::Unit1Volume, "mm3", Some(true)),
+    ("mass unit 1", FigureField::Unit1Mass, "g", Some(true)),
+];
+
+impl FigureField {
+    /// This figure of `f`.
+    pub fn of(self, f: &crate::output::summary::Figures) -> f64 {
+        match self {
+            FigureField::PrintSeconds => f.print_seconds,
+            FigureField::Travel => f.travel_mm,
+            FigureField::Volume => f.volume_mm3,
+            FigureField::Mass => f.mass_g,
+            FigureField::Unit0Seconds => f.unit0_seconds,
+            FigureField::Unit1Seconds => f.unit1_seconds,
+            FigureField::Unit1Volume => f.unit1_volume_mm3,
+            FigureField::Unit1Mass => f.unit1_mass_g,
+        }
+    }
+
+    /// Sets this figure of `f`.
+    pub fn set(self, f: &mut crate::output::summary::Figures, v: f64) {
+        *match self {
+            FigureField::PrintSeconds => &mut f.print_seconds,
+            FigureField::Travel => &mut f.travel_mm,
+            FigureField::Volume => &mut f.volume_mm3,
+            FigureField::Mass => &mut f.mass_g,
+            FigureField::Unit0Seconds => &mut f.unit0_seconds,
+            FigureField::Unit1Seconds => &mut f.unit1_seconds,
+            FigureField::Unit1Volume => &mut f.unit1_volume_mm3,
+            FigureField::Unit1Mass => &mut f.unit1_mass_g,
+        } = v;
+    }
+}
+
+/// `v` exactly: the shortest text that reads back as the same `f64` (plain digits from 1e-4
+/// to 1e16, else with an exponent), at most [`FIGURE_WIDTH`] characters. A figure read back
+/// from the header is then the very number the slice showed.
+pub fn exact(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-4..1e16).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
 
 /// `x` with [`OUTPUT_DECIMALS`] (4) decimals, never `-0.0000`.
 pub fn coord(x: f64) -> String {
@@ -127,6 +219,17 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
         "; droplets total       = {}",
         field(c.map(|c| c.total()))
     );
+    // The figures the CLI prints and the page shows, of the same summary and settings.
+    let figures = summary.map(|sum| sum.figures(s));
+    for (label, f, unit, two) in FIGURE_LINES {
+        if two.is_some_and(|two| two != input.unit1_used) {
+            continue;
+        }
+        let value = figures
+            .as_ref()
+            .map_or("pending".into(), |g| exact(f.of(g)));
+        let _ = writeln!(h, "; {label:<20} = {value:>FIGURE_WIDTH$} {unit}");
+    }
     for p in input.instances {
         let _ = writeln!(h, "; {}", part_line(p));
     }
@@ -263,6 +366,76 @@ mod tests {
             (-0.5, "-0.5000"),
         ] {
             assert_eq!(coord(x), s, "{x}");
+        }
+    }
+
+    #[test]
+    fn figures_are_written_exactly_within_their_width() {
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut xs = vec![
+            0.0,
+            1e-4,
+            9.999_999_999_999_999e-5,
+            1e16,
+            9_999_999_999_999_998.0,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            5e-324,
+            20478.123456789012,
+            0.1 + 0.2,
+        ];
+        for _ in 0..100_000 {
+            let unit = crate::base::testing::random(&mut state);
+            xs.push(unit * 10f64.powi((state % 40) as i32 - 20));
+        }
+        for x in xs {
+            for v in [x, -x] {
+                let t = exact(v);
+                assert!(t.len() <= FIGURE_WIDTH, "{t}");
+                assert_eq!(t.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{t}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_filled_header_has_the_length_of_the_placeholders() {
+        use crate::slicing::plan::Counts;
+        let settings = Settings::default();
+        for unit1_used in [false, true] {
+            let input = HeaderInput {
+                file_name: "part.stl",
+                facets: 12,
+                layers: 3,
+                bounds: ([0.0; 3], [1.0; 3]),
+                warnings: &[],
+                instances: &[],
+                unit1_used,
+                profiles: &[],
+            };
+            let pending = header(&settings, &input, None);
+            for (outer, travel) in [(0, 0.0), (7, 1.0 / 3.0), (u32::MAX as u64, 1e300)] {
+                let summary = Summary {
+                    layers: 3,
+                    counts: Counts {
+                        outer,
+                        fill: 5,
+                        unit1: u64::from(unit1_used),
+                        ..Counts::default()
+                    },
+                    travel_mm: travel,
+                    ..Summary::default()
+                };
+                let filled = header(&settings, &input, Some(&summary));
+                assert_eq!(filled.len(), pending.len(), "{filled}");
+                let f = summary.figures(&settings);
+                let line = filled.lines().find(|l| l.starts_with("; travel")).unwrap();
+                assert_eq!(
+                    line,
+                    format!("; travel               = {:>24} mm", exact(travel))
+                );
+                assert!(filled.contains(&format!("= {:>24} s\n", exact(f.print_seconds))));
+                assert_eq!(filled.contains("; volume unit 1"), unit1_used);
+            }
         }
     }
 
