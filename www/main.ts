@@ -287,7 +287,7 @@ window.dropslice = {
     if (!job) return null;
     return {
       name: job.name,
-      parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: p.mesh ? p.mesh.positions.length / 9 : 0 })),
+      parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: (job.meshOf(p)?.positions.length ?? 0) / 9 })),
       layout: job.layout,
       selected: job.selected,
       /** Instances off the plate: {part (index), copy, message}. */
