@@ -63,6 +63,11 @@ export class History<S> {
     return e;
   }
 
+  /** Every state kept: those to undo to, the present, those to redo. */
+  snapshots(): S[] {
+    return [...this.past.map((e) => e.state), ...(this.present === null ? [] : [this.present]), ...this.future.map((e) => e.state)];
+  }
+
   /** What Undo would undo (null: nothing). */
   get undoLabel(): string | null {
     return this.past.at(-1)?.label ?? null;
