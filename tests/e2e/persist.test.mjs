@@ -112,6 +112,30 @@ test("leaving asks while the job is not kept: after an edit and after an Undo; n
   await context.close();
 });
 
+test("a crash loses nothing: the page that crashed after an edit comes back with the edited job", async () => {
+  const { page, errors, context } = await openPage(env.browser, env.url);
+  await waitDone(page, 60_000);
+  await pick(page, [cubeFile]);
+  await waitDone(page);
+  await editPart(page, 0, "rotate_z", 15);
+  await kept(page);
+  // the renderer dies: no pagehide, no beforeunload
+  const crashed = new Promise((ok) => page.once("crash", ok));
+  const cdp = await context.newCDPSession(page);
+  cdp.send("Page.crash").catch(() => {});
+  await crashed;
+  const again = await context.newPage();
+  again.on("pageerror", (e) => errors.push(String(e)));
+  await again.goto(env.url);
+  await waitDone(again, 60_000);
+  const j = await job(again);
+  assert.equal(j.name, "cube_20mm_ascii.stl");
+  assert.equal(j.parts[0].rotate_z, 15);
+  assert.match(await again.locator("#persist-note").innerText(), /Your job from last time was restored/);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
 test("a job over the cap is said not to be kept, and leaving asks", async () => {
   const { page, errors, context } = await openPage(env.browser, `${env.url}?jobcap=0`);
   await waitDone(page, 60_000);
