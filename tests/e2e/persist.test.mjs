@@ -1,9 +1,10 @@
 // The user's work survives (www/core/jobstore.ts, www/flows/persist.ts, flows/history.ts,
-// core/profiles.ts): the job kept in the browser's IndexedDB comes back after a reload (after an
-// Undo too) with a notice whose Start over gives the sample with the defaults; a preview link's
-// job becomes the visitor's at the first edit (the address drops the link); leaving asks while
-// the job is not kept; a damaged store is set aside with a word; a job over the cap is said not
-// to be kept; undo snapshots keep no display meshes; a 201st profile is refused. As a user, through the DOM.
+// core/profiles.ts): the job kept in the browser's IndexedDB comes back after a reload (after
+// an Undo too) and after a crash, with a notice whose Start over gives the sample with the
+// defaults; a preview link's job becomes the visitor's at the first edit (the address drops
+// the link); leaving asks while the job is not kept; a damaged store is set aside with a word;
+// a job over the cap is said not to be kept; undo snapshots keep no display meshes; a 201st
+// profile is refused. As a user, through the DOM.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { boxStl, cube, openPage, pick, shareLink, start, stop, torusStl, waitDone } from "./helpers.mjs";
