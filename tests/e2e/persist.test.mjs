@@ -20,6 +20,23 @@ const cubeFile = { name: "cube_20mm_ascii.stl", mimeType: "model/stl", buffer: c
 /** The parts' specs as a user sees them (ids and meshes aside). */
 const specs = (j) => j.parts.map(({ id, mesh, ...spec }) => spec);
 
+/** The number of models' bytes kept in the browser's IndexedDB. */
+const storedModels = (page) =>
+  page.evaluate(
+    () =>
+      new Promise((ok, fail) => {
+        const r = indexedDB.open("dropslice.job");
+        r.onerror = () => fail(r.error);
+        r.onsuccess = () => {
+          const count = r.result.transaction("models").objectStore("models").count();
+          count.onsuccess = () => {
+            r.result.close();
+            ok(count.result);
+          };
+        };
+      }),
+  );
+
 /** Waits until the job on screen is the one kept in the browser. */
 const kept = (page) => page.waitForFunction(() => window.dropslice.persist().state === "saved", null, { timeout: 30_000 });
 
@@ -65,6 +82,8 @@ test("two models, one rotated, a third opened over them, Undo, reload: the job i
   await page.waitForFunction(() => window.dropslice.job().parts.length === 2);
   assert.deepEqual(specs(await job(page)), specs(two));
   await kept(page);
+  // each model's bytes once (by SHA-256), whatever the edits; the third file's are gone
+  assert.equal(await storedModels(page), 2);
   await page.reload();
   await waitDone(page, 60_000);
   const back = await job(page);
