@@ -15,6 +15,7 @@ import { deleteProfile, exportProfile, importProfile, renameProfile, saveProfile
 import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
 import { fit, setShowOverhangs, show } from "./flows/layer";
 import { openFiles, openLink, openSample } from "./flows/open";
+import { holdJobForLink, initPersist, leavingLoses, pausePersist, persistStatus, restoreJob, startOver } from "./flows/persist";
 import { applyRemembered, holdForLink, loadRemembered, saveNow, saveSoon, settingsTouched } from "./flows/remember";
 import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows/slice";
 import { registerOffline } from "./pwa/offline";
@@ -38,6 +39,7 @@ import { share } from "./views/share";
 import { wireShortcuts } from "./views/shortcuts";
 import { setState } from "./views/status";
 import { View3DPanel, wireView3D } from "./views/view3d/panel";
+import { wirePersistNotice } from "./views/persist";
 
 /** Tuning through the query string (used by the tests): `?workers=3&cache=2` (MB). */
 const query = new URLSearchParams(location.search);
@@ -196,9 +198,11 @@ function wire(): void {
   for (const id of Object.values(OVERLAYS)) $(id).addEventListener("change", () => saveSoon(page));
   for (const id of ["mode-layer", "mode-3d"]) $(id).addEventListener("click", () => saveSoon(page));
   window.addEventListener("pagehide", () => saveNow(page));
-  // leaving the page with an edited job asks first (the settings are remembered anyway)
+  // leaving asks first when the job on screen is not the one kept in the browser (a write
+  // pending, too big to keep, no store): flows/persist.ts
+  wirePersistNotice(() => void startOver(page).catch(error));
   window.addEventListener("beforeunload", (ev) => {
-    if (!store.edited || !store.job) return;
+    if (!leavingLoses(page)) return;
     ev.preventDefault();
     ev.returnValue = "";
   });
@@ -287,7 +291,7 @@ window.dropslice = {
     if (!job) return null;
     return {
       name: job.name,
-      parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: p.mesh ? p.mesh.positions.length / 9 : 0 })),
+      parts: job.parts.map((p) => ({ id: p.id, ...p.spec, mesh: (job.meshOf(p)?.positions.length ?? 0) / 9 })),
       layout: job.layout,
       selected: job.selected,
       /** Instances off the plate: {part (index), copy, message}. */
@@ -296,10 +300,45 @@ window.dropslice = {
   },
   /** What Undo and Redo would undo and redo (null: nothing). */
   history: () => ({ undo: page.history.undoLabel, redo: page.history.redoLabel, edited: store.edited }),
+  /** The job kept in the browser: {state, cap, link, leavingLoses}. */
+  persist: () => ({ ...persistStatus(), leavingLoses: leavingLoses(page) }),
+  /** Holds the job's writes (they stay pending) until released. */
+  persistPause: (on: boolean) => pausePersist(page, on),
+  /** The history's snapshots: how many, and the bytes of typed arrays they reach that the
+   *  page's job on screen does not (display meshes kept alive by undo). */
+  historyBytes: () => historyBytes(),
 };
+
+/** Bytes of the ArrayBuffers reachable from the history's snapshots (past, present, future)
+ *  but not from the job on screen: what undo alone keeps alive. */
+function historyBytes(): { snapshots: number; bytes: number } {
+  const reach = (roots: unknown[]): Set<ArrayBufferLike> => {
+    const seen = new Set<unknown>();
+    const buffers = new Set<ArrayBufferLike>();
+    const stack = [...roots];
+    while (stack.length) {
+      const v = stack.pop();
+      if (typeof v !== "object" || v === null || seen.has(v)) continue;
+      seen.add(v);
+      if (ArrayBuffer.isView(v)) buffers.add(v.buffer);
+      else if (v instanceof ArrayBuffer) buffers.add(v);
+      else if (v instanceof Blob) continue;
+      else if (v instanceof Map) for (const [k, x] of v) stack.push(k, x);
+      else if (v instanceof Set) for (const x of v) stack.push(x);
+      else for (const x of Object.values(v)) stack.push(x);
+    }
+    return buffers;
+  };
+  const snaps = page.history.snapshots();
+  const live = reach([store.job]);
+  let bytes = 0;
+  for (const b of reach(snaps)) if (!live.has(b)) bytes += b.byteLength;
+  return { snapshots: snaps.length, bytes };
+}
 
 async function main(): Promise<void> {
   setState("loading");
+  initPersist(query);
   wire();
   try {
     page.init = await pool.init();
@@ -327,19 +366,27 @@ async function main(): Promise<void> {
       }
     },
   );
-  // the settings and the view of the last visit (a preview link's settings take precedence)
+  // a preview link in the address, else the job kept from last time with the settings and the
+  // view remembered, else the sample part with the default settings (a remembered setting
+  // never makes a first visit's sample slow) and the remembered view
   const remembered = loadRemembered(page);
-  if (remembered) applyRemembered(page, remembered);
   showProfiles(page);
-  lastPlate = plate();
   updateButtons(page);
-  // a link's settings are shown, not remembered over the visitor's own until they edit one
-  holdForLink(location.hash.length > 1);
-  const fromLink = await openLink(page);
+  // a link's settings and job are shown, not kept over the visitor's own until they edit
+  const linked = location.hash.length > 1;
+  holdForLink(linked);
+  holdJobForLink(linked);
+  if (linked && remembered) applyRemembered(page, { settings: {}, view: remembered.view });
+  const fromLink = linked && (await openLink(page));
   if (!fromLink) {
     holdForLink(false);
-    await openSample(page, { layer: remembered?.view.layer ?? undefined });
+    holdJobForLink(false);
+    if (!(await restoreJob(page, remembered))) {
+      if (remembered) applyRemembered(page, { settings: {}, view: remembered.view });
+      await openSample(page, { layer: remembered?.view.layer ?? undefined });
+    }
   }
+  lastPlate = plate();
 }
 
 registerOffline();

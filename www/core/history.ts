@@ -63,6 +63,11 @@ export class History<S> {
     return e;
   }
 
+  /** Every state kept: those to undo to, the present, those to redo. */
+  snapshots(): S[] {
+    return [...this.past.map((e) => e.state), ...(this.present === null ? [] : [this.present]), ...this.future.map((e) => e.state)];
+  }
+
   /** What Undo would undo (null: nothing). */
   get undoLabel(): string | null {
     return this.past.at(-1)?.label ?? null;
@@ -76,7 +81,8 @@ export class History<S> {
 /** The page's state as the history keeps it: the job (the object, so that undoing a new job
  *  brings the previous one back whole), its files and parts as they were, the selection and
  *  the settings. Parts are never changed in place (an edit makes new ones), so keeping them is
- *  enough. */
+ *  enough. A snapshot holds no display mesh: those are the job's, one per file and item
+ *  (`Job.meshes`), shared by every state of the job, so a hundred edits keep no hundred meshes. */
 export interface Snapshot {
   job: Job | null;
   models: JobModel[];

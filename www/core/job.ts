@@ -67,14 +67,15 @@ export interface DisplayMesh {
   budget: number;
 }
 
-/** One part: a stable id (the 3D view's ids are `${id}:${copy}`), its file and its spec. */
+/** One part: a stable id (the 3D view's ids are `${id}:${copy}`), its file and its spec. Its
+ *  display mesh is the job's (`Job.meshOf`), never the part's: undo snapshots keep parts, and
+ *  a mesh in each would keep every mesh ever fetched (megabytes an edit). */
 export interface Part {
   id: number;
   spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "place_angle" | "copies" | "unit">> & {
     /** Absent, never null: the whole file, unplaced (arranged), the file's name. */
     [K in "item" | "place_x" | "place_y" | "name"]?: NonNullable<PartSpec[K]>;
   };
-  mesh: DisplayMesh | null;
 }
 
 export type Spec = Part["spec"];
@@ -141,11 +142,14 @@ export class Job {
   layout: Layout | null = null;
   /** The part selected in the panel and the 3D view (an id). */
   selected: number | null = null;
+  /** The display meshes, one per file and item ([[meshKey]]): shared by the parts and their
+   *  copies, replaced when fetched again, dropped with their file. */
+  readonly meshes = new Map<string, DisplayMesh>();
   private nextId = 0;
 
   /** A new part of `model` (ids count from 0 in each job). */
   newPart(spec: PartSpec): Part {
-    return { id: this.nextId++, spec: fullSpec(spec), mesh: null };
+    return { id: this.nextId++, spec: fullSpec(spec) };
   }
 
   part(id: number | null): Part | undefined {
@@ -163,10 +167,17 @@ export class Job {
     return [...this.models.values()].filter((m) => used.has(m.name)).map((m) => ({ name: m.name, file: m.file }));
   }
 
-  /** Drops the files no part uses any more. */
+  /** Drops the files no part uses any more, and their meshes. */
   prune(): void {
     const used = new Set(this.parts.map((p) => p.spec.file));
     for (const n of [...this.models.keys()]) if (!used.has(n)) this.models.delete(n);
+    const drawn = new Set(this.parts.map((p) => meshKey(p.spec)));
+    for (const k of [...this.meshes.keys()]) if (!drawn.has(k)) this.meshes.delete(k);
+  }
+
+  /** The display mesh of part `p` (null: not fetched yet). */
+  meshOf(p: Part): DisplayMesh | null {
+    return this.meshes.get(meshKey(p.spec)) ?? null;
   }
 
   /** The job's name: its first file, "+ N more" for the others. */
@@ -186,6 +197,9 @@ export class Job {
     return JSON.stringify({ settings, parts: this.parts.map((p) => p.spec), files: this.refs().map((r) => r.name) });
   }
 }
+
+/** The key of a part's display mesh: its file and item (parts of both share one mesh). */
+export const meshKey = (s: Pick<Spec, "file" | "item">): string => `${s.file}\u0000${s.item ?? ""}`;
 
 /** The display name of a part: its own, or its file's (with the 3MF item). */
 export function partName(job: Job, p: Part): string {

@@ -91,6 +91,14 @@ export function profileFileName(p: StoredProfile): string {
   return `${base || "profile"}.${p.kind}.json`;
 }
 
+/** Why `p` cannot join `list` (null: it can): a new name when [[MAX_PROFILES]] are kept
+ *  already (the list read back keeps only that many, so a 201st would be lost). Replacing a
+ *  profile of the same name always fits. */
+export function roomProblem(list: readonly StoredProfile[], p: StoredProfile): string | null {
+  if (list.length < MAX_PROFILES || list.some((q) => q.name === p.name)) return null;
+  return `There are ${MAX_PROFILES} profiles, the most the page keeps: delete one (export it first to keep it as a file), or save under the name of one to replace it.`;
+}
+
 /** `list` with `p` in it: a profile of the same name is replaced in place. */
 export function withProfile(list: readonly StoredProfile[], p: StoredProfile): StoredProfile[] {
   const i = list.findIndex((q) => q.name === p.name);

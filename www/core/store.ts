@@ -190,7 +190,8 @@ export class Store {
   viewTouched = false;
   /** A job (from a link or a job file) waiting for its model files. */
   pending: PendingJob | null = null;
-  /** The job was edited since it was opened (leaving the page asks first). */
+  /** The job was edited (or a change undone or redone) since it was opened. Leaving the page
+   *  asks first when the job is not the one kept in the browser (flows/persist.ts). */
   edited = false;
   /** Bumped by every layout request: only the latest answer is applied. */
   layoutSeq = 0;

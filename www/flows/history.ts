@@ -11,6 +11,7 @@ import { updateButtons } from "../views/controls";
 import { undoNotice, updateUndo } from "../views/notices";
 import type { Page } from "../views/page";
 import { adoptJob, ensureMeshes, layoutBanner, hideLayoutBanner, settingsOf } from "./job";
+import { jobChanged } from "./persist";
 
 /** Typing on in the same setting within this time amends its entry. */
 const AMEND_MS = 1500;
@@ -29,6 +30,8 @@ export function record(page: Page, label: string, kind: "edit" | "open" | "setti
   if (kind === "edit") page.store.edited = true;
   else if (kind === "open") page.store.edited = false;
   updateUndo(page);
+  // kept in the browser (flows/persist.ts)
+  jobChanged(page, label);
 }
 
 /** The names of the settings that differ between `a` and `b`. */
@@ -84,6 +87,8 @@ async function step(page: Page, which: "undo" | "redo"): Promise<void> {
   updateUndo(page);
   if (!e) return;
   await restore(page, page.history.present!);
+  page.store.edited = true;
+  jobChanged(page);
   undoNotice(page, which === "undo" ? `Undone: ${e.label}` : `Redone: ${e.label}`, which === "undo" ? "redo" : "undo");
 }
 

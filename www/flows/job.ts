@@ -4,7 +4,7 @@
 // job: flows/slice.ts startSlice.
 
 import type { Page } from "../views/page";
-import { DISPLAY_BUDGET, Job, jobSettings, partName, specOut, uniqueName, type Changes, type JobModel, type Part, type Spec } from "../core/job";
+import { DISPLAY_BUDGET, Job, jobSettings, meshKey, partName, specOut, uniqueName, type Changes, type DisplayMesh, type JobModel, type Part, type Spec } from "../core/job";
 import type { Orientation, Orientations, PartSpec } from "../core/protocol";
 import { errorBanner, hideBanner } from "../views/banner";
 import { updateButtons } from "../views/controls";
@@ -190,7 +190,6 @@ export function duplicatePart(page: Page, id: number): void {
   // a copy of a placed part is arranged (it would lie on the original)
   delete copy.spec.place_x;
   delete copy.spec.place_y;
-  copy.mesh = p.mesh;
   const at = job.parts.indexOf(p) + 1;
   void applyParts(page, [...job.parts.slice(0, at), copy, ...job.parts.slice(at)], "duplicate part").then((ok) => ok && selectPart(page, copy.id));
 }
@@ -255,15 +254,16 @@ export async function ensureMeshes(page: Page): Promise<void> {
   const job = page.store.job;
   if (!job || !page.view3d.active) return;
   const budget = Math.max(2000, Math.floor(DISPLAY_BUDGET / Math.max(1, job.instances)));
-  const want = job.parts.filter((p) => !p.mesh || p.mesh.budget > 2 * budget || (p.mesh.budget < budget / 2 && p.mesh.positions.length / 9 >= p.mesh.budget * 0.8));
-  // parts of the same file and item share one mesh
-  const byKey = grouped(want, (p) => `${p.spec.file}\u0000${p.spec.item ?? ""}`);
-  for (const parts of byKey.values()) {
+  const stale = (m: DisplayMesh | null) => !m || m.budget > 2 * budget || (m.budget < budget / 2 && m.positions.length / 9 >= m.budget * 0.8);
+  // parts of the same file and item share one mesh (the job's, never a part's)
+  const want = grouped(job.parts.filter((p) => stale(job.meshOf(p))), (p) => meshKey(p.spec));
+  for (const [key, parts] of want) {
     const p = parts[0];
     try {
       const positions = await page.pool.displayMesh(job.refs(), p.spec.file, p.spec.item, budget);
       if (page.store.job !== job) return;
-      for (const q of parts) q.mesh = { positions, budget };
+      // a part of this file and item is still in the job (an undo may have taken it away)
+      if (job.parts.some((q) => meshKey(q.spec) === key)) job.meshes.set(key, { positions, budget });
       page.view3d.sync(page);
     } catch (e) {
       if (page.store.job === job) showError(page, e);

@@ -23,6 +23,9 @@ import { linkFromNote, undoNotice } from "../views/notices";
 import { showModel } from "../views/stats";
 import { setState } from "../views/status";
 
+/** The label of a preview link's own opening: not the visitor's edit (flows/persist.ts). */
+export const LINK_OPEN_LABEL = "open the preview link";
+
 /** The longest model file name a job file's part may give (a file system's limit). */
 const FILE_NAME_MAX = 255;
 
@@ -90,6 +93,13 @@ async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target:
 }
 
 
+/** The job kept from last time (flows/persist.ts): its files under their names and its parts,
+ *  sliced at once like any job opened. False when the core refused it (its message shown). */
+export function openStored(page: Page, files: NewFile[], parts: PartSpec[], target: Target = {}): Promise<boolean> {
+  note("", "none");
+  return openJob(page, files, parts, target, "open the job from last time");
+}
+
 /** Reads a job file (on the page's thread, at most the core's `max_job_file_bytes`) into its
  *  JSON; a message when it is not one. The core checks every field when the job is laid out. */
 async function readJobFile(file: File, limits: JobSchema): Promise<JobFile | string> {
@@ -148,7 +158,7 @@ async function openPending(page: Page, pending: PendingJob, dropped: File[]): Pr
     const name = pending.files[0].name;
     note(`“${strangers[0].name}” does not match the model of the preview link (“${name}”, SHA-256 ${(pending.files[0].sha256 ?? "").slice(0, 12)}…): this is a different file. It is sliced with the link's settings.`, "warn");
     const job = { ...pending.job, parts: pending.job.parts.map((p) => ({ ...p, file: strangers[0].name })) };
-    await openJob(page, [{ file: strangers[0] }], job.parts, {}, "open the preview link");
+    await openJob(page, [{ file: strangers[0] }], job.parts, {}, LINK_OPEN_LABEL);
     return;
   }
   if (missing.length === 0) {
@@ -157,7 +167,7 @@ async function openPending(page: Page, pending: PendingJob, dropped: File[]): Pr
     if (pending.source === "link") note(pending.files.length > 1 ? "The dropped files match the models of the preview link." : `“${pending.files[0].file!.name}” matches the model of the preview link.`, "ok");
     const extra = strangers.length ? ` (not part of it: ${strangers.map((f) => `“${f.name}”`).join(", ")})` : "";
     if (extra) note(`The job's files are all here${extra}.`, "warn");
-    const what = pending.source === "link" ? "open the preview link" : "open the job file";
+    const what = pending.source === "link" ? LINK_OPEN_LABEL : "open the job file";
     if (await openJob(page, pending.files.map((x) => ({ file: x.file!, name: x.name })), pending.job.parts, target, what)) {
       store.pending = null;
       if (link) linkStage(page, link);
@@ -291,7 +301,7 @@ export async function openLink(page: Page): Promise<boolean> {
     const wrong = files.findIndex((f, i) => !hashes[i].startsWith(f.sha256));
     if (wrong < 0) {
       page.store.pending = null;
-      if (await openJob(page, given, job.parts, { layer, view, notice }, "open the preview link")) linkStage(page, link.state);
+      if (await openJob(page, given, job.parts, { layer, view, notice }, LINK_OPEN_LABEL)) linkStage(page, link.state);
       return true;
     }
     link.models = null;

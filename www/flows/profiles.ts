@@ -12,6 +12,7 @@ import {
   profileOf,
   profilesText,
   readProfiles,
+  roomProblem,
   withProfile,
   type ProfileKind,
   type StoredProfile,
@@ -58,6 +59,8 @@ export function saveProfile(page: Page, name: string, kind: ProfileKind): void {
   if (form.errors().length) return profileMessage("Fix the settings marked in red first.", true);
   const p = profileOf(name, kind, form.values(), page.init!.schema);
   const list = load(page);
+  const full = roomProblem(list, p);
+  if (full) return profileMessage(`“${p.name}” was not saved. ${full}`, true);
   const replaced = list.some((q) => q.name === p.name);
   if (store(page, withProfile(list, p))) profileMessage(`${replaced ? "Replaced" : "Saved"} the ${kind} profile “${p.name}”.`);
 }
@@ -115,6 +118,8 @@ export async function importProfile(page: Page, file: File): Promise<void> {
   const p = readProfiles(JSON.stringify([checked]), page.init!.schema)[0];
   if (!p) return refuse("its settings are not those of this page's version.");
   const list = load(page);
+  const full = roomProblem(list, p);
+  if (full) return refuse(full);
   const replaced = list.some((q) => q.name === p.name);
   if (store(page, withProfile(list, p))) profileMessage(`Imported the ${p.kind} profile “${p.name}”${replaced ? " (it replaced the one of that name)" : ""}; pick it to use it.`);
 }

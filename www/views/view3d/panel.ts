@@ -62,9 +62,10 @@ export class View3DPanel implements View3DView {
     if (job && layout) {
       for (const inst of layout.instances) {
         const p = job.parts[inst.part];
-        if (!p?.mesh) continue;
+        const mesh = p ? job.meshOf(p) : null;
+        if (!p || !mesh) continue;
         const warn = off.has(`${inst.part}:${inst.copy}`);
-        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: p.mesh.positions, matrix: inst.matrix, unit: inst.unit === 1 ? 1 : 0, warn });
+        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: mesh.positions, matrix: inst.matrix, unit: inst.unit === 1 ? 1 : 0, warn });
       }
     }
     this.parts = parts;
