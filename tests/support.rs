@@ -269,7 +269,7 @@ fn unsupported_area_in_the_report() {
 }
 
 /// The page's overhang overlay ([`dropslice::support::unsupported_droplets`] on the preview's
-/// droplets, as `src/wasm.rs` passes them) marks, layer by layer, as many droplets as this
+/// droplets, as `src/wasm/mod.rs` passes them) marks, layer by layer, as many droplets as this
 /// file's independent reading of the CLI's G-code finds: with support off (unit 0 only) and on
 /// (droplets of both widths below).
 #[test]

@@ -1,4 +1,4 @@
-//! The wasm facade (src/wasm.rs) in Node: `wasm-bindgen-test-runner` runs these when
+//! The wasm facade (src/wasm/) in Node: `wasm-bindgen-test-runner` runs these when
 //! `cargo test --target wasm32-unknown-unknown --test wasm_session` is given it as the runner.
 #![cfg(target_arch = "wasm32")]
 
