@@ -19,7 +19,12 @@
 // strings are made-up repositories) is not read.
 // Paths under generated folders (target/, dist/, www/pkg/, node_modules/) and patterns (`*`,
 // `{…}`, `NAME`-style placeholders in capitals) are not checked.
-// It prints each missing path with the file and line that names it and exits with 1.
+// Citations of docs/spec.md's sections: `docs/spec.md 5.3.2` needs a heading numbered 5.3.2
+// (or a range such as 4.1–4.2 holding it), `docs/spec.md "Loop seams"` a heading that begins
+// with those words. A bare `SPEC.md` (the old specification, not in the repository) is
+// reported: cite docs/spec.md.
+// It prints each missing path or section with the file and line that names it and exits
+// with 1.
 
 import { existsSync, readdirSync, readFileSync, statSync } from "node:fs";
 import { dirname, join, relative, resolve } from "node:path";
@@ -128,6 +133,44 @@ export function pathsIn(line, srcDirs) {
   return found;
 }
 
+const CITE = /docs\/spec\.md(?:'s)?,?\s+(?:(\d+(?:\.\d+)*)|"([^"]+)")/g;
+const OLD_SPEC = /(?<![\w/.-])SPEC\.md/g;
+
+/** The headings of docs/spec.md: their numbers (a range's ends and what lies between) and texts. */
+export function specHeadings(text) {
+  const numbers = new Set();
+  const titles = [];
+  for (const line of text.split("\n")) {
+    const h = /^#{1,6}\s+(.*)$/.exec(line);
+    if (!h) continue;
+    const title = h[1].trim();
+    titles.push(title);
+    const r = /^(\d+(?:\.\d+)*)(?:[–-](\d+(?:\.\d+)*))?\s/.exec(title);
+    if (!r) continue;
+    numbers.add(r[1]);
+    if (r[2]) {
+      // 4.1–4.2: every number from the first to the last in its last place.
+      const a = r[1].split("."), b = r[2].split(".");
+      const head = a.slice(0, -1).join(".");
+      for (let i = Number(a.at(-1)); i <= Number(b.at(-1)); i++)
+        numbers.add(head ? `${head}.${i}` : String(i));
+    }
+  }
+  return { numbers, titles };
+}
+
+/** The docs/spec.md sections a line cites that have no heading, and its citations of SPEC.md. */
+export function badCitations(line, headings) {
+  const bad = [];
+  for (const m of line.matchAll(CITE)) {
+    if (m[1] !== undefined && !headings.numbers.has(m[1])) bad.push(`docs/spec.md ${m[1]}`);
+    if (m[2] !== undefined && !headings.titles.some((t) => t.startsWith(m[2])))
+      bad.push(`docs/spec.md "${m[2]}"`);
+  }
+  for (const _ of line.matchAll(OLD_SPEC)) bad.push("SPEC.md (not in the repository: cite docs/spec.md)");
+  return bad;
+}
+
 /** Relative link targets of a markdown line: [{path, candidates}] resolved from `dir`. */
 export function linksIn(line, dir) {
   const found = [];
@@ -170,6 +213,11 @@ export function check(root) {
     for (const { path, candidates } of found)
       if (!candidates.some(exists)) missing.push({ file, line: i + 1, path });
   };
+  const specPath = join(root, "docs", "spec.md");
+  const headings = specHeadings(existsSync(specPath) ? readFileSync(specPath, "utf8") : "");
+  const cite = (file, i, line) => {
+    for (const path of badCitations(line, headings)) missing.push({ file, line: i + 1, path });
+  };
   for (const file of docs) {
     const lines = readFileSync(join(root, file), "utf8").split("\n");
     let fence = false;
@@ -177,12 +225,16 @@ export function check(root) {
       if (/^\s*```/.test(line)) fence = !fence;
       report(file, i, pathsIn(line, srcDirs));
       if (!fence) report(file, i, linksIn(line, dirname(file)));
+      cite(file, i, line);
     });
   }
   for (const file of code) {
     const text = readFileSync(join(root, file), "utf8");
     if (text.includes(FIXTURES)) continue;
-    commentLines(text, file).forEach((c, i) => report(file, i, pathsIn(c, srcDirs)));
+    commentLines(text, file).forEach((c, i) => {
+      report(file, i, pathsIn(c, srcDirs));
+      cite(file, i, c);
+    });
   }
   return missing;
 }
@@ -192,7 +244,9 @@ if (process.argv[1] && resolve(process.argv[1]) === self) {
   const root = resolve(process.argv[2] ?? join(dirname(self), ".."));
   const missing = check(root);
   if (missing.length) {
-    console.error(`${missing.length} path(s) named in docs or comments do not exist (under ${relative(process.cwd(), root) || "."}):`);
+    console.error(
+      `${missing.length} path(s) or section(s) named in docs or comments do not exist (under ${relative(process.cwd(), root) || "."}):`,
+    );
     for (const m of missing) console.error(`  ${m.file}:${m.line}: ${m.path}`);
     console.error("Fix the path (where did the file go?) or, if it is not a path of this repository, write it so it is not read as one.");
     process.exit(1);

@@ -28,14 +28,17 @@ function withRepo(files, body) {
 
 const good = {
   "tests/skipped.rs": "// check_paths: fixtures\n// src/not-checked.rs\n",
-  "src/model/mesh.rs": "//! The mesh (docs/spec.md 5.3.1; tests/a.rs).\nfn f() {}\n",
+  "src/model/mesh.rs":
+    "//! The mesh (docs/spec.md 5.3.1; tests/a.rs), docs/spec.md 4.2, docs/spec.md's \"Loop seams\".\nfn f() {}\n",
   "src/lib.rs": "/* see src/model/mesh.rs\n   and model/mesh.rs */\nlet url = \"https://x.org/src/gone.rs\";\n",
   "www/core/job.ts": "// The job (src/model/, www/flows/open.ts, tests/e2e/*.test.mjs, tests/NAME.rs)\n",
   "www/flows/open.ts": "export {};\n",
   "www/pkg/x.d.ts": "// generated: src/nothing.rs is not read here\n",
   "tests/a.rs": "// tests/fixtures/oracle/NAME.json, www/pkg/dropslice.d.ts (generated), dist/worker.js\n",
   "scripts/test.sh": "#!/bin/sh\n# runs scripts/test.sh and node tests/a.rs\necho src/in-code-not-a-comment.rs\n",
-  "docs/spec.md": "# Spec\n`model/mesh.rs`, `core/job.ts`, [the page](../README.md), ![a](images/a.svg), [b](#x), [c](https://e.org/y.md)\n",
+  "docs/spec.md":
+    "# Spec\n`model/mesh.rs`, `core/job.ts`, [the page](../README.md), ![a](images/a.svg), [b](#x), [c](https://e.org/y.md)\n" +
+    "## 4.1–4.2 The machine\n### 5.3.1 Import\n## Loop seams (`loop_spacing`)\nSee docs/spec.md 4.1.\n",
   "docs/images/a.svg": "<svg/>",
   "README.md": "See [docs/spec.md](docs/spec.md) and `src/model/mesh.rs:12`.\n",
   "CHANGELOG.md": "- removed src/old.rs (history is not checked)\n",
@@ -51,10 +54,10 @@ test("a repository whose named paths all exist passes", () => {
 test("every missing path is named with its file and line, and the check fails", () => {
   const bad = {
     ...good,
-    "src/lib.rs": "fn a() {}\n// moved: src/budget.rs\n",
+    "src/lib.rs": "fn a() {}\n// moved: src/budget.rs\n// SPEC.md 5.3.1, docs/spec.md 5.3.2, docs/spec.md \"Seams\"\n",
     "www/core/job.ts": "/**\n * The worker (www/worker.ts).\n */\n",
     "scripts/test.sh": "#!/bin/sh\n# runs tests/gone.test.mjs\n",
-    "docs/spec.md": "# Spec\n\n| stage | `model/prepare.rs` |\n[x](missing.md) ![y](images/b.svg)\n",
+    "docs/spec.md": "# Spec\n\n| stage | `model/prepare.rs` |\n[x](missing.md) ![y](images/b.svg)\n### 5.3.1 Import\n## 4.1–4.2 The machine\n## Loop seams\n",
     "README.md": "See docs/nothing.md.\n",
   };
   withRepo(bad, (root) => {
@@ -68,8 +71,11 @@ test("every missing path is named with its file and line, and the check fails", 
       "docs/spec.md:4: missing.md",
       "scripts/test.sh:2: tests/gone.test.mjs",
       "src/lib.rs:2: src/budget.rs",
+      "src/lib.rs:3: SPEC.md (not in the repository: cite docs/spec.md)",
+      "src/lib.rs:3: docs/spec.md \"Seams\"",
+      "src/lib.rs:3: docs/spec.md 5.3.2",
       "www/core/job.ts:2: www/worker.ts",
     ]);
-    assert.match(r.stderr, /^7 path\(s\) named in docs or comments do not exist/);
+    assert.match(r.stderr, /^10 path\(s\) or section\(s\) named in docs or comments do not exist/);
   });
 });
