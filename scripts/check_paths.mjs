@@ -14,15 +14,17 @@
 //     extension or a slash (`src/model/mesh.rs`, `tests/e2e/`), relative to ROOT;
 //   * a path whose first folder is one of src/'s or www/'s folders (`model/prepare.rs`,
 //     `flows/slice.ts`, as docs/architecture.md writes them): it must exist under src/ or www/;
-//   * in markdown, the target of a relative link `[text](images/x.svg)`, from the file's folder.
+//   * in markdown, the target of a relative link `[text](images/x.svg)`, from the file's folder,
+//     and a link's `#anchor` into a markdown file (the same one or another): one of its
+//     headings must have that anchor, as GitHub makes them.
 // A file whose text holds the words "check_paths: fixtures" (tests/paths.test.mjs, whose
 // strings are made-up repositories) is not read.
 // Paths under generated folders (target/, dist/, www/pkg/, node_modules/) and patterns (`*`,
 // `{…}`, `NAME`-style placeholders in capitals) are not checked.
 // Citations of docs/spec.md's sections: `docs/spec.md 5.3.2` needs a heading numbered 5.3.2
 // (or a range such as 4.1–4.2 holding it), `docs/spec.md "Loop seams"` a heading that begins
-// with those words. A bare `SPEC.md` (the old specification, not in the repository) is
-// reported: cite docs/spec.md.
+// with those words. A citation of the old upper-case specification file, which is not in
+// the repository, is reported: cite docs/spec.md.
 // It prints each missing path or section with the file and line that names it and exits
 // with 1.
 
@@ -159,7 +161,7 @@ export function specHeadings(text) {
   return { numbers, titles };
 }
 
-/** The docs/spec.md sections a line cites that have no heading, and its citations of SPEC.md. */
+/** The docs/spec.md sections a line cites that have no heading, and citations of the old file. */
 export function badCitations(line, headings) {
   const bad = [];
   for (const m of line.matchAll(CITE)) {
@@ -172,18 +174,38 @@ export function badCitations(line, headings) {
 }
 
 /** Relative link targets of a markdown line: [{path, candidates}] resolved from `dir`. */
-export function linksIn(line, dir) {
+export function linksIn(line, dir, file) {
   const found = [];
   for (const m of line.matchAll(LINK)) {
-    let t = m[1].replace(/^<|>$/g, "");
-    if (/^[a-z][a-z0-9+.-]*:/i.test(t) || t.startsWith("#") || t.startsWith("/")) continue;
-    t = decodeURIComponent(t.split("#")[0].split("?")[0]);
-    if (!t) continue;
-    const p = join(dir, t).replaceAll("\\", "/");
+    const raw = m[1].replace(/^<|>$/g, "");
+    if (/^[a-z][a-z0-9+.-]*:/i.test(raw) || raw.startsWith("/")) continue;
+    const [target, anchor] = raw.split("?")[0].split("#");
+    const t = decodeURIComponent(target);
+    const p = t ? join(dir, t).replaceAll("\\", "/") : file;
     if (p.startsWith("..")) continue; // outside the repository
-    found.push({ path: t, candidates: [p] });
+    found.push({ path: t || raw, candidates: [p], anchor: anchor ? decodeURIComponent(anchor) : "" });
   }
   return found;
+}
+
+/** The anchors of a markdown file's headings, as GitHub makes them ("4.5 Machine code" → "45-machine-code"). */
+export function anchors(text) {
+  const seen = new Map();
+  const out = new Set();
+  let fence = false;
+  for (const line of text.split("\n")) {
+    if (/^\s*```/.test(line)) fence = !fence;
+    const h = !fence && /^#{1,6}\s+(.*?)\s*#*\s*$/.exec(line);
+    if (!h) continue;
+    const base = h[1]
+      .toLowerCase()
+      .replace(/[^\p{L}\p{N}\s_-]/gu, "")
+      .replace(/\s/g, "-");
+    const n = seen.get(base) ?? 0;
+    seen.set(base, n + 1);
+    out.add(n ? `${base}-${n}` : base);
+  }
+  return out;
 }
 
 /** The missing paths of the repository at `root`: [{file, line, path}]. */
@@ -224,8 +246,16 @@ export function check(root) {
     lines.forEach((line, i) => {
       if (/^\s*```/.test(line)) fence = !fence;
       report(file, i, pathsIn(line, srcDirs));
-      if (!fence) report(file, i, linksIn(line, dirname(file)));
       cite(file, i, line);
+      if (fence) return;
+      const links = linksIn(line, dirname(file), file);
+      report(file, i, links);
+      for (const { path, candidates, anchor } of links) {
+        const target = candidates[0];
+        if (!anchor || !target.endsWith(".md") || !exists(target)) continue;
+        if (!anchors(readFileSync(join(root, target), "utf8")).has(anchor))
+          missing.push({ file, line: i + 1, path: `${path.split("#")[0]}#${anchor} (no such heading)` });
+      }
     });
   }
   for (const file of code) {

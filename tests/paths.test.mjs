@@ -37,10 +37,10 @@ const good = {
   "tests/a.rs": "// tests/fixtures/oracle/NAME.json, www/pkg/dropslice.d.ts (generated), dist/worker.js\n",
   "scripts/test.sh": "#!/bin/sh\n# runs scripts/test.sh and node tests/a.rs\necho src/in-code-not-a-comment.rs\n",
   "docs/spec.md":
-    "# Spec\n`model/mesh.rs`, `core/job.ts`, [the page](../README.md), ![a](images/a.svg), [b](#x), [c](https://e.org/y.md)\n" +
+    "# Spec\n`model/mesh.rs`, `core/job.ts`, [the page](../README.md), ![a](images/a.svg), [b](#spec), [c](https://e.org/y.md)\n" +
     "## 4.1–4.2 The machine\n### 5.3.1 Import\n## Loop seams (`loop_spacing`)\nSee docs/spec.md 4.1.\n",
   "docs/images/a.svg": "<svg/>",
-  "README.md": "See [docs/spec.md](docs/spec.md) and `src/model/mesh.rs:12`.\n",
+  "README.md": "# Readme\nSee [docs/spec.md](docs/spec.md#loop-seams-loop_spacing), [the tests](#readme) and `src/model/mesh.rs:12`.\n",
   "CHANGELOG.md": "- removed src/old.rs (history is not checked)\n",
 };
 
@@ -57,15 +57,19 @@ test("every missing path is named with its file and line, and the check fails", 
     "src/lib.rs": "fn a() {}\n// moved: src/budget.rs\n// SPEC.md 5.3.1, docs/spec.md 5.3.2, docs/spec.md \"Seams\"\n",
     "www/core/job.ts": "/**\n * The worker (www/worker.ts).\n */\n",
     "scripts/test.sh": "#!/bin/sh\n# runs tests/gone.test.mjs\n",
-    "docs/spec.md": "# Spec\n\n| stage | `model/prepare.rs` |\n[x](missing.md) ![y](images/b.svg)\n### 5.3.1 Import\n## 4.1–4.2 The machine\n## Loop seams\n",
-    "README.md": "See docs/nothing.md.\n",
+    "docs/spec.md":
+      "# Spec\n\n| stage | `model/prepare.rs` |\n[x](missing.md) ![y](images/b.svg)\n### 5.3.1 Import\n## 4.1–4.2 The machine\n## Loop seams\n" +
+      "[m](#4142-the-machine) [n](#nowhere) [o](../README.md#readme) [p](../README.md#gone)\n",
+    "README.md": "# Readme\nSee docs/nothing.md.\n",
   };
   withRepo(bad, (root) => {
     const r = spawnSync("node", [script, root], { encoding: "utf8" });
     assert.equal(r.status, 1, r.stdout + r.stderr);
     const lines = r.stderr.split("\n").filter((l) => l.startsWith("  ")).map((l) => l.trim());
     assert.deepEqual(lines.sort(), [
-      "README.md:1: docs/nothing.md",
+      "README.md:2: docs/nothing.md",
+      "docs/spec.md:8: #nowhere (no such heading)",
+      "docs/spec.md:8: ../README.md#gone (no such heading)",
       "docs/spec.md:3: model/prepare.rs",
       "docs/spec.md:4: images/b.svg",
       "docs/spec.md:4: missing.md",
@@ -75,7 +79,7 @@ test("every missing path is named with its file and line, and the check fails", 
       "src/lib.rs:3: docs/spec.md \"Seams\"",
       "src/lib.rs:3: docs/spec.md 5.3.2",
       "www/core/job.ts:2: www/worker.ts",
-    ]);
-    assert.match(r.stderr, /^10 path\(s\) or section\(s\) named in docs or comments do not exist/);
+    ].sort());
+    assert.match(r.stderr, /^12 path\(s\) or section\(s\) named in docs or comments do not exist/);
   });
 });
