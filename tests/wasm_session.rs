@@ -747,7 +747,7 @@ fn error_message(e: JsValue) -> String {
     String::from(e.unchecked_into::<js_sys::Error>().message())
 }
 
-/// The page's calibration of a slice (`calibrate`) against SPEC.md's formula computed here:
+/// The page's calibration of a slice (`calibrate`) against docs/spec.md's formula computed here:
 /// V = m / (N ρ) · 1000 mm³, filling V / (B² H), aspect √(V/H) / H; refusals are Errors.
 #[wasm_bindgen_test]
 fn calibrates_a_slice() {
