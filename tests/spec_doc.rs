@@ -1,6 +1,6 @@
 //! docs/spec.md "5.4.1 Parameters" against the settings' schema: every setting has exactly one
-//! row, under the heading of its group, with the schema's default, unit and range, and the
-//! tables name no setting the schema does not have.
+//! row, under the heading of its group, with the schema's default, unit and range, in the
+//! schema's order (the header's), and the tables name no setting the schema does not have.
 
 use dropslice::base::settings::{Kind, SettingSpec, schema};
 use std::collections::HashMap;
@@ -113,6 +113,14 @@ fn every_setting_is_in_docs_spec_with_the_schemas_default_unit_and_range() {
                 range(spec)
             ));
         }
+    }
+    // The header lists the settings in the schema's order, and the page says it follows it.
+    let order: Vec<&str> = rows.iter().map(|r| r.1.as_str()).collect();
+    let expected: Vec<&str> = schema.iter().map(|s| s.name).collect();
+    if wrong.is_empty() && order != expected {
+        wrong.push(format!(
+            "the rows are not in the schema's order:\n  docs:   {order:?}\n  schema: {expected:?}"
+        ));
     }
     for spec in &schema {
         match seen.get(spec.name) {
