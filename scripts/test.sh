@@ -15,6 +15,10 @@ bash scripts/check_tools.sh
 step "import cycles between top-level parts of src/ and www/ (deps.py)"
 python3 ../shared/checks/deps.py
 
+step "every path named in docs and comments exists"
+node scripts/check_paths.mjs
+node --test tests/paths.test.mjs
+
 step "cargo fmt --check"
 cargo fmt --check
 

@@ -1,6 +1,6 @@
 //! dropslice: a slicer for droplet-based plastic 3D printing.
 //!
-//! The pipeline (SPEC.md 5.3), one module per stage, each a plain function from one named
+//! The pipeline (docs/spec.md 5.3), one module per stage, each a plain function from one named
 //! type to the next:
 //!
 //! `&[u8]` —[`model::import`]→ triangles —[`model::mesh::Mesh::weld`],

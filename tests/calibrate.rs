@@ -1,4 +1,4 @@
-//! `dropslice calibrate` (SPEC.md "Calibrating the droplet size from a printed part"): a part
+//! `dropslice calibrate` (docs/spec.md "Calibrating the droplet size from a printed part"): a part
 //! of known droplet count and a mass chosen for a known droplet volume give back exactly that
 //! volume, its filling degree and the aspect whose B²H cell holds it; every refusal exits 2
 //! with a message that says what to check.

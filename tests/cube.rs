@@ -1,4 +1,4 @@
-//! The 20 mm calibration cube through the CLI, checked against SPEC.md's geometry with the
+//! The 20 mm calibration cube through the CLI, checked against docs/spec.md's geometry with the
 //! default settings: H = 0.2, B = 0.208, two loops at B/2 and 3B/2, fill boundary at 2B,
 //! hatch at 45°, 135°, 45°, … spaced B, `contour_order = inside_out`.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target

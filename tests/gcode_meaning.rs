@@ -1,4 +1,4 @@
-//! Meaning, not bytes: the CLI's G-code on shared models, parsed and checked against SPEC.md —
+//! Meaning, not bytes: the CLI's G-code on shared models, checked against docs/spec.md 4.5 —
 //! only G01/G25/G26 and comments, 4 decimals, Z = i·H, every setting in the header, header
 //! droplet totals equal to the commands' count, every droplet inside the part, loop droplets
 //! exactly B apart and closed, loops at (outer_offset + k)·B from the boundary — and that
@@ -42,7 +42,7 @@ fn slice(model: &str, sets: &[&str]) -> Gcode {
     g
 }
 
-/// Every check of SPEC.md's machine code on one model; geometry checks on every
+/// Every check of the machine code of docs/spec.md 4.5 on one model; geometry checks on every
 /// `stride`-th layer.
 fn check_model(model: &str, stride: usize) {
     let sets: &[&str] = &[];
@@ -136,7 +136,8 @@ fn recount(g: &Gcode) -> (u64, u64) {
 }
 
 /// Every loop droplet lies (outer_offset + k)·B from the section's boundary, k < contours
-/// (SPEC.md: loop k runs at d_k = (f + k)·B), on every `stride`-th layer.
+/// (docs/spec.md "Geometry derived from them": loop k runs at d_k = (f + k)·B), on every
+/// `stride`-th layer.
 fn check_rings(model: &str, stride: usize) {
     let s = Settings::default();
     let g = slice(model, &[]);
@@ -179,7 +180,7 @@ fn check_header(model: &str, g: &Gcode, used: &Settings) {
     let unit1_used = used.support != dropslice::base::settings::Support::Off;
     for name in dropslice::base::settings::names() {
         if !unit1_used && dropslice::base::settings::is_unit1_setting(name) {
-            // SPEC.md: unit 1's settings are listed only when unit 1 is used.
+            // docs/spec.md "The header": unit 1's settings are listed only when unit 1 is used.
             assert!(
                 g.get(name).is_none(),
                 "{model}: unit-1 setting '{name}' listed though unit 1 is unused"

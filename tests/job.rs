@@ -442,7 +442,7 @@ fn unit_1_parts_are_printed_and_files_must_be_known() {
 // ---------------------------------------------------------------------------------------------
 // The instances' geometry against the oracle, with the transform computed here
 
-/// Rotation about x, then y, then z (degrees), scale, as SPEC.md says — written here.
+/// Rotation about x, then y, then z (degrees), scale, as docs/spec.md 5.3.1 says — written here.
 fn transform_point(p: [f64; 3], rot: [f64; 3], scale: [f64; 3]) -> [f64; 3] {
     let [mut x, mut y, mut z] = p;
     let (s, c) = rot[0].to_radians().sin_cos();

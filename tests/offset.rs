@@ -1,4 +1,4 @@
-//! The offset stage (SPEC.md 5.3.3) against exact cases and, on every layer of the shared
+//! The offset stage (docs/spec.md 5.3.3) against exact cases and, on every layer of the shared
 //! models, against an independent engine: i_overlay's own outline offset (round joins, its
 //! integer core), which resolves overlaps by a different construction.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target

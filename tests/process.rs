@@ -1,4 +1,4 @@
-//! The process engineer's tools (SPEC.md "Turn to the process engineer"; docs/process.md):
+//! The process engineer's tools (docs/spec.md "Shrinkage compensation"…; docs/process.md):
 //! shrinkage compensation against the oracle, the chamber height, orientation against a real
 //! slice, the predicted density of the report, profiles.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target

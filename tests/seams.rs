@@ -1,8 +1,8 @@
-//! `loop_spacing` (SPEC.md "Loop seams") measured on the CLI's G-code, not on the planner's
+//! `loop_spacing` (docs/spec.md "Loop seams") measured on the CLI's G-code, not on the planner's
 //! data: with `even` every loop of at least 3 droplets closes with gaps between
 //! B·(1 − 1/n) and B (less a bound for the corners it cuts: see `seams::corner_allowance`),
 //! none closer than 2/3 B, its seam gap equal to the others and no droplet repeated; with
-//! `exact` (the default) a share of seams is closer than B/4, as SPEC.md measured. Fill is the
+//! `exact` (the default) a share of seams is closer than B/4, as docs/spec.md says. Fill is the
 //! same in both, and so are the part's coverage and void fraction (within a small tolerance)
 //! and the section areas against the oracle. Loops are found as tests/common/seams.rs says.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
@@ -255,8 +255,8 @@ fn even_spacing_on_shared_models() {
         }
         assert!(f.loops > 0);
         if model != "overhang.obj" {
-            // SPEC.md: 20–50 % of real parts' seams are closer than B/4 with exact (the cube's
-            // 200 loops: 18 %).
+            // docs/spec.md "Loop seams": a fifth to a half of real parts' seams are closer than
+            // B/4 with exact (the cube's 200 loops: 18 %).
             let share = e.close_share();
             assert!(
                 (0.1..=0.5).contains(&share),

@@ -1,4 +1,4 @@
-//! Overhangs and support (SPEC.md "Two discharge units", docs/support.md), checked on the
+//! Overhangs and support (docs/spec.md "Overhangs and support", docs/support.md), checked on the
 //! G-code the CLI writes, with an independent reading of it (tests/common's parser) and an
 //! independent section of the mesh (triangles cut by the plane, no loops chained):
 //!
@@ -232,7 +232,8 @@ fn report_areas(name: &str) -> (Vec<f64>, f64) {
 
 #[test]
 fn the_report_gives_the_same_unsupported_area_with_support_on_and_off() {
-    // SPEC.md: the unsupported area is reported whether or not support is on; a layer
+    // docs/spec.md "Overhangs and support": the unsupported area is reported whether or
+    // not support is on; a layer
     // without overhang reports 0 either way (not −0).
     for name in ["U_overhang.obj", "bridge.obj"] {
         let (off, off_total) = report_areas(name);
@@ -269,7 +270,7 @@ fn unsupported_area_in_the_report() {
 }
 
 /// The page's overhang overlay ([`dropslice::support::unsupported_droplets`] on the preview's
-/// droplets, as `src/wasm.rs` passes them) marks, layer by layer, as many droplets as this
+/// droplets, as `src/wasm/mod.rs` passes them) marks, layer by layer, as many droplets as this
 /// file's independent reading of the CLI's G-code finds: with support off (unit 0 only) and on
 /// (droplets of both widths below).
 #[test]

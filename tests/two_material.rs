@@ -1,4 +1,4 @@
-//! Two-material jobs (SPEC.md "Two discharge units": parts of unit 1), checked on the G-code
+//! Two-material jobs (docs/spec.md "Two discharge units": parts of unit 1), checked on the G-code
 //! the CLI writes, read here (tests/common's parser), against the independent oracle
 //! (`../shared/tools/oracle_sections.py`) and the test's own cut of the parts it placed:
 //!

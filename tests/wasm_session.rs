@@ -1,4 +1,4 @@
-//! The wasm facade (src/wasm.rs) in Node: `wasm-bindgen-test-runner` runs these when
+//! The wasm facade (src/wasm/) in Node: `wasm-bindgen-test-runner` runs these when
 //! `cargo test --target wasm32-unknown-unknown --test wasm_session` is given it as the runner.
 #![cfg(target_arch = "wasm32")]
 
@@ -747,7 +747,7 @@ fn error_message(e: JsValue) -> String {
     String::from(e.unchecked_into::<js_sys::Error>().message())
 }
 
-/// The page's calibration of a slice (`calibrate`) against SPEC.md's formula computed here:
+/// The page's calibration of a slice (`calibrate`) against docs/spec.md's formula computed here:
 /// V = m / (N ρ) · 1000 mm³, filling V / (B² H), aspect √(V/H) / H; refusals are Errors.
 #[wasm_bindgen_test]
 fn calibrates_a_slice() {

@@ -1,5 +1,5 @@
 //! Import, stage 1b: triangle soup → [`Mesh`] (welded vertex list + facet list), its
-//! transforms (SPEC.md: rotate, scale, bounding box minimum to the origin, placement) and its
+//! transforms (docs/spec.md 5.3.1: rotate, scale, box minimum to the origin, placement) and its
 //! diagnostics (open and non-manifold edges). Its shells and their orientation: [`crate::model::shells`].
 
 use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
@@ -138,7 +138,7 @@ impl Mesh {
         bounds_of(&self.vertices)
     }
 
-    /// Applies SPEC.md's transforms: rotate about x, y, z (in that order), scale, move the
+    /// Applies docs/spec.md 5.3.1's transforms: rotate about x, y, z (in order), scale, move the
     /// bounding box minimum to the origin, then rotate by `place_angle` about the z axis
     /// through the origin and move by (`place_x`, `place_y`).
     pub fn transform(&mut self, s: &Settings) {
@@ -584,8 +584,8 @@ pub fn edge_key(a: u32, b: u32) -> u64 {
     ((lo as u64) << 32) | hi as u64
 }
 
-/// A part's transform (SPEC.md): rotate about x, y, z (degrees, in that order), scale, bounding
-/// box minimum to the origin, rotate by `place_angle` (degrees) about z, move by `place`.
+/// A part's transform (docs/spec.md 5.3.1): rotate about x, y, z (degrees, in order), scale,
+/// bounding box minimum to the origin, rotate by `place_angle` (degrees) about z, move by `place`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
     pub rotate: [f64; 3],

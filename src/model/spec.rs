@@ -1,4 +1,4 @@
-//! The job file (SPEC.md "Build jobs: several parts"): [`JobSpec`] (the settings of the
+//! The job file (docs/spec.md "Build jobs"): [`JobSpec`] (the settings of the
 //! layers and the parts) and [`PartSpec`] (a file or one 3MF build item, its transform, copies,
 //! unit), their validation with messages naming the part and the key, and the names as
 //! messages and the header show them ([`clean_name`]).

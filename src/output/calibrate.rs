@@ -1,5 +1,5 @@
-//! Calibrating the droplet size from a printed part (SPEC.md "Calibrating the droplet size
-//! from a printed part").
+//! Calibrating the droplet size from a printed part (docs/spec.md "Calibrating the droplet
+//! size from a printed part").
 //!
 //! A part's measured mass m (g), its droplet count N and the material density ρ (g/cm³) give
 //! the effective droplet volume V = m / (N ρ) · 1000 mm³/cm³. The code's lattice gives each

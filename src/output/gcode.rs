@@ -1,4 +1,4 @@
-//! Write code, stage 6 (SPEC.md 4.5, 5.3.6): the header and each [`LayerPlan`] as `.gco` text.
+//! Write code, stage 6 (docs/spec.md 4.5, 5.3.6): the header and each [`LayerPlan`] as `.gco` text.
 //! Coordinates have exactly 4 decimals; `G01` travel, `G25` a line of droplets, `G26` one
 //! droplet. The header lists every setting, the input file, the version and a summary; it is
 //! written before any layer, with fixed-width placeholders for the droplet counts and the
@@ -294,7 +294,7 @@ pub fn layer_text(plan: &LayerPlan) -> String {
 
 /// One layer's commands after a layer that left unit `before` selected: a `T` line (right
 /// after the layer's comment line) wherever the unit of the next move differs from the one
-/// selected, and nowhere else (SPEC.md "Two discharge units").
+/// selected, and nowhere else (docs/spec.md "Two discharge units").
 pub fn layer_text_after(plan: &LayerPlan, before: u8) -> String {
     let mut t = String::with_capacity(plan.moves.len() * 34 + 40);
     let z = coord(plan.z);

@@ -51,7 +51,7 @@ impl Job {
         Job::build(mesh, input, settings)
     }
 
-    /// A build job (SPEC.md "Build jobs"): reads each file of `files` (name, bytes) once and
+    /// A build job (docs/spec.md "Build jobs"): reads each file of `files` (name, bytes) once and
     /// builds the job of `spec` from them (see [`Job::from_models`]).
     pub fn from_parts(files: &[(&str, &[u8])], spec: &job::JobSpec) -> Result<Job, Error> {
         let models = files
@@ -71,8 +71,8 @@ impl Job {
         let by_part = models_of(models, spec)?;
         // Before any part is welded: a small 3MF may instance millions of triangles per part.
         check_job_triangles(models, spec)?;
-        // Runs of consecutive parts of one unit (SPEC.md: where parts of different units
-        // overlap, the part listed first keeps the overlap).
+        // Runs of consecutive parts of one unit (docs/spec.md "Two discharge units": where
+        // parts of different units overlap, the part listed first keeps the overlap).
         let mut run_of = Vec::with_capacity(spec.parts.len());
         for (i, p) in spec.parts.iter().enumerate() {
             let run = match i.checked_sub(1) {

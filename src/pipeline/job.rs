@@ -193,7 +193,7 @@ impl Job {
         }
     }
 
-    /// The regions units 0 and 1 print in layer `i` (SPEC.md "Two discharge units"): each
+    /// The regions units 0 and 1 print in layer `i` (docs/spec.md "Two discharge units"): each
     /// run of consecutive parts of one unit ([`JobInfo::groups`]) is sliced on its own, and
     /// keeps its section less the sections of the runs listed before it (where parts of
     /// different units overlap, the part listed first keeps the overlap). A job without

@@ -1,4 +1,4 @@
-//! Contours, stage 3b (SPEC.md "Geometry derived from them"): a layer's region → its contour
+//! Contours, stage 3b (docs/spec.md "Geometry derived from them"): a layer's region → its contour
 //! loops and its fill region.
 //!
 //! Loop k (k = 0 … contours−1) runs at d_k = (f + k)·B from the boundary, f = `outer_offset`

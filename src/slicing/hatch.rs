@@ -1,4 +1,4 @@
-//! Fill, stage 4 (SPEC.md 5.3.4): a fill region → hatch segments at the layer's angle, spaced
+//! Fill, stage 4 (docs/spec.md 5.3.4): fill region → hatch segments at the layer's angle, spaced
 //! B / fill_density, clipped to the region (non-zero rule), then ordered greedily: after each
 //! segment, go to the nearest end of an unprinted segment, reversing it if that end is its end.
 //!

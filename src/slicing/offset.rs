@@ -1,9 +1,9 @@
-//! Offset, stage 3 (SPEC.md 5.3.3): a region → the region moved into the material by a
+//! Offset, stage 3 (docs/spec.md 5.3.3): a region → the region moved into the material by a
 //! distance, with circular arcs at convex corners and every self-overlap removed, so parts of
 //! the region thinner than twice the offset vanish instead of crossing themselves.
 //!
 //! Every edge is moved by the distance, joined by arcs at the corners where the moved edges
-//! part (reflex corners of the region: the convex corners of the offset curve, in SPEC.md's
+//! part (reflex corners of the region: the convex corners of the offset curve, in the thesis'
 //! words) and by their crossing where they meet; the self-overlaps are resolved by the winding
 //! number (the thesis's step), i_overlay's positive fill rule. Arcs are approximated by chords
 //! no farther than [`CHORD_TOLERANCE_MM`] from the true arc. `tests/offset.rs` compares the

@@ -1,5 +1,5 @@
 //! Plan, stage 5b: a layer's region → its [`LayerPlan`], every move in print order
-//! (SPEC.md `contour_order`, `print_order`).
+//! (`contour_order`, `print_order`: docs/spec.md "Order within a layer").
 
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
 use crate::base::nearest::nearest_walk;
@@ -39,7 +39,7 @@ pub struct Move {
     pub kind: MoveKind,
     pub role: Role,
     pub to: Point,
-    /// The discharge unit that prints it (0 or 1; SPEC.md "Two discharge units"). A travel
+    /// The discharge unit that prints it (0 or 1; docs/spec.md "Two discharge units"). A travel
     /// belongs to the unit whose droplets follow it.
     pub unit: u8,
 }
@@ -323,7 +323,7 @@ pub fn support_settings(s: &Settings) -> Settings {
     }
 }
 
-/// The settings unit 1 prints its parts with (SPEC.md "Two discharge units"): the same
+/// The settings unit 1 prints its parts with (docs/spec.md "Two discharge units"): the same
 /// contour and fill rules as unit 0, with unit 1's droplet width B₁ (`unit1_droplet_aspect`).
 pub fn unit1_part_settings(s: &Settings) -> Settings {
     Settings {

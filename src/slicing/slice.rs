@@ -1,4 +1,4 @@
-//! Slice, stage 2 (SPEC.md 5.3.2): a [`Mesh`] and a plane height → the layer's [`Section`]:
+//! Slice, stage 2 (docs/spec.md 5.3.2): a [`Mesh`] and a plane height → the layer's [`Section`]:
 //! its material region as shapes (outer boundary counter-clockwise, holes clockwise).
 //!
 //! Rules:
@@ -27,7 +27,7 @@ use crate::model::mesh::{Mesh, edge_key};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::float::simplify::SimplifyShape;
 
-/// Points closer than this to their predecessor on a loop are dropped (SPEC.md 5.3.2).
+/// Points closer than this to their predecessor on a loop are dropped (docs/spec.md 5.3.2).
 pub const MIN_POINT_DISTANCE_MM: f64 = 0.001;
 
 /// Plane heights are rounded to 1/this mm so they do not drift (0.1 + 42·0.2 = 8.5 exactly).
@@ -477,7 +477,7 @@ fn join_open(mut open: Vec<(usize, Vec<Point>)>, section: &mut Section) -> Vec<C
 /// simplifies the loop (Douglas–Peucker): no removed point lies farther than
 /// [`SIMPLIFY_TOLERANCE_MM`] from the result. Dense meshes give thousands of nearly collinear
 /// points per section; this keeps the offsets fast while moving the outline by at most a
-/// micrometre (the straight-segment merge of SPEC.md 5.3.2, by distance instead of angle).
+/// micrometre (the straight-segment merge of docs/spec.md 5.3.2, by distance, not angle).
 fn clean_loop(points: Vec<Point>) -> Contour {
     let mut out: Contour = Vec::with_capacity(points.len());
     for p in points {

@@ -1,4 +1,4 @@
-//! The support's top-down need on unit 1's hatch lattices (SPEC.md "Two discharge units";
+//! The support's top-down need on unit 1's hatch lattices (docs/spec.md "Overhangs and support";
 //! docs/support.md *Support regions*).
 //!
 //! Unit 1 prints a support region as hatch lines (j + ½)·spacing across the layer's hatch

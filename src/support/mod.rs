@@ -1,4 +1,4 @@
-//! Overhangs and support (SPEC.md "Two discharge units"; docs/support.md): layer regions →
+//! Overhangs and support (docs/spec.md "Overhangs and support"; docs/support.md): layer regions →
 //! each layer's overhang (area for the figures) and the support region unit 1 prints.
 //!
 //! **The rule.** A droplet is *supported* when the layer below has material within

@@ -1,4 +1,4 @@
-//! Unit 1's moves for a support region (SPEC.md "Two discharge units"): the region's hatch
+//! Unit 1's moves for a support region (docs/spec.md "Overhangs and support"): the region's hatch
 //! segments on unit 1's lattice, split where the part is within `support_gap_xy`·B, then the
 //! single droplets of the droplet-level pass, nearest first.
 
@@ -8,8 +8,8 @@ use crate::base::settings::Settings;
 use crate::slicing::hatch::{HatchLine, order_greedy};
 use crate::slicing::plan::{Move, MoveKind, Role, hatch_angle, support_settings};
 
-/// Unit 1's moves for a support region (SPEC.md: "printed by unit 1 as hatch fill at
-/// `support_density`"), from `start`: the region's hatch segments `lines` (lines
+/// Unit 1's moves for a support region (docs/spec.md "Overhangs and support": hatch only, lines
+/// B₁ / `support_density` apart), from `start`: the region's hatch segments `lines` (lines
 /// B₁ / `support_density` apart at the layer's hatch angle, every line's droplets on a
 /// lattice of pitch B₁ along it, [`crate::support::support_layers`]), without the droplets
 /// closer than `support_gap_xy`·B to the part's region `part` (a line is split there); then

@@ -1,4 +1,4 @@
-//! Orientation (SPEC.md "Orientation"): the rotation of a part that needs the least support
+//! Orientation (docs/spec.md "Orientation"): the rotation of a part that needs the least support
 //! by the overhang rule, judged from its facets, not from a slice.
 //!
 //! A candidate is a direction of the model that is turned down (−z): each of the mesh's

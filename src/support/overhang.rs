@@ -1,4 +1,4 @@
-//! The overhang figure with support off (SPEC.md "Two discharge units"): each layer's
+//! The overhang figure with support off (docs/spec.md "Overhangs and support"): each layer's
 //! overhang *area* in one pass of the boolean engine.
 //!
 //! [`crate::support::overhang`] builds the region F farther than d = `overhang_limit`·B from

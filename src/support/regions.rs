@@ -1,4 +1,4 @@
-//! The support regions unit 1 prints (SPEC.md "Two discharge units"; the rule and the
+//! The support regions unit 1 prints (docs/spec.md "Overhangs and support"; the rule and the
 //! construction are described in [`crate::support`]): every layer's overhang grown by the
 //! support's reach and carried down, on unit 1's lattices or as outlines.
 

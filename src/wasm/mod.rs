@@ -1,4 +1,4 @@
-//! The thin WebAssembly facade used by the page's web workers (`www/worker.ts`).
+//! The thin WebAssembly facade used by the page's web workers (`www/worker/worker.ts`).
 //!
 //! One [`Session`] per worker owns one prepared [`Job`]; the worker asks it for layers by index
 //! and gets flat typed arrays (droplet centres, roles, travel moves) and the layer's G-code text,

@@ -123,7 +123,7 @@ impl Models {
         to_js(&Angles { rotate_x, rotate_y }, "the angles")
     }
 
-    /// The orientations of `job.parts[part]` (SPEC.md "Orientation"; its rotation, scale and
+    /// The orientations of `job.parts[part]` (docs/spec.md "Orientation"; its rotation, scale and
     /// unit's shrinkage as sliced, the rule of `job.settings`): `{current, candidates}`, each
     /// `{rotate_x, rotate_y, rotate_z, unsupported_area (mm²), height (mm)}`, the candidates
     /// best first. Throws `{kind: "job" | "setting", message}`.

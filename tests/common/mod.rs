@@ -1,5 +1,5 @@
 //! Shared helpers for the integration tests: locating the shared models, running the CLI with
-//! a timeout in a temporary directory, a small G-code parser (SPEC.md "Machine code"), and
+//! a timeout in a temporary directory, a small G-code parser (docs/spec.md 4.5), and
 //! geometry on a layer's section (non-zero winding point-in-region, distance to the boundary).
 #![allow(dead_code)]
 
@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 pub type Point = [f64; 2];
 
-/// Default layer height H and droplet width B = 1.04·H (SPEC.md defaults).
+/// Default layer height H and droplet width B = 1.04·H (the defaults of docs/spec.md 5.4.1).
 pub const H: f64 = 0.2;
 pub const B: f64 = 0.2 * 1.04;
 
@@ -328,7 +328,7 @@ pub struct Gcode {
     /// a trailing ` (unit)`.
     pub header: Vec<(String, String)>,
     pub layers: Vec<Layer>,
-    /// Lines that break SPEC.md's format (not a comment, not `G01/G25/G26 Xx Yy Zz` with
+    /// Lines that break docs/spec.md 4.5's format (not a comment, not `G01/G25/G26 Xx Yy Zz` with
     /// exactly 4 decimals, nor `T0`/`T1`), with their line numbers.
     pub bad_lines: Vec<String>,
     /// `T0`/`T1` lines: (line number from 1, unit).
@@ -430,7 +430,8 @@ pub fn parse_gcode(text: &str) -> Gcode {
     g
 }
 
-/// `T` lines (SPEC.md "Machine code") stand only where the unit changes, starting from T0, and
+/// `T` lines (docs/spec.md "Two discharge units") stand only where the unit changes, from T0,
+/// and
 /// each is followed by a command (comments aside). `what` prefixes failure messages.
 pub fn assert_unit_changes(text: &str, what: &str) {
     let lines: Vec<&str> = text.lines().collect();
@@ -459,7 +460,7 @@ pub fn layer_index(z: f64, h: f64) -> usize {
     i as usize
 }
 
-/// Droplets of one `G25` line of length `l` (SPEC.md: one at the start, then one every B).
+/// Droplets of one `G25` line of length `l` (docs/spec.md 4.5: one at the start, then one every B).
 pub fn line_droplets(l: f64, b: f64) -> u64 {
     (l / b + 1e-9).floor() as u64 + 1
 }

@@ -1,4 +1,4 @@
-//! Loop seams measured on written G-code (SPEC.md "Loop seams"), shared by tests/seams.rs and
+//! Loop seams measured on written G-code (docs/spec.md "Loop seams"), shared by tests/seams.rs and
 //! examples/seams.rs.
 //!
 //! The droplets are the `G26` lines of each layer, in file order, as written (4 decimals). The

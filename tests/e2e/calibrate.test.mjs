@@ -1,5 +1,5 @@
 // The droplet calibration panel (views/calibrate.ts) in headless Chromium: a slice's and an
-// opened .gco's droplet count with a mass typed here give the suggestion of SPEC.md's formula,
+// opened .gco's droplet count with a mass typed here give the suggestion of docs/spec.md's formula,
 // computed in this test (V = m / (N ρ) · 1000 mm³, filling V / (B² H), aspect √(V/H) / H);
 // "Use" puts it into the form; impossible and malformed inputs give messages, never a crash.
 // Needs dist/ (scripts/build.sh) and target/release/dropslice.
@@ -20,7 +20,7 @@ before(async () => ({ env, main } = await startWithPage()));
 
 after(() => stop(env, tmp));
 
-/** SPEC.md's figures for N droplets of a code with layer height h and aspect a, mass m (g)
+/** docs/spec.md's figures for N droplets of a code with layer height h and aspect a, mass m (g)
  *  and density rho (g/cm³). */
 function expected(n, h, a, m, rho) {
   const v = (m / (n * rho)) * 1000;

@@ -1,4 +1,4 @@
-// The build job as the page holds it (SPEC.md "Build jobs", docs/jobs.md): its files (each a
+// The build job as the page holds it (docs/spec.md "Build jobs", docs/jobs.md): its files (each a
 // File the job worker's `Models` holds under a unique name), its ordered parts (a file, or one
 // 3MF item, with its own transform, place and copies) and the core's latest `Layout`. The page
 // computes no placement of its own: every matrix and box comes from the core's layout. No DOM.

@@ -1,4 +1,4 @@
-// Profiles (SPEC.md "Profiles"): named sets of settings of one kind, `{name, kind: "machine" |
+// Profiles (docs/spec.md "Profiles"): named sets of settings of one kind, `{name, kind: "machine" |
 // "material", settings}`, kept in the browser under one local-storage key. What is read back is
 // checked entry by entry (a corrupt entry is dropped, the others kept); a file the user imports
 // is checked by the core (`check_profile`, flows/profiles.ts) before it is added here.
@@ -80,7 +80,7 @@ export function profileOf(name: string, kind: ProfileKind, values: Record<string
   return { name: name.trim(), kind, settings };
 }
 
-/** The file a profile is exported as (SPEC.md's JSON). */
+/** The file a profile is exported as (the JSON of docs/spec.md "Profiles"). */
 export function profileFileText(p: StoredProfile): string {
   return JSON.stringify({ name: p.name, kind: p.kind, settings: p.settings }, null, 2) + "\n";
 }

@@ -59,7 +59,7 @@ export interface LayerData {
   travel: Float32Array;
   /** Share of the input read so far, 0..1 (.gco files only). */
   fraction?: number;
-  /** The void analysis (src/analysis.rs), when the request asked for it. */
+  /** The void analysis (src/analysis/), when the request asked for it. */
   analysis?: LayerAnalysis;
   /** Coverage mask of the analysis (cells of B/4). */
   mask?: CoverageMask;

@@ -1,4 +1,4 @@
-// The droplet calibration panel (SPEC.md "Calibrating the droplet size from a printed part"):
+// The droplet calibration panel (docs/spec.md "Calibrating the droplet size from a printed part"):
 // the measured mass of a printed part and the material's density, with the droplet count of
 // the slice shown (its droplet total, H and droplet_aspect as sliced) or of the opened .gco
 // file (its header's total, else its commands'; its header's H and aspect), give the core's

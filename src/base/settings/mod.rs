@@ -1,4 +1,4 @@
-//! Settings: the one source of truth for every parameter (SPEC.md, "Parameters").
+//! Settings: the one source of truth for every parameter (docs/spec.md 5.4.1).
 //!
 //! The same names are used by the CLI (`--set name=value`), the page's form, the preview link
 //! and the G-code header. [`schema()`] exports units, ranges and descriptions so the page can
@@ -55,7 +55,7 @@ pub enum Footprint {
     Spread,
 }
 
-/// How droplets are spaced along a contour loop (SPEC.md "Loop seams").
+/// How droplets are spaced along a contour loop (docs/spec.md "Loop seams").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum LoopSpacing {
@@ -65,7 +65,7 @@ pub enum LoopSpacing {
     Even,
 }
 
-/// Whether support is printed under overhangs (SPEC.md "Two discharge units").
+/// Whether support is printed under overhangs (docs/spec.md "Overhangs and support").
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Support {
@@ -82,7 +82,7 @@ pub enum UnitOrder {
     Unit1First,
 }
 
-/// Every parameter of a slice. `Default` gives the values of SPEC.md.
+/// Every parameter of a slice. `Default` gives the defaults of docs/spec.md 5.4.1.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
@@ -121,7 +121,7 @@ pub struct Settings {
     /// Density of the material (for the mass estimate).
     pub material_density: f64,
     /// Linear shrinkage of unit 0's material in x and y (%): its parts are sliced scaled by
-    /// 1 / (1 − s/100) (SPEC.md "Shrinkage compensation").
+    /// 1 / (1 − s/100) (docs/spec.md "Shrinkage compensation").
     pub shrink_xy: f64,
     /// Linear shrinkage of unit 0's material in z (%).
     pub shrink_z: f64,
@@ -419,7 +419,7 @@ impl Settings {
 
 /// Settings that only discharge unit 1 uses (listed in the header when unit 1 is used).
 pub fn is_unit1_setting(name: &str) -> bool {
-    // The four shrinkage values are always listed (SPEC.md "Shrinkage compensation").
+    // The four shrinkage values are always listed (docs/spec.md "Shrinkage compensation").
     (name.starts_with("unit1_") && !name.starts_with("unit1_shrink_"))
         || name == "unit_order"
         || matches!(name, "support_gap_xy" | "support_gap_z" | "support_density")

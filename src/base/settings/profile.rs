@@ -1,4 +1,4 @@
-//! Profiles (SPEC.md "Profiles"): a named set of settings of one kind, stored as JSON
+//! Profiles (docs/spec.md "Profiles"): a named set of settings of one kind, stored as JSON
 //! `{"name": …, "kind": "machine" | "material", "settings": {…}}`.
 //!
 //! A machine profile holds the plate and the units' rates and speeds ([`MACHINE_KEYS`]); a

@@ -1,6 +1,6 @@
 //! The command-line tool (`dropslice --help`):
 //! - `dropslice [slice] MODEL... [OPTIONS]`: the code of a model, or of several (a build job);
-//! - `dropslice [slice] JOB.json [OPTIONS]`: the code of a job file (SPEC.md "Build jobs");
+//! - `dropslice [slice] JOB.json [OPTIONS]`: the code of a job file (docs/spec.md "Build jobs");
 //! - `dropslice calibrate PART.gco --mass GRAMS [--density G_CM3]`: the droplet size from a
 //!   printed part;
 //! - `dropslice orient MODEL_OR_JOB [--apply]`: the rotation of each part that needs the least

@@ -3,7 +3,7 @@
 //! * **STL** ([`crate::model::import::stl::parse`]): one part, the whole file.
 //! * **OBJ** ([`obj`]): one part, the whole file. `o`/`g` groups are *not* split into parts:
 //!   exporters use groups for materials and smoothing groups of one body, and parts are
-//!   arranged on the plate independently (SPEC.md "Build jobs"), which would tear such a body
+//!   arranged on the plate independently (docs/spec.md "Build jobs"), which would tear such a body
 //!   apart. Polygon faces are split into triangles (a fan per face).
 //! * **3MF** ([`threemf`]): one part per build item (an object referenced by several items
 //!   gives several parts), with the item's transform, its components' transforms and the

@@ -1,4 +1,4 @@
-//! Droplets on contours, stage 5 (SPEC.md 5.3.5, "Loop seams"): a closed loop → droplet
+//! Droplets on contours, stage 5 (docs/spec.md 5.3.5, "Loop seams"): a closed loop → droplet
 //! centres.
 //!
 //! **`exact`** (the thesis): centres exactly B apart (straight-line distance): the next centre

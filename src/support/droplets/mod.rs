@@ -1,4 +1,4 @@
-//! The support's droplet-level pass (SPEC.md "Two discharge units"; docs/support.md): after
+//! The support's droplet-level pass (docs/spec.md "Overhangs and support"; docs/support.md): after
 //! every layer is planned with its support region, find the droplets the layer below does not
 //! support by the overhang rule and add single unit-1 droplets under them, top-down, so that
 //! the rule holds for every droplet of the code (the added droplets need support too).

@@ -1,4 +1,4 @@
-//! 3MF packages → parts (SPEC.md "Build jobs: several parts"), with `zip` (deflate through
+//! 3MF packages → parts (docs/spec.md "Build jobs"), with `zip` (deflate through
 //! miniz_oxide) and `quick-xml`, streaming: a model part is parsed while it is inflated,
 //! never held whole in memory.
 //!
