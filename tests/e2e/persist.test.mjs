@@ -161,16 +161,16 @@ test("a kept job that no longer fits the plate comes back as it was left, with t
   await waitDone(page, 60_000);
   await pick(page, [box("a.stl", 60, 60, 5), box("b.stl", 60, 60, 5)]);
   await waitDone(page);
-  // a plate too narrow for both: the job stays as it was, the banner says so
+  // a plate narrower than the parts: the job stays as it was, the banner says so
   await page.locator("#set-plate_x").evaluate((e) => (e.closest("details").open = true));
-  await page.fill("#set-plate_x", "70");
+  await page.fill("#set-plate_x", "50");
   await page.waitForFunction(() => /fit/.test(document.getElementById("banner").innerText));
   await page.waitForTimeout(500);
   await kept(page);
   await page.reload();
   const s = await waitSettled(page, 60_000);
   assert.equal(s.state, "error", "not sliced: the parts do not fit");
-  assert.equal(await page.inputValue("#set-plate_x"), "70");
+  assert.equal(await page.inputValue("#set-plate_x"), "50");
   const j = await job(page);
   assert.deepEqual(j.parts.map((p) => p.file), ["a.stl", "b.stl"], "the job as it was left");
   assert.equal(j.layout, null);
