@@ -7,7 +7,7 @@
 // profile is refused. As a user, through the DOM.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { boxStl, cube, openPage, pick, shareLink, start, stop, torusStl, waitDone } from "./helpers.mjs";
+import { boxStl, cube, openPage, pick, shareLink, start, stop, torusStl, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 before(async () => (env = await start()));
@@ -152,6 +152,30 @@ test("a crash loses nothing: the page that crashed after an edit comes back with
   assert.equal(j.name, "cube_20mm_ascii.stl");
   assert.equal(j.parts[0].rotate_z, 15);
   assert.match(await again.locator("#persist-note").innerText(), /Your job from last time was restored/);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test("a kept job that no longer fits the plate comes back as it was left, with the banner", async () => {
+  const { page, errors, context } = await openPage(env.browser, env.url);
+  await waitDone(page, 60_000);
+  await pick(page, [box("a.stl", 60, 60, 5), box("b.stl", 60, 60, 5)]);
+  await waitDone(page);
+  // a plate narrower than the parts: the job stays as it was, the banner says so
+  await page.locator("#set-plate_x").evaluate((e) => (e.closest("details").open = true));
+  await page.fill("#set-plate_x", "50");
+  await page.waitForFunction(() => /fit/.test(document.getElementById("banner").innerText));
+  await page.waitForTimeout(500);
+  await kept(page);
+  await page.reload();
+  const s = await waitSettled(page, 60_000);
+  assert.equal(s.state, "error", "not sliced: the parts do not fit");
+  assert.equal(await page.inputValue("#set-plate_x"), "50");
+  const j = await job(page);
+  assert.deepEqual(j.parts.map((p) => p.file), ["a.stl", "b.stl"], "the job as it was left");
+  assert.equal(j.layout, null);
+  assert.match(await page.locator("#banner").innerText(), /fit/);
+  assert.match(await page.locator("#persist-note").innerText(), /Your job from last time was restored/);
   assert.deepEqual(errors, []);
   await context.close();
 });

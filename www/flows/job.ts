@@ -37,8 +37,9 @@ async function importFiles(page: Page, job: Job, files: NewFile[]): Promise<JobM
  *  `specs` (a job file or a link; their `file` names the files). Laid out by the core. When a
  *  file cannot be read, or a job file's parts are refused, the banner says why and the page
  *  keeps its current job (null). Files that do not fit the plate together still make the job
- *  (without a layout, the banner says what does not fit) so that its parts can be changed. */
-export async function newJob(page: Page, files: NewFile[], specs?: PartSpec[]): Promise<Job | null> {
+ *  (without a layout, the banner says what does not fit) so that its parts can be changed;
+ *  so do the parts `specs` with `keepUnfit` (the job kept from last time, flows/persist.ts). */
+export async function newJob(page: Page, files: NewFile[], specs?: PartSpec[], keepUnfit = specs === undefined): Promise<Job | null> {
   const job = new Job();
   let parts: Part[];
   try {
@@ -52,7 +53,7 @@ export async function newJob(page: Page, files: NewFile[], specs?: PartSpec[]): 
     job.layout = await page.pool.layout(job.refs(parts), job.file(settingsOf(page), parts));
     job.parts = parts;
   } catch (e) {
-    if (specs !== undefined || !(e instanceof SliceError) || e.kind !== "job") {
+    if (!keepUnfit || !(e instanceof SliceError) || e.kind !== "job") {
       showError(page, e);
       return null;
     }

@@ -71,8 +71,8 @@ export async function openFiles(page: Page, files: File[]): Promise<void> {
 
 /** A new job of `files` (or of `specs`), sliced at once; 3D first when it has several
  *  instances. */
-async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target: Target = {}, what = "open files"): Promise<boolean> {
-  const job = await newJob(page, files, specs);
+async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target: Target = {}, what = "open files", keepUnfit = specs === undefined): Promise<boolean> {
+  const job = await newJob(page, files, specs, keepUnfit);
   if (!job) return false;
   const before = page.store.job;
   adoptJob(page, job);
@@ -94,10 +94,11 @@ async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target:
 
 
 /** The job kept from last time (flows/persist.ts): its files under their names and its parts,
- *  sliced at once like any job opened. False when the core refused it (its message shown). */
+ *  sliced at once like any job opened; parts that do not fit the plate come back as they were
+ *  left (the banner says so). False when the core refused it (its message shown). */
 export function openStored(page: Page, files: NewFile[], parts: PartSpec[], target: Target = {}): Promise<boolean> {
   note("", "none");
-  return openJob(page, files, parts, target, "open the job from last time");
+  return openJob(page, files, parts, target, "open the job from last time", true);
 }
 
 /** Reads a job file (on the page's thread, at most the core's `max_job_file_bytes`) into its
