@@ -438,7 +438,7 @@ fn rows() -> Vec<Row> {
 /// run for minutes or exhaust memory. The message names the unit and the setting to change.
 fn budget_rows() -> Vec<Row> {
     let mut rows = Vec::new();
-    for aspect in ["0.001", "1e-6"] {
+    for aspect in ["0.001", "0.002"] {
         let mut r = row(
             format!("a unit-1 part with unit1_droplet_aspect {aspect}"),
             Input::Job(format!(
@@ -502,6 +502,57 @@ fn budget_rows() -> Vec<Row> {
         rows.push(r);
     }
     rows
+}
+
+/// Tiny values: refused by their range, the value shown as typed (no 300-digit number), and a
+/// unit-1 setting refused for its range, not for a budget of droplets it does not print.
+fn tiny_value_rows() -> Vec<Row> {
+    let mut rows = Vec::new();
+    for (set, kw) in [
+        ("unit1_droplet_aspect=1e-300", "unit1_droplet_aspect"),
+        ("plate_z=1e-300", "plate_z"),
+        ("layer_height=5e-324", "layer_height"),
+        ("layer_height=1e-300", "layer_height"),
+        ("droplet_aspect=1e-300", "droplet_aspect"),
+        ("droplet_rate=1e-300", "droplet_rate"),
+        ("travel_speed=5e-324", "travel_speed"),
+        ("support_density=1e-300", "support_density"),
+    ] {
+        let mut r = setting_row(format!("--set {set} (tiny)"), set.into(), &[kw]);
+        let value = set.split_once('=').unwrap().1;
+        r.all = vec!["out of range".into(), "at least".into(), value.into()];
+        rows.push(r);
+    }
+    rows
+}
+
+#[test]
+fn cli_refuses_tiny_values_by_their_range_in_a_short_message() {
+    let failures: Vec<String> = tiny_value_rows()
+        .iter()
+        .filter_map(|r| check_row_within(r, 400).err())
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn a_unit1_setting_is_checked_for_droplets_only_where_unit_1_prints() {
+    // The least B₁ (unit1_droplet_aspect 0.001: B₁ = 0.2 µm) on a job without unit-1 parts and
+    // with support off: nothing of unit 1 is printed, the job is sliced.
+    let dir = TempDir::new("unit1");
+    let cube = common::model("cube_20mm_ascii.stl");
+    let args = [
+        cube.to_str().unwrap(),
+        "-q",
+        "-o",
+        "out.gco",
+        "--set",
+        "unit1_droplet_aspect=0.001",
+        "--set",
+        "support=off",
+    ];
+    let run = common::run_cli(&args, dir.path(), TIMEOUT);
+    assert_eq!(run.code, Some(0), "{run:?}");
 }
 
 /// Settings-file regressions (fixed in 2e4b1c7): a JSON array was read as the struct's fields

@@ -169,7 +169,7 @@ fn random_settings(rng: &mut Rng) -> Settings {
     if rng.pick(10) == 0 {
         s.support = dropslice::base::settings::Support::Unit1;
         match rng.pick(2) {
-            0 => s.unit1_droplet_aspect = 1e-6,
+            0 => s.unit1_droplet_aspect = 1e-3,
             _ => s.droplet_aspect = 1e-3,
         }
     }

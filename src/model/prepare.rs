@@ -185,8 +185,10 @@ pub(crate) fn check_height(size: &[f64; 3], settings: &Settings) -> Result<(), E
         return Err(Error::Setting {
             name: "layer_height".into(),
             message: format!(
-                "the part is {:.1} mm tall: {:.0} layers of {h} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
-                size[2], layers_needed
+                "the part is {:.1} mm tall: {} layers of {} mm are more than the {MAX_LAYERS} allowed; check scale_z and layer_height (is the file in micrometres?)",
+                size[2],
+                crate::base::error::rounded(layers_needed),
+                crate::base::error::number(h)
             ),
         });
     }
@@ -201,7 +203,8 @@ pub(crate) fn check_chamber(size: &[f64; 3], settings: &Settings) -> Result<(), 
             name: "plate_z".into(),
             message: format!(
                 "the job is {:.3} mm tall (after scale and shrinkage compensation), taller than the build chamber (plate_z = {} mm): lay the part down (rotate_x/rotate_y, dropslice orient), scale it down, or set plate_z to the machine's chamber height",
-                size[2], settings.plate_z
+                size[2],
+                crate::base::error::number(settings.plate_z)
             ),
         });
     }

@@ -106,13 +106,13 @@ pub fn calibrate(
     }
     let (h_lo, h_hi) = range("layer_height");
     let (a_lo, a_hi) = range("droplet_aspect");
-    if !(layer_height > h_lo && layer_height <= h_hi) {
+    if !(layer_height >= h_lo && layer_height <= h_hi) {
         return err(format!(
             "the code's layer_height = {} mm is out of range ({h_lo} … {h_hi} mm)",
             number(layer_height)
         ));
     }
-    if !(droplet_aspect > a_lo && droplet_aspect <= a_hi) {
+    if !(droplet_aspect >= a_lo && droplet_aspect <= a_hi) {
         return err(format!(
             "the code's droplet_aspect = {} is out of range ({a_lo} … {a_hi})",
             number(droplet_aspect)

@@ -86,9 +86,8 @@ pub struct GcodeReader {
     totals: Summary,
 }
 
-/// The header's droplet size must lie within the settings' ranges (greater than 0, at most
-/// this).
-fn header_max(name: &str) -> Option<(f64, &'static str)> {
+/// The header's droplet size must lie within the settings' ranges: (least, greatest, unit).
+fn header_range(name: &str) -> Option<(f64, f64, &'static str)> {
     let spec = crate::base::settings::schema().into_iter().find(|s| {
         s.name == name
             && matches!(
@@ -96,7 +95,7 @@ fn header_max(name: &str) -> Option<(f64, &'static str)> {
                 "layer_height" | "droplet_aspect" | "unit1_droplet_aspect"
             )
     })?;
-    Some((spec.max?, spec.unit))
+    Some((spec.min?, spec.max?, spec.unit))
 }
 
 fn shown(word: &str) -> String {
@@ -446,17 +445,17 @@ impl GcodeReader {
         let Some(value) = after.split_whitespace().next() else {
             return Ok(());
         };
-        if let Some((max, unit)) = header_max(name) {
+        if let Some((min, max, unit)) = header_range(name) {
             // The droplet size decides how many droplets a G25 line holds: only the core's range.
             let v: f64 = value.parse().unwrap_or(f64::NAN);
-            if v.is_nan() || v <= 0.0 || v > max {
+            if v.is_nan() || v < min || v > max {
                 let unit = if unit.is_empty() {
                     String::new()
                 } else {
                     format!(" {unit}")
                 };
                 return Err(GcodeError(format!(
-                    "line {}: the header's {name} = {} is out of range: it must be greater than 0 and at most {max}{unit}",
+                    "line {}: the header's {name} = {} is out of range: it must be at least {min} and at most {max}{unit}",
                     self.line_no,
                     shown(value)
                 )));
@@ -613,7 +612,7 @@ mod tests {
         assert!(err(&long).contains("is longer than 1,048,576 characters"));
         assert_eq!(
             err("; layer_height = 7\n"),
-            "line 1: the header's layer_height = 7 is out of range: it must be greater than 0 and at most 5 mm"
+            "line 1: the header's layer_height = 7 is out of range: it must be at least 0.0001 and at most 5 mm"
         );
     }
 

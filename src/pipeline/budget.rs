@@ -359,7 +359,13 @@ impl Estimate {
         let (b0, b1) = (s.droplet_width(), s.unit1_droplet_width());
         let support = s.support == Support::Unit1;
         let d0 = self.unit0_volume / (b0 * b0 * h);
-        let d1 = self.unit1_volume / (b1 * b1 * h);
+        // Unit 1's droplets only where it prints: a B₁ that no part and no support uses is
+        // never checked (its B₁² may be tiny).
+        let d1 = if self.unit1_volume > 0.0 {
+            self.unit1_volume / (b1 * b1 * h)
+        } else {
+            0.0
+        };
         let ds = if support { self.support_droplets } else { 0.0 };
         let total = d0 + d1 + ds;
         let [x, y, z] = self.size;

@@ -251,6 +251,7 @@ impl Session {
             last_section: std::cell::RefCell::new(None),
             raster: std::cell::RefCell::new(analysis::Raster::empty()),
             stage: std::sync::Arc::new(analysis::LayerStage::new(&job.analysis_grid(), &settings)),
+            analysis_refused: job.analysis_grid().check(&settings).err(),
             job,
             settings,
         }
@@ -309,6 +310,9 @@ pub struct Session {
     raster: std::cell::RefCell<analysis::Raster>,
     /// The 3D estimate's stage (its grids are the job's).
     pub(crate) stage: std::sync::Arc<analysis::LayerStage>,
+    /// Why the job's layers are not analysed (too large for the analysis' memory,
+    /// [`analysis::AnalysisGrid::check`]), if they are not.
+    analysis_refused: Option<Error>,
 }
 
 #[wasm_bindgen]
@@ -380,6 +384,9 @@ impl Session {
     /// times the work of planning the layer.
     pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
+        if let Some(e) = &self.analysis_refused {
+            return Err(js_error(e.clone()));
+        }
         let (plan, region, text) = self.planned(i);
         let cell = self.settings.droplet_width() / MASK_CELLS_PER_B;
         let (a, mask) = analysis::analyse_layer_for_page(
@@ -400,6 +407,16 @@ impl Session {
         r.analysis = Some(a);
         r.mask = Some(mask);
         Ok(r)
+    }
+
+    /// Why the job's layers cannot be analysed (`{kind: "analysis", message}`: a layer would
+    /// take more memory than the analysis may, [`analysis::AnalysisGrid::check`]), or `null`:
+    /// then [`Session::slice_layer_analysed`] analyses them. The slice is not affected.
+    #[wasm_bindgen(unchecked_return_type = "ErrorReport | null")]
+    pub fn analysis_refusal(&self) -> JsValue {
+        self.analysis_refused
+            .clone()
+            .map_or(JsValue::NULL, js_error)
     }
 
     /// The header comment block for a finished slice (`summary`: every unit's summary

@@ -17,13 +17,13 @@ function link(state) {
 
 // [what, link state, the banner must match all of these]
 const CASES = [
-  ["support on, unit1_droplet_aspect 1e-6", { settings: { support: "unit1", unit1_droplet_aspect: 1e-6 } }, [/support/, /unit1_droplet_aspect/, /droplets/]],
+  ["support on, unit1_droplet_aspect 0.002", { settings: { support: "unit1", unit1_droplet_aspect: 0.002 } }, [/support/, /unit1_droplet_aspect/, /droplets/]],
   ["support on, unit1_droplet_aspect 0.001", { settings: { support: "unit1", unit1_droplet_aspect: 0.001 } }, [/support/, /unit1_droplet_aspect/, /droplets/]],
   ["support on, droplet_aspect 0.025", { settings: { support: "unit1", droplet_aspect: 0.025 } }, [/droplet_aspect/, /unit 0/, /support = off/]],
   [
-    "a job with a unit-1 part, unit1_droplet_aspect 1e-6",
+    "a job with a unit-1 part, unit1_droplet_aspect 0.001",
     {
-      settings: { unit1_droplet_aspect: 1e-6 },
+      settings: { unit1_droplet_aspect: 0.001 },
       files: [{ name: "cube.stl", sha256: cubeSha, bytes: cube.length }],
       parts: [{ file: "cube.stl", unit: 1 }],
     },

@@ -33,7 +33,7 @@ test("invalid settings are flagged before slicing", async () => {
   const { page } = main;
   await page.fill("#set-layer_height", "-1");
   assert.equal(await page.getAttribute("#set-layer_height", "aria-invalid"), "true");
-  assert.match(await page.locator(".field.invalid .message").first().innerText(), /greater than 0/);
+  assert.match(await page.locator(".field.invalid .message").first().innerText(), /at least 0.0001/);
   assert.equal(await page.isDisabled("#btn-slice"), true);
   await page.fill("#set-layer_height", "abc");
   assert.match(await page.locator(".field.invalid .message").first().innerText(), /not a number/);

@@ -2,7 +2,7 @@
 // canvas, "Go to worst layer". Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { canvasPixels, startWithPage, status, stop, voidPixels, waitSettled } from "./helpers.mjs";
+import { boxStl, canvasPixels, pick, startWithPage, status, stop, voidPixels, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -77,6 +77,37 @@ test("the voids overlay: figures, canvas, worst layer", async () => {
   s = await waitSettled(page, 60_000);
   assert.equal(s.state, "done");
   assert.equal(s.analysed, s.layers);
+  await page.uncheck("#opt-voids");
+  assert.deepEqual(errors, []);
+});
+
+test("a sheet too large to analyse: sliced, and the page says why the voids are not analysed", async () => {
+  // 600 × 600 mm, one layer of about 8 million droplets: its analysis would take several GB
+  // (the core's bound is 1 GB a layer); a 700 mm sheet once panicked the worker
+  const { page, errors } = main;
+  await waitSettled(page, 60_000);
+  for (const name of ["plate_x", "plate_y"]) {
+    await page.$eval(`#settings [name="${name}"]`, (el) => {
+      for (let d = el.closest("details"); d; d = d.parentElement?.closest("details")) d.open = true;
+    });
+    await page.fill(`#settings [name="${name}"]`, "1000");
+    await page.press(`#settings [name="${name}"]`, "Tab");
+  }
+  await page.check("#opt-voids");
+  await waitSettled(page, 60_000);
+  await pick(page, [{ name: "sheet.stl", mimeType: "model/stl", buffer: boxStl(600, 600, 0.2) }]);
+  // the slice completes without the analysis, then the analysis pass says why
+  await page.waitForFunction(() => {
+    const b = document.getElementById("banner");
+    return !b.hidden && /cannot be analysed/i.test(b.innerText);
+  }, null, { timeout: 240_000, polling: 200 });
+  const s = await waitSettled(page, 60_000);
+  assert.equal(s.layers, 1);
+  assert.equal(s.analysed, 0);
+  const banner = await page.locator("#banner").innerText();
+  assert.match(banner, /would take about [\d.]+ GB to analyse, more than the 1 GB allowed/);
+  assert.match(banner, /droplet_aspect/);
+  assert.equal(await page.isDisabled("#btn-download"), false, "the slice can be downloaded");
   await page.uncheck("#opt-voids");
   assert.deepEqual(errors, []);
 });

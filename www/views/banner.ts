@@ -10,6 +10,7 @@ export const TITLES: Record<string, string> = {
   nothing_to_print: "Nothing to print.",
   crash: "The slicer crashed.",
   internal: "Internal error.",
+  analysis: "The voids cannot be analysed.",
   link: "Cannot open this preview link.",
   linkPart: "Parts of this preview link were ignored.",
   job: "Cannot lay out this job.",

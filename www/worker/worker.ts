@@ -140,12 +140,17 @@ async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
   const s = need();
   const { from, to } = req;
   const counted = req.gcode ?? true;
+  // a job too large to analyse (the core's bound on a layer's memory): a slice goes on
+  // without the analysis, the analysis pass alone says why
+  const refusal = req.analyse ? (s.analysis_refusal() as ErrorValue | null) : null;
+  if (refusal && !counted) throw refusal;
+  const analyse = req.analyse && !refusal;
   const parts = { tally: new Tally() };
   let batch: LayerData[] = [];
   let since = performance.now();
   try {
     for (let i = from; i < to; i++) {
-      batch.push(layerOf(s, i, parts, req.analyse, counted));
+      batch.push(layerOf(s, i, parts, analyse, counted));
       if (i + 1 < to && performance.now() - since < BATCH_MS) continue;
       const sent = batch;
       batch = [];
@@ -157,7 +162,7 @@ async function sliceUnit(id: number, req: RequestData<"slice">): Promise<void> {
       if (session !== s) throw internal("the model was replaced during slicing");
     }
     // the 3D estimate's slabs at the unit's ends (the layers next to it are planned again)
-    if (req.analyse) clock.time("core: the unit's end slabs", () => s.finish_slabs(parts.tally));
+    if (analyse) clock.time("core: the unit's end slabs", () => s.finish_slabs(parts.tally));
     const unit: SliceUnit = { from, to, summary: parts.tally.summary() };
     // the Blob copies the view of the module's memory at once (no call into the module between)
     if (counted) unit.gcode = clock.time("worker: blob", () => new Blob([parts.tally.gcode_view()] as BlobPart[], { type: "text/plain" }));
@@ -277,7 +282,9 @@ async function handle(req: Request): Promise<void> {
       return;
     }
     case "preview": {
-      const layer = layerOf(need(), req.data.index, null, req.data.analyse);
+      const s = need();
+      // a job too large to analyse is previewed without (the analysis pass said why)
+      const layer = layerOf(s, req.data.index, null, req.data.analyse && s.analysis_refusal() === null);
       post({ id: req.id, kind: "result", data: layer }, transferablesOf(layer));
       return;
     }

@@ -489,7 +489,7 @@ mod tests {
         s.set("layer_height", "-1").unwrap();
         let e = s.validate().unwrap_err().to_string();
         assert!(
-            e.contains("layer_height") && e.contains("greater than 0"),
+            e.contains("layer_height") && e.contains("at least 0.0001"),
             "{e}"
         );
     }

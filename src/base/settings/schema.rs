@@ -19,6 +19,16 @@ pub const PART_KEYS: [&str; 9] = [
     "place_angle",
 ];
 
+/// The least layer height, mm (0.1 µm), the least droplet aspect (B/H, and B₁/H; also the
+/// least `support_density`), the least droplet rate and travel speed (Hz, mm/s) and the least
+/// plate size (mm): with them every derived figure (B², a part's droplets and layers, a
+/// print time, a support spacing) stays a finite number a message can show, and a plate of
+/// 1e-300 mm is refused for what it is.
+pub const MIN_LAYER_HEIGHT: f64 = 1e-4;
+pub const MIN_ASPECT: f64 = 1e-3;
+pub const MIN_RATE: f64 = 1e-3;
+pub const MIN_PLATE: f64 = 1.0;
+
 /// Kind of a setting's value, for the page's form.
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -114,22 +124,22 @@ fn choice(
 /// The settings table in display order, with defaults filled in.
 pub fn schema() -> Vec<SettingSpec> {
     let mut specs = vec![
-        positive(num(
+        num(
             "layer_height",
             "mm",
-            0.0,
+            MIN_LAYER_HEIGHT,
             5.0,
             "Droplet",
             "Layer height H: the height of one droplet",
-        )),
-        positive(num(
+        ),
+        num(
             "droplet_aspect",
             "",
-            0.0,
+            MIN_ASPECT,
             10.0,
             "Droplet",
             "Droplet width B divided by its height H (B = aspect x H)",
-        )),
+        ),
         SettingSpec {
             kind: Kind::Integer,
             ..num(
@@ -297,22 +307,22 @@ pub fn schema() -> Vec<SettingSpec> {
             "Part",
             "Cut each layer at its middle (more accurate) or at its top (the thesis)",
         ),
-        positive(num(
+        num(
             "droplet_rate",
             "Hz",
-            0.0,
+            MIN_RATE,
             100000.0,
             "Machine",
             "Droplets the discharge unit sets per second (time estimate)",
-        )),
-        positive(num(
+        ),
+        num(
             "travel_speed",
             "mm/s",
-            0.0,
+            MIN_RATE,
             10000.0,
             "Machine",
             "Table speed of travel moves (time estimate)",
-        )),
+        ),
         positive(num(
             "material_density",
             "g/cm³",
@@ -344,30 +354,30 @@ pub fn schema() -> Vec<SettingSpec> {
             "Analysis",
             "Droplet footprint in the coverage report: disc = diameter B; spread = diameter 2B/sqrt(pi), the area of a B x B cell",
         ),
-        positive(num(
+        num(
             "plate_x",
             "mm",
-            0.0,
+            MIN_PLATE,
             100000.0,
             "Plate",
             "Build plate size in x: parts without a placement are arranged on it",
-        )),
-        positive(num(
+        ),
+        num(
             "plate_y",
             "mm",
-            0.0,
+            MIN_PLATE,
             100000.0,
             "Plate",
             "Build plate size in y",
-        )),
-        positive(num(
+        ),
+        num(
             "plate_z",
             "mm",
-            0.0,
+            MIN_PLATE,
             100000.0,
             "Plate",
             "Height of the build chamber: a job taller than this (after scale and shrinkage compensation) is refused before slicing",
-        )),
+        ),
         num(
             "part_spacing",
             "mm",
@@ -417,30 +427,30 @@ pub fn schema() -> Vec<SettingSpec> {
                 "Support ends this many layers below the overhang (0: a soluble support touches the part)",
             )
         },
-        positive(num(
+        num(
             "support_density",
             "",
-            0.0,
+            MIN_ASPECT,
             1.0,
             "Support",
             "Hatch spacing of the support = B1 / support_density",
-        )),
-        positive(num(
+        ),
+        num(
             "unit1_droplet_aspect",
             "",
-            0.0,
+            MIN_ASPECT,
             10.0,
             "Unit 1",
             "Droplet width B1 of discharge unit 1 divided by the layer height",
-        )),
-        positive(num(
+        ),
+        num(
             "unit1_droplet_rate",
             "Hz",
-            0.0,
+            MIN_RATE,
             100000.0,
             "Unit 1",
             "Droplets unit 1 sets per second (time estimate)",
-        )),
+        ),
         positive(num(
             "unit1_material_density",
             "g/cm³",

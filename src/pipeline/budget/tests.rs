@@ -274,3 +274,17 @@ fn each_unit_and_the_support_count_with_their_own_droplets() {
     assert!(cube_check(&small).is_ok());
     assert_eq!(setting(cube_check(&with_support(&small))), "droplet_aspect");
 }
+
+#[test]
+fn a_b1_whose_square_underflows_counts_nothing_where_unit_1_prints_nothing() {
+    // B₁ = 2·10⁻³⁰¹ mm: B₁² is 0, and 0 droplets / 0 was NaN, which refused every job ("0.0e0
+    // droplets … NaN"). The range refuses such a B₁ now; the count holds without it too.
+    let size = [20.0, 20.0, 20.0];
+    let s = Settings {
+        unit1_droplet_aspect: 1e-300,
+        ..Settings::default()
+    };
+    let e = Estimate::new(8000.0, None, false, &size, &[], &Overhangs::default(), &s);
+    assert!(e.check(&s).is_ok(), "{:?}", e.check(&s));
+    assert!(s.validate().is_err());
+}
