@@ -3,13 +3,16 @@
 // (that worker is replaced, the others keep the slice), the part keeps its rotation, and a
 // later Orient, a slice and a download work. Needs dist/ (scripts/build.sh).
 import assert from "node:assert/strict";
+import { mkdtempSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { after, before, test } from "node:test";
 import { downloadText, openPage, pick, shared, start, status, stop, torusStl, waitDone } from "./helpers.mjs";
 
 let env;
+const dir = mkdtempSync(join(tmpdir(), "dropslice-orient-"));
 before(async () => (env = await start()));
-after(() => stop(env));
+after(() => stop(env, dir));
 
 const rotation = (page) =>
   page.evaluate(() => {
@@ -91,7 +94,9 @@ test("with one worker, the finished slice's model is opened again after a cancel
 test("Orient of a part of a million facets cancelled while the core compares: the part unchanged, a later Orient answers", async () => {
   const { page, errors } = await openPage(env.browser, `${env.url}?workers=2`);
   await waitDone(page, 60_000);
-  await pick(page, { name: "torus1m.stl", mimeType: "model/stl", buffer: torusStl(1000, 500) });
+  const torus = join(dir, "torus1m.stl");
+  writeFileSync(torus, torusStl(1000, 500));
+  await pick(page, torus);
   await waitDone(page, 240_000);
   const rot0 = await rotation(page);
   const started0 = (await status(page)).workersStarted;
