@@ -885,6 +885,46 @@ fn orient_ranks_a_part_as_sliced_and_names_a_missing_one() {
     assert!(e["message"].as_str().unwrap().contains("parts[1]"), "{e}");
 }
 
+/// A binary STL of `n` separate small triangles in a row (welded: `n` facets).
+fn strip_stl(n: usize) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend_from_slice(&(n as u32).to_le_bytes());
+    for i in 0..n {
+        let x = (i % 1000) as f32 * 0.1;
+        let y = (i / 1000) as f32 * 0.1;
+        b.extend_from_slice(&[0u8; 12]);
+        for p in [[x, y, 0.0], [x + 0.05, y, 0.0], [x, y + 0.05, 0.05]] {
+            for c in p {
+                b.extend_from_slice(&f32::to_le_bytes(c));
+            }
+        }
+        b.extend_from_slice(&[0u8; 2]);
+    }
+    b
+}
+
+#[wasm_bindgen_test]
+fn orient_refuses_a_job_past_the_triangle_bound_in_slicings_words() {
+    // 5 parts × 100 copies (the most instances a job may have) of 40,001 facets: 20,000,500
+    // triangles, past the bound of 20 M; orient is refused before any work, as slicing is.
+    let mut models = Models::new();
+    models.add_bytes(&strip_stl(40_001), "s.stl").unwrap();
+    let part = serde_json::json!({"file": "s.stl", "copies": 100});
+    let job = serde_json::json!({"parts": [part, part, part, part, part]});
+    let e = throws(models.orient(js(job.clone()), 0), "job");
+    let message = e["message"].as_str().unwrap();
+    assert!(
+        message.contains("the job has more than 20000000 triangles in all (parts × copies)"),
+        "{e}"
+    );
+    let sliced = throws(Session::from_models(&models, js(job)), "job");
+    assert_eq!(sliced["message"].as_str(), Some(message));
+    // 4 parts are within it.
+    let part = serde_json::json!({"file": "s.stl", "copies": 100});
+    let job = serde_json::json!({"parts": [part, part, part, part]});
+    assert!(models.orient(js(job), 0).is_ok());
+}
+
 #[wasm_bindgen_test]
 fn a_session_refuses_a_job_taller_than_the_chamber() {
     let models = boxes(&[("b.stl", [5.0, 5.0, 3.0])]);

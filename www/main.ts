@@ -10,7 +10,7 @@ import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
 import { showError } from "./flows/errors";
-import { addParts, applyOrientation, arrangeAll, duplicatePart, editParts, ensureMeshes, layFlat, movePart, orientations, relayout, removePart, saveJob, selectPart } from "./flows/job";
+import { addParts, applyOrientation, arrangeAll, cancelOrient, duplicatePart, editParts, ensureMeshes, layFlat, movePart, orientations, relayout, removePart, saveJob, selectPart } from "./flows/job";
 import { deleteProfile, exportProfile, importProfile, renameProfile, saveProfile, showProfiles, useProfile } from "./flows/profiles";
 import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
 import { fit, setShowOverhangs, show } from "./flows/layer";
@@ -67,6 +67,7 @@ const actions: Actions = {
   layFlat: (id) => void layFlat(page, id),
   orient: (id) => orientations(page, id),
   applyOrientation: (id, o) => applyOrientation(page, id, o),
+  cancelOrient: () => (page.store.busy ? cancel(page) : cancelOrient(page)),
   profileSave: (name, kind) => saveProfile(page, name, kind),
   profileUse: (name) => useProfile(page, name),
   profileRename: (name, to) => renameProfile(page, name, to),
@@ -240,6 +241,10 @@ window.dropslice = {
       view: { ...renderer.view },
       name: slice?.name ?? null,
       workers: pool.size,
+      /** Workers started so far (a slice's cancel replaces all, an Orient's the job worker). */
+      workersStarted: Pool.started,
+      /** Requests the job worker has not answered yet. */
+      jobWorkerLoad: pool.jobWorkerLoad,
       /** Seconds from the file chosen to every layer's G-code ready (the last finished slice). */
       seconds: slice?.seconds ?? null,
       cached: slice?.cache.size ?? 0,

@@ -126,7 +126,8 @@ impl Models {
     /// The orientations of `job.parts[part]` (docs/spec.md "Orientation"; its rotation, scale and
     /// unit's shrinkage as sliced, the rule of `job.settings`): `{current, candidates}`, each
     /// `{rotate_x, rotate_y, rotate_z, unsupported_area (mm²), height (mm)}`, the candidates
-    /// best first. Throws `{kind: "job" | "setting", message}`.
+    /// best first. A job past slicing's triangle bound is refused first, in slicing's words.
+    /// Throws `{kind: "job" | "setting", message}`.
     #[wasm_bindgen(unchecked_return_type = "Orientations")]
     pub fn orient(&self, job: JsValue, part: usize) -> Result<JsValue, JsValue> {
         let spec = job_of(job)?;
@@ -137,6 +138,9 @@ impl Models {
             )))
         })?;
         let model = self.model(&p.file)?;
+        // Slicing's bound on the whole job, before any work: a part instanced millions of
+        // times over would keep the job worker busy for minutes.
+        crate::model::models::check_job_triangles(&self.models, &spec).map_err(js_error)?;
         let o = crate::support::orient::orient_part(model, p, &spec.settings)
             .map_err(|e| js_error(layout::at_part(part, e)))?;
         to_js(&o, "the orientations")

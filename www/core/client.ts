@@ -56,6 +56,9 @@ interface Pending {
   progress?: (layer: LayerData) => void;
 }
 
+/** Workers started so far (the tests' hook: a cancel replaces which ones). */
+let started = 0;
+
 class WorkerHandle {
   private worker: Worker;
   private pending = new Map<number, Pending>();
@@ -66,8 +69,12 @@ class WorkerHandle {
   hasModel = false;
   /** The job's files this worker's `Models` holds, by job name (the job worker's). */
   readonly models = new Map<string, File>();
+  /** Why the worker was terminated: a request made after that (one that awaited something
+   *  first) is refused with it at once, never left without an answer. */
+  private ended: Error | null = null;
 
   constructor() {
+    started++;
     this.worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module", name: "dropslice" });
     this.worker.onmessage = (ev: MessageEvent<Reply>) => this.receive(ev.data);
     this.worker.onerror = (ev: ErrorEvent) => {
@@ -88,6 +95,7 @@ class WorkerHandle {
     // one member of protocol.ts `Request`, checked by the signature (no cast)
     const message: { id: number; kind: K; data: RequestData<K> } = { id, kind, data };
     return new Promise<ResultOf<K>>((resolve, reject) => {
+      if (this.ended) return reject(this.ended);
       this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, progress });
       this.worker.postMessage(message, transfer);
     });
@@ -119,6 +127,7 @@ class WorkerHandle {
   }
 
   terminate(reason: Error): void {
+    this.ended = reason;
     this.worker.terminate();
     this.failAll(reason);
   }
@@ -256,6 +265,16 @@ export class Pool {
   private handles: WorkerHandle[] = [];
   readonly size: number;
 
+  /** Requests the job worker has not answered yet (the tests' hook). */
+  get jobWorkerLoad(): number {
+    return this.handles[0].load;
+  }
+
+  /** Workers started so far by every pool (cancels and crashes replace them). */
+  static get started(): number {
+    return started;
+  }
+
   /** `size` workers, brought within 1 … [[MAX_WORKERS]] (the default when not a number). */
   constructor(size = defaultPoolSize()) {
     this.size = Number.isFinite(size) ? Math.max(1, Math.min(MAX_WORKERS, Math.round(size))) : defaultPoolSize();
@@ -276,6 +295,18 @@ export class Pool {
       return new WorkerHandle();
     });
     return healed;
+  }
+
+  /** Stops the job worker at once (a long call of its own, such as orient: it cannot be
+   *  interrupted) and starts a fresh one in its place; what it had pending rejects with
+   *  [[Cancelled]]. The fresh worker gets the job's files again with its next request (see
+   *  [[onJobWorker]]); the other workers go on as they were. Returns whether a worker still
+   *  holds the slice's model (with one worker, none: the caller opens it again). */
+  restartJobWorker(): boolean {
+    const old = this.handles[0];
+    this.handles = [new WorkerHandle(), ...this.handles.slice(1)];
+    old.terminate(new Cancelled());
+    return this.handles.some((h) => h.hasModel && !h.broken);
   }
 
   /** Stops everything at once and starts fresh workers. */

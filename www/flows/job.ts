@@ -11,7 +11,7 @@ import { updateButtons } from "../views/controls";
 import { saveFile } from "../views/download";
 import { SliceError } from "../core/client";
 import { grouped } from "../core/grouped";
-import { showError } from "./errors";
+import { restoreModel, showError } from "./errors";
 import { record } from "./history";
 
 /** A file to add to a job: the File and, from a job file or a link, the name it has there. */
@@ -229,6 +229,13 @@ export function orientations(page: Page, id: number): Promise<Orientations> {
   const p = job?.part(id);
   if (!job || !p) return Promise.reject(new Error("the part is no longer in the job"));
   return page.pool.orient(job.refs(), job.file(settingsOf(page)), job.parts.indexOf(p));
+}
+
+/** Stops an Orient under way (no slice running): the job worker, busy in the core's long
+ *  call, is replaced by a fresh one, which gets the job's files again with its next request;
+ *  the part stays as it was. A finished slice's model is opened again if no worker holds it. */
+export function cancelOrient(page: Page): void {
+  if (!page.pool.restartJobWorker()) restoreModel(page);
 }
 
 /** The part turned to the orientation `o` picked (its scale and placement kept). */

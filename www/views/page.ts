@@ -52,6 +52,9 @@ export interface Actions {
   layFlat(id: number): void;
   /** The part's candidate orientations, best first (the core's; throws its error). */
   orient(id: number): Promise<Orientations>;
+  /** Stops the Orient under way (its promise rejects with `Cancelled`); the job stays as it
+   *  was. While a slice runs, the slice is cancelled too (the job worker does both). */
+  cancelOrient(): void;
   /** The part turned to `o` (one undoable part edit). */
   applyOrientation(id: number, o: Orientation): Promise<boolean>;
   /** Profiles (flows/profiles.ts): save the current settings of `kind` as `name`, use,

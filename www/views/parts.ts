@@ -9,7 +9,7 @@ import { jobOffPlate, plainJobMessage } from "../core/plate";
 import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
-import { orientEditorShows, orientPart } from "./orient";
+import { cancelOrient, orientEditorShows, orientPart } from "./orient";
 
 const NUMBER_FIELDS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "copies"] as const;
 type NumberField = (typeof NUMBER_FIELDS)[number];
@@ -61,6 +61,7 @@ export class PartsPanel implements PartsView {
     });
     $("part-lay-flat").addEventListener("click", () => this.part() && actions.layFlat(this.part()!.id));
     $("part-orient").addEventListener("click", () => this.part() && void orientPart(this.page, this.part()!));
+    $("orient-cancel").addEventListener("click", () => cancelOrient(this.page));
     $("part-duplicate").addEventListener("click", () => this.part() && actions.duplicatePart(this.part()!.id));
     $("part-remove").addEventListener("click", () => this.part() && actions.removePart(this.part()!.id));
     $("btn-arrange").addEventListener("click", () => actions.arrangeAll());
