@@ -153,7 +153,10 @@ fn diagnostics_in_summary_header_and_footer() {
     // Non-manifold edges and several bodies.
     let (err, gco) = run_cli(&common::model("esca_nonmanifold.stl"), &["-q"]);
     assert!(err.contains("16 non-manifold edges"), "{err}");
-    assert!(gco.contains("; warning: 6 separate bodies"), "{gco:.2000}");
+    assert!(
+        gco.contains("; warning: Part “esca_nonmanifold.stl” has 6 separate bodies"),
+        "{gco:.2000}"
+    );
     // A part in inches: warned, with the fix, and not rescaled.
     let inch: Vec<Tri> = load("cube_20mm_ascii")
         .into_iter()
