@@ -25,8 +25,10 @@ const MODELS: [&str; 4] = [
 fn rasters(step: usize) -> impl Iterator<Item = (&'static str, bool, Raster)> {
     MODELS.into_iter().flat_map(move |model| {
         [false, true].into_iter().flat_map(move |stagger| {
+            // The bunny is wider than the default plate: allowed here.
             let s = Settings {
                 stagger,
+                allow_off_plate: true,
                 ..Settings::default()
             };
             let layers = rasters_with(model, s, step);

@@ -135,7 +135,11 @@ fn run_cli(model: &std::path::Path, extra: &[&str]) -> (String, String) {
 #[test]
 fn diagnostics_in_summary_header_and_footer() {
     // The open scan: open edges in the header and the CLI; the repaired layers at the end.
-    let (err, gco) = run_cli(&common::model("stanford_bunny.stl"), &["-q"]);
+    // (The bunny is 155.7 mm wide, wider than the default plate: allowed.)
+    let (err, gco) = run_cli(
+        &common::model("stanford_bunny.stl"),
+        &["-q", "--set", "allow_off_plate=true"],
+    );
     assert!(
         err.contains("warning: the mesh is not closed: 223 open edges"),
         "{err}"
@@ -149,7 +153,10 @@ fn diagnostics_in_summary_header_and_footer() {
     // Non-manifold edges and several bodies.
     let (err, gco) = run_cli(&common::model("esca_nonmanifold.stl"), &["-q"]);
     assert!(err.contains("16 non-manifold edges"), "{err}");
-    assert!(gco.contains("; warning: 6 separate bodies"), "{gco:.2000}");
+    assert!(
+        gco.contains("; warning: Part “esca_nonmanifold.stl” has 6 separate bodies"),
+        "{gco:.2000}"
+    );
     // A part in inches: warned, with the fix, and not rescaled.
     let inch: Vec<Tri> = load("cube_20mm_ascii")
         .into_iter()

@@ -9,9 +9,13 @@ mod common;
 
 use dropslice::{Job, Settings};
 
+/// The job of `name` (cube_gears' build is wider than the default plate: allowed here).
 fn job(name: &str) -> Job {
-    Job::new(&common::model_bytes(name), name, Settings::default())
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    let s = Settings {
+        allow_off_plate: true,
+        ..Settings::default()
+    };
+    Job::new(&common::model_bytes(name), name, s).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
 #[test]

@@ -314,29 +314,83 @@ fn a_job_that_does_not_fit_is_refused_with_what_to_do() {
 }
 
 #[test]
-fn one_oversize_part_goes_to_the_origin_with_a_warning() {
+fn one_oversize_part_goes_to_the_origin_and_is_refused_with_what_fits() {
     let models = [box_model("huge.stl", 200.0, 20.0, 3.0)];
     let s = spec(json!({"parts": [{"file": "huge.stl"}]})).unwrap();
     let l = layout(&models, &s).unwrap();
     assert_eq!(l.instances[0].min, [0.0, 0.0, 0.0]);
-    assert!(
-        l.warnings
-            .iter()
-            .any(|w| w.contains("larger than the plate")),
-        "{:?}",
-        l.warnings
+    // The page's words: no "placed at the origin", no "Arrange" (it cannot help).
+    assert_eq!(l.misfits.len(), 1, "{:?}", l.misfits);
+    let m = &l.misfits[0];
+    assert_eq!(
+        m.message,
+        "Part 1 “huge.stl” (200 × 20 mm) is larger than the plate (154 × 134 mm); scaled to 77 % it fits."
     );
-    let j = Job::from_models(&models, &s).unwrap();
+    assert_eq!((m.scale_percent, m.turn_rotate_z), (Some(77), None));
+    assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    // The library refuses the job with the same words and the part keys to change.
+    let e = Job::from_models(&models, &s).err().unwrap();
+    assert_eq!(e.kind(), "job");
+    let text = e.to_string();
+    assert!(text.contains(&m.message), "{text}");
+    assert!(
+        text.contains(
+            "Use parts[0].scale_x = 0.77, parts[0].scale_y = 0.77, parts[0].scale_z = 0.77"
+        ),
+        "{text}"
+    );
+    // The scale it offers fits.
+    let s77 = spec(
+        json!({"parts": [{"file": "huge.stl", "scale_x": 0.77, "scale_y": 0.77, "scale_z": 0.77}]}),
+    )
+    .unwrap();
+    assert!(layout(&models, &s77).unwrap().misfits.is_empty());
+    assert!(Job::from_models(&models, &s77).is_ok());
+    // allow_off_plate slices it as it is, the sentence as a warning.
+    let allow =
+        spec(json!({"settings": {"allow_off_plate": true}, "parts": [{"file": "huge.stl"}]}))
+            .unwrap();
+    let j = Job::from_models(&models, &allow).unwrap();
     assert_eq!(j.info().bounds.min, [0.0, 0.0, 0.0]);
     assert!(
-        j.info()
-            .warnings
-            .iter()
-            .any(|w| w.contains("larger than the plate"))
+        j.info().warnings.contains(&m.message),
+        "{:?}",
+        j.info().warnings
     );
-    // Two copies of it: refused.
+    // Two copies of it: both at the origin, named once; refused.
     let s = spec(json!({"parts": [{"file": "huge.stl", "copies": 2}]})).unwrap();
-    assert!(layout(&models, &s).is_err());
+    let l = layout(&models, &s).unwrap();
+    assert_eq!(l.misfits.len(), 1);
+    assert!(Job::from_models(&models, &s).is_err());
+    // Turned 90° about z, 20 × 200 on a 30 × 250 plate: the turn is offered, and fits.
+    let s = spec(json!({"settings": {"plate_x": 250, "plate_y": 30}, "parts": [{"file": "huge.stl", "rotate_z": 90}]})).unwrap();
+    let m = &layout(&models, &s).unwrap().misfits[0];
+    assert_eq!(m.turn_rotate_z, Some(180.0));
+    assert!(
+        m.message.ends_with("turned 90° about z it fits."),
+        "{}",
+        m.message
+    );
+    let s = spec(json!({"settings": {"plate_x": 250, "plate_y": 30}, "parts": [{"file": "huge.stl", "rotate_z": 180}]})).unwrap();
+    assert!(layout(&models, &s).unwrap().misfits.is_empty());
+}
+
+#[test]
+fn a_part_larger_than_the_plate_among_others_does_not_stop_their_arrangement() {
+    let models = [
+        box_model("huge.stl", 200.0, 20.0, 3.0),
+        box_model("small.stl", 10.0, 10.0, 3.0),
+    ];
+    let s = spec(json!({"parts": [{"file": "small.stl"}, {"file": "huge.stl"}]})).unwrap();
+    let l = layout(&models, &s).unwrap();
+    assert_eq!(l.misfits.len(), 1);
+    assert_eq!(l.misfits[0].part, 1);
+    assert!(
+        l.misfits[0].message.starts_with("Part 2 “huge.stl”"),
+        "{}",
+        l.misfits[0].message
+    );
+    assert!(l.instances[0].max[0] <= 154.0 && l.instances[0].max[1] <= 134.0);
 }
 
 #[test]
@@ -360,16 +414,22 @@ fn placed_and_arranged_parts_mix() {
     assert!(a0.placed && a0.min == [0.0, 0.0, 0.0] && a0.max == [30.0, 20.0, 5.0]);
     // The second copy of the placed part is arranged.
     assert!(!l.instances[1].placed);
-    // The last one reaches outside the 100 mm plate: a warning, but placed as asked.
+    // The last one reaches outside the 100 mm plate: placed as asked, a misfit (the job is
+    // refused unless allow_off_plate).
     let last = &l.instances[5];
     assert_eq!(
         (last.min, last.max),
         ([95.0, 95.0, 0.0], [105.0, 105.0, 8.0])
     );
+    assert_eq!(l.misfits.len(), 1, "{:?}", l.misfits);
+    assert_eq!(
+        l.misfits[0].message,
+        "Part 3 “b.stl” reaches 5 mm past the plate's right edge — move it or press Arrange."
+    );
+    let e = Job::from_models(&models, &s).err().unwrap().to_string();
     assert!(
-        l.warnings
-            .iter()
-            .any(|w| w.contains("parts[2]") && w.contains("outside the plate"))
+        e.contains("Change parts[2].place_x/place_y, or leave them out to have it arranged"),
+        "{e}"
     );
     // No two instances closer than the spacing, except placed ones among themselves.
     for (i, a) in l.instances.iter().enumerate() {
@@ -407,7 +467,10 @@ fn placed_and_arranged_parts_mix() {
             );
         }
     }
-    // The job's mesh is exactly the instances' union of boxes.
+    // The job's mesh is exactly the instances' union of boxes (allowed off the plate).
+    let mut s = s;
+    s.settings.allow_off_plate = true;
+    assert_eq!(layout(&models, &s).unwrap(), l);
     let j = Job::from_models(&models, &s).unwrap();
     assert_eq!(j.info().instances, l.instances);
     assert_eq!(j.mesh().facets.len(), 6 * 12);
@@ -583,7 +646,11 @@ fn one_part_job_gives_the_moves_of_job_new() {
         ),
     ] {
         let bytes = model_bytes(file);
-        let mut settings = Settings::default();
+        // Off the plate on purpose (the plate rule is not what this compares).
+        let mut settings = Settings {
+            allow_off_plate: true,
+            ..Settings::default()
+        };
         let mut part = json!({"file": file});
         for (k, v) in &sets {
             settings.set(k, &v.to_string()).unwrap();
@@ -595,7 +662,7 @@ fn one_part_job_gives_the_moves_of_job_new() {
             part["place_y"] = json!(0);
         }
         let a = Job::new(&bytes, file, settings.clone()).unwrap();
-        let s = spec(json!({"parts": [part]})).unwrap();
+        let s = spec(json!({"settings": {"allow_off_plate": true}, "parts": [part]})).unwrap();
         let b = Job::from_parts(&[(file, &bytes[..])], &s).unwrap();
         assert_eq!(a.mesh().vertices, b.mesh().vertices, "{file}: vertices");
         assert_eq!(a.mesh().facets, b.mesh().facets, "{file}: facets");
@@ -627,7 +694,7 @@ fn matrices_map_the_model_onto_the_sliced_mesh() {
     let m = Model::read(&bytes, "cube_gears.3mf").unwrap();
     assert!(m.parts.len() > 1);
     let s = spec(json!({
-        "settings": {"plate_x": 400, "plate_y": 400},
+        "settings": {"plate_x": 400, "plate_y": 400, "allow_off_plate": true},
         "parts": [
             {"file": "cube_gears.3mf", "item": 1, "rotate_x": 20, "rotate_y": 45, "rotate_z": 10,
              "scale_z": 1.3, "place_angle": 33, "copies": 2},
@@ -842,7 +909,7 @@ fn cli_single_model_header_lists_the_part() {
     let dir = TempDir::new("job-cli-one");
     let cube_gears = model("cube_gears.3mf").display().to_string();
     let r = run_words(
-        &format!("{cube_gears} -o one.gco --set place_x=3 --set place_y=4"),
+        &format!("{cube_gears} -o one.gco --set place_x=3 --set place_y=4 --set plate_x=180"),
         &dir,
     );
     assert_eq!(r.code, Some(0), "{r:?}");

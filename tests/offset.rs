@@ -45,7 +45,12 @@ fn loops(s: &Shapes) -> usize {
 }
 
 fn layers_of(name: &str) -> Vec<Shapes> {
-    let job = Job::new(&model_bytes(name), name, Settings::default()).expect("job");
+    // The bunny is wider than the default plate: allowed here.
+    let s = Settings {
+        allow_off_plate: true,
+        ..Settings::default()
+    };
+    let job = Job::new(&model_bytes(name), name, s).expect("job");
     (0..job.layer_count())
         .map(|i| job.section(i).region)
         .collect()

@@ -203,6 +203,8 @@ fn sliced_overhang(name: &str, rotate: [f64; 3]) -> f64 {
         ("rotate_x", &rotate[0].to_string()),
         ("rotate_y", &rotate[1].to_string()),
         ("rotate_z", &rotate[2].to_string()),
+        // The wing is 182.6 mm long, longer than the default plate: allowed here.
+        ("allow_off_plate", "true"),
     ]);
     let job = Job::new(&model_bytes(name), name, s).unwrap();
     write_gcode(&job, &mut std::io::sink(), |_, _| {})

@@ -348,16 +348,12 @@ mod tests {
         // The turn really fits: the box turned by the suggested rotate_z.
         let (t, _) = boxed([95.5, 145.0, 60.0], [0.0, 0.0, 90.0], [1.0; 3], 0.0);
         assert!(t.max[0] <= 154.0 && t.max[1] <= 134.0, "{:?}", t.max);
-        // From rotate_z 300 the turn wraps to 30 (the schema's range).
-        let (i, f) = boxed([145.0, 95.5, 60.0], [0.0, 0.0, 300.0], [1.0; 3], 0.0);
+        // From rotate_z 270 the turn is 360; from 300 it wraps to 30 (the schema's range).
+        let (i, f) = boxed([145.0, 95.5, 60.0], [0.0, 0.0, 270.0], [1.0; 3], 0.0);
         let m = misfit(&i, &f, "n", &Settings::default()).unwrap();
-        assert_eq!(m.turn_rotate_z, Some(30.0));
-        let (t, _) = boxed([145.0, 95.5, 60.0], [0.0, 0.0, 30.0], [1.0; 3], 0.0);
-        assert!(
-            t.max[0] <= 154.0 + 1e-9 && t.max[1] <= 134.0 + 1e-9,
-            "{:?}",
-            t.max
-        );
+        assert_eq!(m.turn_rotate_z, Some(360.0));
+        assert_eq!(turned(300.0), 30.0);
+        assert_eq!(turned(-360.0), -270.0);
     }
 
     #[test]

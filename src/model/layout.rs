@@ -302,14 +302,16 @@ pub fn place_instances(
 }
 
 /// The part's name as the page lists it: the spec's `name`; a 3MF item's name with its file,
-/// "gear (gears.3mf)"; else the file's name.
+/// "gear (gears.3mf)"; else the file's name (without the folders a job file or the command
+/// line gave).
 pub fn shown_name(model: &Model, p: &PartSpec) -> String {
     if let Some(n) = &p.name {
         return clean_name(n);
     }
+    let file = p.file.rsplit(['/', '\\']).next().unwrap_or(&p.file);
     match p.item {
-        Some(i) => clean_name(&format!("{} ({})", model.part_name(Some(i)), p.file)),
-        None => clean_name(&p.file),
+        Some(i) => clean_name(&format!("{} ({file})", model.part_name(Some(i)))),
+        None => clean_name(file),
     }
 }
 

@@ -108,6 +108,8 @@ pub(crate) struct Input {
     pub(crate) misfits: Vec<fit::Misfit>,
     /// How the refusal names the change (the command line's `--set` for one model).
     pub(crate) hint: fit::Hint,
+    /// Whose separate bodies the warnings count.
+    pub(crate) bodies: Bodies,
     /// [`JobInfo::groups`] of the merged mesh (before the repair drops facets).
     pub(crate) groups: Vec<FacetGroup>,
 }
@@ -255,16 +257,50 @@ pub(crate) fn close_cracks(
     (better, (merged, dropped))
 }
 
+/// Which bodies a job's warning counts: those of its one part's prepared mesh (named), or
+/// those counted per part (a job of several instances, whose mesh holds every copy).
+pub(crate) enum Bodies {
+    Whole(String),
+    Parts(Vec<(String, usize)>),
+}
+
+/// The warning of a part made of several separate bodies (a file of two cubes), naming it; a
+/// job of several parts is not one (docs/jobs.md: every part is its own body).
+pub(crate) fn bodies_warning(name: &str, bodies: usize) -> Option<String> {
+    (bodies > 1).then(|| {
+        format!(
+            "Part “{name}” has {bodies} separate bodies; where they overlap they are printed as one"
+        )
+    })
+}
+
+/// The separate bodies of one part's welded mesh, counted as the prepared mesh would count
+/// them: when the exact weld left the surface open, after the tolerance weld that closes
+/// cracks, if it does ([`close_cracks`]). Cost: one pass over the facets; more only for a part
+/// of several bodies with open edges.
+pub(crate) fn part_bodies(mesh: &Mesh) -> usize {
+    let n = mesh.bodies();
+    if n <= 1 {
+        return n;
+    }
+    let shells = mesh.shells();
+    if shells.open_edges == 0 {
+        return n;
+    }
+    let mut repaired = mesh.clone();
+    let (_, (merged, _)) = close_cracks(&mut repaired, shells, &mut []);
+    if merged == 0 { n } else { repaired.bodies() }
+}
+
 /// Plain-language warnings about the mesh.
 pub(crate) fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
-    let counted: [(usize, &str, String); 7] = [
+    let counted: [(usize, &str, String); 6] = [
         (m.open_edges, "the mesh is not closed: ", " open edges (holes in the surface); open sections are closed by joining their ends".into()),
         (m.nonmanifold_edges, "", " non-manifold edges (shared by more than two facets); overlapping parts are printed as their union".into()),
         (m.misoriented_edges, "", " edges between facets of opposite orientation (flipped facets); loops are oriented by the majority".into()),
         (m.duplicate_facets, "", " duplicate facets were ignored".into()),
         (m.degenerate_facets, "", " degenerate facets (zero area) were ignored".into()),
         (m.tolerance_welded, "", format!(" near-coincident vertices (closer than {WELD_TOLERANCE_MM} mm) were merged to close cracks in the surface")),
-        (if m.bodies > 1 { m.bodies } else { 0 }, "", " separate bodies; where they overlap they are printed as one".into()),
     ];
     let mut w: Vec<String> = counted
         .into_iter()

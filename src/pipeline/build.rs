@@ -7,14 +7,15 @@ use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
 use crate::model::fit;
-use crate::model::layout::{Frame, Instance, at_part, place_instances};
+use crate::model::layout::{Frame, Instance, at_part, place_instances, shown_name};
 use crate::model::mesh::{self, Mesh, MeshStats};
 use crate::model::models::{
     MAX_JOB_TRIANGLES, Model, check_job_triangles, models_of, too_many_triangles,
 };
 use crate::model::prepare::{
-    FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_chamber, check_height,
-    check_volume, close_cracks, import, keep_groups, suggested_scale, warnings,
+    Bodies, FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, bodies_warning,
+    check_chamber, check_height, check_volume, close_cracks, import, keep_groups, part_bodies,
+    suggested_scale, warnings,
 };
 use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
@@ -46,6 +47,7 @@ impl Job {
             warnings: Vec::new(),
             misfits: misfit.into_iter().collect(),
             hint: fit::Hint::Set,
+            bodies: Bodies::Whole(job::clean_name(file_name)),
             groups: Vec::new(),
         };
         Job::build(mesh, input, settings)
@@ -111,6 +113,21 @@ impl Job {
             frames.push(frame);
         }
         let layout = place_instances(&by_part, spec, &frames)?;
+        // A job of one instance counts the bodies of its prepared mesh; a job of several, each
+        // part's own (two files are two parts, not one part of two bodies).
+        let bodies = if layout.instances.len() == 1 {
+            let p = &spec.parts[0];
+            Bodies::Whole(shown_name(by_part[0], p))
+        } else {
+            let mut named: Vec<(String, usize)> = Vec::new();
+            for (i, p) in spec.parts.iter().enumerate() {
+                let name = shown_name(by_part[i], p);
+                if !named.iter().any(|(n, _)| *n == name) {
+                    named.push((name, part_bodies(&welded[i])));
+                }
+            }
+            Bodies::Parts(named)
+        };
         // The instances run by run (a job of unit 0 alone: one run, in the layout's order).
         let mut order: Vec<&Instance> = layout.instances.iter().collect();
         order.sort_by_key(|inst| run_of[inst.part]);
@@ -183,6 +200,7 @@ impl Job {
             warnings: layout.warnings,
             misfits: layout.misfits,
             hint: fit::Hint::Parts,
+            bodies,
             groups,
         };
         Job::build(mesh, input, settings)
@@ -289,6 +307,11 @@ impl Job {
         check_chamber(&size, &settings)?;
         let mut all_warnings = input.warnings;
         all_warnings.extend(input.misfits.into_iter().map(|m| m.message));
+        let bodies = match input.bodies {
+            Bodies::Whole(name) => vec![(name, stats.bodies)],
+            Bodies::Parts(parts) => parts,
+        };
+        all_warnings.extend(bodies.iter().filter_map(|(n, b)| bodies_warning(n, *b)));
         all_warnings.extend(warnings(&stats, &size));
         let info = JobInfo {
             file_name: input.file_name,
