@@ -94,3 +94,116 @@ fn figures_come_from_the_header_settings() {
             .contains("droplet_rate")
     );
 }
+
+/// The code as the CLI leaves it: the header's placeholders filled in (same length).
+fn finished_code(job: &Job) -> (String, dropslice::Summary) {
+    let mut code = Vec::new();
+    let summary = dropslice::write_gcode(job, &mut code, |_, _| {}).expect("code");
+    let header = job.header(Some(&summary));
+    assert_eq!(header.len(), job.header(None).len());
+    code[..header.len()].copy_from_slice(header.as_bytes());
+    (String::from_utf8(code).expect("text"), summary)
+}
+
+/// Re-opening a code shows exactly the figures of the slice that wrote it: the header's own
+/// (time, travel, volume, mass, droplets by role; per unit with two units), not figures
+/// computed again from the commands (whose travel and roles differ).
+#[test]
+fn a_finished_code_reads_back_the_figures_of_its_slice() {
+    let one = Settings {
+        droplet_aspect: 1.3,
+        travel_speed: 70.0,
+        material_density: 1.17,
+        ..Settings::default()
+    };
+    let two = Settings {
+        support: dropslice::base::settings::Support::Unit1,
+        unit1_droplet_rate: 40.0,
+        ..Settings::default()
+    };
+    for (model, s) in [("cube_20mm_ascii.stl", one), ("U_overhang.obj", two)] {
+        let job = Job::new(&common::model_bytes(model), model, s.clone()).expect("job");
+        let (code, summary) = finished_code(&job);
+        let want = summary.figures(&s);
+        let (_, reader) = read_gcode(&code).expect("read");
+        assert_eq!(reader.figures_note(), None, "{model}");
+        let got = reader.figures().expect("figures");
+        let exact = |a: f64, b: f64, what: &str| {
+            assert_eq!(a.to_bits(), b.to_bits(), "{model}: {what} {a} vs {b}");
+        };
+        exact(got.print_seconds, want.print_seconds, "print time");
+        exact(got.travel_mm, want.travel_mm, "travel");
+        exact(got.volume_mm3, want.volume_mm3, "volume");
+        exact(got.mass_g, want.mass_g, "mass");
+        exact(got.unit0_seconds, want.unit0_seconds, "unit 0 time");
+        exact(got.unit1_seconds, want.unit1_seconds, "unit 1 time");
+        exact(got.unit1_volume_mm3, want.unit1_volume_mm3, "unit 1 volume");
+        exact(got.unit1_mass_g, want.unit1_mass_g, "unit 1 mass");
+        assert_eq!(got.counts, want.counts, "{model}: droplets by role");
+        assert_eq!(got.droplets, want.droplets);
+        assert_eq!(got.unit1_droplets, want.unit1_droplets);
+        // the commands alone give another travel (and loops and fill only)
+        let unfilled = read_gcode(&code.replacen("; print time", "; print tim", 1))
+            .expect("read")
+            .1;
+        assert_eq!(
+            unfilled.figures_note().as_deref(),
+            Some("the header has no print time")
+        );
+        let moves = unfilled.figures().expect("figures");
+        assert_ne!(moves.travel_mm.to_bits(), want.travel_mm.to_bits());
+        assert_eq!(moves.counts.inner, 0);
+        if model.starts_with('U') {
+            assert!(want.unit1_droplets > 0 && code.contains("; volume unit 1"));
+        } else {
+            assert!(code.contains("; droplet_aspect = 1.3") && !code.contains("unit 1"));
+        }
+    }
+}
+
+/// The header's figures are used only when they fit the file: a header never filled in, an
+/// older header without them, a figure that is not a number ≥ 0, or commands changed after
+/// slicing give the figures of the commands and say why.
+#[test]
+fn figures_of_the_commands_when_the_header_does_not_fit() {
+    let model = "cube_20mm_ascii.stl";
+    let s = Settings::default();
+    let job = Job::new(&common::model_bytes(model), model, s.clone()).expect("job");
+    let (code, _) = finished_code(&job);
+    let mut pending = Vec::new();
+    dropslice::write_gcode(&job, &mut pending, |_, _| {}).expect("code");
+    let note = |text: &str| {
+        let (_, r) = read_gcode(text).expect("read");
+        let f = r.figures().expect("figures");
+        (r.figures_note().unwrap_or_default(), f)
+    };
+    let (n, _) = note(std::str::from_utf8(&pending).unwrap());
+    assert_eq!(
+        n,
+        "the header's figures were never filled in (the code was not finished)"
+    );
+    let older: String = code
+        .lines()
+        .filter(|l| {
+            !["; print time", "; travel ", "; volume", "; mass"]
+                .iter()
+                .any(|p| l.starts_with(p))
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    assert!(note(&older).0.starts_with("the header has no figures"));
+    let line = code.lines().find(|l| l.starts_with("; mass")).unwrap();
+    let bad = code.replacen(
+        line,
+        "; mass                 =                      -1 g",
+        1,
+    );
+    assert_eq!(
+        note(&bad).0,
+        "the header's mass \"-1\" (line 14) is not a number ≥ 0"
+    );
+    let first = code.lines().find(|l| l.starts_with("G26")).unwrap();
+    let (n, f) = note(&code.replacen(&format!("{first}\n"), "", 1));
+    assert!(n.ends_with("the code was changed after slicing"), "{n}");
+    assert_eq!(f.counts.inner, 0);
+}

@@ -72,11 +72,11 @@ pub const FIGURE_LINES: [(&str, FigureField, &str, Option<bool>); 10] = [
         Some(true),
     ),
     ("travel", FigureField::Travel, "mm", None),
-    ("volume", FigureField::Volume, "mm3", Some(false)),
+    ("volume", FigureField::Volume, "mm³", Some(false)),
     ("mass", FigureField::Mass, "g", Some(false)),
-    ("volume unit 0", FigureField::Volume, "mm3", Some(true)),
+    ("volume unit 0", FigureField::Volume, "mm³", Some(true)),
     ("mass unit 0", FigureField::Mass, "g", Some(true)),
-    ("volume unit 1", FigureField::Unit1Volume, "mm3", Some(true)),
+    ("volume unit 1", FigureField::Unit1Volume, "mm³", Some(true)),
     ("mass unit 1", FigureField::Unit1Mass, "g", Some(true)),
 ];
 

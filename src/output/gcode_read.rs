@@ -12,12 +12,20 @@
 //! B₁ = `layer_height` × `unit1_droplet_aspect` (default 1.04).
 //!
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
-//! filling its memory, and every refusal names the line and the reason.
+//! filling its memory, and every refusal names the line and the reason. G-code of another kind
+//! of printer (`M140`, `G1 … E…`: a filament printer's) is refused as such, naming the
+//! commands found.
+//!
+//! The figures of a file ([`GcodeReader::figures`]) are the header's own (droplets by role,
+//! print time, travel, volume, mass: the very numbers of the slice that wrote it) when it has
+//! them, checked (finite, ≥ 0, the droplet total that of the commands); else they are computed
+//! from the commands with the header's settings, and [`GcodeReader::figures_note`] says why.
 
 use crate::base::error::Error;
 use crate::base::error::grouped;
 use crate::base::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
 use crate::base::settings::{Settings, schema};
+use crate::output::gcode::{FIGURE_LINES, FigureField};
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::{Figures, Summary};
 use crate::slicing::plan::Counts;
@@ -84,6 +92,95 @@ pub struct GcodeReader {
     counts_only: bool,
     /// The layers finished so far: their droplets by role and unit, and travel.
     totals: Summary,
+    /// The header's droplet counts (`; droplets outer loops = N`, …), by role; `None` for a
+    /// line it does not have or the placeholder `pending`.
+    header_counts: [Option<u64>; 5],
+    /// The header's figures (`; print time = S s`, …), as read.
+    header_figures: Vec<(FigureField, f64)>,
+    /// Why the header's figures cannot be used (a line that is not a number ≥ 0, `pending`).
+    header_figures_problem: Option<String>,
+    /// The command that made the reader refuse the file as another printer's (the first).
+    foreign: Option<String>,
+}
+
+/// The header's droplet count lines, in the order of [`GcodeReader::header_counts`]: outer,
+/// inner, fill, support, unit 1.
+const COUNT_LINES: [&str; 5] = [
+    "droplets outer loops",
+    "droplets inner loops",
+    "droplets fill",
+    "droplets support",
+    "droplets of unit 1",
+];
+
+/// A filament (FDM) or CNC command: `M104`, `G1`, `G28`, `G92.1` — a G or M and a number.
+fn machine_command(word: &str) -> bool {
+    let Some(number) = word.strip_prefix(['G', 'g', 'M', 'm']) else {
+        return false;
+    };
+    let (int, frac) = number.split_once('.').unwrap_or((number, "0"));
+    let digits = |t: &str| !t.is_empty() && t.len() <= 5 && t.bytes().all(|b| b.is_ascii_digit());
+    digits(int) && digits(frac)
+}
+
+/// The message for G-code of another kind of printer with the commands `names`.
+fn foreign_message(names: &[String]) -> String {
+    format!(
+        "this is G-code for another kind of printer (it has {}): dropslice reads the droplet printer's code it writes (G01 travel, G25 droplet line, G26 droplet); open the model (STL, OBJ or 3MF) and slice it instead",
+        names.join(", ")
+    )
+}
+
+/// The distinct foreign commands of a file: `first`, then those of the lines of `ahead` (its
+/// first 64 kB): at most four, one that feeds filament (`G1 … E…`) among them when any does.
+fn foreign_names(first: &str, ahead: &str) -> Vec<String> {
+    let mut end = ahead.len().min(1 << 16);
+    while !ahead.is_char_boundary(end) {
+        end -= 1;
+    }
+    let mut names = vec![first.to_string()];
+    let mut feeds = first.contains('E').then(|| first.to_string());
+    for name in ahead[..end].lines().filter_map(foreign_name) {
+        if name.ends_with("E…") && feeds.is_none() {
+            feeds = Some(name.clone());
+        }
+        if names.len() < 4 && !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    if let Some(f) = feeds
+        && !names.contains(&f)
+    {
+        if names.len() < 4 {
+            names.push(f);
+        } else {
+            names[3] = f;
+        }
+    }
+    names
+}
+
+/// How the foreign commands of a line are named: the command word as written in upper case
+/// (`M140`), and `G1 … E…` for a move that feeds filament.
+fn foreign_name(line: &str) -> Option<String> {
+    let line = line.split(';').next().unwrap_or("").trim();
+    let mut words = line.split_whitespace();
+    let first = words.next()?;
+    if !machine_command(first) {
+        return None;
+    }
+    let first = first.to_ascii_uppercase();
+    // A move (G0 … G3) with an E word feeds filament; `G92 E0` only sets the position.
+    let moves = matches!(
+        first.as_str(),
+        "G0" | "G1" | "G2" | "G3" | "G00" | "G02" | "G03"
+    );
+    let feeds = moves && words.any(|w| w.starts_with(['E', 'e']));
+    Some(if feeds {
+        format!("{first} … E…")
+    } else {
+        first
+    })
 }
 
 /// The header's droplet size must lie within the settings' ranges: (least, greatest, unit).
@@ -197,14 +294,21 @@ impl GcodeReader {
     pub fn feed(&mut self, text: &str) -> Result<(), GcodeError> {
         let mut text = text;
         while let Some(nl) = text.find('\n') {
-            if self.rest.is_empty() {
-                self.line(&text[..nl])?;
+            let read = if self.rest.is_empty() {
+                self.line(&text[..nl])
             } else {
                 let mut line = std::mem::take(&mut self.rest);
                 line.push_str(&text[..nl]);
-                self.line(&line)?;
-            }
+                self.line(&line)
+            };
             text = &text[nl + 1..];
+            if let (Err(e), Some(first)) = (&read, &self.foreign) {
+                // Another printer's code: its first commands named (the rest of this piece).
+                let names = foreign_names(first, text);
+                let at = e.0.split_once(": ").map_or("", |(l, _)| l);
+                return Err(GcodeError(format!("{at}: {}", foreign_message(&names))));
+            }
+            read?;
         }
         self.rest.push_str(text);
         if self.rest.len() > MAX_LINE_CHARS && self.rest.chars().count() > MAX_LINE_CHARS {
@@ -244,7 +348,19 @@ impl GcodeReader {
         }
         let code = line.get(..3).map(str::to_ascii_uppercase);
         let code = match code.as_deref() {
-            Some(c @ ("G01" | "G25" | "G26")) => c.to_string(),
+            Some(c @ ("G01" | "G25" | "G26"))
+                if !line[3..].starts_with(|c: char| c.is_ascii_digit() || c == '.') =>
+            {
+                c.to_string()
+            }
+            _ if let Some(name) = foreign_name(line) => {
+                let e = GcodeError(format!(
+                    "line {no}: {}",
+                    foreign_message(std::slice::from_ref(&name))
+                ));
+                self.foreign = Some(name);
+                return Err(e);
+            }
             _ => {
                 return Err(GcodeError(format!(
                     "line {no}: \"{}\" is not a G01, G25 or G26 command",
@@ -252,11 +368,6 @@ impl GcodeReader {
                 )));
             }
         };
-        if self.width.is_nan() || self.width <= 0.0 {
-            return Err(GcodeError(
-                "the header does not give the droplet size (lines '; layer_height = …' and '; droplet_aspect = …' are needed before the first command)".into(),
-            ));
-        }
         let (mut x, mut y, mut z) = (self.at.x, self.at.y, self.z);
         for word in line[3..].split_whitespace() {
             if word.starts_with(';') {
@@ -287,6 +398,16 @@ impl GcodeReader {
                 'X' => x = v,
                 'Y' => y = v,
                 'Z' => z = v,
+                // Filament and feed rate: a filament printer's move written as G01.
+                'E' | 'F' => {
+                    let name = format!("{code} … {}…", letter.to_ascii_uppercase());
+                    let e = GcodeError(format!(
+                        "line {no}: {}",
+                        foreign_message(std::slice::from_ref(&name))
+                    ));
+                    self.foreign = Some(name);
+                    return Err(e);
+                }
                 _ => {
                     return Err(GcodeError(format!(
                         "line {no}: unknown word \"{}\"",
@@ -294,6 +415,11 @@ impl GcodeReader {
                     )));
                 }
             }
+        }
+        if self.width.is_nan() || self.width <= 0.0 {
+            return Err(GcodeError(
+                "the header does not give the droplet size (lines '; layer_height = …' and '; droplet_aspect = …' are needed before the first command)".into(),
+            ));
         }
         let to = DVec2::new(x, y);
         // What this line adds, checked before anything is stored.
@@ -421,11 +547,39 @@ impl GcodeReader {
         if self.commands > 0 {
             return Ok(());
         }
-        // The header's droplet total (`pending` in a header that was never filled in).
-        if let Some(rest) = text.strip_prefix("droplets total") {
-            let value = rest.trim_start().strip_prefix('=').map(str::trim);
-            self.header_droplets = value.and_then(|v| v.parse::<u64>().ok());
-            return Ok(());
+        // The header's droplet counts and figures (`pending` in a header never filled in).
+        if let Some((label, value)) = text.split_once('=') {
+            let (label, value) = (label.trim(), value.split_whitespace().next().unwrap_or(""));
+            if label == "droplets total" {
+                self.header_droplets = value.parse::<u64>().ok();
+                return Ok(());
+            }
+            if let Some(i) = COUNT_LINES.iter().position(|l| *l == label) {
+                self.header_counts[i] = value.parse::<u64>().ok();
+                return Ok(());
+            }
+            if let Some((_, field, _, _)) = FIGURE_LINES.iter().find(|l| l.0 == label) {
+                match value.parse::<f64>() {
+                    Ok(v) if v.is_finite() && v >= 0.0 => {
+                        self.header_figures.retain(|(f, _)| f != field);
+                        self.header_figures.push((*field, v));
+                    }
+                    _ if value == "pending" => {
+                        self.header_figures_problem = Some(
+                            "the header's figures were never filled in (the code was not finished)"
+                                .into(),
+                        );
+                    }
+                    _ => {
+                        self.header_figures_problem = Some(format!(
+                            "the header's {label} \"{}\" (line {}) is not a number ≥ 0",
+                            shown(value),
+                            self.line_no
+                        ));
+                    }
+                }
+                return Ok(());
+            }
         }
         // `name = value`: a lower-case name, then the value's first word.
         let name_len = text
@@ -529,11 +683,107 @@ impl GcodeReader {
         Ok(settings)
     }
 
-    /// The figures (droplets, material, mass, print time) of the layers read so far, with
-    /// the header's settings ([`header_settings`](Self::header_settings)): the estimate the
-    /// slicer printed when it wrote the file.
+    /// The header's settings as typed values (`{"droplet_aspect": 1.3, …}`), only those its
+    /// lines name, checked as [`header_settings`](Self::header_settings) checks them: what the
+    /// page's form shows for an opened code.
+    pub fn header_setting_values(
+        &self,
+    ) -> Result<serde_json::Map<String, serde_json::Value>, Error> {
+        let settings = self.header_settings()?;
+        let all = serde_json::to_value(&settings)
+            .map_err(|e| Error::Internal(format!("the settings do not serialize: {e}")))?;
+        Ok(self
+            .header
+            .iter()
+            .filter_map(|(name, _)| Some((name.clone(), all.get(name)?.clone())))
+            .collect())
+    }
+
+    /// The figures of the file: the header's own (the slice's, exactly) when it has them all
+    /// and they agree with the commands, else those of the layers read so far with the
+    /// header's settings ([`header_settings`](Self::header_settings)) — then
+    /// [`figures_note`](Self::figures_note) says why.
     pub fn figures(&self) -> Result<Figures, Error> {
-        Ok(self.totals.figures(&self.header_settings()?))
+        let settings = self.header_settings()?;
+        let Ok(counts) = self.header_counts() else {
+            return Ok(self.totals.figures(&settings));
+        };
+        let travel = self
+            .header_figures
+            .iter()
+            .find(|(f, _)| *f == FigureField::Travel)
+            .map_or(self.totals.travel_mm, |(_, v)| *v);
+        let mut f = Summary {
+            layers: self.totals.layers,
+            counts,
+            travel_mm: travel,
+            ..Summary::default()
+        }
+        .figures(&settings);
+        for (field, v) in &self.header_figures {
+            field.set(&mut f, *v);
+        }
+        Ok(f)
+    }
+
+    /// Why [`figures`](Self::figures) are computed from the commands rather than read from
+    /// the header (`None`: they are the header's).
+    pub fn figures_note(&self) -> Option<String> {
+        self.header_counts().err()
+    }
+
+    /// The header's droplet counts when its figures can be used: every count and figure line
+    /// of its kind (one unit or two) there, each a number ≥ 0, the counts adding up to its
+    /// total and that total (and unit 1's) the commands' own.
+    fn header_counts(&self) -> Result<Counts, String> {
+        if let Some(p) = &self.header_figures_problem {
+            return Err(p.clone());
+        }
+        if self.header_figures.is_empty() {
+            return Err(
+                "the header has no figures (a code of an earlier dropslice, or of another program)"
+                    .into(),
+            );
+        }
+        let [outer, inner, fill, support, unit1] = self.header_counts;
+        let (Some(outer), Some(inner), Some(fill), Some(total)) =
+            (outer, inner, fill, self.header_droplets)
+        else {
+            return Err("the header's droplet counts are missing".into());
+        };
+        let two = unit1.is_some();
+        let counts = Counts {
+            outer,
+            inner,
+            fill,
+            support: support.unwrap_or(0),
+            unit1: unit1.unwrap_or(0),
+        };
+        let sum = [inner, fill, counts.support]
+            .into_iter()
+            .try_fold(outer, u64::checked_add);
+        if sum != Some(total) || counts.unit1 > total {
+            return Err("the header's droplet counts do not add up to its total".into());
+        }
+        let read = &self.totals.counts;
+        if read.total() != total || read.unit1 != counts.unit1 {
+            return Err(format!(
+                "the header's droplets ({} in all, {} of unit 1) are not those of the commands ({}, {}): the code was changed after slicing",
+                grouped(total),
+                grouped(counts.unit1),
+                grouped(read.total()),
+                grouped(read.unit1)
+            ));
+        }
+        for (label, field, _, only) in FIGURE_LINES {
+            if only.is_some_and(|o| o != two) {
+                continue;
+            }
+            if !self.header_figures.iter().any(|(f, _)| *f == field) {
+                return Err(format!("the header has no {label}"));
+            }
+        }
+        Ok(counts)
     }
 }
 
@@ -583,7 +833,10 @@ mod tests {
     fn refusals_name_the_line_and_the_reason() {
         let err = |t: &str| read_gcode(t).unwrap_err().0;
         assert!(err("G26 X1 Y1 Z0.2\n").contains("droplet size"));
-        assert!(err(&format!("{HEADER}M104 S200\n")).contains("not a G01, G25 or G26"));
+        assert!(
+            err(&format!("{HEADER}M104 S200\n"))
+                .contains("G-code for another kind of printer (it has M104)")
+        );
         assert!(err(&format!("{HEADER}G26 X1 Yabc Z0.2\n")).contains("bad number"));
         assert!(err(&format!("{HEADER}G26 X1 Q2 Z0.2\n")).contains("unknown word"));
         assert!(err(HEADER).contains("no G01/G25/G26"));
@@ -634,6 +887,40 @@ mod tests {
             err,
             "line 4: \"T2\" selects a discharge unit this slicer does not have: only T0 and T1 are known"
         );
+    }
+
+    /// A filament printer's code (PrusaSlicer, Cura) is named as such, with its first
+    /// commands, whatever the header says; so is a G01 that feeds filament.
+    #[test]
+    fn another_printers_code_is_named_as_such() {
+        let err = |t: &str| read_gcode(t).unwrap_err().0;
+        let cura = ";FLAVOR:Marlin\n;Generated with Cura_SteamEngine 5.0\nM140 S60\nM105\nM190 S60\nM104 S200\nG28 ;Home\nG92 E0\nG1 Z2.0 F3000\nG1 X10.1 Y20 Z0.28 F5000.0\nG1 X10.1 Y200.0 Z0.28 F1500.0 E15\n";
+        assert_eq!(
+            err(cura),
+            "line 3: this is G-code for another kind of printer (it has M140, M105, M190, G1 … E…): dropslice reads the droplet printer's code it writes (G01 travel, G25 droplet line, G26 droplet); open the model (STL, OBJ or 3MF) and slice it instead"
+        );
+        // fed line by line (the page's reader may get any split): the first command alone
+        let mut r = GcodeReader::new();
+        let e = cura.lines().try_for_each(|l| r.line(l)).unwrap_err().0;
+        assert!(
+            e.starts_with("line 3: this is G-code for another kind of printer (it has M140)"),
+            "{e}"
+        );
+        // a droplet header before it changes nothing
+        assert!(
+            err(&format!("{HEADER}G90\nM83\n")).starts_with(
+                "line 5: this is G-code for another kind of printer (it has G90, M83)"
+            )
+        );
+        assert!(err(&format!("{HEADER}G1 X1 Y2 E0.4\n")).contains("(it has G1 … E…)"));
+        assert!(err(&format!("{HEADER}G01 X1 Y2 E0.4\n")).contains("(it has G01 … E…)"));
+        assert!(err("G01 X1 Y2 F1200\n").contains("(it has G01 … F…)"));
+        assert!(err(&format!("{HEADER}G010 X1\n")).contains("(it has G010)"));
+        // not G-code at all: as before
+        assert!(
+            err(&format!("{HEADER}hello\n")).contains("\"hello\" is not a G01, G25 or G26 command")
+        );
+        assert!(err(&format!("{HEADER}Gx1\n")).contains("is not a G01, G25 or G26 command"));
     }
 
     #[test]

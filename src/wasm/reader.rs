@@ -99,6 +99,23 @@ impl GcodeStream {
         let f = self.reader.figures().map_err(crate::wasm::js_error)?;
         crate::wasm::to_js(&f, "the figures")
     }
+
+    /// After `finish`: why `figures()` are computed from the commands rather than the
+    /// header's own (`undefined` when they are the header's: the slice's, exactly).
+    pub fn figures_note(&self) -> Option<String> {
+        self.reader.figures_note()
+    }
+
+    /// The settings the header names, as typed values (`{droplet_aspect: 1.3, …}`), checked
+    /// as `--set` values; throws the reason (`{kind, message}`) when they do not pass.
+    #[wasm_bindgen(unchecked_return_type = "Record<string, number | boolean | string>")]
+    pub fn header_settings(&self) -> Result<JsValue, JsValue> {
+        let values = self
+            .reader
+            .header_setting_values()
+            .map_err(crate::wasm::js_error)?;
+        crate::wasm::to_js(&values, "the header's settings")
+    }
 }
 
 /// The calibration from a slice's droplet count (its summary) and settings: `droplets`,

@@ -77,7 +77,8 @@ test("G-code reader: after T1 droplets are unit 1's, every B₁ along a G25 line
 
 test("G-code reader: refuses files it cannot understand", () => {
   assert.throws(() => read("G26 X1 Y1 Z0.2\n"), /droplet size/);
-  assert.throws(() => read(HEADER + "M104 S200\n"), /not a G01, G25 or G26/);
+  assert.throws(() => read(HEADER + "M104 S200\n"), /G-code for another kind of printer \(it has M104\)/);
+  assert.throws(() => read(HEADER + "hello\n"), /not a G01, G25 or G26/);
   assert.throws(() => read(HEADER + "G26 X1 Yabc Z0.2\n"), /bad number/);
   assert.throws(() => read(HEADER + "G26 X1 Q2 Z0.2\n"), /unknown word/);
   assert.throws(() => read(HEADER), /no G01\/G25\/G26/);

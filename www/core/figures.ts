@@ -26,12 +26,21 @@ export class Figures {
 
   /** Why a .gco file has no estimates (its header does not give the settings). */
   readNote: string | null = null;
+  /** Why a .gco file's figures are computed from its commands (null: they are its header's,
+   *  the figures of the slice that wrote it, or there are none). */
+  movesNote: string | null = null;
 
-  /** A .gco file read to its end: the core's figures with its header's settings, or why
-   *  there are none. */
-  setRead(figures: CoreFigures | null, note: string | null): void {
+  /** A .gco file read to its end: the core's figures (its header's own, else computed from
+   *  its commands with its header's settings: `moves` says why), or why there are none. */
+  setRead(figures: CoreFigures | null, note: string | null, moves: string | null): void {
     this.core = figures;
     this.readNote = figures ? null : note;
+    this.movesNote = figures ? moves : null;
+  }
+
+  /** A .gco file whose figures are its header's (the slice's, with its roles). */
+  get fromHeader(): boolean {
+    return this.core !== null && this.readNote === null && this.movesNote === null;
   }
 
   /** A layer of a .gco file (once per layer). */

@@ -157,6 +157,13 @@ export interface GcodeParseResult {
    *  null and the reason why the header does not give them. */
   figures: Figures | null;
   figuresError: string | null;
+  /** Why `figures` are computed from the commands (null: they are the header's own, the
+   *  figures of the slice that wrote the file). */
+  figuresNote: string | null;
+  /** The settings the header names, typed and checked by the core (`GcodeStream.header_settings`),
+   *  or null and the reason. */
+  settings: Record<string, number | boolean | string> | null;
+  settingsError: string | null;
 }
 
 /** Every request a worker answers: what it is sent and what it replies. */

@@ -80,8 +80,10 @@ export class Slice {
   seconds: number | null = null;
   /** The job's key (job.ts `Job.key`) the slice was made of. */
   key = "";
-  /** An opened .gco file and its header (source "gco"), for the calibration (views/calibrate.ts). */
-  gcodeFile: { file: Blob; header: Record<string, string> } | null = null;
+  /** An opened .gco file and its header (source "gco"), for the calibration (views/calibrate.ts);
+   *  the settings its header names (typed, checked by the core), or why there are none, for
+   *  the form (views/controls.ts). */
+  gcodeFile: { file: Blob; header: Record<string, string>; settings: Record<string, Value> | null; settingsError: string | null } | null = null;
 
   constructor(
     readonly source: "stl" | "gco",

@@ -277,8 +277,10 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.open(r.layers, {});
     s.dropletWidth = r.dropletWidth;
     s.layerHeight = r.layerHeight;
-    s.gcodeFile = { file, header: r.header };
-    s.figures.setRead(r.figures, r.figuresError);
+    s.gcodeFile = { file, header: r.header, settings: r.settings, settingsError: r.settingsError };
+    s.figures.setRead(r.figures, r.figuresError, r.figuresNote);
+    // the form shows the file's settings (views/controls.ts says so, or how it differs)
+    if (r.settings) page.form!.set(r.settings);
     s.complete = true;
     store.slice = s;
     const before = store.job;

@@ -48,6 +48,38 @@ export function updateButtons(page: Page): void {
   // the support switch shows the setting (a link, a job file or the form may have set it)
   if (form) $<HTMLInputElement>("opt-support").checked = form.get("support") === "unit1";
   settingsStatus(page, state === "stale", off.map((o) => o.message));
+  formSource(page);
+}
+
+/** An opened .gco file: the form shows the settings its header names (flows/slice.ts put
+ *  them there), or says plainly that it shows others, and which. */
+function formSource(page: Page): void {
+  const el = $("form-source");
+  const s = page.store.slice;
+  const g = s?.source === "gco" ? s.gcodeFile : null;
+  const form = page.form;
+  el.hidden = !g || !form;
+  if (!g || !form) {
+    el.textContent = "";
+    delete el.dataset.state;
+    return;
+  }
+  const name = `“${s!.name}”`;
+  if (!g.settings) {
+    el.textContent = `The settings form shows the page's settings, not those of ${name}: ${g.settingsError ?? "its header gives none"}.`;
+    el.dataset.state = "none";
+    return;
+  }
+  const differ = Object.entries(g.settings).filter(([k, v]) => form.get(k) !== undefined && form.get(k) !== v);
+  if (differ.length === 0) {
+    el.textContent = `The settings form shows the settings of ${name} (from its header).`;
+    el.dataset.state = "file";
+    return;
+  }
+  const shown = differ.slice(0, 3).map(([k, v]) => `${k} is ${String(form.get(k))} here, ${String(v)} in the file`);
+  const more = differ.length > 3 ? ` and ${differ.length - 3} more` : "";
+  el.textContent = `The settings form differs from ${name}: ${shown.join("; ")}${more}.`;
+  el.dataset.state = "differs";
 }
 
 function settingsStatus(page: Page, stale: boolean, offPlate: string[]): void {

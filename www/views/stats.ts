@@ -10,14 +10,20 @@ import { writeVoids } from "./voids";
 
 const fmtMm = (x: number) => `${x.toFixed(1)}`;
 
-function roleLabels(source: "stl" | "gco"): void {
+/** The roles' names: a slice's, and those of a .gco file whose header gives its droplets by
+ *  role (the slice's figures); a .gco file without them is counted by command (G26 droplets
+ *  as loops, G25 lines as fill). The canvas draws a file's G26 droplets in the outer loop's
+ *  colour, inner loops included. */
+function roleLabels(source: "stl" | "gco", fromHeader: boolean): void {
   const gco = source === "gco";
-  $("legend-0").textContent = $("stat-label-0").textContent = gco ? "Loop droplets (G26)" : "Outer loop";
-  $("legend-2").textContent = $("stat-label-2").textContent = gco ? "Fill lines (G25)" : "Fill";
+  const byCommand = gco && !fromHeader;
+  $("legend-0").textContent = gco ? (fromHeader ? "Loops (outer and inner)" : "Loop droplets (G26)") : "Outer loop";
+  $("stat-label-0").textContent = byCommand ? "Loop droplets (G26)" : "Outer loop";
+  $("legend-2").textContent = $("stat-label-2").textContent = byCommand ? "Fill lines (G25)" : "Fill";
   $("legend-1-wrap").hidden = gco;
-  $("legend-unit1-label").textContent = $("stat-unit1-label").textContent = gco ? "Unit 1 (after T1)" : "Unit-1 part";
-  $("stat-support-label").hidden = $("stat-support").hidden = gco;
-  if (!gco) $("stat-unit1-label").textContent = "Unit 1, all";
+  $("legend-unit1-label").textContent = gco ? "Unit 1 (after T1)" : "Unit-1 part";
+  $("stat-unit1-label").textContent = byCommand ? "Unit 1 (after T1)" : "Unit 1, all";
+  $("stat-support-label").hidden = $("stat-support").hidden = byCommand;
 }
 
 const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
@@ -65,7 +71,10 @@ export function writeStats(page: Page): void {
   const { store } = page;
   const s = store.slice;
   const current = store.current;
-  roleLabels(s?.source ?? "stl");
+  roleLabels(s?.source ?? "stl", s?.figures.fromHeader ?? false);
+  const note = s?.figures.movesNote ?? null;
+  $("figures-note").hidden = note === null;
+  $("figures-note").textContent = note ? `Computed from the file's moves: ${note}.` : "";
   writeCalibration(page);
   $("empty").hidden = s !== null;
   if (!s) {

@@ -54,6 +54,18 @@ export class GcodeReader {
     return this.stream.figures();
   }
 
+  /** After [[finish]]: why [[figures]] are computed from the commands; null when they are
+   *  the header's own (the slice's). */
+  figuresNote(): string | null {
+    return this.stream.figures_note() ?? null;
+  }
+
+  /** The settings the header names, typed and checked by the core; throws the core's reason
+   *  ({kind, message}) when they do not pass. */
+  headerSettings(): Record<string, number | boolean | string> {
+    return this.stream.header_settings();
+  }
+
   /** Frees the core's reader (the object is unusable afterwards). */
   free(): void {
     this.s?.free();

@@ -313,9 +313,19 @@ async function handle(req: Request): Promise<void> {
       } catch (e) {
         figuresError = (e as { message?: string })?.message ?? String(e);
       }
+      let settings: Record<string, number | boolean | string> | null = null;
+      let settingsError: string | null = null;
+      try {
+        settings = reader.headerSettings();
+      } catch (e) {
+        settingsError = (e as { message?: string })?.message ?? String(e);
+      }
       answer(req.kind, req.id, {
         figures,
         figuresError,
+        figuresNote: figures ? reader.figuresNote() : null,
+        settings,
+        settingsError,
         layers: reader.layers,
         dropletWidth: reader.dropletWidth,
         layerHeight: Number(reader.header.layer_height),
