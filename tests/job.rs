@@ -654,6 +654,25 @@ fn matrices_map_the_model_onto_the_sliced_mesh() {
     assert_eq!(offset, verts.len());
 }
 
+#[test]
+fn an_instance_gives_its_size_along_the_axes_its_scale_acts_on() {
+    // The page's size fields: scale_x × wanted / size_x is a part that wide, whatever the
+    // rotation on the plate.
+    let models = [box_model("b.stl", 10.0, 30.0, 5.0)];
+    let s = spec(
+        json!({"parts": [{"file": "b.stl", "scale_x": 2, "mirror_y": true,
+        "place_angle": 90, "place_x": 10, "place_y": 10}]}),
+    )
+    .unwrap();
+    let l = layout(&models, &s).unwrap();
+    let i = &l.instances[0];
+    for (got, want) in i.size.iter().zip([20.0, 30.0, 5.0]) {
+        assert!((got - want).abs() < 1e-9, "{:?}", i.size);
+    }
+    // on the plate, turned by 90°: 30 × 20
+    assert!((i.max[0] - i.min[0] - 30.0).abs() < 1e-9 && (i.max[1] - i.min[1] - 20.0).abs() < 1e-9);
+}
+
 /// Six times the signed volume of a mesh (positive when its facets face out).
 fn volume6(m: &dropslice::model::mesh::Mesh) -> f64 {
     m.facets
