@@ -21,6 +21,7 @@ const fmt = (v: number) => String(+v.toFixed(4));
 const mm = (v: number) => v.toFixed(1);
 
 const AXES = ["x", "y", "z"] as const;
+const SIZE_HELP = "Type a size in mm (100 or 100mm): the part is scaled to it";
 type Axis = (typeof AXES)[number];
 
 /** A size typed in mm ("100", "100mm", "100 mm", "99,5"): the millimetres, or why not. */
@@ -144,6 +145,11 @@ export class PartsPanel implements PartsView {
   private sized(axis: Axis, input: HTMLInputElement): void {
     const p = this.part();
     if (!p) return;
+    if (input.value === input.dataset.shown) {
+      input.setAttribute("aria-invalid", "false");
+      input.title = SIZE_HELP;
+      return;
+    }
     const now = this.size(p, axis);
     let r: { changes?: Changes; error?: string } = parseSize(input.value);
     if (r.error === undefined) {
@@ -157,6 +163,13 @@ export class PartsPanel implements PartsView {
   private changed(k: NumberField, input: HTMLInputElement): void {
     const p = this.part();
     if (!p) return;
+    // the text the editor wrote, left as it was (a change event on leaving a field the editor
+    // wrote into): no edit, so a value shown rounded is never taken rounded
+    if (input.value === input.dataset.shown) {
+      input.setAttribute("aria-invalid", "false");
+      input.title = "";
+      return;
+    }
     if (k.startsWith("scale_") && /mm\s*$/i.test(input.value)) {
       // "100mm" in a scale field: a size
       this.sized(k.slice(-1) as Axis, input);
@@ -242,7 +255,10 @@ export class PartsPanel implements PartsView {
       });
       return li;
     });
+    // a part's line that had the focus keeps it (an edit draws the list again)
+    const focused = list.contains(document.activeElement) ? (document.activeElement as HTMLElement).closest<HTMLElement>("li")?.dataset.id : undefined;
     list.replaceChildren(...items);
+    if (focused !== undefined) list.querySelector<HTMLElement>(`li[data-id="${focused}"]`)?.focus({ preventScroll: true });
     // the page's own words for a part off the plate (core/plate.ts); the core's others reworded
     const warnings = [...off.map((o) => o.message), ...(job.layout?.warnings ?? []).filter((w) => !/outside the plate/.test(w)).map(plainJobMessage)];
     $("parts-warnings").classList.toggle("bad", off.length > 0);
@@ -277,6 +293,7 @@ export class PartsPanel implements PartsView {
       const input = $<HTMLInputElement>(`part-${k}`);
       const text = k.startsWith("place_") && k !== "place_angle" ? values[k].toFixed(2) : fmt(values[k]);
       if (input.value !== text) input.value = text;
+      input.dataset.shown = text;
       input.setAttribute("aria-invalid", "false");
       input.title = "";
     }
@@ -285,8 +302,9 @@ export class PartsPanel implements PartsView {
       const size = this.size(p, a);
       const text = size === null ? "" : size.toFixed(2);
       if (input.value !== text) input.value = text;
+      input.dataset.shown = text;
       input.setAttribute("aria-invalid", "false");
-      input.title = "Type a size in mm (100 or 100mm): the part is scaled to it";
+      input.title = SIZE_HELP;
       $(`part-mirror_${a}`).setAttribute("aria-pressed", String(p.spec[`mirror_${a}`]));
     }
     $<HTMLInputElement>("part-auto").checked = auto;
