@@ -721,6 +721,121 @@ fn matrices_map_the_model_onto_the_sliced_mesh() {
     assert_eq!(offset, verts.len());
 }
 
+#[test]
+fn an_instance_gives_its_size_along_the_axes_its_scale_acts_on() {
+    // The page's size fields: scale_x × wanted / size_x is a part that wide, whatever the
+    // rotation on the plate.
+    let models = [box_model("b.stl", 10.0, 30.0, 5.0)];
+    let s = spec(
+        json!({"parts": [{"file": "b.stl", "scale_x": 2, "mirror_y": true,
+        "place_angle": 90, "place_x": 10, "place_y": 10}]}),
+    )
+    .unwrap();
+    let l = layout(&models, &s).unwrap();
+    let i = &l.instances[0];
+    for (got, want) in i.size.iter().zip([20.0, 30.0, 5.0]) {
+        assert!((got - want).abs() < 1e-9, "{:?}", i.size);
+    }
+    // on the plate, turned by 90°: 30 × 20
+    assert!((i.max[0] - i.min[0] - 30.0).abs() < 1e-9 && (i.max[1] - i.min[1] - 20.0).abs() < 1e-9);
+}
+
+/// Six times the signed volume of a mesh (positive when its facets face out).
+fn volume6(m: &dropslice::model::mesh::Mesh) -> f64 {
+    m.facets
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| glam::DVec3::from(m.vertices[v as usize]));
+            a.dot(b.cross(c))
+        })
+        .sum()
+}
+
+#[test]
+fn a_mirrored_part_slices_to_mirrored_sections_facing_out() {
+    let bytes = model_bytes("3DBenchy.stl");
+    let m = Model::read(&bytes, "3DBenchy.stl").unwrap();
+    let job_of = |part: Value| {
+        let s = spec(json!({"settings": {"layer_height": 0.4}, "parts": [part]})).unwrap();
+        Job::from_models(std::slice::from_ref(&m), &s).unwrap()
+    };
+    let plain = job_of(json!({"file": "3DBenchy.stl"}));
+    let mx = job_of(json!({"file": "3DBenchy.stl", "mirror_x": true}));
+    let mxz =
+        job_of(json!({"file": "3DBenchy.stl", "mirror_x": true, "mirror_z": true, "copies": 2}));
+    let (a, b) = (plain.mesh().bounds(), mx.mesh().bounds());
+    for k in 0..3 {
+        assert!((a.min[k] - b.min[k]).abs() < 1e-9 && (a.max[k] - b.max[k]).abs() < 1e-9);
+    }
+    // Facing out: no shell turned, the same volume, positive.
+    let v = volume6(plain.mesh());
+    assert!(v > 0.0);
+    for j in [&mx, &mxz] {
+        assert!(
+            !j.info().warnings.iter().any(|w| w.contains("inside out")),
+            "{:?}",
+            j.info().warnings
+        );
+    }
+    assert!((volume6(mx.mesh()) - v).abs() < 1e-6 * v);
+    assert!((volume6(mxz.mesh()) - 2.0 * v).abs() < 1e-6 * v);
+    // The matrix of a mirrored instance mirrors (negative determinant) and maps the model
+    // onto the sliced mesh's box.
+    let inst = &mx.info().instances[0];
+    let c = inst.matrix;
+    let det = c[0] * (c[5] * c[10] - c[9] * c[6]) - c[4] * (c[1] * c[10] - c[9] * c[2])
+        + c[8] * (c[1] * c[6] - c[5] * c[2]);
+    assert!(det < 0.0, "{det}");
+    // Each layer: the same area, its corners those of the plain part mirrored about the
+    // box's middle in x.
+    let mid2 = a.min[0] + a.max[0];
+    assert_eq!(plain.layer_count(), mx.layer_count());
+    for i in (0..plain.layer_count()).step_by(7) {
+        let (p, q) = (plain.section(i).region, mx.section(i).region);
+        let area = |r: &[dropslice::base::geom::Shape]| r.iter().map(|s| s.area()).sum::<f64>();
+        assert!(area(&p) > 0.0);
+        assert!(
+            (area(&p) - area(&q)).abs() < 1e-4 * area(&p),
+            "layer {i}: {} {}",
+            area(&p),
+            area(&q)
+        );
+        // (the sections are simplified within a small tolerance, so a corner of one lies on
+        // an edge of the other, not always on a corner)
+        let edges = |r: &[dropslice::base::geom::Shape]| -> Vec<[glam::DVec2; 2]> {
+            dropslice::base::geom::all_contours(&r.to_vec())
+                .flat_map(|c| (0..c.len()).map(move |k| [c[k], c[(k + 1) % c.len()]]))
+                .collect()
+        };
+        let pe = edges(&p);
+        for [v, _] in edges(&q) {
+            let w = glam::DVec2::new(mid2 - v.x, v.y);
+            let near = pe
+                .iter()
+                .map(|[a, b]| {
+                    let t = ((w - *a).dot(*b - *a) / (*b - *a).length_squared().max(1e-30))
+                        .clamp(0.0, 1.0);
+                    (*a + (*b - *a) * t).distance(w)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                near < 0.01,
+                "layer {i}: {v:?} mirrored is {near} mm from the plain section"
+            );
+        }
+    }
+    // The job file writes it only when set, and reads it back.
+    let s =
+        spec(json!({"parts": [{"file": "a.stl", "mirror_y": true}, {"file": "b.stl"}]})).unwrap();
+    let out = serde_json::to_value(&s.parts).unwrap();
+    assert_eq!(out[0]["mirror_y"], json!(true));
+    assert!(out[0].get("mirror_x").is_none() && out[1].get("mirror_y").is_none());
+    assert!(
+        job_message(spec(json!({"parts": [{"file": "a.stl", "mirror_x": 1}]})))
+            .contains("parts[0]")
+    );
+}
+
 // ---------------------------------------------------------------------------------------------
 // lay_flat and the display mesh
 

@@ -25,7 +25,7 @@ import { CutRenderer } from "./views/canvas/cutrender";
 import { Renderer } from "./views/canvas/render";
 import { updateButtons } from "./views/controls";
 import { setLine, wireCut } from "./views/cut";
-import { $ } from "./views/dom";
+import { $, wireSkipLinks } from "./views/dom";
 import { SettingsForm } from "./views/form";
 import { wireKeys } from "./views/keys";
 import { OVERLAYS, wireLayerView } from "./views/layer";
@@ -148,6 +148,7 @@ function wire(): void {
   wirePartDrag(page);
   wirePlot(page, actions.show);
   wireShortcuts();
+  wireSkipLinks();
   wireCalibrate(page);
   $<HTMLInputElement>("opt-voids").addEventListener("change", (ev) => {
     renderer.showVoids = (ev.target as HTMLInputElement).checked;

@@ -13,13 +13,14 @@ use crate::model::spec::{JobSpec, PartSpec, clean_name};
 use serde::{Deserialize, Serialize};
 
 /// An instance's transform before its last move: the rotation and scale of [`Placement`],
-/// the bounding box minimum after them (`min1`, moved to the origin), the rotation on the
+/// the bounding box after them (`min1`, moved to the origin, and `max1`), the rotation on the
 /// plate and the bounding box that gives (`qmin`, `qmax`; `qmin.z` = 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
     pub rotation: DMat3,
     pub scale: DVec3,
     pub min1: DVec3,
+    pub max1: DVec3,
     pub angle: DMat3,
     pub qmin: DVec3,
     pub qmax: DVec3,
@@ -42,10 +43,12 @@ impl Frame {
         let r = rotation(p.rotate);
         let scale = DVec3::from(p.scale);
         let step1 = |v: [f64; 3]| r * DVec3::from(v) * scale;
-        let mut min1 = DVec3::INFINITY;
+        let (mut min1, mut max1) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         in_runs(items.len(), &mut |run| {
             for v in items[run].iter().flat_map(&corners) {
-                min1 = min1.min(step1(v));
+                let q = step1(v);
+                min1 = min1.min(q);
+                max1 = max1.max(q);
             }
         });
         let angle = rot(2, p.place_angle);
@@ -61,6 +64,7 @@ impl Frame {
             rotation: r,
             scale,
             min1,
+            max1,
             angle,
             qmin,
             qmax,
@@ -109,6 +113,11 @@ pub struct Instance {
     pub matrix: [f64; 16],
     pub min: [f64; 3],
     pub max: [f64; 3],
+    /// The part's size (mm) along the axes its `scale_*` and `mirror_*` act on: after the
+    /// rotation, the scale and the shrinkage compensation, before `place_angle` (the page's
+    /// size fields: scale_x × size_x / this = a part size_x wide).
+    #[serde(default)]
+    pub size: [f64; 3],
     /// The final move given to [`crate::model::mesh::Mesh::place`].
     #[serde(skip)]
     pub shift: [f64; 2],
@@ -385,6 +394,7 @@ fn instance(
         matrix: f.matrix(shift),
         min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
         max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
+        size: (f.max1 - f.min1).to_array(),
         shift,
     }
 }

@@ -145,9 +145,13 @@ impl Mesh {
         self.place(&Placement::of_settings(s));
     }
 
-    /// [`Mesh::transform`] with the values of a [`Placement`] (a build job's part).
+    /// [`Mesh::transform`] with the values of a [`Placement`] (a build job's part); a
+    /// mirroring placement also turns every facet ([`turn_facets`]).
     pub fn place(&mut self, p: &Placement) {
         place_vertices(&mut self.vertices, p);
+        if p.mirrors() {
+            turn_facets(&mut self.facets);
+        }
     }
 
     /// Drops facets that repeat another facet with the same orientation (the same three
@@ -517,6 +521,14 @@ pub fn place_vertices(vertices: &mut [[f64; 3]], p: &Placement) {
     }
 }
 
+/// Each facet's corners in the other order (its normal reversed): after a mirroring
+/// [`Placement`] the facets face out again.
+pub fn turn_facets(facets: &mut [[u32; 3]]) {
+    for f in facets {
+        f.swap(1, 2);
+    }
+}
+
 /// Items filed under rows 0..n, each row's items one run of memory in the order given (the
 /// compressed rows of a sparse matrix): a mesh's per-vertex lists without a `Vec` per vertex.
 pub(crate) struct CompressedRows<T> {
@@ -584,8 +596,9 @@ pub fn edge_key(a: u32, b: u32) -> u64 {
     ((lo as u64) << 32) | hi as u64
 }
 
-/// A part's transform (docs/spec.md 5.3.1): rotate about x, y, z (degrees, in order), scale,
-/// bounding box minimum to the origin, rotate by `place_angle` (degrees) about z, move by `place`.
+/// A part's transform (docs/spec.md 5.3.1): rotate about x, y, z (degrees, in that order),
+/// scale, bounding box minimum to the origin, rotate by `place_angle` (degrees) about z, move by
+/// `place`. A negative scale mirrors that axis (a job's `mirror_*`, docs/jobs.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Placement {
     pub rotate: [f64; 3],
@@ -603,6 +616,12 @@ impl Placement {
             place_angle: s.place_angle,
             place: [s.place_x, s.place_y],
         }
+    }
+
+    /// Whether it mirrors the part (an odd number of negative scales): its facets' corners
+    /// then run the other way round ([`Mesh::place`] turns them, so that they face out).
+    pub fn mirrors(&self) -> bool {
+        self.scale.iter().filter(|s| **s < 0.0).count() % 2 == 1
     }
 
     /// The same placement with its scale multiplied by `factors` (the shrinkage

@@ -160,6 +160,7 @@ pub(crate) fn import(
             frame.qmax.y + place[1],
             frame.qmax.z,
         ],
+        size: (frame.max1 - frame.min1).to_array(),
         shift: place,
     };
     mesh.place(&placement);

@@ -40,11 +40,11 @@ pub const UNITS: u8 = 2;
 pub use crate::base::settings::PART_KEYS;
 
 /// The keys of a part in the job file, in the order messages list them: the file, the 3MF
-/// item, the [`PART_KEYS`], then copies, unit and name.
+/// item, the [`PART_KEYS`], then the mirrors, copies, unit and name.
 fn part_spec_keys() -> Vec<&'static str> {
     let mut keys = vec!["file", "item"];
     keys.extend(PART_KEYS);
-    keys.extend(["copies", "unit", "name"]);
+    keys.extend(["mirror_x", "mirror_y", "mirror_z", "copies", "unit", "name"]);
     keys
 }
 
@@ -117,6 +117,9 @@ fn one() -> f64 {
 fn one_copy() -> u32 {
     1
 }
+fn is_false(b: &bool) -> bool {
+    !*b
+}
 
 /// One part of a job file: a file (or one build item of a 3MF) and its transform.
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
@@ -142,6 +145,14 @@ pub struct PartSpec {
     pub scale_y: f64,
     #[serde(default = "one")]
     pub scale_z: f64,
+    /// Mirrored along the plate's x, y, z (after the rotation and the scale, before the
+    /// bounding box minimum goes to the origin); its facets turned so that they face out.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub mirror_x: bool,
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub mirror_y: bool,
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub mirror_z: bool,
     /// Where the bounding box minimum goes (with `place_y`); `None`: arranged.
     #[serde(default)]
     pub place_x: Option<f64>,
@@ -176,6 +187,9 @@ impl PartSpec {
             scale_x: s.scale_x,
             scale_y: s.scale_y,
             scale_z: s.scale_z,
+            mirror_x: false,
+            mirror_y: false,
+            mirror_z: false,
             place_x: None,
             place_y: None,
             place_angle: 0.0,
@@ -186,11 +200,17 @@ impl PartSpec {
     }
 
     /// Its transform with the bounding box minimum moved by `place`, its scale compensating
-    /// the shrinkage of its unit's material (`settings`' `shrink_*` or `unit1_shrink_*`).
+    /// the shrinkage of its unit's material (`settings`' `shrink_*` or `unit1_shrink_*`); a
+    /// mirrored axis is a negative scale ([`Placement::mirrors`]).
     pub fn placement(&self, place: [f64; 2], settings: &Settings) -> Placement {
+        let sign = |m: bool| if m { -1.0 } else { 1.0 };
         Placement {
             rotate: [self.rotate_x, self.rotate_y, self.rotate_z],
-            scale: [self.scale_x, self.scale_y, self.scale_z],
+            scale: [
+                self.scale_x * sign(self.mirror_x),
+                self.scale_y * sign(self.mirror_y),
+                self.scale_z * sign(self.mirror_z),
+            ],
             place_angle: self.place_angle,
             place,
         }
@@ -442,6 +462,11 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
             "copies" | "unit" => {
                 if !v.is_u64() {
                     return bad(k, "must be a whole number");
+                }
+            }
+            "mirror_x" | "mirror_y" | "mirror_z" => {
+                if !v.is_boolean() {
+                    return bad(k, "must be true (mirrored along that axis) or false");
                 }
             }
             "place_x" | "place_y" => {

@@ -148,7 +148,7 @@ impl Job {
         let mesh = if let [only] = order[..] {
             let mut mesh = std::mem::take(&mut welded[only.part]);
             let placement = spec.parts[only.part].placement(only.shift, &settings);
-            mesh::place_vertices(&mut mesh.vertices, &placement);
+            mesh.place(&placement);
             add_to_run(only.part, mesh.facets.len());
             mesh
         } else {
@@ -160,11 +160,15 @@ impl Job {
             for inst in order {
                 let part = &welded[inst.part];
                 let base = mesh.vertices.len();
+                let first = mesh.facets.len();
                 mesh.vertices.extend_from_slice(&part.vertices);
                 mesh.facets
                     .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
                 let placement = spec.parts[inst.part].placement(inst.shift, &settings);
                 mesh::place_vertices(&mut mesh.vertices[base..], &placement);
+                if placement.mirrors() {
+                    mesh::turn_facets(&mut mesh.facets[first..]);
+                }
                 add_to_run(inst.part, part.facets.len());
             }
             mesh

@@ -210,8 +210,9 @@ fn evaluate(
         if f.corners.iter().all(|c| row.dot(*c) <= lo + half_layer) {
             continue;
         }
-        // Projected area: |rotated normal z| × the scale in x and y (× 2).
-        area2 += -(r * f.normal2).z * scale.x * scale.y;
+        // Projected area: |rotated normal z| × the scale in x and y (× 2; a mirrored axis,
+        // a negative scale, mirrors no area).
+        area2 += (r * f.normal2).z.abs() * (scale.x * scale.y).abs();
     }
     (area2 / 2.0, hi - lo)
 }

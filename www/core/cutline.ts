@@ -47,3 +47,14 @@ export function crossesBox(l: Line, box: { minX: number; minY: number; maxX: num
   }
   return true;
 }
+
+/** Where the line is, in words: "y = 12.40 mm" for a line along x (both ends at one y), "x =
+ *  …" for one along y, else its ends and its angle to the x axis ("(1.00, 2.00) → (30.00,
+ *  12.50) mm, 19.9°"). */
+export function cutLabel(l: Line): string {
+  const mm = (v: number) => (Object.is(Math.round(v * 100), -0) ? 0 : v).toFixed(2);
+  if (Math.abs(l.a[1] - l.b[1]) < 1e-9) return `y = ${mm(l.a[1])} mm`;
+  if (Math.abs(l.a[0] - l.b[0]) < 1e-9) return `x = ${mm(l.a[0])} mm`;
+  const deg = (Math.atan2(l.b[1] - l.a[1], l.b[0] - l.a[0]) * 180) / Math.PI;
+  return `(${mm(l.a[0])}, ${mm(l.a[1])}) → (${mm(l.b[0])}, ${mm(l.b[1])}) mm, ${deg.toFixed(1)}°`;
+}

@@ -49,6 +49,19 @@ export function partRangeWords(spec: SettingSpec): string {
   return `${n(min)} … ${n(max)}${unit}`;
 }
 
+/** A part's mirror flags (docs/jobs.md: along the plate's x, y, z after rotation and scale). */
+export const MIRRORS = ["mirror_x", "mirror_y", "mirror_z"] as const;
+
+/** The core's lay-flat angles (the face down after rotate x, then y) for a part mirrored along
+ *  z or not: a z mirror after the rotation turns the face up, so the face is turned up first —
+ *  a half turn about x before, Rx(180)·Ry(b)·Rx(a) = Ry(−b)·Rx(a + 180) — and the mirror puts
+ *  it down. Angles stay in −360 … 360. */
+export function layFlatAngles(a: { rotate_x: number; rotate_y: number }, mirrorZ: boolean): { rotate_x: number; rotate_y: number } {
+  if (!mirrorZ) return { rotate_x: a.rotate_x, rotate_y: a.rotate_y };
+  const x = a.rotate_x + 180;
+  return { rotate_x: x > 360 ? x - 360 : x, rotate_y: a.rotate_y === 0 ? 0 : -a.rotate_y };
+}
+
 /** Triangles the 3D view draws for a whole job, shared by its instances. */
 export const DISPLAY_BUDGET = 300_000;
 
@@ -72,7 +85,7 @@ export interface DisplayMesh {
  *  a mesh in each would keep every mesh ever fetched (megabytes an edit). */
 export interface Part {
   id: number;
-  spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "place_angle" | "copies" | "unit">> & {
+  spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "mirror_x" | "mirror_y" | "mirror_z" | "place_angle" | "copies" | "unit">> & {
     /** Absent, never null: the whole file, unplaced (arranged), the file's name. */
     [K in "item" | "place_x" | "place_y" | "name"]?: NonNullable<PartSpec[K]>;
   };
@@ -93,6 +106,9 @@ export function fullSpec(p: PartSpec): Spec {
     scale_x: p.scale_x ?? 1,
     scale_y: p.scale_y ?? 1,
     scale_z: p.scale_z ?? 1,
+    mirror_x: p.mirror_x === true,
+    mirror_y: p.mirror_y === true,
+    mirror_z: p.mirror_z === true,
     place_angle: p.place_angle ?? 0,
     copies: p.copies ?? 1,
     unit: p.unit ?? 0,
@@ -113,6 +129,7 @@ export function specOut(s: Spec): PartSpec {
   if (s.item !== undefined) out.item = s.item;
   for (const k of ["rotate_x", "rotate_y", "rotate_z", "place_angle"] as const) if (s[k] !== 0) out[k] = s[k];
   for (const k of ["scale_x", "scale_y", "scale_z"] as const) if (s[k] !== 1) out[k] = s[k];
+  for (const k of MIRRORS) if (s[k]) out[k] = true;
   if (s.place_x !== undefined && s.place_y !== undefined && Number.isFinite(s.place_x) && Number.isFinite(s.place_y)) {
     out.place_x = s.place_x;
     out.place_y = s.place_y;

@@ -371,6 +371,9 @@ function checkParts(raw: unknown, files: LinkFile[], job: JobSchema, ignored: st
       } else if (k === "item") {
         if (typeof v === "number" && Number.isInteger(v) && v >= 0 && v <= ITEM_MAX) out.item = v;
         else ignored.push(`${at}'s item (${shown(v)} is not a whole number in 0 … ${ITEM_MAX}: the whole file is used)`);
+      } else if (k === "mirror_x" || k === "mirror_y" || k === "mirror_z") {
+        if (typeof v === "boolean") out[k] = v;
+        else ignored.push(`${at}'s ${k} (${shown(v)} is not true or false: not mirrored)`);
       } else if (!spec) {
         ignored.push(`${at}'s ${/^[a-z_]{1,40}$/.test(k) ? k : "unknown key"} (not a part's setting)`);
       } else if (typeof v !== "number" || !fitsPart(spec, v)) {

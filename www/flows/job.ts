@@ -4,7 +4,7 @@
 // job: flows/slice.ts startSlice.
 
 import type { Page } from "../views/page";
-import { DISPLAY_BUDGET, Job, jobSettings, meshKey, partName, specOut, uniqueName, type Changes, type DisplayMesh, type JobModel, type Part, type Spec } from "../core/job";
+import { DISPLAY_BUDGET, Job, jobSettings, layFlatAngles, meshKey, partName, specOut, uniqueName, type Changes, type DisplayMesh, type JobModel, type Part, type Spec } from "../core/job";
 import type { Orientation, Orientations, PartSpec } from "../core/protocol";
 import { errorBanner, hideBanner } from "../views/banner";
 import { updateButtons } from "../views/controls";
@@ -210,14 +210,15 @@ export function arrangeAll(page: Page): void {
   void editParts(page, job.parts.map((p) => ({ id: p.id, changes: { place: null } })), "arrange");
 }
 
-/** The core's lay-flat angles put into the part (its z rotation and scale kept). */
+/** The core's lay-flat angles put into the part (its z rotation, scale and mirror kept: with a
+ *  z mirror the angles that put the face down through it, `layFlatAngles`). */
 export async function layFlat(page: Page, id: number): Promise<void> {
   const job = page.store.job;
   const p = job?.part(id);
   if (!job || !p) return;
   try {
     const a = await page.pool.layFlat(job.refs(), p.spec.file, p.spec.item);
-    await editParts(page, [{ id, changes: { rotate_x: a.rotate_x, rotate_y: a.rotate_y } }], "lay flat");
+    await editParts(page, [{ id, changes: layFlatAngles(a, p.spec.mirror_z) }], "lay flat");
   } catch (e) {
     showError(page, e);
   }

@@ -1,8 +1,11 @@
-// Messages: the banner (errors, notices) and the note about a preview link.
+// Messages: the banner (errors, notices) and the note about a preview link. Above the stage in
+// the page's flow (never over a control); an error stays until its ✕, information goes by
+// itself (notices.ts `dismissAfter`); the note goes on a click.
 
 import { SliceError } from "../core/client";
 import { plainJobMessage } from "../core/plate";
 import { $ } from "./dom";
+import { NOTICE_MS, dismissAfter } from "./notices";
 
 export const TITLES: Record<string, string> = {
   import: "",
@@ -36,9 +39,11 @@ export function showBanner(title: string, message: string, tone: "error" | "info
   $("banner-message").textContent = message;
   b.hidden = false;
   b.dataset.kind = tone;
+  dismissAfter(b, tone === "error" ? null : NOTICE_MS);
 }
 
 export function hideBanner(): void {
+  dismissAfter($("banner"), null);
   $("banner").hidden = true;
 }
 
@@ -62,4 +67,10 @@ export function note(text: string, tone: "warn" | "ok" | "none"): void {
   n.hidden = tone === "none";
   n.textContent = text;
   n.className = tone === "ok" ? "banner ok" : "note";
+  n.title = tone === "none" ? "" : "Click to dismiss";
+  dismissAfter(n, tone === "ok" ? NOTICE_MS : null);
+  if (!n.dataset.wired) {
+    n.dataset.wired = "1";
+    n.addEventListener("click", () => (n.hidden = true));
+  }
 }

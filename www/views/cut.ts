@@ -3,7 +3,7 @@
 // the cut panel around the section (canvas/cutrender.ts draws it). The section's runs of the
 // workers: flows/cut.ts (through the page's actions).
 
-import { checkLine, lineLength, type Line, type Pt } from "../core/cutline";
+import { checkLine, cutLabel, lineLength, type Line, type Pt } from "../core/cutline";
 import type { Page } from "./page";
 import { wirePanZoom } from "./canvas/panzoom";
 import { $ } from "./dom";
@@ -37,6 +37,7 @@ export function writeCutStatus(more: string, missed = false): void {
  *  else "x =" its middle's x (an axis line's own position; a slanted one's middle). */
 function writePosition(line: Line | null): void {
   if (!line) return;
+  $("cut-where").textContent = `Section along ${cutLabel(line)}, from A to B`;
   const across = Math.abs(line.b[0] - line.a[0]) >= Math.abs(line.b[1] - line.a[1]) ? "y" : "x";
   const k = across === "y" ? 1 : 0;
   $<HTMLSelectElement>("cut-axis").value = across;
@@ -56,8 +57,11 @@ function axisLine(page: Page, axis: "x" | "y", v: number): Line | null {
 /** The line on the layer canvas (after every draw of it), with its ends as handles. */
 function drawOnLayer(page: Page): void {
   const l = drawn;
-  if (!l) return;
   const r = page.renderer;
+  if (!l) {
+    delete r.canvas.dataset.cutLabel;
+    return;
+  }
   const ctx = r.canvas.getContext("2d");
   if (!ctx) return;
   const dpr = window.devicePixelRatio || 1;
@@ -90,6 +94,18 @@ function drawOnLayer(page: Page): void {
     ctx.textBaseline = "bottom";
     ctx.fillText(name, x + 8 * dpr, y - 6 * dpr);
   }
+  // where it is, beside the line's middle (on a white ground; the canvas' attribute for tests)
+  const label = cutLabel(l);
+  r.canvas.dataset.cutLabel = label;
+  ctx.font = `600 ${12 * dpr}px system-ui, sans-serif`;
+  ctx.textBaseline = "top";
+  const w = ctx.measureText(label).width;
+  const mx = Math.min(Math.max((ax + bx) / 2 + 8 * dpr, 4 * dpr), r.canvas.width - w - 8 * dpr);
+  const my = Math.min(Math.max((ay + by) / 2 + 8 * dpr, 4 * dpr), r.canvas.height - 22 * dpr);
+  ctx.fillStyle = "rgba(255, 255, 255, 0.88)";
+  ctx.fillRect(mx - 4 * dpr, my - 3 * dpr, w + 8 * dpr, 18 * dpr);
+  ctx.fillStyle = "#1c2430";
+  ctx.fillText(label, mx, my);
   ctx.restore();
 }
 

@@ -21,3 +21,25 @@ export function duration(seconds: number): string {
   if (m > 0) return `${m} min ${s} s`;
   return `${s} s`;
 }
+
+/** The skip links (the page's first focusable elements): "Skip to Slice" and "Skip to the layer
+ *  view" move the focus there (the page's own move: a fragment alone would only scroll). A
+ *  Slice button still disabled (no model yet) gives the focus to its row; a layer canvas hidden
+ *  (the 3D tab) to the layer slider. */
+export function wireSkipLinks(): void {
+  const go = (ev: Event, el: HTMLElement) => {
+    ev.preventDefault();
+    el.scrollIntoView({ block: "nearest" });
+    el.focus({ preventScroll: true });
+  };
+  $("skip-slice").addEventListener("click", (ev) => {
+    const slice = $<HTMLButtonElement>("btn-slice");
+    const row = slice.parentElement!;
+    if (slice.disabled) row.tabIndex = -1;
+    go(ev, slice.disabled ? row : slice);
+  });
+  $("skip-layer").addEventListener("click", (ev) => {
+    const view = $("view");
+    go(ev, view.getClientRects().length > 0 ? view : $("layer"));
+  });
+}

@@ -1,13 +1,51 @@
 // Short notices of the page: the Undo and Redo buttons (what they would undo in their titles),
 // the notice after a change that replaced work ("… — Undo"), and the note of a page opened
-// from a preview link (the settings that differ from the defaults).
+// from a preview link (the settings that differ from the defaults). Notices sit above the stage
+// in the page's flow (they push the canvases down, never over a control); information goes by
+// itself after [[NOTICE_MS]] (not while the pointer or the focus is on it), and every notice
+// goes on its ✕; errors stay until then (banner.ts).
 
 import { $ } from "./dom";
 import type { Page } from "./page";
 
-/** A notice goes by itself after this long. */
-const NOTICE_MS = 12_000;
-let noticeTimer = 0;
+/** Information goes by itself after this long (ms). */
+export const NOTICE_MS = 8_000;
+
+const timers = new WeakMap<HTMLElement, number>();
+const paused = new WeakSet<HTMLElement>();
+
+/** `el` hidden after `ms` (again from the start while the pointer or the focus is on it, so
+ *  that it is never taken away from under the user); `ms` null: it stays (a timer before is
+ *  cleared). */
+export function dismissAfter(el: HTMLElement, ms: number | null): void {
+  clearTimeout(timers.get(el));
+  timers.delete(el);
+  if (ms === null) return;
+  if (!paused.has(el)) {
+    paused.add(el);
+    const hold = () => clearTimeout(timers.get(el));
+    const again = () => {
+      if (timers.has(el) && !el.hidden && !el.matches(":hover") && !el.contains(document.activeElement)) arm(el, ms);
+    };
+    el.addEventListener("pointerenter", hold);
+    el.addEventListener("focusin", hold);
+    el.addEventListener("pointerleave", again);
+    el.addEventListener("focusout", () => setTimeout(again, 0));
+  }
+  arm(el, ms);
+}
+
+function arm(el: HTMLElement, ms: number): void {
+  clearTimeout(timers.get(el));
+  timers.set(
+    el,
+    window.setTimeout(() => {
+      timers.delete(el);
+      el.hidden = true;
+    }, ms),
+  );
+}
+
 /** What the notice's button does. */
 let noticeAction: "undo" | "redo" = "undo";
 
@@ -30,13 +68,12 @@ export function undoNotice(page: Page, text: string, action: "undo" | "redo" = "
   $("undo-text").textContent = text;
   $("undo-again").textContent = capital(action);
   $("undo-note").hidden = false;
-  clearTimeout(noticeTimer);
-  noticeTimer = window.setTimeout(hideNotice, NOTICE_MS);
+  dismissAfter($("undo-note"), NOTICE_MS);
   updateUndo(page);
 }
 
 function hideNotice(): void {
-  clearTimeout(noticeTimer);
+  dismissAfter($("undo-note"), null);
   $("undo-note").hidden = true;
 }
 
@@ -47,6 +84,7 @@ export function linkFromNote(differing: string[]): void {
     ? `Settings that differ from the defaults: ${differing.join(", ")}.`
     : "Every setting is at its default.";
   $("link-from").hidden = false;
+  dismissAfter($("link-from"), NOTICE_MS);
 }
 
 export function wireNotices(page: Page): void {

@@ -1,6 +1,8 @@
 // The parts panel (left column, above the settings): the job's parts (name, triangles, size on
-// the plate, copies), the selected part's editor (rotation, scale with a uniform lock, place or
-// "auto", place angle, copies, lay flat, duplicate, remove) and the job's buttons (add part,
+// the plate, copies; a context menu, views/contextmenu.ts), the selected part's editor
+// (rotation, scale with a uniform lock, the size in mm per axis — typing one scales the part to
+// it —, mirror per axis, place or "auto", place angle, copies, lay flat, duplicate, remove) and
+// the job's buttons (add part,
 // arrange, save job). Every change is an action (flows/job.ts), which has the core lay the job out
 // again; what is shown comes from the job and the core's layout only.
 
@@ -10,12 +12,43 @@ import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
 import { cancelOrient, orientEditorShows, orientPart } from "./orient";
+import { mirrorChange, openPartMenu } from "./contextmenu";
 
 const NUMBER_FIELDS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "copies"] as const;
 type NumberField = (typeof NUMBER_FIELDS)[number];
 
 const fmt = (v: number) => String(+v.toFixed(4));
 const mm = (v: number) => v.toFixed(1);
+
+const AXES = ["x", "y", "z"] as const;
+const SIZE_HELP = "Type a size in mm (100 or 100mm): the part is scaled to it";
+type Axis = (typeof AXES)[number];
+
+/** A size typed in mm ("100", "100mm", "100 mm", "99,5"): the millimetres, or why not. */
+export function parseSize(raw: string): { value?: number; error?: string } {
+  const t = raw.trim().replace(",", ".").replace(/\s*mm$/i, "");
+  const x = Number(t);
+  if (t === "" || !Number.isFinite(x)) return { error: "a size in mm is needed (e.g. 100 or 100mm)" };
+  if (!(x > 0)) return { error: "the size must be > 0 mm" };
+  return { value: x };
+}
+
+/** The scales that make the part `size` mm along `axis` (all three with the uniform lock), from
+ *  its scale now and its size now along that axis (the core's `Instance.size`); or why not (a
+ *  scale out of the core's range). */
+export function scaleTo(spec: Part["spec"], now: number, axis: Axis, size: number, uniform: boolean, job: JobSchema): { changes?: Changes; error?: string } {
+  if (!(now > 0)) return { error: "the part has no size along this axis" };
+  const f = size / now;
+  const keys = uniform ? AXES.map((a) => `scale_${a}` as const) : [`scale_${axis}` as const];
+  const changes: Changes = {};
+  for (const k of keys) {
+    const v = +(spec[k] * f).toPrecision(12);
+    const range = partNumber(job, k);
+    if (!range || !fitsPart(range, v)) return { error: `that needs a scale of ${fmt(v)}, but the scale must be ${range ? partRangeWords(range) : "in range"}` };
+    changes[k] = v;
+  }
+  return { changes };
+}
 
 /** A number typed into a field ("0,5" too): the value, or why not (its range is the core's:
  *  `job`, the core's job schema). */
@@ -59,6 +92,21 @@ export class PartsPanel implements PartsView {
       const unit = Number((ev.target as HTMLSelectElement).value);
       if (p && (unit === 0 || unit === 1) && unit !== p.spec.unit) void this.edit(p, { unit }).then((ok) => ok || this.renderEditor());
     });
+    for (const a of AXES) {
+      const input = $<HTMLInputElement>(`part-size_${a}`);
+      const go = () => this.sized(a, input);
+      input.addEventListener("change", go);
+      input.addEventListener("keydown", (ev) => {
+        if (ev.key === "Enter") {
+          ev.preventDefault();
+          go();
+        }
+      });
+      $(`part-mirror_${a}`).addEventListener("click", () => {
+        const p = this.part();
+        if (p) void this.edit(p, mirrorChange(p, a));
+      });
+    }
     $("part-lay-flat").addEventListener("click", () => this.part() && actions.layFlat(this.part()!.id));
     $("part-orient").addEventListener("click", () => this.part() && void orientPart(this.page, this.part()!));
     $("orient-cancel").addEventListener("click", () => cancelOrient(this.page));
@@ -86,9 +134,48 @@ export class PartsPanel implements PartsView {
     return this.page.actions.editParts([{ id: p.id, changes }]);
   }
 
+  /** The part's size (mm) now along `axis`, before the rotation on the plate (its first copy in
+   *  the core's layout). */
+  private size(p: Part, axis: Axis): number | null {
+    const job = this.page.store.job!;
+    const inst = job.layout?.instances.find((x) => job.parts[x.part] === p && x.copy === 0);
+    return inst?.size ? inst.size[AXES.indexOf(axis)] : null;
+  }
+
+  /** A size typed into a size field (or "…mm" into a scale field): the part scaled to it. */
+  private sized(axis: Axis, input: HTMLInputElement): void {
+    const p = this.part();
+    if (!p) return;
+    if (input.value === input.dataset.shown) {
+      input.setAttribute("aria-invalid", "false");
+      input.title = SIZE_HELP;
+      return;
+    }
+    const now = this.size(p, axis);
+    let r: { changes?: Changes; error?: string } = parseSize(input.value);
+    if (r.error === undefined) {
+      r = now === null ? { error: "the part has no layout yet" } : scaleTo(p.spec, now, axis, (r as { value: number }).value, $<HTMLInputElement>("part-scale-lock").checked, this.page.init!.job);
+    }
+    input.setAttribute("aria-invalid", r.error ? "true" : "false");
+    input.title = r.error ?? "";
+    if (r.changes) void this.edit(p, r.changes).then((ok) => ok || this.renderEditor());
+  }
+
   private changed(k: NumberField, input: HTMLInputElement): void {
     const p = this.part();
     if (!p) return;
+    // the text the editor wrote, left as it was (a change event on leaving a field the editor
+    // wrote into): no edit, so a value shown rounded is never taken rounded
+    if (input.value === input.dataset.shown) {
+      input.setAttribute("aria-invalid", "false");
+      input.title = "";
+      return;
+    }
+    if (k.startsWith("scale_") && /mm\s*$/i.test(input.value)) {
+      // "100mm" in a scale field: a size
+      this.sized(k.slice(-1) as Axis, input);
+      return;
+    }
     const r = parseField(k, input.value, this.page.init!.job);
     input.setAttribute("aria-invalid", r.error ? "true" : "false");
     input.title = r.error ?? "";
@@ -148,15 +235,31 @@ export class PartsPanel implements PartsView {
       li.append(name, right, meta);
       const pick = () => this.page.actions.selectPart(p.id);
       li.addEventListener("click", pick);
+      // the part's context menu: right-click, the ContextMenu key or Shift+F10; the focus
+      // comes back to the part's line (made again by then: found by its id)
+      const back = () => list.querySelector<HTMLElement>(`li[data-id="${p.id}"]`);
+      li.addEventListener("contextmenu", (ev) => {
+        ev.preventDefault();
+        const keyboard = ev.button !== 2 && ev.clientX === 0 && ev.clientY === 0;
+        const r = li.getBoundingClientRect();
+        openPartMenu(this.page, p.id, keyboard ? r.left + 12 : ev.clientX, keyboard ? r.bottom : ev.clientY, back);
+      });
       li.addEventListener("keydown", (ev) => {
         if (ev.key === "Enter" || ev.key === " ") {
           ev.preventDefault();
           pick();
+        } else if (ev.key === "ContextMenu" || (ev.key === "F10" && ev.shiftKey)) {
+          ev.preventDefault();
+          const r = li.getBoundingClientRect();
+          openPartMenu(this.page, p.id, r.left + 12, r.bottom, back);
         }
       });
       return li;
     });
+    // a part's line that had the focus keeps it (an edit draws the list again)
+    const focused = list.contains(document.activeElement) ? (document.activeElement as HTMLElement).closest<HTMLElement>("li")?.dataset.id : undefined;
     list.replaceChildren(...items);
+    if (focused !== undefined) list.querySelector<HTMLElement>(`li[data-id="${focused}"]`)?.focus({ preventScroll: true });
     // the page's own words for a part off the plate (core/plate.ts); the core's others reworded
     const warnings = [...off.map((o) => o.message), ...(job.layout?.warnings ?? []).filter((w) => !/outside the plate/.test(w)).map(plainJobMessage)];
     $("parts-warnings").classList.toggle("bad", off.length > 0);
@@ -191,8 +294,19 @@ export class PartsPanel implements PartsView {
       const input = $<HTMLInputElement>(`part-${k}`);
       const text = k.startsWith("place_") && k !== "place_angle" ? values[k].toFixed(2) : fmt(values[k]);
       if (input.value !== text) input.value = text;
+      input.dataset.shown = text;
       input.setAttribute("aria-invalid", "false");
       input.title = "";
+    }
+    for (const a of AXES) {
+      const input = $<HTMLInputElement>(`part-size_${a}`);
+      const size = this.size(p, a);
+      const text = size === null ? "" : size.toFixed(2);
+      if (input.value !== text) input.value = text;
+      input.dataset.shown = text;
+      input.setAttribute("aria-invalid", "false");
+      input.title = SIZE_HELP;
+      $(`part-mirror_${a}`).setAttribute("aria-pressed", String(p.spec[`mirror_${a}`]));
     }
     $<HTMLInputElement>("part-auto").checked = auto;
     $<HTMLSelectElement>("part-unit").value = String(p.spec.unit === 1 ? 1 : 0);

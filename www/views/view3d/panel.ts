@@ -12,6 +12,7 @@ import { jobSettings } from "../../core/job";
 import { supportColumns } from "../../core/supportcolumns";
 import { jobOffPlate } from "../../core/plate";
 import { errorBanner } from "../banner";
+import { openPartMenu, openSelectedPartMenu } from "../contextmenu";
 import { $ } from "../dom";
 import type { Page, View3DView } from "../page";
 import type { Camera3D, View3D, View3DPart, View3DSlice } from "./view3d";
@@ -173,6 +174,20 @@ export class View3DPanel implements View3DView {
       this.selected = id;
       const at = id === null ? null : parseInstanceId(id);
       page.actions.selectPart(at ? at.part : null);
+    });
+    view.onMenu((id, x, y) => {
+      const page = this.page;
+      if (!page) return;
+      const canvas = () => this.container.querySelector("canvas");
+      if (id === null) {
+        const c = canvas();
+        if (c) openSelectedPartMenu(page, c);
+        return;
+      }
+      const at = parseInstanceId(id);
+      if (!at) return;
+      this.selected = id;
+      openPartMenu(page, at.part, x, y, canvas);
     });
     view.onDrag((id, dx, dy, done) => {
       const page = this.page;

@@ -11,6 +11,10 @@
 //   select(id | null)            the selected part is tinted (no callback)
 //   onSelect(cb)                 a click (press and release within a few pixels) on a part, or
 //                                on empty space (null); the view selects it before calling cb
+//   onMenu(cb)                   a right-click (press and release within a few pixels: a
+//                                right drag pans) on a part: cb(id, clientX, clientY), the
+//                                view selects it first; the ContextMenu key on the canvas:
+//                                cb(null, …) at the canvas' middle (the owner picks the part)
 //   onDrag(cb)                   with a listener, a left drag that starts on a part moves it on
 //                                the plate plane: cb(id, dx, dy, done) with dx, dy the plate
 //                                millimetres from the drag's start (cumulative); the view moves
@@ -167,6 +171,11 @@ export class View3D {
   private slice: Required<View3DSlice> | null = null;
   private selectCb: ((id: string | null) => void) | null = null;
   private dragCb: ((id: string, dx: number, dy: number, done: boolean) => void) | null = null;
+  private menuCb: ((id: string | null, x: number, y: number) => void) | null = null;
+  /** A right button press under way (a release near it is a right-click: the menu). */
+  private rightPress: { pointerId: number; x: number; y: number } | null = null;
+  /** When the last right press ended (its contextmenu event may come after it). */
+  private rightUp = -Infinity;
   private frame = 0;
   private frames = 0;
   private width = 0;
@@ -238,7 +247,7 @@ export class View3D {
     this.canvas.addEventListener("pointermove", this.onPointerMove);
     this.canvas.addEventListener("pointerup", this.onPointerUp);
     this.canvas.addEventListener("pointercancel", this.onPointerCancel);
-    this.canvas.addEventListener("contextmenu", this.preventDefault);
+    this.canvas.addEventListener("contextmenu", this.onContextMenu);
 
     this.observer = new ResizeObserver(() => this.resize());
     this.observer.observe(container);
@@ -385,6 +394,10 @@ export class View3D {
     this.dragCb = cb;
   }
 
+  onMenu(cb: (id: string | null, x: number, y: number) => void): void {
+    this.menuCb = cb;
+  }
+
   private applyMaterials(): void {
     for (const e of this.entries.values()) {
       const m = this.materials;
@@ -525,14 +538,14 @@ export class View3D {
 
   // ---- picking and dragging ----
 
-  private ray(ev: PointerEvent): void {
+  private ray(ev: MouseEvent): void {
     const r = this.canvas.getBoundingClientRect();
     this.ndc.set(((ev.clientX - r.left) / r.width) * 2 - 1, -((ev.clientY - r.top) / r.height) * 2 + 1);
     this.raycaster.setFromCamera(this.ndc, this.camera);
   }
 
   /** The visible part under the pointer and where it was hit (in `this.point`); O(triangles). */
-  private pick(ev: PointerEvent): string | null {
+  private pick(ev: MouseEvent): string | null {
     this.ray(ev);
     this.scene.updateMatrixWorld();
     this.targets.length = 0;
@@ -557,6 +570,7 @@ export class View3D {
     if (ev.target !== this.canvas) return;
     this.canvas.focus({ preventScroll: true });
     if (this.press) this.endPress(false);
+    if (ev.button === 2) this.rightPress = { pointerId: ev.pointerId, x: ev.clientX, y: ev.clientY };
     if (ev.button !== 0 || ev.shiftKey || ev.ctrlKey || ev.metaKey) return;
     // parts are only looked up now when they can be dragged; a click looks them up on release
     const id = this.dragCb ? this.pick(ev) : null;
@@ -599,6 +613,20 @@ export class View3D {
   };
 
   private readonly onPointerUp = (ev: PointerEvent): void => {
+    const r = this.rightPress;
+    if (ev.button === 2 && r && r.pointerId === ev.pointerId) {
+      this.rightPress = null;
+      this.rightUp = performance.now();
+      if (Math.hypot(ev.clientX - r.x, ev.clientY - r.y) < CLICK_PX && this.menuCb) {
+        const id = this.pick(ev);
+        if (id !== null) {
+          this.select(id);
+          this.selectCb?.(this.selected);
+          this.menuCb(id, ev.clientX, ev.clientY);
+        }
+      }
+      return;
+    }
     const p = this.press;
     if (!p || ev.pointerId !== p.pointerId) return;
     const click = !p.dragging && Math.hypot(ev.clientX - p.x, ev.clientY - p.y) < CLICK_PX;
@@ -620,7 +648,14 @@ export class View3D {
     if (p && p.dragging && p.id !== null && report) this.dragCb?.(p.id, p.dx, p.dy, true);
   }
 
-  private readonly preventDefault = (ev: Event): void => ev.preventDefault();
+  /** The browser's menu never shows; the ContextMenu key (no right press before it, none just
+   *  ended) asks for the selected part's menu. */
+  private readonly onContextMenu = (ev: MouseEvent): void => {
+    ev.preventDefault();
+    if (this.rightPress || performance.now() - this.rightUp < 500 || !this.menuCb) return;
+    const r = this.canvas.getBoundingClientRect();
+    this.menuCb(null, r.left + r.width / 2, r.top + r.height / 2);
+  };
 
   dispose(): void {
     if (this.disposed) return;
@@ -633,7 +668,7 @@ export class View3D {
     this.canvas.removeEventListener("pointermove", this.onPointerMove);
     this.canvas.removeEventListener("pointerup", this.onPointerUp);
     this.canvas.removeEventListener("pointercancel", this.onPointerCancel);
-    this.canvas.removeEventListener("contextmenu", this.preventDefault);
+    this.canvas.removeEventListener("contextmenu", this.onContextMenu);
     for (const e of [...this.entries.values()]) this.drop(e);
     this.support = showSupport(this.scene, this.support, null, this.clipTop);
     disposeObject(this.plate);
