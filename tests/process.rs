@@ -513,6 +513,77 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
 }
 
 #[test]
+fn a_profile_is_read_by_one_rule_whatever_its_encoding() {
+    // The page's import reads the same bytes through the same core function (`check_profile`):
+    // UTF-8 with or without its mark, UTF-16 with its mark, read; Latin-1 refused saying what
+    // to do; a name of just U+FEFF refused as the page refuses it.
+    let dir = TempDir::new("profile-enc");
+    let text = r#"{"name": "Düsseldorf", "kind": "machine", "settings": {"plate_z": 100}}"#;
+    let utf16 = |big: bool| -> Vec<u8> {
+        let mark: [u8; 2] = if big { [0xFE, 0xFF] } else { [0xFF, 0xFE] };
+        let units = text.encode_utf16();
+        mark.into_iter()
+            .chain(units.flat_map(|u| {
+                if big {
+                    u.to_be_bytes()
+                } else {
+                    u.to_le_bytes()
+                }
+            }))
+            .collect()
+    };
+    let good: [(&str, Vec<u8>); 4] = [
+        ("UTF-8", text.as_bytes().to_vec()),
+        (
+            "UTF-8 with its mark",
+            [&[0xEF, 0xBB, 0xBF][..], text.as_bytes()].concat(),
+        ),
+        ("UTF-16 LE", utf16(false)),
+        ("UTF-16 BE", utf16(true)),
+    ];
+    for (what, bytes) in good {
+        std::fs::write(dir.join("p.json"), bytes).unwrap();
+        let out = sliced(
+            &dir,
+            "@cube_20mm_ascii.stl -q -o c.gco --profile p.json",
+            "c.gco",
+        );
+        assert!(
+            out.contains("; profiles = Düsseldorf (machine)\n"),
+            "{what}"
+        );
+        assert!(out.contains("; plate_z = 100.0 (mm)"), "{what}");
+    }
+    let latin1: Vec<u8> = text.chars().map(|c| c as u32 as u8).collect();
+    let bad: [(&str, Vec<u8>, &[&str]); 3] = [
+        (
+            "Latin-1",
+            latin1,
+            &["p.json", "not UTF-8", "save it as UTF-8"],
+        ),
+        (
+            "a name of U+FEFF",
+            r#"{"name": "\ufeff", "kind": "machine", "settings": {}}"#.into(),
+            &["p.json", "name", "visible characters"],
+        ),
+        (
+            "a name of U+FEFF, written as the character",
+            "{\"name\": \"\u{feff} \", \"kind\": \"machine\", \"settings\": {}}".into(),
+            &["p.json", "visible characters"],
+        ),
+    ];
+    for (what, bytes, expected) in bad {
+        std::fs::write(dir.join("p.json"), bytes).unwrap();
+        let r = cli(&dir, "@cube_20mm_ascii.stl -o bad.gco --profile p.json");
+        assert_eq!(r.code, Some(2), "{what}: {r:?}");
+        for e in expected {
+            assert!(r.stderr.contains(e), "{what}: {}", r.stderr);
+        }
+        assert!(!dir.join("bad.gco").exists());
+    }
+}
+
+#[test]
 fn a_profile_applies_to_a_job_file_before_set() {
     let dir = TempDir::new("profile-job");
     std::fs::copy(model("cube_20mm_ascii.stl"), dir.join("cube.stl")).unwrap();

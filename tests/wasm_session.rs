@@ -961,20 +961,34 @@ fn a_session_refuses_a_job_taller_than_the_chamber() {
 #[wasm_bindgen_test]
 fn check_profile_returns_the_profile_or_names_the_key() {
     let p = json(
-        check_profile(r#"{"name": " M ", "kind": "machine", "settings": {"plate_z": 180}}"#)
-            .unwrap(),
+        check_profile(
+            r#"{"name": " M ", "kind": "machine", "settings": {"plate_z": 180}}"#.as_bytes(),
+        )
+        .unwrap(),
     );
     assert_eq!(
         p,
         serde_json::json!({"name": "M", "kind": "machine", "settings": {"plate_z": 180}})
     );
     let e = thrown(check_profile(
-        r#"{"name": "M", "kind": "machine", "settings": {"shrink_z": 1}}"#,
+        r#"{"name": "M", "kind": "machine", "settings": {"shrink_z": 1}}"#.as_bytes(),
     ));
     assert_eq!(
         (e["kind"].as_str(), e["setting"].as_str()),
         (Some("setting"), Some("shrink_z"))
     );
+    // The bytes as the file holds them: UTF-16 with its mark as the CLI reads it; a name of
+    // just U+FEFF is refused here as the page refuses it.
+    let text = r#"{"name": "Mü", "kind": "machine", "settings": {}}"#;
+    let utf16: Vec<u8> = [0xFF, 0xFE]
+        .into_iter()
+        .chain(text.encode_utf16().flat_map(u16::to_le_bytes))
+        .collect();
+    assert_eq!(json(check_profile(&utf16).unwrap())["name"], "Mü");
+    let e = thrown(check_profile(
+        "{\"name\": \"\u{feff}\", \"kind\": \"machine\", \"settings\": {}}".as_bytes(),
+    ));
+    assert!(e["message"].as_str().unwrap().contains("name"), "{e}");
 }
 
 /// The merged summary of a session's layers analysed in runs of layers [from, to), each run's

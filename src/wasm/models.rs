@@ -151,8 +151,8 @@ impl Models {
 /// settings}` with every key of its kind and every value in range. Throws `{kind: "setting",
 /// message, setting?}` naming the key.
 #[wasm_bindgen(unchecked_return_type = "Profile")]
-pub fn check_profile(text: &str) -> Result<JsValue, JsValue> {
-    let profile = crate::base::settings::Profile::from_json(text).map_err(js_error)?;
+pub fn check_profile(bytes: &[u8]) -> Result<JsValue, JsValue> {
+    let profile = crate::base::settings::Profile::from_bytes(bytes).map_err(js_error)?;
     to_js(&profile, "the profile")
 }
 

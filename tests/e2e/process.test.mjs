@@ -121,6 +121,25 @@ test("a profile saved, exported, deleted and imported again gives the same setti
   assert.equal(await page.locator("#profile-list li").count(), 0, "nothing was added");
   assert.deepEqual(await formValues(page), reset, "the settings did not change");
 
+  // the bytes go to the core, which reads them as the CLI's --profile does: Latin-1 refused
+  // saying what to do, a name of just U+FEFF refused, UTF-16 with its mark read (then deleted)
+  const latin1 = join(dir, "latin1.json");
+  writeFileSync(latin1, Buffer.from(JSON.stringify({ name: "Düsseldorf", kind: "machine", settings: {} }), "latin1"));
+  await page.setInputFiles("#profile-file", latin1);
+  await page.waitForFunction(() => /latin1\.json was not imported/.test(document.getElementById("profile-status").textContent), null, { timeout: 30_000 });
+  assert.match(await page.locator("#profile-status").innerText(), /not UTF-8 .*save it as UTF-8/);
+  const bom = join(dir, "bom.json");
+  writeFileSync(bom, JSON.stringify({ name: "\ufeff", kind: "machine", settings: {} }));
+  await page.setInputFiles("#profile-file", bom);
+  await page.waitForFunction(() => /bom\.json was not imported/.test(document.getElementById("profile-status").textContent), null, { timeout: 30_000 });
+  assert.match(await page.locator("#profile-status").innerText(), /visible characters/);
+  const utf16 = join(dir, "utf16.json");
+  writeFileSync(utf16, Buffer.concat([Buffer.from([0xff, 0xfe]), Buffer.from(JSON.stringify({ name: "Düsseldorf", kind: "machine", settings: { plate_z: 150 } }), "utf16le")]));
+  await page.setInputFiles("#profile-file", utf16);
+  await page.waitForSelector('#profile-list li[data-name="Düsseldorf"]', { timeout: 30_000 });
+  await page.click('#profile-list li[data-name="Düsseldorf"] .profile-delete');
+  await page.waitForSelector('#profile-list li[data-name="Düsseldorf"]', { state: "detached" });
+
   await page.setInputFiles("#profile-file", file);
   await page.waitForSelector('#profile-list li[data-name="Test machine"]', { timeout: 30_000 });
   assert.deepEqual(await formValues(page), reset, "importing does not apply");

@@ -499,9 +499,9 @@ export class Pool {
   }
 
   /** A profile's JSON text checked by the core. */
-  checkProfile(text: string): Promise<ResultOf<"check_profile">> {
+  checkProfile(bytes: Uint8Array): Promise<ResultOf<"check_profile">> {
     this.heal();
-    return this.guarded(() => this.handles[0].call("check_profile", { text }));
+    return this.guarded(() => this.handles[0].call("check_profile", { bytes }));
   }
 
   /** For tests: makes the wasm panic in one worker. */

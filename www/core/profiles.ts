@@ -31,9 +31,19 @@ export interface StoredProfile {
 const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "object" && v !== null && !Array.isArray(v);
 
 /** Why `raw` is not a usable profile name (null: it is). */
+/** Characters that show nothing, trimmed from a name's ends with the spaces: the core's set
+ *  (`invisible` in src/base/settings/profile.rs), so a name is a name by one rule. */
+const INVISIBLE = "\u00ad\u034f\u061c\u180e\u200b-\u200f\u202a-\u202e\u2060-\u2064\u2066-\u2069\ufeff";
+const ENDS = new RegExp(`^[\\s${INVISIBLE}]+|[\\s${INVISIBLE}]+$`, "gu");
+
+/** A name as the core keeps it: trimmed of spaces and invisible characters at its ends. */
+export function trimName(raw: string): string {
+  return raw.replace(ENDS, "");
+}
+
 export function nameProblem(raw: string): string | null {
-  const name = raw.trim();
-  if (name === "" || [...name].length > MAX_NAME_CHARS) return `A profile's name must have 1 to ${MAX_NAME_CHARS} characters.`;
+  const name = trimName(raw);
+  if (name === "" || [...name].length > MAX_NAME_CHARS) return `A profile's name must have 1 to ${MAX_NAME_CHARS} visible characters.`;
   // eslint-disable-next-line no-control-regex
   if (/[\u0000-\u001f\u007f-\u009f]/.test(name)) return "A profile's name must not hold line breaks or tabs.";
   return null;
@@ -50,7 +60,7 @@ export function checkProfile(raw: unknown, schema: readonly SettingSpec[]): Stor
   if (given.some((k) => !keys.includes(k))) return null;
   const settings = checkSettings(raw.settings, schema);
   if (Object.keys(settings).length !== given.length) return null;
-  return { name: raw.name.trim(), kind: raw.kind, settings };
+  return { name: trimName(raw.name), kind: raw.kind, settings };
 }
 
 /** The profiles kept in `text` (the storage's entry): the good ones, names unique. */
@@ -77,7 +87,7 @@ export const profilesText = (list: readonly StoredProfile[]): string => JSON.str
 export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>, schema: readonly SettingSpec[]): StoredProfile {
   const settings: Record<string, Value> = {};
   for (const k of profileKeys(kind, schema)) if (values[k] !== undefined) settings[k] = values[k];
-  return { name: name.trim(), kind, settings };
+  return { name: trimName(name), kind, settings };
 }
 
 /** The file a profile is exported as (the JSON of docs/spec.md "Profiles"). */

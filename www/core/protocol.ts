@@ -190,8 +190,9 @@ export interface Calls {
   lay_flat: { data: { name: string; item?: number }; result: Angles };
   /** The candidate orientations of `job.parts[part]`, best first (src/wasm/models.rs `orient`). */
   orient: { data: { job: JobFile; part: number }; result: Orientations };
-  /** A profile's JSON text checked by the core (`check_profile`); needs no model. */
-  check_profile: { data: { text: string }; result: Profile };
+  /** A profile file's bytes decoded and checked by the core (`check_profile`: UTF-8, or UTF-16
+   *  with a byte-order mark; the CLI's `--profile` reads them alike); needs no model. */
+  check_profile: { data: { bytes: Uint8Array }; result: Profile };
   /** Prepares the job `job` of the files added (Session.from_models), in the job worker;
    *  with `share: n`, also n copies of the prepared job as bytes (`Session.prepared`), one for
    *  each other worker's `adopt_job`. */

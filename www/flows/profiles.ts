@@ -6,6 +6,7 @@
 import {
   MAX_PROFILE_BYTES,
   nameProblem,
+  trimName,
   PROFILES_KEY,
   profileFileName,
   profileFileText,
@@ -82,7 +83,7 @@ export function renameProfile(page: Page, name: string, to: string): void {
   const problem = nameProblem(to);
   if (problem) return profileMessage(problem, true);
   const list = load(page);
-  const target = to.trim();
+  const target = trimName(to);
   if (target !== name && list.some((q) => q.name === target)) return profileMessage(`A profile “${target}” exists already: delete it first or pick another name.`, true);
   if (store(page, list.map((q) => (q.name === name ? { ...q, name: target } : q)))) profileMessage(`Renamed “${name}” to “${target}”.`);
 }
@@ -101,15 +102,16 @@ export function exportProfile(page: Page, name: string): void {
 export async function importProfile(page: Page, file: File): Promise<void> {
   const refuse = (why: string) => profileMessage(`${file.name} was not imported: ${why}`, true);
   if (file.size > MAX_PROFILE_BYTES) return refuse(`it has ${file.size} bytes; a profile file has at most ${MAX_PROFILE_BYTES}. Pick a profile's JSON file.`);
-  let text: string;
+  // the bytes as they are: the core decodes them by the CLI's rule (src/base/settings/profile.rs)
+  let bytes: Uint8Array;
   try {
-    text = await file.text();
+    bytes = new Uint8Array(await file.arrayBuffer());
   } catch {
     return refuse("the browser could not read it.");
   }
   let checked: unknown;
   try {
-    checked = await page.pool.checkProfile(text);
+    checked = await page.pool.checkProfile(bytes);
   } catch (e) {
     const detail = isErrorValue(e) ? e.message.replace(/\.$/, "") : String(e);
     return refuse(`${detail}. A profile is {"name": …, "kind": "machine" | "material", "settings": {…}}.`);

@@ -244,7 +244,7 @@ async function handle(req: Request): Promise<void> {
       return;
     case "check_profile":
       await load();
-      answer(req.kind, req.id, check_profile(req.data.text));
+      answer(req.kind, req.id, check_profile(req.data.bytes));
       return;
     case "open_job": {
       await load();

@@ -9,6 +9,7 @@ mod schema;
 
 pub use profile::{
     MACHINE_KEYS, MATERIAL_KEYS, MAX_PROFILE_BYTES, MAX_PROFILE_NAME_CHARS, Profile, ProfileKind,
+    invisible, profile_name, profile_text,
 };
 pub use schema::{Kind, PART_KEYS, SettingSpec, names, schema, schema_json};
 

@@ -94,7 +94,95 @@ fn bad(message: String) -> Error {
     }
 }
 
+/// A profile file's bytes as text, by one rule for the CLI's `--profile` and the page's
+/// import: UTF-8 (a byte-order mark EF BB BF dropped), or UTF-16 with its byte-order mark
+/// (FF FE little-endian, FE FF big-endian); anything else — Latin-1, Windows-1252, UTF-16
+/// without a mark, a binary file — is refused with what was found and what to do, never
+/// guessed (a guess garbles a name).
+pub fn profile_text(bytes: &[u8]) -> Result<String, Error> {
+    if bytes.len() > MAX_PROFILE_BYTES {
+        return Err(bad(format!(
+            "the profile is {} bytes, more than the {MAX_PROFILE_BYTES} a profile may have",
+            bytes.len()
+        )));
+    }
+    let utf16 = |rest: &[u8], unit: fn([u8; 2]) -> u16, which: &str| {
+        if rest.len() % 2 != 0 {
+            return Err(bad(format!(
+                "the profile starts with the byte-order mark of UTF-16 {which} but has an odd number of bytes: save it again as UTF-8"
+            )));
+        }
+        let units = rest.chunks_exact(2).map(|c| unit([c[0], c[1]]));
+        char::decode_utf16(units)
+            .collect::<Result<String, _>>()
+            .map_err(|e| {
+                bad(format!(
+                    "the profile is not valid UTF-16 {which} (a lone surrogate {:#06x}): save it again as UTF-8",
+                    e.unpaired_surrogate()
+                ))
+            })
+    };
+    match bytes {
+        [0xEF, 0xBB, 0xBF, rest @ ..] => utf8(rest),
+        [0xFF, 0xFE, rest @ ..] => utf16(rest, u16::from_le_bytes, "little-endian"),
+        [0xFE, 0xFF, rest @ ..] => utf16(rest, u16::from_be_bytes, "big-endian"),
+        _ => utf8(bytes),
+    }
+}
+
+fn utf8(bytes: &[u8]) -> Result<String, Error> {
+    String::from_utf8(bytes.to_vec()).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        bad(format!(
+            "the profile is not UTF-8 text (byte {:#04x} at offset {at}; Latin-1 or Windows-1252?): save it as UTF-8 (or UTF-16 with a byte-order mark)",
+            bytes[at]
+        ))
+    })
+}
+
+/// Characters that show nothing: a name made of them alone (or with spaces) is no name, and
+/// they are trimmed from a name's ends with the spaces. The page's `nameProblem`
+/// (www/core/profiles.ts) trims the same set.
+pub fn invisible(c: char) -> bool {
+    matches!(
+        c,
+        '\u{00AD}'
+            | '\u{034F}'
+            | '\u{061C}'
+            | '\u{180E}'
+            | '\u{200B}'..='\u{200F}'
+            | '\u{202A}'..='\u{202E}'
+            | '\u{2060}'..='\u{2064}'
+            | '\u{2066}'..='\u{2069}'
+            | '\u{FEFF}'
+    )
+}
+
+/// A profile's name by the one rule of the CLI and the page: trimmed of spaces and
+/// [`invisible`] characters at its ends, 1 to [`MAX_PROFILE_NAME_CHARS`] characters, no
+/// control character.
+pub fn profile_name(raw: &str) -> Result<&str, Error> {
+    let name = raw.trim_matches(|c: char| c.is_whitespace() || invisible(c));
+    if name.is_empty() || name.chars().count() > MAX_PROFILE_NAME_CHARS {
+        return Err(bad(format!(
+            "a profile's name must have 1 to {MAX_PROFILE_NAME_CHARS} visible characters"
+        )));
+    }
+    if name.chars().any(char::is_control) {
+        return Err(bad(
+            "a profile's name must not hold control characters (line breaks, tabs)".into(),
+        ));
+    }
+    Ok(name)
+}
+
 impl Profile {
+    /// Reads and checks a profile file's bytes ([`profile_text`], then
+    /// [`from_json`](Self::from_json)): what the CLI's `--profile` and the page's import do.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Profile, Error> {
+        Profile::from_json(&profile_text(bytes)?)
+    }
+
     /// Parses and checks a profile's JSON text (at most [`MAX_PROFILE_BYTES`]).
     pub fn from_json(text: &str) -> Result<Profile, Error> {
         if text.len() > MAX_PROFILE_BYTES {
@@ -120,17 +208,7 @@ impl Profile {
     }
 
     fn checked(raw: Raw) -> Result<Profile, Error> {
-        let name = raw.name.trim();
-        if name.is_empty() || name.chars().count() > MAX_PROFILE_NAME_CHARS {
-            return Err(bad(format!(
-                "a profile's name must have 1 to {MAX_PROFILE_NAME_CHARS} characters"
-            )));
-        }
-        if name.chars().any(char::is_control) {
-            return Err(bad(
-                "a profile's name must not hold control characters (line breaks, tabs)".into(),
-            ));
-        }
+        let name = profile_name(&raw.name)?;
         let kind = raw.kind;
         let known = schema::names();
         for (key, value) in &raw.settings {
@@ -244,5 +322,89 @@ mod tests {
                 .to_string()
                 .contains("bytes")
         );
+    }
+
+    fn machine(name: &str) -> String {
+        format!(r#"{{"name": "{name}", "kind": "machine", "settings": {{"plate_z": 180}}}}"#)
+    }
+
+    fn utf16(text: &str, big_endian: bool) -> Vec<u8> {
+        let mut out = if big_endian {
+            vec![0xFE, 0xFF]
+        } else {
+            vec![0xFF, 0xFE]
+        };
+        for u in text.encode_utf16() {
+            out.extend(if big_endian {
+                u.to_be_bytes()
+            } else {
+                u.to_le_bytes()
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn one_reader_for_every_encoding_with_a_mark() {
+        let text = machine("Düsseldorf – 3 µm");
+        let plain = text.as_bytes().to_vec();
+        let bom = [&[0xEF, 0xBB, 0xBF][..], text.as_bytes()].concat();
+        for bytes in [plain, bom, utf16(&text, false), utf16(&text, true)] {
+            let p = Profile::from_bytes(&bytes).unwrap();
+            assert_eq!(p.name, "Düsseldorf – 3 µm", "{bytes:x?}");
+            assert_eq!(p.settings["plate_z"], 180);
+        }
+    }
+
+    #[test]
+    fn latin1_and_unmarked_utf16_are_refused_saying_what_to_do() {
+        // "Düsseldorf" in Latin-1: ü is the byte 0xFC.
+        let latin1: Vec<u8> = machine("D\u{fc}sseldorf")
+            .chars()
+            .map(|c| c as u32 as u8)
+            .collect();
+        let e = Profile::from_bytes(&latin1).unwrap_err().to_string();
+        assert!(e.contains("not UTF-8") && e.contains("0xfc"), "{e}");
+        assert!(e.contains("save it as UTF-8"), "{e}");
+        // UTF-16 without a mark: its zero bytes are valid UTF-8, the JSON is not.
+        let unmarked = &utf16(&machine("M"), false)[2..];
+        let e = Profile::from_bytes(unmarked).unwrap_err().to_string();
+        assert!(e.contains("not JSON"), "{e}");
+        // A mark with an odd tail or a lone surrogate.
+        let mut odd = utf16(&machine("M"), false);
+        odd.push(b' ');
+        let e = Profile::from_bytes(&odd).unwrap_err().to_string();
+        assert!(e.contains("odd number of bytes"), "{e}");
+        let lone = [0xFF, 0xFE, 0x00, 0xD8, b'{', 0];
+        let e = Profile::from_bytes(&lone).unwrap_err().to_string();
+        assert!(e.contains("surrogate"), "{e}");
+        let big = vec![b' '; MAX_PROFILE_BYTES + 1];
+        assert!(
+            Profile::from_bytes(&big)
+                .unwrap_err()
+                .to_string()
+                .contains("bytes")
+        );
+    }
+
+    #[test]
+    fn a_name_of_invisible_characters_is_no_name() {
+        for name in [
+            "\u{feff}",
+            " \u{200b}\u{feff} ",
+            "\u{2060}",
+            "\u{00ad}",
+            "   ",
+        ] {
+            let e = Profile::from_json(&machine(name)).unwrap_err().to_string();
+            assert!(e.contains("visible characters"), "{name:?}: {e}");
+        }
+        // Trimmed at the ends, kept inside; the length counted after the trim.
+        let p = Profile::from_json(&machine("\u{feff} PLA\u{200b}x ")).unwrap();
+        assert_eq!(p.name, "PLA\u{200b}x");
+        let long = "a".repeat(MAX_PROFILE_NAME_CHARS);
+        assert_eq!(profile_name(&format!("\u{feff}{long} ")).unwrap(), long);
+        assert!(profile_name(&format!("{long}b")).is_err());
+        assert!(profile_name("a\tb").is_err());
     }
 }

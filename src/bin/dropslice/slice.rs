@@ -155,10 +155,7 @@ pub fn read_profile(path: &Path) -> Result<Profile, String> {
     let shown = path.display();
     let bytes = read_regular(path, MAX_PROFILE_BYTES as u64, "a profile")
         .map_err(|e| format!("the profile: {e}"))?;
-    let text = String::from_utf8(bytes).map_err(|_| {
-        format!("the profile {shown} is not text (UTF-8): it is not a JSON profile")
-    })?;
-    Profile::from_json(&text).map_err(|e| format!("the profile {shown}: {e}"))
+    Profile::from_bytes(&bytes).map_err(|e| format!("the profile {shown}: {e}"))
 }
 
 fn list_settings() -> String {
