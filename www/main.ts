@@ -353,9 +353,10 @@ async function main(): Promise<void> {
     return;
   }
   $("version").textContent = page.init.version;
-  // the plate's settings lay the job out again (at most every 200 ms while typing)
+  // the plate's settings (and whether a part may be off it) lay the job out again (at most
+  // every 200 ms while typing)
   let plateTimer = 0;
-  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing"].map((k) => page.form?.get(k)));
+  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate"].map((k) => page.form?.get(k)));
   let lastPlate = "";
   page.form = new SettingsForm(
     $("settings"),

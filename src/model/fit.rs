@@ -161,7 +161,7 @@ pub fn misfit(inst: &Instance, frame: &Frame, label: &str, s: &Settings) -> Opti
         {
             p -= 1.0;
         }
-        if p >= 1.0 && p < 100.0 {
+        if (1.0..100.0).contains(&p) {
             m.scale_percent = Some(p as u32);
             m.scale_to = Some(inst.scale.map(|k| k * p / 100.0));
         }

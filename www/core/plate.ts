@@ -1,64 +1,55 @@
-// The plate as a rule: which instances of a layout reach past the plate (`plate_x` × `plate_y`,
-// and above `plate_z` when the core has that setting), in plain words; and the core's job
+// The plate rule as the core states it (docs/jobs.md "The plate rule"): the layout's misfits —
+// instances larger than the plate, taller than the chamber or placed past an edge — each with
+// the core's sentence and what fits (the turn about z, the scale); which of them block slicing
+// (all, unless `allow_off_plate`, which never allows a chamber too low); and the core's job
 // messages ("parts[2].scale_x: …") in the words the page shows ("Part 3, scale x: …"). No DOM.
 
-import { partName, type Job } from "./job";
-import type { Layout } from "./protocol";
+import type { Job } from "./job";
+import type { Layout, Misfit } from "./protocol";
 import type { Value } from "./settings";
 
-export interface Plate {
-  x: number;
-  y: number;
-  /** The plate's height (null: the settings have none). */
-  z: number | null;
-}
-
-/** An instance off the plate: its part (index in the job), its copy and the message. */
+/** An instance off the plate: its part (index in the job), its copy, the core's sentence, and
+ *  what fits (`turn`: the part's rotate_z turned 90° about z; `scale`: the whole percent,
+ *  `scaleTo` its scale_x/y/z). `blocks`: the job is not sliced while it is there. */
 export interface OffPlate {
   part: number;
   copy: number;
   message: string;
+  turn: number | null;
+  scale: number | null;
+  scaleTo: [number, number, number] | null;
+  blocks: boolean;
 }
 
-/** Overshoots smaller than this (mm) are rounding, not a part off the plate. */
-const TOLERANCE_MM = 1e-6;
+const finite = (v: unknown): v is number => typeof v === "number" && Number.isFinite(v);
 
-const positive = (v: Value | undefined): number | null => (typeof v === "number" && Number.isFinite(v) && v > 0 ? v : null);
-
-/** The plate of the settings `values` (null when its size is not a positive number). */
-export function plateOf(values: Record<string, Value>): Plate | null {
-  const x = positive(values.plate_x);
-  const y = positive(values.plate_y);
-  if (x === null || y === null) return null;
-  return { x, y, z: positive(values.plate_z) };
+function offPlateOf(m: Misfit, allow: boolean): OffPlate {
+  const to = m.scale_to;
+  return {
+    part: m.part,
+    copy: m.copy,
+    message: m.message,
+    turn: finite(m.turn_rotate_z) ? m.turn_rotate_z : null,
+    scale: finite(m.scale_percent) ? m.scale_percent : null,
+    scaleTo: to && to.length === 3 && to.every(finite) ? [to[0], to[1], to[2]] : null,
+    blocks: !(allow && m.kind !== "taller"),
+  };
 }
 
-const mm = (v: number) => (v < 0.1 ? "less than 0.1" : v.toFixed(1).replace(/\.0$/, ""));
+/** Every misfit of `layout` (`allow`: the settings' `allow_off_plate`). */
+export function offPlate(layout: Layout | null, allow: boolean): OffPlate[] {
+  return (layout?.misfits ?? []).map((m) => offPlateOf(m, allow));
+}
 
-/** The instances of `layout` that reach past `plate`, each with a message naming the part
- *  (`names[part]`: its display name) and how far, in plain words. */
-export function offPlate(layout: Layout | null, plate: Plate | null, names: readonly string[]): OffPlate[] {
-  if (!layout || !plate) return [];
-  const out: OffPlate[] = [];
-  for (const inst of layout.instances) {
-    const sides: [number, string][] = [
-      [-inst.min[0], "left edge"],
-      [inst.max[0] - plate.x, "right edge"],
-      [-inst.min[1], "front edge"],
-      [inst.max[1] - plate.y, "back edge"],
-    ];
-    const [by, side] = sides.reduce((a, b) => (b[0] > a[0] ? b : a));
-    const high = plate.z !== null ? inst.max[2] - plate.z : -Infinity;
-    if (!(by > TOLERANCE_MM) && !(high > TOLERANCE_MM)) continue;
-    const copy = inst.copies > 1 ? ` (copy ${inst.copy + 1})` : "";
-    const who = `Part ${inst.part + 1} “${names[inst.part] ?? inst.name}”${copy}`;
-    const message =
-      by > TOLERANCE_MM
-        ? `${who} reaches ${mm(by)} mm past the plate's ${side} — move it or press Arrange.`
-        : `${who} is ${mm(high)} mm taller than the printer's height (plate z ${plate.z} mm) — scale it down or lay it flat.`;
-    out.push({ part: inst.part, copy: inst.copy, message });
-  }
-  return out;
+/** Every misfit of the page's `job` with the settings `values`, blocking or not. */
+export function jobMisfits(job: Job | null, values: Record<string, Value> | undefined): OffPlate[] {
+  if (!job || !values) return [];
+  return offPlate(job.layout, values.allow_off_plate === true);
+}
+
+/** The instances of the page's `job` off the plate that keep it from being sliced. */
+export function jobOffPlate(job: Job | null, values: Record<string, Value> | undefined): OffPlate[] {
+  return jobMisfits(job, values).filter((o) => o.blocks);
 }
 
 /** A message of the core about a job in the page's words: "bad job:" dropped, `parts[i].key`
@@ -69,10 +60,4 @@ export function plainJobMessage(message: string): string {
     .replace(/parts\[(\d+)\]\.([a-z_]+)/g, (_, i: string, key: string) => `Part ${Number(i) + 1}, ${key.replace(/_/g, " ")}`)
     .replace(/parts\[(\d+)\] \(([^()]*)\)/g, (_, i: string, name: string) => `Part ${Number(i) + 1} “${name}”`)
     .replace(/parts\[(\d+)\]/g, (_, i: string) => `Part ${Number(i) + 1}`);
-}
-
-/** The instances of the page's `job` off the plate of the settings `values`. */
-export function jobOffPlate(job: Job | null, values: Record<string, Value> | undefined): OffPlate[] {
-  if (!job || !values) return [];
-  return offPlate(job.layout, plateOf(values), job.parts.map((p) => partName(job, p)));
 }

@@ -8,6 +8,7 @@ import type { Value } from "../core/settings";
 import { dropSlice, openGcode, startSlice, type Target } from "./slice";
 import { record } from "./history";
 import { jobSettings, partKeys } from "../core/job";
+import { jobOffPlate } from "../core/plate";
 import { adoptJob, newJob, type NewFile } from "./job";
 import type { Page } from "../views/page";
 import type { JobFile, JobSchema, PartSpec, SettingSpec } from "../core/protocol";
@@ -80,11 +81,14 @@ async function openJob(page: Page, files: NewFile[], specs?: PartSpec[], target:
   // the job replaced is one Undo away
   if (before && before.parts.length) undoNotice(page, `“${job.name}” replaced the previous job.`);
   if (job.instances > 1) page.view3d.setActive(true);
-  if (!job.layout) {
-    // the parts do not fit together: the banner says so; change them, then slice. The slice
-    // shown was of the job before: it goes with it (never the new parts with the old code)
+  if (!job.layout || jobOffPlate(job, page.form?.values()).length) {
+    // the parts do not fit (together, or one of them the plate): the banner says so, with
+    // what fits in the parts panel; change them, then slice. The slice shown was of the job
+    // before: it goes with it, its name too (never the new parts with the old code)
     dropSlice(page);
-    setState("error");
+    showModel(job.name);
+    if (job.layout) await startSlice(page, target);
+    else setState("error");
     updateButtons(page);
     return true;
   }

@@ -85,7 +85,11 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
   // a job is sliced only when it fits: every part on the plate
   const off = jobOffPlate(job, form.values());
   if (off.length || !job.layout) {
-    if (off.length) showBanner("A part is off the plate.", off.map((o) => o.message).join(" "));
+    if (off.length) {
+      showBanner("A part does not fit the plate.", off.map((o) => o.message).join(" "));
+      // the next layout the core takes (the part turned, scaled or moved) hides it
+      document.getElementById("banner")!.dataset.layout = "1";
+    }
     setState("error");
     updateButtons(page);
     return;

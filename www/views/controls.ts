@@ -36,7 +36,7 @@ export function updateButtons(page: Page): void {
   markStale(state === "stale");
   const off = jobOffPlate(store.job, form?.values());
   const ready = !store.busy && s !== null && s.complete && (s.source === "gco" || (state === "current" && off.length === 0));
-  const why = state === "stale" ? "The slice is out of date: press Slice first" : off.length ? "A part is off the plate: move it or press Arrange" : "";
+  const why = state === "stale" ? "The slice is out of date: press Slice first" : off.length ? off[0].message : "";
   // Like the CLI, no code for a part without a single droplet.
   const download = $<HTMLButtonElement>("btn-download");
   download.disabled = !(ready && s!.source === "stl" && !s!.figures.nothingToPrint);

@@ -7,7 +7,7 @@
 // again; what is shown comes from the job and the core's layout only.
 
 import { fitsPart, partName, partNumber, partRangeWords, type Changes, type Part } from "../core/job";
-import { jobOffPlate, plainJobMessage } from "../core/plate";
+import { jobMisfits, plainJobMessage, type OffPlate } from "../core/plate";
 import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
@@ -203,7 +203,8 @@ export class PartsPanel implements PartsView {
     $("parts-panel").hidden = !job;
     if (!job) return;
     const list = $("part-list");
-    const off = jobOffPlate(job, this.page.form?.values());
+    const misfits = jobMisfits(job, this.page.form?.values());
+    const off = misfits.filter((o) => o.blocks);
     const items = job.parts.map((p, i) => {
       const li = document.createElement("li");
       li.className = "part-item";
@@ -260,12 +261,43 @@ export class PartsPanel implements PartsView {
     const focused = list.contains(document.activeElement) ? (document.activeElement as HTMLElement).closest<HTMLElement>("li")?.dataset.id : undefined;
     list.replaceChildren(...items);
     if (focused !== undefined) list.querySelector<HTMLElement>(`li[data-id="${focused}"]`)?.focus({ preventScroll: true });
-    // the page's own words for a part off the plate (core/plate.ts); the core's others reworded
-    const warnings = [...off.map((o) => o.message), ...(job.layout?.warnings ?? []).filter((w) => !/outside the plate/.test(w)).map(plainJobMessage)];
-    $("parts-warnings").classList.toggle("bad", off.length > 0);
-    $("parts-warnings").hidden = warnings.length === 0;
-    $("parts-warnings").textContent = warnings.join(" ");
+    // the core's sentence for each part off the plate, with a button per remedy; its other
+    // warnings reworded
+    const box = $("parts-warnings");
+    const notes = misfits.map((o) => this.misfitNote(o));
+    const others = (job.layout?.warnings ?? []).map(plainJobMessage);
+    if (others.length) notes.push(Object.assign(document.createElement("span"), { textContent: others.join(" ") }));
+    box.classList.toggle("bad", off.length > 0);
+    box.hidden = notes.length === 0;
+    box.replaceChildren(...notes);
     this.renderEditor();
+  }
+
+  /** A misfit's sentence and its buttons: *Turn 90° to fit*, *Scale to fit (N %)* — each one
+   *  undoable edit of the part. */
+  private misfitNote(o: OffPlate): HTMLElement {
+    const note = document.createElement("p");
+    note.className = "misfit";
+    note.dataset.part = String(o.part);
+    note.append(Object.assign(document.createElement("span"), { textContent: o.message }));
+    const job = this.page.store.job;
+    const p = job?.parts[o.part];
+    if (!p) return note;
+    const button = (id: string, text: string, changes: Changes) => {
+      const b = document.createElement("button");
+      b.type = "button";
+      b.className = "btn small";
+      b.dataset.fit = id;
+      b.textContent = text;
+      b.addEventListener("click", () => void this.edit(p, changes));
+      note.append(" ", b);
+    };
+    if (o.turn !== null) button("turn", "Turn 90° to fit", { rotate_z: o.turn });
+    else if (o.scale !== null && o.scaleTo) {
+      const [scale_x, scale_y, scale_z] = o.scaleTo;
+      button("scale", `Scale to fit (${o.scale} %)`, { scale_x, scale_y, scale_z });
+    }
+    return note;
   }
 
   renderEditor(): void {
