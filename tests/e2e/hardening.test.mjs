@@ -224,6 +224,7 @@ const GCO = [
   ["a G25 with a tiny droplet", "; layer_height = 0.0001\n; droplet_aspect = 0.001\nG01 X0 Y0 Z0.2\nG25 X100000 Y100000\n", /line 4: a G25 of 141421 mm would expand to [\d,]+ million droplets \(one every 1e-7 mm\)/],
   ["G25 lines past the droplet cap", `${HEADER}G01 X-100000 Y0 Z0.2\n${"G25 X100000 Y0\nG25 X-100000 Y0\n".repeat(30)}`, /line \d+: the file holds more than 50 million droplets, the most this viewer expands/],
   ["a line of 2 MB", `${HEADER}; ${"x".repeat(2 * 2 ** 20)}`, /is longer than 1,048,576 characters/],
+  ["a filament printer's G-code", ";FLAVOR:Marlin\nM140 S60\nM104 S200\nG28\nG1 X10 Y10 Z0.3 E1.2\n", /line 2: this is G-code for another kind of printer \(it has M140, M104, G28, G1 … E…\): dropslice reads the droplet printer's code/],
 ];
 
 test(".gco files: refused with the line and the reason; the page keeps answering and reads a good file after", async () => {

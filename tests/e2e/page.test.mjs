@@ -122,8 +122,8 @@ test("the downloaded .gco has the CLI's commands", async (t) => {
   assert.equal(viewed.layers, sliced.layers);
   // G25 lines re-expanded from their written coordinates give the core's counts exactly
   assert.equal(viewed.droplets, sliced.droplets);
-  assert.equal(viewed.counts.fill, sliced.counts.fill);
-  assert.equal(viewed.counts.outer, sliced.counts.outer + sliced.counts.inner, "every G26 is a loop droplet");
+  // the header's droplets by role: the slice's (the commands alone do not tell outer from inner)
+  assert.deepEqual(viewed.counts, sliced.counts);
   assert.ok((await inkPixels(page)) > 1000);
 });
 

@@ -68,7 +68,7 @@ test("the settings form shows the opened .gco's settings, or says how it differs
   assert.equal(await note.innerText(), "The settings form shows the settings of “sample.gco” (from its header).");
   await setField(page, "droplet_aspect", "1.1");
   assert.equal(await note.innerText(), "The settings form differs from “sample.gco”: droplet_aspect is 1.1 here, 1.3 in the file.");
-  // undo puts the form back as the file opened it
+  // back at the file's value: the form says so again
   await setField(page, "droplet_aspect", "1.3");
   assert.equal(await page.getAttribute("#form-source", "data-state"), "file");
 });
