@@ -655,6 +655,37 @@ fn matrices_map_the_model_onto_the_sliced_mesh() {
 }
 
 #[test]
+fn orient_measures_a_mirrored_part_as_its_mirror_image() {
+    // Mirrored along x or y, a part overhangs as much as before (a negative scale mirrors no
+    // area); mirrored along z, its current orientation is the plain part's upside down.
+    let bytes = model_bytes("U_overhang.obj");
+    let m = Model::read(&bytes, "U_overhang.obj").unwrap();
+    let s = Settings::default();
+    let part = |v: Value| serde_json::from_value::<job::PartSpec>(v).unwrap();
+    let orient = |p: &job::PartSpec| dropslice::support::orient::orient_part(&m, p, &s).unwrap();
+    let plain = orient(&part(json!({"file": "U_overhang.obj"})));
+    let flipped = orient(&part(json!({"file": "U_overhang.obj", "rotate_x": 180})));
+    assert!(plain.current.unsupported_area > 1.0 || flipped.current.unsupported_area > 1.0);
+    for mirror in ["mirror_x", "mirror_y"] {
+        let o = orient(&part(json!({"file": "U_overhang.obj", mirror: true})));
+        assert!(
+            (o.current.unsupported_area - plain.current.unsupported_area).abs() < 1e-6,
+            "{mirror}: {} vs {}",
+            o.current.unsupported_area,
+            plain.current.unsupported_area
+        );
+    }
+    let z = orient(&part(json!({"file": "U_overhang.obj", "mirror_z": true})));
+    assert!(
+        (z.current.unsupported_area - flipped.current.unsupported_area).abs() < 1e-6,
+        "{} vs {}",
+        z.current.unsupported_area,
+        flipped.current.unsupported_area
+    );
+    assert!((z.current.height - plain.current.height).abs() < 1e-9);
+}
+
+#[test]
 fn an_instance_gives_its_size_along_the_axes_its_scale_acts_on() {
     // The page's size fields: scale_x × wanted / size_x is a part that wide, whatever the
     // rotation on the plate.

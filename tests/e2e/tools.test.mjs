@@ -5,6 +5,7 @@
 // (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
+import { readFileSync } from "node:fs";
 import { clientPoint3d, open3d, openPage, pixels3d, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
@@ -122,6 +123,11 @@ test("mirror per axis: the toggle mirrors the part (its matrix), its size stays,
   const det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
   assert.ok(det < 0, `determinant ${det}`);
   for (let k = 0; k < 3; k++) assert.ok(close(inst.size[k], before.size[k], 1e-6));
+  // the job file says so (and only for the mirrored axis)
+  const [d] = await Promise.all([page.waitForEvent("download"), page.click("#btn-save-job")]);
+  const saved = JSON.parse(readFileSync(await d.path(), "utf8"));
+  assert.equal(saved.parts[0].mirror_x, true);
+  assert.equal("mirror_y" in saved.parts[0], false);
   // the slice of the mirrored part
   await page.evaluate(() => (document.body.dataset.state = "picking"));
   await page.click("#btn-slice");
@@ -189,6 +195,11 @@ test("a part's context menu: right-click or Shift+F10 in the list, right-click i
   await page.waitForFunction(() => window.dropslice.job().parts.length === 1);
   assert.equal(await page.isVisible("#part-menu"), false);
   await page.click("#mode-layer");
+  // the shortcuts panel lists the menu's keys
+  await page.click("#btn-shortcuts");
+  const text = await page.locator("#shortcuts-dialog").innerText();
+  for (const key of ["Shift+F10", "Right-click", "Skip to Slice"]) assert.ok(text.includes(key), `the panel lists ${key}`);
+  await page.click("#shortcuts-close");
   assert.deepEqual(errors, []);
 });
 
