@@ -137,6 +137,36 @@ test("mirror per axis: the toggle mirrors the part (its matrix), its size stays,
   await page.click("#part-mirror_x");
   await page.waitForFunction(() => window.dropslice.job().parts[0].mirror_x === false);
   assert.equal(await page.getAttribute("#part-mirror_x", "aria-pressed"), "false");
+
+  // lay flat through a z mirror puts the same face down: the first layer as large as the
+  // plain part's (not the part standing on what was its top)
+  const firstLayer = async () => {
+    await page.evaluate(() => (document.body.dataset.state = "picking"));
+    await page.click("#btn-slice");
+    await waitDone(page);
+    await page.evaluate(() => window.dropslice.show(0));
+    await page.waitForFunction(() => window.dropslice.status().shown === 0);
+    // the layer's droplets by role, added up
+    const c = (await page.evaluate(() => window.dropslice.status())).layerDroplets;
+    return typeof c === "number" ? c : Object.values(c).reduce((a, v) => a + (typeof v === "number" ? v : 0), 0);
+  };
+  const plain = await firstLayer();
+  await page.click("#part-mirror_z");
+  await page.waitForFunction(() => window.dropslice.job().parts[0].mirror_z === true);
+  const upside = await firstLayer();
+  await page.click("#part-lay-flat");
+  // (the core's answer turns it; a page that kept the face up would change nothing)
+  await page.waitForFunction(() => window.dropslice.job().parts[0].rotate_x !== 0, null, { timeout: 10_000 }).catch(() => {});
+  const flat = await firstLayer();
+  assert.ok(upside < 0.8 * plain, `mirrored along z the part stands on its top: ${upside} vs ${plain} droplets`);
+  assert.ok(Math.abs(flat - plain) <= 0.05 * plain, `laid flat: ${flat} vs ${plain} droplets on the first layer`);
+  await page.click("#part-mirror_z");
+  await page.fill("#part-rotate_x", "0");
+  await page.press("#part-rotate_x", "Enter");
+  await page.waitForFunction(() => {
+    const p = window.dropslice.job().parts[0];
+    return p.mirror_z === false && p.rotate_x === 0;
+  });
   assert.deepEqual(errors, []);
 });
 
