@@ -221,6 +221,11 @@ test("a part's context menu: right-click or Shift+F10 in the list, right-click i
   const id = (await page.evaluate(() => window.dropslice.view3d())).selected;
   assert.ok(id !== null, "the part right-clicked is selected");
   assert.equal(await page.isDisabled("#part-menu-remove"), false);
+  // Esc gives the focus back to the 3D view; Shift+F10 there opens the selected part's menu
+  await page.keyboard.press("Escape");
+  assert.equal(await page.evaluate(() => document.activeElement === document.querySelector("#view3d canvas")), true);
+  await page.keyboard.press("Shift+F10");
+  await page.waitForSelector("#part-menu:not([hidden])");
   await page.click("#part-menu-remove");
   await page.waitForFunction(() => window.dropslice.job().parts.length === 1);
   assert.equal(await page.isVisible("#part-menu"), false);
