@@ -6,7 +6,7 @@
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { readFileSync } from "node:fs";
-import { clientPoint3d, open3d, openPage, pixels3d, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
+import { clientPoint3d, open3d, openPage, pixels3d, shareLink, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -133,6 +133,13 @@ test("mirror per axis: the toggle mirrors the part (its matrix), its size stays,
   await page.click("#btn-slice");
   const s = await waitDone(page);
   assert.ok(s.droplets > 0);
+  // a preview link carries the mirror
+  const other = await openPage(env.browser, await shareLink(page));
+  await waitDone(other.page);
+  assert.equal((await job(other.page)).parts[0].mirror_x, true);
+  assert.equal((await job(other.page)).parts[0].mirror_y, false);
+  assert.equal((await other.page.evaluate(() => window.dropslice.status())).droplets, s.droplets);
+  await other.context.close();
   // off again
   await page.click("#part-mirror_x");
   await page.waitForFunction(() => window.dropslice.job().parts[0].mirror_x === false);
