@@ -722,6 +722,64 @@ fn matrices_map_the_model_onto_the_sliced_mesh() {
 }
 
 #[test]
+fn cli_job_files_mirror_parts_and_the_header_says_so() {
+    let dir = TempDir::new("job-cli-mirror");
+    std::fs::copy(model("U_overhang.obj"), dir.join("u.obj")).unwrap();
+    let job = json!({"parts": [{"file": "u.obj", "mirror_x": true, "mirror_z": true}]});
+    std::fs::write(dir.join("job.json"), job.to_string()).unwrap();
+    let r = run_words("job.json -o m.gco", &dir);
+    assert_eq!(r.code, Some(0), "{r:?}");
+    let text = std::fs::read_to_string(dir.join("m.gco")).unwrap();
+    assert!(
+        text.contains("scale 1/1/1, mirror x/z, at X"),
+        "{:.1500}",
+        text
+    );
+    assert!(!r.stderr.contains("inside out"), "{}", r.stderr);
+    // a mirror that is not true or false: refused, naming the part and the key
+    let bad = json!({"parts": [{"file": "u.obj", "mirror_y": "yes"}]});
+    std::fs::write(dir.join("bad.json"), bad.to_string()).unwrap();
+    let r = run_words("bad.json -o b.gco", &dir);
+    assert_eq!(r.code, Some(2), "{r:?}");
+    assert!(
+        r.stderr.contains("parts[0].mirror_y") && r.stderr.contains("true"),
+        "{}",
+        r.stderr
+    );
+}
+
+#[test]
+fn orient_measures_a_mirrored_part_as_its_mirror_image() {
+    // Mirrored along x or y, a part overhangs as much as before (a negative scale mirrors no
+    // area); mirrored along z, its current orientation is the plain part's upside down.
+    let bytes = model_bytes("U_overhang.obj");
+    let m = Model::read(&bytes, "U_overhang.obj").unwrap();
+    let s = Settings::default();
+    let part = |v: Value| serde_json::from_value::<job::PartSpec>(v).unwrap();
+    let orient = |p: &job::PartSpec| dropslice::support::orient::orient_part(&m, p, &s).unwrap();
+    let plain = orient(&part(json!({"file": "U_overhang.obj"})));
+    let flipped = orient(&part(json!({"file": "U_overhang.obj", "rotate_x": 180})));
+    assert!(plain.current.unsupported_area > 1.0 || flipped.current.unsupported_area > 1.0);
+    for mirror in ["mirror_x", "mirror_y"] {
+        let o = orient(&part(json!({"file": "U_overhang.obj", mirror: true})));
+        assert!(
+            (o.current.unsupported_area - plain.current.unsupported_area).abs() < 1e-6,
+            "{mirror}: {} vs {}",
+            o.current.unsupported_area,
+            plain.current.unsupported_area
+        );
+    }
+    let z = orient(&part(json!({"file": "U_overhang.obj", "mirror_z": true})));
+    assert!(
+        (z.current.unsupported_area - flipped.current.unsupported_area).abs() < 1e-6,
+        "{} vs {}",
+        z.current.unsupported_area,
+        flipped.current.unsupported_area
+    );
+    assert!((z.current.height - plain.current.height).abs() < 1e-9);
+}
+
+#[test]
 fn an_instance_gives_its_size_along_the_axes_its_scale_acts_on() {
     // The page's size fields: scale_x × wanted / size_x is a part that wide, whatever the
     // rotation on the plate.

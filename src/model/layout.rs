@@ -101,6 +101,9 @@ pub struct Instance {
     pub object: Option<String>,
     pub rotate: [f64; 3],
     pub scale: [f64; 3],
+    /// Mirrored along the plate's x, y, z (the part's `mirror_*`).
+    #[serde(default)]
+    pub mirror: [bool; 3],
     pub place_angle: f64,
     /// Placed by the job (`place_x`, `place_y`) rather than arranged.
     pub placed: bool,
@@ -387,6 +390,7 @@ fn instance(
             .map(|o| clean_name(&o)),
         rotate: [p.rotate_x, p.rotate_y, p.rotate_z],
         scale: [p.scale_x, p.scale_y, p.scale_z],
+        mirror: [p.mirror_x, p.mirror_y, p.mirror_z],
         place_angle: p.place_angle,
         placed,
         at,

@@ -145,6 +145,7 @@ pub(crate) fn import(
         object: None,
         rotate: placement.rotate,
         scale: [settings.scale_x, settings.scale_y, settings.scale_z],
+        mirror: [false; 3],
         place_angle: placement.place_angle,
         placed: true,
         at: place,

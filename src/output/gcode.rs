@@ -257,7 +257,8 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
 }
 
 /// An instance as the header lists it: `part 1 = gear.3mf (object 3), rotate 0/0/90 deg,
-/// scale 1/1/1, at X30.0000 Y5.0000, angle 0 deg, copy 1 of 2, unit 0`.
+/// scale 1/1/1, at X30.0000 Y5.0000, angle 0 deg, copy 1 of 2, unit 0` (", mirror x/z" after
+/// the scale of a mirrored part).
 pub fn part_line(p: &crate::model::layout::Instance) -> String {
     let clean = |s: &str| crate::model::spec::clean_name(s);
     let what = match (&p.object, p.item) {
@@ -272,8 +273,19 @@ pub fn part_line(p: &crate::model::layout::Instance) -> String {
     };
     let [rx, ry, rz] = p.rotate;
     let [sx, sy, sz] = p.scale;
+    let axes: Vec<&str> = ["x", "y", "z"]
+        .into_iter()
+        .zip(p.mirror)
+        .filter(|(_, m)| *m)
+        .map(|(a, _)| a)
+        .collect();
+    let mirror = if axes.is_empty() {
+        String::new()
+    } else {
+        format!(", mirror {}", axes.join("/"))
+    };
     format!(
-        "part {} = {}{what}{name}, rotate {rx}/{ry}/{rz} deg, scale {sx}/{sy}/{sz}, at X{} Y{}{}, angle {} deg, copy {} of {}, unit {}",
+        "part {} = {}{what}{name}, rotate {rx}/{ry}/{rz} deg, scale {sx}/{sy}/{sz}{mirror}, at X{} Y{}{}, angle {} deg, copy {} of {}, unit {}",
         p.part + 1,
         clean(&p.file),
         coord(p.at[0]),

@@ -98,7 +98,8 @@ impl Models {
     }
 
     /// Where every copy of every part goes: `Layout {instances: [{part, copy, copies, name,
-    /// file, item, object, rotate, scale, place_angle, placed, at, unit, matrix, min, max}],
+    /// file, item, object, rotate, scale, mirror, place_angle, placed, at, unit, matrix, min,
+    /// max, size}],
     /// bounds, warnings}` (`matrix`: column-major 4×4, model → plate coordinates, exactly
     /// the transform sliced). `job`: `{settings, parts}` as in a job file. Throws
     /// `{kind: "job" | "setting", message, setting?}`.

@@ -5,7 +5,8 @@
 // (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { clientPoint3d, open3d, openPage, pixels3d, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
+import { readFileSync } from "node:fs";
+import { clientPoint3d, open3d, openPage, pixels3d, shareLink, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -122,15 +123,57 @@ test("mirror per axis: the toggle mirrors the part (its matrix), its size stays,
   const det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
   assert.ok(det < 0, `determinant ${det}`);
   for (let k = 0; k < 3; k++) assert.ok(close(inst.size[k], before.size[k], 1e-6));
+  // the job file says so (and only for the mirrored axis)
+  const [d] = await Promise.all([page.waitForEvent("download"), page.click("#btn-save-job")]);
+  const saved = JSON.parse(readFileSync(await d.path(), "utf8"));
+  assert.equal(saved.parts[0].mirror_x, true);
+  assert.equal("mirror_y" in saved.parts[0], false);
   // the slice of the mirrored part
   await page.evaluate(() => (document.body.dataset.state = "picking"));
   await page.click("#btn-slice");
   const s = await waitDone(page);
   assert.ok(s.droplets > 0);
+  // a preview link carries the mirror
+  const other = await openPage(env.browser, await shareLink(page));
+  await waitDone(other.page);
+  assert.equal((await job(other.page)).parts[0].mirror_x, true);
+  assert.equal((await job(other.page)).parts[0].mirror_y, false);
+  assert.equal((await other.page.evaluate(() => window.dropslice.status())).droplets, s.droplets);
+  await other.context.close();
   // off again
   await page.click("#part-mirror_x");
   await page.waitForFunction(() => window.dropslice.job().parts[0].mirror_x === false);
   assert.equal(await page.getAttribute("#part-mirror_x", "aria-pressed"), "false");
+
+  // lay flat through a z mirror puts the same face down: the first layer as large as the
+  // plain part's (not the part standing on what was its top)
+  const firstLayer = async () => {
+    await page.evaluate(() => (document.body.dataset.state = "picking"));
+    await page.click("#btn-slice");
+    await waitDone(page);
+    await page.evaluate(() => window.dropslice.show(0));
+    await page.waitForFunction(() => window.dropslice.status().shown === 0);
+    // the layer's droplets by role, added up
+    const c = (await page.evaluate(() => window.dropslice.status())).layerDroplets;
+    return typeof c === "number" ? c : Object.values(c).reduce((a, v) => a + (typeof v === "number" ? v : 0), 0);
+  };
+  const plain = await firstLayer();
+  await page.click("#part-mirror_z");
+  await page.waitForFunction(() => window.dropslice.job().parts[0].mirror_z === true);
+  const upside = await firstLayer();
+  await page.click("#part-lay-flat");
+  // (the core's answer turns it; a page that kept the face up would change nothing)
+  await page.waitForFunction(() => window.dropslice.job().parts[0].rotate_x !== 0, null, { timeout: 10_000 }).catch(() => {});
+  const flat = await firstLayer();
+  assert.ok(upside < 0.8 * plain, `mirrored along z the part stands on its top: ${upside} vs ${plain} droplets`);
+  assert.ok(Math.abs(flat - plain) <= 0.05 * plain, `laid flat: ${flat} vs ${plain} droplets on the first layer`);
+  await page.click("#part-mirror_z");
+  await page.fill("#part-rotate_x", "0");
+  await page.press("#part-rotate_x", "Enter");
+  await page.waitForFunction(() => {
+    const p = window.dropslice.job().parts[0];
+    return p.mirror_z === false && p.rotate_x === 0;
+  });
   assert.deepEqual(errors, []);
 });
 
@@ -185,10 +228,20 @@ test("a part's context menu: right-click or Shift+F10 in the list, right-click i
   const id = (await page.evaluate(() => window.dropslice.view3d())).selected;
   assert.ok(id !== null, "the part right-clicked is selected");
   assert.equal(await page.isDisabled("#part-menu-remove"), false);
+  // Esc gives the focus back to the 3D view; Shift+F10 there opens the selected part's menu
+  await page.keyboard.press("Escape");
+  assert.equal(await page.evaluate(() => document.activeElement === document.querySelector("#view3d canvas")), true);
+  await page.keyboard.press("Shift+F10");
+  await page.waitForSelector("#part-menu:not([hidden])");
   await page.click("#part-menu-remove");
   await page.waitForFunction(() => window.dropslice.job().parts.length === 1);
   assert.equal(await page.isVisible("#part-menu"), false);
   await page.click("#mode-layer");
+  // the shortcuts panel lists the menu's keys
+  await page.click("#btn-shortcuts");
+  const text = await page.locator("#shortcuts-dialog").innerText();
+  for (const key of ["Shift+F10", "Right-click", "Skip to Slice"]) assert.ok(text.includes(key), `the panel lists ${key}`);
+  await page.click("#shortcuts-close");
   assert.deepEqual(errors, []);
 });
 

@@ -188,6 +188,7 @@ async function openPending(page: Page, pending: PendingJob, dropped: File[]): Pr
     pending.source === "link" ? TITLES.linkFiles : TITLES.jobFiles,
     `Still missing: ${list}. Drop ${missing.length > 1 ? "those files" : "that file"} here${strange}`,
     "info",
+    true,
   );
   setState("idle");
   updateButtons(page);
@@ -321,9 +322,9 @@ export async function openLink(page: Page): Promise<boolean> {
     const also = ignored.length ? ` Also ignored: ${ignored.join("; ")}.` : "";
     showBanner(TITLES.link, `This preview link is too large or damaged: ${link.modelError}. Its settings are applied; drop ${several ? "its models" : `“${name}”`} here to see the slice.${also}`);
   } else if (notice) {
-    showBanner(notice.title, notice.message, notice.tone);
+    showBanner(notice.title, notice.message, notice.tone, true);
   } else if (several) {
-    showBanner(TITLES.linkFiles, `Still missing: ${files.map((f) => `“${f.name}”`).join(", ")}. Drop those files here.`, "info");
+    showBanner(TITLES.linkFiles, `Still missing: ${files.map((f) => `“${f.name}”`).join(", ")}. Drop those files here.`, "info", true);
   }
   note(
     link.modelError

@@ -96,7 +96,7 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
   }
   cancelRunning(page);
   hideBanner();
-  if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone);
+  if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone, true);
   const gen = ++store.generation;
   const values = form.values();
   const settings = jobSettings(values, page.init!.schema);

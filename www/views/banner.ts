@@ -30,7 +30,9 @@ export function clampMessage(message: string): string {
   return message.length > BANNER_MAX_CHARS ? `${message.slice(0, BANNER_MAX_CHARS)}…` : message;
 }
 
-export function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error"): void {
+/** Shows the banner; it stays until its ✕ when `stay` (an error, or information the page waits
+ *  on: files still missing), else it goes by itself (notices.ts `dismissAfter`). */
+export function showBanner(title: string, message: string, tone: "error" | "info" | "ok" = "error", stay = tone === "error"): void {
   message = clampMessage(message);
   const b = $("banner");
   b.className = `banner ${tone === "error" ? "" : tone}`;
@@ -39,7 +41,7 @@ export function showBanner(title: string, message: string, tone: "error" | "info
   $("banner-message").textContent = message;
   b.hidden = false;
   b.dataset.kind = tone;
-  dismissAfter(b, tone === "error" ? null : NOTICE_MS);
+  dismissAfter(b, stay ? null : NOTICE_MS);
 }
 
 export function hideBanner(): void {

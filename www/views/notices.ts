@@ -1,9 +1,9 @@
 // Short notices of the page: the Undo and Redo buttons (what they would undo in their titles),
 // the notice after a change that replaced work ("… — Undo"), and the note of a page opened
-// from a preview link (the settings that differ from the defaults). Notices sit above the stage
-// in the page's flow (they push the canvases down, never over a control); information goes by
-// itself after [[NOTICE_MS]] (not while the pointer or the focus is on it), and every notice
-// goes on its ✕; errors stay until then (banner.ts).
+// from a preview link (the settings that differ from the defaults: kept until its ✕, a list to
+// read). Notices sit above the stage in the page's flow (they push the canvases down, never
+// over a control); information goes by itself after [[NOTICE_MS]] (not while the pointer or the
+// focus is on it), and every notice goes on its ✕; errors stay until then (banner.ts).
 
 import { $ } from "./dom";
 import type { Page } from "./page";
@@ -84,7 +84,6 @@ export function linkFromNote(differing: string[]): void {
     ? `Settings that differ from the defaults: ${differing.join(", ")}.`
     : "Every setting is at its default.";
   $("link-from").hidden = false;
-  dismissAfter($("link-from"), NOTICE_MS);
 }
 
 export function wireNotices(page: Page): void {

@@ -2,7 +2,7 @@
 // field) or the *Keyboard shortcuts* button; Esc or *Close* closes it and the focus goes back
 // to where it was. The keys themselves are wired where they act (views/layer.ts: layers and
 // fit; main.ts: Enter slices, undo and redo, Delete; views/parts.ts, views/cut.ts: Enter in
-// their fields).
+// their fields; views/contextmenu.ts: a part's menu; views/dom.ts: the skip links).
 
 import { $ } from "./dom";
 
@@ -26,6 +26,8 @@ export const SHORTCUTS: { title: string; keys: [string, string][] }[] = [
       ["Delete", "Remove the selected part"],
       ["Enter (in the settings)", "Slice"],
       ["Enter or Space (on a part in the list)", "Select the part"],
+      ["Menu key or Shift+F10 (on a part in the list; in 3D: the selected part)", "The part's menu: duplicate, remove, lay flat, orient, mirror, reset"],
+      ["↑ / ↓, Enter, Esc (in a part's menu)", "Move, pick, close (the focus goes back)"],
       ["Enter (in a part's field)", "Apply the value"],
       ["Enter (in the cut's position)", "Set the cut there"],
     ],
@@ -34,6 +36,7 @@ export const SHORTCUTS: { title: string; keys: [string, string][] }[] = [
     title: "The page",
     keys: [
       ["Tab / Shift+Tab", "Next / previous control (the per-layer plot too: its arrows move the layer)"],
+      ["Tab, Enter (from the page's top)", "Skip to Slice; Tab twice: skip to the layer view"],
       ["?", "This list"],
       ["Esc", "Close this list or a dialog"],
     ],
@@ -44,6 +47,7 @@ export const SHORTCUTS: { title: string; keys: [string, string][] }[] = [
       ["Wheel", "Zoom about the pointer"],
       ["Drag", "Pan (3D: orbit; right-drag: pan)"],
       ["Double-click", "Fit"],
+      ["Right-click (on a part in the list or in 3D)", "The part's menu"],
     ],
   },
 ];

@@ -30,7 +30,8 @@ Build jobs:
      \"parts\": [{\"file\": \"a.stl\", \"rotate_z\": 90, \"place_x\": 30, \"place_y\": 5},
                {\"file\": \"gear.3mf\", \"item\": 0, \"copies\": 3}]}
   Part keys: file (relative to the job file's folder), item (a 3MF build item, from 0;
-  none: the whole build), rotate_x/y/z, scale_x/y/z, place_x + place_y (none: arranged),
+  none: the whole build), rotate_x/y/z, scale_x/y/z, mirror_x/y/z (true: mirrored along
+  that plate axis), place_x + place_y (none: arranged),
   place_angle, copies (1..100), unit (0 or 1: the discharge unit; where parts of
   different units overlap, the part listed first keeps the overlap). --set and --settings
   override the job file's settings (not the parts').

@@ -13,8 +13,8 @@
 //                                on empty space (null); the view selects it before calling cb
 //   onMenu(cb)                   a right-click (press and release within a few pixels: a
 //                                right drag pans) on a part: cb(id, clientX, clientY), the
-//                                view selects it first; the ContextMenu key on the canvas:
-//                                cb(null, …) at the canvas' middle (the owner picks the part)
+//                                view selects it first; the Menu key or Shift+F10 on the
+//                                canvas: cb(null, …) at its middle (the owner picks the part)
 //   onDrag(cb)                   with a listener, a left drag that starts on a part moves it on
 //                                the plate plane: cb(id, dx, dy, done) with dx, dy the plate
 //                                millimetres from the drag's start (cumulative); the view moves
@@ -248,6 +248,7 @@ export class View3D {
     this.canvas.addEventListener("pointerup", this.onPointerUp);
     this.canvas.addEventListener("pointercancel", this.onPointerCancel);
     this.canvas.addEventListener("contextmenu", this.onContextMenu);
+    this.canvas.addEventListener("keydown", this.onKeyDown);
 
     this.observer = new ResizeObserver(() => this.resize());
     this.observer.observe(container);
@@ -648,6 +649,14 @@ export class View3D {
     if (p && p.dragging && p.id !== null && report) this.dragCb?.(p.id, p.dx, p.dy, true);
   }
 
+  /** The Menu key or Shift+F10 on the canvas: the selected part's menu (at the canvas' middle). */
+  private readonly onKeyDown = (ev: KeyboardEvent): void => {
+    if (!this.menuCb || !(ev.key === "ContextMenu" || (ev.key === "F10" && ev.shiftKey))) return;
+    ev.preventDefault();
+    const r = this.canvas.getBoundingClientRect();
+    this.menuCb(null, r.left + r.width / 2, r.top + r.height / 2);
+  };
+
   /** The browser's menu never shows; the ContextMenu key (no right press before it, none just
    *  ended) asks for the selected part's menu. */
   private readonly onContextMenu = (ev: MouseEvent): void => {
@@ -669,6 +678,7 @@ export class View3D {
     this.canvas.removeEventListener("pointerup", this.onPointerUp);
     this.canvas.removeEventListener("pointercancel", this.onPointerCancel);
     this.canvas.removeEventListener("contextmenu", this.onContextMenu);
+    this.canvas.removeEventListener("keydown", this.onKeyDown);
     for (const e of [...this.entries.values()]) this.drop(e);
     this.support = showSupport(this.scene, this.support, null, this.clipTop);
     disposeObject(this.plate);
