@@ -19,11 +19,16 @@ fn translate(x: f64, y: f64, z: f64) -> String {
     format!("1 0 0 0 1 0 0 0 1 {x} {y} {z}")
 }
 
-/// Slices `bytes` with the defaults, writes the code and reads it back: for every layer, the
+/// Slices `bytes` with the defaults (off the plate allowed), writes the code and reads it back: for every layer, the
 /// droplets of each cube column (x, y on a grid of `pitch` mm), checking that each droplet
 /// lies on a cube's square (its centre within the square, to the code's rounding).
 fn droplets_per_cube(bytes: &[u8], name: &str, pitch: f64) -> Vec<HashMap<(i64, i64), u32>> {
-    let job = Job::new(bytes, name, Settings::default()).expect("a job of many cubes slices");
+    // The grid of cubes is wider than the default plate: allowed (the plate is not tested here).
+    let s = Settings {
+        allow_off_plate: true,
+        ..Settings::default()
+    };
+    let job = Job::new(bytes, name, s).expect("a job of many cubes slices");
     let mut code = Vec::new();
     let summary = dropslice::write_gcode(&job, &mut code, |_, _| {}).expect("code");
     let text = String::from_utf8(code).expect("text");

@@ -394,7 +394,14 @@ mod tests {
             m.message
         );
         // 77 % fits, 78 % does not.
-        assert!(200.0 * 0.77 <= 154.0 && 200.0 * 0.78 > 154.0);
+        for (k, fits) in [(0.77, true), (0.78, false)] {
+            let (i, f) = boxed([200.0, 150.0, 10.0], [0.0; 3], [k, k, 2.0 * k], 0.0);
+            assert_eq!(
+                misfit(&i, &f, "b", &Settings::default()).is_none(),
+                fits,
+                "{k}"
+            );
+        }
         // A ratio just under a whole percent: 154/200.5 = 0.7680… → 76 %.
         let (i, f) = boxed([200.5, 150.0, 10.0], [0.0; 3], [1.0; 3], 0.0);
         assert_eq!(

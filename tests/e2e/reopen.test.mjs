@@ -8,7 +8,7 @@ import assert from "node:assert/strict";
 import { mkdtempSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { downloadText, pick, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
+import { downloadText, pick, shared, startWithPage, stop, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -102,4 +102,27 @@ test("a filament printer's .gcode is named as such", async () => {
   const banner = await page.locator("#banner").innerText();
   assert.match(banner, /line 3: this is G-code for another kind of printer \(it has M140, M105, M190, G1 … E…\): dropslice reads the droplet printer's code it writes \(G01 travel, G25 droplet line, G26 droplet\)/);
   assert.doesNotMatch(banner, /is not a G01, G25 or G26 command/);
+});
+
+test("two units: the re-opened .gco shows each unit's figures of the slice", async () => {
+  const { page, errors } = main;
+  await page.check("#opt-support");
+  await pick(page, join(shared, "models/U_overhang.obj"));
+  await waitDone(page, 120_000);
+  await waitSettled(page);
+  const ids = [...FIGURES, "stat-support", "stat-unit1", "stat-volume1", "stat-mass1", "stat-unit-times"];
+  const texts = () => page.evaluate((ids) => Object.fromEntries(ids.map((id) => [id, document.getElementById(id).innerText])), ids);
+  const two = await texts();
+  assert.notEqual(two["stat-support"], "0", "the part needs support");
+  assert.match(two["stat-unit-times"], /·/);
+  const text = await downloadText(page);
+  assert.match(text, /^; volume unit 1 {8}= +[\d.e-]+ mm³$/m);
+  const file = join(tmp, "u.gco");
+  writeFileSync(file, text);
+  await page.uncheck("#opt-support");
+  await pick(page, file);
+  await waitDone(page);
+  assert.deepEqual(await texts(), two);
+  assert.equal(await page.isChecked("#opt-support"), true, "the form takes the file's support = unit1");
+  assert.deepEqual(errors, []);
 });
