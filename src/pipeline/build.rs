@@ -12,7 +12,7 @@ use crate::model::mesh::{self, Mesh, MeshStats};
 use crate::model::models::{Model, models_of};
 use crate::model::prepare::{
     FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, check_chamber, check_height,
-    check_volume, close_cracks, import, keep_groups, suggested_scale, warnings,
+    check_surface, check_volume, close_cracks, import, keep_groups, suggested_scale, warnings,
 };
 use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
@@ -80,14 +80,22 @@ impl Job {
         let (mut facets_in_file, mut degenerate, mut facets) = (0usize, 0usize, 0usize);
         for (i, (p, m)) in spec.parts.iter().zip(&by_part).enumerate() {
             let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
-            let (mesh, dropped) = Mesh::weld(&tris);
             let copies = p.copies as usize;
-            facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
-            if facets > import::MAX_TRIANGLES {
-                return Err(Error::Job(format!(
+            let too_many = || {
+                Error::Job(format!(
                     "the job has more than {} triangles in all (parts × copies); print fewer copies or simplify the models",
                     import::MAX_TRIANGLES
-                )));
+                ))
+            };
+            // The job's bound before the weld (its map is sized from the triangles), then
+            // again with the facets the weld kept.
+            if facets.saturating_add(tris.len().saturating_mul(copies)) > import::MAX_TRIANGLES {
+                return Err(too_many());
+            }
+            let (mesh, dropped) = Mesh::weld(&tris);
+            facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
+            if facets > import::MAX_TRIANGLES {
+                return Err(too_many());
             }
             let frame = Frame::of(
                 &mesh.vertices,
@@ -218,6 +226,7 @@ impl Job {
             }
         };
         let (mesh_shells, weld) = close_cracks(&mut mesh, mesh_shells, &mut groups);
+        let open_edges = mesh_shells.open_edges;
         let index = index.filter(|_| weld == (0, 0));
         let dropped = input.degenerate + weld.1;
         let ((shells, flip), stats) = both(
@@ -228,6 +237,8 @@ impl Job {
         mesh.turn(&mesh_shells, &flip);
         drop(mesh_shells);
         let volume = check_volume(&mesh, &shells, &size)?;
+        // A triangle soup is refused before any section of it is made.
+        check_surface(open_edges, mesh.facets.len())?;
         // One droplet estimate for the whole job: every unit and the support.
         let unit1 = budget::Unit1Parts::of(&mesh, &groups);
         let open = shells.open > 0;
