@@ -266,3 +266,249 @@ fn the_index_and_statistics_made_beside_the_repair_are_those_of_the_repaired_mes
         }
     }
 }
+
+/// `n` random triangles in a 100 mm box: each corner anywhere in it (long triangles crossing
+/// one another), or, with `size`, within `size` mm of the triangle's first corner.
+fn soup(n: usize, size: Option<f64>, seed: u64) -> Vec<Tri> {
+    let mut rng = Rng::new(seed);
+    let mut tris = Vec::with_capacity(n);
+    for _ in 0..n {
+        let a: [f32; 3] = std::array::from_fn(|_| (100.0 * rng.unit()) as f32);
+        let corner = |rng: &mut Rng| -> [f32; 3] {
+            std::array::from_fn(|k| match size {
+                Some(s) => (f64::from(a[k]) + s * (rng.unit() - 0.5)).clamp(0.0, 100.0) as f32,
+                None => (100.0 * rng.unit()) as f32,
+            })
+        };
+        let (b, c) = (corner(&mut rng), corner(&mut rng));
+        tris.push([a, b, c]);
+    }
+    tris
+}
+
+#[test]
+fn a_triangle_soup_is_refused_before_it_is_sliced() {
+    // 50,000 loose triangles (a 2.5 MB STL): before, the slicer joined their sections across
+    // the whole part, minutes and a gigabyte per run; now it names the problem and the fix.
+    for (what, size, seed) in [("long, crossing", None, 3), ("small", Some(8.0), 4)] {
+        let tris = soup(50_000, size, seed);
+        let err = match Job::new(&binary(&tris), "soup.stl", Settings::default()) {
+            Ok(_) => panic!("{what} soup: sliced"),
+            Err(e) => e,
+        };
+        assert_eq!(err.kind(), "import", "{what}: {err}");
+        let msg = err.to_string();
+        for part in [
+            "not a closed surface",
+            "% of its facets' edges",
+            "triangle soup",
+            "repair it in a mesh tool",
+        ] {
+            assert!(msg.contains(part), "{what} soup: {msg}");
+        }
+    }
+    // The CLI: refused with the message, no output file.
+    let dir = common::TempDir::new("soup");
+    let path = dir.join("soup.stl");
+    std::fs::write(&path, binary(&soup(50_000, None, 3))).unwrap();
+    let run = common::run_cli(
+        &[path.to_str().unwrap(), "-o", "soup.gco"],
+        dir.path(),
+        std::time::Duration::from_secs(600),
+    );
+    assert!(
+        !run.timed_out && run.code.is_some_and(|c| c != 0),
+        "{run:?}"
+    );
+    assert!(
+        run.stderr.contains("not a closed surface") && run.stderr.contains("triangle soup"),
+        "{}",
+        run.stderr
+    );
+    assert!(!dir.join("soup.gco").exists());
+}
+
+#[test]
+fn meshes_with_holes_cracks_or_flipped_facets_are_not_soups() {
+    // The damage the repairs handle stays well under the soup's share of open edges: a tenth
+    // of the facets removed (holes everywhere) still slices.
+    for model in MODELS {
+        let mut rng = Rng::new(71);
+        let t: Vec<Tri> = load(model)
+            .into_iter()
+            .filter(|_| rng.unit() >= 0.1)
+            .collect();
+        let job = Job::new(&binary(&t), "holes.stl", Settings::default());
+        assert!(job.is_ok(), "{model}: {:?}", job.err());
+    }
+}
+
+/// A torus lying flat (major radius 20 mm, tube 6 mm; 96 × 40 quads), outward.
+fn torus() -> Vec<[[f64; 3]; 3]> {
+    let (r_major, r_tube, nu, nv) = (20.0, 6.0, 96, 40);
+    let p = |i: usize, j: usize| {
+        let u = std::f64::consts::TAU * (i % nu) as f64 / nu as f64;
+        let v = std::f64::consts::TAU * (j % nv) as f64 / nv as f64;
+        let w = r_major + r_tube * v.cos();
+        [w * u.cos(), w * u.sin(), r_tube + r_tube * v.sin()]
+    };
+    let mut t = Vec::new();
+    for i in 0..nu {
+        for j in 0..nv {
+            let (a, b, c, d) = (p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
+            t.push([a, b, c]);
+            t.push([a, c, d]);
+        }
+    }
+    t
+}
+
+/// Whether a facet's centre lies in the patch of the torus around (u0, v0) (degrees; u about
+/// the z axis, v about the tube) within du, dv.
+fn in_patch(t: &[[f64; 3]; 3], u0: f64, v0: f64, du: f64, dv: f64) -> bool {
+    let c: [f64; 3] = std::array::from_fn(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0);
+    let u = c[1].atan2(c[0]);
+    let v = (c[2] - 6.0).atan2(c[0].hypot(c[1]) - 20.0);
+    let near = |a: f64, b: f64, d: f64| {
+        let x = (a - b.to_radians()).rem_euclid(std::f64::consts::TAU);
+        x.min(std::f64::consts::TAU - x) < d.to_radians()
+    };
+    near(u, u0, du) && near(v, v0, dv)
+}
+
+/// Two mirrored open halves of a torus: the facets left of a wavy line (x < 1 + 0.9 sin(y/3 +
+/// z/2), so the halves overlap by up to 3.8 mm and their rims are not planar), a hole punched
+/// into the tube's inner wall (rim on a saddle, not planar), and the half mirrored (inside
+/// out) with a hole of its own. The meant solid is the whole torus.
+fn torus_halves() -> Vec<[[f64; 3]; 3]> {
+    let wave = |c: [f64; 3]| 1.0 + 0.9 * (c[1] / 3.0 + c[2] / 2.0).sin();
+    let centre = |t: &[[f64; 3]; 3]| -> [f64; 3] {
+        std::array::from_fn(|k| (t[0][k] + t[1][k] + t[2][k]) / 3.0)
+    };
+    let left: Vec<[[f64; 3]; 3]> = torus()
+        .into_iter()
+        .filter(|t| centre(t)[0] < wave(centre(t)))
+        .filter(|t| !in_patch(t, 150.0, 180.0, 30.0, 60.0))
+        .collect();
+    let right: Vec<[[f64; 3]; 3]> = left
+        .iter()
+        .map(|t| t.map(|p| [-p[0], p[1], p[2]]))
+        .filter(|t| !in_patch(t, -30.0, 170.0, 25.0, 50.0))
+        .collect();
+    [left, right].concat()
+}
+
+/// Whether p lies inside the closed section `segs` (odd crossings of a ray to +x) or within
+/// `tol` of it.
+fn in_section(segs: &[(common::Point, common::Point)], p: common::Point, tol: f64) -> bool {
+    common::deep_inside(segs, p, 0.0)
+        || segs.iter().any(|&(a, b)| {
+            let (_, q) = common::segment::project(p, a, b);
+            (q[0] - p[0]).hypot(q[1] - p[1]) <= tol
+        })
+}
+
+/// Not met yet (issue 39): the slicer closes a layer's open chains by their nearest ends, so
+/// each piece of the torus' inner boundary broken by a hole closes on itself and the torus'
+/// hole is filled: 27.1 % of the droplets outside, 0.9 % of the section uncovered (an
+/// independent prototype: 26.9 % and 0.9 %; with the holes closed by fan caps in the mesh,
+/// 0.0 % outside and 1.6 % uncovered). Run with `--ignored`.
+#[test]
+#[ignore = "not met yet: 27 % of the droplets outside (issue 39, broken meshes)"]
+fn mirrored_open_halves_with_holes_off_the_plane_print_the_part_and_nothing_else() {
+    let model = torus_halves();
+    let meant = torus();
+    let f32s = |t: &[[[f64; 3]; 3]]| -> Vec<Tri> {
+        t.iter().map(|f| f.map(|p| p.map(|c| c as f32))).collect()
+    };
+    let dir = common::TempDir::new("torus-halves");
+    let meant_path = dir.join("torus.stl");
+    std::fs::write(&meant_path, binary(&f32s(&meant))).unwrap();
+    let oracle = common::oracle_sections(&meant_path, 0.2);
+    let job = Job::new(&binary(&f32s(&model)), "halves.stl", Settings::default()).unwrap();
+    let m = &job.info().mesh;
+    assert!(m.open_edges > 0 && m.flipped_open_shells > 0, "{m:?}");
+    // The independent cut of the meant torus, in the job's coordinates.
+    let lo = job.info().bounds.min;
+    let meant: Vec<[[f64; 3]; 3]> = meant
+        .iter()
+        .map(|t| t.map(|p| [p[0] + 26.0 + lo[0], p[1] + 26.0 + lo[1], p[2]]))
+        .collect();
+    let layers = oracle["layers"].as_array().unwrap();
+    assert_eq!(job.layer_count(), layers.len());
+    let b = job.settings().droplet_width();
+    let (mut outside, mut droplets, mut uncovered, mut sampled) = (0usize, 0usize, 0usize, 0usize);
+    let mut worst = Vec::new();
+    for (i, l) in layers.iter().enumerate() {
+        let section = job.section(i);
+        let segs = common::cut(&meant, section.z);
+        // The section against the oracle's area.
+        let want = l["nonzero"]["area"].as_f64().unwrap();
+        let got = dropslice::base::geom::region_area(&section.region);
+        // Droplet centres outside the meant section (beyond float noise).
+        let plan = job.plan_layer(i);
+        let mut at = dropslice::base::geom::Point::ZERO;
+        let (mut out_here, mut here) = (0, 0);
+        for mv in &plan.moves {
+            use dropslice::slicing::plan::MoveKind;
+            let mut put = |p: dropslice::base::geom::Point| {
+                here += 1;
+                if !in_section(&segs, [p.x, p.y], 1e-3) {
+                    out_here += 1;
+                }
+            };
+            match mv.kind {
+                MoveKind::Travel => {}
+                MoveKind::Droplet => put(mv.to),
+                MoveKind::Line => {
+                    let l = at.distance(mv.to);
+                    for k in 0..common::line_droplets(l, b) {
+                        put(at + (mv.to - at) * (k as f64 * b / l));
+                    }
+                }
+            }
+            at = mv.to;
+        }
+        // Points of the meant section (a 0.25 mm grid) that the sliced region leaves out.
+        let region = common::IndexedRegion::new(&common::nested(&section.region));
+        let (mut unc_here, mut in_here) = (0, 0);
+        for gx in 0..(52.0 / 0.25) as usize {
+            for gy in 0..(52.0 / 0.25) as usize {
+                let p = [
+                    lo[0] + 0.125 + gx as f64 * 0.25,
+                    lo[1] + 0.125 + gy as f64 * 0.25,
+                ];
+                if common::deep_inside(&segs, p, 0.05) {
+                    in_here += 1;
+                    if !region.contains(p, 0.0) {
+                        unc_here += 1;
+                    }
+                }
+            }
+        }
+        worst.push((out_here as f64 / here.max(1) as f64, i, got, want));
+        outside += out_here;
+        droplets += here;
+        uncovered += unc_here;
+        sampled += in_here;
+    }
+    worst.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let out_share = outside as f64 / droplets as f64;
+    let unc_share = uncovered as f64 / sampled as f64;
+    eprintln!(
+        "droplets outside the meant torus {:.2} %, its section uncovered {:.2} %; worst layers (outside share, layer, area, oracle): {:?}",
+        100.0 * out_share,
+        100.0 * unc_share,
+        &worst[..4]
+    );
+    assert!(
+        out_share <= 0.01,
+        "{:.2} % of the droplets lie outside",
+        100.0 * out_share
+    );
+    assert!(
+        unc_share <= 0.01,
+        "{:.2} % of the section uncovered",
+        100.0 * unc_share
+    );
+}

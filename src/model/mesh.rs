@@ -245,10 +245,17 @@ impl Mesh {
     /// were kept (the others keep their order).
     pub fn weld_tolerance_kept(&mut self, tol: f64) -> (usize, Vec<bool>) {
         let cell = |p: &[f64; 3]| p.map(|c| floor_i64(c / tol));
-        let mut grid: HashMap<[i64; 3], Vec<u32>> =
-            HashMap::with_capacity_and_hasher(self.vertices.len(), Default::default());
+        // Per cell its kept vertices as a list: the first and the last (in the map), each
+        // one's next (`next`), in the order they were kept. The map grows as cells are met
+        // from a bounded reservation ([`reserve_entries`]).
+        let entry = std::mem::size_of::<([i64; 3], [u32; 2])>();
+        let mut grid: HashMap<[i64; 3], [u32; 2]> = HashMap::with_capacity_and_hasher(
+            reserve_entries(self.vertices.len(), entry),
+            Default::default(),
+        );
+        let mut next: Vec<u32> = Vec::new();
         let mut remap: Vec<u32> = Vec::with_capacity(self.vertices.len());
-        let mut kept: Vec<[f64; 3]> = Vec::with_capacity(self.vertices.len());
+        let mut kept: Vec<[f64; 3]> = Vec::new();
         let mut merged = 0;
         for v in &self.vertices {
             let c = cell(v);
@@ -256,14 +263,16 @@ impl Mesh {
             'search: for dx in -1..=1 {
                 for dy in -1..=1 {
                     for dz in -1..=1 {
-                        if let Some(ids) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                            for &id in ids {
+                        if let Some(&[first, _]) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                            let mut id = first;
+                            while id != u32::MAX {
                                 let w = kept[id as usize];
                                 let d2 = (0..3).map(|k| (w[k] - v[k]).powi(2)).sum::<f64>();
                                 if d2 <= tol * tol {
                                     found = Some(id);
                                     break 'search;
                                 }
+                                id = next[id as usize];
                             }
                         }
                     }
@@ -271,8 +280,14 @@ impl Mesh {
             }
             let id = found.unwrap_or_else(|| {
                 kept.push(*v);
+                next.push(u32::MAX);
                 let id = (kept.len() - 1) as u32;
-                grid.entry(c).or_default().push(id);
+                grid.entry(c)
+                    .and_modify(|[_, last]| {
+                        next[*last as usize] = id;
+                        *last = id;
+                    })
+                    .or_insert([id, id]);
                 id
             });
             if found.is_some() {
@@ -280,6 +295,7 @@ impl Mesh {
             }
             remap.push(id);
         }
+        drop((grid, next));
         self.vertices = kept;
         let facets: Vec<[u32; 3]> = self
             .facets
@@ -416,6 +432,17 @@ impl Mesh {
     }
 }
 
+/// Most bytes a weld's map reserves before it is filled: beyond, it grows as vertices are
+/// met, so it never asks for more than the vertices it holds need (a reservation for every
+/// corner of a 20-million-triangle file would be gigabytes up front).
+pub const WELD_RESERVE_BYTES: usize = 64 << 20;
+
+/// The entries a weld's map of `entry_bytes` an entry reserves for `expected` entries: as
+/// many, at most [`WELD_RESERVE_BYTES`] worth.
+pub fn reserve_entries(expected: usize, entry_bytes: usize) -> usize {
+    expected.min(WELD_RESERVE_BYTES / entry_bytes.max(1))
+}
+
 /// Files of this many facets are welded in two halves side by side ([`Mesh::weld`]; natively).
 /// Below, the join costs more than the halves save; above, memory decides: the halves' two
 /// maps and lists take up to twice the one pass' (where each half meets nearly every vertex,
@@ -450,8 +477,11 @@ fn weld_local(
     facets: usize,
     vertices: usize,
 ) -> (HashMap<[u32; 3], u32>, Vec<[f64; 3]>, Vec<[u32; 3]>) {
-    let mut index: HashMap<[u32; 3], u32> =
-        HashMap::with_capacity_and_hasher(tris.len() / 2 + 16, Default::default());
+    let entry = std::mem::size_of::<([u32; 3], u32)>();
+    let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity_and_hasher(
+        reserve_entries(tris.len() / 2 + 16, entry),
+        Default::default(),
+    );
     let mut points = Vec::with_capacity(vertices);
     let mut ids = Vec::with_capacity(facets);
     // In runs of triangles ([`in_runs`]: the page's engine compiles the later runs well).
@@ -656,6 +686,43 @@ pub fn rot(axis: usize, deg: f64) -> DMat3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_weld_reserves_at_most_its_bound() {
+        // A closed mesh's vertices are reserved for as they are expected, under the bound.
+        assert_eq!(reserve_entries(500_016, 16), 500_016);
+        // 20 million loose triangles: 60 million corners, 32-byte entries of the tolerance
+        // weld: the reservation stays at the bound (64 MB), not 2 GB (6.5 GB with the map's
+        // buckets); the map grows beyond as vertices are met.
+        let r = reserve_entries(60_000_000, 32);
+        assert_eq!(r, WELD_RESERVE_BYTES / 32);
+        assert!(r * 32 <= 64 << 20);
+        assert_eq!(reserve_entries(10_000_016, 16), (64 << 20) / 16);
+        assert_eq!(reserve_entries(7, 0), 7);
+    }
+
+    #[test]
+    fn the_tolerance_weld_merges_into_the_first_kept_vertex_of_a_cell() {
+        // Two kept vertices in one cell (farther apart than the tolerance along its diagonal)
+        // and a third near both: it takes the number of the one kept first.
+        let t = 1e-4;
+        let mut m = Mesh {
+            vertices: vec![
+                [1e-6; 3],           // kept 0
+                [0.99e-4; 3],        // 1.7e-4 from 0: kept 1, in the same cell
+                [0.5e-4; 3],         // 0.85e-4 from both: into 0
+                [5.0, 5.0, 5.0],     // kept 2
+                [5.0, 5.0, 5.00005], // into 2
+                [3e-4, 0.0, 0.0],    // kept 3
+            ],
+            facets: vec![[0, 3, 5], [1, 3, 5], [2, 4, 5]],
+        };
+        let (merged, alive) = m.weld_tolerance_kept(t);
+        assert_eq!(merged, 2);
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(alive, vec![true, true, true]);
+        assert_eq!(m.facets, vec![[0, 2, 3], [1, 2, 3], [0, 2, 3]]);
+    }
 
     #[test]
     fn rotation_is_exact_at_right_angles() {

@@ -14,8 +14,8 @@ use crate::model::models::{
 };
 use crate::model::prepare::{
     Bodies, FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, bodies_warning,
-    check_chamber, check_height, check_volume, close_cracks, import, keep_groups, part_bodies,
-    suggested_scale, warnings,
+    check_chamber, check_height, check_surface, check_volume, close_cracks, import, keep_groups,
+    part_bodies, suggested_scale, warnings,
 };
 use crate::model::shells::ShellOrientation;
 use crate::model::spec as job;
@@ -246,6 +246,7 @@ impl Job {
             }
         };
         let (mesh_shells, weld) = close_cracks(&mut mesh, mesh_shells, &mut groups);
+        let open_edges = mesh_shells.open_edges;
         let index = index.filter(|_| weld == (0, 0));
         let dropped = input.degenerate + weld.1;
         let ((shells, flip), stats) = both(
@@ -256,6 +257,8 @@ impl Job {
         mesh.turn(&mesh_shells, &flip);
         drop(mesh_shells);
         let volume = check_volume(&mesh, &shells, &size)?;
+        // A triangle soup is refused before any section of it is made.
+        check_surface(open_edges, mesh.facets.len())?;
         // One droplet estimate for the whole job: every unit and the support.
         let unit1 = budget::Unit1Parts::of(&mesh, &groups);
         let open = shells.open > 0;

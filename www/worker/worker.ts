@@ -366,7 +366,38 @@ async function handle(req: Request): Promise<void> {
   }
 }
 
-function describe(e: unknown): ErrorValue {
+/** What ran out of memory, by the request that did: the model's size or complexity (reading
+ * or preparing it), the layers' complexity (slicing; layers are made one at a time, so their
+ * number is not the cause) or the void analysis. */
+function outOfMemory(req: Request | null): string {
+  const limit = "the slicer ran out of memory (a browser tab's WebAssembly is limited to 4 GB)";
+  const model =
+    "the model is too large or too complex: too many triangles, or not a closed surface (loose triangles). Simplify or repair it in a mesh tool, or print fewer copies.";
+  switch (req?.kind) {
+    case "models_add":
+    case "display_mesh":
+    case "layout":
+    case "lay_flat":
+    case "orient":
+    case "open_job":
+    case "adopt_job":
+      return `${limit} while reading and preparing the model: ${model}`;
+    case "slice":
+    case "preview":
+      return req.data.analyse
+        ? `${limit} while analysing the voids: slice without the Voids analysis, or slice a smaller part.`
+        : `${limit} while slicing a layer: ${model}`;
+    case "cut":
+      return `${limit} while making the cut's section: ${model}`;
+    case "parse_gcode":
+    case "calibrate":
+      return `${limit} while reading the G-code file: the file is too large for the page.`;
+    default:
+      return `${limit}: ${model}`;
+  }
+}
+
+function describe(e: unknown, req: Request | null = null): ErrorValue {
   if (e instanceof GcodeError) return { kind: "import", message: `cannot read the G-code file: ${e.message}` };
   if (e instanceof WebAssembly.RuntimeError || e instanceof RangeError) {
     broken = true;
@@ -375,7 +406,7 @@ function describe(e: unknown): ErrorValue {
     if (big || /memory|allocation|out of bounds/i.test(String(e))) {
       return {
         kind: "crash",
-        message: "the slicer ran out of memory (a browser tab's WebAssembly is limited to 4 GB). Try fewer layers (a larger layer height) or a smaller part.",
+        message: outOfMemory(req),
       };
     }
     return { kind: "crash", message: `the slicer stopped unexpectedly (${String(e)}). Please report it.` };
@@ -395,5 +426,5 @@ scope.onmessage = (ev: MessageEvent<Request>) => {
     post({ id: req.id, kind: "error", data: { kind: "crash", message: "this worker crashed earlier" } });
     return;
   }
-  handle(req).catch((e: unknown) => post({ id: req.id, kind: "error", data: describe(e) }));
+  handle(req).catch((e: unknown) => post({ id: req.id, kind: "error", data: describe(e, req) }));
 };
