@@ -297,6 +297,11 @@ test("drag and drop opens a file; wheel zooms, dragging pans, Fit restores", asy
   assert.equal(s.name, "dropped-cube.stl");
   assert.equal(s.layers, 100);
   assert.equal(await page.isVisible("#drop-overlay"), false);
+  // the notice that the job was replaced sits above the stage (the canvas is shorter while it
+  // shows, and it goes by itself): closed, so that the canvas keeps its size from here on, and
+  // the part fitted to that size
+  if (await page.isVisible("#undo-note")) await page.click("#undo-close");
+  await page.click("#btn-fit");
 
   const box = await page.locator("#view").boundingBox();
   await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);

@@ -92,22 +92,13 @@ test("a size in mm per axis scales the part to it (uniform or one axis); a scale
     assert.match(await page.getAttribute("#part-size_x", "title"), why);
   }
   assert.deepEqual((await job(page)).parts, was.parts);
-  // back to the file's own scale (the context menu's Reset, tested below, would do it too)
-  await page.check("#part-scale-lock");
-  await page.evaluate(() => window.dropslice.job());
-  for (const k of ["x", "y", "z"]) {
-    await page.fill(`#part-scale_${k}`, "1");
-    await page.press(`#part-scale_${k}`, "Enter");
-  }
+  // back to the file's own scale, one axis after the other (each laid out before the next)
   await page.uncheck("#part-scale-lock");
   for (const k of ["x", "y", "z"]) {
     await page.fill(`#part-scale_${k}`, "1");
     await page.press(`#part-scale_${k}`, "Enter");
+    await page.waitForFunction((k) => window.dropslice.job().parts[0][`scale_${k}`] === 1, k);
   }
-  await page.waitForFunction(() => {
-    const p = window.dropslice.job().parts[0];
-    return p.scale_x === 1 && p.scale_y === 1 && p.scale_z === 1;
-  });
   await page.check("#part-scale-lock");
   assert.deepEqual(errors, []);
 });
@@ -167,7 +158,9 @@ test("mirror per axis: the toggle mirrors the part (its matrix), its size stays,
   const flat = await firstLayer();
   assert.ok(upside < 0.8 * plain, `mirrored along z the part stands on its top: ${upside} vs ${plain} droplets`);
   assert.ok(Math.abs(flat - plain) <= 0.05 * plain, `laid flat: ${flat} vs ${plain} droplets on the first layer`);
+  // (one edit after the other: each is laid out by the core before the next)
   await page.click("#part-mirror_z");
+  await page.waitForFunction(() => window.dropslice.job().parts[0].mirror_z === false);
   await page.fill("#part-rotate_x", "0");
   await page.press("#part-rotate_x", "Enter");
   await page.waitForFunction(() => {

@@ -74,7 +74,12 @@ function onKey(ev: KeyboardEvent): void {
   else if (ev.key === "Escape") closeMenu(true);
   else if (ev.key === "Tab") {
     closeMenu(true);
-  } else return;
+  } else {
+    // the menu has the keys while it has the focus: the page's own (Delete, the layer keys)
+    // do not act behind it; Enter and Space press the item as usual
+    ev.stopPropagation();
+    return;
+  }
   ev.preventDefault();
   ev.stopPropagation();
 }
