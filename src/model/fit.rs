@@ -306,6 +306,7 @@ mod tests {
             object: None,
             rotate,
             scale,
+            mirror: [false; 3],
             place_angle: angle,
             placed: false,
             at: [0.0, 0.0],
@@ -313,6 +314,7 @@ mod tests {
             matrix: f.matrix(shift),
             min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
             max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
+            size: [0.0; 3],
             shift,
         };
         (inst, f)
