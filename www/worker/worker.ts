@@ -5,11 +5,13 @@
 // core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred).
 // The model files arrive as Files and are read here (by the core, with FileReaderSync), never
 // on the page's thread. Everything from the core is a typed value; its errors are thrown as
-// `{kind, message, setting?}` and passed on as they are.
+// `{kind, message, setting?}` and passed on as they are. The core's module comes compiled
+// from the page as the first message (core/client.ts `compiledCore`): this worker only
+// instantiates it, never fetches or compiles it.
 
-import init, { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
+import { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
-import { GcodeError, GcodeReader, readGcode } from "./gcode";
+import { GcodeError, GcodeReader, loadCore, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
   coverageMaskOf,
@@ -25,6 +27,7 @@ import {
   type RequestData,
   type RequestKind,
   type ResultOf,
+  type ToWorker,
   type SliceUnit,
   type ModelInfo,
   type LayerData,
@@ -41,7 +44,14 @@ const clock = publish(
   }),
 );
 
-let wasm: Promise<InitOutput> | null = null;
+/** The core, once the page's module arrived and was instantiated. */
+let arrived: (module: WebAssembly.Module) => void = () => {};
+const wasm: Promise<InitOutput> = new Promise<WebAssembly.Module>((resolve) => (arrived = resolve)).then((module) => {
+  const out = loadCore(module);
+  memory = out.memory;
+  return out;
+});
+wasm.catch(() => {}); // reported to the requests that need the core
 let memory: WebAssembly.Memory | null = null;
 let session: Session | null = null;
 /** The job's files (the job worker's; the others take the prepared job instead). */
@@ -53,13 +63,8 @@ let broken = false;
   lastPanic = m;
 };
 
+/** The core: waits for the page's module (the worker's first message). */
 function load(): Promise<InitOutput> {
-  if (!wasm) {
-    wasm = init({ module_or_path: new URL("./dropslice_bg.wasm", import.meta.url) }).then((out) => {
-      memory = out.memory;
-      return out;
-    });
-  }
   return wasm;
 }
 
@@ -367,13 +372,16 @@ function describe(e: unknown): ErrorValue {
   return internal(e instanceof Error ? e.message : String(e));
 }
 
-// The module is compiled and instantiated as soon as the worker starts, not at its first
-// request: a worker asked to open a job (often its first request, after a cancel) would
-// otherwise compile it only then, on the slice's path. A failure is reported to the first request that needs the core.
-load().catch(() => {});
-
-scope.onmessage = (ev: MessageEvent<Request>) => {
-  const req = ev.data;
+scope.onmessage = (ev: MessageEvent<ToWorker>) => {
+  const msg = ev.data;
+  if (msg.kind === "module") {
+    // instantiated at once, before any request (they arrive after it), so that a worker asked
+    // to open a job does not instantiate the module only then; a failure is reported to the
+    // first request that needs the core
+    arrived(msg.module);
+    return;
+  }
+  const req: Request = msg;
   if (broken) {
     post({ id: req.id, kind: "error", data: { kind: "crash", message: "this worker crashed earlier" } });
     return;
