@@ -100,7 +100,9 @@ function yieldToQueue(): Promise<void> {
 }
 
 function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analyse = false, counted = true): LayerData {
-  const r = clock.time("core: a layer (all its stages)", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index)));
+  const r = clock.time("core: a layer (all its stages)", () =>
+    timedCall("core: a layer, the longest call", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index))),
+  );
   const t0 = performance.now();
   try {
     if (unit) {
@@ -128,6 +130,31 @@ function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analy
   } finally {
     r.free();
     clock.since("worker: copy out of wasm", t0);
+  }
+}
+
+/** `Session.from_models` in short calls (`Session.begin`, then a pass a call): the engine
+ *  keeps a running call's first code to its end, so a call that ran the whole preparation
+ *  ran it all in that code; later calls of a pass get the optimised code. */
+function prepare(m: Models, job: RequestData<"open_job">["job"]): Session {
+  const p = timedCall("core: preparation, the longest call", () => Session.begin(m, job));
+  let done = false;
+  try {
+    while (!done) done = timedCall("core: preparation, the longest call", () => p.step());
+  } catch (e) {
+    p.free();
+    throw e;
+  }
+  return Session.from_preparation(p);
+}
+
+/** Runs one call into the core, keeping the longest of `name` in the profile. */
+function timedCall<T>(name: string, f: () => T): T {
+  const t0 = performance.now();
+  try {
+    return f();
+  } finally {
+    clock.max(name, performance.now() - t0);
   }
 }
 
@@ -205,7 +232,7 @@ async function handle(req: Request): Promise<void> {
       try {
         for (const { name, file } of req.data.files) {
           const hash = hashing ? sha256Of(file) : null;
-          infos.push(clock.time("worker: file read and parsed", () => m.add(file, name)));
+          infos.push(clock.time("worker: file read and parsed", () => timedCall("core: file read and parsed, the longest call", () => m.add(file, name))));
           if (hash) {
             const t0 = performance.now();
             sha256.push(await hash);
@@ -249,7 +276,7 @@ async function handle(req: Request): Promise<void> {
     case "open_job": {
       await load();
       // the old session stays usable if the job is refused
-      const s = Session.from_models(needModels(), req.data.job);
+      const s = prepare(needModels(), req.data.job);
       // one copy of the prepared job per other worker (at most the pool's), made here rather
       // than on the page's thread, all transferred; made before the session is taken, so a
       // failure keeps the old one
@@ -257,7 +284,7 @@ async function handle(req: Request): Promise<void> {
       const n = Number.isFinite(asked) ? Math.min(Math.max(0, Math.floor(asked)), 8) : 0;
       const prepared: Uint8Array[] = [];
       try {
-        if (n > 0) prepared.push(clock.time("core: the prepared job as bytes", () => s.prepared()));
+        if (n > 0) prepared.push(clock.time("core: the prepared job as bytes", () => timedCall("core: the prepared job as bytes, the longest call", () => s.prepared())));
         for (let k = 1; k < n; k++) prepared.push(prepared[0].slice());
       } catch (e) {
         s.free();
@@ -270,7 +297,7 @@ async function handle(req: Request): Promise<void> {
     }
     case "adopt_job": {
       await load();
-      answer(req.kind, req.id, adopt(Session.from_prepared(req.data.prepared)));
+      answer(req.kind, req.id, adopt(timedCall("core: the prepared job taken, the longest call", () => Session.from_prepared(req.data.prepared))));
       return;
     }
     case "slice": {
