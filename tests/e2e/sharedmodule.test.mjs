@@ -94,3 +94,22 @@ test("the page compiles the module once: a cancel's fresh workers get the same m
   assert.deepEqual(errors, []);
   await context.close();
 });
+
+test("a server that sends the module with another type: the page compiles its bytes and slices", async () => {
+  const context = await env.browser.newContext();
+  const page = await context.newPage();
+  const errors = [];
+  page.on("pageerror", (e) => errors.push(String(e)));
+  let served = 0;
+  await context.route(/dropslice_bg\.wasm$/, async (route) => {
+    const response = await route.fetch();
+    if (!route.request().serviceWorker()) served++;
+    route.fulfill({ response, headers: { ...response.headers(), "content-type": "application/octet-stream" } });
+  });
+  await page.goto(env.url);
+  const s = await waitSettled(page, 120_000);
+  assert.equal(s.state, "done", await page.locator("#banner").innerText().catch(() => JSON.stringify(s)));
+  assert.equal(served, 1);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
