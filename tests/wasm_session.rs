@@ -1009,7 +1009,10 @@ fn the_preparation_in_short_calls_is_the_one_call_preparation() {
     assert!(whole.prepared() == stepped.prepared(), "other bytes");
     assert_eq!(json(whole.info().unwrap()), json(stepped.info().unwrap()));
     for i in 0..whole.layer_count() {
-        let (a, b) = (whole.slice_layer(i).unwrap(), stepped.slice_layer(i).unwrap());
+        let (a, b) = (
+            whole.slice_layer(i).unwrap(),
+            stepped.slice_layer(i).unwrap(),
+        );
         assert!(a.gcode().to_vec() == b.gcode().to_vec(), "layer {i}");
     }
     // a refusal is the same refusal, as a typed error
@@ -1019,6 +1022,10 @@ fn the_preparation_in_short_calls_is_the_one_call_preparation() {
     let b = throws(prepared_in_steps(&big, &job), "job");
     assert_eq!(a, b);
     // a preparation not finished is not a session
-    let p = Session::begin(&models, js(serde_json::json!({"parts": [{"file": "a.stl"}]}))).unwrap();
+    let p = Session::begin(
+        &models,
+        js(serde_json::json!({"parts": [{"file": "a.stl"}]})),
+    )
+    .unwrap();
     throws(Session::from_preparation(p), "internal");
 }
