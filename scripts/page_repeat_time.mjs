@@ -4,6 +4,8 @@
 // printed. The first slice runs while the engine still compiles the code the model needs;
 // the next ones run compiled code. Usage, after `bash scripts/build.sh`:
 //   node scripts/page_repeat_time.mjs [MODEL] [SLICES] [PAGES]   (DROPSLICE_DIST=DIR for another build)
+// PROFILE=1 prints each slice's per-stage profile too (core/stages.ts: ms summed over the page
+// and its workers; a "longest call" line is the longest of the workers' calls of that kind).
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 
@@ -17,6 +19,7 @@ const count = (arg, fallback) => {
 };
 const slices = count(process.argv[3], 3);
 const pages = count(process.argv[4], 3);
+const profile = process.env.PROFILE === "1";
 
 const env = await start();
 try {
@@ -27,10 +30,22 @@ try {
       const times = [];
       for (let k = 0; k < slices; k++) {
         await page.evaluate(() => (document.body.dataset.state = "picking"));
+        if (profile) {
+          await page.evaluate(() => globalThis.__dropsliceStages?.reset());
+          for (const wk of page.workers()) await wk.evaluate(() => globalThis.__dropsliceStages?.reset()).catch(() => {});
+        }
         await page.setInputFiles("#file-input", model);
         const s = await waitSettled(page, 900_000);
         if (s.state !== "done") throw new Error(`the page ended in state ${s.state}`);
         times.push(s.seconds.toFixed(3));
+        if (profile) {
+          const all = [await page.evaluate(() => globalThis.__dropsliceStages?.read() ?? {})];
+          for (const wk of page.workers()) all.push((await wk.evaluate(() => globalThis.__dropsliceStages?.read() ?? null).catch(() => null)) ?? {});
+          const sum = {};
+          for (const st of all) for (const [k, v] of Object.entries(st)) sum[k] = /longest/.test(k) ? Math.max(sum[k] ?? 0, v) : (sum[k] ?? 0) + v;
+          const line = Object.entries(sum).sort(([a], [b]) => a.localeCompare(b)).map(([k, v]) => `${k} ${v.toFixed(1)}`).join("; ");
+          console.log(`  page ${p + 1} slice ${k + 1} (${s.seconds.toFixed(3)} s): ${line}`);
+        }
       }
       console.log(`page ${p + 1}: ${times.join(" s, ")} s`);
     } finally {

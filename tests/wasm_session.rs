@@ -1040,3 +1040,46 @@ fn the_predicted_density_per_unit_is_the_same_in_any_runs_of_layers() {
     );
     assert!(f["figures"]["predicted_density"].is_null(), "{f}");
 }
+
+/// Steps `Session::begin`'s preparation to its end (at most 20 steps).
+fn prepared_in_steps(models: &Models, job: &serde_json::Value) -> Result<Session, JsValue> {
+    let mut p = Session::begin(models, js(job.clone()))?;
+    for _ in 0..20 {
+        if p.step()? {
+            // a step after the end changes nothing
+            assert!(p.step().unwrap());
+            return Session::from_preparation(p);
+        }
+    }
+    panic!("the preparation did not end in 20 steps");
+}
+
+#[wasm_bindgen_test]
+fn the_preparation_in_short_calls_is_the_one_call_preparation() {
+    let models = boxes(&[("a.stl", [20.0, 10.0, 5.0]), ("b.stl", [8.0, 8.0, 8.0])]);
+    let job = serde_json::json!({"parts": [{"file": "a.stl"}, {"file": "b.stl", "copies": 2}]});
+    let whole = Session::from_models(&models, js(job.clone())).unwrap();
+    let stepped = prepared_in_steps(&models, &job).unwrap();
+    assert!(whole.prepared() == stepped.prepared(), "other bytes");
+    assert_eq!(json(whole.info().unwrap()), json(stepped.info().unwrap()));
+    for i in 0..whole.layer_count() {
+        let (a, b) = (
+            whole.slice_layer(i).unwrap(),
+            stepped.slice_layer(i).unwrap(),
+        );
+        assert!(a.gcode().to_vec() == b.gcode().to_vec(), "layer {i}");
+    }
+    // a refusal is the same refusal, as a typed error
+    let big = boxes(&[("big.stl", [100.0, 100.0, 2.0])]);
+    let job = serde_json::json!({"parts": [{"file": "big.stl", "copies": 2}]});
+    let a = throws(Session::from_models(&big, js(job.clone())), "job");
+    let b = throws(prepared_in_steps(&big, &job), "job");
+    assert_eq!(a, b);
+    // a preparation not finished is not a session
+    let p = Session::begin(
+        &models,
+        js(serde_json::json!({"parts": [{"file": "a.stl"}]})),
+    )
+    .unwrap();
+    throws(Session::from_preparation(p), "internal");
+}

@@ -17,7 +17,7 @@ use crate::model::prepare::{
     check_chamber, check_height, check_surface, check_volume, close_cracks, import, keep_groups,
     part_bodies, suggested_scale, warnings,
 };
-use crate::model::shells::ShellOrientation;
+use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
@@ -68,6 +68,25 @@ impl Job {
     /// [`Job::new`] — the instances merged into one mesh and prepared as [`Job::new`] does
     /// (checks, shells, repair, facet index). The job's settings are `spec.settings`.
     pub fn from_models(models: &[Model], spec: &job::JobSpec) -> Result<Job, Error> {
+        let (mesh, input, settings) = Job::merged(models, spec)?;
+        Job::build(mesh, input, settings)
+    }
+
+    /// [`Job::from_models`] in steps (the page's engine keeps a running call's first code to
+    /// its end, so the preparation is a series of short calls): this call welds and places
+    /// the parts; [`Preparation::step`] does the rest, one pass a call. The job is the one
+    /// [`Job::from_models`] makes.
+    pub fn prepare_in_steps(models: &[Model], spec: &job::JobSpec) -> Result<Preparation, Error> {
+        let (mesh, input, settings) = Job::merged(models, spec)?;
+        Ok(Preparation {
+            building: Some(Building::new(mesh, input, settings)?),
+            next: Step::Shells,
+        })
+    }
+
+    /// The parts of `spec` welded, placed and merged into one mesh: what [`Job::build`]
+    /// prepares.
+    fn merged(models: &[Model], spec: &job::JobSpec) -> Result<(Mesh, Input, Settings), Error> {
         spec.validate()?;
         let settings = spec.settings.clone();
         let by_part = models_of(models, spec)?;
@@ -207,53 +226,175 @@ impl Job {
             bodies,
             groups,
         };
-        Job::build(mesh, input, settings)
+        Ok((mesh, input, settings))
     }
 
     /// The common tail of [`Job::new`] and [`Job::from_models`]: checks → shells → mesh repair
     /// → facet index.
-    fn build(mut mesh: Mesh, input: Input, settings: Settings) -> Result<Job, Error> {
-        let bounds = mesh.bounds();
-        let size = bounds.size();
-        check_height(&size, &settings)?;
+    fn build(mesh: Mesh, input: Input, settings: Settings) -> Result<Job, Error> {
+        let mut b = Building::new(mesh, input, settings)?;
         // Repeated facets first (they would make a shell's edges look non-manifold), then
         // cracks (a tolerance weld, kept if it closes some), then every shell as its author
         // meant it (inside-out shells turned outward, cavities kept), so the volume below
         // counts what will be printed: shells of opposite orientation can no longer cancel.
-        let mut groups = input.groups;
-        let zs = plane_heights(&size, &settings);
         // The facet index beside the repeated facets and the shells, and the statistics
         // beside the shells' orientation: each reads the mesh as it is then, which the steps
         // beside it leave as it is on a sound mesh (the index needs only the vertices and the
         // facets' numbers, which turning a shell keeps). Where facets are dropped, the cracks
         // closed or a shell is turned, they are made again from the changed mesh (the job is
-        // checked before the index is used).
+        // checked before the index is used). [`Preparation`] runs the same passes one by one.
+        let mesh = &b.mesh;
+        let zs = &b.zs;
         let ((kept, mesh_shells), index) = both(
             || {
                 let kept = mesh.unrepeated_facets();
                 let shells = kept.iter().all(|&k| k).then(|| mesh.shells());
                 (kept, shells)
             },
-            || zs.as_ref().ok().map(|zs| FacetBuckets::new(&mesh, zs)),
+            || zs.as_ref().ok().map(|zs| FacetBuckets::new(mesh, zs)),
         );
-        let duplicates = kept.iter().filter(|&&k| !k).count();
-        let (mesh_shells, index) = match mesh_shells {
-            Some(shells) => (shells, index),
+        b.index = index;
+        b.unrepeated(kept, mesh_shells);
+        b.close_cracks();
+        let shells = b.shells.as_ref().expect("the shells were found");
+        let mesh = &b.mesh;
+        let dropped = b.dropped();
+        let facets_in_file = b.input.facets_in_file;
+        let (orientation, stats) = both(
+            || mesh.orientation(shells),
+            || mesh.stats(facets_in_file, dropped),
+        );
+        b.stats = (orientation.1.is_empty()).then_some(stats);
+        b.orientation = Some(orientation);
+        b.finish()
+    }
+
+    /// The common tail of [`Job::new`] and [`Job::from_models`].
+    pub(super) fn assemble(
+        settings: Settings,
+        mesh: Mesh,
+        buckets: FacetBuckets,
+        zs: Vec<f64>,
+        info: JobInfo,
+    ) -> Job {
+        let mut groups = Vec::with_capacity(info.groups.len());
+        let mut at = 0u32;
+        for g in &info.groups {
+            let end = at + g.facets as u32;
+            groups.push((at..end, g.unit));
+            at = end;
+        }
+        Job {
+            settings,
+            mesh,
+            buckets,
+            zs,
+            info,
+            groups,
+            supported: std::sync::OnceLock::new(),
+        }
+    }
+}
+
+/// A job being prepared: the merged mesh and what the passes of [`Job::build`] found so far.
+struct Building {
+    mesh: Mesh,
+    input: Input,
+    settings: Settings,
+    groups: Vec<FacetGroup>,
+    bounds: mesh::Bounds,
+    size: [f64; 3],
+    zs: Result<Vec<f64>, Error>,
+    /// Facets dropped as repeats.
+    duplicates: usize,
+    /// The facet index of the mesh as it is (dropped when the mesh changes).
+    index: Option<FacetBuckets>,
+    shells: Option<Shells>,
+    /// What the tolerance weld did (see [`close_cracks`]).
+    weld: (usize, usize),
+    orientation: Option<(ShellOrientation, Vec<bool>)>,
+    /// The statistics of the mesh as it is, when no shell is to be turned.
+    stats: Option<MeshStats>,
+}
+
+impl Building {
+    /// The checks of the mesh's size; the plane heights (an error that the checks of the
+    /// droplets should speak before is kept for later).
+    fn new(mesh: Mesh, mut input: Input, settings: Settings) -> Result<Building, Error> {
+        let bounds = mesh.bounds();
+        let size = bounds.size();
+        check_height(&size, &settings)?;
+        let zs = plane_heights(&size, &settings);
+        let groups = std::mem::take(&mut input.groups);
+        Ok(Building {
+            mesh,
+            input,
+            settings,
+            groups,
+            bounds,
+            size,
+            zs,
+            duplicates: 0,
+            index: None,
+            shells: None,
+            weld: (0, 0),
+            orientation: None,
+            stats: None,
+        })
+    }
+
+    /// Takes the repeated facets' pass (`kept`) and the shells found beside it (only when
+    /// nothing was repeated); else drops the repeats and finds the shells of what is left.
+    fn unrepeated(&mut self, kept: Vec<bool>, shells: Option<Shells>) {
+        self.duplicates = kept.iter().filter(|&&k| !k).count();
+        self.shells = Some(match shells {
+            Some(shells) => shells,
             None => {
-                mesh.keep_facets(&kept);
-                keep_groups(&mut groups, &kept);
-                (mesh.shells(), None)
+                self.index = None;
+                self.mesh.keep_facets(&kept);
+                keep_groups(&mut self.groups, &kept);
+                self.mesh.shells()
             }
-        };
-        let (mesh_shells, weld) = close_cracks(&mut mesh, mesh_shells, &mut groups);
-        let open_edges = mesh_shells.open_edges;
-        let index = index.filter(|_| weld == (0, 0));
+        });
+    }
+
+    fn close_cracks(&mut self) {
+        let shells = self.shells.take().expect("the shells were found");
+        let (shells, weld) = close_cracks(&mut self.mesh, shells, &mut self.groups);
+        self.shells = Some(shells);
+        self.weld = weld;
+        if weld != (0, 0) {
+            self.index = None;
+        }
+    }
+
+    /// Facets dropped: degenerate ones and those the weld dropped.
+    fn dropped(&self) -> usize {
+        self.input.degenerate + self.weld.1
+    }
+
+    /// Turns the shells, checks the volume and the droplets, and makes what was not made
+    /// (or was made of a mesh that changed since): the job.
+    fn finish(self) -> Result<Job, Error> {
+        let Building {
+            mut mesh,
+            input,
+            settings,
+            groups,
+            bounds,
+            size,
+            zs,
+            duplicates,
+            index,
+            shells: mesh_shells,
+            weld,
+            orientation,
+            stats,
+        } = self;
         let dropped = input.degenerate + weld.1;
-        let ((shells, flip), stats) = both(
-            || mesh.orientation(&mesh_shells),
-            || mesh.stats(input.facets_in_file, dropped),
-        );
-        let stats = (flip.is_empty()).then_some(stats);
+        let mesh_shells = mesh_shells.expect("the shells were found");
+        let open_edges = mesh_shells.open_edges;
+        let (shells, flip) = orientation.expect("the shells were oriented");
         mesh.turn(&mesh_shells, &flip);
         drop(mesh_shells);
         let volume = check_volume(&mesh, &shells, &size)?;
@@ -335,31 +476,70 @@ impl Job {
         };
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
+}
 
-    /// The common tail of [`Job::new`] and [`Job::from_models`].
-    pub(super) fn assemble(
-        settings: Settings,
-        mesh: Mesh,
-        buckets: FacetBuckets,
-        zs: Vec<f64>,
-        info: JobInfo,
-    ) -> Job {
-        let mut groups = Vec::with_capacity(info.groups.len());
-        let mut at = 0u32;
-        for g in &info.groups {
-            let end = at + g.facets as u32;
-            groups.push((at..end, g.unit));
-            at = end;
+/// [`Job::from_models`] in steps: [`Job::prepare_in_steps`], then [`Preparation::step`] until
+/// it hands out the job.
+pub struct Preparation {
+    /// `None` once the job was handed out (or a step failed).
+    building: Option<Building>,
+    next: Step,
+}
+
+#[derive(Clone, Copy)]
+enum Step {
+    Shells,
+    Index,
+    Cracks,
+    Orientation,
+    Statistics,
+    Finish,
+}
+
+impl Preparation {
+    /// Runs the next pass of the preparation: `Ok(None)` while there are more, the job after
+    /// the last. After the job or an error there is nothing left: an `Internal` error.
+    pub fn step(&mut self) -> Result<Option<Job>, Error> {
+        let Some(b) = self.building.as_mut() else {
+            return Err(Error::Internal(
+                "the job's preparation has already ended".into(),
+            ));
+        };
+        match self.next {
+            Step::Shells => {
+                let kept = b.mesh.unrepeated_facets();
+                let shells = kept.iter().all(|&k| k).then(|| b.mesh.shells());
+                let all = shells.is_some();
+                b.unrepeated(kept, shells);
+                // the index of a mesh that dropped facets would be dropped unused
+                self.next = if all { Step::Index } else { Step::Cracks };
+            }
+            Step::Index => {
+                b.index = b.zs.as_ref().ok().map(|zs| FacetBuckets::new(&b.mesh, zs));
+                self.next = Step::Cracks;
+            }
+            Step::Cracks => {
+                b.close_cracks();
+                self.next = Step::Orientation;
+            }
+            Step::Orientation => {
+                let shells = b.shells.as_ref().expect("the shells were found");
+                b.orientation = Some(b.mesh.orientation(shells));
+                self.next = Step::Statistics;
+            }
+            Step::Statistics => {
+                let flip = &b.orientation.as_ref().expect("the shells were oriented").1;
+                if flip.is_empty() {
+                    b.stats = Some(b.mesh.stats(b.input.facets_in_file, b.dropped()));
+                }
+                self.next = Step::Finish;
+            }
+            Step::Finish => {
+                let b = self.building.take().expect("checked above");
+                return b.finish().map(Some);
+            }
         }
-        Job {
-            settings,
-            mesh,
-            buckets,
-            zs,
-            info,
-            groups,
-            supported: std::sync::OnceLock::new(),
-        }
+        Ok(None)
     }
 }
 

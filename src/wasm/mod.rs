@@ -296,6 +296,29 @@ struct SliceFigures {
     nothing_to_print: Option<ErrorReport>,
 }
 
+/// A job being prepared in short calls ([`Session::begin`]).
+#[wasm_bindgen]
+pub struct Preparing {
+    prep: crate::pipeline::Preparation,
+    /// The job, once the last step made it.
+    job: Option<Job>,
+}
+
+#[wasm_bindgen]
+impl Preparing {
+    /// Runs the next pass of the preparation: true once the job is made (then
+    /// [`Session::from_preparation`]). Throws `{kind, message, setting?}` as `from_models`
+    /// does when the job is refused.
+    pub fn step(&mut self) -> Result<bool, JsValue> {
+        if self.job.is_some() {
+            return Ok(true);
+        }
+        let made = stages::time(Stage::Prepare, || self.prep.step()).map_err(js_error)?;
+        self.job = made;
+        Ok(self.job.is_some())
+    }
+}
+
 /// One prepared slicing job: the parsed, transformed mesh and its settings.
 #[wasm_bindgen]
 pub struct Session {
@@ -344,6 +367,30 @@ impl Session {
         let job = stages::time(Stage::Prepare, || Job::from_models(&models.models, &spec))
             .map_err(js_error)?;
         Ok(Session::with(job))
+    }
+
+    /// [`Session::from_models`] in short calls (the page's engine keeps a running call's
+    /// first code to its end, so later calls get the well-compiled code): this call welds and
+    /// places the parts; [`Preparing::step`] runs the rest one pass a call until it returns
+    /// true; [`Session::from_preparation`] takes the job. The same job as `from_models`.
+    pub fn begin(models: &Models, job: JsValue) -> Result<Preparing, JsValue> {
+        let spec = job_of(job)?;
+        let prep = stages::time(Stage::Prepare, || {
+            Job::prepare_in_steps(&models.models, &spec)
+        })
+        .map_err(js_error)?;
+        Ok(Preparing { prep, job: None })
+    }
+
+    /// The session of a finished preparation ([`Session::begin`]); `internal` if it has not
+    /// ended (every step returned false so far).
+    pub fn from_preparation(preparing: Preparing) -> Result<Session, JsValue> {
+        match preparing.job {
+            Some(job) => Ok(Session::with(job)),
+            None => Err(js_error(Error::Internal(
+                "the job's preparation has not ended".into(),
+            ))),
+        }
     }
 
     /// The prepared job as bytes ([`Job::to_bytes`]), for [`Session::from_prepared`] in the

@@ -272,6 +272,8 @@ test("a worker's refused import leaves none of the files asked for: the job queu
   const r = await page.evaluate(
     async ({ spec, cubeText }) => {
       const w = new Worker(new URL("worker.js", location.href), { type: "module" });
+      // the worker's first message is the module the page compiled (core/client.ts)
+      w.postMessage({ kind: "module", module: await WebAssembly.compileStreaming(fetch("dropslice_bg.wasm")) });
       const pending = new Map();
       w.onmessage = (ev) => {
         const m = ev.data;

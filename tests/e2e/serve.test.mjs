@@ -89,3 +89,51 @@ test("traversal, links out, NUL and bad encoding are refused", async () => {
     assert.doesNotMatch(r.body, /SECRET/, path);
   }
 });
+
+/** GET with request headers; the status and the headers of the answer. */
+function getWith(path, headers) {
+  return new Promise((ok, fail) => {
+    const req = request({ host: "127.0.0.1", port, path, method: "GET", headers }, (res) => {
+      let body = "";
+      res.setEncoding("utf8");
+      res.on("data", (c) => (body += c));
+      res.on("end", () => ok({ status: res.statusCode, body, headers: res.headers }));
+    });
+    req.on("error", fail);
+    req.end();
+  });
+}
+
+test("files carry validators; a request naming the current one gets a 304 without the body", async () => {
+  const first = await getWith("/app.js", {});
+  assert.equal(first.status, 200);
+  assert.equal(first.headers["cache-control"], "no-cache");
+  const tag = first.headers.etag;
+  const modified = first.headers["last-modified"];
+  assert.match(tag, /^"[0-9a-f]+-[0-9a-f]+"$/);
+  assert.ok(Number.isFinite(Date.parse(modified)), modified);
+
+  const again = await getWith("/app.js", { "if-none-match": tag });
+  assert.equal(again.status, 304);
+  assert.equal(again.body, "");
+  assert.equal(again.headers.etag, tag);
+  assert.equal((await getWith("/app.js", { "if-none-match": `"other", W/${tag}` })).status, 304);
+  assert.equal((await getWith("/app.js", { "if-modified-since": modified })).status, 304);
+  // another tag: the file; If-None-Match wins over a date that would match
+  const other = await getWith("/app.js", { "if-none-match": '"0-0"', "if-modified-since": modified });
+  assert.equal(other.status, 200);
+  assert.equal(other.body, "export {};");
+  assert.equal((await getWith("/app.js", { "if-modified-since": "not a date" })).status, 200);
+  assert.equal((await getWith("/app.js", { "if-modified-since": new Date(Date.parse(modified) - 5000).toUTCString() })).status, 200);
+
+  // a changed file gets a new tag and is sent again to the old one
+  await new Promise((r) => setTimeout(r, 20));
+  writeFileSync(join(root, "app.js"), "export {}; // changed");
+  const changed = await getWith("/app.js", { "if-none-match": tag });
+  assert.equal(changed.status, 200);
+  assert.equal(changed.body, "export {}; // changed");
+  assert.notEqual(changed.headers.etag, tag);
+  writeFileSync(join(root, "app.js"), "export {};");
+  // a refused path never gets a 304
+  assert.equal((await getWith("/link.txt", { "if-none-match": "*" })).status, 404);
+});

@@ -10,7 +10,9 @@
 // flight, so it never waits for the page between units). Layers come back in batches ("layers" replies,
 // buffers transferred) and are stored by index, so the page sees them in layer order however
 // the workers finish; a unit's result carries its G-code as one Blob. Cancel terminates every
-// worker at once, rejects what was pending and starts fresh workers.
+// worker at once, rejects what was pending and starts fresh workers. The core's module is
+// compiled once, here ([[compiledCore]]), and posted to every worker as its first message: no
+// worker fetches or compiles it, and the engine shares its compiled code among them.
 
 import type {
   GcodeParseResult,
@@ -18,6 +20,7 @@ import type {
   JobFile,
   Layout,
   ModelInfo,
+  ModuleMessage,
   LayerData,
   OpenResult,
   Reply,
@@ -32,6 +35,43 @@ import { StageClock, publish } from "./stages";
 
 /** The page's side of the per-stage profile (core/stages.ts). */
 const clock = publish(new StageClock());
+
+/** The core's module, compiled once per page (streaming from its URL, so that the HTTP cache
+ *  and the engine's code cache apply on the next visit) and shared by every worker. A failure
+ *  is an error of kind "crash" naming the cause; the next worker started tries again. */
+let compiled: Promise<WebAssembly.Module> | null = null;
+
+export function compiledCore(): Promise<WebAssembly.Module> {
+  if (!compiled) {
+    const url = new URL("./dropslice_bg.wasm", import.meta.url);
+    compiled = compileCore(url);
+    compiled.catch(() => (compiled = null));
+  }
+  return compiled;
+}
+
+async function compileCore(url: URL): Promise<WebAssembly.Module> {
+  performance.mark("dropslice: compile start");
+  let response: Response;
+  try {
+    response = await fetch(url);
+  } catch (e) {
+    throw new SliceError("crash", `could not load the slicer (${url.pathname}): ${String(e)}. Check the connection and reload the page.`);
+  }
+  if (!response.ok) {
+    throw new SliceError("crash", `could not load the slicer (${url.pathname}): the server answered ${response.status}. Reload the page; if it stays, the site is incomplete.`);
+  }
+  try {
+    // compileStreaming needs the type application/wasm; a server that sends another type
+    // gets the plain compile of the bytes (no streaming, no code cache)
+    const wasmType = (response.headers.get("content-type") ?? "").split(";")[0].trim().toLowerCase() === "application/wasm";
+    const module = wasmType ? await WebAssembly.compileStreaming(response) : await WebAssembly.compile(await response.arrayBuffer());
+    performance.measure("dropslice: compile", "dropslice: compile start");
+    return module;
+  } catch (e) {
+    throw new SliceError("crash", `the slicer's module does not load in this browser (${String(e)}). Reload the page, or use a current browser.`);
+  }
+}
 
 /** An error from a worker: the core's `{kind, message, setting?}` or the page's "crash". */
 export class SliceError extends Error {
@@ -61,6 +101,8 @@ let started = 0;
 
 class WorkerHandle {
   private worker: Worker;
+  /** Settles once the module was posted (the worker's first message): requests go after it. */
+  private started: Promise<void>;
   private pending = new Map<number, Pending>();
   private nextId = 1;
   /** A crashed wasm instance cannot be trusted again. */
@@ -82,6 +124,11 @@ class WorkerHandle {
       this.broken = true;
       this.failAll(new SliceError("crash", `the slicer worker failed: ${ev.message || "could not start"}`));
     };
+    this.started = compiledCore().then((module) => {
+      const first: ModuleMessage = { kind: "module", module };
+      this.worker.postMessage(first);
+    });
+    this.started.catch(() => (this.broken = true)); // each request is rejected with the reason
   }
 
   get load(): number {
@@ -97,7 +144,13 @@ class WorkerHandle {
     return new Promise<ResultOf<K>>((resolve, reject) => {
       if (this.ended) return reject(this.ended);
       this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, progress });
-      this.worker.postMessage(message, transfer);
+      // after the module (a `then` of the one promise runs in the order they were added)
+      this.started.then(
+        () => this.worker.postMessage(message, transfer),
+        (e: unknown) => {
+          if (this.pending.delete(id)) reject(e instanceof Error ? e : new SliceError("crash", String(e)));
+        },
+      );
     });
   }
 

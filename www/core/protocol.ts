@@ -252,6 +252,16 @@ export type ResultOf<K extends RequestKind> = Calls[K]["result"];
 
 export type Request = { [K in RequestKind]: { id: number; kind: K; data: RequestData<K> } }[RequestKind];
 
+/** A worker's first message: the core's module, compiled once by the page (core/client.ts
+ *  `compiledCore`); the worker instantiates it and never fetches or compiles the module. */
+export interface ModuleMessage {
+  kind: "module";
+  module: WebAssembly.Module;
+}
+
+/** What the page posts to a worker. */
+export type ToWorker = ModuleMessage | Request;
+
 export type Reply =
   | { id: number; kind: "progress"; data: LayerData }
   | { id: number; kind: "layers"; data: LayerData[] }

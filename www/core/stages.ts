@@ -42,6 +42,11 @@ export class StageClock {
     if (this.on) this.ms[name] = (this.ms[name] ?? 0) + performance.now() - t0;
   }
 
+  /** Keeps the largest `ms` given for `name` (the longest of a kind of call). */
+  max(name: string, ms: number): void {
+    if (this.on) this.ms[name] = Math.max(this.ms[name] ?? 0, ms);
+  }
+
   get active(): boolean {
     return this.on;
   }

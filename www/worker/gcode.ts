@@ -4,18 +4,19 @@
 // header) and the bounds a file from anyone must keep (coordinates, droplets, travel moves,
 // layers, line length), with the messages that name the line and the reason.
 
-import init, { GcodeStream } from "../pkg/dropslice.js";
+import { GcodeStream, initSync, type InitOutput } from "../pkg/dropslice.js";
 import type { Calibration, Figures, LayerData } from "../core/protocol";
 
 export class GcodeError extends Error {}
 
-let ready: Promise<unknown> | null = null;
+let core: InitOutput | null = null;
 
-/** Loads the core (once; a no-op when the worker already did). `source`: the module's bytes
- *  or URL (default: beside the bundle, as the worker loads it). */
-export function loadCore(source?: BufferSource | URL): Promise<unknown> {
-  ready ??= init({ module_or_path: source ?? new URL("./dropslice_bg.wasm", import.meta.url) });
-  return ready;
+/** Instantiates the core (once; later calls return the first instance). `source`: the module
+ *  the page compiled (the worker's first message), or its bytes (tests in Node). Nothing here
+ *  fetches the module. */
+export function loadCore(source: BufferSource | WebAssembly.Module): InitOutput {
+  core ??= initSync({ module: source });
+  return core;
 }
 
 /** The reader's refusals become GcodeErrors; a crash of the core stays what it is. */
@@ -131,7 +132,7 @@ export class GcodeReader {
 
 /** Reads a whole .gco Blob as a stream of text; `progress` gets the share of bytes read. */
 export async function readGcode(file: Blob, reader: GcodeReader, progress?: (fraction: number) => void): Promise<void> {
-  await loadCore();
+  if (!core) throw new Error("the slicer's module is not loaded in this worker");
   let bytes = 0;
   const counter = new TransformStream<Uint8Array<ArrayBuffer>, Uint8Array<ArrayBuffer>>({
     transform(chunk, controller) {

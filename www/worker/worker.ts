@@ -5,11 +5,13 @@
 // core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred).
 // The model files arrive as Files and are read here (by the core, with FileReaderSync), never
 // on the page's thread. Everything from the core is a typed value; its errors are thrown as
-// `{kind, message, setting?}` and passed on as they are.
+// `{kind, message, setting?}` and passed on as they are. The core's module comes compiled
+// from the page as the first message (core/client.ts `compiledCore`): this worker only
+// instantiates it, never fetches or compiles it.
 
-import init, { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
+import { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
-import { GcodeError, GcodeReader, readGcode } from "./gcode";
+import { GcodeError, GcodeReader, loadCore, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
   coverageMaskOf,
@@ -25,6 +27,7 @@ import {
   type RequestData,
   type RequestKind,
   type ResultOf,
+  type ToWorker,
   type SliceUnit,
   type ModelInfo,
   type LayerData,
@@ -41,7 +44,14 @@ const clock = publish(
   }),
 );
 
-let wasm: Promise<InitOutput> | null = null;
+/** The core, once the page's module arrived and was instantiated. */
+let arrived: (module: WebAssembly.Module) => void = () => {};
+const wasm: Promise<InitOutput> = new Promise<WebAssembly.Module>((resolve) => (arrived = resolve)).then((module) => {
+  const out = loadCore(module);
+  memory = out.memory;
+  return out;
+});
+wasm.catch(() => {}); // reported to the requests that need the core
 let memory: WebAssembly.Memory | null = null;
 let session: Session | null = null;
 /** The job's files (the job worker's; the others take the prepared job instead). */
@@ -53,13 +63,8 @@ let broken = false;
   lastPanic = m;
 };
 
+/** The core: waits for the page's module (the worker's first message). */
 function load(): Promise<InitOutput> {
-  if (!wasm) {
-    wasm = init({ module_or_path: new URL("./dropslice_bg.wasm", import.meta.url) }).then((out) => {
-      memory = out.memory;
-      return out;
-    });
-  }
   return wasm;
 }
 
@@ -95,7 +100,9 @@ function yieldToQueue(): Promise<void> {
 }
 
 function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analyse = false, counted = true): LayerData {
-  const r = clock.time("core: a layer (all its stages)", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index)));
+  const r = clock.time("core: a layer (all its stages)", () =>
+    timedCall("core: a layer, the longest call", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index))),
+  );
   const t0 = performance.now();
   try {
     if (unit) {
@@ -123,6 +130,31 @@ function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analy
   } finally {
     r.free();
     clock.since("worker: copy out of wasm", t0);
+  }
+}
+
+/** `Session.from_models` in short calls (`Session.begin`, then a pass a call): the engine
+ *  keeps a running call's first code to its end, so a call that ran the whole preparation
+ *  ran it all in that code; later calls of a pass get the optimised code. */
+function prepare(m: Models, job: RequestData<"open_job">["job"]): Session {
+  const p = timedCall("core: preparation, the longest call", () => Session.begin(m, job));
+  let done = false;
+  try {
+    while (!done) done = timedCall("core: preparation, the longest call", () => p.step());
+  } catch (e) {
+    p.free();
+    throw e;
+  }
+  return Session.from_preparation(p);
+}
+
+/** Runs one call into the core, keeping the longest of `name` in the profile. */
+function timedCall<T>(name: string, f: () => T): T {
+  const t0 = performance.now();
+  try {
+    return f();
+  } finally {
+    clock.max(name, performance.now() - t0);
   }
 }
 
@@ -205,7 +237,7 @@ async function handle(req: Request): Promise<void> {
       try {
         for (const { name, file } of req.data.files) {
           const hash = hashing ? sha256Of(file) : null;
-          infos.push(clock.time("worker: file read and parsed", () => m.add(file, name)));
+          infos.push(clock.time("worker: file read and parsed", () => timedCall("core: file read and parsed, the longest call", () => m.add(file, name))));
           if (hash) {
             const t0 = performance.now();
             sha256.push(await hash);
@@ -249,7 +281,7 @@ async function handle(req: Request): Promise<void> {
     case "open_job": {
       await load();
       // the old session stays usable if the job is refused
-      const s = Session.from_models(needModels(), req.data.job);
+      const s = prepare(needModels(), req.data.job);
       // one copy of the prepared job per other worker (at most the pool's), made here rather
       // than on the page's thread, all transferred; made before the session is taken, so a
       // failure keeps the old one
@@ -257,7 +289,7 @@ async function handle(req: Request): Promise<void> {
       const n = Number.isFinite(asked) ? Math.min(Math.max(0, Math.floor(asked)), 8) : 0;
       const prepared: Uint8Array[] = [];
       try {
-        if (n > 0) prepared.push(clock.time("core: the prepared job as bytes", () => s.prepared()));
+        if (n > 0) prepared.push(clock.time("core: the prepared job as bytes", () => timedCall("core: the prepared job as bytes, the longest call", () => s.prepared())));
         for (let k = 1; k < n; k++) prepared.push(prepared[0].slice());
       } catch (e) {
         s.free();
@@ -270,7 +302,7 @@ async function handle(req: Request): Promise<void> {
     }
     case "adopt_job": {
       await load();
-      answer(req.kind, req.id, adopt(Session.from_prepared(req.data.prepared)));
+      answer(req.kind, req.id, adopt(timedCall("core: the prepared job taken, the longest call", () => Session.from_prepared(req.data.prepared))));
       return;
     }
     case "slice": {
@@ -415,13 +447,16 @@ function describe(e: unknown, req: Request | null = null): ErrorValue {
   return internal(e instanceof Error ? e.message : String(e));
 }
 
-// The module is compiled and instantiated as soon as the worker starts, not at its first
-// request: a worker asked to open a job (often its first request, after a cancel) would
-// otherwise compile it only then, on the slice's path. A failure is reported to the first request that needs the core.
-load().catch(() => {});
-
-scope.onmessage = (ev: MessageEvent<Request>) => {
-  const req = ev.data;
+scope.onmessage = (ev: MessageEvent<ToWorker>) => {
+  const msg = ev.data;
+  if (msg.kind === "module") {
+    // instantiated at once, before any request (they arrive after it), so that a worker asked
+    // to open a job does not instantiate the module only then; a failure is reported to the
+    // first request that needs the core
+    arrived(msg.module);
+    return;
+  }
+  const req: Request = msg;
   if (broken) {
     post({ id: req.id, kind: "error", data: { kind: "crash", message: "this worker crashed earlier" } });
     return;

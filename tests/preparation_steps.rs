@@ -1,0 +1,183 @@
+//! The job's preparation in steps (`Job::prepare_in_steps`, `Preparation::step`: the page's
+//! short calls) makes exactly the job of `Job::from_models`: the same bytes handed to the
+//! page's other workers (mesh, facet index, plane heights, settings, info) and the same
+//! G-code, on the shared models and on meshes that take every branch of the preparation
+//! (repeated facets, an inside-out shell, a crack closed, an open part); a refusal is the
+//! same refusal, and a step after the end is an error, never a panic.
+#![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
+
+mod common;
+
+use dropslice::Job;
+use dropslice::model::models::Model;
+use dropslice::model::spec::JobSpec;
+
+type Tri = [[f32; 3]; 3];
+
+fn box_tris(o: [f32; 3], w: f32, d: f32, h: f32) -> Vec<Tri> {
+    let p = |x: f32, y: f32, z: f32| [o[0] + x, o[1] + y, o[2] + z];
+    let quads = [
+        [p(0., 0., 0.), p(0., d, 0.), p(w, d, 0.), p(w, 0., 0.)],
+        [p(0., 0., h), p(w, 0., h), p(w, d, h), p(0., d, h)],
+        [p(0., 0., 0.), p(w, 0., 0.), p(w, 0., h), p(0., 0., h)],
+        [p(w, 0., 0.), p(w, d, 0.), p(w, d, h), p(w, 0., h)],
+        [p(w, d, 0.), p(0., d, 0.), p(0., d, h), p(w, d, h)],
+        [p(0., d, 0.), p(0., 0., 0.), p(0., 0., h), p(0., d, h)],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect()
+}
+
+fn gcode(job: &Job) -> Vec<u8> {
+    let mut out = Vec::new();
+    dropslice::pipeline::write_gcode(job, &mut out, |_, _| {}).unwrap();
+    out
+}
+
+/// Steps the preparation to its end; the number of steps beside the job (or the refusal).
+fn in_steps(models: &[Model], spec: &JobSpec) -> (Result<Job, String>, usize) {
+    let mut prep = match Job::prepare_in_steps(models, spec) {
+        Ok(p) => p,
+        Err(e) => return (Err(e.to_string()), 0),
+    };
+    for n in 1..=20 {
+        match prep.step() {
+            Ok(Some(job)) => {
+                // nothing is left once the job was handed out
+                let after = prep.step().map(|_| ()).unwrap_err().to_string();
+                assert!(after.contains("already ended"), "{after}");
+                return (Ok(job), n);
+            }
+            Ok(None) => {}
+            Err(e) => {
+                assert!(prep.step().is_err(), "a step after a refusal");
+                return (Err(e.to_string()), n);
+            }
+        }
+    }
+    panic!("the preparation did not end in 20 steps");
+}
+
+/// The stepped preparation of `spec` is the one-call preparation; returns its step count.
+fn assert_same(models: &[Model], spec: &str, what: &str) -> usize {
+    let spec = JobSpec::from_json(spec).unwrap();
+    let whole = Job::from_models(models, &spec).map_err(|e| e.to_string());
+    let (stepped, steps) = in_steps(models, &spec);
+    match (whole, stepped) {
+        (Ok(a), Ok(b)) => {
+            assert!(a.to_bytes() == b.to_bytes(), "{what}: other bytes");
+            assert_eq!(a.info(), b.info(), "{what}: info");
+            assert!(gcode(&a) == gcode(&b), "{what}: the G-code differs");
+        }
+        (Err(a), Err(b)) => assert_eq!(a, b, "{what}: another refusal"),
+        (a, b) => panic!(
+            "{what}: one call {:?}, in steps {:?}",
+            a.map(|_| "a job"),
+            b.map(|_| "a job")
+        ),
+    }
+    steps
+}
+
+fn model(tris: &[Tri], name: &str) -> Model {
+    Model::read(&common::stl_bytes(tris), name).unwrap()
+}
+
+#[test]
+fn the_shared_models_prepare_alike_in_steps() {
+    for file in std::fs::read_dir(common::shared_dir().join("models")).unwrap() {
+        let path = file.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !(name.ends_with(".stl") || name.ends_with(".obj") || name.ends_with(".3mf")) {
+            continue;
+        }
+        let Ok(m) = Model::read(&std::fs::read(&path).unwrap(), &name) else {
+            continue;
+        };
+        let spec = format!(r#"{{"parts": [{{"file": {name:?}}}]}}"#);
+        let steps = assert_same(&[m], &spec, &name);
+        if name == "3DBenchy.stl" {
+            // shells, index, cracks, orientation, statistics, the rest
+            assert_eq!(steps, 6, "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_build_job_with_a_unit_1_part_and_support_prepares_alike_in_steps() {
+    let benchy = Model::read(&common::model_bytes("3DBenchy.stl"), "boat.stl").unwrap();
+    let screw = Model::read(&common::model_bytes("M3x10_screw.stl"), "screw.stl").unwrap();
+    assert_same(
+        &[benchy, screw],
+        r#"{"settings": {"support": "unit1", "unit1_droplet_aspect": 1.6},
+            "parts": [{"file": "boat.stl"}, {"file": "screw.stl", "unit": 1, "copies": 2}]}"#,
+        "boat and two unit-1 screws",
+    );
+}
+
+#[test]
+fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
+    let cube = box_tris([0.; 3], 10., 10., 10.);
+    // repeated facets: dropped, the index not built beside the shells
+    let mut repeated = cube.clone();
+    repeated.extend_from_slice(&cube[..3]);
+    let steps = assert_same(
+        &[model(&repeated, "r.stl")],
+        r#"{"parts": [{"file": "r.stl"}]}"#,
+        "repeated facets",
+    );
+    assert_eq!(
+        steps, 5,
+        "no index beside the shells when facets are dropped"
+    );
+    // an inside-out cavity box inside a box: one shell turned
+    let mut cavity = cube.clone();
+    cavity.extend(
+        box_tris([3., 3., 3.], 4., 4., 4.)
+            .into_iter()
+            .map(|[a, b, c]| [a, c, b]),
+    );
+    cavity.extend(
+        box_tris([20., 0., 0.], 5., 5., 5.)
+            .into_iter()
+            .map(|[a, b, c]| [a, c, b]),
+    );
+    assert_same(
+        &[model(&cavity, "c.stl")],
+        r#"{"parts": [{"file": "c.stl"}]}"#,
+        "a cavity and an inside-out box",
+    );
+    // a crack: one corner of a facet moved by a micrometre
+    let mut cracked = cube.clone();
+    cracked[4][1][0] += 0.001;
+    assert_same(
+        &[model(&cracked, "k.stl")],
+        r#"{"parts": [{"file": "k.stl"}]}"#,
+        "a crack",
+    );
+    // an open box (its top missing)
+    let open: Vec<Tri> = cube
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i / 2 != 1)
+        .map(|(_, t)| *t)
+        .collect();
+    assert_same(
+        &[model(&open, "o.stl")],
+        r#"{"parts": [{"file": "o.stl"}]}"#,
+        "an open box",
+    );
+    // refusals: a part taller than the chamber, far too many droplets
+    assert_same(
+        &[model(&box_tris([0.; 3], 10., 10., 10.), "t.stl")],
+        r#"{"settings": {"plate_z": 5}, "parts": [{"file": "t.stl"}]}"#,
+        "too tall",
+    );
+    assert_same(
+        &[model(&cube, "b.stl")],
+        r#"{"parts": [{"file": "b.stl", "scale_x": 40, "scale_y": 40, "scale_z": 2}]}"#,
+        "too big",
+    );
+}
