@@ -107,7 +107,7 @@ pub fn profile_text(bytes: &[u8]) -> Result<String, Error> {
         )));
     }
     let utf16 = |rest: &[u8], unit: fn([u8; 2]) -> u16, which: &str| {
-        if rest.len() % 2 != 0 {
+        if !rest.len().is_multiple_of(2) {
             return Err(bad(format!(
                 "the profile starts with the byte-order mark of UTF-16 {which} but has an odd number of bytes: save it again as UTF-8"
             )));
