@@ -140,6 +140,8 @@ fn report_and_peak_memory(stl: &[u8]) -> (serde_json::Value, u64) {
         .arg(&gco)
         .arg("--report")
         .arg(&json)
+        // parts metres apart: past the default plate, sliced where they lie
+        .args(["--set", "allow_off_plate=true"])
         .stderr(stderr)
         .spawn()
         .unwrap();
