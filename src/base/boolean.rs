@@ -226,3 +226,154 @@ pub fn apart_groups(boxes: &[(DVec2, DVec2)], margin: f64) -> Vec<Vec<usize>> {
     }
     groups
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::testing::random;
+
+    /// A closed path of `k` points around `c` at radii in [r/3, r], in order of angle or, with
+    /// `tangled`, in random order (a path crossing itself).
+    fn path(seed: &mut u64, c: [f64; 2], r: f64, k: usize, tangled: bool) -> Vec<[f64; 2]> {
+        let mut angles: Vec<f64> = (0..k)
+            .map(|_| random(seed) * std::f64::consts::TAU)
+            .collect();
+        if !tangled {
+            angles.sort_by(f64::total_cmp);
+        }
+        angles
+            .into_iter()
+            .map(|a| {
+                let rr = r * (1.0 + 2.0 * random(seed)) / 3.0;
+                [c[0] + rr * a.cos(), c[1] + rr * a.sin()]
+            })
+            .collect()
+    }
+
+    /// Islands on a jittered grid: most apart, some overlapping, some touching at a point,
+    /// some inside-out or crossing themselves, a few with a second path (a hole or an overlap).
+    fn islands(seed: &mut u64) -> Vec<Paths> {
+        let n = 2 + (random(seed) * 80.0) as usize;
+        let pitch = 1.0 + random(seed) * 2.0;
+        let side = (n as f64).sqrt().ceil() as usize;
+        let mut items: Vec<Paths> = Vec::new();
+        for i in 0..n {
+            let c = [
+                (i % side) as f64 * pitch + (random(seed) - 0.5) * pitch,
+                (i / side) as f64 * pitch + (random(seed) - 0.5) * pitch,
+            ];
+            let r = pitch * (0.2 + 0.6 * random(seed));
+            let k = 3 + (random(seed) * 9.0) as usize;
+            let tangled = random(seed) < 0.2;
+            let mut p = path(seed, c, r, k, tangled);
+            if random(seed) < 0.2 {
+                p.reverse();
+            }
+            let mut item = vec![p];
+            if random(seed) < 0.3 {
+                let k = 3 + (random(seed) * 5.0) as usize;
+                let mut hole = path(seed, c, r * 0.3, k, false);
+                hole.reverse();
+                item.push(hole);
+            }
+            if random(seed) < 0.1 {
+                // A square touching the next grid cell's corner exactly.
+                let (x, y) = (c[0] + pitch * 0.5, c[1] + pitch * 0.5);
+                item.push(vec![[x - 0.3, y - 0.3], [x, y - 0.3], [x, y], [x - 0.3, y]]);
+                items.push(vec![vec![
+                    [x, y],
+                    [x + 0.3, y],
+                    [x + 0.3, y + 0.3],
+                    [x, y + 0.3],
+                ]]);
+            }
+            items.push(item);
+        }
+        if random(seed) < 0.3 {
+            items.push(Vec::new());
+        }
+        items
+    }
+
+    #[test]
+    fn apart_equals_one_pass_on_random_islands() {
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let mut grouped = 0;
+        for case in 0..400 {
+            let items = islands(&mut seed);
+            for rule in [FillRule::Positive, FillRule::NonZero, FillRule::EvenOdd] {
+                let one = simplify_together(&items, rule);
+                let apart = simplify_apart(&items, rule);
+                assert_eq!(apart, one, "case {case}, {rule:?}");
+            }
+            let boxes: Vec<(DVec2, DVec2)> = items
+                .iter()
+                .map(|paths| {
+                    paths.iter().flatten().fold(
+                        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+                        |(lo, hi), p| (lo.min(DVec2::from(*p)), hi.max(DVec2::from(*p))),
+                    )
+                })
+                .collect();
+            grouped += usize::from(apart_groups(&boxes, APART_MM).len() > 1);
+        }
+        // The cases do exercise the grouped path.
+        assert!(grouped > 300, "{grouped}");
+    }
+
+    #[test]
+    fn apart_groups_are_the_components_of_meeting_boxes() {
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..300 {
+            let n = (random(&mut seed) * 60.0) as usize;
+            let boxes: Vec<(DVec2, DVec2)> = (0..n)
+                .map(|_| {
+                    let lo = DVec2::new(random(&mut seed) * 10.0, random(&mut seed) * 10.0);
+                    let size = DVec2::new(random(&mut seed), random(&mut seed)) * 2.0;
+                    (lo, lo + size)
+                })
+                .collect();
+            let margin = random(&mut seed) * 0.2;
+            let groups = apart_groups(&boxes, margin);
+            let mut group_of = vec![usize::MAX; n];
+            for (g, items) in groups.iter().enumerate() {
+                assert!(items.windows(2).all(|w| w[0] < w[1]));
+                for &i in items {
+                    assert_eq!(group_of[i], usize::MAX);
+                    group_of[i] = g;
+                }
+            }
+            assert!(group_of.iter().all(|&g| g != usize::MAX));
+            assert!(groups.windows(2).all(|w| w[0][0] < w[1][0]));
+            // Boxes that meet share a group; every group is connected by meeting boxes.
+            let meet = |a: usize, b: usize| {
+                let (p, q) = (boxes[a], boxes[b]);
+                p.0.x - margin <= q.1.x + margin
+                    && q.0.x - margin <= p.1.x + margin
+                    && p.0.y - margin <= q.1.y + margin
+                    && q.0.y - margin <= p.1.y + margin
+            };
+            for a in 0..n {
+                for b in 0..n {
+                    if meet(a, b) {
+                        assert_eq!(group_of[a], group_of[b]);
+                    }
+                }
+            }
+            for items in &groups {
+                let mut reached = vec![items[0]];
+                let mut k = 0;
+                while k < reached.len() {
+                    let a = reached[k];
+                    for &b in items {
+                        if !reached.contains(&b) && meet(a, b) {
+                            reached.push(b);
+                        }
+                    }
+                    k += 1;
+                }
+                assert_eq!(reached.len(), items.len());
+            }
+        }
+    }
+}
