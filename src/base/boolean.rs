@@ -10,6 +10,7 @@ use i_overlay::float::overlay::FloatOverlay;
 use i_overlay::float::simplify::SimplifyShape;
 use i_overlay::float::single::SingleFloatOverlay;
 use i_overlay::i_float::adapter::FloatPointAdapter;
+use i_overlay::i_float::int::point::IntPoint;
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 
@@ -141,9 +142,21 @@ pub fn simplify_apart(items: &[Paths], fill_rule: FillRule) -> Paths3 {
     if groups.len() < 2 {
         return simplify_together(items, fill_rule);
     }
-    let mut keyed: Vec<([f64; 2], Vec<Vec<[f64; 2]>>)> = Vec::new();
+    let mut keyed: Vec<([f64; 2], Paths)> = Vec::new();
     let mut overlay = FloatOverlay::<[f64; 2], i32>::with_adapter(adapter.clone(), 0);
+    let mut grid: Vec<IntPoint<i32>> = Vec::new();
     for group in groups {
+        if let [i] = group[..]
+            && let [path] = &items[i][..]
+            && convex_on_grid(path, &adapter, &mut grid)
+        {
+            // One convex loop counter-clockwise: the engine returns it as it is on its grid.
+            if fill_rule != FillRule::Negative {
+                let shape = vec![engine_order(&grid, &adapter)];
+                keyed.push((lowest_left(&shape[0]), shape));
+            }
+            continue;
+        }
         overlay.clear();
         for &i in &group {
             overlay = overlay.unsafe_add_source(&items[i], ShapeType::Subject);
@@ -168,6 +181,56 @@ pub fn simplify_together(items: &[Paths], fill_rule: FillRule) -> Paths3 {
     all.simplify_shape(fill_rule)
 }
 
+/// Whether `path` on the engine's grid (into `grid`, repeated points once) is a strictly
+/// convex loop turning counter-clockwise once: every corner turns left and the points run
+/// up then down in (x, y) order exactly once (a loop turning left twice round runs so twice).
+fn convex_on_grid(
+    path: &[[f64; 2]],
+    adapter: &FloatPointAdapter<[f64; 2], i32>,
+    grid: &mut Vec<IntPoint<i32>>,
+) -> bool {
+    grid.clear();
+    for p in path {
+        let q = adapter.float_to_int(p);
+        if grid.last() != Some(&q) {
+            grid.push(q);
+        }
+    }
+    while grid.len() > 1 && grid.first() == grid.last() {
+        grid.pop();
+    }
+    let n = grid.len();
+    if n < 3 {
+        return false;
+    }
+    let up = |a: IntPoint<i32>, b: IntPoint<i32>| (b.x, b.y) > (a.x, a.y);
+    let mut changes = 0;
+    for k in 0..n {
+        let (a, b, c) = (grid[k], grid[(k + 1) % n], grid[(k + 2) % n]);
+        let cross = (i64::from(b.x) - i64::from(a.x)) * (i64::from(c.y) - i64::from(b.y))
+            - (i64::from(b.y) - i64::from(a.y)) * (i64::from(c.x) - i64::from(b.x));
+        if cross <= 0 {
+            return false;
+        }
+        changes += usize::from(up(a, b) != up(b, c));
+    }
+    changes == 2
+}
+
+/// A convex loop on the grid as the engine emits it: counter-clockwise, from the point before
+/// its lowest-leftmost one, back in floats.
+fn engine_order(
+    grid: &[IntPoint<i32>],
+    adapter: &FloatPointAdapter<[f64; 2], i32>,
+) -> Vec<[f64; 2]> {
+    let n = grid.len();
+    let low = (0..n).min_by_key(|&k| (grid[k].x, grid[k].y)).unwrap_or(0);
+    let start = (low + n - 1) % n;
+    (0..n)
+        .map(|k| adapter.int_to_float(&grid[(start + k) % n]))
+        .collect()
+}
+
 /// The lowest of the leftmost points of a path (x, then y).
 fn lowest_left(path: &[[f64; 2]]) -> [f64; 2] {
     path.iter().fold([f64::INFINITY; 2], |m, p| {
@@ -181,38 +244,27 @@ fn lowest_left(path: &[[f64; 2]]) -> [f64; 2] {
 
 /// Items in groups such that no box of one group, grown by `margin` on every side, meets a
 /// box of another (touching counts as meeting): the connected components of "grown boxes
-/// meet". Sort and sweep along x with a union-find; each group's items in increasing order,
-/// the groups in the order of their first item. An empty box (no points) is a group alone.
+/// meet", by a union-find. Boxes are binned to square cells of about twice the median box
+/// (a box in every cell it covers, unless that makes over 16 entries per box: then one cell),
+/// and the boxes of each cell swept along x. Each group's items in increasing order, the
+/// groups in the order of their first item. An empty box (no points) is a group alone.
 pub fn apart_groups(boxes: &[(DVec2, DVec2)], margin: f64) -> Vec<Vec<usize>> {
     let n = boxes.len();
     let mut parent: Vec<usize> = (0..n).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
     let grown: Vec<(DVec2, DVec2)> = boxes
         .iter()
         .map(|&(lo, hi)| (lo - DVec2::splat(margin), hi + DVec2::splat(margin)))
         .collect();
-    let mut order: Vec<usize> = (0..n).filter(|&i| grown[i].0.x <= grown[i].1.x).collect();
-    order.sort_by(|&a, &b| grown[a].0.x.total_cmp(&grown[b].0.x));
-    // Boxes whose x range may still meet the next box's, by the end of their x range.
-    let mut active: Vec<usize> = Vec::new();
-    for &i in &order {
-        let (lo, hi) = grown[i];
-        active.retain(|&j| grown[j].1.x >= lo.x);
-        for &j in &active {
-            if grown[j].0.y <= hi.y && lo.y <= grown[j].1.y {
-                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                if a != b {
-                    parent[a.max(b)] = a.min(b);
-                }
-            }
-        }
-        active.push(i);
+    let live: Vec<usize> = (0..n)
+        .filter(|&i| grown[i].0.x <= grown[i].1.x && grown[i].0.y <= grown[i].1.y)
+        .collect();
+    let mut entries = cell_entries(&grown, &live);
+    entries.sort_unstable();
+    let mut cell: Vec<usize> = Vec::new();
+    for run in entries.chunk_by(|a, b| a.0 == b.0) {
+        cell.clear();
+        cell.extend(run.iter().map(|e| e.1));
+        sweep_unite(&grown, &mut cell, &mut parent);
     }
     let mut slot = vec![usize::MAX; n];
     let mut groups: Vec<Vec<usize>> = Vec::new();
@@ -225,6 +277,77 @@ pub fn apart_groups(boxes: &[(DVec2, DVec2)], margin: f64) -> Vec<Vec<usize>> {
         groups[slot[r]].push(i);
     }
     groups
+}
+
+/// The root of `i` in a union-find whose roots are their sets' smallest items.
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// (cell, item) for every cell of a grid that each live box covers; all in one cell when
+/// that would make too many.
+fn cell_entries(grown: &[(DVec2, DVec2)], live: &[usize]) -> Vec<((i64, i64), usize)> {
+    let one_cell = || live.iter().map(|&i| ((0, 0), i)).collect();
+    if live.len() < 2 {
+        return one_cell();
+    }
+    let mut extents: Vec<f64> = live
+        .iter()
+        .map(|&i| (grown[i].1 - grown[i].0).max_element())
+        .collect();
+    let mid = extents.len() / 2;
+    let median = *extents.select_nth_unstable_by(mid, f64::total_cmp).1;
+    let origin = live
+        .iter()
+        .fold(DVec2::splat(f64::INFINITY), |m, &i| m.min(grown[i].0));
+    let size = (2.0 * median).max(1e-6);
+    let budget = 16 * live.len();
+    let mut out = Vec::with_capacity(live.len() * 2);
+    for &i in live {
+        let (lo, hi) = grown[i];
+        let a = ((lo - origin) / size).floor();
+        let b = ((hi - origin) / size).floor();
+        // Cells beyond the budget (or beyond i64) mean one cell for all.
+        if !(b.x - a.x + 1.0).is_finite() || (b.x - a.x + 1.0) * (b.y - a.y + 1.0) > budget as f64 {
+            return one_cell();
+        }
+        for x in a.x as i64..=b.x as i64 {
+            for y in a.y as i64..=b.y as i64 {
+                out.push(((x, y), i));
+                if out.len() > budget {
+                    return one_cell();
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Unites the items of `cell` whose boxes meet: sorted by the start of their x range, each
+/// compared with those whose x range still reaches it.
+fn sweep_unite(grown: &[(DVec2, DVec2)], cell: &mut [usize], parent: &mut [usize]) {
+    if cell.len() < 2 {
+        return;
+    }
+    cell.sort_unstable_by(|&a, &b| grown[a].0.x.total_cmp(&grown[b].0.x).then(a.cmp(&b)));
+    let mut active: Vec<usize> = Vec::new();
+    for &i in cell.iter() {
+        let (lo, hi) = grown[i];
+        active.retain(|&j| grown[j].1.x >= lo.x);
+        for &j in &active {
+            if grown[j].0.y <= hi.y && lo.y <= grown[j].1.y {
+                let (a, b) = (root(parent, i), root(parent, j));
+                if a != b {
+                    parent[a.max(b)] = a.min(b);
+                }
+            }
+        }
+        active.push(i);
+    }
 }
 
 #[cfg(test)]
@@ -266,6 +389,18 @@ mod tests {
             let k = 3 + (random(seed) * 9.0) as usize;
             let tangled = random(seed) < 0.2;
             let mut p = path(seed, c, r, k, tangled);
+            if random(seed) < 0.4 {
+                // Convex: the points on one circle (some nearly in line, some repeated).
+                p = (0..k)
+                    .map(|j| {
+                        let a = (j as f64 + 0.3 * random(seed)) / k as f64 * std::f64::consts::TAU;
+                        [c[0] + r * a.cos(), c[1] + r * a.sin()]
+                    })
+                    .collect();
+                if random(seed) < 0.2 {
+                    p.push(p[p.len() - 1]);
+                }
+            }
             if random(seed) < 0.2 {
                 p.reverse();
             }
