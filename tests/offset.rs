@@ -45,7 +45,12 @@ fn loops(s: &Shapes) -> usize {
 }
 
 fn layers_of(name: &str) -> Vec<Shapes> {
-    let job = Job::new(&model_bytes(name), name, Settings::default()).expect("job");
+    // Every layer of the model as it is, the bunny wider than the plate too.
+    let settings = Settings {
+        allow_off_plate: true,
+        ..Settings::default()
+    };
+    let job = Job::new(&model_bytes(name), name, settings).expect("job");
     (0..job.layer_count())
         .map(|i| job.section(i).region)
         .collect()
