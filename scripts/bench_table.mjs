@@ -1,7 +1,9 @@
 // The speed table of docs/performance.md in one run (`npm run bench`): on 3DBenchy, the CLI
 // against CuraEngine, support on against off, `--report` against plain, the page (file chosen
 // → every layer's G-code ready, the page's own clock) against the CLI, the page's longest
-// main-thread task while slicing; and the 1M torus in the page against the CLI. Every figure
+// main-thread task while slicing; the 1M torus in the page against the CLI; 10⁵ separate
+// 0.5 mm cubes (scripts/many_parts.py fan 5) against 3DBenchy on the CLI and, with
+// BENCH_CUBES6=1, 10⁶ cubes (fan 6, a minute or more per run) against 10⁵. Every figure
 // is a median of BENCH_RUNS (default 5) runs after one untimed warm-up, the runs of the tools
 // compared interleaved (run k of each, then run k + 1), so a burst of other work on the machine
 // falls on all of them alike. Ratios are of wall times; CPU (user + sys) is printed beside.
@@ -13,7 +15,8 @@
 // Cura's definitions, the raw runs in table.json), PYTHON (a python3 with numpy for
 // shared/tools/gen_mesh.py; default target/pyenv's), DROPSLICE_SHARED (../shared), CURA_DEFS
 // (the folder of Cura's fdmprinter.def.json; else unpacked from Debian's `cura` package),
-// BENCH_INSTALL (1: install CuraEngine from Debian if it is missing; 0: do not).
+// BENCH_INSTALL (1: install CuraEngine from Debian if it is missing; 0: do not), BENCH_CUBES6
+// (0; 1: also the 10⁶ cubes).
 //
 // CuraEngine runs with shared/bench/peers.sh's matched FDM settings (its run_cura, read out of
 // that file): the same 240 layers, 100 % fill. Where CuraEngine is not installed (Debian
@@ -64,6 +67,15 @@ function torus1m() {
 }
 const torus = torus1m();
 
+/** 10^levels separate inside-out 0.5 mm cubes on a 1 mm grid (a 3MF of components). */
+function cubes(levels) {
+  const f = join(dir, `models/cubes_fan${levels}.3mf`);
+  if (!existsSync(f)) execFileSync("python3", [join(repo, "scripts/many_parts.py"), "fan", String(levels), f], { stdio: ["ignore", 2, 2] });
+  return f;
+}
+const cubes5 = cubes(5);
+const cubes6 = process.env.BENCH_CUBES6 === "1" ? cubes(6) : null;
+
 // ------------------------------------------------------------------ CuraEngine
 function curaCommand() {
   const has = () => spawnSync("bash", ["-c", "command -v CuraEngine"]).status === 0;
@@ -111,6 +123,8 @@ const cli = {
   support: () => timed([ds, "-q", benchy, "-o", out("benchy_s.gco"), "--set", "support=unit1"]),
   report: () => timed([ds, "-q", benchy, "-o", out("benchy_r.gco"), "--report", out("benchy_r.json")]),
   torus: () => timed([ds, "-q", torus, "-o", out("torus.gco")]),
+  cubes5: () => timed([ds, "-q", cubes5, "-o", out("cubes5.gco")]),
+  cubes6: () => timed([ds, "-q", cubes6, "-o", out("cubes6.gco")]),
 };
 if (cura.script) cli.cura = () => timed(["bash", "-c", cura.script, "run_cura", benchy, out("benchy.cura.gcode")]);
 
@@ -188,6 +202,8 @@ try {
     ["cli2", () => cli.plain()],
     ["torus_cli", () => cli.torus()],
     ...(page ? [["torus_page", () => page.once(torus)]] : []),
+    ["cubes5", () => cli.cubes5()],
+    ...(cubes6 ? [["cubes6", () => cli.cubes6()]] : []),
   ];
   for (let k = 0; k <= runs; k++) {
     for (const [name, run] of steps) {
@@ -228,6 +244,8 @@ if (page) {
   const tc = med("torus_cli");
   row("page / CLI (1M torus)", `${f2(tp)} / ${f2(tc)} s (CLI CPU ${f2(med("torus_cli", "cpu"))})`, tp / tc, 1.5);
 }
+row("10⁵ cubes / 3DBenchy (CLI, wall)", `${f2(med("cubes5"))} / ${f2(cliWall)} s (CPU ${f2(med("cubes5", "cpu"))} / ${f2(cliCpu)})`, med("cubes5") / cliWall, 2);
+if (cubes6) row("10⁶ cubes / 10⁵ cubes (CLI, wall)", `${f2(med("cubes6"))} / ${f2(med("cubes5"))} s (CPU ${f2(med("cubes6", "cpu"))} / ${f2(med("cubes5", "cpu"))})`, med("cubes6") / med("cubes5"), 10);
 const meta = `commit ${execFileSync("git", ["-C", repo, "describe", "--always", "--dirty"], { encoding: "utf8" }).trim()}, ${new Date().toISOString().slice(0, 16)}Z, ${runs} runs each (median, interleaved), load now ${load()}`;
 const table = [
   meta,

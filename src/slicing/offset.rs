@@ -9,13 +9,12 @@
 //! no farther than [`CHORD_TOLERANCE_MM`] from the true arc. `tests/offset.rs` compares the
 //! result with i_overlay's own outline offset on every layer of the shared models.
 
+use crate::base::boolean::{Paths, simplify_apart};
 use crate::base::geom::{
     Contour, DVec2, Point, Shape, Shapes, all_contours, dist, segment_distance2, signed_area,
-    to_overlay,
 };
 use crate::base::spatial::EdgeIndex;
 use i_overlay::core::fill_rule::FillRule;
-use i_overlay::float::simplify::SimplifyShape;
 
 /// Largest distance between an arc and the chords that approximate it.
 pub const CHORD_TOLERANCE_MM: f64 = 0.001;
@@ -90,18 +89,21 @@ pub fn inset_with(
     tolerance: f64,
     corners: Corners,
 ) -> Shapes {
-    let mut raw: Vec<Contour> = Vec::new();
-    for shape in region {
-        for (hole, c) in shape.contours_with_hole() {
-            let d = if hole { d_hole } else { d_outer };
-            let r = raw_offset(c, d, tolerance, corners);
-            if r.len() >= 3 {
-                raw.push(r);
-            }
-        }
-    }
-    to_overlay(&raw)
-        .simplify_shape(FillRule::Positive)
+    // The raw curves of each shape: shapes far apart are united apart (`simplify_apart`).
+    let raw: Vec<Paths> = region
+        .iter()
+        .map(|shape| {
+            shape
+                .contours_with_hole()
+                .map(|(hole, c)| {
+                    raw_offset(c, if hole { d_hole } else { d_outer }, tolerance, corners)
+                })
+                .filter(|r| r.len() >= 3)
+                .map(|r| r.iter().map(|p| p.to_array()).collect())
+                .collect()
+        })
+        .collect();
+    simplify_apart(&raw, FillRule::Positive)
         .into_iter()
         .filter_map(|shape| {
             let mut contours = shape

@@ -17,6 +17,7 @@
 //! - Overlapping shells are merged with the non-zero fill rule (their union), as PrusaSlicer
 //!   and CuraEngine do.
 
+use crate::base::boolean::{Paths, simplify_apart};
 use crate::base::geom::{
     Contour, DVec2, Point, Shapes, dist, greater, lesser, shapes_from_overlay, signed_area,
     to_overlay,
@@ -256,12 +257,17 @@ fn resolve_joined(c: &Contour) -> Vec<Contour> {
         .collect()
 }
 
-/// The non-zero union of closed loops: shapes with outer boundaries CCW and holes CW.
+/// The non-zero union of closed loops: shapes with outer boundaries CCW and holes CW. Loops
+/// far apart are united apart, with the result of one pass (`simplify_apart`).
 pub fn union(contours: &[Contour]) -> Shapes {
     if contours.is_empty() {
         return Shapes::new();
     }
-    shapes_from_overlay(to_overlay(contours).simplify_shape(FillRule::NonZero))
+    let items: Vec<Paths> = contours
+        .iter()
+        .map(|c| vec![c.iter().map(|p| p.to_array()).collect()])
+        .collect();
+    shapes_from_overlay(simplify_apart(&items, FillRule::NonZero))
 }
 
 fn segments(mesh: &Mesh, facets: &[u32], z: f64) -> Vec<Segment> {
