@@ -253,6 +253,9 @@ pub struct AnalysisGrid {
     /// layer's region and droplets lie within them. They bound a layer's memory
     /// ([`layer_bytes`](Self::layer_bytes)).
     pub boxes: Vec<[Point; 2]>,
+    /// The job's volume, mm³ (0 if unknown): a layer's region holds at most about volume / H,
+    /// so bodies far apart in one box are not taken as filling it.
+    pub volume: f64,
     pub layers: usize,
     /// Whether the job has unit-1 parts (a second material), measured on their own.
     pub unit1_parts: bool,
@@ -285,11 +288,20 @@ impl AnalysisGrid {
         let d = footprint_diameter(s);
         let per_mm2 = DROPLETS_PER_B2 * s.fill_density.max(1.0) / (b * b);
         let unit1 = self.unit1_parts.then(|| unit1_part_settings(s));
+        let boxes_area: f64 = (self.boxes.iter())
+            .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0) * grow * grow)
+            .sum();
+        let cap = self.volume / s.layer_height;
+        let k = if cap.is_finite() && cap > 0.0 && boxes_area > cap {
+            (cap / boxes_area).sqrt()
+        } else {
+            1.0
+        };
         self.boxes
             .iter()
             .map(|[lo, hi]| {
-                let w = (hi[0] - lo[0]).max(0.0) * grow;
-                let h = (hi[1] - lo[1]).max(0.0) * grow;
+                let w = (hi[0] - lo[0]).max(0.0) * grow * k;
+                let h = (hi[1] - lo[1]).max(0.0) * grow * k;
                 let maps = HeightMap::box_bytes(w, h, b / GRID3_PER_B, d)
                     + unit1.as_ref().map_or(0.0, |s1| {
                         let d1 = footprint_diameter(s1);

@@ -85,6 +85,7 @@ impl Job {
         crate::analysis::AnalysisGrid {
             min: geom::DVec2::new(min[0], min[1]),
             boxes,
+            volume: self.info.mesh.signed_volume.abs(),
             layers: self.layer_count(),
             unit1_parts: !self.groups.is_empty(),
             file_name: self.info.file_name.clone(),
