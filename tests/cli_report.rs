@@ -99,7 +99,7 @@ fn a_layer_too_large_to_analyse_is_refused_and_the_code_still_written() {
     }
     // A small droplet on a flat part (droplet_aspect 0.1: B = 0.02 mm): refused as well.
     std::fs::write(&stl, box_stl(150.0, 150.0, 0.4)).unwrap();
-    let (r, v) = report(&stl, &["droplet_aspect=0.1"]);
+    let (r, v) = report(&stl, &["droplet_aspect=0.1", "plate_x=200", "plate_y=200"]);
     assert_eq!(r.code, Some(2), "{r:?}");
     assert!(
         v.is_none() && r.stderr.contains("no void analysis"),
@@ -114,6 +114,7 @@ fn the_code_of_a_refused_analysis_is_the_code_without_report() {
     std::fs::write(&stl, box_stl(600.0, 600.0, 0.2)).unwrap();
     let run = |extra: &[&str]| {
         let mut args = vec![stl.to_str().unwrap(), "-q", "-o", "out.gco"];
+        args.extend(["--set", "plate_x=700", "--set", "plate_y=700"]);
         args.extend(extra);
         let r = run_cli(&args, dir.path(), Duration::from_secs(300));
         (r, std::fs::read(dir.join("out.gco")).unwrap_or_default())

@@ -228,8 +228,8 @@ fn even_spacing_on_shared_models() {
     let mut failures = Vec::new();
     for model in MODELS {
         let path = common::model(model);
-        let exact = common::slice_cli(&path, &[]);
-        let even = common::slice_cli(&path, &["loop_spacing=even"]);
+        let exact = common::slice_cli(&path, &["allow_off_plate=true"]);
+        let even = common::slice_cli(&path, &["loop_spacing=even", "allow_off_plate=true"]);
         assert_eq!(
             fill_segments(&exact),
             fill_segments(&even),

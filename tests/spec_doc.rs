@@ -143,7 +143,7 @@ fn the_checks_see_a_wrong_row() {
         .into_iter()
         .find(|s| s.name == "layer_height")
         .unwrap();
-    assert_eq!(range(&spec), "> 0 … 5");
+    assert_eq!(range(&spec), "0.0001 … 5");
     assert_eq!(unit(&spec), "mm");
     assert!(same_default("0.2", &spec.default));
     assert!(!same_default("0.25", &spec.default));
