@@ -436,7 +436,9 @@ fn the_mask_of_parts_far_apart_has_tiles_near_them_only() {
     // Two 3 x 3 mm boxes 1 m apart: a dense mask over their bounding box (cells of B/4) would
     // hold 2.6e8 cells of 2 bytes and not fit in the 4 GB a wasm instance can address.
     let stl = two_boxes_stl(3.0, 3.0, 1.0, 1000.0, 1000.0);
-    let s = Session::new(stl.as_bytes(), "two.stl", defaults()).unwrap();
+    // a metre past the default plate: sliced where it lies
+    let off_plate = js(serde_json::json!({"allow_off_plate": true}));
+    let s = Session::new(stl.as_bytes(), "two.stl", off_plate).unwrap();
     let l = s.slice_layer_analysed(2).unwrap();
     let a = json(l.analysis().unwrap());
     let region = a["region_area"].as_f64().unwrap();
