@@ -1,4 +1,4 @@
-//! The model: files in (STL, OBJ, 3MF: [`import`]), the welded mesh ([`mesh`]) and its shells
+//! The model: files in (STL, OBJ, 3MF: [`import`]), the welded mesh ([`mesh`], its welds [`weld`]) and its shells
 //! ([`shells`]), the job file ([`spec`]), the files a job reads ([`models`]), where its
 //! instances go ([`layout`]) and whether they fit the plate ([`fit`]), the page's display meshes ([`display`]) and the preparation of
 //! one file's mesh ([`prepare`]).
@@ -13,3 +13,4 @@ pub mod models_job;
 pub mod prepare;
 pub mod shells;
 pub mod spec;
+pub mod weld;

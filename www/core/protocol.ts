@@ -83,7 +83,7 @@ export interface MaskTile {
   overfill: Uint8Array;
 }
 
-/** The mask from the core's flat arrays (src/wasm/mod.rs: `mask_cell`, `mask_tiles` = origin x,
+/** The mask from the core's flat arrays (src/wasm/layer.rs: `mask_cell`, `mask_tiles` = origin x,
  *  origin y, width, height per tile, `void_mask` and `overfill_mask` = the tiles' shares one
  *  after the other, `mask_overfilled` = per tile whether it has overfill). The tiles' void
  *  shares are views of one buffer (one copy out of the core per layer); overfill shares are

@@ -1,5 +1,5 @@
 // Reading a .gco file back into droplets (viewer for existing machine code): a thin wrapper
-// of the core's reader (src/output/gcode_read.rs, through src/wasm/reader.rs), which owns the rules
+// of the core's reader (src/output/gcode_read/, through src/wasm/reader.rs), which owns the rules
 // (G01 travel, G25 a droplet every B from the current position, G26 one droplet; B from the
 // header) and the bounds a file from anyone must keep (coordinates, droplets, travel moves,
 // layers, line length), with the messages that name the line and the reason.
