@@ -136,12 +136,21 @@ pub struct Figures {
     pub repairs: Vec<String>,
 }
 
+/// A layer's travel on a grid of 2⁻²⁰ mm (about 1 nm). Sums of such numbers below 2³³ mm are
+/// exact in f64, so a job's travel (and the print time made from it) is the same whatever
+/// runs of layers it was summed in: the CLI's one pass and the page's workers, which merge
+/// their runs as they end, write the same figures into the header (docs/gcode.md).
+pub fn travel_step(mm: f64) -> f64 {
+    const GRID: f64 = 1_048_576.0;
+    (mm * GRID).round() / GRID
+}
+
 impl Summary {
     /// Adds one planned layer.
     pub fn add(&mut self, plan: &LayerPlan) {
         self.layers += 1;
         self.counts.add(&plan.counts);
-        self.travel_mm += plan.travel_mm;
+        self.travel_mm += travel_step(plan.travel_mm);
         self.layers_with_open_chains += usize::from(plan.open_chains > 0);
         self.reoriented_loops += plan.reoriented_loops;
         self.unsupported_area += plan.unsupported_area;
