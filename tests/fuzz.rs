@@ -44,6 +44,10 @@ const SPECIAL_TEXT: [&str; 9] = [
 
 /// One damaged copy of `bytes`.
 fn mutate(rng: &mut Rng, bytes: &[u8]) -> (Vec<u8>, String) {
+    // A first mutation may have left nothing (truncated at 0): nothing more to damage.
+    if bytes.is_empty() {
+        return (Vec::new(), "left empty".into());
+    }
     let mut b = bytes.to_vec();
     let binary = b.len() >= 84 && {
         let n = u32::from_le_bytes([b[80], b[81], b[82], b[83]]) as usize;
