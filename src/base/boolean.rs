@@ -93,10 +93,23 @@ pub fn union(a: &Shapes, b: &Shapes) -> Shapes {
 
 /// The bounding box of a shape (of its outer loop).
 pub fn bounds(s: &Shape) -> (DVec2, DVec2) {
-    s.outer.iter().fold(
+    box_of(s.outer.iter().copied())
+}
+
+/// The bounding box of points (infinite and empty for none).
+fn box_of(points: impl Iterator<Item = DVec2>) -> (DVec2, DVec2) {
+    points.fold(
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
     )
+}
+
+/// The bounding box of each item's paths, the boxes [`apart_groups`] takes.
+fn paths_boxes(items: &[Paths]) -> Vec<(DVec2, DVec2)> {
+    items
+        .iter()
+        .map(|paths| box_of(paths.iter().flatten().map(|p| DVec2::from(*p))))
+        .collect()
 }
 
 /// Whether two bounding boxes overlap (touching counts).
@@ -129,15 +142,7 @@ pub fn simplify_apart(items: &[Paths], fill_rule: FillRule) -> Paths3 {
     }
     let points = items.iter().flatten().flatten();
     let adapter = FloatPointAdapter::<[f64; 2], i32>::with_iter_conservative(points);
-    let boxes: Vec<(DVec2, DVec2)> = items
-        .iter()
-        .map(|paths| {
-            paths.iter().flatten().fold(
-                (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-                |(lo, hi), p| (lo.min(DVec2::from(*p)), hi.max(DVec2::from(*p))),
-            )
-        })
-        .collect();
+    let boxes = paths_boxes(items);
     let groups = apart_groups(&boxes, APART_MM);
     if groups.len() < 2 {
         return simplify_together(items, fill_rule);
@@ -441,16 +446,7 @@ mod tests {
                 let apart = simplify_apart(&items, rule);
                 assert_eq!(apart, one, "case {case}, {rule:?}");
             }
-            let boxes: Vec<(DVec2, DVec2)> = items
-                .iter()
-                .map(|paths| {
-                    paths.iter().flatten().fold(
-                        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-                        |(lo, hi), p| (lo.min(DVec2::from(*p)), hi.max(DVec2::from(*p))),
-                    )
-                })
-                .collect();
-            grouped += usize::from(apart_groups(&boxes, APART_MM).len() > 1);
+            grouped += usize::from(apart_groups(&paths_boxes(&items), APART_MM).len() > 1);
         }
         // The cases do exercise the grouped path.
         assert!(grouped > 300, "{grouped}");
