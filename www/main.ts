@@ -23,7 +23,7 @@ import { hideBanner } from "./views/banner";
 import { wireCalibrate } from "./views/calibrate";
 import { CutRenderer } from "./views/canvas/cutrender";
 import { Renderer } from "./views/canvas/render";
-import { updateButtons } from "./views/controls";
+import { supportOn, updateButtons } from "./views/controls";
 import { setLine, wireCut } from "./views/cut";
 import { $, wireSkipLinks } from "./views/dom";
 import { SettingsForm } from "./views/form";
@@ -166,7 +166,7 @@ function wire(): void {
   $<HTMLInputElement>("opt-support").addEventListener("change", (ev) => {
     const form = page.form;
     if (!form) return;
-    form.set({ support: (ev.target as HTMLInputElement).checked ? "unit1" : "off" });
+    form.set({ support: (ev.target as HTMLInputElement).checked ? supportOn() : "off" });
     updateButtons(page);
     actions.settingsEdited();
   });
@@ -233,7 +233,11 @@ window.dropslice = {
       droplets: slice?.droplets ?? 0,
       counts: slice ? { ...slice.figures.totals } : null,
       /** Unit 1's droplets (support and unit-1 parts; a .gco file's after T1). */
-      unit1: slice?.figures.unit1.droplets ?? 0,
+      unit1: slice?.figures.units(2)[1].droplets ?? 0,
+      /** The units shown, and each one's droplets (its parts' and, for the unit that prints
+       *  it, the support's). */
+      units: slice?.unitCount ?? null,
+      unitDroplets: slice?.figures.units(slice.unitCount).map((u) => u.droplets) ?? [],
       worstOverhang: slice?.figures.worstOverhang?.index ?? null,
       unsupportedArea: slice?.figures.unsupportedArea ?? null,
       /** The overhang overlay of the layer on the canvas: droplets marked (null: none yet). */
@@ -353,10 +357,11 @@ async function main(): Promise<void> {
     return;
   }
   $("version").textContent = page.init.version;
-  // the plate's settings (and whether a part may be off it) lay the job out again (at most
+  // the plate's settings (and whether a part may be off it, and the units that may print it)
+  // lay the job out again (at most
   // every 200 ms while typing)
   let plateTimer = 0;
-  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate"].map((k) => page.form?.get(k)));
+  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "units"].map((k) => page.form?.get(k)));
   let lastPlate = "";
   page.form = new SettingsForm(
     $("settings"),

@@ -8,6 +8,47 @@
 import type { Pool } from "./client";
 import type { Counts, ErrorValue, Figures as CoreFigures, LayerData, SliceFigures, SliceUnit, Summary } from "./protocol";
 
+/** One discharge unit's figures: its droplets (its parts' and, for the unit that prints it,
+ *  the support), and, for a slice, their material (mm³), mass (g, with the unit's
+ *  `…material_density`), droplet time (s, with its `…droplet_rate`) and the predicted density
+ *  of its parts (%, the 3D estimate; null without it or without parts of the unit). */
+export interface UnitFigures {
+  droplets: number;
+  volume: number | null;
+  mass: number | null;
+  seconds: number | null;
+  density: number | null;
+}
+
+/** The core's per-unit figures as arrays indexed by unit, where the core gives them so (a core
+ *  of N units); else its two-unit fields (`unit1_droplets`, …) are read. */
+const UNIT_ARRAYS = {
+  droplets: "unit_droplets",
+  volume: "unit_volume_mm3",
+  mass: "unit_mass_g",
+  seconds: "unit_seconds",
+  density: "unit_predicted_density",
+} as const;
+
+const finiteOr = (v: unknown, or: number | null): number | null => (typeof v === "number" && Number.isFinite(v) ? v : or);
+
+/** Unit u's figures of the core's `c`, of a job of `n` units. */
+function coreUnit(c: CoreFigures, u: number): UnitFigures {
+  const arrays = c as unknown as Record<string, unknown>;
+  const at = (key: keyof typeof UNIT_ARRAYS): unknown => {
+    const a = arrays[UNIT_ARRAYS[key]];
+    return Array.isArray(a) ? a[u] : undefined;
+  };
+  if (Array.isArray(arrays[UNIT_ARRAYS.droplets])) {
+    return { droplets: finiteOr(at("droplets"), 0)!, volume: finiteOr(at("volume"), 0), mass: finiteOr(at("mass"), 0), seconds: finiteOr(at("seconds"), 0), density: finiteOr(at("density"), null) };
+  }
+  // a core of two units: unit 0's volume and mass are the job's, its droplets the rest
+  const unit1 = c.unit1_droplets ?? 0;
+  if (u === 0) return { droplets: Math.max(0, c.droplets - unit1), volume: c.volume_mm3, mass: c.mass_g, seconds: finiteOr(c.unit0_seconds, null), density: finiteOr(c.predicted_density, null) };
+  if (u === 1) return { droplets: unit1, volume: c.unit1_volume_mm3 ?? 0, mass: c.unit1_mass_g ?? 0, seconds: finiteOr(c.unit1_seconds, null), density: finiteOr(c.unit1_predicted_density, null) };
+  return { droplets: 0, volume: 0, mass: 0, seconds: 0, density: null };
+}
+
 export class Figures {
   /** The core's summaries of the slice's units, and of a later analysis pass. */
   private parts: Summary[] = [];
@@ -21,6 +62,8 @@ export class Figures {
   /** A .gco file's droplets and travel, as read. */
   private read: Counts = { outer: 0, inner: 0, fill: 0, support: 0, unit1: 0 };
   private readTravel = 0;
+  /** A .gco file's droplets per unit (after `T0`, `T1`, …), as read. */
+  private readUnits: number[] = [0];
   private running: Promise<void> | null = null;
   private again = false;
 
@@ -49,6 +92,7 @@ export class Figures {
     this.read.inner += l.counts.inner;
     this.read.fill += l.counts.fill;
     this.read.unit1 = (this.read.unit1 ?? 0) + (l.counts.unit1 ?? 0);
+    l.counts.parts.forEach((d, u) => (this.readUnits[u] = (this.readUnits[u] ?? 0) + d));
     this.readTravel += l.travelMm;
   }
 
@@ -106,13 +150,13 @@ export class Figures {
     return t.outer + t.inner + t.fill + (t.support ?? 0);
   }
 
-  /** Unit 1's droplets (support and unit-1 parts; a .gco file's after `T1`), and, for a
-   *  slice, their material (mm³), mass (g, unit1_material_density) and each unit's droplet
-   *  time (s). */
-  get unit1(): { droplets: number; volume: number | null; mass: number | null; seconds0: number | null; seconds1: number | null } {
+  /** Each of `n` units' figures (index u: unit u's); a .gco file's droplets after each `T`,
+   *  without estimates. */
+  units(n: number): UnitFigures[] {
     const c = this.core;
-    if (!c) return { droplets: this.read.unit1 ?? 0, volume: null, mass: null, seconds0: null, seconds1: null };
-    return { droplets: c.unit1_droplets ?? 0, volume: c.unit1_volume_mm3 ?? 0, mass: c.unit1_mass_g ?? 0, seconds0: c.unit0_seconds ?? null, seconds1: c.unit1_seconds ?? null };
+    return Array.from({ length: n }, (_, u) =>
+      c ? coreUnit(c, u) : { droplets: this.readUnits[u] ?? 0, volume: null, mass: null, seconds: null, density: null },
+    );
   }
 
   /** Overhang area of the part, mm² (summed over the layers; null for a .gco file). */

@@ -38,11 +38,15 @@ export interface JobFile {
   parts: PartSpec[];
 }
 
+/** A layer's droplets as the core counts them (by role, the support, unit 1's), and those of
+ *  each unit's parts (the support not included: units.ts `partsByUnit`, index u is unit u's). */
+export type LayerCounts = Counts & { parts: number[] };
+
 /** One layer as drawn: flat arrays, never an object per droplet. */
 export interface LayerData {
   index: number;
   z: number;
-  counts: Counts;
+  counts: LayerCounts;
   travelMm: number;
   /** The core's estimated print time of the layer, s (src/output/summary.rs `layer_seconds`; the
    *  layers' times add up to the job's `print_seconds`). Absent for a .gco file's layers. */
@@ -51,7 +55,7 @@ export interface LayerData {
   droplets: Float32Array;
   /** 0 outermost loop, 1 inner loops, 2 fill, 3 support; one per droplet. */
   roles: Uint8Array;
-  /** The discharge unit of each droplet (0 or 1). */
+  /** The discharge unit of each droplet (0 … units − 1). */
   units: Uint8Array;
   /** The layer's overhang area, mm² (the core's, slices only). */
   unsupportedArea?: number;

@@ -6,7 +6,8 @@ import type { JobFileRef } from "./client";
 import type { Value } from "./settings";
 import { Figures } from "./figures";
 import type { Job } from "./job";
-import type { Counts, JobFile, JobInfo, LayerAnalysis, LayerData, SliceUnit } from "./protocol";
+import type { JobFile, JobInfo, LayerAnalysis, LayerCounts, LayerData, SliceUnit } from "./protocol";
+import { unitsOf } from "./units";
 import type { Bounds } from "./view";
 import type { ShareState } from "./share";
 
@@ -53,7 +54,9 @@ export class Slice {
   /** The core's info of a slice; empty for a .gco file (the core did not prepare it). */
   info: Partial<JobInfo> = {};
   z: number[] = [];
-  counts: (Counts | undefined)[] = [];
+  counts: (LayerCounts | undefined)[] = [];
+  /** Units whose droplets some layer in so far has (the highest unit + 1). */
+  private seenUnits = 1;
   travelMm: number[] = [];
   /** The core's print time per layer, s (slices only; the per-layer plot). */
   layerSeconds: number[] = [];
@@ -96,6 +99,13 @@ export class Slice {
     readonly cacheBudget: number,
   ) {}
 
+  /** The discharge units the slice shows (units.ts): its settings' `units` (a .gco file's
+   *  header's, when it names them), and never fewer than the units its droplets name. */
+  get unitCount(): number {
+    const named = this.source === "gco" ? (this.gcodeFile?.settings ?? this.gcodeFile?.header ?? null) : this.settings;
+    return Math.max(unitsOf(named), this.seenUnits);
+  }
+
   open(layers: number, info: Partial<JobInfo>): void {
     this.layers = layers;
     this.info = info;
@@ -105,6 +115,7 @@ export class Slice {
     if (this.counts[l.index] === undefined) {
       this.done++;
       this.counts[l.index] = l.counts;
+      this.seenUnits = Math.max(this.seenUnits, l.counts.parts.length);
       this.z[l.index] = l.z;
       this.travelMm[l.index] = l.travelMm;
       if (l.seconds !== undefined) this.layerSeconds[l.index] = l.seconds;

@@ -14,7 +14,7 @@ import { NOT_SENT, type CutReply, type LayerData } from "../core/protocol";
 import type { Slice } from "../core/store";
 import type { CutLayer } from "../views/canvas/cutrender";
 import { dropletClass } from "../views/canvas/render";
-import { writeCutStatus } from "../views/cut";
+import { writeCutLegend, writeCutStatus } from "../views/cut";
 import type { Page } from "../views/page";
 import { showError } from "./errors";
 
@@ -199,6 +199,7 @@ export function updateCut(page: Page): void {
   if (s.complete && s.source === "stl" && state.queue.length === 0 && state.inFlight === 0 && state.resolved.size < s.layers) plan(page);
   cut.request();
   const pending = s.source === "stl" ? s.layers - state.resolved.size : 0;
+  writeCutLegend(s.unitCount);
   writeCutStatus(s.source === "gco" ? " · voids need a model, not a .gco file" : pending > 0 ? ` · section of ${s.layers - pending} / ${s.layers} layers` : "", crossesNothing(s, state.line, pending, cut.layers.values()));
 }
 

@@ -6,6 +6,8 @@
 
 import { jobSettings } from "../core/job";
 import { jobOffPlate } from "../core/plate";
+import type { Value } from "../core/settings";
+import { supportUnit, unitsOf } from "../core/units";
 import type { Page } from "./page";
 import { $ } from "./dom";
 
@@ -45,8 +47,7 @@ export function updateButtons(page: Page): void {
   share.disabled = !(ready && s!.source === "stl" && s!.job !== null);
   share.title = why || "Copy a link that opens this slice (settings, parts, view)";
   $<HTMLButtonElement>("btn-slice").disabled = store.job === null || form === undefined || off.length > 0 || !store.job.layout;
-  // the support switch shows the setting (a link, a job file or the form may have set it)
-  if (form) $<HTMLInputElement>("opt-support").checked = form.get("support") === "unit1";
+  if (form) writeUnits(page, form.values());
   settingsStatus(page, state === "stale", off.map((o) => o.message));
   formSource(page);
 }
@@ -106,4 +107,35 @@ function settingsStatus(page: Page, stale: boolean, offPlate: string[]): void {
   st.className = "hint";
   st.textContent = !(stale || unsliced) ? "" : settingsChanged ? "Settings changed: press Slice (or Enter) to update." : "The parts changed: press Slice (or Enter) to update.";
   btn.classList.toggle("attention", stale || unsliced);
+}
+
+/** The unit the support switch turns on: the last `support = unitN` the form had (unit 1 at
+ *  first). */
+let supportBy = 1;
+let shownUnits = 0;
+
+/** The switch's `support` value when it is turned on (main.ts). */
+export const supportOn = (): string => `unit${supportBy}`;
+
+/** What follows the machine's units (the form's `units`) and the support's unit: the support
+ *  switch (a link, a job file or the form may have set `support`; with one unit there is no
+ *  unit to print support), and, when the count changed, the form's unit groups, the parts
+ *  panel's unit choice and the 3D view's legend. */
+function writeUnits(page: Page, values: Record<string, Value>): void {
+  const n = unitsOf(values);
+  const by = supportUnit(values.support);
+  if (by !== null) supportBy = by;
+  if (supportBy >= n) supportBy = 1;
+  $<HTMLInputElement>("opt-support").checked = by !== null;
+  const name = `Support (unit ${by ?? supportBy})`;
+  if ($("opt-support-name").textContent !== name) {
+    $("opt-support-name").textContent = name;
+    $("support-switch").title = `Print support under every overhang with discharge unit ${by ?? supportBy} (the setting support = unit${by ?? supportBy}; its details are in the Support group)`;
+  }
+  $("support-switch").hidden = n === 1 && by === null;
+  if (n === shownUnits) return;
+  shownUnits = n;
+  page.form?.showUnits(n);
+  page.parts.render();
+  page.view3d.sync(page);
 }

@@ -6,7 +6,8 @@
 import { checkLine, cutLabel, lineLength, type Line, type Pt } from "../core/cutline";
 import type { Page } from "./page";
 import { wirePanZoom } from "./canvas/panzoom";
-import { $ } from "./dom";
+import { $, el, unitRows } from "./dom";
+import { unitsOf } from "../core/units";
 
 /** Pointer distance (CSS px) that grabs an end or the line. */
 const GRAB_PX = 9;
@@ -21,9 +22,15 @@ let timer = 0;
 export function setLine(page: Page, line: Line | null, refit = true): void {
   drawn = line;
   $("cut-panel").hidden = !line;
+  writeCutLegend(page.store.slice?.unitCount ?? unitsOf(page.form?.values()));
   writePosition(line);
   page.renderer.request();
   page.actions.setCutLine(line, refit);
+}
+
+/** The legend's entries of units 1 … n − 1 (their parts' droplets; unit 0's are by role). */
+export function writeCutLegend(n: number): void {
+  unitRows("cut", $("cut-legend-support"), n, (u) => [el("span", {}, el("i", { class: `unit${u}` }), `Unit ${u}`)]);
 }
 
 /** The cut's status line: the line's length, then `more` (the section's progress); `missed`:

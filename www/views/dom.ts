@@ -43,3 +43,29 @@ export function wireSkipLinks(): void {
     go(ev, view.getClientRects().length > 0 ? view : $("layer"));
   });
 }
+
+/** An element `tag` with attributes (`class`, `id`, `title`, `hidden`: "" …) and children. */
+export function el(tag: string, attrs: Record<string, string | undefined>, ...children: (Node | string)[]): HTMLElement {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) if (v !== undefined) e.setAttribute(k, v);
+  e.append(...children);
+  return e;
+}
+
+/** The elements of units 1 … n − 1 (`make(u)`, in order) right after `anchor` (`before`: before it), each marked
+ *  `data-units-of = key`; made again only when n changes (the views call this on every
+ *  redraw). Unit 0's rows are the page's own markup. */
+export function unitRows(key: string, anchor: Element, n: number, make: (u: number) => Element[], before = false): void {
+  const parent = anchor.parentElement!;
+  if (parent.dataset[`units${key}`] === String(n)) return;
+  parent.dataset[`units${key}`] = String(n);
+  for (const old of parent.querySelectorAll(`[data-units-of="${key}"]`)) old.remove();
+  const made: Element[] = [];
+  for (let u = 1; u < n; u++) made.push(...make(u));
+  for (const e of made) e.setAttribute("data-units-of", key);
+  if (before) anchor.before(...made);
+  else anchor.after(...made);
+}
+
+/** "₁" for 1: a unit's droplet width B₁, B₂, … */
+export const sub = (u: number): string => String(u).replace(/[0-9]/g, (d) => String.fromCharCode(0x2080 + Number(d)));

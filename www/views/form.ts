@@ -4,6 +4,7 @@
 
 import type { SettingSpec } from "../core/protocol";
 import { parse, type Value } from "../core/settings";
+import { unitOfSetting } from "../core/units";
 
 const OPEN_GROUPS = new Set(["Droplet", "Contours", "Fill"]);
 
@@ -20,8 +21,23 @@ interface Field {
   value: Value;
 }
 
+/** The group a setting is shown in: a unit's own settings (`unitN_<name>`) under "Unit N",
+ *  whatever group the schema gives them; the others in the schema's. */
+export function groupOf(spec: SettingSpec): string {
+  const u = unitOfSetting(spec.name);
+  return u === null ? spec.group : `Unit ${u}`;
+}
+
+/** The unit N of a group "Unit N" (null: not a unit's group). */
+const groupUnit = (group: string): number | null => {
+  const m = /^Unit ([1-9][0-9]*)$/.exec(group);
+  return m ? Number(m[1]) : null;
+};
+
 export class SettingsForm {
   private fields = new Map<string, Field>();
+  /** The groups' `<details>`, by name. */
+  private groups = new Map<string, HTMLDetailsElement>();
 
   constructor(
     container: HTMLElement,
@@ -37,21 +53,36 @@ export class SettingsForm {
         this.build(spec);
         continue;
       }
-      let body = groups.get(spec.group);
+      const group = groupOf(spec);
+      let body = groups.get(group);
       if (!body) {
         const details = document.createElement("details");
         details.className = "group";
-        details.open = OPEN_GROUPS.has(spec.group);
+        details.open = OPEN_GROUPS.has(group);
         const summary = document.createElement("summary");
-        summary.textContent = spec.group;
+        summary.textContent = group;
         details.append(summary);
         body = document.createElement("div");
         body.className = "group-body";
         details.append(body);
         container.append(details);
-        groups.set(spec.group, body);
+        groups.set(group, body);
+        this.groups.set(group, details);
       }
       body.append(this.build(spec));
+    }
+  }
+
+  /** Shows the settings of units 0 … n − 1 only: a group "Unit N" and every `unitN_` row
+   *  with N ≥ n are hidden (their values stay, and go to the core as they are). */
+  showUnits(n: number): void {
+    for (const [group, details] of this.groups) {
+      const u = groupUnit(group);
+      details.hidden = u !== null && u >= n;
+    }
+    for (const f of this.fields.values()) {
+      const u = unitOfSetting(f.spec.name);
+      if (u !== null) f.row.hidden = u >= n;
     }
   }
 
@@ -168,6 +199,9 @@ export class SettingsForm {
   focusFirstError(): void {
     const f = [...this.fields.values()].find((x) => x.error);
     if (f) {
+      // a unit's settings hidden by `units` are shown while they need fixing
+      f.row.hidden = false;
+      (f.row.closest("details") as HTMLDetailsElement | null)?.removeAttribute("hidden");
       (f.row.closest("details") as HTMLDetailsElement | null)?.setAttribute("open", "");
       f.input.focus();
     }

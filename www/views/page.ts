@@ -162,4 +162,6 @@ export interface SettingsView {
   reset(): void;
   errors(): { name: string; message: string }[];
   focusFirstError(): void;
+  /** Shows the settings of units 0 … n − 1 only (the groups "Unit N" of the others hidden). */
+  showUnits(n: number): void;
 }

@@ -11,6 +11,7 @@ import { jobMisfits, plainJobMessage, type OffPlate } from "../core/plate";
 import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
+import { MAX_UNITS, unitIndices, unitRole, unitsOf } from "../core/units";
 import { cancelOrient, orientEditorShows, orientPart } from "./orient";
 import { mirrorChange, openPartMenu } from "./contextmenu";
 
@@ -90,7 +91,8 @@ export class PartsPanel implements PartsView {
     $<HTMLSelectElement>("part-unit").addEventListener("change", (ev) => {
       const p = this.part();
       const unit = Number((ev.target as HTMLSelectElement).value);
-      if (p && (unit === 0 || unit === 1) && unit !== p.spec.unit) void this.edit(p, { unit }).then((ok) => ok || this.renderEditor());
+      // the core checks the unit against the machine's `units` (a refusal puts the choice back)
+      if (p && Number.isInteger(unit) && unit >= 0 && unit < MAX_UNITS && unit !== p.spec.unit) void this.edit(p, { unit }).then((ok) => ok || this.renderEditor());
     });
     for (const a of AXES) {
       const input = $<HTMLInputElement>(`part-size_${a}`);
@@ -228,8 +230,8 @@ export class PartsPanel implements PartsView {
       copies.textContent = p.spec.copies > 1 ? `× ${p.spec.copies}` : "";
       const unit = document.createElement("span");
       unit.className = "part-unit";
-      unit.textContent = p.spec.unit === 1 ? "unit 1" : "";
-      unit.title = "Printed by discharge unit 1";
+      unit.textContent = p.spec.unit > 0 ? `unit ${p.spec.unit}` : "";
+      unit.title = p.spec.unit > 0 ? `Printed by discharge unit ${p.spec.unit}` : "";
       const right = document.createElement("span");
       right.className = "part-tags";
       right.append(unit, copies);
@@ -341,8 +343,23 @@ export class PartsPanel implements PartsView {
       $(`part-mirror_${a}`).setAttribute("aria-pressed", String(p.spec[`mirror_${a}`]));
     }
     $<HTMLInputElement>("part-auto").checked = auto;
-    $<HTMLSelectElement>("part-unit").value = String(p.spec.unit === 1 ? 1 : 0);
+    this.renderUnits(p.spec.unit);
     $("part-place-row").classList.toggle("auto", auto);
     ($("part-remove") as HTMLButtonElement).disabled = job.parts.length <= 1;
+  }
+
+  /** The unit choice: one option per unit of the machine (the form's `units`), and the part's
+   *  own unit when the machine has not that many (the core refuses the job then: the user
+   *  picks another); hidden with one unit. */
+  private renderUnits(unit: number): void {
+    const n = unitsOf(this.page.form?.values());
+    const select = $<HTMLSelectElement>("part-unit");
+    const want = unitIndices(Math.max(n, unit + 1)).map((u) => `${u}:${u < n ? `Unit ${u} (${unitRole(u)})` : `Unit ${u} (the machine has ${n === 1 ? "one unit" : `units 0 … ${n - 1}`})`}`);
+    if (select.dataset.options !== want.join("|")) {
+      select.dataset.options = want.join("|");
+      select.replaceChildren(...want.map((w) => new Option(w.slice(w.indexOf(":") + 1), w.slice(0, w.indexOf(":")))));
+    }
+    select.value = String(unit);
+    select.hidden = $("part-unit-label").hidden = n === 1 && unit === 0;
   }
 }

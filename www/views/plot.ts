@@ -1,5 +1,5 @@
 // The per-layer plot under the layer slider: droplets per layer (bars stacked by what prints
-// them: unit 0's parts, unit 1's parts, the support; their sum is the statistics' *This layer*)
+// them: each unit's parts, unit 0 first, then the support; their sum is the statistics' *This layer*)
 // and the running print time (a line, the right axis) along the layers, the current layer
 // marked. A click or a drag goes to the layer under the pointer (as the slider does); hovering
 // shows that layer's figures. The canvas is a slider for the keyboard (focusable; the page's
@@ -11,16 +11,18 @@
 
 import { sizeCanvas, watchCanvas } from "./canvas/hidpi";
 import type { Page } from "./page";
-import type { Counts } from "../core/protocol";
+import type { LayerCounts } from "../core/protocol";
 import type { Slice } from "../core/store";
-import { $, duration, nf } from "./dom";
+import { UNIT_BARS, unitColor, unitsOf } from "../core/units";
+import { $, duration, el, nf, unitRows } from "./dom";
 
 const BUSY_REDRAW_MS = 150;
 /** The plot area inside the canvas, CSS pixels: room for the axes' labels. */
 const PAD = { left: 58, right: 62, top: 16, bottom: 28 };
-/** The stack's colours, bottom up: unit 0's parts, unit 1's parts, the support (the legend's
- *  swatches in style.css `.plot-key i.*` match). */
-const BARS = ["#a5c8ec", "#b9a7f4", "#86d0dc"];
+/** The stack's colours, bottom up: each unit's parts (core/units.ts `UNIT_BARS`), the support
+ *  (the legend's swatches in style.css `.plot-key i.*` match). */
+const SUPPORT_BAR = "#86d0dc";
+const barColor = (j: number, n: number) => (j < n ? unitColor(UNIT_BARS, j) : SUPPORT_BAR);
 const BAR_EMPTY = "#eef1f5";
 const LINE = "#d9480f";
 /** The time axis' labels: darker than the line, for text contrast ≥ 4.5:1 on white. */
@@ -62,17 +64,17 @@ function sumsOf(s: Slice): Sums {
   return sums;
 }
 
-/** A layer's droplets by what prints them: [unit 0's parts, unit 1's parts, support] (the
- *  core's counts: unit 1 prints the support and its own parts; roles partition the droplets). */
-export function stackOf(c: Counts): [number, number, number] {
-  const support = c.support ?? 0;
-  const total = c.outer + c.inner + c.fill + support;
-  const unit1 = Math.min(total, c.unit1 ?? support);
-  return [total - unit1, Math.max(0, unit1 - support), support];
+/** A layer's droplets by what prints them: each of `n` units' parts (unit 0 first), then the
+ *  support (n + 1 numbers; the roles partition the droplets). */
+export function stackOf(c: LayerCounts, n: number): number[] {
+  const out = new Array<number>(n + 1).fill(0);
+  c.parts.forEach((d, u) => (out[Math.min(u, n - 1)] += d));
+  out[n] = c.support ?? 0;
+  return out;
 }
 
 /** A layer's droplets, all of them: the statistics' *This layer*. */
-export function layerTotal(c: Counts): number {
+export function layerTotal(c: LayerCounts): number {
   return c.outer + c.inner + c.fill + (c.support ?? 0);
 }
 
@@ -117,17 +119,18 @@ function writeLabel(): void {
   }
 }
 
-/** Layer i's figures in words: its droplets (the total, then by what prints them when unit 1
- *  prints any), its time and when it starts. */
+/** Layer i's figures in words: its droplets (the total, then by what prints them when a unit
+ *  but unit 0 prints any), its time and when it starts. */
 function readout(s: Slice, i: number): string {
   const c = s.counts[i];
   const z = s.z[i];
   const parts = [`Layer ${i + 1}`];
   if (z !== undefined) parts.push(`z ${z.toFixed(2)} mm`);
   if (c) {
-    const [u0, u1, support] = stackOf(c);
-    const split = [u1 > 0 ? `${nf.format(u1)} unit 1` : "", support > 0 ? `${nf.format(support)} support` : ""].filter(Boolean);
-    parts.push(`${nf.format(layerTotal(c))} droplets` + (split.length ? ` (${nf.format(u0)} unit 0, ${split.join(", ")})` : ""));
+    const n = s.unitCount;
+    const stack = stackOf(c, n);
+    const split = stack.flatMap((d, j) => (j === 0 || d === 0 ? [] : [`${nf.format(d)} ${j < n ? `unit ${j}` : "support"}`]));
+    parts.push(`${nf.format(layerTotal(c))} droplets` + (split.length ? ` (${nf.format(stack[0])} unit 0, ${split.join(", ")})` : ""));
   } else parts.push("not sliced yet");
   const t = s.layerSeconds[i];
   if (t !== undefined) parts.push(`${duration(t)} to print`);
@@ -137,11 +140,14 @@ function readout(s: Slice, i: number): string {
   return text;
 }
 
-/** The legend's entries for what the slice has: unit 0 always, unit 1's parts and the support
- *  when some layer has them. */
+/** The legend's entries for what the slice has (`kinds`: each of n units' parts, then the
+ *  support): unit 0 always, another unit's parts and the support when some layer has them. */
 function writeKey(kinds: boolean[]): void {
-  $("plot-key-unit1").hidden = !kinds[1];
-  $("plot-key-support").hidden = !kinds[2];
+  const n = kinds.length - 1;
+  const support = $("plot-key-support");
+  unitRows("key", support, n, (u) => [el("span", { id: `plot-key-unit${u}`, hidden: "" }, el("i", { class: `bar${u}` }), `unit ${u}`)], true);
+  for (let u = 1; u < n; u++) $(`plot-key-unit${u}`).hidden = !kinds[u];
+  support.hidden = !kinds[n];
 }
 
 /** Draws the plot now. */
@@ -162,8 +168,9 @@ export function drawPlot(): void {
   canvas.setAttribute("aria-valuemin", "1");
   canvas.dataset.left = String(PAD.left);
   canvas.dataset.right = String(cssW - PAD.right);
+  const units = s ? s.unitCount : unitsOf(page.form?.values());
   if (!s || n === 0) {
-    writeKey([true, false, false]);
+    writeKey([true, ...new Array<boolean>(units).fill(false)]);
     return;
   }
 
@@ -181,7 +188,7 @@ export function drawPlot(): void {
   const which = new Int32Array(cols).fill(-1);
   const missing = new Uint8Array(cols);
   let maxDroplets = 0;
-  const kinds = [false, false, false];
+  const kinds = new Array<boolean>(units + 1).fill(false);
   for (let c = 0; c < cols; c++) {
     const a = Math.floor((c * n) / cols);
     const b = Math.max(a + 1, Math.floor(((c + 1) * n) / cols));
@@ -201,7 +208,7 @@ export function drawPlot(): void {
     tallest[c] = Math.max(0, m);
     if (m > maxDroplets) maxDroplets = m;
   }
-  for (const k of s.counts) if (k) stackOf(k).forEach((v, j) => (kinds[j] ||= v > 0));
+  for (const k of s.counts) if (k) stackOf(k, units).forEach((v, j) => (kinds[j] ||= v > 0));
   writeKey(kinds);
   // whole droplets and whole layers per tick
   const dStep = Math.max(1, step(maxDroplets, Math.max(1, Math.floor(h / (22 * dpr)))));
@@ -238,9 +245,9 @@ export function drawPlot(): void {
     }
     if (which[c] < 0) continue;
     let y = y1;
-    stackOf(s.counts[which[c]]!).forEach((v, j) => {
+    stackOf(s.counts[which[c]]!, units).forEach((v, j) => {
       const bh = (v / dTop) * h;
-      g.fillStyle = BARS[j];
+      g.fillStyle = barColor(j, units);
       g.fillRect(x0 + c, y - bh, 1, bh);
       y -= bh;
     });

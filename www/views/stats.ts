@@ -4,7 +4,8 @@
 import type { Page } from "./page";
 import type { Slice } from "../core/store";
 import { writeCalibration } from "./calibrate";
-import { $, duration, nf, setText } from "./dom";
+import { $, duration, el, nf, setText, sub, unitRows } from "./dom";
+import { supportUnit, unitIndices, unitRole, unitSetting, unitsOf } from "../core/units";
 import { requestPlot } from "./plot";
 import { writeVoids } from "./voids";
 
@@ -21,40 +22,86 @@ function roleLabels(source: "stl" | "gco", fromHeader: boolean): void {
   $("stat-label-0").textContent = byCommand ? "Loop droplets (G26)" : "Outer loop";
   $("legend-2").textContent = $("stat-label-2").textContent = byCommand ? "Fill lines (G25)" : "Fill";
   $("legend-1-wrap").hidden = gco;
-  $("legend-unit1-label").textContent = gco ? "Unit 1 (after T1)" : "Unit-1 part";
-  $("stat-unit1-label").textContent = byCommand ? "Unit 1 (after T1)" : "Unit 1, all";
   $("stat-support-label").hidden = $("stat-support").hidden = byCommand;
 }
 
 const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
 
-/** Support and unit-1 droplets: the legend's entries, the droplet rows, unit 1's material,
- *  mass and time, and the overhang block. All figures are the core's. */
-function writeUnit1(s: Slice | null, current: number): void {
+/** The rows of units 1 … n − 1 (unit 0's are the page's markup): the legend's entry of its
+ *  parts' droplets, its droplet row, its material and mass, its parts' predicted density. */
+function unitRowsOf(n: number): void {
+  const name = (u: number) => `Unit ${u}`;
+  unitRows("legend", $("legend-support"), n, (u) => [
+    el("span", { id: `legend-unit${u}`, hidden: "" }, el("i", { class: `unit${u}` }), el("span", { id: `legend-unit${u}-label` }, `Unit-${u} part`)),
+  ]);
+  unitRows("drops", $("stat-droplets"), n, (u) => [
+    el("dt", {}, el("i", { class: `unit${u}` }), el("span", { id: `stat-unit${u}-label` }, `${name(u)}, all`)),
+    el("dd", { id: `stat-unit${u}` }, "–"),
+  ]);
+  unitRows(
+    "mass",
+    $("stat-unit-times-label"),
+    n,
+    (u) => [
+      el("dt", { id: `stat-volume${u}-label`, title: `${name(u)}'s droplets × B${sub(u)}²H` }, `Material, unit ${u}`),
+      el("dd", { id: `stat-volume${u}` }, "–"),
+      el("dt", { id: `stat-mass${u}-label`, title: `With ${unitSetting("material_density", u)}` }, `Mass, unit ${u}`),
+      el("dd", { id: `stat-mass${u}` }, "–"),
+    ],
+    true,
+  );
+  unitRows("density", $("stat-density"), n, (u) => [
+    el("dt", { id: `stat-density${u}-label`, title: `The same for the parts of unit ${u} (a ${unitRole(u)}, droplets of B${sub(u)})`, hidden: "" }, `Predicted density, unit ${u}`),
+    el("dd", { id: `stat-density${u}`, hidden: "" }, "–"),
+  ]);
+  setText("stat-unit-times-label", `Droplet time, unit ${unitIndices(n).join(" · ")}`);
+}
+
+/** Each unit's droplets and the support: the legend's entries, the droplet rows, the units'
+ *  material, mass and time, and the overhang block. All figures are the core's (a .gco
+ *  file's droplets after each `T`, as read). */
+function writeUnits(s: Slice | null, current: number, n: number): void {
   const f = s?.figures;
-  const u = f?.unit1;
+  const units = f ? f.units(n) : [];
   const support = f?.totals.support ?? 0;
+  const gco = s?.source === "gco";
+  const byCommand = gco && !(f?.fromHeader ?? false);
+  // the unit that prints the support (the slice's setting; unit 1 when it is off)
+  const supportBy = (s && supportUnit(s.settings.support)) ?? 1;
+  const supportName = n > 1 || supportBy > 1 ? `Support (unit ${supportBy})` : "Support";
+  setText("stat-support-name", supportName);
+  setText("legend-support-label", supportName);
   const layer = s?.cache.get(current);
   let layerSupport = 0;
-  let layerUnit1Part = 0;
+  const layerParts = new Array<number>(n).fill(0);
   if (layer?.units) {
     for (let i = 0; i < layer.roles.length; i++) {
       if (layer.roles[i] === 3) layerSupport++;
-      else if (layer.units[i] === 1) layerUnit1Part++;
+      else if (layer.units[i] < n) layerParts[layer.units[i]]++;
     }
   }
-  const unit1Parts = (u?.droplets ?? 0) - support;
   $("legend-support").hidden = !(support > 0 || layerSupport > 0);
-  $("legend-unit1").hidden = !(unit1Parts > 0 || layerUnit1Part > 0);
-  setText("stat-support", s ? nf.format(support) : "–");
-  setText("stat-unit1", s ? nf.format(u?.droplets ?? 0) : "–");
-  const any = (u?.droplets ?? 0) > 0 && u?.volume !== null;
-  $("unit1-stats").hidden = !any;
-  if (any && u) {
-    setText("stat-volume1", u.volume !== null ? `${(u.volume / 1000).toFixed(2)} cm³` : "–");
-    setText("stat-mass1", u.mass !== null ? `${u.mass.toFixed(2)} g` : "–");
-    setText("stat-unit-times", u.seconds0 !== null && u.seconds1 !== null ? `${duration(u.seconds0)} · ${duration(u.seconds1)}` : "–");
+  let any = false;
+  const times: string[] = [];
+  for (let u = 0; u < n; u++) {
+    const d = units[u];
+    const parts = (d?.droplets ?? 0) - (u === supportBy ? support : 0);
+    times.push(d?.seconds !== null && d?.seconds !== undefined ? duration(d.seconds) : "–");
+    if (u === 0) continue;
+    $(`legend-unit${u}`).hidden = !(parts > 0 || (layerParts[u] ?? 0) > 0);
+    setText(`legend-unit${u}-label`, gco ? `Unit ${u} (after T${u})` : `Unit-${u} part`);
+    setText(`stat-unit${u}-label`, byCommand ? `Unit ${u} (after T${u})` : `Unit ${u}, all`);
+    setText(`stat-unit${u}`, s ? nf.format(d?.droplets ?? 0) : "–");
+    const has = (d?.droplets ?? 0) > 0 && d?.volume !== null;
+    any ||= has;
+    for (const id of [`stat-volume${u}`, `stat-mass${u}`]) $(id).hidden = $(`${id}-label`).hidden = !has;
+    if (has && d) {
+      setText(`stat-volume${u}`, d.volume !== null ? `${(d.volume / 1000).toFixed(2)} cm³` : "–");
+      setText(`stat-mass${u}`, d.mass !== null ? `${d.mass.toFixed(2)} g` : "–");
+    }
   }
+  $("unit-stats").hidden = !any;
+  if (any) setText("stat-unit-times", times.every((t) => t !== "–") ? times.join(" · ") : "–");
   // overhangs (the core's areas: per layer as the layers come in, the part's and the worst)
   const stl = s?.source === "stl";
   const a = stl ? s!.unsupportedArea[current] : undefined;
@@ -71,6 +118,9 @@ export function writeStats(page: Page): void {
   const { store } = page;
   const s = store.slice;
   const current = store.current;
+  // the units shown: the slice's, else the form's
+  const n = s ? s.unitCount : unitsOf(page.form?.values());
+  unitRowsOf(n);
   roleLabels(s?.source ?? "stl", s?.figures.fromHeader ?? false);
   const note = s?.figures.movesNote ?? null;
   $("figures-note").hidden = note === null;
@@ -78,8 +128,8 @@ export function writeStats(page: Page): void {
   writeCalibration(page);
   $("empty").hidden = s !== null;
   if (!s) {
-    writeVoids(null, current);
-    writeUnit1(null, current);
+    writeVoids(null, current, n);
+    writeUnits(null, current, n);
     for (const id of ["stat-model", "stat-parts", "stat-size", "stat-facets", "stat-layers", "stat-droplet", "stat-outer", "stat-inner", "stat-fill", "stat-droplets", "stat-volume", "stat-mass", "stat-time", "stat-travel", "stat-z", "stat-layer-droplets"]) setText(id, "–");
     $("warnings").hidden = true;
     requestPlot();
@@ -109,8 +159,8 @@ export function writeStats(page: Page): void {
   const c = s.counts[current];
   setText("stat-z", s.z[current] !== undefined ? `${s.z[current].toFixed(3)} mm` : "–");
   setText("stat-layer-droplets", c ? nf.format(c.outer + c.inner + c.fill + (c.support ?? 0)) : "–");
-  writeVoids(s, current);
-  writeUnit1(s, current);
+  writeVoids(s, current, n);
+  writeUnits(s, current, n);
   const warnings = [...((s.info.warnings ?? []) as string[]), ...s.repairs];
   $("warnings").hidden = warnings.length === 0;
   const list = $("warning-list");

@@ -8,7 +8,8 @@ const mm2 = (x: number) => `${x < 0.1 ? x.toFixed(3) : x.toFixed(2)} mm²`;
 
 const finite = (x: number | null | undefined): number | null => (x !== null && x !== undefined && Number.isFinite(x) ? x : null);
 
-export function writeVoids(s: Slice | null, current: number): void {
+/** `n`: the units shown (the rows of units 1 … n − 1 are made by stats.ts). */
+export function writeVoids(s: Slice | null, current: number, n: number): void {
   const a = s?.analysis[current];
   setText("stat-coverage", a ? pct(a.coverage) : "–");
   setText("stat-void", a ? mm2(a.void_area) : "–");
@@ -19,17 +20,18 @@ export function writeVoids(s: Slice | null, current: number): void {
   setText("stat-part-coverage", coverage !== null ? pct(coverage) + partial : "–");
   // the core's 3D void estimate only (the page never makes up a density of its own), per unit
   // that prints parts
-  const core = s?.figures.core;
-  const d0 = finite(core?.predicted_density);
-  const d1 = finite(core?.unit1_predicted_density);
   const dens = (d: number | null) => (d !== null ? `${d.toFixed(1)} %${partial}` : "–");
+  const byUnit = s?.figures.core ? s.figures.units(n).map((u) => finite(u.density)) : new Array<null>(n).fill(null);
+  const d0 = byUnit[0] ?? null;
   setText("stat-density", dens(d0));
-  setText("stat-density1", dens(d1));
-  $("stat-density1").hidden = $("stat-density1-label").hidden = d1 === null;
+  for (let u = 1; u < n; u++) {
+    setText(`stat-density${u}`, dens(byUnit[u]));
+    $(`stat-density${u}`).hidden = $(`stat-density${u}-label`).hidden = byUnit[u] === null;
+  }
   $("stat-density").title =
     d0 !== null
       ? "100 % minus the 3D void fraction of the analysed layers (each slab with the droplet spheroids of the layers below and above), of unit 0's parts: a geometric estimate from the droplet model, not a measured density"
-      : d1 !== null
+      : byUnit.some((d) => d !== null)
         ? "The job has no parts of unit 0"
         : "Turn on Voids: the 3D void analysis estimates it";
   const worst = s?.figures.worst;

@@ -6,6 +6,7 @@
 
 import { GcodeStream, initSync, type InitOutput } from "../pkg/dropslice.js";
 import type { Calibration, Figures, LayerData } from "../core/protocol";
+import { partsByUnit } from "../core/units";
 
 export class GcodeError extends Error {}
 
@@ -106,14 +107,16 @@ export class GcodeReader {
   private drain(): void {
     for (let l = this.stream.take_layer(); l; l = this.stream.take_layer()) {
       const [outer, inner, fill] = l.counts();
+      const roles = l.roles();
+      const units = l.units();
       this.emit({
         index: l.index,
         z: l.z,
-        counts: { outer, inner, fill, support: 0, unit1: l.unit1 },
+        counts: { outer, inner, fill, support: 0, unit1: l.unit1, parts: partsByUnit(roles, units) },
         travelMm: l.travel_mm,
         droplets: l.droplets(),
-        roles: l.roles(),
-        units: l.units(),
+        roles,
+        units,
         travel: l.travel(),
       });
       l.free();

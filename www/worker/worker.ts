@@ -11,6 +11,7 @@
 
 import { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
+import { partsByUnit } from "../core/units";
 import { GcodeError, GcodeReader, loadCore, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
 import {
@@ -110,15 +111,17 @@ function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analy
       if (counted) unit.tally.add_layer(r);
       else unit.tally.add_analysis(r);
     }
+    const roles = r.roles;
+    const units = r.units;
     const layer: LayerData = {
       index: r.index,
       z: r.z,
-      counts: { outer: r.outer, inner: r.inner, fill: r.fill, support: r.support, unit1: r.unit1 },
+      counts: { outer: r.outer, inner: r.inner, fill: r.fill, support: r.support, unit1: r.unit1, parts: partsByUnit(roles, units) },
       travelMm: r.travel_mm,
       seconds: r.seconds,
       droplets: r.droplets,
-      roles: r.roles,
-      units: r.units,
+      roles,
+      units,
       unsupportedArea: r.unsupported_area,
       travel: r.travel,
     };

@@ -8,7 +8,7 @@
 
 import type { CutCanvas } from "../page";
 import { PanZoomCanvas } from "./panzoom";
-import { CLASS_COLORS, drawTag, dropletClass, VOID_RGB } from "./render";
+import { CLASS_COLORS, CLASS_ORDER, drawTag, dropletClass, VOID_RGB } from "./render";
 
 /** One layer of the cut: what the page or the core found along the line. */
 export interface CutLayer {
@@ -21,7 +21,7 @@ export interface CutLayer {
 }
 
 /** Colour of a droplet of the cut by its role and discharge unit (render.ts `dropletClass`:
- *  support and unit-1 parts have colours of their own). */
+ *  the support and the parts of each unit but unit 0 have colours of their own). */
 export function cutColor(role: number, unit = 0): string {
   return CLASS_COLORS[dropletClass(role, unit)];
 }
@@ -139,7 +139,7 @@ export class CutRenderer extends PanZoomCanvas implements CutCanvas {
         if (w2 <= 0) continue;
         const w = Math.sqrt(w2);
         const g = 2 * w * k > 5 ? gap : 0;
-        roles[Math.min(4, Math.max(0, n[j + 2]))].rect(t - w + g, bottom + inset, 2 * (w - g), h - 2 * inset);
+        roles[Math.min(CLASS_COLORS.length - 1, Math.max(0, n[j + 2]))].rect(t - w + g, bottom + inset, 2 * (w - g), h - 2 * inset);
       }
       const v = layer.voids;
       if (v && this.showVoids) {
@@ -153,7 +153,7 @@ export class CutRenderer extends PanZoomCanvas implements CutCanvas {
     }
     ctx.fillStyle = SECTION_COLOR;
     ctx.fill(section);
-    for (const cls of [3, 4, 2, 1, 0]) {
+    for (const cls of CLASS_ORDER) {
       ctx.fillStyle = CLASS_COLORS[cls];
       ctx.fill(roles[cls]);
     }

@@ -12,22 +12,23 @@ import type { Bounds } from "../../core/view";
 import type { LayerCanvas } from "../page";
 import { DiscBuffer, DiscStamps, rgb } from "./discs";
 import { PanZoomCanvas } from "./panzoom";
+import { UNIT_COLORS } from "../../core/units";
 
 export const ROLE_COLORS = ["#d9480f", "#f59f00", "#3b8fdd"] as const;
 export const ROLE_NAMES = ["Outer loop", "Inner loops", "Fill"] as const;
-/** Support droplets (role 3, printed by discharge unit 1) and the droplets of unit-1 parts. */
+/** Support droplets (role 3, printed by the unit of `support = unitN`). */
 export const SUPPORT_COLOR = "#1098ad";
-export const UNIT1_COLOR = "#7048e8";
-/** A droplet's colour class: 0–2 its role (unit 0), 3 support, 4 a unit-1 part's droplet (or,
- *  in a .gco file, any droplet after `T1`). */
-export const CLASS_COLORS = [...ROLE_COLORS, SUPPORT_COLOR, UNIT1_COLOR] as const;
+/** A droplet's colour class: 0–2 its role (unit 0), 3 support, 3 + u a droplet of unit u's
+ *  parts for u = 1 … 3 (core/units.ts `UNIT_COLORS`; in a .gco file, any droplet after `Tu`). */
+export const CLASS_COLORS = [...ROLE_COLORS, SUPPORT_COLOR, ...UNIT_COLORS.slice(1)] as const;
 export function dropletClass(role: number, unit: number): number {
   if (role === 3) return 3;
-  if (unit === 1) return 4;
+  if (unit >= 1) return 3 + Math.min(unit, CLASS_COLORS.length - 4);
   return Math.min(2, Math.max(0, role));
 }
-/** Drawn first to last: support at the bottom, the outer loop on top. */
-const CLASS_ORDER = [3, 4, 2, 1, 0] as const;
+/** Drawn first to last: support at the bottom, the other units' parts, unit 0's fill, inner
+ *  loops, the outer loop on top. */
+export const CLASS_ORDER = [3, 6, 5, 4, 2, 1, 0] as const;
 /** The overhang overlay: droplets without a droplet of the layer below within the rule. */
 export const OVERHANG_COLOR = "#e8107a";
 const BELOW_COLOR = "#dde2ea";
@@ -293,8 +294,10 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
       const n = cur.roles.length;
       const at = place(cur);
       const cls = new Uint8Array(n);
-      for (let i = 0; i < n; i++) cls[i] = dropletClass(cur.roles[i], cur.units?.[i] ?? 0);
-      for (const c of CLASS_ORDER) passes.push({ stamps: drop, color: rgb(CLASS_COLORS[c]), at, count: n, pick: cls, want: c });
+      const has = new Uint8Array(CLASS_COLORS.length);
+      for (let i = 0; i < n; i++) has[(cls[i] = dropletClass(cur.roles[i], cur.units?.[i] ?? 0))] = 1;
+      // a pass walks every droplet: classes the layer has not (another unit's parts) are skipped
+      for (const c of CLASS_ORDER) if (has[c] || c < 5) passes.push({ stamps: drop, color: rgb(CLASS_COLORS[c]), at, count: n, pick: cls, want: c });
       if (marks) passes.push({ stamps: this.stampsFor(this.dropletWidth * k * OVERHANG_DIAMETER), color: rgb(OVERHANG_COLOR), at, count: n, pick: marks, want: 1 });
     }
     const buf = this.discs!;
@@ -367,7 +370,11 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
           return n;
         },
       });
-      for (const c of CLASS_ORDER) steps.push(paint(cur, size, pixel(CLASS_COLORS[c]), cls, c));
+      // the classes of units 2 and 3 only when the layer's units name them (a step walks every droplet)
+      const has = new Uint8Array(CLASS_COLORS.length);
+      const units = cur.units;
+      if (units) for (let i = 0; i < units.length; i++) if (units[i] > 1) has[dropletClass(0, units[i])] = 1;
+      for (const c of CLASS_ORDER) if (c < 5 || has[c]) steps.push(paint(cur, size, pixel(CLASS_COLORS[c]), cls, c));
       if (marks) steps.push(paint(cur, size + 2, pixel(OVERHANG_COLOR), marks, 1));
     }
     return steps;

@@ -13,7 +13,8 @@ import { supportColumns } from "../../core/supportcolumns";
 import { jobOffPlate } from "../../core/plate";
 import { errorBanner } from "../banner";
 import { openPartMenu, openSelectedPartMenu } from "../contextmenu";
-import { $ } from "../dom";
+import { $, el, unitRows } from "../dom";
+import { unitsOf } from "../../core/units";
 import type { Page, View3DView } from "../page";
 import type { Camera3D, View3D, View3DPart, View3DSlice } from "./view3d";
 
@@ -66,12 +67,16 @@ export class View3DPanel implements View3DView {
         const mesh = p ? job.meshOf(p) : null;
         if (!p || !mesh) continue;
         const warn = off.has(`${inst.part}:${inst.copy}`);
-        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: mesh.positions, matrix: inst.matrix, unit: inst.unit === 1 ? 1 : 0, warn });
+        parts.push({ id: instanceId(p.id, inst.copy), name: inst.name, positions: mesh.positions, matrix: inst.matrix, unit: inst.unit, warn });
       }
     }
     this.parts = parts;
     this.model = job && parts.length ? job : null;
     $("legend3d-off").hidden = off.size === 0;
+    // an entry per unit but unit 0 whose parts the job has, in that unit's colour
+    const n = Math.max(unitsOf(values), ...parts.map((p) => (p.unit ?? 0) + 1));
+    unitRows("3d", $("legend3d-part"), n, (u) => [el("span", { id: `legend3d-unit${u}`, hidden: "" }, el("i", { class: `part${u}` }), `Unit ${u} part`)]);
+    for (let u = 1; u < n; u++) $(`legend3d-unit${u}`).hidden = !parts.some((p) => p.unit === u);
     const px = Number(values?.plate_x);
     const py = Number(values?.plate_y);
     const pz = Number(values?.plate_z);

@@ -72,6 +72,7 @@ import {
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
 import { disposeObject, plateObjects } from "./plate3d";
 import { showSupport } from "./support3d";
+import { MAX_UNITS, UNIT_COLORS_3D } from "../../core/units";
 
 export interface View3DPart {
   id: string;
@@ -80,8 +81,9 @@ export interface View3DPart {
   positions: Float32Array;
   /** 16 numbers, column-major, model -> plate coordinates (mm), z up. */
   matrix: number[];
-  /** The discharge unit printing the part (1 is drawn in a second colour). */
-  unit?: 0 | 1;
+  /** The discharge unit printing the part (0 … MAX_UNITS − 1; each in its colour,
+   *  core/units.ts `UNIT_COLORS_3D`). */
+  unit?: number;
   /** Off the plate: drawn in the warning colour. */
   warn?: boolean;
 }
@@ -103,9 +105,8 @@ export const COLORS = {
   grid: 0xdde2e9,
   gridMajor: 0xc5cdd7,
   outline: 0x7d8a99,
-  part: 0x7f9cc4,
-  /** Parts printed by discharge unit 1 (the layer view's unit-1 colour). */
-  unit1: 0x7048e8,
+  /** Parts of unit 0. */
+  part: UNIT_COLORS_3D[0],
   /** Overhanging faces (the layer view's overhang overlay colour). */
   overhang: 0xe8107a,
   selected: 0x1c7ed6,
@@ -132,7 +133,7 @@ interface Entry {
   body: Mesh;
   slab: Mesh;
   cap: Mesh;
-  unit: 0 | 1;
+  unit: number;
 }
 
 interface Press {
@@ -191,7 +192,8 @@ export class View3D {
   private readonly overhangUniforms = { uOverhangZ: { value: 2 }, uOverhangColor: { value: new Color(COLORS.overhang) } };
   private readonly materials = {
     part: this.bodyMaterial(COLORS.part),
-    unit1: this.bodyMaterial(COLORS.unit1),
+    /** The parts of units 1 … MAX_UNITS − 1 (index u − 1). */
+    units: UNIT_COLORS_3D.slice(1).map((c) => this.bodyMaterial(c)),
     selected: this.bodyMaterial(COLORS.selected),
     warn: this.bodyMaterial(COLORS.warn),
     slab: new MeshStandardMaterial({
@@ -319,7 +321,7 @@ export class View3D {
         throw new Error(`part ${p.name || p.id}: positions must be a Float32Array of 9 numbers per triangle`);
       }
       checkMatrix(p.matrix, `part ${p.name || p.id}`);
-      if (p.unit !== undefined && p.unit !== 0 && p.unit !== 1) throw new Error(`part ${p.name || p.id}: unit must be 0 or 1`);
+      if (p.unit !== undefined && !(Number.isInteger(p.unit) && p.unit >= 0 && p.unit < MAX_UNITS)) throw new Error(`part ${p.name || p.id}: unit must be 0 … ${MAX_UNITS - 1}`);
     }
     for (const [id, e] of this.entries) {
       if (!seen.has(id)) this.drop(e);
@@ -402,7 +404,7 @@ export class View3D {
   private applyMaterials(): void {
     for (const e of this.entries.values()) {
       const m = this.materials;
-      e.body.material = e.part.warn ? m.warn : e.id === this.selected ? m.selected : e.unit === 1 ? m.unit1 : m.part;
+      e.body.material = e.part.warn ? m.warn : e.id === this.selected ? m.selected : e.unit > 0 ? m.units[e.unit - 1] : m.part;
       e.slab.visible = e.cap.visible = this.slice !== null;
     }
   }
@@ -682,7 +684,7 @@ export class View3D {
     for (const e of [...this.entries.values()]) this.drop(e);
     this.support = showSupport(this.scene, this.support, null, this.clipTop);
     disposeObject(this.plate);
-    for (const m of Object.values(this.materials)) m.dispose();
+    for (const m of Object.values(this.materials).flat()) m.dispose();
     this.renderer.dispose();
     this.canvas.remove();
   }
