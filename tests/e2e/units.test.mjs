@@ -1,5 +1,5 @@
 // Unit tests of the page's pure modules (G-code reader, preview links, settings parsing,
-// sample part), bundled from www/core and www/worker with esbuild and run in Node.
+// sample part, the discharge units, profiles, per-unit figures), bundled from www/core, www/views/form and www/worker with esbuild and run in Node.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync } from "node:fs";
@@ -10,12 +10,14 @@ import { build } from "esbuild";
 import { repo } from "./helpers.mjs";
 
 const out = mkdtempSync(join(tmpdir(), "dropslice-units-"));
-let gcode, share, form, sample;
+let gcode, share, form, sample, units, profiles, figures, forms;
 /** The core's job schema: a link's parts are checked against it. */
 let jobSchema;
+/** The core's settings schema. */
+let schema;
 
 before(async () => {
-  const names = ["worker/gcode", "core/share", "core/settings", "core/sample"];
+  const names = ["worker/gcode", "core/share", "core/settings", "core/sample", "core/units", "core/profiles", "core/figures", "views/form"];
   await build({
     entryPoints: names.map((n) => join(repo, "www", `${n}.ts`)),
     bundle: true,
@@ -24,12 +26,13 @@ before(async () => {
     outdir: out,
     logLevel: "error",
   });
-  [gcode, share, form, sample] = await Promise.all(names.map((n) => import(pathToFileURL(join(out, `${n}.js`)).href)));
+  [gcode, share, form, sample, units, profiles, figures, forms] = await Promise.all(names.map((n) => import(pathToFileURL(join(out, `${n}.js`)).href)));
   // the G-code reader is the core's (built into www/pkg by the page build)
   await gcode.loadCore(readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")));
   const core = await import(pathToFileURL(join(repo, "www", "pkg", "dropslice.js")).href);
   await core.default({ module_or_path: readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")) });
   jobSchema = core.job_schema();
+  schema = core.settings_schema();
 });
 
 after(() => rmSync(out, { recursive: true, force: true }));
@@ -54,7 +57,7 @@ test("G-code reader: G25 lines expand to droplets every B, layers split on Z", (
   );
   assert.equal(reader.dropletWidth, B);
   assert.equal(layers.length, 2);
-  assert.deepEqual(layers[0].counts, { outer: 2, inner: 0, fill: 11, support: 0, unit1: 0 });
+  assert.deepEqual(layers[0].counts, { outer: 2, inner: 0, fill: 11, support: 0, unit1: 0, parts: [13] });
   assert.equal(layers[0].roles.length, 13);
   assert.ok(Math.abs(layers[0].droplets[2 * 12] - 10 * B) < 1e-4, "last droplet at the line's end");
   assert.ok(Math.abs(layers[0].droplets[2 * 3] - B) < 1e-6, "second droplet one B along");
@@ -72,6 +75,7 @@ test("G-code reader: after T1 droplets are unit 1's, every B₁ along a G25 line
   );
   assert.deepEqual([...layers[0].units], [0, 1, 1, 1, 1, 0]);
   assert.equal(layers[0].counts.unit1, 4);
+  assert.deepEqual(layers[0].counts.parts, [2, 4], "each unit's droplets, from the droplets' units");
   assert.ok(Math.abs(layers[0].droplets[2 * 2] - B1) < 1e-4, "unit 1's droplets B₁ apart");
 });
 
@@ -151,4 +155,104 @@ test("sample part: a closed binary STL (every edge shared by exactly two facets,
     assert.equal(count, 1, `edge ${e} used ${count} times in one direction`);
     assert.equal(edges.get(`${b}|${a}`), 1, `edge ${e} has no opposite`);
   }
+});
+
+test("units: the count from the settings (2 without `units`), per-unit names, each unit's droplets", () => {
+  assert.equal(units.unitsOf({}), 2, "a core without `units`: unit 0 and unit 1");
+  assert.equal(units.unitsOf(null), 2);
+  assert.equal(units.unitsOf({ units: 1 }), 1);
+  assert.equal(units.unitsOf({ units: 4 }), 4);
+  assert.equal(units.unitsOf({ units: 5 }), 2, "out of range: the default (the core refuses it)");
+  assert.equal(units.unitsOf({ units: 2.5 }), 2);
+  assert.deepEqual(units.unitIndices(3), [0, 1, 2]);
+  assert.equal(units.unitOfSetting("unit1_droplet_aspect"), 1);
+  assert.equal(units.unitOfSetting("unit3_shrink_xy"), 3);
+  assert.equal(units.unitOfSetting("unit_order"), null);
+  assert.equal(units.unitOfSetting("droplet_aspect"), null);
+  assert.equal(units.unitSetting("droplet_aspect", 0), "droplet_aspect");
+  assert.equal(units.unitSetting("droplet_aspect", 2), "unit2_droplet_aspect");
+  assert.equal(units.plainSetting("unit2_material_density"), "material_density");
+  assert.equal(units.supportUnit("unit2"), 2);
+  assert.equal(units.supportUnit("off"), null);
+  // roles 0–2 of units 0 … 2, support (role 3) left out whatever its unit
+  const roles = Uint8Array.from([0, 1, 2, 3, 3, 0, 2, 1]);
+  const us = Uint8Array.from([0, 0, 1, 1, 2, 2, 2, 0]);
+  assert.deepEqual(units.partsByUnit(roles, us), [3, 1, 2]);
+  assert.deepEqual(units.partsByUnit(Uint8Array.from([0, 3]), Uint8Array.from([0, 1])), [1], "support alone adds no unit");
+  // the palette: four distinct colours; units 0 and 1 keep the page's two-unit colours
+  assert.equal(new Set(units.UNIT_COLORS).size, 4);
+  assert.equal(units.UNIT_COLORS[1], "#7048e8");
+  assert.equal(units.UNIT_BARS[0], "#a5c8ec");
+  assert.equal(units.UNIT_BARS[1], "#b9a7f4");
+});
+
+test("units: the form groups unitN_ rows under Unit N", () => {
+  const row = (name, group) => ({ name, group });
+  assert.equal(forms.groupOf(row("unit1_droplet_aspect", "Unit 1")), "Unit 1");
+  assert.equal(forms.groupOf(row("unit2_droplet_aspect", "Units")), "Unit 2");
+  assert.equal(forms.groupOf(row("droplet_aspect", "Droplet")), "Droplet");
+  assert.equal(forms.groupOf(row("unit_order", "Unit 1")), "Unit 1");
+  // every per-unit row of this core's schema lands in its unit's group
+  for (const s of schema) if (units.unitOfSetting(s.name) !== null) assert.equal(forms.groupOf(s), `Unit ${units.unitOfSetting(s.name)}`);
+});
+
+test("units: each unit's figures from the core's two-unit fields, or its per-unit arrays", () => {
+  const f = new figures.Figures();
+  // a core of two units (the fields of today's Figures)
+  f.core = { droplets: 100, volume_mm3: 5, mass_g: 0.1, unit1_droplets: 30, unit1_volume_mm3: 2, unit1_mass_g: 0.05, unit0_seconds: 7, unit1_seconds: 3, predicted_density: 99, unit1_predicted_density: null };
+  assert.deepEqual(f.units(2), [
+    { droplets: 70, volume: 5, mass: 0.1, seconds: 7, density: 99 },
+    { droplets: 30, volume: 2, mass: 0.05, seconds: 3, density: null },
+  ]);
+  assert.deepEqual(f.units(3)[2], { droplets: 0, volume: 0, mass: 0, seconds: 0, density: null });
+  assert.deepEqual(f.units(1).map((u) => u.droplets), [70]);
+  // a core of N units: arrays indexed by unit
+  f.core = { droplets: 6, unit_droplets: [1, 2, 3], unit_volume_mm3: [1, 1, 1], unit_mass_g: [1, 1, 1], unit_seconds: [4, 5, 6], unit_predicted_density: [null, 98, null] };
+  assert.deepEqual(f.units(3).map((u) => [u.droplets, u.seconds, u.density]), [[1, 4, null], [2, 5, 98], [3, 6, null]]);
+  // a .gco file: each unit's droplets as read
+  const g = new figures.Figures();
+  g.addReadLayer({ counts: { outer: 2, inner: 0, fill: 3, support: 0, unit1: 1, parts: [4, 1] }, travelMm: 0 });
+  g.addReadLayer({ counts: { outer: 1, inner: 0, fill: 0, support: 0, unit1: 0, parts: [1] }, travelMm: 0 });
+  assert.deepEqual(g.units(2).map((u) => u.droplets), [5, 1]);
+  assert.equal(g.units(2)[1].volume, null);
+});
+
+test("profiles: a material profile holds one material, used for the unit picked; older ones with unit1_ keys as before", () => {
+  const values = Object.fromEntries(schema.map((s) => [s.name, s.default]));
+  values.droplet_aspect = 1.2;
+  values.material_density = 1.1;
+  values.unit1_droplet_aspect = 1.5;
+  values.unit1_material_density = 1.3;
+  // saved from unit 1: its values, no unit in the keys
+  const p = profiles.profileOf("PC", "material", values, schema, 1);
+  assert.ok(Object.keys(p.settings).length > 0);
+  assert.ok(Object.keys(p.settings).every((k) => units.unitOfSetting(k) === null), JSON.stringify(p.settings));
+  assert.equal(p.settings.droplet_aspect, 1.5);
+  assert.equal(p.settings.material_density, 1.3);
+  assert.equal(profiles.needsUnit(p), true);
+  assert.deepEqual(profiles.checkProfile(JSON.parse(profiles.profileFileText(p)), schema), p, "it reads back");
+  // used for unit 0, then for unit 1: that unit's names, nothing else
+  const to0 = profiles.profileSettings(p, 0, schema);
+  assert.deepEqual(to0.missing, []);
+  assert.equal(to0.settings.droplet_aspect, 1.5);
+  assert.ok(!("unit1_droplet_aspect" in to0.settings));
+  const to1 = profiles.profileSettings(p, 1, schema);
+  assert.equal(to1.settings.unit1_droplet_aspect, 1.5);
+  assert.equal(to1.settings.unit1_material_density, 1.3);
+  assert.ok(!("droplet_aspect" in to1.settings), "unit 0's material stays as it is");
+  // a unit the core has no settings for is named, not set
+  const to3 = profiles.profileSettings(p, 3, schema);
+  if (!schema.some((s) => s.name === "unit3_droplet_aspect")) assert.ok(to3.missing.includes("unit3_droplet_aspect"));
+  // a profile saved before: both units' keys, used as it is (no unit asked)
+  const old = { name: "old", kind: "material", settings: { droplet_aspect: 1.1, unit1_droplet_aspect: 1.7, unit1_shrink_xy: 0.5 } };
+  const checked = profiles.checkProfile(old, schema);
+  assert.deepEqual(checked, old);
+  assert.equal(profiles.needsUnit(checked), false);
+  assert.deepEqual(profiles.profileSettings(checked, 1, schema).settings, old.settings);
+  // a machine profile as before; a material key in it is still refused
+  const m = profiles.profileOf("M", "machine", values, schema);
+  assert.equal(profiles.needsUnit(m), false);
+  assert.ok("plate_x" in m.settings);
+  assert.equal(profiles.checkProfile({ name: "bad", kind: "machine", settings: { droplet_aspect: 1 } }, schema), null);
+  assert.equal(profiles.checkProfile({ name: "bad", kind: "material", settings: { unit1_plate_x: 1 } }, schema), null);
 });

@@ -2,10 +2,16 @@
 // "material", settings}`, kept in the browser under one local-storage key. What is read back is
 // checked entry by entry (a corrupt entry is dropped, the others kept); a file the user imports
 // is checked by the core (`check_profile`, flows/profiles.ts) before it is added here.
+//
+// A material profile holds one material: its keys name no unit (`droplet_aspect`, …), and
+// using it names the unit it is for (its keys become that unit's: `unit2_droplet_aspect`, …).
+// A material profile saved before the units were a list holds both units' keys (`unit1_…`
+// beside unit 0's): it is used as it is, its values where they went before.
 
 import type { SettingSpec } from "./protocol";
 import { checkSettings } from "./remember";
 import type { Value } from "./settings";
+import { plainSetting, unitOfSetting, unitSetting } from "./units";
 
 export const PROFILES_KEY = "dropslice.profiles.v1";
 /** Most profiles kept (each is a dozen settings at most). */
@@ -49,6 +55,13 @@ export function nameProblem(raw: string): string | null {
   return null;
 }
 
+/** Whether a profile of `kind` may hold `key`: a key of its kind's, or a unit's own name of
+ *  one (`unitN_<key>`, a setting of the schema: an older material profile's `unit1_…`). */
+function allowedKey(key: string, keys: readonly string[], schema: readonly SettingSpec[]): boolean {
+  if (keys.includes(key)) return true;
+  return unitOfSetting(key) !== null && keys.includes(plainSetting(key)) && schema.some((s) => s.name === key);
+}
+
 /** `raw` as a profile: every setting of its kind's, known to the schema and in range, none
  *  else (null: not a profile, or a value the schema refuses). */
 export function checkProfile(raw: unknown, schema: readonly SettingSpec[]): StoredProfile | null {
@@ -57,7 +70,7 @@ export function checkProfile(raw: unknown, schema: readonly SettingSpec[]): Stor
   if (!isObject(raw.settings)) return null;
   const keys = profileKeys(raw.kind, schema);
   const given = Object.keys(raw.settings);
-  if (given.some((k) => !keys.includes(k))) return null;
+  if (given.some((k) => !allowedKey(k, keys, schema))) return null;
   const settings = checkSettings(raw.settings, schema);
   if (Object.keys(settings).length !== given.length) return null;
   return { name: trimName(raw.name), kind: raw.kind, settings };
@@ -83,11 +96,38 @@ export function readProfiles(text: string | null, schema: readonly SettingSpec[]
 
 export const profilesText = (list: readonly StoredProfile[]): string => JSON.stringify(list);
 
-/** A profile of `kind` with the current `values` of its settings. */
-export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>, schema: readonly SettingSpec[]): StoredProfile {
+/** A profile of `kind` with the current `values` of its settings: a material profile the
+ *  material of `unit` (its values under names without a unit), a machine profile every unit's. */
+export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>, schema: readonly SettingSpec[], unit = 0): StoredProfile {
   const settings: Record<string, Value> = {};
-  for (const k of profileKeys(kind, schema)) if (values[k] !== undefined) settings[k] = values[k];
+  for (const k of profileKeys(kind, schema)) {
+    if (kind === "material") {
+      if (unitOfSetting(k) !== null) continue;
+      const v = values[unitSetting(k, unit)];
+      if (v !== undefined) settings[k] = v;
+    } else if (values[k] !== undefined) settings[k] = values[k];
+  }
   return { name: trimName(name), kind, settings };
+}
+
+/** Whether using `p` names a unit: a material profile whose keys name none. */
+export function needsUnit(p: StoredProfile): boolean {
+  return p.kind === "material" && Object.keys(p.settings).every((k) => unitOfSetting(k) === null);
+}
+
+/** The settings `p` sets used for `unit` (a material profile of one material: its keys become
+ *  that unit's), or as they are (a machine profile, an older material profile with `unit1_`
+ *  keys); `missing`: keys the schema has not for that unit (a unit the core does not know). */
+export function profileSettings(p: StoredProfile, unit: number, schema: readonly SettingSpec[]): { settings: Record<string, Value>; missing: string[] } {
+  if (!needsUnit(p)) return { settings: { ...p.settings }, missing: [] };
+  const settings: Record<string, Value> = {};
+  const missing: string[] = [];
+  for (const [k, v] of Object.entries(p.settings)) {
+    const name = unitSetting(k, unit);
+    if (schema.some((s) => s.name === name)) settings[name] = v;
+    else missing.push(name);
+  }
+  return { settings, missing };
 }
 
 /** The file a profile is exported as (the JSON of docs/spec.md "Profiles"). */

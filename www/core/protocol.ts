@@ -224,12 +224,12 @@ export type CalibrateRequest =
   | { from: "gcode"; file: Blob; mass: number; density: number | null };
 
 /** A layer's droplets and units, the layer below's (null: the first layer), the droplet widths
- *  [B, B₁] and `overhang_limit`·B (mm). */
+ *  of each unit [B, B₁, …] and `overhang_limit`·B (mm). */
 export interface UnsupportedRequest {
   droplets: Float32Array;
   units: Uint8Array;
   below: { droplets: Float32Array; units: Uint8Array } | null;
-  widths: [number, number];
+  widths: number[];
   limitMm: number;
 }
 

@@ -4,6 +4,7 @@
 
 import { Cancelled } from "../core/client";
 import type { Slice } from "../core/store";
+import { unitIndices, unitSetting } from "../core/units";
 import { overhangsShown, showLayerNumber } from "../views/layer";
 import type { Page } from "../views/page";
 import { writeStats } from "../views/stats";
@@ -34,19 +35,20 @@ export function show(page: Page, i: number): void {
   if (renderer.showVoids && shown && !shown.mask && s.complete && s.source === "stl") fetchPreview(page, s, current);
 }
 
-/** The overhang rule's numbers for a slice: [B, B₁] and `overhang_limit`·B (mm), from the
- *  slice's settings, or a .gco file's header (the core's defaults where it says nothing). */
-function overhangRule(page: Page, s: Slice): { widths: [number, number]; limitMm: number } | null {
+/** The overhang rule's numbers for a slice: each unit's droplet width [B, B₁, …] and
+ *  `overhang_limit`·B (mm), from the slice's settings, or a .gco file's header (the core's
+ *  defaults where it says nothing). */
+function overhangRule(page: Page, s: Slice): { widths: number[]; limitMm: number } | null {
   const header = s.gcodeFile?.header ?? {};
   const get = (k: string) => {
     const v = Number(s.source === "gco" ? (header[k] ?? page.init?.defaults[k]) : s.settings[k]);
     return Number.isFinite(v) ? v : NaN;
   };
   const b = s.dropletWidth;
-  const b1 = s.layerHeight * get("unit1_droplet_aspect");
+  const widths = unitIndices(s.unitCount).map((u) => (u === 0 ? b : s.layerHeight * get(unitSetting("droplet_aspect", u))));
   const limitMm = get("overhang_limit") * b;
-  if (!(b > 0 && b1 > 0 && limitMm >= 0)) return null;
-  return { widths: [b, b1], limitMm };
+  if (!(widths.every((w) => w > 0) && limitMm >= 0)) return null;
+  return { widths, limitMm };
 }
 
 const overhangRequests = new Set<string>();

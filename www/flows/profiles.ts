@@ -1,6 +1,7 @@
 // Profiles (core/profiles.ts keeps and checks them, views/profiles.ts draws them): save the
-// current settings of a kind as a profile, use one (its settings into the form, one undoable
-// change), rename, delete, export a JSON file, import one (checked by the core first). The
+// current settings of a kind as a profile (a material: one unit's), use one (its settings into
+// the form, one undoable change; a material for the unit the user picks), rename, delete,
+// export a JSON file, import one (checked by the core first). The
 // list lives in local storage; storage that is blocked or full gets a message, never an error.
 
 import {
@@ -11,10 +12,12 @@ import {
   profileFileName,
   profileFileText,
   profileOf,
+  profileSettings,
   profilesText,
   readProfiles,
   roomProblem,
   withProfile,
+  needsUnit,
   type ProfileKind,
   type StoredProfile,
 } from "../core/profiles";
@@ -23,6 +26,7 @@ import { updateButtons } from "../views/controls";
 import { saveFile } from "../views/download";
 import type { Page } from "../views/page";
 import { profileMessage, renderProfiles } from "../views/profiles";
+import { unitsOf } from "../core/units";
 import { record } from "./history";
 import { relayout } from "./job";
 import { saveSoon } from "./remember";
@@ -52,31 +56,37 @@ export function showProfiles(page: Page): void {
   renderProfiles(page, load(page));
 }
 
-export function saveProfile(page: Page, name: string, kind: ProfileKind): void {
+/** Saves the settings of `kind` as `name`: a material profile the material of `unit`. */
+export function saveProfile(page: Page, name: string, kind: ProfileKind, unit = 0): void {
   const form = page.form;
   if (!form) return;
   const problem = nameProblem(name);
   if (problem) return profileMessage(problem, true);
   if (form.errors().length) return profileMessage("Fix the settings marked in red first.", true);
-  const p = profileOf(name, kind, form.values(), page.init!.schema);
+  const p = profileOf(name, kind, form.values(), page.init!.schema, unit);
   const list = load(page);
   const full = roomProblem(list, p);
   if (full) return profileMessage(`“${p.name}” was not saved. ${full}`, true);
   const replaced = list.some((q) => q.name === p.name);
-  if (store(page, withProfile(list, p))) profileMessage(`${replaced ? "Replaced" : "Saved"} the ${kind} profile “${p.name}”.`);
+  const of = kind === "material" && unitsOf(form.values()) > 1 ? ` (the material of unit ${unit})` : "";
+  if (store(page, withProfile(list, p))) profileMessage(`${replaced ? "Replaced" : "Saved"} the ${kind} profile “${p.name}”${of}.`);
 }
 
-/** The profile's settings into the form: one undoable change. */
-export function useProfile(page: Page, name: string): void {
+/** The profile's settings into the form, one undoable change: a material profile of one
+ *  material as unit `unit`'s (views/profiles.ts asks which), any other as it is. */
+export function useProfile(page: Page, name: string, unit = 0): void {
   const p = load(page).find((q) => q.name === name);
   const form = page.form;
   if (!p || !form) return profileMessage(`There is no profile “${name}” any more.`, true);
-  form.set(p.settings);
-  record(page, `use profile ${p.name}`, "settings");
+  const { settings, missing } = profileSettings(p, unit, page.init!.schema);
+  if (missing.length) return profileMessage(`The profile “${p.name}” was not used: this version has no ${missing.join(", ")}.`, true);
+  const forUnit = needsUnit(p) ? ` for unit ${unit}` : "";
+  form.set(settings);
+  record(page, `use profile ${p.name}${forUnit}`, "settings");
   updateButtons(page);
   saveSoon(page);
   void relayout(page);
-  profileMessage(`Using the ${p.kind} profile “${p.name}”.`);
+  profileMessage(`Using the ${p.kind} profile “${p.name}”${forUnit}.`);
 }
 
 export function renameProfile(page: Page, name: string, to: string): void {

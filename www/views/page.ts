@@ -59,8 +59,9 @@ export interface Actions {
   applyOrientation(id: number, o: Orientation): Promise<boolean>;
   /** Profiles (flows/profiles.ts): save the current settings of `kind` as `name`, use,
    *  rename, delete, export one, import a file. */
-  profileSave(name: string, kind: ProfileKind): void;
-  profileUse(name: string): void;
+  profileSave(name: string, kind: ProfileKind, unit: number): void;
+  /** `unit`: the unit a material profile of one material is for. */
+  profileUse(name: string, unit: number): void;
   profileRename(name: string, to: string): void;
   profileDelete(name: string): void;
   profileExport(name: string): void;
