@@ -113,7 +113,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   let s = await waitDone(page);
   assert.equal(s.counts.support ?? 0, 0, "no support without the switch");
   assert.equal(await page.isChecked("#opt-support"), false);
-  assert.equal(await page.isVisible("#unit1-stats"), false);
+  assert.equal(await page.isVisible("#unit-stats"), false);
 
   // the worst overhang (the core's figure): its button goes there
   assert.notEqual(s.worstOverhang, null);
@@ -152,7 +152,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   assert.equal(s.unit1, s.counts.support, "all unit-1 droplets are support");
   const shown = Number((await page.locator("#stat-support").innerText()).replace(/[^\d]/g, ""));
   assert.equal(shown, s.counts.support);
-  assert.equal(await page.isVisible("#unit1-stats"), true);
+  assert.equal(await page.isVisible("#unit-stats"), true);
   assert.match(await page.locator("#stat-mass1").innerText(), /^\d+\.\d\d g$/);
   assert.equal(await page.isVisible("#legend-support"), true);
 

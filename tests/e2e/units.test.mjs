@@ -1,5 +1,6 @@
 // Unit tests of the page's pure modules (G-code reader, preview links, settings parsing,
-// sample part, the discharge units, profiles, per-unit figures), bundled from www/core, www/views/form and www/worker with esbuild and run in Node.
+// sample part, the discharge units, profiles, per-unit figures), bundled from www/core,
+// www/views/form and www/worker with esbuild and run in Node.
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
 import { mkdtempSync, readFileSync, rmSync } from "node:fs";

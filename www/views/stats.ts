@@ -81,6 +81,7 @@ function writeUnits(s: Slice | null, current: number, n: number): void {
     }
   }
   $("legend-support").hidden = !(support > 0 || layerSupport > 0);
+  setText("stat-support", s ? nf.format(support) : "–");
   let any = false;
   const times: string[] = [];
   for (let u = 0; u < n; u++) {
