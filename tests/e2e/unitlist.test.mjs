@@ -1,0 +1,171 @@
+// Discharge units as a list in the page (issue 41): with the two units of today's settings
+// every per-unit control shows units 0 and 1 (the parts panel's choice, the form's "Unit 1"
+// group, the support switch); a material profile holds one material and asks which unit it is
+// for (a button per unit), one saved before with `unit1_` keys is used as it was. With a core
+// that has the setting `units`: one unit hides unit 1's controls, three give a third unit its
+// choice, group, droplets, colour and legends. Needs dist/ (scripts/build.sh).
+import { after, before, test } from "node:test";
+import assert from "node:assert/strict";
+import { copyFileSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import { pathToFileURL } from "node:url";
+import { benchy, countPixels, pick, repo, startWithPage, stop, waitDone } from "./helpers.mjs";
+
+let env;
+let main;
+const tmp = mkdtempSync(join(tmpdir(), "dropslice-unitlist-"));
+
+// whether the core has the setting `units` (a core before it has two units, unnamed)
+const core = await import(pathToFileURL(join(repo, "www", "pkg", "dropslice.js")).href);
+await core.default({ module_or_path: readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")) });
+const hasUnits = core.settings_schema().some((s) => s.name === "units");
+
+before(async () => ({ env, main } = await startWithPage({ settle: true })));
+
+after(() => stop(env, tmp));
+
+async function setField(page, name, value) {
+  await page.$eval(`#settings [name="${name}"]`, (el) => {
+    for (let d = el.closest("details"); d; d = d.parentElement?.closest("details")) d.open = true;
+  });
+  await page.fill(`#settings [name="${name}"]`, String(value));
+  await page.press(`#settings [name="${name}"]`, "Tab");
+}
+
+const field = (page, name) => page.inputValue(`#settings [name="${name}"]`);
+const options = (page, sel) => page.$$eval(`${sel} option`, (os) => os.map((o) => [o.value, o.textContent]));
+/** The form's groups as shown: their titles, hidden ones left out. */
+const groups = (page) => page.$$eval("#settings details.group", (ds) => ds.filter((d) => !d.hidden).map((d) => d.querySelector("summary").textContent));
+
+test("two units: the parts panel, the form and the support switch show units 0 and 1", async () => {
+  const { page, errors } = main;
+  await page.click(".part-item:nth-child(1)");
+  assert.deepEqual(await options(page, "#part-unit"), [
+    ["0", "Unit 0 (main material)"],
+    ["1", "Unit 1 (second material)"],
+  ]);
+  assert.equal(await page.isVisible("#part-unit"), true);
+  assert.equal(await page.isVisible("#support-switch"), true);
+  assert.equal(await page.locator("#opt-support-name").innerText(), "Support (unit 1)");
+  const shown = await groups(page);
+  assert.ok(shown.includes("Unit 1"), shown.join(", "));
+  assert.ok(!shown.includes("Unit 2"));
+  // every unit1_ row sits in the group "Unit 1"
+  const misplaced = await page.$$eval('#settings [name^="unit1_"]', (els) => els.filter((e) => e.closest("details")?.querySelector("summary")?.textContent !== "Unit 1").map((e) => e.name));
+  assert.deepEqual(misplaced, []);
+  // the statistics' unit rows: unit 1's, no other
+  assert.equal(await page.locator("#stat-unit1").count(), 1);
+  assert.equal(await page.locator("#stat-unit2").count(), 0);
+  assert.equal(await page.locator("#stat-unit-times-label").textContent(), "Droplet time, unit 0 · 1");
+  assert.deepEqual(errors, []);
+});
+
+test("a material profile holds one material: saved from a unit, used for the unit picked; an older one as before", async () => {
+  const { page, errors } = main;
+  await page.click("#profiles summary");
+  await setField(page, "unit1_droplet_aspect", 1.5);
+  await setField(page, "unit1_material_density", 1.3);
+  const aspect0 = await field(page, "droplet_aspect");
+  // saved from unit 1: the save row asks whose material
+  await page.selectOption("#profile-kind", "material");
+  assert.equal(await page.isVisible("#profile-unit"), true);
+  assert.deepEqual(await options(page, "#profile-unit"), [
+    ["0", "of unit 0"],
+    ["1", "of unit 1"],
+  ]);
+  await page.selectOption("#profile-unit", "1");
+  await page.fill("#profile-name", "PC");
+  await page.click("#profile-save");
+  await page.waitForSelector('#profile-list li[data-name="PC"]');
+  const kept = await page.evaluate(() => JSON.parse(localStorage.getItem("dropslice.profiles.v1")).find((p) => p.name === "PC"));
+  assert.equal(kept.kind, "material");
+  assert.equal(kept.settings.droplet_aspect, 1.5);
+  assert.equal(kept.settings.material_density, 1.3);
+  assert.ok(Object.keys(kept.settings).every((k) => !/^unit\d+_/.test(k)), `no unit in the keys: ${Object.keys(kept.settings)}`);
+
+  // back to the defaults, then used for unit 0: a button per unit
+  await page.click("#btn-reset");
+  assert.equal(await field(page, "unit1_droplet_aspect"), "1.04");
+  await page.click('#profile-list li[data-name="PC"] .profile-use');
+  const buttons = await page.$$eval("#profile-list .profile-units .profile-unit", (bs) => bs.map((b) => [b.dataset.unit, b.textContent]));
+  assert.deepEqual(buttons, [
+    ["0", "Unit 0"],
+    ["1", "Unit 1"],
+  ]);
+  assert.equal(await field(page, "droplet_aspect"), aspect0, "nothing set before a unit is picked");
+  await page.click('#profile-list .profile-unit[data-unit="0"]');
+  assert.equal(await field(page, "droplet_aspect"), "1.5");
+  assert.equal(await field(page, "unit1_droplet_aspect"), "1.04", "unit 1 keeps its material");
+  assert.equal(await page.locator("#profile-list .profile-units").count(), 0);
+  // then for unit 1: unit 0 keeps what it has
+  await page.click('#profile-list li[data-name="PC"] .profile-use');
+  await page.click('#profile-list .profile-unit[data-unit="1"]');
+  assert.equal(await field(page, "unit1_droplet_aspect"), "1.5");
+  assert.equal(await field(page, "unit1_material_density"), "1.3");
+  assert.equal(await field(page, "droplet_aspect"), "1.5");
+  assert.equal((await page.evaluate(() => window.dropslice.history())).undo, "use profile PC for unit 1");
+  // Escape closes the question without using the profile
+  await page.click('#profile-list li[data-name="PC"] .profile-use');
+  await page.keyboard.press("Escape");
+  assert.equal(await page.locator("#profile-list .profile-units").count(), 0);
+
+  // a material profile saved before (both units' keys, as the page saved them): used at once,
+  // each value where it went before
+  const old = join(tmp, "old.material.json");
+  writeFileSync(old, JSON.stringify({ name: "Old", kind: "material", settings: { droplet_aspect: 1.1, material_density: 1.2, unit1_droplet_aspect: 1.7, unit1_material_density: 1.25 } }));
+  await page.setInputFiles("#profile-file", old);
+  await page.waitForSelector('#profile-list li[data-name="Old"]', { timeout: 30_000 });
+  await page.click('#profile-list li[data-name="Old"] .profile-use');
+  assert.equal(await page.locator("#profile-list .profile-units").count(), 0, "no unit asked");
+  assert.equal(await field(page, "droplet_aspect"), "1.1");
+  assert.equal(await field(page, "unit1_droplet_aspect"), "1.7");
+  assert.equal(await field(page, "unit1_material_density"), "1.25");
+  await page.click("#btn-reset");
+  assert.deepEqual(errors, []);
+});
+
+test("one unit hides unit 1's controls; three give unit 2 its choice, group, droplets and colour", { skip: !hasUnits && "the core has no setting `units` yet" }, async () => {
+  const { page, errors } = main;
+  await setField(page, "units", 1);
+  await page.click(".part-item:nth-child(1)");
+  assert.equal(await page.isVisible("#part-unit"), false, "no unit to choose");
+  assert.equal(await page.isVisible("#support-switch"), false, "no unit for support");
+  assert.ok(!(await groups(page)).includes("Unit 1"));
+  assert.equal(await page.locator("#stat-unit1").count(), 0);
+
+  await setField(page, "units", 3);
+  await page.waitForFunction(() => document.querySelectorAll("#part-unit option").length === 3);
+  assert.deepEqual((await options(page, "#part-unit"))[2], ["2", "Unit 2 (third material)"]);
+  assert.equal(await page.isVisible("#support-switch"), true);
+  if (await page.locator('#settings [name^="unit2_"]').count()) assert.ok((await groups(page)).includes("Unit 2"));
+  // two cubes, the second printed by unit 2
+  const cube = join(benchy, "../cube_20mm_ascii.stl");
+  const a = join(tmp, "cube-a.stl");
+  const b = join(tmp, "cube-b.stl");
+  copyFileSync(cube, a);
+  copyFileSync(cube, b);
+  await pick(page, [a, b]);
+  await waitDone(page);
+  await page.click(".part-item:nth-child(2)");
+  await page.selectOption("#part-unit", "2");
+  await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 2);
+  await page.click("#btn-slice");
+  const s = await waitDone(page);
+  assert.equal(s.units, 3);
+  assert.equal(s.unitDroplets.length, 3);
+  assert.ok(s.unitDroplets[2] > 0, `unit 2's droplets ${s.unitDroplets}`);
+  assert.equal(s.unitDroplets[1], 0);
+  const shown = Number((await page.locator("#stat-unit2").innerText()).replace(/[^\d]/g, ""));
+  assert.equal(shown, s.unitDroplets[2]);
+  assert.equal(await page.isVisible("#plot-key-unit2"), true);
+  assert.equal(await page.isVisible("#plot-key-unit1"), false);
+  await page.evaluate((i) => window.dropslice.show(i), Math.floor(s.layers / 2));
+  await page.click("#btn-fit");
+  await page.waitForTimeout(200);
+  assert.equal(await page.isVisible("#legend-unit2"), true);
+  // unit 2's droplets in its colour (#6b4226, within a few levels: the selected part is tinted)
+  const unit2 = "Math.abs(r - 0x6b) < 12 && Math.abs(g - 0x42) < 12 && Math.abs(b - 0x26) < 12";
+  assert.ok((await countPixels(page, unit2)) > 300, "the unit-2 part in its colour");
+  assert.deepEqual(errors, []);
+});
