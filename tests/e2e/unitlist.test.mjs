@@ -57,7 +57,6 @@ test("two units: the parts panel, the form and the support switch show units 0 a
   // the statistics' unit rows: unit 1's, no other
   assert.equal(await page.locator("#stat-unit1").count(), 1);
   assert.equal(await page.locator("#stat-unit2").count(), 0);
-  assert.equal(await page.locator("#stat-unit-times-label").textContent(), "Droplet time, unit 0 · 1");
   assert.deepEqual(errors, []);
 });
 
@@ -158,6 +157,9 @@ test("one unit hides unit 1's controls; three give unit 2 its choice, group, dro
   assert.equal(s.unitDroplets[1], 0);
   const shown = Number((await page.locator("#stat-unit2").innerText()).replace(/[^\d]/g, ""));
   assert.equal(shown, s.unitDroplets[2]);
+  assert.equal(await page.locator("#stat-unit-times-label").innerText(), "Droplet time, unit 0 · 2", "the units that print");
+  assert.equal(await page.isVisible("#stat-mass2"), true);
+  assert.equal(await page.isVisible("#stat-mass1"), false);
   assert.equal(await page.isVisible("#plot-key-unit2"), true);
   assert.equal(await page.isVisible("#plot-key-unit1"), false);
   await page.evaluate((i) => window.dropslice.show(i), Math.floor(s.layers / 2));

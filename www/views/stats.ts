@@ -5,7 +5,7 @@ import type { Page } from "./page";
 import type { Slice } from "../core/store";
 import { writeCalibration } from "./calibrate";
 import { $, duration, el, nf, setText, sub, unitRows } from "./dom";
-import { supportUnit, unitIndices, unitRole, unitSetting, unitsOf } from "../core/units";
+import { supportUnit, unitRole, unitSetting, unitsOf } from "../core/units";
 import { requestPlot } from "./plot";
 import { writeVoids } from "./voids";
 
@@ -54,7 +54,6 @@ function unitRowsOf(n: number): void {
     el("dt", { id: `stat-density${u}-label`, title: `The same for the parts of unit ${u} (a ${unitRole(u)}, droplets of B${sub(u)})`, hidden: "" }, `Predicted density, unit ${u}`),
     el("dd", { id: `stat-density${u}`, hidden: "" }, "–"),
   ]);
-  setText("stat-unit-times-label", `Droplet time, unit ${unitIndices(n).join(" · ")}`);
 }
 
 /** Each unit's droplets and the support: the legend's entries, the droplet rows, the units'
@@ -82,12 +81,15 @@ function writeUnits(s: Slice | null, current: number, n: number): void {
   }
   $("legend-support").hidden = !(support > 0 || layerSupport > 0);
   setText("stat-support", s ? nf.format(support) : "–");
+  // one unit prints no support: its row only when a .gco file has some
+  if (n === 1 && support === 0) $("stat-support-label").hidden = $("stat-support").hidden = true;
   let any = false;
-  const times: string[] = [];
+  // the droplet time of unit 0 and of every other unit that prints
+  const times: { unit: number; text: string }[] = [];
   for (let u = 0; u < n; u++) {
     const d = units[u];
     const parts = (d?.droplets ?? 0) - (u === supportBy ? support : 0);
-    times.push(d?.seconds !== null && d?.seconds !== undefined ? duration(d.seconds) : "–");
+    if (u === 0 || (d?.droplets ?? 0) > 0) times.push({ unit: u, text: d?.seconds !== null && d?.seconds !== undefined ? duration(d.seconds) : "–" });
     if (u === 0) continue;
     $(`legend-unit${u}`).hidden = !(parts > 0 || (layerParts[u] ?? 0) > 0);
     setText(`legend-unit${u}-label`, gco ? `Unit ${u} (after T${u})` : `Unit-${u} part`);
@@ -102,7 +104,10 @@ function writeUnits(s: Slice | null, current: number, n: number): void {
     }
   }
   $("unit-stats").hidden = !any;
-  if (any) setText("stat-unit-times", times.every((t) => t !== "–") ? times.join(" · ") : "–");
+  if (any) {
+    setText("stat-unit-times-label", `Droplet time, unit ${times.map((t) => t.unit).join(" · ")}`);
+    setText("stat-unit-times", times.every((t) => t.text !== "–") ? times.map((t) => t.text).join(" · ") : "–");
+  }
   // overhangs (the core's areas: per layer as the layers come in, the part's and the worst)
   const stl = s?.source === "stl";
   const a = stl ? s!.unsupportedArea[current] : undefined;
