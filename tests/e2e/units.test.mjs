@@ -11,14 +11,14 @@ import { build } from "esbuild";
 import { repo } from "./helpers.mjs";
 
 const out = mkdtempSync(join(tmpdir(), "dropslice-units-"));
-let gcode, share, form, sample, units, profiles, figures, forms;
+let gcode, share, form, sample, units, profiles, figures, forms, render, plot;
 /** The core's job schema: a link's parts are checked against it. */
 let jobSchema;
 /** The core's settings schema. */
 let schema;
 
 before(async () => {
-  const names = ["worker/gcode", "core/share", "core/settings", "core/sample", "core/units", "core/profiles", "core/figures", "views/form"];
+  const names = ["worker/gcode", "core/share", "core/settings", "core/sample", "core/units", "core/profiles", "core/figures", "views/form", "views/canvas/render", "views/plot"];
   await build({
     entryPoints: names.map((n) => join(repo, "www", `${n}.ts`)),
     bundle: true,
@@ -27,7 +27,7 @@ before(async () => {
     outdir: out,
     logLevel: "error",
   });
-  [gcode, share, form, sample, units, profiles, figures, forms] = await Promise.all(names.map((n) => import(pathToFileURL(join(out, `${n}.js`)).href)));
+  [gcode, share, form, sample, units, profiles, figures, forms, render, plot] = await Promise.all(names.map((n) => import(pathToFileURL(join(out, `${n}.js`)).href)));
   // the G-code reader is the core's (built into www/pkg by the page build)
   await gcode.loadCore(readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")));
   const core = await import(pathToFileURL(join(repo, "www", "pkg", "dropslice.js")).href);
@@ -256,4 +256,21 @@ test("profiles: a material profile holds one material, used for the unit picked;
   assert.ok("plate_x" in m.settings);
   assert.equal(profiles.checkProfile({ name: "bad", kind: "machine", settings: { droplet_aspect: 1 } }, schema), null);
   assert.equal(profiles.checkProfile({ name: "bad", kind: "material", settings: { unit1_plate_x: 1 } }, schema), null);
+});
+
+test("units: each unit's colour class in the layer view and the cut, each unit's bar in the plot", () => {
+  const { dropletClass, CLASS_COLORS, CLASS_ORDER } = render;
+  // unit 0 by role, the support whatever its unit, units 1 … 3 a colour each
+  assert.deepEqual([0, 1, 2].map((r) => dropletClass(r, 0)), [0, 1, 2]);
+  assert.deepEqual([0, 1, 2, 3].map((u) => dropletClass(3, u)), [3, 3, 3, 3]);
+  assert.deepEqual([1, 2, 3].map((u) => dropletClass(1, u)), [4, 5, 6]);
+  assert.deepEqual([...CLASS_COLORS], ["#d9480f", "#f59f00", "#3b8fdd", "#1098ad", "#7048e8", "#6b4226", "#343a40"]);
+  assert.deepEqual([...CLASS_ORDER].sort(), [0, 1, 2, 3, 4, 5, 6], "every class drawn once");
+  // a layer's stack: each unit's parts, then the support; with fewer units shown than the
+  // droplets name, the rest go to the last unit shown
+  const c = { outer: 5, inner: 0, fill: 6, support: 4, unit1: 6, parts: [7, 2, 2] };
+  assert.deepEqual(plot.stackOf(c, 3), [7, 2, 2, 4]);
+  assert.deepEqual(plot.stackOf(c, 4), [7, 2, 2, 0, 4]);
+  assert.deepEqual(plot.stackOf(c, 2), [7, 4, 4]);
+  assert.equal(plot.layerTotal(c), 15);
 });
