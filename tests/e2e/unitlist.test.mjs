@@ -25,12 +25,18 @@ before(async () => ({ env, main } = await startWithPage({ settle: true })));
 
 after(() => stop(env, tmp));
 
+/** Types (or picks, for a list) a setting's value in the form, as a user does. */
 async function setField(page, name, value) {
-  await page.$eval(`#settings [name="${name}"]`, (el) => {
+  const sel = `#settings [name="${name}"]`;
+  const tag = await page.$eval(sel, (el) => {
     for (let d = el.closest("details"); d; d = d.parentElement?.closest("details")) d.open = true;
+    return el.tagName;
   });
-  await page.fill(`#settings [name="${name}"]`, String(value));
-  await page.press(`#settings [name="${name}"]`, "Tab");
+  if (tag === "SELECT") await page.selectOption(sel, String(value));
+  else {
+    await page.fill(sel, String(value));
+    await page.press(sel, "Tab");
+  }
 }
 
 const field = (page, name) => page.inputValue(`#settings [name="${name}"]`);
@@ -162,6 +168,9 @@ test("one unit hides unit 1's controls; three give unit 2 its choice, group, dro
   assert.equal(await page.isVisible("#stat-mass1"), false);
   assert.equal(await page.isVisible("#plot-key-unit2"), true);
   assert.equal(await page.isVisible("#plot-key-unit1"), false);
+  // the unit-0 part selected: the unit-2 part is drawn untinted
+  await page.click(".part-item:nth-child(1)");
+  await page.click("#mode-layer");
   await page.evaluate((i) => window.dropslice.show(i), Math.floor(s.layers / 2));
   await page.click("#btn-fit");
   await page.waitForTimeout(200);
