@@ -135,18 +135,54 @@ fn m3_screw() {
     check("M3x10_screw");
 }
 
-/// The open scan (223 open edges, open chains on 50 layers): sections closed like the
-/// oracle's `--close-open` (areas only: where gaps are bridged, the union's hole count depends
-/// on where bridges touch), and no empty layer inside the part.
+/// The open scan (223 open edges, open chains on 50 layers) against the same scan with its
+/// holes filled by an independent mesh repair (MeshFix, `scripts/fill_holes_meshfix.py`):
+/// layers without open sections within the oracle's tolerance, as every model; the open
+/// layers, whose closing is a guess, within 2.5 % of the filled scan's area in all and never
+/// empty. Joining nearest ends instead (the oracle's `--close-open`, as CuraEngine and Slic3r
+/// do) is 4.6 % off: that fixture shows the rule the test tells apart.
 #[test]
-fn stanford_bunny_open_mesh_closed_like_the_oracle() {
-    let compared = check_fixture("stanford_bunny", "stanford_bunny_close_open", false);
-    assert_eq!(compared, 772);
+fn stanford_bunny_open_mesh_closed_like_its_holes_filled() {
     let bytes = common::model_bytes("stanford_bunny.stl");
     let job = Job::new(&bytes, "bunny", off_plate()).unwrap();
+    let filled = common::oracle_fixture("stanford_bunny_holes_filled");
+    let nearest = common::oracle_fixture("stanford_bunny_close_open");
+    let area = |v: &Value, i: usize| v["layers"][i]["nonzero"]["area"].as_f64().unwrap();
+    assert_eq!(
+        filled["layers"].as_array().unwrap().len(),
+        job.layer_count()
+    );
+    let (mut open_layers, mut want, mut off, mut off_nearest) = (0, 0.0, 0.0, 0.0);
+    let mut bad = Vec::new();
     for i in 0..job.layer_count() {
-        assert!(!job.section(i).region.is_empty(), "layer {i} is empty");
+        let section = job.section(i);
+        let got = dropslice::base::geom::region_area(&section.region);
+        assert!(got > 0.0, "layer {i} is empty");
+        let w = area(&filled, i);
+        if section.open_chains == 0 {
+            if (got - w).abs() > (w * 0.005).max(0.05) {
+                bad.push(format!("layer {i}: area {got:.4} vs filled scan {w:.4}"));
+            }
+            continue;
+        }
+        open_layers += 1;
+        want += w;
+        off += (got - w).abs();
+        off_nearest += (area(&nearest, i) - w).abs();
     }
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+    assert_eq!(open_layers, 50);
+    let (share, share_nearest) = (off / want, off_nearest / want);
+    eprintln!(
+        "open layers off the filled scan: {:.2} % (nearest ends: {:.2} %)",
+        100.0 * share,
+        100.0 * share_nearest
+    );
+    assert!(share <= 0.025, "{:.2} % off", 100.0 * share);
+    assert!(
+        share_nearest > 0.04,
+        "the reference no longer tells the rules apart"
+    );
 }
 
 #[test]

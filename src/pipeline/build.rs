@@ -292,6 +292,7 @@ impl Job {
             info,
             groups,
             supported: std::sync::OnceLock::new(),
+            rims: std::sync::OnceLock::new(),
         }
     }
 }
@@ -609,10 +610,11 @@ const VOLUME_SAMPLES: usize = 24;
 fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f64 {
     let n = zs.len();
     let samples = n.min(VOLUME_SAMPLES);
+    let rims = std::sync::OnceLock::new();
     let total: f64 = (0..samples)
         .map(|k| {
             let i = (2 * k + 1) * n / (2 * samples);
-            geom::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i]).region)
+            geom::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i], &rims).region)
         })
         .sum();
     total / samples as f64 * n as f64 * h

@@ -25,6 +25,8 @@ pub struct Job {
     /// Every layer's plan with support (`support = unit1`), computed on first use: the
     /// droplet-level pass needs all layers' droplets (see [`Job::supported_plans`]).
     pub(crate) supported: std::sync::OnceLock<SupportedPlans>,
+    /// The mesh's open boundary, found when a layer first has an open section.
+    pub(crate) rims: std::sync::OnceLock<slice::Rims>,
 }
 
 impl Job {
@@ -100,13 +102,13 @@ impl Job {
     /// The cross-section of layer `i`.
     pub fn section(&self, i: usize) -> Section {
         stages::time(Stage::Section, || {
-            slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i])
+            slice::slice_layer(&self.mesh, self.buckets.layer(i), self.zs[i], &self.rims)
         })
     }
 
     /// The closed loops of layer `i` before their union (for diagnostics).
     pub fn section_loops(&self, i: usize) -> Vec<geom::Contour> {
-        slice::section_loops(&self.mesh, self.buckets.layer(i), self.zs[i]).0
+        slice::section_loops(&self.mesh, self.buckets.layer(i), self.zs[i], &self.rims).0
     }
 
     /// Every move of layer `i`.
@@ -215,7 +217,7 @@ impl Job {
             if mine.is_empty() {
                 continue;
             }
-            let section = slice::slice_layer(&self.mesh, &mine, self.zs[i]).region;
+            let section = slice::slice_layer(&self.mesh, &mine, self.zs[i], &self.rims).region;
             let own = crate::base::boolean::difference(&section, &covered);
             if k + 1 < self.groups.len() {
                 covered = crate::base::boolean::union(&covered, &section);
