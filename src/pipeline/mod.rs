@@ -14,4 +14,4 @@ pub use build::{MAX_DROPLETS, Preparation};
 pub use job::Job;
 pub use supported::SupportedPlans;
 #[cfg(not(target_arch = "wasm32"))]
-pub use writer::{write_gcode, write_gcode_with};
+pub use writer::{write_gcode, write_gcode_with, writer_threads};
