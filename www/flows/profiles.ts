@@ -23,7 +23,7 @@ import { updateButtons } from "../views/controls";
 import { saveFile } from "../views/download";
 import type { Page } from "../views/page";
 import { profileMessage, renderProfiles } from "../views/profiles";
-import { record } from "./history";
+import { record } from "./record";
 import { relayout } from "./job";
 import { saveSoon } from "./remember";
 

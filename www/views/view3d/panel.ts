@@ -15,7 +15,8 @@ import { errorBanner } from "../banner";
 import { openPartMenu, openSelectedPartMenu } from "../contextmenu";
 import { $ } from "../dom";
 import type { Page, View3DView } from "../page";
-import type { Camera3D, View3D, View3DPart, View3DSlice } from "./view3d";
+import type { Camera3D } from "../../core/view";
+import type { View3D, View3DPart, View3DSlice } from "./view3d";
 
 /** The 3D view's id of an instance, and back. */
 export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
