@@ -435,6 +435,7 @@ pub fn angles_down(n: DVec3) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::mesh::rotation;
 
     #[test]
     fn angles_turn_normals_down() {

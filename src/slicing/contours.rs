@@ -63,6 +63,11 @@ impl ContourParams {
 /// previous loop.
 const DIRECT_MAX_B: f64 = 3.0;
 
+/// The loops and the fill region of one layer with the settings `s`.
+pub fn contours(region: &Shapes, s: &Settings) -> LayerContours {
+    contours_with(region, &ContourParams::from_settings(s))
+}
+
 /// The loops and the fill region of one layer.
 ///
 /// Near the boundary (up to [`DIRECT_MAX_B`]·B) each region is the part's region moved in by
@@ -72,7 +77,7 @@ const DIRECT_MAX_B: f64 = 3.0;
 /// section crosses itself everywhere (50–120 ms on some layers of 3DBenchy at 20–40 B); a step
 /// of B costs well under a millisecond. A chain of n such steps approximates its arcs within
 /// [`CHORD_TOLERANCE_MM`] / n each, so it stays within the tolerance of the true distance.
-pub fn contours(region: &Shapes, s: &ContourParams) -> LayerContours {
+pub fn contours_with(region: &Shapes, s: &ContourParams) -> LayerContours {
     let b = s.droplet_width();
     let fill = s.fill_density > 0.0;
     let last = s.contours as f64 - 1.0;

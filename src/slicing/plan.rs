@@ -4,7 +4,7 @@
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
 use crate::base::nearest::nearest_walk;
 use crate::base::settings::{ContourOrder, PrintOrder, Settings};
-use crate::slicing::contours::{ContourParams, Loop, contours};
+use crate::slicing::contours::{Loop, contours};
 use crate::slicing::droplets::loop_droplets_spaced;
 use crate::slicing::fill::{FillParams, FillPattern};
 pub use crate::slicing::fill::{hatch_angle, hatch_shifted};
@@ -147,7 +147,7 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
 /// unit 0's (see [`plan_unit1_layer`]).
 pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point) -> LayerPlan {
     let b = s.droplet_width();
-    let layer = contours(region, &ContourParams::from_settings(s));
+    let layer = contours(region, s);
     let mut plan = LayerPlan {
         index,
         z: (index + 1) as f64 * s.layer_height,
