@@ -40,5 +40,4 @@ pub use pipeline::{Job, MAX_DROPLETS, SupportedPlans};
 pub use pipeline::{write_gcode, write_gcode_with};
 pub use slicing::sink::LayerSink;
 
-/// The version of dropslice, written into every `.gco` header.
-pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+pub use base::VERSION;

@@ -100,13 +100,7 @@ fn apply_through_a_symlink_writes_its_target_and_keeps_the_link() {
     std::fs::write(dir.join("jobs/real.json"), JOB).unwrap();
     std::os::unix::fs::symlink("jobs/real.json", dir.join("job.json")).unwrap();
     let r = cli(&dir, &["orient", "job.json", "--apply"]);
-    assert_eq!(r.code, Some(0), "{r:?}");
-    assert!(
-        r.stdout
-            .contains("written: job.json (the file it links to, "),
-        "{}",
-        r.stdout
-    );
+    r.prints(0, "written: job.json (the file it links to, ");
     let link = std::fs::symlink_metadata(dir.join("job.json")).unwrap();
     assert!(link.is_symlink(), "the link stays a link");
     assert_eq!(
@@ -353,19 +347,9 @@ fn orient_takes_profiles_as_slicing_does() {
     // Sliced 1/(1 − 4 %) as tall: 8.33 mm, the same as --set shrink_z=4.
     for file in ["bridge.obj", "job.json"] {
         let plain = cli(&dir, &["orient", file]);
-        assert_eq!(plain.code, Some(0), "{plain:?}");
-        assert!(
-            plain.stdout.contains("height 8.00 mm → 8.00 mm"),
-            "{}",
-            plain.stdout
-        );
+        plain.prints(0, "height 8.00 mm → 8.00 mm");
         let with = cli(&dir, &["orient", file, "--profile", "pc.json"]);
-        assert_eq!(with.code, Some(0), "{with:?}");
-        assert!(
-            with.stdout.contains("height 8.33 mm → 8.33 mm"),
-            "{}",
-            with.stdout
-        );
+        with.prints(0, "height 8.33 mm → 8.33 mm");
         let set = cli(&dir, &["orient", file, "--set", "shrink_z=4"]);
         assert_eq!(set.stdout, with.stdout);
         // --set after the profile wins, as for slicing.

@@ -445,13 +445,7 @@ fn the_predicted_density_is_per_unit() {
     );
     // Without --report the summary says how to get the figure.
     let r = cli(&dir, "cube.stl -o plain.gco");
-    assert_eq!(r.code, Some(0), "{r:?}");
-    assert!(
-        r.stderr
-            .contains("predicted density: not estimated (--report FILE.json"),
-        "{}",
-        r.stderr
-    );
+    r.says(0, "predicted density: not estimated (--report FILE.json");
     // Support is not a part: a job with support on has no unit-1 density.
     let (supported, _) = report("supported", "@bridge.obj --set support=unit1");
     assert!(supported["unit1"].is_null(), "{supported}");

@@ -12,10 +12,11 @@ import { cutStatus, setCutLine, updateCut } from "./flows/cut";
 import { showError } from "./flows/errors";
 import { addParts, applyOrientation, arrangeAll, cancelOrient, duplicatePart, editParts, ensureMeshes, layFlat, movePart, orientations, relayout, removePart, saveJob, selectPart } from "./flows/job";
 import { deleteProfile, exportProfile, importProfile, renameProfile, saveProfile, showProfiles, useProfile } from "./flows/profiles";
-import { redo, resetSettings, settingsChanged, undo } from "./flows/history";
+import { redo, undo } from "./flows/history";
+import { resetSettings, settingsChanged, whenRecorded } from "./flows/record";
 import { fit, setShowOverhangs, show } from "./flows/layer";
 import { openFiles, openLink, openSample } from "./flows/open";
-import { holdJobForLink, initPersist, leavingLoses, pausePersist, persistStatus, restoreJob, startOver } from "./flows/persist";
+import { holdJobForLink, initPersist, jobChanged, leavingLoses, pausePersist, persistStatus, restoreJob, startOver } from "./flows/persist";
 import { applyRemembered, holdForLink, loadRemembered, saveNow, saveSoon, settingsTouched } from "./flows/remember";
 import { analyseVoids, cancel, download, fixUnits, startSlice } from "./flows/slice";
 import { registerOffline } from "./pwa/offline";
@@ -103,6 +104,8 @@ const page: Page = {
   history: new History(sameSnapshot),
 };
 (page as { parts: PartsView }).parts = new PartsPanel(page);
+// every recorded change is kept in the browser (flows/persist.ts)
+whenRecorded(jobChanged);
 const { store, pool, renderer } = page;
 const error = actions.error;
 

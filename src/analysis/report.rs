@@ -456,6 +456,17 @@ impl LayerStage {
     }
 }
 
+impl slabs::SlabStage for LayerStage {
+    fn slab(
+        &self,
+        analysis: &LayerAnalysis,
+        regions: &UnitRegions,
+        maps: [Option<&LayerMaps>; 3],
+    ) -> SlabFigures {
+        LayerStage::slab(self, analysis, regions, maps)
+    }
+}
+
 /// A slab's (exact volume, void volume): `area` × H, and the void share of the region sampled
 /// on `grid` between the maps of the layers below, of its own and above.
 fn slab_of(

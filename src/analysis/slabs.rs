@@ -5,7 +5,6 @@
 
 use super::estimate3d::HeightMap;
 use super::raster::LayerAnalysis;
-use super::report::LayerStage;
 use crate::base::geom::Shapes;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -49,6 +48,17 @@ impl SlabFigures {
     }
 }
 
+/// What computes one slab's figures from its layer's 2D analysis and regions and the maps of
+/// the layers below, of its own and above (the report's per-layer stage).
+pub trait SlabStage: Send + Sync {
+    fn slab(
+        &self,
+        analysis: &LayerAnalysis,
+        regions: &UnitRegions,
+        maps: [Option<&LayerMaps>; 3],
+    ) -> SlabFigures;
+}
+
 /// A layer of a [`SlabRun`] whose slab is not done yet.
 struct Held {
     index: usize,
@@ -63,7 +73,7 @@ struct Held {
 /// its last unless that is the job's last), given at [`SlabRun::finish`]. A run holds four
 /// layers' maps at most.
 pub struct SlabRun {
-    stage: Arc<LayerStage>,
+    stage: Arc<dyn SlabStage>,
     /// The run's first layer.
     first: Option<usize>,
     /// The run's first layer while its slab waits for the map below the run (not layer 0),
@@ -76,7 +86,7 @@ pub struct SlabRun {
 }
 
 impl SlabRun {
-    pub fn new(stage: Arc<LayerStage>) -> SlabRun {
+    pub fn new(stage: Arc<dyn SlabStage>) -> SlabRun {
         SlabRun {
             stage,
             first: None,

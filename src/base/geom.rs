@@ -341,8 +341,7 @@ mod tests {
     fn a_lines_droplets_in_a_box_are_those_of_the_whole_line_in_it() {
         // Lines long and short, axis-parallel and of no length; boxes around, across, at an
         // end and beside them: the same points in the same order as the whole line filtered.
-        let mut seed = 0x5851_f42d_4c95_7f2du64;
-        let mut random = || crate::base::testing::random(&mut seed);
+        let mut random = crate::base::testing::rng(0x5851_f42d_4c95_7f2du64);
         let mut kept = 0;
         for case in 0..2000 {
             let from = DVec2::new(random() * 40.0, random() * 40.0);
@@ -452,8 +451,7 @@ mod tests {
         // Random loops (self-crossing ones too: windings of 2 and more), with holes, on
         // steps fine and coarse; and parts far apart on a fine step (far more lines than
         // crossings: the other way of sorting).
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut random = || crate::base::testing::random(&mut seed);
+        let mut random = crate::base::testing::rng(0x9e37_79b9_7f4a_7c15u64);
         let mut spans = 0;
         for case in 0..300 {
             let mut loop_at = |cx: f64, cy: f64, r: f64, n: usize| -> Contour {

@@ -11,3 +11,6 @@ pub mod spatial;
 pub mod stages;
 #[cfg(test)]
 pub(crate) mod testing;
+
+/// The version of dropslice, written into every `.gco` header.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");

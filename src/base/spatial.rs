@@ -499,8 +499,7 @@ mod tests {
         // Edges short and long (across many cells), points, axis-parallel; queries inside,
         // outside and at the edges: every edge within r of p is offered, "any edge closer
         // than r" and the nearest edge's distance are what a scan of every edge says.
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut random = || crate::base::testing::random(&mut seed);
+        let mut random = crate::base::testing::rng(0x9e37_79b9_7f4a_7c15u64);
         for case in 0..40 {
             let n = 1 + case * 13 % 300;
             let scale = if case % 3 == 0 { 1.0 } else { 30.0 };

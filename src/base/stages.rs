@@ -1,9 +1,9 @@
 //! Time per stage of the work (prepare, slice, plan, overhang, support, text, preview, sink),
 //! summed over every thread, for the per-stage profile of docs/performance.md. Off unless
-//! [`enable`]d: a stage then costs one relaxed atomic load. The native writer turns it on when
-//! the environment has `DROPSLICE_STAGES=1` and prints the table to stderr; the page's workers
-//! through the WebAssembly facade's `profile_stages`. A stage inside another (a section sliced
-//! while the overhang is figured) counts only in the outer one.
+//! [`enable`]d: a stage then costs one relaxed atomic load. The CLI turns it on around the
+//! writer when the environment has `DROPSLICE_STAGES=1` and prints the table to stderr; the
+//! page's workers through the WebAssembly facade's `profile_stages`. A stage inside another (a
+//! section sliced while the overhang is figured) counts only in the outer one.
 
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};

@@ -9,6 +9,11 @@ pub(crate) fn random(seed: &mut u64) -> f64 {
     (*seed >> 11) as f64 / (1u64 << 53) as f64
 }
 
+/// A generator of values in [0, 1) from `seed` (non-zero): [`random`] as a closure.
+pub(crate) fn rng(mut seed: u64) -> impl FnMut() -> f64 {
+    move || random(&mut seed)
+}
+
 /// Values to check a floor-to-integer against `f64::floor`: signed zeros, halves, the
 /// neighbours of integers, values near 2⁵¹ and 2⁵², beyond `i64`, infinities and NaN, and
 /// 300,000 pseudo-random values of every scale from 10⁻²⁰ to 10¹⁹ with their floors and

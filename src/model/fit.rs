@@ -8,7 +8,7 @@
 
 use crate::base::error::Error;
 use crate::base::settings::Settings;
-use crate::model::layout::{Frame, Instance};
+use crate::model::frame::{Frame, Instance};
 use serde::{Deserialize, Serialize};
 
 /// Overshoots smaller than this (mm) are rounding, not a part off the plate.

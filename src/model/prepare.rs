@@ -5,8 +5,8 @@
 use crate::base::error::Error;
 use crate::base::settings::Settings;
 use crate::model::fit;
+use crate::model::frame::{Frame, Instance};
 use crate::model::import::{self, stl};
-use crate::model::layout::{Frame, Instance};
 use crate::model::mesh::{self, Bounds, Mesh, MeshStats};
 use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;

@@ -177,7 +177,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
     let _ = writeln!(
         h,
         "; dropslice {} — droplet machine code (G01 travel, G25 droplet line, G26 droplet)",
-        crate::VERSION
+        crate::base::VERSION
     );
     let _ = writeln!(
         h,

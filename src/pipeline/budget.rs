@@ -12,7 +12,9 @@ use crate::base::settings::{Settings, Support};
 use crate::model::layout::Instance;
 use crate::model::mesh::Mesh;
 use crate::model::prepare::{FacetGroup, MAX_WIDTH_IN_DROPLETS};
-use crate::pipeline::build::{MAX_DROPLETS, check_droplets};
+
+/// Most droplets a job may set (volume / B²H): beyond this the code would not fit on a disk.
+pub const MAX_DROPLETS: f64 = 2e9;
 
 /// Most droplets one layer may hold with support on: the droplet-level pass
 /// ([`crate::support::droplets::complete`]) lists a layer's droplets and sorts them into a grid,
@@ -480,6 +482,22 @@ pub fn mm(x: f64) -> String {
     } else {
         format!("{x:.1e}")
     }
+}
+
+/// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
+fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
+    let b = settings.droplet_width();
+    let droplets = volume / (b * b * settings.layer_height);
+    if droplets > MAX_DROPLETS || !droplets.is_finite() {
+        return Err(Error::Setting {
+            name: "layer_height".into(),
+            message: format!(
+                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of unit 0's B = {} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height, droplet_aspect) or check the scale",
+                mm(b)
+            ),
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -22,8 +22,6 @@ use crate::model::spec as job;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
 
-/// Most droplets a job may set (volume / B²H): beyond this the code would not fit on a disk.
-pub const MAX_DROPLETS: f64 = 2e9;
 impl Job {
     /// Reads the model (STL, OBJ or a 3MF build, see [`import`]), validates the settings and
     /// places the part: import → checks → mesh repair → facet index. A 3MF build's items keep
@@ -584,22 +582,6 @@ fn repaired(
         unchecked_shells: shells.unchecked,
         ..stats
     }
-}
-
-/// Refuses a job whose estimated volume would take more than [`MAX_DROPLETS`] droplets.
-pub(crate) fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
-    let b = settings.droplet_width();
-    let droplets = volume / (b * b * settings.layer_height);
-    if droplets > MAX_DROPLETS || !droplets.is_finite() {
-        return Err(Error::Setting {
-            name: "layer_height".into(),
-            message: format!(
-                "the part ({volume:.0} mm³) would take about {droplets:.1e} droplets of unit 0's B = {} mm, more than the {MAX_DROPLETS:.0e} allowed (the code would be hundreds of gigabytes); use larger droplets (layer_height, droplet_aspect) or check the scale",
-                budget::mm(b)
-            ),
-        });
-    }
-    Ok(())
 }
 
 /// Layers sampled by [`sampled_volume`].

@@ -9,9 +9,9 @@ mod supported;
 #[cfg(not(target_arch = "wasm32"))]
 mod writer;
 
-pub use budget::{MAX_DROPLETS_WITH_SUPPORT, MAX_LAYER_DROPLETS_WITH_SUPPORT};
-pub use build::{MAX_DROPLETS, Preparation};
+pub use budget::{MAX_DROPLETS, MAX_DROPLETS_WITH_SUPPORT, MAX_LAYER_DROPLETS_WITH_SUPPORT};
+pub use build::Preparation;
 pub use job::Job;
 pub use supported::SupportedPlans;
 #[cfg(not(target_arch = "wasm32"))]
-pub use writer::{write_gcode, write_gcode_with};
+pub use writer::{write_gcode, write_gcode_with, writer_threads};

@@ -28,9 +28,45 @@ pub struct LayerContours {
     pub fill_region: Shapes,
 }
 
+/// The values the contours of a layer depend on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContourParams {
+    /// B, mm.
+    pub b: f64,
+    pub contours: u32,
+    pub outer_offset: f64,
+    pub inner_offset: f64,
+    pub fill_density: f64,
+    pub fill_overlap: f64,
+}
+
+impl ContourParams {
+    /// The part's contours with the settings `s`.
+    pub fn from_settings(s: &Settings) -> ContourParams {
+        ContourParams {
+            b: s.droplet_width(),
+            contours: s.contours,
+            outer_offset: s.outer_offset,
+            inner_offset: s.inner_offset,
+            fill_density: s.fill_density,
+            fill_overlap: s.fill_overlap,
+        }
+    }
+
+    /// B, mm.
+    pub fn droplet_width(&self) -> f64 {
+        self.b
+    }
+}
+
 /// Offsets up to this many B are made from the part's region itself; farther in, from the
 /// previous loop.
 const DIRECT_MAX_B: f64 = 3.0;
+
+/// The loops and the fill region of one layer with the settings `s`.
+pub fn contours(region: &Shapes, s: &Settings) -> LayerContours {
+    contours_with(region, &ContourParams::from_settings(s))
+}
 
 /// The loops and the fill region of one layer.
 ///
@@ -41,7 +77,7 @@ const DIRECT_MAX_B: f64 = 3.0;
 /// section crosses itself everywhere (50–120 ms on some layers of 3DBenchy at 20–40 B); a step
 /// of B costs well under a millisecond. A chain of n such steps approximates its arcs within
 /// [`CHORD_TOLERANCE_MM`] / n each, so it stays within the tolerance of the true distance.
-pub fn contours(region: &Shapes, s: &Settings) -> LayerContours {
+pub fn contours_with(region: &Shapes, s: &ContourParams) -> LayerContours {
     let b = s.droplet_width();
     let fill = s.fill_density > 0.0;
     let last = s.contours as f64 - 1.0;

@@ -4,7 +4,7 @@
 //!
 //! Hatch lines lie at (j + ½)·spacing from the origin across the hatch direction, for whole j,
 //! so two layers with the same angle have their lines in the same places; with `stagger`, some
-//! layers use (j + 0)·spacing instead (see [`crate::slicing::plan::hatch_shifted`]).
+//! layers use (j + 0)·spacing instead (see [`crate::slicing::fill::hatch_shifted`]).
 
 use crate::base::nearest::NearestGrid;
 

@@ -1,7 +1,8 @@
-//! One layer from mesh to plan: slice → offset/contours → droplets and hatch → plan.
+//! One layer from mesh to plan: slice → offset/contours → droplets and fill (hatch) → plan.
 
 pub mod contours;
 pub mod droplets;
+pub mod fill;
 pub mod hatch;
 pub mod offset;
 pub mod plan;

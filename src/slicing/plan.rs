@@ -6,7 +6,9 @@ use crate::base::nearest::nearest_walk;
 use crate::base::settings::{ContourOrder, PrintOrder, Settings};
 use crate::slicing::contours::{Loop, contours};
 use crate::slicing::droplets::loop_droplets_spaced;
-use crate::slicing::hatch::{hatch_at, order_greedy};
+use crate::slicing::fill::{FillParams, FillPattern};
+pub use crate::slicing::fill::{hatch_angle, hatch_shifted};
+use crate::slicing::hatch::order_greedy;
 use serde::{Deserialize, Serialize};
 
 /// What a move does (the machine command it becomes).
@@ -121,11 +123,6 @@ impl LayerPlan {
     }
 }
 
-/// Hatch angle of a layer (from 0): α_s + index·α_v.
-pub fn hatch_angle(s: &Settings, index: usize) -> f64 {
-    (s.hatch_angle + index as f64 * s.hatch_angle_step).rem_euclid(360.0)
-}
-
 /// How far each layer's loops start after the layer below's, in mm (arc length).
 ///
 /// Without `stagger`: `start_jitter`. With it: `start_jitter` rounded to the nearest odd
@@ -139,44 +136,6 @@ pub fn loop_start_step(s: &Settings) -> f64 {
     }
     let b = s.droplet_width();
     ((s.start_jitter / b - 0.5).round().max(0.0) + 0.5) * b
-}
-
-/// Whether layer `index`'s hatch lattice is shifted by half a spacing across and half a
-/// droplet along (`stagger`). With `stagger` every hatch line's droplets are set on a lattice
-/// fixed to the origin: lines at (j + ½)·spacing across, droplets at k·B along (line ends
-/// moved outward to lattice points, see [`crate::slicing::hatch::hatch_at`]), or (j + 0), (k + ½) when
-/// shifted.
-///
-/// With a 90° step (the default), the next layer's lattice is this one turned by 90° about the
-/// origin, and with spacing B its points are exactly the centres of this layer's lattice cells:
-/// every layer already lies over the gaps of the layer below, and layer i + 2 over layer i's
-/// droplets, with layer i + 1's droplets in between, so nothing is shifted (shifting layer
-/// i + 2 by half a spacing, as for repeating angles, measured worse: docs/quality.md).
-/// Otherwise layers whose lines run in the same direction (angle mod 180°) alternate between
-/// shifted and not (a 0° step: every other layer); a step whose direction never repeats within
-/// 360 layers shifts nothing.
-pub fn hatch_shifted(s: &Settings, index: usize) -> bool {
-    if !s.stagger {
-        return false;
-    }
-    let quarter = (s.hatch_angle_step.rem_euclid(180.0) - 90.0).abs() < 1e-6;
-    if quarter {
-        return false;
-    }
-    let period = (1..=360usize).find(|&p| {
-        let r = (p as f64 * s.hatch_angle_step).rem_euclid(180.0);
-        r < 1e-6 || 180.0 - r < 1e-6
-    });
-    period.is_some_and(|p| (index / p) % 2 == 1)
-}
-
-/// The least distance between the fill region and the part's boundary (outer or hole), mm:
-/// hatch ends may move out this far without a droplet centre leaving the part.
-fn fill_margin(s: &Settings) -> f64 {
-    let last = s.contours as f64 - 1.0;
-    let extra = 1.0 - s.fill_overlap;
-    let f = s.outer_offset.min(s.inner_offset);
-    ((f + last + extra) * s.droplet_width()).max(0.0)
 }
 
 /// Plans one layer from its region (unit 0, starting at the origin).
@@ -236,16 +195,9 @@ pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point
         if s.fill_density <= 0.0 {
             return;
         }
-        let lines = hatch_at(
-            &layer.fill_region,
-            hatch_angle(s, index),
-            b / s.fill_density,
-            if hatch_shifted(s, index) { 0.0 } else { 0.5 },
-            s.stagger.then(|| {
-                let along = if hatch_shifted(s, index) { 0.5 } else { 0.0 };
-                (b, along, fill_margin(s))
-            }),
-        );
+        let lines = FillPattern::Lines
+            .new_from_type()
+            .fill(&layer.fill_region, &FillParams::from_settings(s, index));
         for l in order_greedy(lines, *at) {
             plan.travel_mm += dist(*at, l.a);
             plan.moves.push(Move {

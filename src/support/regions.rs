@@ -7,7 +7,8 @@ use crate::base::geom::{DVec2, Shape, Shapes, segment_distance2};
 use crate::base::parallel::par_map;
 use crate::base::settings::Settings;
 use crate::base::spatial::EdgeIndex;
-use crate::slicing::hatch::{HatchLine, hatch_at};
+use crate::slicing::fill::{FillParams, FillPattern, hatch_angle};
+use crate::slicing::hatch::HatchLine;
 use crate::slicing::offset::{CHORD_TOLERANCE_MM, Corners, raw_offset};
 use crate::support::lattice::{Bits, Lattices, Runs};
 use crate::support::overhang::{overhang_figure, support_reach};
@@ -178,12 +179,14 @@ pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
             let areas_regions = support_regions(regions, s);
             par_map(regions.len(), &|i| LayerSupport {
                 unsupported_area: areas_regions[i].0,
-                lines: hatch_at(
+                lines: FillPattern::Lines.new_from_type().fill(
                     &areas_regions[i].1,
-                    crate::slicing::plan::hatch_angle(s, i),
-                    spacing,
-                    0.5,
-                    Some((b1, 0.0, 0.0)),
+                    &FillParams {
+                        angle_deg: hatch_angle(s, i),
+                        spacing,
+                        phase: 0.5,
+                        lattice: Some((b1, 0.0, 0.0)),
+                    },
                 ),
             })
         }

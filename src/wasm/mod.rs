@@ -105,7 +105,7 @@ pub fn start() {
 /// The core's version (`dropslice::VERSION`).
 #[wasm_bindgen]
 pub fn version() -> String {
-    crate::VERSION.to_string()
+    crate::base::VERSION.to_string()
 }
 
 /// A point or vector in the plane as serde writes glam's `DVec2` (the analysis' centroids,

@@ -106,6 +106,22 @@ pub struct Run {
     pub seconds: f64,
 }
 
+impl Run {
+    /// Asserts that the run exited with `code` and wrote `text` to stderr.
+    #[track_caller]
+    pub fn says(&self, code: i32, text: &str) {
+        assert_eq!(self.code, Some(code), "{self:?}");
+        assert!(self.stderr.contains(text), "{}", self.stderr);
+    }
+
+    /// Asserts that the run exited with `code` and wrote `text` to stdout.
+    #[track_caller]
+    pub fn prints(&self, code: i32, text: &str) {
+        assert_eq!(self.code, Some(code), "{self:?}");
+        assert!(self.stdout.contains(text), "{}", self.stdout);
+    }
+}
+
 /// Runs the CLI with `args` in `cwd`, killing it after `timeout`.
 pub fn run_cli<S: AsRef<OsStr>>(args: &[S], cwd: &Path, timeout: Duration) -> Run {
     static N: AtomicUsize = AtomicUsize::new(0);

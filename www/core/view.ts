@@ -1,5 +1,6 @@
-// The 2D views' geometry, shared by the layer view, the vertical cut and the preview links:
-// a view (zoom and centre) with its limits, and a box on the plate.
+// The views' geometry, shared by the layer view, the vertical cut, the 3D view and the preview
+// links: a view (zoom and centre) with its limits, a box on the plate, the cut's view and the
+// 3D camera.
 
 export interface View {
   /** CSS pixels per mm. */
@@ -35,3 +36,15 @@ export interface Bounds {
   maxX: number;
   maxY: number;
 }
+
+/** The vertical cut's view: its zoom and centre along the line and in z. */
+export interface CutView {
+  /** CSS pixels per mm (both axes). */
+  scale: number;
+  /** mm along the line and z (mm) at the plot's centre. */
+  ct: number;
+  cz: number;
+}
+
+/** The 3D view's camera: where it is and what it looks at (plate mm). */
+export type Camera3D = { position: [number, number, number]; target: [number, number, number] };

@@ -12,7 +12,7 @@ import { crossesBox, lineLength, type Line } from "../core/cutline";
 import { grouped, records } from "../core/grouped";
 import { NOT_SENT, type CutReply, type LayerData } from "../core/protocol";
 import type { Slice } from "../core/store";
-import type { CutLayer } from "../views/canvas/cutrender";
+import type { CutLayer } from "../views/page";
 import { dropletClass } from "../views/canvas/render";
 import { writeCutLegend, writeCutStatus } from "../views/cut";
 import type { Page } from "../views/page";

@@ -12,7 +12,7 @@ import { saveFile } from "../views/download";
 import { SliceError } from "../core/client";
 import { grouped } from "../core/grouped";
 import { restoreModel, showError } from "./errors";
-import { record } from "./history";
+import { record } from "./record";
 
 /** A file to add to a job: the File and, from a job file or a link, the name it has there. */
 export interface NewFile {

@@ -6,7 +6,7 @@
 
 import type { Value } from "../core/settings";
 import { dropSlice, openGcode, startSlice, type Target } from "./slice";
-import { record } from "./history";
+import { record } from "./record";
 import { jobSettings, partKeys } from "../core/job";
 import { jobOffPlate } from "../core/plate";
 import { adoptJob, newJob, type NewFile } from "./job";

@@ -27,7 +27,7 @@ import { saveFile } from "../views/download";
 import type { Page } from "../views/page";
 import { profileMessage, renderProfiles } from "../views/profiles";
 import { unitsOf } from "../core/units";
-import { record } from "./history";
+import { record } from "./record";
 import { relayout } from "./job";
 import { saveSoon } from "./remember";
 

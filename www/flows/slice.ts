@@ -9,7 +9,7 @@ import { restoreModel, showError } from "./errors";
 import type { Page } from "../views/page";
 import { jobSettings } from "../core/job";
 import { editParts } from "./job";
-import { record } from "./history";
+import { record } from "./record";
 import { undoNotice } from "../views/notices";
 import type { Slice, SlicedJob } from "../core/store";
 import { recordSupport } from "../core/supportcolumns";

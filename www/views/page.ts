@@ -10,11 +10,8 @@ import type { ProfileKind } from "../core/profiles";
 import type { CalibrateRequest, Calibration, InitResult, LayerData, Orientation, Orientations, Settings } from "../core/protocol";
 import type { Value } from "../core/settings";
 import type { Store } from "../core/store";
-import type { Bounds, View } from "../core/view";
+import type { Bounds, Camera3D, CutView, View } from "../core/view";
 import type { Line } from "../core/cutline";
-import type { CutLayer, CutView } from "./canvas/cutrender";
-import type { PanZoom } from "./canvas/panzoom";
-import type { Camera3D, View3D } from "./view3d/view3d";
 
 export interface Page {
   readonly store: Store;
@@ -90,6 +87,23 @@ export interface Actions {
   settingsEdited(): void;
 }
 
+/** The zoom and pan a canvas has for what it shows. */
+export interface PanZoom {
+  readonly canvas: HTMLCanvasElement;
+  zoomAt(px: number, py: number, factor: number): void;
+  panBy(dxPx: number, dyPx: number): void;
+}
+
+/** One layer of the cut: what the page or the core found along the line. */
+export interface CutLayer {
+  /** t, d (mm) and role per droplet whose footprint the plane crosses. */
+  near: Float64Array;
+  /** The part's region along the line: t0, t1 per span (from the core; null until then). */
+  spans: Float64Array | null;
+  /** The 3D estimate's voids: band, t0, t1 per void (from the core; null until then). */
+  voids: Float64Array | null;
+}
+
 /** The layer canvas (views/canvas/render.ts). */
 export interface LayerCanvas extends PanZoom {
   /** The view, kept within the limits (set it as a whole). */
@@ -143,7 +157,7 @@ export interface View3DView {
   /** Puts the camera there (kept until the view is made and has framed its job). */
   setCamera(c: Camera3D): void;
   /** For the tests: the view's state after a synchronous draw (null before it was made). */
-  testState(): ReturnType<View3D["state"]> | null;
+  testState(): object | null;
 }
 
 /** The parts panel (views/parts.ts). */

@@ -566,8 +566,7 @@ mod tests {
     fn runs_closed_word_by_word_are_the_rows_runs_of_set_bits() {
         // Rows of 1 to 5 words, sparse to dense, against a scan of the bits one by one
         // (the labelling and the reference both take their runs from `close_runs`).
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut random = || crate::base::testing::random(&mut seed);
+        let mut random = crate::base::testing::rng(0x2545_f491_4f6c_dd1du64);
         let mut seen = 0;
         for case in 0..3000 {
             let words = 1 + case % 5;

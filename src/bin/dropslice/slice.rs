@@ -9,9 +9,11 @@ use crate::staged::{self, Staged};
 use dropslice::analysis::JobAnalysis;
 use dropslice::base::error::quote;
 use dropslice::base::settings::{MAX_PROFILE_BYTES, Profile};
+use dropslice::base::stages;
 use dropslice::model::models::Model;
 use dropslice::model::models_job::{SettingsOverride, models_job_spec, override_settings};
 use dropslice::model::spec::{self as job, JobSpec};
+use dropslice::pipeline::writer_threads;
 use dropslice::{Error, Job, Settings, write_gcode_with};
 use std::io::{BufWriter, IsTerminal, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
@@ -282,7 +284,9 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             eprintln!("dropslice: layer {done}/{total} ({pct} %)");
         }
     };
-    let summary = write_gcode_with(&job, &mut w, progress, &mut analysis)?;
+    let summary = timed_stages(job.layer_count(), || {
+        write_gcode_with(&job, &mut w, progress, &mut analysis)
+    })?;
     let finish = || -> std::io::Result<()> {
         let file = w.into_inner().map_err(|e| e.into_error())?;
         // Fill in the header's droplet counts (same length as the placeholders).
@@ -379,6 +383,29 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
 }
 
 /// The summary's predicted density, per unit that prints parts (`None` without a figure).
+/// `write` with the per-stage counters on when the environment has `DROPSLICE_STAGES=1`: the
+/// time of each stage, summed over the writer's threads, to stderr at the end
+/// (docs/performance.md).
+fn timed_stages<T>(layers: usize, write: impl FnOnce() -> T) -> T {
+    if std::env::var_os("DROPSLICE_STAGES").is_none_or(|v| v != "1") {
+        return write();
+    }
+    stages::enable(true);
+    let started = Instant::now();
+    let result = write();
+    let parts: Vec<String> = stages::read()
+        .iter()
+        .map(|(name, ms)| format!("{name} {ms:.0}"))
+        .collect();
+    eprintln!(
+        "stages (ms, summed over {} threads): {}; the writer's wall {:.0}",
+        writer_threads(layers),
+        parts.join(", "),
+        started.elapsed().as_secs_f64() * 1e3
+    );
+    result
+}
+
 fn density_line(unit0: Option<f64>, unit1: Option<f64>) -> Option<String> {
     const WHAT: &str = "100 % − the 3D void fraction: a geometric estimate from the droplet model, not a measured density";
     Some(match (unit0, unit1) {

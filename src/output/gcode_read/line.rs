@@ -107,34 +107,14 @@ impl GcodeReader {
             if word.starts_with(';') {
                 break;
             }
-            let mut chars = word.chars();
-            let letter = chars.next().unwrap_or(' ');
-            let number = chars.as_str();
-            let v = if number.is_empty() {
-                f64::NAN
-            } else {
-                number.parse::<f64>().unwrap_or(f64::NAN)
-            };
-            if !v.is_finite() {
-                return Err(GcodeError(format!(
-                    "line {no}: bad number in \"{}\"",
-                    shown(word)
-                )));
-            }
-            if v.abs() > MAX_COORD_MM {
-                return Err(GcodeError(format!(
-                    "line {no}: the coordinate \"{}\" is too far out: this viewer reads coordinates up to ±{} mm",
-                    shown(word),
-                    grouped(MAX_COORD_MM as u64)
-                )));
-            }
-            match letter.to_ascii_uppercase() {
+            let (letter, v) = word_value(no, word)?;
+            match letter {
                 'X' => x = v,
                 'Y' => y = v,
                 'Z' => z = v,
                 // Filament and feed rate: a filament printer's move written as G01.
                 'E' | 'F' => {
-                    let name = format!("{code} … {}…", letter.to_ascii_uppercase());
+                    let name = format!("{code} … {letter}…");
                     return Err(self.foreign_refusal(no, name));
                 }
                 _ => {
@@ -158,22 +138,7 @@ impl GcodeReader {
         width: f64,
     ) -> Result<u64, GcodeError> {
         if self.counts_only {
-            return match code {
-                "G25" => {
-                    // Counted by arithmetic (as `line_droplets` expands), never expanded.
-                    let n = line_droplet_count_f64(len, width);
-                    if !n.is_finite() {
-                        return Err(GcodeError(format!(
-                            "line {no}: a G25 of {} mm with droplets every {} mm has no droplet count",
-                            precise(len, 6),
-                            precise(width, 4)
-                        )));
-                    }
-                    Ok(n as u64)
-                }
-                "G26" => Ok(1),
-                _ => Ok(0),
-            };
+            return counted(no, code, len, width);
         }
         match code {
             "G25" => self.expanded_g25(no, len, width),
@@ -280,6 +245,53 @@ impl GcodeReader {
         if unit == 1 {
             l.counts.unit1 = l.counts.unit1.saturating_add(n);
         }
+    }
+}
+
+/// A word of a command (`X12.5`): its letter in upper case and its number, a finite number
+/// within [`MAX_COORD_MM`].
+fn word_value(no: usize, word: &str) -> Result<(char, f64), GcodeError> {
+    let mut chars = word.chars();
+    let letter = chars.next().unwrap_or(' ');
+    let number = chars.as_str();
+    let v = if number.is_empty() {
+        f64::NAN
+    } else {
+        number.parse::<f64>().unwrap_or(f64::NAN)
+    };
+    if !v.is_finite() {
+        return Err(GcodeError(format!(
+            "line {no}: bad number in \"{}\"",
+            shown(word)
+        )));
+    }
+    if v.abs() > MAX_COORD_MM {
+        return Err(GcodeError(format!(
+            "line {no}: the coordinate \"{}\" is too far out: this viewer reads coordinates up to ±{} mm",
+            shown(word),
+            grouped(MAX_COORD_MM as u64)
+        )));
+    }
+    Ok((letter.to_ascii_uppercase(), v))
+}
+
+/// The droplets of the command `code` for a counting reader: a `G25`'s counted by arithmetic
+/// (as `line_droplets` expands), never expanded; any finite count.
+fn counted(no: usize, code: &str, len: f64, width: f64) -> Result<u64, GcodeError> {
+    match code {
+        "G25" => {
+            let n = line_droplet_count_f64(len, width);
+            if !n.is_finite() {
+                return Err(GcodeError(format!(
+                    "line {no}: a G25 of {} mm with droplets every {} mm has no droplet count",
+                    precise(len, 6),
+                    precise(width, 4)
+                )));
+            }
+            Ok(n as u64)
+        }
+        "G26" => Ok(1),
+        _ => Ok(0),
     }
 }
 

@@ -255,8 +255,7 @@ mod tests {
     fn the_grid_finds_a_droplet_within_reach_as_a_scan_of_every_droplet_does() {
         // Droplets of two widths in clusters and a sparse spread, queries inside and outside
         // the grid and right at the reach: the grid answers "is there one" as a full scan.
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut random = || crate::base::testing::random(&mut seed);
+        let mut random = crate::base::testing::rng(0x2545_f491_4f6c_dd1du64);
         let (b, b1, limit) = (0.208, 0.15, 0.104);
         let reach = |w: f64| w / 2.0 + limit;
         let (mut found, mut missed) = (0, 0);

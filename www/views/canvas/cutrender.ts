@@ -6,19 +6,10 @@
 // (the core's intervals, at 6 heights per slab) over them; the current layer outlined. Only
 // layers and droplets in view are drawn, batched into one Path2D per colour.
 
-import type { CutCanvas } from "../page";
+import type { CutView } from "../../core/view";
+import type { CutCanvas, CutLayer } from "../page";
 import { PanZoomCanvas } from "./panzoom";
 import { CLASS_COLORS, CLASS_ORDER, drawTag, dropletClass, VOID_RGB } from "./render";
-
-/** One layer of the cut: what the page or the core found along the line. */
-export interface CutLayer {
-  /** t, d (mm) and role per droplet whose footprint the plane crosses. */
-  near: Float64Array;
-  /** The part's region along the line: t0, t1 per span (from the core; null until then). */
-  spans: Float64Array | null;
-  /** The 3D estimate's voids: band, t0, t1 per void (from the core; null until then). */
-  voids: Float64Array | null;
-}
 
 /** Colour of a droplet of the cut by its role and discharge unit (render.ts `dropletClass`:
  *  the support and the parts of each unit but unit 0 have colours of their own). */
@@ -31,14 +22,6 @@ const CURRENT_COLOR = "#1c2430";
 const AXIS_COLOR = "#495057";
 const MARGIN_LEFT = 54;
 const MARGIN_BOTTOM = 30;
-
-export interface CutView {
-  /** CSS pixels per mm (both axes). */
-  scale: number;
-  /** mm along the line and z (mm) at the plot's centre. */
-  ct: number;
-  cz: number;
-}
 
 export class CutRenderer extends PanZoomCanvas implements CutCanvas {
   layers = new Map<number, CutLayer>();

@@ -5,6 +5,7 @@
 // double-click fit) both canvases share.
 
 import { clampView, MAX_SCALE, MIN_SCALE, type View } from "../../core/view";
+import type { PanZoom } from "../page";
 import { sizeCanvas, watchCanvas } from "./hidpi";
 
 export abstract class PanZoomCanvas {
@@ -91,13 +92,6 @@ export abstract class PanZoomCanvas {
     const v = this.view;
     return [(x - v.cx) * v.scale + ox, -(y - v.cy) * v.scale + oy];
   }
-}
-
-/** The zoom and pan a canvas has for what it shows. */
-export interface PanZoom {
-  readonly canvas: HTMLCanvasElement;
-  zoomAt(px: number, py: number, factor: number): void;
-  panBy(dxPx: number, dyPx: number): void;
 }
 
 /** Wheel zoom about the pointer, drag pan and double-click `fit` on `target`'s canvas;

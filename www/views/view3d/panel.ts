@@ -16,7 +16,8 @@ import { openPartMenu, openSelectedPartMenu } from "../contextmenu";
 import { $, el, unitRows } from "../dom";
 import { unitsOf } from "../../core/units";
 import type { Page, View3DView } from "../page";
-import type { Camera3D, View3D, View3DPart, View3DSlice } from "./view3d";
+import type { Camera3D } from "../../core/view";
+import type { View3D, View3DPart, View3DSlice } from "./view3d";
 
 /** The 3D view's id of an instance, and back. */
 export const instanceId = (part: number, copy: number) => `${part}:${copy}`;

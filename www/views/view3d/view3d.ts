@@ -70,6 +70,7 @@ import {
   Box3,
 } from "three";
 import { OrbitControls } from "three/examples/jsm/controls/OrbitControls.js";
+import type { Camera3D } from "../../core/view";
 import { disposeObject, plateObjects } from "./plate3d";
 import { showSupport } from "./support3d";
 import { MAX_UNITS, UNIT_COLORS_3D } from "../../core/units";
@@ -87,8 +88,6 @@ export interface View3DPart {
   /** Off the plate: drawn in the warning colour. */
   warn?: boolean;
 }
-
-export type Camera3D = { position: [number, number, number]; target: [number, number, number] };
 
 export interface View3DSlice {
   layerHeight: number;

@@ -374,17 +374,30 @@ impl Reader<'_> {
             }
             v[k] = c;
         }
-        if let Some((
-            _,
-            Object {
-                content: Content::Mesh { vertices, .. },
-                ..
-            },
-        )) = self.cur.as_mut()
-        {
+        if let Some((_, vertices, _)) = self.mesh() {
             vertices.push(v);
         }
         Ok(())
+    }
+
+    /// The object being read, if it is a mesh: its id, vertices and triangles.
+    #[allow(clippy::type_complexity)]
+    fn mesh(&mut self) -> Option<(u32, &mut Vec<[f32; 3]>, &mut Vec<[u32; 3]>)> {
+        match self.cur.as_mut() {
+            Some((
+                id,
+                Object {
+                    content:
+                        Content::Mesh {
+                            vertices,
+                            triangles,
+                            ..
+                        },
+                    ..
+                },
+            )) => Some((*id, vertices, triangles)),
+            _ => None,
+        }
     }
 
     /// A `<triangle>` of the object's mesh: three indices of vertices listed before it.
@@ -400,19 +413,7 @@ impl Reader<'_> {
             index(attr(attrs, "v2"), "a triangle's v2", p)?,
             index(attr(attrs, "v3"), "a triangle's v3", p)?,
         ];
-        if let Some((
-            id,
-            Object {
-                content:
-                    Content::Mesh {
-                        vertices,
-                        triangles,
-                        ..
-                    },
-                ..
-            },
-        )) = self.cur.as_mut()
-        {
+        if let Some((id, vertices, triangles)) = self.mesh() {
             // 3MF lists the vertices before the triangles.
             if let Some(&bad) = t.iter().find(|&&i| i as usize >= vertices.len()) {
                 return Err(err(format!(
