@@ -307,14 +307,16 @@ pub struct Preparing {
 
 #[wasm_bindgen]
 impl Preparing {
-    /// Runs the next pass of the preparation: true once the job is made (then
+    /// Works through about `items` items of the preparation (facets, corners, vertices: the
+    /// page picks a number that keeps a call short): true once the job is made (then
     /// [`Session::from_preparation`]). Throws `{kind, message, setting?}` as `from_models`
     /// does when the job is refused.
-    pub fn step(&mut self) -> Result<bool, JsValue> {
+    pub fn step(&mut self, items: u32) -> Result<bool, JsValue> {
         if self.job.is_some() {
             return Ok(true);
         }
-        let made = stages::time(Stage::Prepare, || self.prep.step()).map_err(js_error)?;
+        let made =
+            stages::time(Stage::Prepare, || self.prep.step(items as usize)).map_err(js_error)?;
         self.job = made;
         Ok(self.job.is_some())
     }
@@ -371,15 +373,13 @@ impl Session {
     }
 
     /// [`Session::from_models`] in short calls (the page's engine keeps a running call's
-    /// first code to its end, so later calls get the well-compiled code): this call welds and
-    /// places the parts; [`Preparing::step`] runs the rest one pass a call until it returns
-    /// true; [`Session::from_preparation`] takes the job. The same job as `from_models`.
+    /// first code to its end, so later calls get the well-compiled code): this call reads the
+    /// job; [`Preparing::step`] works through a budget of items a call (weld, placing,
+    /// shells, facet index, statistics, checks) until it returns true;
+    /// [`Session::from_preparation`] takes the job. The same job as `from_models`.
     pub fn begin(models: &Models, job: JsValue) -> Result<Preparing, JsValue> {
         let spec = job_of(job)?;
-        let prep = stages::time(Stage::Prepare, || {
-            Job::prepare_in_steps(&models.models, &spec)
-        })
-        .map_err(js_error)?;
+        let prep = Job::prepare_in_steps(models.models.clone(), &spec);
         Ok(Preparing { prep, job: None })
     }
 
