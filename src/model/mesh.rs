@@ -376,18 +376,35 @@ fn bounds_of(vertices: &[[f64; 3]]) -> Bounds {
 /// they lie: a build job places each instance's vertices after copying them into the merged
 /// mesh, with no placed copy between.
 pub fn place_vertices(vertices: &mut [[f64; 3]], p: &Placement) {
+    steps::now(place_vertices_in_steps(vertices, p, &steps::UNLIMITED))
+}
+
+/// [`place_vertices`] in resumable steps ([`steps::runs`]).
+pub async fn place_vertices_in_steps(vertices: &mut [[f64; 3]], p: &Placement, budget: &Budget) {
     let r = rotation(p.rotate);
     let scale = DVec3::from(p.scale);
-    for v in vertices.iter_mut() {
-        *v = (r * DVec3::from(*v) * scale).to_array();
-    }
-    let b = bounds_of(vertices);
+    steps::runs(vertices.len(), budget, &mut |run| {
+        for v in vertices[run].iter_mut() {
+            *v = (r * DVec3::from(*v) * scale).to_array();
+        }
+    })
+    .await;
+    let mut b = Bounds::EMPTY;
+    steps::runs(vertices.len(), budget, &mut |run| {
+        for v in &vertices[run] {
+            b.grow(*v, *v);
+        }
+    })
+    .await;
     let place = rot(2, p.place_angle);
     let min = DVec3::from(b.min);
-    for v in vertices.iter_mut() {
-        let q = place * (DVec3::from(*v) - min);
-        *v = [q.x + p.place[0], q.y + p.place[1], q.z];
-    }
+    steps::runs(vertices.len(), budget, &mut |run| {
+        for v in vertices[run].iter_mut() {
+            let q = place * (DVec3::from(*v) - min);
+            *v = [q.x + p.place[0], q.y + p.place[1], q.z];
+        }
+    })
+    .await;
 }
 
 /// Each facet's corners in the other order (its normal reversed): after a mirroring

@@ -187,11 +187,13 @@ impl Job {
             if facets > MAX_JOB_TRIANGLES {
                 return Err(too_many_triangles());
             }
-            let frame = Frame::of(
+            let frame = Frame::of_in_steps(
                 &mesh.vertices,
                 |v| [*v],
                 &p.placement([0.0, 0.0], &settings),
-            );
+                budget,
+            )
+            .await;
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
                 return Err(Error::Import(format!(
                     "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
@@ -240,7 +242,10 @@ impl Job {
         let mesh = if let [only] = order[..] {
             let mut mesh = std::mem::take(&mut welded[only.part]);
             let placement = spec.parts[only.part].placement(only.shift, &settings);
-            mesh.place(&placement);
+            mesh::place_vertices_in_steps(&mut mesh.vertices, &placement, budget).await;
+            if placement.mirrors() {
+                mesh::turn_facets(&mut mesh.facets);
+            }
             add_to_run(only.part, mesh.facets.len());
             mesh
         } else {
@@ -257,7 +262,7 @@ impl Job {
                 mesh.facets
                     .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
                 let placement = spec.parts[inst.part].placement(inst.shift, &settings);
-                mesh::place_vertices(&mut mesh.vertices[base..], &placement);
+                mesh::place_vertices_in_steps(&mut mesh.vertices[base..], &placement, budget).await;
                 if placement.mirrors() {
                     mesh::turn_facets(&mut mesh.facets[first..]);
                 }

@@ -12,8 +12,9 @@
 //! console, and the worker turns the trap that follows into an error message.
 //!
 //! The model comes in as a `File` read in the worker ([`Session::from_file`], `FileReaderSync`),
-//! so the page's thread never copies its bytes. Every worker prepares the job from its own
-//! import of the files ([`Session::from_models`]), all at the same time.
+//! so the page's thread never copies its bytes. The job worker prepares the job from its
+//! import of the files in short calls ([`Session::begin`]) and hands it to the others as
+//! bytes ([`Session::prepared`], [`Session::from_prepared`]).
 //!
 //! The core knows nothing of wasm; this file only converts.
 
@@ -297,6 +298,28 @@ struct SliceFigures {
     nothing_to_print: Option<ErrorReport>,
 }
 
+/// A buffer outside the module's memory, as the hand-off's sink and source.
+struct JsBytes(Uint8Array);
+
+impl crate::pipeline::handoff::Sink for JsBytes {
+    fn write(&mut self, at: usize, bytes: &[u8]) {
+        self.0
+            .subarray(at as u32, (at + bytes.len()) as u32)
+            .copy_from(bytes);
+    }
+}
+
+impl crate::pipeline::handoff::Source for JsBytes {
+    fn len(&self) -> usize {
+        self.0.length() as usize
+    }
+    fn read(&self, at: usize, out: &mut [u8]) {
+        self.0
+            .subarray(at as u32, (at + out.len()) as u32)
+            .copy_to(out);
+    }
+}
+
 /// A job being prepared in short calls ([`Session::begin`]).
 #[wasm_bindgen]
 pub struct Preparing {
@@ -396,15 +419,22 @@ impl Session {
 
     /// The prepared job as bytes ([`Job::to_bytes`]), for [`Session::from_prepared`] in the
     /// page's other workers: they take this worker's preparation instead of repeating it.
-    /// (Not counted as `Prepare`: the worker times it on its own line of the profile.)
-    pub fn prepared(&self) -> Vec<u8> {
-        self.job.to_bytes()
+    /// Written a run at a time straight into a new buffer outside the module's memory, so
+    /// this worker never holds the job twice. (Not counted as `Prepare`: the worker times it
+    /// on its own line of the profile.)
+    pub fn prepared(&self) -> Uint8Array {
+        let (size, write) = self.job.bytes_writer();
+        let out = Uint8Array::new_with_length(size as u32);
+        write(&mut JsBytes(out.clone()));
+        out
     }
 
-    /// The job another worker prepared ([`Session::prepared`]). Throws `{kind: "internal",
-    /// message}` if the bytes are damaged.
-    pub fn from_prepared(bytes: &[u8]) -> Result<Session, JsValue> {
-        let job = stages::time(Stage::Prepare, || Job::from_bytes(bytes)).map_err(js_error)?;
+    /// The job another worker prepared ([`Session::prepared`]), read a run at a time out of
+    /// the message's buffer (never copied whole into the module's memory). Throws `{kind:
+    /// "internal", message}` if the bytes are damaged.
+    pub fn from_prepared(bytes: Uint8Array) -> Result<Session, JsValue> {
+        let source = JsBytes(bytes);
+        let job = stages::time(Stage::Prepare, || Job::read_bytes(&source)).map_err(js_error)?;
         Ok(Session::with(job))
     }
 

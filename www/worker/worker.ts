@@ -133,14 +133,18 @@ function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analy
   }
 }
 
-/** `Session.from_models` in short calls (`Session.begin`, then a pass a call): the engine
- *  keeps a running call's first code to its end, so a call that ran the whole preparation
- *  ran it all in that code; later calls of a pass get the optimised code. */
+/** Items (facets, corners, vertices) per call of the preparation: a few milliseconds of
+ *  the engine's first code, less once it is optimised. */
+const PREPARE_ITEMS = 16_384;
+
+/** `Session.from_models` in short calls (`Session.begin`, then a budget of items a call):
+ *  the engine keeps a running call's first code to its end, so a call that ran the whole
+ *  preparation ran it all in that code; later calls of a pass get the optimised code. */
 function prepare(m: Models, job: RequestData<"open_job">["job"]): Session {
   const p = timedCall("core: preparation, the longest call", () => Session.begin(m, job));
   let done = false;
   try {
-    while (!done) done = timedCall("core: preparation, the longest call", () => p.step());
+    while (!done) done = timedCall("core: preparation, the longest call", () => p.step(PREPARE_ITEMS));
   } catch (e) {
     p.free();
     throw e;
