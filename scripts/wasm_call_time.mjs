@@ -62,6 +62,8 @@ for (let k = 0; k < passes; k++) {
   const hand = { sum: 0, max: 0, calls: 0 };
   const bytesOut = timed(hand, () => s.prepared());
   timed(hand, () => core.Session.from_prepared(bytesOut)).free();
+  const support = { sum: 0, max: 0, calls: 0 };
+  if (typeof s.support_step === "function") while (!timed(support, () => s.support_step(4)));
   const layers = { sum: 0, max: 0, calls: 0, each: [] };
   for (let i = 0; i < s.layer_count(); i++) timed(layers, () => s.slice_layer(i)).free();
   s.free();
@@ -71,5 +73,5 @@ for (let k = 0; k < passes; k++) {
     return `layer ${i}`;
   };
   const shown = prep.each.length > 24 ? `${prep.each.slice(0, 24).map((t) => t.toFixed(0)).join(", ")}, …` : prep.each.map((t) => t.toFixed(0)).join(", ");
-  console.log(`pass ${k + 1}: preparation ${f(prep)} (${shown}); hand-off (prepared, from_prepared) ${f(hand)}; layers ${f(layers)} (${longest(layers)})`);
+  console.log(`pass ${k + 1}: preparation ${f(prep)} (${shown}); hand-off (prepared, from_prepared) ${f(hand)}; supported pass ${f(support)}; layers ${f(layers)} (${longest(layers)})`);
 }

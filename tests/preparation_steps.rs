@@ -201,3 +201,39 @@ fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
         "too big",
     );
 }
+
+#[test]
+fn the_supported_pass_in_steps_plans_every_layer_alike() {
+    use dropslice::base::steps::{Budget, Stepped};
+    use std::rc::Rc;
+    let spec =
+        JobSpec::from_json(r#"{"settings": {"support": "unit1"}, "parts": [{"file": "u.obj"}]}"#)
+            .unwrap();
+    let u = Model::read(&common::model_bytes("U_overhang.obj"), "u.obj").unwrap();
+    let models = [u];
+    let whole = gcode(&Job::from_models(&models, &spec).unwrap());
+    for items in [1, 7, usize::MAX] {
+        let job = Rc::new(Job::from_models(&models, &spec).unwrap());
+        let budget = Rc::new(Budget::new(0));
+        let (j, b) = (job.clone(), budget.clone());
+        let mut pass = Stepped::new(async move { j.supported_in_steps(&b).await });
+        let mut steps = 0;
+        loop {
+            budget.refill(items);
+            steps += 1;
+            if pass.step().is_some() {
+                break;
+            }
+            assert!(!job.supported_made(), "made before its last step");
+        }
+        assert!(job.supported_made());
+        if items == 1 {
+            // four passes of one item a layer, two undivided
+            assert!(steps > 4 * job.layer_count(), "{steps} steps");
+        }
+        assert!(
+            gcode(&job) == whole,
+            "{items} layers a step: the G-code differs"
+        );
+    }
+}

@@ -34,6 +34,7 @@ use crate::analysis;
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
 use crate::base::stages::{self, Stage};
+use crate::base::steps::{Budget, Stepped};
 use crate::model::spec as job;
 use crate::output::gcode;
 use crate::output::summary::{Figures, Summary};
@@ -254,7 +255,8 @@ impl Session {
             raster: std::cell::RefCell::new(analysis::Raster::empty()),
             stage: std::sync::Arc::new(analysis::LayerStage::new(&job.analysis_grid(), &settings)),
             analysis_refused: job.analysis_grid().check(&settings).err(),
-            job,
+            job: std::rc::Rc::new(job),
+            support_pass: std::cell::RefCell::new(None),
             settings,
         }
     }
@@ -297,6 +299,9 @@ struct SliceFigures {
     figures: Figures,
     nothing_to_print: Option<ErrorReport>,
 }
+
+/// The supported pass being made in steps, and its budget.
+type SupportPass = (std::rc::Rc<Budget>, Stepped<()>);
 
 /// A buffer outside the module's memory, as the hand-off's sink and source.
 struct JsBytes(Uint8Array);
@@ -348,7 +353,10 @@ impl Preparing {
 /// One prepared slicing job: the parsed, transformed mesh and its settings.
 #[wasm_bindgen]
 pub struct Session {
-    pub(crate) job: Job,
+    /// Shared with the supported pass while it runs in steps ([`Session::support_step`]).
+    pub(crate) job: std::rc::Rc<Job>,
+    /// The supported pass in steps, while it runs, and its budget.
+    support_pass: std::cell::RefCell<Option<SupportPass>>,
     pub(crate) settings: Settings,
     /// The last layer planned and the unit selected after it.
     unit_after: std::cell::Cell<Option<(usize, u8)>>,
@@ -436,6 +444,28 @@ impl Session {
         let source = JsBytes(bytes);
         let job = stages::time(Stage::Prepare, || Job::read_bytes(&source)).map_err(js_error)?;
         Ok(Session::with(job))
+    }
+
+    /// Works through about `items` layers' worth of the supported pass (`support = unit1`:
+    /// every layer's plan with the support, which the first layer planned would otherwise
+    /// make whole in one call; [`Job::supported_in_steps`]): true once it is made, at once
+    /// when the support is off. The page calls it until true before it plans layers.
+    pub fn support_step(&self, items: u32) -> bool {
+        if self.job.settings().support != settings::Support::Unit1 || self.job.supported_made() {
+            return true;
+        }
+        let mut pass = self.support_pass.borrow_mut();
+        let (budget, stepped) = pass.get_or_insert_with(|| {
+            let budget = std::rc::Rc::new(Budget::new(0));
+            let (job, b) = (self.job.clone(), budget.clone());
+            let run = Stepped::new(async move { job.supported_in_steps(&b).await });
+            (budget, run)
+        });
+        budget.refill(items as usize);
+        if stepped.step().is_some() {
+            *pass = None;
+        }
+        self.job.supported_made()
     }
 
     /// Number of layers.

@@ -99,7 +99,17 @@ function yieldToQueue(): Promise<void> {
   });
 }
 
+/** Layers per call of the supported pass. */
+const SUPPORT_ITEMS = 4;
+
+/** With `support = unit1`: the supported pass (every layer's plan with the support) in short
+ *  calls, before the first layer is planned (which would otherwise make it in one call). */
+function supported(s: Session): void {
+  while (!timedCall("core: the supported pass, the longest call", () => s.support_step(SUPPORT_ITEMS)));
+}
+
 function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analyse = false, counted = true): LayerData {
+  supported(s);
   const r = clock.time("core: a layer (all its stages)", () =>
     timedCall("core: a layer, the longest call", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index))),
   );
@@ -382,7 +392,9 @@ async function handle(req: Request): Promise<void> {
       return;
     case "cut": {
       const { line, from, to, sent, centres } = req.data;
-      const r = need().cut(Float64Array.from(line), from, to, sent, centres);
+      const s = need();
+      supported(s);
+      const r = s.cut(Float64Array.from(line), from, to, sent, centres);
       try {
         const reply = { droplets: r.droplets, spans: r.spans, voids: r.voids, bands: r.bands };
         answer(req.kind, req.id, reply, [reply.droplets.buffer, reply.spans.buffer, reply.voids.buffer]);
