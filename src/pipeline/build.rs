@@ -463,7 +463,6 @@ impl Building {
         // The support's overhang figures for the estimate beside what is left of the
         // statistics and the facet index.
         let (stats, index) = (c.stats.take(), c.index.take());
-        let c = c;
         let (overhangs, repaired) = both(
             || c.overhangs(),
             || {
