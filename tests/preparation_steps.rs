@@ -1,9 +1,10 @@
 //! The job's preparation in steps (`Job::prepare_in_steps`, `Preparation::step`: the page's
-//! short calls) makes exactly the job of `Job::from_models`: the same bytes handed to the
-//! page's other workers (mesh, facet index, plane heights, settings, info) and the same
-//! G-code, on the shared models and on meshes that take every branch of the preparation
-//! (repeated facets, an inside-out shell, a crack closed, an open part); a refusal is the
-//! same refusal, and a step after the end is an error, never a panic.
+//! short calls, each of a budget of items) makes exactly the job of `Job::from_models`,
+//! whatever the budget (one run of items a step, a few runs, more than the whole job): the
+//! same bytes handed to the page's other workers (mesh, facet index, plane heights,
+//! settings, info) and the same G-code, on the shared models and on meshes that take every
+//! branch of the preparation (repeated facets, an inside-out shell, a crack closed, an open
+//! part); a refusal is the same refusal, and a step after the end is an error, never a panic.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
@@ -11,6 +12,10 @@ mod common;
 use dropslice::Job;
 use dropslice::model::models::Model;
 use dropslice::model::spec::JobSpec;
+use std::sync::Arc;
+
+/// The budgets every preparation is stepped with: one item (a run a step), a few runs, all.
+const BUDGETS: [usize; 3] = [1, 20_000, usize::MAX];
 
 type Tri = [[f32; 3]; 3];
 
@@ -36,49 +41,67 @@ fn gcode(job: &Job) -> Vec<u8> {
     out
 }
 
-/// Steps the preparation to its end; the number of steps beside the job (or the refusal).
-fn in_steps(models: &[Model], spec: &JobSpec) -> (Result<Job, String>, usize) {
-    let mut prep = match Job::prepare_in_steps(models, spec) {
-        Ok(p) => p,
-        Err(e) => return (Err(e.to_string()), 0),
-    };
-    for n in 1..=20 {
-        match prep.step() {
+/// Steps the preparation to its end with `budget` items a step; the number of steps beside
+/// the job (or the refusal).
+fn in_steps(models: &[Model], spec: &JobSpec, budget: usize) -> (Result<Job, String>, usize) {
+    let mut prep = Job::prepare_in_steps(Arc::new(models.to_vec()), spec);
+    for n in 1..=1_000_000 {
+        match prep.step(budget) {
             Ok(Some(job)) => {
                 // nothing is left once the job was handed out
-                let after = prep.step().map(|_| ()).unwrap_err().to_string();
+                let after = prep.step(budget).map(|_| ()).unwrap_err().to_string();
                 assert!(after.contains("already ended"), "{after}");
                 return (Ok(job), n);
             }
             Ok(None) => {}
             Err(e) => {
-                assert!(prep.step().is_err(), "a step after a refusal");
+                assert!(prep.step(budget).is_err(), "a step after a refusal");
                 return (Err(e.to_string()), n);
             }
         }
     }
-    panic!("the preparation did not end in 20 steps");
+    panic!("the preparation did not end in a million steps");
 }
 
-/// The stepped preparation of `spec` is the one-call preparation; returns its step count.
-fn assert_same(models: &[Model], spec: &str, what: &str) -> usize {
+/// The stepped preparation of `spec` is the one-call preparation, with every budget of
+/// [`BUDGETS`] (the G-code compared once); returns the step counts.
+fn assert_same(models: &[Model], spec: &str, what: &str) -> Vec<usize> {
     let spec = JobSpec::from_json(spec).unwrap();
     let whole = Job::from_models(models, &spec).map_err(|e| e.to_string());
-    let (stepped, steps) = in_steps(models, &spec);
-    match (whole, stepped) {
-        (Ok(a), Ok(b)) => {
-            assert!(a.to_bytes() == b.to_bytes(), "{what}: other bytes");
-            assert_eq!(a.info(), b.info(), "{what}: info");
-            assert!(gcode(&a) == gcode(&b), "{what}: the G-code differs");
+    let whole_code = whole.as_ref().ok().map(gcode);
+    let mut counts = Vec::new();
+    for budget in BUDGETS {
+        let (stepped, steps) = in_steps(models, &spec, budget);
+        counts.push(steps);
+        match (&whole, stepped) {
+            (Ok(a), Ok(b)) => {
+                assert!(
+                    a.to_bytes() == b.to_bytes(),
+                    "{what}, {budget}: other bytes"
+                );
+                assert_eq!(a.info(), b.info(), "{what}, {budget}: info");
+                if budget == BUDGETS[1] {
+                    assert!(
+                        whole_code.as_ref() == Some(&gcode(&b)),
+                        "{what}: the G-code differs"
+                    );
+                }
+            }
+            (Err(a), Err(b)) => assert_eq!(*a, b, "{what}, {budget}: another refusal"),
+            (a, b) => panic!(
+                "{what}, {budget}: one call {:?}, in steps {:?}",
+                a.as_ref().map(|_| "a job"),
+                b.map(|_| "a job")
+            ),
         }
-        (Err(a), Err(b)) => assert_eq!(a, b, "{what}: another refusal"),
-        (a, b) => panic!(
-            "{what}: one call {:?}, in steps {:?}",
-            a.map(|_| "a job"),
-            b.map(|_| "a job")
-        ),
     }
-    steps
+    // a smaller budget never takes fewer steps; all of it, one
+    assert!(
+        counts.windows(2).all(|w| w[0] >= w[1]),
+        "{what}: {counts:?}"
+    );
+    assert_eq!(counts[2], 1, "{what}: an unlimited budget is one step");
+    counts
 }
 
 fn model(tris: &[Tri], name: &str) -> Model {
@@ -99,8 +122,9 @@ fn the_shared_models_prepare_alike_in_steps() {
         let spec = format!(r#"{{"parts": [{{"file": {name:?}}}]}}"#);
         let steps = assert_same(&[m], &spec, &name);
         if name == "3DBenchy.stl" {
-            // shells, index, cracks, orientation, statistics, the rest
-            assert_eq!(steps, 6, "{name}");
+            // 225,154 facets: a budget of one item pauses after every run of 4,096 items
+            // (the weld alone takes 55 runs), a budget of 20,000 after every fifth
+            assert!(steps[0] > 200 && steps[1] > 40, "{name}: {steps:?}");
         }
     }
 }
@@ -123,14 +147,10 @@ fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
     // repeated facets: dropped, the index not built beside the shells
     let mut repeated = cube.clone();
     repeated.extend_from_slice(&cube[..3]);
-    let steps = assert_same(
+    assert_same(
         &[model(&repeated, "r.stl")],
         r#"{"parts": [{"file": "r.stl"}]}"#,
         "repeated facets",
-    );
-    assert_eq!(
-        steps, 5,
-        "no index beside the shells when facets are dropped"
     );
     // an inside-out cavity box inside a box: one shell turned
     let mut cavity = cube.clone();
@@ -180,4 +200,40 @@ fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
         r#"{"parts": [{"file": "b.stl", "scale_x": 40, "scale_y": 40, "scale_z": 2}]}"#,
         "too big",
     );
+}
+
+#[test]
+fn the_supported_pass_in_steps_plans_every_layer_alike() {
+    use dropslice::base::steps::{Budget, Stepped};
+    use std::rc::Rc;
+    let spec =
+        JobSpec::from_json(r#"{"settings": {"support": "unit1"}, "parts": [{"file": "u.obj"}]}"#)
+            .unwrap();
+    let u = Model::read(&common::model_bytes("U_overhang.obj"), "u.obj").unwrap();
+    let models = [u];
+    let whole = gcode(&Job::from_models(&models, &spec).unwrap());
+    for items in [1, 7, usize::MAX] {
+        let job = Rc::new(Job::from_models(&models, &spec).unwrap());
+        let budget = Rc::new(Budget::new(0));
+        let (j, b) = (job.clone(), budget.clone());
+        let mut pass = Stepped::new(async move { j.supported_in_steps(&b).await });
+        let mut steps = 0;
+        loop {
+            budget.refill(items);
+            steps += 1;
+            if pass.step().is_some() {
+                break;
+            }
+            assert!(!job.supported_made(), "made before its last step");
+        }
+        assert!(job.supported_made());
+        if items == 1 {
+            // four passes of one item a layer, two undivided
+            assert!(steps > 4 * job.layer_count(), "{steps} steps");
+        }
+        assert!(
+            gcode(&job) == whole,
+            "{items} layers a step: the G-code differs"
+        );
+    }
 }

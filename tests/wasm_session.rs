@@ -1043,17 +1043,17 @@ fn the_predicted_density_per_unit_is_the_same_in_any_runs_of_layers() {
     assert!(f["figures"]["predicted_density"].is_null(), "{f}");
 }
 
-/// Steps `Session::begin`'s preparation to its end (at most 20 steps).
+/// Steps `Session::begin`'s preparation to its end, one run of items a step.
 fn prepared_in_steps(models: &Models, job: &serde_json::Value) -> Result<Session, JsValue> {
     let mut p = Session::begin(models, js(job.clone()))?;
-    for _ in 0..20 {
-        if p.step()? {
+    for _ in 0..10_000 {
+        if p.step(1)? {
             // a step after the end changes nothing
-            assert!(p.step().unwrap());
+            assert!(p.step(1).unwrap());
             return Session::from_preparation(p);
         }
     }
-    panic!("the preparation did not end in 20 steps");
+    panic!("the preparation did not end in 10,000 steps");
 }
 
 #[wasm_bindgen_test]
@@ -1062,7 +1062,13 @@ fn the_preparation_in_short_calls_is_the_one_call_preparation() {
     let job = serde_json::json!({"parts": [{"file": "a.stl"}, {"file": "b.stl", "copies": 2}]});
     let whole = Session::from_models(&models, js(job.clone())).unwrap();
     let stepped = prepared_in_steps(&models, &job).unwrap();
-    assert!(whole.prepared() == stepped.prepared(), "other bytes");
+    assert!(
+        whole.prepared().to_vec() == stepped.prepared().to_vec(),
+        "other bytes"
+    );
+    // the hand-off's bytes make the same session in another worker
+    let other = Session::from_prepared(stepped.prepared()).unwrap();
+    assert!(other.prepared().to_vec() == whole.prepared().to_vec());
     assert_eq!(json(whole.info().unwrap()), json(stepped.info().unwrap()));
     for i in 0..whole.layer_count() {
         let (a, b) = (

@@ -9,6 +9,7 @@ pub mod parallel;
 pub mod settings;
 pub mod spatial;
 pub mod stages;
+pub mod steps;
 #[cfg(test)]
 pub(crate) mod testing;
 

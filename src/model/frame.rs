@@ -3,7 +3,7 @@
 //! share.
 
 use crate::base::geom::{DMat3, DVec3};
-use crate::base::parallel::in_runs;
+use crate::base::steps::{self, Budget};
 use crate::model::mesh::{Placement, rot, rotation};
 use serde::{Deserialize, Serialize};
 
@@ -25,12 +25,22 @@ impl Frame {
     /// The frame of the part's points under `p` (its `place` is not used): `corners(item)` of
     /// every item in order (a vertex, or a triangle's three corners). The same arithmetic as
     /// [`crate::model::mesh::Mesh::place`], so `qmin + place` is exactly the placed mesh's
-    /// bounding box. Each pass runs in runs of items ([`in_runs`]: the page's engine compiles
+    /// bounding box. Each pass runs in runs of items ([`steps::runs`]: the page's engine compiles
     /// the later runs well).
     pub fn of<T, const K: usize>(
         items: &[T],
         corners: impl Fn(&T) -> [[f64; 3]; K],
         p: &Placement,
+    ) -> Option<Frame> {
+        steps::now(Frame::of_in_steps(items, corners, p, &steps::UNLIMITED))
+    }
+
+    /// [`Frame::of`] in resumable steps ([`steps::runs`]).
+    pub async fn of_in_steps<T, const K: usize>(
+        items: &[T],
+        corners: impl Fn(&T) -> [[f64; 3]; K],
+        p: &Placement,
+        b: &Budget,
     ) -> Option<Frame> {
         if items.is_empty() || K == 0 {
             return None;
@@ -39,22 +49,24 @@ impl Frame {
         let scale = DVec3::from(p.scale);
         let step1 = |v: [f64; 3]| r * DVec3::from(v) * scale;
         let (mut min1, mut max1) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        in_runs(items.len(), &mut |run| {
+        steps::runs(items.len(), b, &mut |run| {
             for v in items[run].iter().flat_map(&corners) {
                 let q = step1(v);
                 min1 = min1.min(q);
                 max1 = max1.max(q);
             }
-        });
+        })
+        .await;
         let angle = rot(2, p.place_angle);
         let (mut qmin, mut qmax) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
-        in_runs(items.len(), &mut |run| {
+        steps::runs(items.len(), b, &mut |run| {
             for v in items[run].iter().flat_map(&corners) {
                 let q = angle * (step1(v) - min1);
                 qmin = qmin.min(q);
                 qmax = qmax.max(q);
             }
-        });
+        })
+        .await;
         Some(Frame {
             rotation: r,
             scale,

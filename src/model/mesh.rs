@@ -6,6 +6,7 @@
 use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
 use crate::base::parallel::in_runs;
 use crate::base::settings::Settings;
+use crate::base::steps::{self, Budget};
 pub use crate::model::weld::{WELD_RESERVE_BYTES, keeps_facet, reserve_entries};
 
 /// A welded triangle mesh in millimetres.
@@ -128,47 +129,56 @@ impl Mesh {
     /// Per facet, whether [`remove_duplicate_facets`](Self::remove_duplicate_facets) keeps it:
     /// false for a repeat of an earlier facet. Reads the mesh only.
     pub fn unrepeated_facets(&self) -> Vec<bool> {
+        steps::now(self.unrepeated_in_steps(&steps::UNLIMITED))
+    }
+
+    /// [`Mesh::unrepeated_facets`] in resumable steps ([`steps::runs`]).
+    pub async fn unrepeated_in_steps(&self, b: &Budget) -> Vec<bool> {
         // Each facet as the cyclic rotation starting at its smallest vertex id; two facets are
         // equal exactly when these are. The facets are bucketed by that smallest vertex (in
         // their order), and within a bucket a facet is a repeat when an earlier one equals it:
         // a few sequential passes instead of a hash set of every facet.
-        // (Each pass in runs: [`in_runs`].)
+        // (Each pass in runs: [`steps::runs`].)
         let mut canon: Vec<[u32; 3]> = Vec::with_capacity(self.facets.len());
-        in_runs(self.facets.len(), &mut |r| {
+        steps::runs(self.facets.len(), b, &mut |r| {
             canon.extend(self.facets[r].iter().map(|f| {
                 let k = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
                 [f[k], f[(k + 1) % 3], f[(k + 2) % 3]]
             }))
-        });
+        })
+        .await;
         let n = self
             .vertices
             .len()
             .max(canon.iter().map(|c| c[0] as usize + 1).max().unwrap_or(0));
         let mut start = vec![0u32; n + 1];
-        in_runs(canon.len(), &mut |r| {
+        steps::runs(canon.len(), b, &mut |r| {
             // (slices of their own: their bounds stay in registers through the stores)
             let start = &mut start[..];
             for c in &canon[r] {
                 start[c[0] as usize + 1] += 1;
             }
-        });
-        in_runs(n, &mut |r| {
+        })
+        .await;
+        steps::runs(n, b, &mut |r| {
             for v in r {
                 start[v + 1] += start[v];
             }
-        });
+        })
+        .await;
         let mut next = start.clone();
         let mut order = vec![0u32; canon.len()];
-        in_runs(canon.len(), &mut |r| {
+        steps::runs(canon.len(), b, &mut |r| {
             let (order, next) = (&mut order[..], &mut next[..]);
             for (i, c) in r.clone().zip(&canon[r]) {
                 let at = &mut next[c[0] as usize];
                 order[*at as usize] = i as u32;
                 *at += 1;
             }
-        });
+        })
+        .await;
         let mut kept = vec![true; canon.len()];
-        in_runs(n, &mut |r| {
+        steps::runs(n, b, &mut |r| {
             let (order, kept) = (&mut order[..], &mut kept[..]);
             for v in r {
                 repeats_in(
@@ -177,41 +187,52 @@ impl Mesh {
                     kept,
                 );
             }
-        });
+        })
+        .await;
         kept
     }
 
     /// Number of connected bodies (facets sharing a vertex belong to one body).
     pub fn bodies(&self) -> usize {
-        let root = self.vertex_components();
+        steps::now(self.bodies_in_steps(&steps::UNLIMITED))
+    }
+
+    async fn bodies_in_steps(&self, b: &Budget) -> usize {
+        let root = self.vertex_components(b).await;
         let mut used = vec![false; self.vertices.len()];
-        in_runs(self.facets.len(), &mut |r| {
+        steps::runs(self.facets.len(), b, &mut |r| {
             let used = &mut used[..];
             for f in &self.facets[r] {
                 used[root[f[0] as usize] as usize] = true;
             }
-        });
+        })
+        .await;
         used.iter().filter(|&&u| u).count()
     }
 
     /// Volume enclosed by the facets, signed by their orientation (negative: inside out).
     pub fn signed_volume(&self) -> f64 {
-        // The sum in facet order from −0.0, as `Iterator::sum` adds (in runs: [`in_runs`]).
+        steps::now(self.signed_volume_in_steps(&steps::UNLIMITED))
+    }
+
+    async fn signed_volume_in_steps(&self, b: &Budget) -> f64 {
+        // The sum in facet order from −0.0, as `Iterator::sum` adds (in runs: [`steps::runs`]).
         let mut sum = -0.0;
-        in_runs(self.facets.len(), &mut |r| {
+        steps::runs(self.facets.len(), b, &mut |r| {
             for f in &self.facets[r] {
                 let [a, b, c] = f.map(|i| self.vertices[i as usize]);
                 sum += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
                     + a[2] * (b[0] * c[1] - b[1] * c[0]))
                     / 6.0;
             }
-        });
+        })
+        .await;
         sum
     }
 
     /// The connected piece (a root vertex id) of every vertex; facets sharing a vertex are in
     /// one piece.
-    fn vertex_components(&self) -> Vec<u32> {
+    async fn vertex_components(&self, b: &Budget) -> Vec<u32> {
         let mut parent: Vec<u32> = (0..self.vertices.len() as u32).collect();
         fn find(p: &mut [u32], mut x: u32) -> u32 {
             while p[x as usize] != x {
@@ -220,7 +241,7 @@ impl Mesh {
             }
             x
         }
-        in_runs(self.facets.len(), &mut |r| {
+        steps::runs(self.facets.len(), b, &mut |r| {
             let parent = &mut parent[..];
             for f in &self.facets[r] {
                 let a = find(parent, f[0]);
@@ -231,21 +252,33 @@ impl Mesh {
                     }
                 }
             }
-        });
-        in_runs(parent.len(), &mut |r| {
+        })
+        .await;
+        steps::runs(parent.len(), b, &mut |r| {
             let parent = &mut parent[..];
             for v in r {
                 let root = find(parent, v as u32);
                 parent[v] = root;
             }
-        });
+        })
+        .await;
         parent
     }
 
     /// Edge statistics and signed volume.
     pub fn stats(&self, facets_in_file: usize, degenerate: usize) -> MeshStats {
-        let (open, nonmanifold, misoriented) = self.edge_counts();
-        let signed_volume = self.signed_volume();
+        steps::now(self.stats_in_steps(facets_in_file, degenerate, &steps::UNLIMITED))
+    }
+
+    /// [`Mesh::stats`] in resumable steps ([`steps::runs`]).
+    pub async fn stats_in_steps(
+        &self,
+        facets_in_file: usize,
+        degenerate: usize,
+        b: &Budget,
+    ) -> MeshStats {
+        let (open, nonmanifold, misoriented) = self.edge_counts(b).await;
+        let signed_volume = self.signed_volume_in_steps(b).await;
         MeshStats {
             facets_in_file,
             facets: self.facets.len(),
@@ -255,7 +288,7 @@ impl Mesh {
             nonmanifold_edges: nonmanifold,
             misoriented_edges: misoriented,
             signed_volume,
-            bodies: self.bodies(),
+            bodies: self.bodies_in_steps(b).await,
             tolerance_welded: 0,
             duplicate_facets: 0,
             flipped_shells: 0,
@@ -269,16 +302,21 @@ impl Mesh {
     /// the same way. Every facet's edges are filed under their lower vertex ([`CompressedRows`],
     /// 4 bytes an edge: the other vertex and the direction), and each vertex's few are sorted
     /// and grouped: no sort of all edges, and each row read once.
-    fn edge_counts(&self) -> (usize, usize, usize) {
+    async fn edge_counts(&self, b: &Budget) -> (usize, usize, usize) {
         // The other vertex << 1 | whether the edge runs from the lower vertex. Vertex ids
         // stay below 2^31 (at most 3 per facet, and files over 20 million facets are
         // refused), so the shift loses nothing.
-        let mut rows = CompressedRows::per_corner(self, |_, f, k| {
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            (a.min(b), a.max(b) << 1 | u32::from(a < b))
-        });
+        let mut rows = CompressedRows::per_corner_in_steps(
+            self,
+            |_, f, k| {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                (a.min(b), a.max(b) << 1 | u32::from(a < b))
+            },
+            b,
+        )
+        .await;
         let (mut open, mut nonmanifold, mut misoriented) = (0, 0, 0);
-        in_runs(self.vertices.len(), &mut |r| {
+        steps::runs(self.vertices.len(), b, &mut |r| {
             for v in r {
                 let row = rows.row_mut(v);
                 row.sort_unstable();
@@ -294,7 +332,8 @@ impl Mesh {
                     }
                 }
             }
-        });
+        })
+        .await;
         (open, nonmanifold, misoriented)
     }
 }
@@ -337,18 +376,35 @@ fn bounds_of(vertices: &[[f64; 3]]) -> Bounds {
 /// they lie: a build job places each instance's vertices after copying them into the merged
 /// mesh, with no placed copy between.
 pub fn place_vertices(vertices: &mut [[f64; 3]], p: &Placement) {
+    steps::now(place_vertices_in_steps(vertices, p, &steps::UNLIMITED))
+}
+
+/// [`place_vertices`] in resumable steps ([`steps::runs`]).
+pub async fn place_vertices_in_steps(vertices: &mut [[f64; 3]], p: &Placement, budget: &Budget) {
     let r = rotation(p.rotate);
     let scale = DVec3::from(p.scale);
-    for v in vertices.iter_mut() {
-        *v = (r * DVec3::from(*v) * scale).to_array();
-    }
-    let b = bounds_of(vertices);
+    steps::runs(vertices.len(), budget, &mut |run| {
+        for v in vertices[run].iter_mut() {
+            *v = (r * DVec3::from(*v) * scale).to_array();
+        }
+    })
+    .await;
+    let mut b = Bounds::EMPTY;
+    steps::runs(vertices.len(), budget, &mut |run| {
+        for v in &vertices[run] {
+            b.grow(*v, *v);
+        }
+    })
+    .await;
     let place = rot(2, p.place_angle);
     let min = DVec3::from(b.min);
-    for v in vertices.iter_mut() {
-        let q = place * (DVec3::from(*v) - min);
-        *v = [q.x + p.place[0], q.y + p.place[1], q.z];
-    }
+    steps::runs(vertices.len(), budget, &mut |run| {
+        for v in vertices[run].iter_mut() {
+            let q = place * (DVec3::from(*v) - min);
+            *v = [q.x + p.place[0], q.y + p.place[1], q.z];
+        }
+    })
+    .await;
 }
 
 /// Each facet's corners in the other order (its normal reversed): after a mirroring
@@ -371,16 +427,18 @@ impl<T: Copy + Default> CompressedRows<T> {
     /// for k = 0, 1, 2 gives (row, item). It is called twice per item (once to count the rows,
     /// once to fill them): plain loops, which run faster than a flattened iterator walked
     /// twice. At most `u32::MAX` items.
-    pub(crate) fn per_corner(
+    /// In resumable steps ([`steps::runs`]; [`steps::now`] runs them at once).
+    pub(crate) async fn per_corner_in_steps(
         mesh: &Mesh,
         item: impl Fn(u32, &[u32; 3], usize) -> (u32, T),
+        b: &Budget,
     ) -> Self {
-        // Each pass in runs of facets ([`in_runs`]: the page's engine compiles the later runs
-        // well).
+        // Each pass in runs of facets ([`steps::runs`]: the page's engine compiles the later
+        // runs well).
         let n = mesh.vertices.len();
         let facets = &mesh.facets;
         let mut start = vec![0u32; n + 1];
-        in_runs(facets.len(), &mut |run| {
+        steps::runs(facets.len(), b, &mut |run| {
             // (a slice of its own: its bounds stay in registers through the stores)
             let start = &mut start[..];
             for (fi, f) in run.clone().zip(&facets[run]) {
@@ -388,15 +446,17 @@ impl<T: Copy + Default> CompressedRows<T> {
                     start[item(fi as u32, f, k).0 as usize + 1] += 1;
                 }
             }
-        });
-        in_runs(n, &mut |run| {
+        })
+        .await;
+        steps::runs(n, b, &mut |run| {
             for r in run {
                 start[r + 1] += start[r];
             }
-        });
+        })
+        .await;
         let mut next = start.clone();
         let mut items = vec![T::default(); start[n] as usize];
-        in_runs(facets.len(), &mut |run| {
+        steps::runs(facets.len(), b, &mut |run| {
             let (items, next) = (&mut items[..], &mut next[..]);
             for (fi, f) in run.clone().zip(&facets[run]) {
                 for k in 0..3 {
@@ -405,7 +465,8 @@ impl<T: Copy + Default> CompressedRows<T> {
                     next[r as usize] += 1;
                 }
             }
-        });
+        })
+        .await;
         CompressedRows { start, items }
     }
 

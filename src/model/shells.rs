@@ -3,7 +3,7 @@
 //! inside-out shells turned outward unless they lie inside another shell (cavities), decided
 //! by winding numbers and a grid of the shells' bounding boxes (`BoxIndex`).
 
-use crate::base::parallel::in_runs;
+use crate::base::steps::{self, Budget};
 use crate::model::mesh::{CompressedRows, Mesh};
 
 /// The shells of a mesh ([`Mesh::shells`]), for [`Mesh::orient`].
@@ -214,7 +214,12 @@ impl Mesh {
     /// running along them in opposite directions (two bodies touching at a vertex or along a
     /// non-manifold edge stay apart). A shell is closed when it has no other edge.
     pub fn shells(&self) -> Shells {
-        let (facet_shell, closed, bad, open_edges) = self.edge_shells();
+        steps::now(self.shells_in_steps(&steps::UNLIMITED))
+    }
+
+    /// [`Mesh::shells`] in resumable steps ([`steps::runs`]).
+    pub async fn shells_in_steps(&self, b: &Budget) -> Shells {
+        let (facet_shell, closed, bad, open_edges) = self.edge_shells(b).await;
         Shells {
             facet_shell,
             closed,
@@ -248,6 +253,15 @@ impl Mesh {
     /// whether to turn it (empty when none is turned; [`Mesh::turn`] turns them). Reads the
     /// mesh only, so other work on the mesh as it is may run beside it.
     pub fn orientation(&self, shells: &Shells) -> (ShellOrientation, Vec<bool>) {
+        steps::now(self.orientation_in_steps(shells, &steps::UNLIMITED))
+    }
+
+    /// [`Mesh::orientation`] in resumable steps ([`steps::runs`]).
+    pub async fn orientation_in_steps(
+        &self,
+        shells: &Shells,
+        b: &Budget,
+    ) -> (ShellOrientation, Vec<bool>) {
         let mut out = ShellOrientation::default();
         let Shells {
             facet_shell,
@@ -266,7 +280,7 @@ impl Mesh {
             bmax,
             first_facet,
             facet_count,
-        } = self.shell_boxes(facet_shell, n);
+        } = self.shell_boxes(facet_shell, n, b).await;
         let centre = |s: usize| [0, 1, 2].map(|k| 0.5 * (bmin[s][k] + bmax[s][k]));
         // The caps of the open shells' holes (a single facet encloses nothing: skipped).
         let (cap_start, caps) = self.hole_caps(facet_shell, closed, bad, &facet_count);
@@ -279,7 +293,7 @@ impl Mesh {
         };
         // Volumes, each about its shell's centre (for precision), caps included.
         let mut volume = vec![0.0f64; n];
-        in_runs(self.facets.len(), &mut |run| {
+        steps::runs(self.facets.len(), b, &mut |run| {
             let volume = &mut volume[..];
             for (fi, f) in run.clone().zip(&self.facets[run]) {
                 let s = facet_shell[fi] as usize;
@@ -287,7 +301,8 @@ impl Mesh {
                 let [p, q, r] = f.map(|i| sub(self.vertices[i as usize], o));
                 volume[s] += dot(p, cross(q, r)) / 6.0;
             }
-        });
+        })
+        .await;
         for (s, v) in volume.iter_mut().enumerate() {
             let o = centre(s);
             for t in caps_of(s) {
@@ -376,15 +391,15 @@ impl Mesh {
     }
 
     /// Bounding boxes, first facet and facet count of the `n` shells.
-    fn shell_boxes(&self, facet_shell: &[u32], n: usize) -> ShellBoxes {
+    async fn shell_boxes(&self, facet_shell: &[u32], n: usize, budget: &Budget) -> ShellBoxes {
         let mut b = ShellBoxes {
             bmin: vec![[f64::INFINITY; 3]; n],
             bmax: vec![[f64::NEG_INFINITY; 3]; n],
             first_facet: vec![u32::MAX; n],
             facet_count: vec![0u32; n],
         };
-        // In runs of facets ([`in_runs`]).
-        in_runs(self.facets.len(), &mut |r| {
+        // In runs of facets ([`steps::runs`]).
+        steps::runs(self.facets.len(), budget, &mut |r| {
             for (fi, f) in r.clone().zip(&self.facets[r]) {
                 let s = facet_shell[fi] as usize;
                 for v in f.map(|i| self.vertices[i as usize]) {
@@ -398,7 +413,8 @@ impl Mesh {
                 }
                 b.facet_count[s] += 1;
             }
-        });
+        })
+        .await;
         b
     }
 
@@ -495,13 +511,16 @@ impl Mesh {
     /// shell of every facet and, per shell, whether it is closed: each of its edges shared by
     /// exactly two facets running along it in opposite directions; the other edges (facet × 3
     /// + corner: the edge from that corner to the next); and how many edges only one facet has.
-    fn edge_shells(&self) -> (Vec<u32>, Vec<bool>, Vec<u32>, usize) {
+    async fn edge_shells(&self, budget: &Budget) -> (Vec<u32>, Vec<bool>, Vec<u32>, usize) {
         let nf = self.facets.len();
         // Each facet around a vertex with its vertices after and before that one, so the
         // scan of a vertex's facets reads one run of memory and never the facets themselves.
-        let around = CompressedRows::per_corner(self, |fi, f, k| {
-            (f[k], [fi, f[(k + 1) % 3], f[(k + 2) % 3]])
-        });
+        let around = CompressedRows::per_corner_in_steps(
+            self,
+            |fi, f, k| (f[k], [fi, f[(k + 1) % 3], f[(k + 2) % 3]]),
+            budget,
+        )
+        .await;
         let mut parent: Vec<u32> = (0..nf as u32).collect();
         fn find(p: &mut [u32], mut x: u32) -> u32 {
             while p[x as usize] != x {
@@ -512,9 +531,9 @@ impl Mesh {
         }
         let mut bad: Vec<u32> = Vec::new();
         let mut open_edges = 0;
-        // In runs of facets ([`in_runs`]: the page's engine compiles the later runs well).
+        // In runs of facets ([`steps::runs`]: the page's engine compiles the later runs well).
         let facets = &self.facets;
-        in_runs(nf, &mut |run| {
+        steps::runs(nf, budget, &mut |run| {
             // (a slice of its own: its bounds stay in registers through the stores)
             let parent = &mut parent[..];
             for (fi, f) in run.clone().zip(&facets[run]) {
@@ -541,12 +560,13 @@ impl Mesh {
                     }
                 }
             }
-        });
+        })
+        .await;
         drop(around);
         let mut id = vec![u32::MAX; nf];
         let mut shells = 0u32;
         let mut facet_shell: Vec<u32> = Vec::with_capacity(nf);
-        in_runs(nf, &mut |run| {
+        steps::runs(nf, budget, &mut |run| {
             let (parent, id) = (&mut parent[..], &mut id[..]);
             facet_shell.extend(run.map(|fi| {
                 let r = find(parent, fi as u32) as usize;
@@ -556,7 +576,8 @@ impl Mesh {
                 }
                 id[r]
             }))
-        });
+        })
+        .await;
         let mut closed = vec![true; shells as usize];
         for &e in &bad {
             closed[facet_shell[(e / 3) as usize] as usize] = false;

@@ -3,8 +3,8 @@
 //! tolerance weld (near-coincident vertices, through a grid of cells) and the bounded
 //! reservation of their maps ([`reserve_entries`]).
 
-use crate::base::parallel::in_runs;
 use crate::base::spatial::floor_i64;
+use crate::base::steps::{self, Budget};
 use crate::model::mesh::Mesh;
 use rustc_hash::FxHashMap as HashMap;
 
@@ -20,7 +20,13 @@ impl Mesh {
 
     /// [`Mesh::weld`] in one pass: each corner looked up in one map of every vertex so far.
     fn weld_in_one(tris: &[[[f32; 3]; 3]]) -> (Mesh, usize) {
-        let (_, vertices, mut facets) = weld_local(tris, tris.len(), tris.len() / 2 + 16);
+        steps::now(Self::weld_in_steps(tris, &steps::UNLIMITED))
+    }
+
+    /// [`Mesh::weld`] in resumable steps ([`steps::runs`]): the one pass' mesh.
+    pub async fn weld_in_steps(tris: &[[[f32; 3]; 3]], budget: &Budget) -> (Mesh, usize) {
+        let (_, vertices, mut facets) =
+            weld_local(tris, tris.len(), tris.len() / 2 + 16, budget).await;
         facets.retain(distinct);
         let degenerate = tris.len() - facets.len();
         (Mesh { vertices, facets }, degenerate)
@@ -35,8 +41,14 @@ impl Mesh {
         let ((index, mut vertices, mut facets), (later_index, later, later_ids)) =
             crate::base::parallel::both(
                 // the first half's lists take the whole mesh (no copy when they grow)
-                || weld_local(first, tris.len(), tris.len() / 2 + 16),
-                || weld_local(second, second.len(), second.len() / 2 + 16),
+                || {
+                    let all = &steps::UNLIMITED;
+                    steps::now(weld_local(first, tris.len(), tris.len() / 2 + 16, all))
+                },
+                || {
+                    let all = &steps::UNLIMITED;
+                    steps::now(weld_local(second, second.len(), second.len() / 2 + 16, all))
+                },
             );
         drop(later_index);
         // (f32 → f64 → f32 is exact: the key of the corner as read)
@@ -183,10 +195,11 @@ fn distinct(f: &[u32; 3]) -> bool {
 /// map of its vertices, the vertices in the order first met, and every facet's vertex numbers
 /// (collapsed ones too); the two lists with room for `vertices` and `facets`.
 #[allow(clippy::type_complexity)]
-fn weld_local(
+async fn weld_local(
     tris: &[[[f32; 3]; 3]],
     facets: usize,
     vertices: usize,
+    budget: &Budget,
 ) -> (HashMap<[u32; 3], u32>, Vec<[f64; 3]>, Vec<[u32; 3]>) {
     let entry = std::mem::size_of::<([u32; 3], u32)>();
     let mut index: HashMap<[u32; 3], u32> = HashMap::with_capacity_and_hasher(
@@ -195,8 +208,8 @@ fn weld_local(
     );
     let mut points = Vec::with_capacity(vertices);
     let mut ids = Vec::with_capacity(facets);
-    // In runs of triangles ([`in_runs`]: the page's engine compiles the later runs well).
-    in_runs(tris.len(), &mut |r| {
+    // In runs of triangles ([`steps::runs`]: the page's engine compiles the later runs well).
+    steps::runs(tris.len(), budget, &mut |r| {
         ids.extend(tris[r].iter().map(|t| {
             t.map(|p| {
                 *index.entry(weld_key(p)).or_insert_with(|| {
@@ -205,7 +218,8 @@ fn weld_local(
                 })
             })
         }))
-    });
+    })
+    .await;
     (index, points, ids)
 }
 

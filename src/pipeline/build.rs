@@ -6,6 +6,7 @@ use crate::base::error::Error;
 use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
+use crate::base::steps::{self, Budget, Stepped};
 use crate::model::fit;
 use crate::model::layout::{Frame, Instance, at_part, place_instances, shown_name};
 use crate::model::mesh::{self, Mesh, MeshStats};
@@ -21,6 +22,8 @@ use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
+use std::rc::Rc;
+use std::sync::Arc;
 
 impl Job {
     /// Reads the model (STL, OBJ or a 3MF build, see [`import`]), validates the settings and
@@ -66,25 +69,92 @@ impl Job {
     /// [`Job::new`] — the instances merged into one mesh and prepared as [`Job::new`] does
     /// (checks, shells, repair, facet index). The job's settings are `spec.settings`.
     pub fn from_models(models: &[Model], spec: &job::JobSpec) -> Result<Job, Error> {
-        let (mesh, input, settings) = Job::merged(models, spec)?;
+        let (mesh, input, settings) = steps::now(Job::merged(models, spec, &steps::UNLIMITED))?;
         Job::build(mesh, input, settings)
     }
 
-    /// [`Job::from_models`] in steps (the page's engine keeps a running call's first code to
-    /// its end, so the preparation is a series of short calls): this call welds and places
-    /// the parts; [`Preparation::step`] does the rest, one pass a call. The job is the one
-    /// [`Job::from_models`] makes.
-    pub fn prepare_in_steps(models: &[Model], spec: &job::JobSpec) -> Result<Preparation, Error> {
-        let (mesh, input, settings) = Job::merged(models, spec)?;
-        Ok(Preparation {
-            building: Some(Building::new(mesh, input, settings)?),
-            next: Step::Shells,
-        })
+    /// [`Job::from_models`] in resumable steps (the page's engine keeps a running call's
+    /// first code to its end, so the preparation is a series of short calls): nothing is done
+    /// until [`Preparation::step`], which works through a budget of items (facets, corners,
+    /// vertices) a call, every pass in turn, and hands out the job after the last. The job (or
+    /// the refusal) is the one [`Job::from_models`] makes, whatever the budgets.
+    pub fn prepare_in_steps(models: Arc<Vec<Model>>, spec: &job::JobSpec) -> Preparation {
+        let budget = Rc::new(Budget::new(0));
+        let b = budget.clone();
+        let spec = spec.clone();
+        Preparation {
+            budget,
+            pass: Some(Stepped::new(async move {
+                Job::build_in_steps(&models, &spec, &b).await
+            })),
+        }
+    }
+
+    /// [`Job::from_models`] as a pass of `b`'s budget: the passes of [`Job::build`] one after
+    /// the other (not side by side), each in runs of items.
+    async fn build_in_steps(
+        models: &[Model],
+        spec: &job::JobSpec,
+        b: &Budget,
+    ) -> Result<Job, Error> {
+        let (mesh, input, settings) = Job::merged(models, spec, b).await?;
+        let mut building = Building::new(mesh, input, settings)?;
+        let kept = building.mesh.unrepeated_in_steps(b).await;
+        let all = kept.iter().all(|&k| k);
+        let shells = match all {
+            true => Some(building.mesh.shells_in_steps(b).await),
+            false => None,
+        };
+        building.unrepeated_in_steps(kept, shells, b).await;
+        // the index of a mesh that dropped facets would be dropped unused
+        if all && let Ok(zs) = &building.zs {
+            building.index = Some(FacetBuckets::new_in_steps(&building.mesh, zs, b).await);
+        }
+        building.close_cracks();
+        let shells = building.shells.as_ref().expect("the shells were found");
+        let orientation = building.mesh.orientation_in_steps(shells, b).await;
+        if orientation.1.is_empty() {
+            let (facets_in_file, dropped) = (building.input.facets_in_file, building.dropped());
+            building.stats = Some(
+                building
+                    .mesh
+                    .stats_in_steps(facets_in_file, dropped, b)
+                    .await,
+            );
+        }
+        building.orientation = Some(orientation);
+        let mut checked = building.checked()?;
+        let overhangs = checked.overhangs();
+        let (made_stats, made_index) = (checked.stats.take(), checked.index.take());
+        let repaired = match checked.zs.as_ref() {
+            Ok(zs) => {
+                let (mesh, input) = (&checked.mesh, &checked.input);
+                let stats = match made_stats {
+                    Some(s) => s,
+                    None => {
+                        let dropped = input.degenerate + checked.weld.1;
+                        mesh.stats_in_steps(input.facets_in_file, dropped, b).await
+                    }
+                };
+                let buckets = match made_index {
+                    Some(index) => index,
+                    None => FacetBuckets::new_in_steps(mesh, zs, b).await,
+                };
+                Some((buckets, stats))
+            }
+            Err(_) => None,
+        };
+        checked.conclude(overhangs, repaired)
     }
 
     /// The parts of `spec` welded, placed and merged into one mesh: what [`Job::build`]
-    /// prepares.
-    fn merged(models: &[Model], spec: &job::JobSpec) -> Result<(Mesh, Input, Settings), Error> {
+    /// prepares. The weld in runs of `budget` (natively, of no limit: in two halves side by
+    /// side where [`Mesh::weld`] does).
+    async fn merged(
+        models: &[Model],
+        spec: &job::JobSpec,
+        budget: &Budget,
+    ) -> Result<(Mesh, Input, Settings), Error> {
         spec.validate()?;
         let settings = spec.settings.clone();
         let by_part = models_of(models, spec)?;
@@ -106,17 +176,22 @@ impl Job {
         let (mut facets_in_file, mut degenerate, mut facets) = (0usize, 0usize, 0usize);
         for (i, (p, m)) in spec.parts.iter().zip(&by_part).enumerate() {
             let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
-            let (mesh, dropped) = Mesh::weld(&tris);
+            let (mesh, dropped) = match budget.limited() {
+                true => Mesh::weld_in_steps(&tris, budget).await,
+                false => Mesh::weld(&tris),
+            };
             let copies = p.copies as usize;
             facets = facets.saturating_add(mesh.facets.len().saturating_mul(copies));
             if facets > MAX_JOB_TRIANGLES {
                 return Err(too_many_triangles());
             }
-            let frame = Frame::of(
+            let frame = Frame::of_in_steps(
                 &mesh.vertices,
                 |v| [*v],
                 &p.placement([0.0, 0.0], &settings),
-            );
+                budget,
+            )
+            .await;
             let Some(frame) = frame.filter(|_| !mesh.facets.is_empty()) else {
                 return Err(Error::Import(format!(
                     "parts[{i}] ({}): all {} triangles are degenerate (their corners coincide): the part has no surface",
@@ -165,7 +240,10 @@ impl Job {
         let mesh = if let [only] = order[..] {
             let mut mesh = std::mem::take(&mut welded[only.part]);
             let placement = spec.parts[only.part].placement(only.shift, &settings);
-            mesh.place(&placement);
+            mesh::place_vertices_in_steps(&mut mesh.vertices, &placement, budget).await;
+            if placement.mirrors() {
+                mesh::turn_facets(&mut mesh.facets);
+            }
             add_to_run(only.part, mesh.facets.len());
             mesh
         } else {
@@ -182,7 +260,7 @@ impl Job {
                 mesh.facets
                     .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
                 let placement = spec.parts[inst.part].placement(inst.shift, &settings);
-                mesh::place_vertices(&mut mesh.vertices[base..], &placement);
+                mesh::place_vertices_in_steps(&mut mesh.vertices[base..], &placement, budget).await;
                 if placement.mirrors() {
                     mesh::turn_facets(&mut mesh.facets[first..]);
                 }
@@ -345,6 +423,11 @@ impl Building {
     /// Takes the repeated facets' pass (`kept`) and the shells found beside it (only when
     /// nothing was repeated); else drops the repeats and finds the shells of what is left.
     fn unrepeated(&mut self, kept: Vec<bool>, shells: Option<Shells>) {
+        steps::now(self.unrepeated_in_steps(kept, shells, &steps::UNLIMITED))
+    }
+
+    /// [`Building::unrepeated`] in resumable steps.
+    async fn unrepeated_in_steps(&mut self, kept: Vec<bool>, shells: Option<Shells>, b: &Budget) {
         self.duplicates = kept.iter().filter(|&&k| !k).count();
         self.shells = Some(match shells {
             Some(shells) => shells,
@@ -352,7 +435,7 @@ impl Building {
                 self.index = None;
                 self.mesh.keep_facets(&kept);
                 keep_groups(&mut self.groups, &kept);
-                self.mesh.shells()
+                self.mesh.shells_in_steps(b).await
             }
         });
     }
@@ -375,6 +458,30 @@ impl Building {
     /// Turns the shells, checks the volume and the droplets, and makes what was not made
     /// (or was made of a mesh that changed since): the job.
     fn finish(self) -> Result<Job, Error> {
+        let mut c = self.checked()?;
+        // The support's overhang figures for the estimate beside what is left of the
+        // statistics and the facet index.
+        let (stats, index) = (c.stats.take(), c.index.take());
+        let (overhangs, repaired) = both(
+            || c.overhangs(),
+            || {
+                let zs = c.zs.as_ref().ok()?;
+                let dropped = c.input.degenerate + c.weld.1;
+                let mesh = &c.mesh;
+                let facets_in_file = c.input.facets_in_file;
+                let (stats, buckets) = both(
+                    || stats.unwrap_or_else(|| mesh.stats(facets_in_file, dropped)),
+                    || index.unwrap_or_else(|| FacetBuckets::new(mesh, zs)),
+                );
+                Some((buckets, stats))
+            },
+        );
+        c.conclude(overhangs, repaired)
+    }
+
+    /// Turns the shells and checks the volume and the surface: what [`Checked::conclude`]
+    /// finishes.
+    fn checked(self) -> Result<Checked, Error> {
         let Building {
             mut mesh,
             input,
@@ -390,7 +497,6 @@ impl Building {
             orientation,
             stats,
         } = self;
-        let dropped = input.degenerate + weld.1;
         let mesh_shells = mesh_shells.expect("the shells were found");
         let open_edges = mesh_shells.open_edges;
         let (shells, flip) = orientation.expect("the shells were oriented");
@@ -399,33 +505,84 @@ impl Building {
         let volume = check_volume(&mesh, &shells, &size)?;
         // A triangle soup is refused before any section of it is made.
         check_surface(open_edges, mesh.facets.len())?;
+        Ok(Checked {
+            mesh,
+            input,
+            settings,
+            groups,
+            bounds,
+            size,
+            zs,
+            duplicates,
+            index,
+            weld,
+            shells,
+            stats,
+            volume,
+        })
+    }
+}
+
+/// A job whose mesh is turned and checked ([`Building::checked`]): what is left to make is
+/// the overhang figures, the statistics and the facet index (those not made yet).
+struct Checked {
+    mesh: Mesh,
+    input: Input,
+    settings: Settings,
+    groups: Vec<FacetGroup>,
+    bounds: mesh::Bounds,
+    size: [f64; 3],
+    zs: Result<Vec<f64>, Error>,
+    duplicates: usize,
+    index: Option<FacetBuckets>,
+    weld: (usize, usize),
+    shells: ShellOrientation,
+    stats: Option<MeshStats>,
+    volume: f64,
+}
+
+impl Checked {
+    /// The support's overhang figures for the estimate (none when the support is off or the
+    /// mesh is open).
+    fn overhangs(&self) -> budget::Overhangs {
+        let support =
+            self.shells.open == 0 && self.settings.support != crate::base::settings::Support::Off;
+        if support {
+            let h = self.settings.layer_height;
+            budget::Overhangs::of(
+                &self.mesh,
+                &slice::layer_heights(self.size[2], h, self.settings.slice_plane),
+            )
+        } else {
+            budget::Overhangs::default()
+        }
+    }
+
+    /// Checks the droplets and the plate, and makes the job of the facet index and the
+    /// statistics (`repaired`, none when the layers are not known).
+    fn conclude(
+        self,
+        overhangs: budget::Overhangs,
+        repaired: Option<(FacetBuckets, MeshStats)>,
+    ) -> Result<Job, Error> {
+        let Checked {
+            mesh,
+            input,
+            settings,
+            groups,
+            bounds,
+            size,
+            zs,
+            duplicates,
+            weld,
+            shells,
+            volume,
+            ..
+        } = self;
+        let repaired = repaired.map(|(b, s)| (b, with_repairs(s, &shells, weld, duplicates)));
         // One droplet estimate for the whole job: every unit and the support.
         let unit1 = budget::Unit1Parts::of(&mesh, &groups);
         let open = shells.open > 0;
-        let support = !open && settings.support != crate::base::settings::Support::Off;
-        // The support's overhang figures for the estimate beside what is left of the
-        // statistics and the facet index.
-        let (overhangs, repaired) = both(
-            || {
-                if support {
-                    let h = settings.layer_height;
-                    budget::Overhangs::of(
-                        &mesh,
-                        &slice::layer_heights(size[2], h, settings.slice_plane),
-                    )
-                } else {
-                    budget::Overhangs::default()
-                }
-            },
-            || {
-                let zs = zs.as_ref().ok()?;
-                let (stats, buckets) = both(
-                    || stats.unwrap_or_else(|| mesh.stats(input.facets_in_file, dropped)),
-                    || index.unwrap_or_else(|| FacetBuckets::new(&mesh, zs)),
-                );
-                Some((buckets, repaired(stats, &shells, weld, duplicates)))
-            },
-        );
         let mut estimate = budget::Estimate::new(
             volume,
             unit1,
@@ -477,68 +634,34 @@ impl Building {
     }
 }
 
-/// [`Job::from_models`] in steps: [`Job::prepare_in_steps`], then [`Preparation::step`] until
-/// it hands out the job.
+/// [`Job::from_models`] in resumable steps: [`Job::prepare_in_steps`], then
+/// [`Preparation::step`] until it hands out the job.
 pub struct Preparation {
+    /// The items the next step may work through.
+    budget: Rc<Budget>,
     /// `None` once the job was handed out (or a step failed).
-    building: Option<Building>,
-    next: Step,
-}
-
-#[derive(Clone, Copy)]
-enum Step {
-    Shells,
-    Index,
-    Cracks,
-    Orientation,
-    Statistics,
-    Finish,
+    pass: Option<Stepped<Result<Job, Error>>>,
 }
 
 impl Preparation {
-    /// Runs the next pass of the preparation: `Ok(None)` while there are more, the job after
-    /// the last. After the job or an error there is nothing left: an `Internal` error.
-    pub fn step(&mut self) -> Result<Option<Job>, Error> {
-        let Some(b) = self.building.as_mut() else {
+    /// Works through about `items` items of the preparation (at least one run of them, see
+    /// [`steps::runs`]; a few passes between the long ones are not divided): `Ok(None)`
+    /// while there is more, the job at the end. After the job or an error there is nothing
+    /// left: an `Internal` error.
+    pub fn step(&mut self, items: usize) -> Result<Option<Job>, Error> {
+        let Some(pass) = self.pass.as_mut() else {
             return Err(Error::Internal(
                 "the job's preparation has already ended".into(),
             ));
         };
-        match self.next {
-            Step::Shells => {
-                let kept = b.mesh.unrepeated_facets();
-                let shells = kept.iter().all(|&k| k).then(|| b.mesh.shells());
-                let all = shells.is_some();
-                b.unrepeated(kept, shells);
-                // the index of a mesh that dropped facets would be dropped unused
-                self.next = if all { Step::Index } else { Step::Cracks };
-            }
-            Step::Index => {
-                b.index = b.zs.as_ref().ok().map(|zs| FacetBuckets::new(&b.mesh, zs));
-                self.next = Step::Cracks;
-            }
-            Step::Cracks => {
-                b.close_cracks();
-                self.next = Step::Orientation;
-            }
-            Step::Orientation => {
-                let shells = b.shells.as_ref().expect("the shells were found");
-                b.orientation = Some(b.mesh.orientation(shells));
-                self.next = Step::Statistics;
-            }
-            Step::Statistics => {
-                let flip = &b.orientation.as_ref().expect("the shells were oriented").1;
-                if flip.is_empty() {
-                    b.stats = Some(b.mesh.stats(b.input.facets_in_file, b.dropped()));
-                }
-                self.next = Step::Finish;
-            }
-            Step::Finish => {
-                let b = self.building.take().expect("checked above");
-                return b.finish().map(Some);
+        self.budget.refill(items);
+        match pass.step() {
+            None => Ok(None),
+            Some(made) => {
+                self.pass = None;
+                made.map(Some)
             }
         }
-        Ok(None)
     }
 }
 
@@ -567,7 +690,7 @@ fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error
 }
 
 /// The mesh statistics with what the repair did.
-fn repaired(
+fn with_repairs(
     stats: MeshStats,
     shells: &ShellOrientation,
     (welded, _): (usize, usize),

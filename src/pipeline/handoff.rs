@@ -7,10 +7,15 @@
 //! page, but they cross a message between workers: every length is checked against what is
 //! left before anything is allocated, every number and index is checked, so damaged bytes are
 //! refused with a message, never a panic or a job that slices wrongly.
+//!
+//! The bytes are written to a [`Sink`] and read from a [`Source`] a run of items at a time
+//! through a small buffer: in the page, the sink and the source are the message's buffer
+//! itself (outside the module's memory), so a worker never holds the job twice — once as its
+//! arrays, once as their bytes — in a memory that never shrinks.
 
 use super::Job;
 use crate::base::error::Error;
-use crate::base::parallel::in_runs;
+use crate::base::parallel::{RUN, in_runs};
 use crate::base::settings::Settings;
 use crate::model::mesh::Mesh;
 use crate::model::prepare::JobInfo;
@@ -27,10 +32,45 @@ struct Meta {
     shifts: Vec<[f64; 2]>,
 }
 
+/// Where [`Job::write_bytes`] writes: bytes at a place, every place written once.
+pub trait Sink {
+    fn write(&mut self, at: usize, bytes: &[u8]);
+}
+
+impl Sink for Vec<u8> {
+    fn write(&mut self, at: usize, bytes: &[u8]) {
+        self[at..at + bytes.len()].copy_from_slice(bytes);
+    }
+}
+
+/// What [`Job::read_bytes`] reads: a length and bytes copied out at a place.
+pub trait Source {
+    fn len(&self) -> usize;
+    /// Fills `out` with the bytes from `at` on (`at + out.len()` is within the length).
+    fn read(&self, at: usize, out: &mut [u8]);
+}
+
+impl Source for &[u8] {
+    fn len(&self) -> usize {
+        <[u8]>::len(self)
+    }
+    fn read(&self, at: usize, out: &mut [u8]) {
+        out.copy_from_slice(&self[at..at + out.len()]);
+    }
+}
+
 impl Job {
     /// The prepared job as bytes for [`Job::from_bytes`] (about 24 B per vertex, 12 B per
     /// facet and 4 B per facet and layer it crosses).
     pub fn to_bytes(&self) -> Vec<u8> {
+        let (size, write) = self.bytes_writer();
+        let mut out = vec![0u8; size];
+        write(&mut out);
+        out
+    }
+
+    /// The length of [`Job::to_bytes`] and what writes them into a sink of that length.
+    pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
         let meta = serde_json::to_vec(&Meta {
             settings: self.settings.clone(),
             info: self.info.clone(),
@@ -45,33 +85,35 @@ impl Job {
             + self.mesh.facets.len() * 12
             + self.zs.len() * 8
             + (offsets.len() + bucket_facets.len()) * 4;
-        let mut out = Vec::with_capacity(size);
-        out.extend_from_slice(MAGIC);
-        let count = |out: &mut Vec<u8>, n: usize| out.extend_from_slice(&(n as u64).to_le_bytes());
-        count(&mut out, meta.len());
-        out.extend_from_slice(&meta);
-        count(&mut out, self.mesh.vertices.len());
-        put(
-            &mut out,
-            self.mesh.vertices.as_flattened(),
-            f64::to_le_bytes,
-        );
-        count(&mut out, self.mesh.facets.len());
-        put(&mut out, self.mesh.facets.as_flattened(), u32::to_le_bytes);
-        count(&mut out, self.zs.len());
-        put(&mut out, &self.zs, f64::to_le_bytes);
-        for row in [offsets, bucket_facets] {
-            count(&mut out, row.len());
-            put(&mut out, row, u32::to_le_bytes);
-        }
-        debug_assert_eq!(out.len(), size);
-        out
+        let write = move |sink: &mut dyn Sink| {
+            let mut out = Writer { sink, at: 0 };
+            out.bytes(MAGIC);
+            out.count(meta.len());
+            out.bytes(&meta);
+            out.count(self.mesh.vertices.len());
+            out.put(self.mesh.vertices.as_flattened(), f64::to_le_bytes);
+            out.count(self.mesh.facets.len());
+            out.put(self.mesh.facets.as_flattened(), u32::to_le_bytes);
+            out.count(self.zs.len());
+            out.put(&self.zs, f64::to_le_bytes);
+            for row in [offsets, bucket_facets] {
+                out.count(row.len());
+                out.put(row, u32::to_le_bytes);
+            }
+            debug_assert_eq!(out.at, size);
+        };
+        (size, write)
     }
 
     /// The job [`Job::to_bytes`] wrote. Bytes that are not such a job (truncated, of another
     /// version, with a number out of range or an index past its array) are refused as an
     /// internal error: they only ever come from another worker of the same page.
     pub fn from_bytes(bytes: &[u8]) -> Result<Job, Error> {
+        Job::read_bytes(&bytes)
+    }
+
+    /// [`Job::from_bytes`] from any source of the bytes, read a run of items at a time.
+    pub fn read_bytes(bytes: &dyn Source) -> Result<Job, Error> {
         read(bytes).map_err(|e| {
             Error::Internal(format!(
                 "the prepared job handed over is damaged: {e}; slice again"
@@ -80,8 +122,12 @@ impl Job {
     }
 }
 
-fn read(bytes: &[u8]) -> Result<Job, String> {
-    let mut r = Reader { bytes, at: 0 };
+fn read(bytes: &dyn Source) -> Result<Job, String> {
+    let mut r = Reader {
+        bytes,
+        at: 0,
+        buf: Vec::new(),
+    };
     if r.take(MAGIC.len())? != MAGIC {
         return Err("not a prepared job of this version".into());
     }
@@ -90,7 +136,7 @@ fn read(bytes: &[u8]) -> Result<Job, String> {
         serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
     meta.settings.validate().map_err(|e| e.to_string())?;
     let n = r.count(24)?;
-    let vertices: Vec<[f64; 3]> = get(r.take(n * 24)?, |c: [u8; 24]| {
+    let vertices: Vec<[f64; 3]> = r.get(n, |c: [u8; 24]| {
         std::array::from_fn(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap()))
     });
     // Every vertex within the job's box (grown by 1 mm: the box is measured before the repair
@@ -101,7 +147,7 @@ fn read(bytes: &[u8]) -> Result<Job, String> {
         return Err("a vertex lies outside the job's box".into());
     }
     let n = r.count(12)?;
-    let facets: Vec<[u32; 3]> = get(r.take(n * 12)?, |c: [u8; 12]| {
+    let facets: Vec<[u32; 3]> = r.get(n, |c: [u8; 12]| {
         std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
     });
     if !all(&facets, |f| {
@@ -110,7 +156,7 @@ fn read(bytes: &[u8]) -> Result<Job, String> {
         return Err("a facet names a vertex past the last".into());
     }
     let n = r.count(8)?;
-    let zs: Vec<f64> = get(r.take(n * 8)?, f64::from_le_bytes);
+    let zs: Vec<f64> = r.get(n, f64::from_le_bytes);
     if zs.is_empty() || !zs.iter().all(|z| z.is_finite()) || zs.windows(2).any(|w| w[0] >= w[1]) {
         return Err("the plane heights are not finite and rising".into());
     }
@@ -128,7 +174,7 @@ fn read(bytes: &[u8]) -> Result<Job, String> {
     let mut rows = [Vec::new(), Vec::new()];
     for row in &mut rows {
         let n = r.count(4)?;
-        *row = get(r.take(n * 4)?, u32::from_le_bytes);
+        *row = r.get(n, u32::from_le_bytes);
     }
     if r.at != bytes.len() {
         return Err("bytes follow the facet index".into());
@@ -155,33 +201,35 @@ fn read(bytes: &[u8]) -> Result<Job, String> {
     ))
 }
 
-/// Appends `items` in the bytes `le` gives each (in runs: [`in_runs`]).
-fn put<T: Copy, const N: usize>(out: &mut Vec<u8>, items: &[T], le: fn(T) -> [u8; N]) {
-    let at = out.len();
-    out.resize(at + N * items.len(), 0);
-    let dst = &mut out[at..];
-    in_runs(items.len(), &mut |r| {
-        for (c, &x) in dst[N * r.start..N * r.end]
-            .chunks_exact_mut(N)
-            .zip(&items[r])
-        {
-            c.copy_from_slice(&le(x));
-        }
-    });
+/// Writes the bytes in order into a [`Sink`], a run of items at a time.
+struct Writer<'a> {
+    sink: &'a mut dyn Sink,
+    at: usize,
 }
 
-/// The items of `bytes`, `N` bytes each, as `from` reads them (in runs: [`in_runs`]).
-fn get<T, const N: usize>(bytes: &[u8], from: impl Fn([u8; N]) -> T) -> Vec<T> {
-    let n = bytes.len() / N;
-    let mut out = Vec::with_capacity(n);
-    in_runs(n, &mut |r| {
-        out.extend(
-            bytes[N * r.start..N * r.end]
-                .chunks_exact(N)
-                .map(|c| from(c.try_into().expect("N bytes"))),
-        )
-    });
-    out
+impl Writer<'_> {
+    fn bytes(&mut self, b: &[u8]) {
+        self.sink.write(self.at, b);
+        self.at += b.len();
+    }
+
+    fn count(&mut self, n: usize) {
+        self.bytes(&(n as u64).to_le_bytes());
+    }
+
+    /// `items` in the bytes `le` gives each, a run at a time through one buffer (in runs:
+    /// [`in_runs`]).
+    fn put<T: Copy, const N: usize>(&mut self, items: &[T], le: fn(T) -> [u8; N]) {
+        let mut buf = vec![0u8; N * RUN.min(items.len())];
+        in_runs(items.len(), &mut |r| {
+            let chunk = &mut buf[..N * r.len()];
+            for (c, &x) in chunk.chunks_exact_mut(N).zip(&items[r]) {
+                c.copy_from_slice(&le(x));
+            }
+            self.sink.write(self.at, chunk);
+            self.at += chunk.len();
+        });
+    }
 }
 
 /// Whether `ok` holds for every item (in runs: [`in_runs`]).
@@ -193,20 +241,24 @@ fn all<T>(items: &[T], ok: impl Fn(&T) -> bool) -> bool {
 
 /// Reads the bytes in order; every length is checked against what is left.
 struct Reader<'a> {
-    bytes: &'a [u8],
+    bytes: &'a dyn Source,
     at: usize,
+    /// The bytes last taken.
+    buf: Vec<u8>,
 }
 
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+impl Reader<'_> {
+    /// The next `n` bytes (copied out of the source).
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
         let end = self
             .at
             .checked_add(n)
             .filter(|&e| e <= self.bytes.len())
             .ok_or("it ends early")?;
-        let s = &self.bytes[self.at..end];
+        self.buf.resize(n, 0);
+        self.bytes.read(self.at, &mut self.buf);
         self.at = end;
-        Ok(s)
+        Ok(&self.buf)
     }
 
     /// A count of items of `size` bytes each that the bytes left can hold.
@@ -217,5 +269,23 @@ impl<'a> Reader<'a> {
             return Err("a length runs past its end".into());
         }
         Ok(n as usize)
+    }
+
+    /// The next `n` items (checked by [`Reader::count`]), `N` bytes each, as `from` reads
+    /// them: a run of items at a time through one buffer (in runs: [`in_runs`]).
+    fn get<T, const N: usize>(&mut self, n: usize, from: impl Fn([u8; N]) -> T) -> Vec<T> {
+        let mut out = Vec::with_capacity(n);
+        let mut buf = vec![0u8; N * RUN.min(n)];
+        in_runs(n, &mut |r| {
+            let chunk = &mut buf[..N * r.len()];
+            self.bytes.read(self.at, chunk);
+            self.at += chunk.len();
+            out.extend(
+                chunk
+                    .chunks_exact(N)
+                    .map(|c| from(c.try_into().expect("N bytes"))),
+            )
+        });
+        out
     }
 }

@@ -3,7 +3,7 @@
 
 mod budget;
 mod build;
-mod handoff;
+pub mod handoff;
 mod job;
 mod supported;
 #[cfg(not(target_arch = "wasm32"))]

@@ -4,6 +4,7 @@
 use crate::base::geom;
 use crate::base::parallel::{both, par_map, par_map_owned};
 use crate::base::stages::{self, Stage};
+use crate::base::steps::Budget;
 use crate::pipeline::Job;
 use crate::slicing::plan::{self, LayerPlan};
 use crate::support::{self, droplets as support_droplets};
@@ -24,6 +25,59 @@ impl Job {
     /// worker's job plans them all once (docs/support.md).
     pub fn supported_plans(&self) -> &[(LayerPlan, geom::Shapes)] {
         &self.supported_pass().layers
+    }
+
+    /// Whether the supported pass was made (support on: before it, a layer's plan makes it).
+    pub fn supported_made(&self) -> bool {
+        self.supported.get().is_some()
+    }
+
+    /// [`Job::supported_pass`] in resumable steps (the page's short calls): the same plans,
+    /// each layer's section, part plan, hatch and final plan a step's item, one layer after
+    /// the other. The support regions' top-down pass and the droplet-level pass are one item
+    /// each (not divided). Keeps the plans in the job (as [`Job::supported_pass`] would),
+    /// unless it already has them.
+    pub async fn supported_in_steps(&self, b: &Budget) {
+        if self.supported_made() {
+            return;
+        }
+        let n = self.layer_count();
+        let s = &self.settings;
+        let mut sections = Vec::with_capacity(n);
+        for i in 0..n {
+            sections.push(self.section(i));
+            b.spend(1).await;
+        }
+        let regions: Vec<geom::Shapes> = sections.iter().map(|x| x.region.clone()).collect();
+        let mut parts = Vec::with_capacity(n);
+        for (i, section) in sections.iter().enumerate() {
+            parts.push(stages::time(Stage::Plan, || self.plan_parts(i, section)));
+            b.spend(1).await;
+        }
+        drop(sections);
+        let layers = stages::time(Stage::Support, || support::support_layers(&regions, s));
+        b.spend(1).await;
+        let mut hatches = Vec::with_capacity(n);
+        for i in 0..n {
+            let start = plan::unit1_start(&parts[i].0, s);
+            hatches.push(stages::time(Stage::Support, || {
+                support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
+            }));
+            b.spend(1).await;
+        }
+        let planned = with_hatches(parts, hatches, &layers);
+        drop(layers);
+        let (extra, figures) = droplet_pass(&planned, &regions, s);
+        b.spend(1).await;
+        let mut plans = Vec::with_capacity(n);
+        for (i, layer) in planned.into_iter().enumerate() {
+            plans.push(final_plan(i, layer, &extra, s));
+            b.spend(1).await;
+        }
+        let _ = self.supported.set(SupportedPlans {
+            layers: plans,
+            figures,
+        });
     }
 
     /// [`Job::supported_plans`] and what the droplet-level pass added.
@@ -51,50 +105,81 @@ impl Job {
                     support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
                 })
             });
-            let planned: Vec<(LayerPlan, geom::Shapes, Vec<plan::Move>)> = parts
-                .into_iter()
-                .zip(hatches)
-                .zip(&layers)
-                .map(|(((mut p, own), moves), layer)| {
-                    p.unsupported_area = layer.unsupported_area;
-                    (p, own, moves)
-                })
-                .collect();
+            let planned = with_hatches(parts, hatches, &layers);
             drop(layers);
-            // The droplet-level pass reads each layer's droplets from its moves when it needs
-            // them (no list of all droplets is kept).
-            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
-            let (extra, figures) = stages::time(Stage::Support, || {
-                support_droplets::complete(
-                    &|i, within, out: &mut Vec<support_droplets::Droplet>| {
-                        support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
-                        support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
-                    },
-                    &regions,
-                    s,
-                )
-            });
+            let (extra, figures) = droplet_pass(&planned, &regions, s);
             // Each layer's added droplets and unit 1's moves into its plan (on all cores).
-            let plans = par_map_owned(planned, &|i, (mut p, region, mut moves)| {
-                if !extra[i].is_empty() {
-                    let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
-                    let none = geom::Shapes::new();
-                    moves.extend(support::moves::support_moves(
-                        &[],
-                        &none,
-                        &extra[i],
-                        i,
-                        s,
-                        start,
-                    ));
-                }
-                plan::add_unit1(&mut p, moves, s);
-                (p, region)
-            });
+            let plans = par_map_owned(planned, &|i, layer| final_plan(i, layer, &extra, s));
             SupportedPlans {
                 layers: plans,
                 figures,
             }
         })
     }
+}
+
+/// A layer's part plan, its own region and unit 1's hatch moves.
+type Planned = (LayerPlan, geom::Shapes, Vec<plan::Move>);
+
+/// Each layer's part plan with its overhang figure and unit 1's hatch moves.
+fn with_hatches(
+    parts: Vec<(LayerPlan, geom::Shapes)>,
+    hatches: Vec<Vec<plan::Move>>,
+    layers: &[support::LayerSupport],
+) -> Vec<Planned> {
+    parts
+        .into_iter()
+        .zip(hatches)
+        .zip(layers)
+        .map(|(((mut p, own), moves), layer)| {
+            p.unsupported_area = layer.unsupported_area;
+            (p, own, moves)
+        })
+        .collect()
+}
+
+/// The droplet-level pass: it reads each layer's droplets from its moves when it needs them
+/// (no list of all droplets is kept).
+fn droplet_pass(
+    planned: &[Planned],
+    regions: &[geom::Shapes],
+    s: &crate::base::settings::Settings,
+) -> (
+    Vec<Vec<crate::base::geom::DVec2>>,
+    support_droplets::PassFigures,
+) {
+    let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+    stages::time(Stage::Support, || {
+        support_droplets::complete(
+            &|i, within, out: &mut Vec<support_droplets::Droplet>| {
+                support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
+                support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
+            },
+            regions,
+            s,
+        )
+    })
+}
+
+/// Layer `i`'s added droplets and unit 1's moves into its plan.
+fn final_plan(
+    i: usize,
+    (mut p, region, mut moves): Planned,
+    extra: &[Vec<crate::base::geom::DVec2>],
+    s: &crate::base::settings::Settings,
+) -> (LayerPlan, geom::Shapes) {
+    if !extra[i].is_empty() {
+        let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+        let none = geom::Shapes::new();
+        moves.extend(support::moves::support_moves(
+            &[],
+            &none,
+            &extra[i],
+            i,
+            s,
+            start,
+        ));
+    }
+    plan::add_unit1(&mut p, moves, s);
+    (p, region)
 }

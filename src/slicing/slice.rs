@@ -26,6 +26,7 @@ use crate::base::geom::{
 };
 use crate::base::parallel::in_runs;
 use crate::base::settings::SlicePlane;
+use crate::base::steps::{self, Budget};
 use crate::model::mesh::{Mesh, edge_key};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::float::simplify::SimplifyShape;
@@ -76,12 +77,17 @@ pub struct FacetBuckets {
 
 impl FacetBuckets {
     pub fn new(mesh: &Mesh, zs: &[f64]) -> FacetBuckets {
+        steps::now(FacetBuckets::new_in_steps(mesh, zs, &steps::UNLIMITED))
+    }
+
+    /// [`FacetBuckets::new`] in resumable steps ([`steps::runs`]).
+    pub async fn new_in_steps(mesh: &Mesh, zs: &[f64], b: &Budget) -> FacetBuckets {
         // Every pass over the facets runs in runs of them (`in_runs`: the page's engine
         // compiles the later runs well).
         let nf = mesh.facets.len();
         // Per facet: its lowest z and the planes it crosses (lo < z <= hi).
         let mut spans: Vec<(f64, u32, u32)> = Vec::with_capacity(nf);
-        in_runs(nf, &mut |r| {
+        steps::runs(nf, b, &mut |r| {
             spans.extend(mesh.facets[r].iter().map(|f| {
                 let z = f.map(|i| mesh.vertices[i as usize][2]);
                 let lo = lesser(lesser(z[0], z[1]), z[2]);
@@ -90,12 +96,13 @@ impl FacetBuckets {
                 let b = zs.partition_point(|&p| p <= hi) as u32;
                 (lo, a, b.max(a))
             }))
-        });
+        })
+        .await;
         let mut counts = vec![0u32; zs.len() + 1];
         // The facets by their first plane (a counting sort that keeps file order; those
         // crossing no plane are left out), counted beside the rows.
         let mut run = vec![0u32; zs.len() + 1];
-        in_runs(nf, &mut |r| {
+        steps::runs(nf, b, &mut |r| {
             // (slices of their own: their bounds stay in registers through the stores)
             let (counts, run) = (&mut counts[..], &mut run[..]);
             for &(_, a, b) in &spans[r] {
@@ -106,7 +113,8 @@ impl FacetBuckets {
                     run[a as usize + 1] += 1;
                 }
             }
-        });
+        })
+        .await;
         for i in 1..counts.len() {
             counts[i] += counts[i - 1];
         }
@@ -121,7 +129,7 @@ impl FacetBuckets {
         }
         let mut order: Vec<(f64, u32)> = vec![(0.0, 0); *run.last().unwrap_or(&0) as usize];
         let mut at = run.clone();
-        in_runs(nf, &mut |r| {
+        steps::runs(nf, b, &mut |r| {
             let (order, at) = (&mut order[..], &mut at[..]);
             for (f, &(lo, a, b)) in spans[r.clone()].iter().enumerate() {
                 if a < b {
@@ -129,13 +137,15 @@ impl FacetBuckets {
                     at[a as usize] += 1;
                 }
             }
-        });
+        })
+        .await;
         drop(at);
         for w in run.windows(2) {
             order[w[0] as usize..w[1] as usize]
                 .sort_unstable_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+            b.spend((w[1] - w[0]) as usize).await;
         }
-        in_runs(order.len(), &mut |r| {
+        steps::runs(order.len(), b, &mut |r| {
             let (facets, fill) = (&mut facets[..], &mut fill[..]);
             for &(_, f) in &order[r] {
                 let (_, a, b) = spans[f as usize];
@@ -144,7 +154,8 @@ impl FacetBuckets {
                     fill[i as usize] += 1;
                 }
             }
-        });
+        })
+        .await;
         FacetBuckets { offsets, facets }
     }
 

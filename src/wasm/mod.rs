@@ -12,8 +12,9 @@
 //! console, and the worker turns the trap that follows into an error message.
 //!
 //! The model comes in as a `File` read in the worker ([`Session::from_file`], `FileReaderSync`),
-//! so the page's thread never copies its bytes. Every worker prepares the job from its own
-//! import of the files ([`Session::from_models`]), all at the same time.
+//! so the page's thread never copies its bytes. The job worker prepares the job from its
+//! import of the files in short calls ([`Session::begin`]) and hands it to the others as
+//! bytes ([`Session::prepared`], [`Session::from_prepared`]).
 //!
 //! The core knows nothing of wasm; this file only converts.
 
@@ -33,6 +34,7 @@ use crate::analysis;
 use crate::base::error::{Error, ErrorReport};
 use crate::base::settings::{self, Settings};
 use crate::base::stages::{self, Stage};
+use crate::base::steps::{Budget, Stepped};
 use crate::model::spec as job;
 use crate::output::gcode;
 use crate::output::summary::{Figures, Summary};
@@ -253,7 +255,8 @@ impl Session {
             raster: std::cell::RefCell::new(analysis::Raster::empty()),
             stage: std::sync::Arc::new(analysis::LayerStage::new(&job.analysis_grid(), &settings)),
             analysis_refused: job.analysis_grid().check(&settings).err(),
-            job,
+            job: std::rc::Rc::new(job),
+            support_pass: std::cell::RefCell::new(None),
             settings,
         }
     }
@@ -297,6 +300,31 @@ struct SliceFigures {
     nothing_to_print: Option<ErrorReport>,
 }
 
+/// The supported pass being made in steps, and its budget.
+type SupportPass = (std::rc::Rc<Budget>, Stepped<()>);
+
+/// A buffer outside the module's memory, as the hand-off's sink and source.
+struct JsBytes(Uint8Array);
+
+impl crate::pipeline::handoff::Sink for JsBytes {
+    fn write(&mut self, at: usize, bytes: &[u8]) {
+        self.0
+            .subarray(at as u32, (at + bytes.len()) as u32)
+            .copy_from(bytes);
+    }
+}
+
+impl crate::pipeline::handoff::Source for JsBytes {
+    fn len(&self) -> usize {
+        self.0.length() as usize
+    }
+    fn read(&self, at: usize, out: &mut [u8]) {
+        self.0
+            .subarray(at as u32, (at + out.len()) as u32)
+            .copy_to(out);
+    }
+}
+
 /// A job being prepared in short calls ([`Session::begin`]).
 #[wasm_bindgen]
 pub struct Preparing {
@@ -307,14 +335,16 @@ pub struct Preparing {
 
 #[wasm_bindgen]
 impl Preparing {
-    /// Runs the next pass of the preparation: true once the job is made (then
+    /// Works through about `items` items of the preparation (facets, corners, vertices: the
+    /// page picks a number that keeps a call short): true once the job is made (then
     /// [`Session::from_preparation`]). Throws `{kind, message, setting?}` as `from_models`
     /// does when the job is refused.
-    pub fn step(&mut self) -> Result<bool, JsValue> {
+    pub fn step(&mut self, items: u32) -> Result<bool, JsValue> {
         if self.job.is_some() {
             return Ok(true);
         }
-        let made = stages::time(Stage::Prepare, || self.prep.step()).map_err(js_error)?;
+        let made =
+            stages::time(Stage::Prepare, || self.prep.step(items as usize)).map_err(js_error)?;
         self.job = made;
         Ok(self.job.is_some())
     }
@@ -323,7 +353,10 @@ impl Preparing {
 /// One prepared slicing job: the parsed, transformed mesh and its settings.
 #[wasm_bindgen]
 pub struct Session {
-    pub(crate) job: Job,
+    /// Shared with the supported pass while it runs in steps ([`Session::support_step`]).
+    pub(crate) job: std::rc::Rc<Job>,
+    /// The supported pass in steps, while it runs, and its budget.
+    support_pass: std::cell::RefCell<Option<SupportPass>>,
     pub(crate) settings: Settings,
     /// The last layer planned and the unit selected after it.
     unit_after: std::cell::Cell<Option<(usize, u8)>>,
@@ -371,15 +404,13 @@ impl Session {
     }
 
     /// [`Session::from_models`] in short calls (the page's engine keeps a running call's
-    /// first code to its end, so later calls get the well-compiled code): this call welds and
-    /// places the parts; [`Preparing::step`] runs the rest one pass a call until it returns
-    /// true; [`Session::from_preparation`] takes the job. The same job as `from_models`.
+    /// first code to its end, so later calls get the well-compiled code): this call reads the
+    /// job; [`Preparing::step`] works through a budget of items a call (weld, placing,
+    /// shells, facet index, statistics, checks) until it returns true;
+    /// [`Session::from_preparation`] takes the job. The same job as `from_models`.
     pub fn begin(models: &Models, job: JsValue) -> Result<Preparing, JsValue> {
         let spec = job_of(job)?;
-        let prep = stages::time(Stage::Prepare, || {
-            Job::prepare_in_steps(&models.models, &spec)
-        })
-        .map_err(js_error)?;
+        let prep = Job::prepare_in_steps(models.models.clone(), &spec);
         Ok(Preparing { prep, job: None })
     }
 
@@ -396,16 +427,45 @@ impl Session {
 
     /// The prepared job as bytes ([`Job::to_bytes`]), for [`Session::from_prepared`] in the
     /// page's other workers: they take this worker's preparation instead of repeating it.
-    /// (Not counted as `Prepare`: the worker times it on its own line of the profile.)
-    pub fn prepared(&self) -> Vec<u8> {
-        self.job.to_bytes()
+    /// Written a run at a time straight into a new buffer outside the module's memory, so
+    /// this worker never holds the job twice. (Not counted as `Prepare`: the worker times it
+    /// on its own line of the profile.)
+    pub fn prepared(&self) -> Uint8Array {
+        let (size, write) = self.job.bytes_writer();
+        let out = Uint8Array::new_with_length(size as u32);
+        write(&mut JsBytes(out.clone()));
+        out
     }
 
-    /// The job another worker prepared ([`Session::prepared`]). Throws `{kind: "internal",
-    /// message}` if the bytes are damaged.
-    pub fn from_prepared(bytes: &[u8]) -> Result<Session, JsValue> {
-        let job = stages::time(Stage::Prepare, || Job::from_bytes(bytes)).map_err(js_error)?;
+    /// The job another worker prepared ([`Session::prepared`]), read a run at a time out of
+    /// the message's buffer (never copied whole into the module's memory). Throws `{kind:
+    /// "internal", message}` if the bytes are damaged.
+    pub fn from_prepared(bytes: Uint8Array) -> Result<Session, JsValue> {
+        let source = JsBytes(bytes);
+        let job = stages::time(Stage::Prepare, || Job::read_bytes(&source)).map_err(js_error)?;
         Ok(Session::with(job))
+    }
+
+    /// Works through about `items` layers' worth of the supported pass (`support = unit1`:
+    /// every layer's plan with the support, which the first layer planned would otherwise
+    /// make whole in one call; [`Job::supported_in_steps`]): true once it is made, at once
+    /// when the support is off. The page calls it until true before it plans layers.
+    pub fn support_step(&self, items: u32) -> bool {
+        if self.job.settings().support != settings::Support::Unit1 || self.job.supported_made() {
+            return true;
+        }
+        let mut pass = self.support_pass.borrow_mut();
+        let (budget, stepped) = pass.get_or_insert_with(|| {
+            let budget = std::rc::Rc::new(Budget::new(0));
+            let (job, b) = (self.job.clone(), budget.clone());
+            let run = Stepped::new(async move { job.supported_in_steps(&b).await });
+            (budget, run)
+        });
+        budget.refill(items as usize);
+        if stepped.step().is_some() {
+            *pass = None;
+        }
+        self.job.supported_made()
     }
 
     /// Number of layers.

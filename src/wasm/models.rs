@@ -40,7 +40,9 @@ pub(super) fn read_file(file: &web_sys::File) -> Result<Vec<u8>, JsValue> {
 #[wasm_bindgen]
 #[derive(Default)]
 pub struct Models {
-    pub(super) models: Vec<Model>,
+    /// Shared with a preparation in steps while it runs ([`Session::begin`]; a file added or
+    /// removed meanwhile leaves the preparation's files as they were).
+    pub(super) models: std::sync::Arc<Vec<Model>>,
 }
 
 #[wasm_bindgen]
@@ -64,15 +66,16 @@ impl Models {
     pub fn add_bytes(&mut self, bytes: &[u8], name: &str) -> Result<JsValue, JsValue> {
         let model = Model::read(bytes, name).map_err(js_error)?;
         let info = model.info();
-        self.models.retain(|m| m.name != name);
-        self.models.push(model);
+        let models = std::sync::Arc::make_mut(&mut self.models);
+        models.retain(|m| m.name != name);
+        models.push(model);
         to_js(&info, "the model info")
     }
 
     /// Forgets a file; whether it was there.
     pub fn remove(&mut self, name: &str) -> bool {
         let before = self.models.len();
-        self.models.retain(|m| m.name != name);
+        std::sync::Arc::make_mut(&mut self.models).retain(|m| m.name != name);
         self.models.len() != before
     }
 

@@ -100,7 +100,17 @@ function yieldToQueue(): Promise<void> {
   });
 }
 
+/** Layers per call of the supported pass. */
+const SUPPORT_ITEMS = 4;
+
+/** With `support = unit1`: the supported pass (every layer's plan with the support) in short
+ *  calls, before the first layer is planned (which would otherwise make it in one call). */
+function supported(s: Session): void {
+  while (!timedCall("core: the supported pass, the longest call", () => s.support_step(SUPPORT_ITEMS)));
+}
+
 function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analyse = false, counted = true): LayerData {
+  supported(s);
   const r = clock.time("core: a layer (all its stages)", () =>
     timedCall("core: a layer, the longest call", () => (analyse ? s.slice_layer_analysed(index) : s.slice_layer(index))),
   );
@@ -136,14 +146,18 @@ function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analy
   }
 }
 
-/** `Session.from_models` in short calls (`Session.begin`, then a pass a call): the engine
- *  keeps a running call's first code to its end, so a call that ran the whole preparation
- *  ran it all in that code; later calls of a pass get the optimised code. */
+/** Items (facets, corners, vertices) per call of the preparation: a few milliseconds of
+ *  the engine's first code, less once it is optimised. */
+const PREPARE_ITEMS = 16_384;
+
+/** `Session.from_models` in short calls (`Session.begin`, then a budget of items a call):
+ *  the engine keeps a running call's first code to its end, so a call that ran the whole
+ *  preparation ran it all in that code; later calls of a pass get the optimised code. */
 function prepare(m: Models, job: RequestData<"open_job">["job"]): Session {
   const p = timedCall("core: preparation, the longest call", () => Session.begin(m, job));
   let done = false;
   try {
-    while (!done) done = timedCall("core: preparation, the longest call", () => p.step());
+    while (!done) done = timedCall("core: preparation, the longest call", () => p.step(PREPARE_ITEMS));
   } catch (e) {
     p.free();
     throw e;
@@ -381,7 +395,9 @@ async function handle(req: Request): Promise<void> {
       return;
     case "cut": {
       const { line, from, to, sent, centres } = req.data;
-      const r = need().cut(Float64Array.from(line), from, to, sent, centres);
+      const s = need();
+      supported(s);
+      const r = s.cut(Float64Array.from(line), from, to, sent, centres);
       try {
         const reply = { droplets: r.droplets, spans: r.spans, voids: r.voids, bands: r.bands };
         answer(req.kind, req.id, reply, [reply.droplets.buffer, reply.spans.buffer, reply.voids.buffer]);
