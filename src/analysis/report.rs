@@ -233,6 +233,9 @@ pub struct LayerStage {
     grid: Grid3,
     /// Unit 1's part settings and grid, in a job with unit-1 parts.
     unit1: Option<(Settings, Grid3)>,
+    /// Whether the 2D analysis rasterises only a band around each layer's boundary
+    /// ([`Raster::rebuild_banded`]); the whole layer (the reference) when not.
+    banded: bool,
 }
 
 /// One layer analysed by a [`LayerStage`]: its 2D figures, and its regions and spheroid maps
@@ -362,6 +365,17 @@ impl LayerStage {
             settings: settings.clone(),
             grid: grid.grid3(settings),
             unit1,
+            banded: true,
+        }
+    }
+
+    /// The stage rasterising every layer whole: the reference the banded analysis is held
+    /// to (tests, profiles).
+    #[cfg(any(test, feature = "reference"))]
+    pub fn reference(grid: &AnalysisGrid, settings: &Settings) -> LayerStage {
+        LayerStage {
+            banded: false,
+            ..LayerStage::new(grid, settings)
         }
     }
 
@@ -396,7 +410,12 @@ impl LayerStage {
     ) -> (LayerAnalysis, LayerMaps) {
         let s = &self.settings;
         let centres = droplet_centres(plan, s.droplet_width());
-        raster.rebuild(plan.index, plan.z, &centres, region, s);
+        if self.banded {
+            let rate = 0.0;
+            raster.rebuild_banded(plan.index, plan.z, &centres, region, s, band_width(s), rate);
+        } else {
+            raster.rebuild(plan.index, plan.z, &centres, region, s);
+        }
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
         (analysis, self.maps_with(&centres, plan))
@@ -456,6 +475,16 @@ impl LayerStage {
     }
 }
 
+/// The width of the band a banded raster keeps around a layer's boundary, mm: the contours
+/// and the fill's margin (where the hatch ends), and 3 B more for the gaps around the hatch
+/// ends and the droplets' reach.
+fn band_width(s: &Settings) -> f64 {
+    let b = s.droplet_width();
+    let last = s.contours as f64 - 1.0;
+    let margin = s.outer_offset.max(s.inner_offset) + last + 1.0 - s.fill_overlap;
+    (margin.max(0.0) + 3.0) * b
+}
+
 /// A slab's (exact volume, void volume): `area` × H, and the void share of the region sampled
 /// on `grid` between the maps of the layers below, of its own and above.
 fn slab_of(
@@ -494,7 +523,17 @@ pub struct JobAnalysis {
 impl JobAnalysis {
     /// The analysis of a job of `grid.layers` layers, sliced with `settings`.
     pub fn new(grid: &AnalysisGrid, settings: &Settings) -> JobAnalysis {
-        let stage = Arc::new(LayerStage::new(grid, settings));
+        JobAnalysis::with_stage(grid, LayerStage::new(grid, settings))
+    }
+
+    /// The analysis with every layer rasterised whole ([`LayerStage::reference`]).
+    #[cfg(any(test, feature = "reference"))]
+    pub fn reference(grid: &AnalysisGrid, settings: &Settings) -> JobAnalysis {
+        JobAnalysis::with_stage(grid, LayerStage::reference(grid, settings))
+    }
+
+    fn with_stage(grid: &AnalysisGrid, stage: LayerStage) -> JobAnalysis {
+        let stage = Arc::new(stage);
         JobAnalysis {
             run: SlabRun::new(stage.clone()),
             stage,
