@@ -64,6 +64,7 @@
 mod cut;
 mod droplet;
 mod estimate3d;
+mod interior;
 mod raster;
 mod report;
 mod slabs;
@@ -72,7 +73,10 @@ pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_vo
 pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres};
 #[cfg(any(test, feature = "reference"))]
 pub use estimate3d::slab_voids_reference;
-pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
+pub use estimate3d::{
+    Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
+};
+pub use interior::{InteriorCache, InteriorRates};
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,

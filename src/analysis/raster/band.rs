@@ -88,6 +88,12 @@ fn set_stored(
 }
 
 impl Raster {
+    /// Grid cells of the interior a banded rebuild counted instead of rasterising (0 after
+    /// a whole one).
+    pub fn interior_cells(&self) -> u64 {
+        self.banding.map_or(0, |b| b.interior_cells)
+    }
+
     /// Whether a layer sliced with `s` can be banded: each droplet a disc of diameter B, the
     /// fill's lines B apart, so that no two droplets of the interior overlap (their cells
     /// add up) and its voids are the small gaps between them. Otherwise (`spread`, a fill
