@@ -33,6 +33,9 @@ pub(super) struct Banding {
     pub(super) void_rate: f64,
 }
 
+/// At most this many blocks over a layer's box (else it is rasterised whole).
+const MAX_BLOCKS: usize = 4_000_000;
+
 /// A block's kind.
 const OUTSIDE: u8 = 0;
 const BAND: u8 = 1;
@@ -124,6 +127,11 @@ impl Raster {
             return self.rebuild(index, z, centres, region, s);
         }
         let prep = self.prepare(centres, region, s);
+        let g = prep.grid;
+        if g.ny.div_ceil(BLOCK_ROWS).saturating_mul(g.nx.div_ceil(64)) > MAX_BLOCKS {
+            // Parts far apart in one layer: its sparse tiles, not a dense map of blocks.
+            return self.rebuild(index, z, centres, region, s);
+        }
         let kind = self.blocks(&prep.grid, width);
         let banding = self.set_banded(&prep, &kind, void_rate);
         self.finish(index, z, centres.len(), region, s, prep.grid);
@@ -231,37 +239,60 @@ impl Raster {
             (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
         let tiles = &self.tiles;
         let mut spot: Option<Spot> = None;
-        // The region in the band: each span's stretches over blocks not in the interior.
+        // Per block row, its runs of interior blocks [first, last].
+        let runs: Vec<Vec<(usize, usize)>> = kind
+            .chunks(nc)
+            .map(|row| {
+                let mut out: Vec<(usize, usize)> = Vec::new();
+                for (w, _) in row.iter().enumerate().filter(|(_, k)| **k == INTERIOR) {
+                    match out.last_mut() {
+                        Some(r) if r.1 + 1 == w => r.1 = w,
+                        _ => out.push((w, w)),
+                    }
+                }
+                out
+            })
+            .collect();
+        // The region in the band: each span but its stretches over interior blocks.
         for &(k, c0, c1) in self.spans.iter() {
             let (k, c0, c1) = (k as usize, c0 as usize, c1 as usize);
+            let row = &runs[k / BLOCK_ROWS];
+            let mut i = row.partition_point(|r| r.1 < c0 >> 6);
             let mut from = c0;
             while from <= c1 {
-                let w = from >> 6;
-                let inner = interior(k, w);
-                let mut to = (64 * w + 63).min(c1);
-                while to < c1 && interior(k, (to + 1) >> 6) == inner {
-                    to = (64 * ((to + 1) >> 6) + 63).min(c1);
+                match row.get(i) {
+                    Some(&(a, e)) if 64 * a <= c1 => {
+                        if from < 64 * a {
+                            set_stored(tiles, &mut spot, region_bits, extent, k, from, 64 * a - 1);
+                        }
+                        from = from.max(64 * (e + 1));
+                        i += 1;
+                    }
+                    _ => {
+                        set_stored(tiles, &mut spot, region_bits, extent, k, from, c1);
+                        break;
+                    }
                 }
-                if !inner {
-                    set_stored(tiles, &mut spot, region_bits, extent, k, from, to);
-                }
-                from = to + 1;
             }
         }
         // The interior blocks of the stored tiles, as covered region.
-        for band in tiles.bands() {
+        for (bi, band) in tiles.bands().iter().enumerate() {
             for seg in tiles.segments(band) {
                 for w in seg.c0..seg.c1 {
-                    for k in (band.first_row..band.end_row).step_by(BLOCK_ROWS) {
-                        if !interior(k, w) {
+                    let at = w - seg.shift();
+                    for k0 in (band.first_row..band.end_row).step_by(BLOCK_ROWS) {
+                        if !interior(k0, w) {
                             continue;
                         }
-                        for k in k..(k + BLOCK_ROWS).min(ny) {
-                            for bits in [&mut *region_bits, &mut *drop_bits] {
-                                set_stored(tiles, &mut spot, bits, extent, k, 64 * w, 64 * w + 63);
-                            }
+                        for k in k0..(k0 + BLOCK_ROWS).min(band.end_row) {
+                            let i = band.offset + (k - band.first_row) * band.row_len + at;
+                            region_bits[i] = !0;
+                            drop_bits[i] = !0;
+                            let e = &mut extent[bi * tiles.band_rows() + k - band.first_row];
+                            e.0 = e.0.min(at as u32);
+                            e.1 = e.1.max(at as u32 + 1);
+                            out.stored_interior_cells += BLOCK_COLS as u64;
                         }
-                        out.stored_interior_cells += (BLOCK_ROWS * BLOCK_COLS) as u64;
                     }
                 }
             }
