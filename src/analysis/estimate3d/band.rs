@@ -14,8 +14,11 @@ use crate::base::spatial::floor_i64;
 const BLOCK_CELLS: i64 = 8;
 /// At most this many blocks over a layer's box (else it is not banded).
 const MAX_BLOCKS: usize = 4_000_000;
-/// A block within the band is 1; in the region beyond it 2; and 3 when every block within 2
-/// of it is too (its droplets are left out of the layer's map).
+/// A block within the band is 1; in the region beyond it 2; and 3 when every block within
+/// [`DEEP_MARGIN`] of it is too (its droplets are left out of the layer's map).
+/// Blocks between the band and the deep interior: a layer's boundary may move this far from
+/// the next layer's before a slab puts left-out droplets back.
+const DEEP_MARGIN: usize = 1;
 const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 const DEEP: u8 = 3;
@@ -124,7 +127,7 @@ impl Blocks {
             }
         });
         let other: Vec<bool> = kind.iter().map(|&k| k != INTERIOR).collect();
-        let near = dilate2(&other, w, h, 2);
+        let near = dilate2(&other, w, h, DEEP_MARGIN);
         for (k, near) in kind.iter_mut().zip(near) {
             if *k == INTERIOR && !near {
                 *k = DEEP;

@@ -205,14 +205,17 @@ impl Raster {
         let nc = nx.div_ceil(64);
         let nr = ny.div_ceil(BLOCK_ROWS);
         let (tr, tc) = (nr.div_ceil(TILE_BLOCK_ROWS), nc.div_ceil(TILE_BLOCK_COLS));
-        let mut has_band = vec![false; tr * tc];
-        for (i, &k) in kind.iter().enumerate() {
-            if k == BAND {
-                has_band[(i / nc) / TILE_BLOCK_ROWS * tc + (i % nc) / TILE_BLOCK_COLS] = true;
+        // The tiles holding band blocks, or interior blocks next to one (which the band's
+        // voids must find covered, not outside the region).
+        let band: Vec<bool> = kind.iter().map(|&k| k == BAND).collect();
+        let across = dilate(&band, nr, nc, 1, |row, c| row * nc + c);
+        let near = dilate(&across, nc, nr, 1, |col, row| row * nc + col);
+        let mut stored = vec![false; tr * tc];
+        for (i, (&k, &near)) in kind.iter().zip(&near).enumerate() {
+            if k == BAND || (k == INTERIOR && near) {
+                stored[(i / nc) / TILE_BLOCK_ROWS * tc + (i % nc) / TILE_BLOCK_COLS] = true;
             }
         }
-        let across = dilate(&has_band, tr, tc, 1, |row, c| row * tc + c);
-        let stored = dilate(&across, tc, tr, 1, |col, row| row * tc + col);
         let tiles = &mut self.tiles;
         for (t, _) in stored.iter().enumerate().filter(|(_, s)| **s) {
             let (r0, w0) = (
@@ -228,6 +231,7 @@ impl Raster {
         }
         self.allocate();
         let interior = |k: usize, w: usize| kind[(k / BLOCK_ROWS) * nc + w] == INTERIOR;
+        debug_assert!(rows <= BLOCK_ROWS + 1 && widest.iter().all(|w| w.0 < 64));
         let mut out = Banding {
             void_rate,
             interior_cells: (kind.iter().filter(|&&k| k == INTERIOR).count()
@@ -310,12 +314,15 @@ impl Raster {
             }
             let c0 = (u - half + 0.5) as i64;
             let (c1, k1) = (c0 + n - 1, k0 + rows - 1);
-            let inner = c0 >= 0
-                && c1 < nx as i64
-                && k1 < ny
-                && (k0 / BLOCK_ROWS..=k1 / BLOCK_ROWS).all(|br| {
-                    (c0 as usize >> 6..=c1 as usize >> 6).all(|w| kind[br * nc + w] == INTERIOR)
-                });
+            // A droplet spans at most two blocks each way (12 rows, 41 columns).
+            let inner = c0 >= 0 && c1 < nx as i64 && k1 < ny && {
+                let (r0, r1) = (k0 / BLOCK_ROWS * nc, k1 / BLOCK_ROWS * nc);
+                let (w0, w1) = (c0 as usize >> 6, c1 as usize >> 6);
+                kind[r0 + w0] == INTERIOR
+                    && kind[r0 + w1] == INTERIOR
+                    && kind[r1 + w0] == INTERIOR
+                    && kind[r1 + w1] == INTERIOR
+            };
             if inner {
                 out.interior_drop_cells += cells_of[ph];
                 continue;
