@@ -272,13 +272,20 @@ fn report_of(job: &dropslice::Job) -> (dropslice::analysis::Report, Vec<u8>) {
     (analysis.finish(), code)
 }
 
-/// The analysis in the slicing workers gives every layer's figures, in order, the same as a
-/// layer analysed on its own, and leaves the code as it is without it.
+/// The analysis in the slicing workers (the reference, rasterising every layer whole) gives
+/// every layer's figures, in order, the same as a layer analysed on its own, and leaves the
+/// code as it is without it; so does the banded analysis of `--report`.
 #[test]
 fn analysis_in_the_slicing_workers_leaves_the_code_and_figures_alone() {
+    use dropslice::analysis::JobAnalysis;
     let s = Settings::default();
     let job = dropslice::Job::new(&cube(), "cube", s.clone()).unwrap();
-    let (report, with) = report_of(&job);
+    let (_, banded) = report_of(&job);
+    let mut analysis = JobAnalysis::reference(&job.analysis_grid(), job.settings());
+    let mut with = Vec::new();
+    dropslice::write_gcode_with(&job, &mut with, |_, _| {}, &mut analysis).unwrap();
+    let report = analysis.finish();
+    assert_eq!(banded, with);
     assert_eq!(report.layers.len(), job.layer_count());
     for i in [0, 7, job.layer_count() - 1] {
         let (plan, region) = job.plan_layer_and_region(i);

@@ -7,8 +7,10 @@ use crate::base::geom::{Point, Shapes, all_contours};
 use crate::base::settings::Settings;
 use crate::base::spatial::{Segment, Spot, Tiles, floor_i64};
 
+mod band;
 #[cfg(any(test, feature = "reference"))]
 mod reference;
+pub use band::{Blocks, UnitMap, slab_voids_banded};
 #[cfg(any(test, feature = "reference"))]
 pub use reference::slab_voids_reference;
 

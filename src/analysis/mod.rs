@@ -54,6 +54,37 @@
 //! `reference` feature only). docs/quality.md (*Analysis speed*) has the profile, and why the
 //! periodic interior of the hatch does not help on this axis-aligned grid.
 //!
+//! # The band (`--report`)
+//! The job analysis ([`JobAnalysis`], [`LayerStage`]) works in a band around each layer's
+//! boundary and counts the interior, so that its cost grows with the boundary, not the
+//! volume. Away from the contours the droplets are the fill's lines, B apart, and the
+//! figures there depend only on the settings and the kind of layer:
+//! - **2D** ([`Raster::rebuild_banded`]): blocks of 16 rows × 64 columns (1.6 B) within the
+//!   band's width (the contours, the fill's margin and 3 B) of a boundary edge are rasterised
+//!   and labelled as before; the interior blocks are not. Their cells and their droplets'
+//!   cells are counted (discs of diameter B on lines B apart do not overlap, so their cells
+//!   add up; with `footprint = spread` or a fill density other than 1 the whole layer is
+//!   rasterised); interior blocks inside the stored tiles are stored as covered region, so
+//!   the band's voids end there as at a droplet. Coverage, void and enclosed areas, overfill
+//!   and the boundary deviation are so computed; the interior's void count is estimated at
+//!   the rate measured on a patch ([`InteriorCache`]: a disc of radius 32 B planned as the
+//!   job's layer, its voids by the whole raster against the band's); the **largest void is
+//!   the band's**: the whole raster joins the channels between the fill's lines through the
+//!   interior into networks of several mm² that the band does not see.
+//! - **3D** ([`slab_voids_banded`]): blocks of 8 × 8 cells of the 3D grid, fixed to the job;
+//!   a layer's droplets whose cells all lie in its deep interior (2 blocks beyond the band)
+//!   are left out of its map ([`UnitMap`]). A slab's cells in blocks that are interior in its
+//!   own layer and both neighbours take the void share measured on the slab's own sample
+//!   blocks (one in 8, whose droplets every map keeps and whose cells are filled exactly; the
+//!   patch's share when fewer than 256 cells are sampled); every other cell is filled
+//!   exactly, from maps with every droplet that reaches it (a left-out droplet in a block that
+//!   is deep in one layer but not interior in a neighbour is put back for that slab).
+//!
+//! The whole raster and the exact fill stay as the reference ([`JobAnalysis::reference`],
+//! built for tests and with the `reference` feature); tests/analysis_band.rs holds the banded
+//! report to it. The page's per-layer figures and void overlay use the whole raster
+//! ([`analyse_layer_for_page`]); its slabs take unit 0's maps without a region, so whole.
+//!
 //! # Memory
 //! The grids span the layer's bounding box, but only tiles near its region and droplets are
 //! stored ([`Tiles`]): the 2D bitmaps in tiles of 64 rows × 256 columns (1.3 mm square with the
@@ -64,6 +95,7 @@
 mod cut;
 mod droplet;
 mod estimate3d;
+mod interior;
 mod raster;
 mod report;
 mod slabs;
@@ -72,7 +104,10 @@ pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_vo
 pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres};
 #[cfg(any(test, feature = "reference"))]
 pub use estimate3d::slab_voids_reference;
-pub use estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
+pub use estimate3d::{
+    Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
+};
+pub use interior::{InteriorCache, InteriorRates};
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,

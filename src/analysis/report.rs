@@ -4,7 +4,10 @@
 use super::droplet::{
     droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres,
 };
-use super::estimate3d::{GRID3_PER_B, Grid3, HeightMap, slab_voids};
+use super::estimate3d::{
+    Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
+};
+use super::interior::InteriorCache;
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
 use super::slabs::{self, LayerMaps, SlabFigures, SlabRun, Slabs, UnitRegions};
 use crate::base::geom::{DVec2, Point, Shapes, region_area};
@@ -233,6 +236,13 @@ pub struct LayerStage {
     grid: Grid3,
     /// Unit 1's part settings and grid, in a job with unit-1 parts.
     unit1: Option<(Settings, Grid3)>,
+    /// Whether the 2D analysis rasterises only a band around each layer's boundary
+    /// ([`Raster::rebuild_banded`]), and the 3D estimate fills only the cells near a
+    /// boundary of the slab's three layers ([`slab_voids_banded`]); the whole layer (the
+    /// reference) when not.
+    banded: bool,
+    /// What the fill's lattice gives the interior, per kind of layer.
+    interior: Arc<InteriorCache>,
 }
 
 /// One layer analysed by a [`LayerStage`]: its 2D figures, and its regions and spheroid maps
@@ -362,6 +372,18 @@ impl LayerStage {
             settings: settings.clone(),
             grid: grid.grid3(settings),
             unit1,
+            banded: true,
+            interior: Arc::default(),
+        }
+    }
+
+    /// The stage rasterising every layer whole: the reference the banded analysis is held
+    /// to (tests, profiles).
+    #[cfg(any(test, feature = "reference"))]
+    pub fn reference(grid: &AnalysisGrid, settings: &Settings) -> LayerStage {
+        LayerStage {
+            banded: false,
+            ..LayerStage::new(grid, settings)
         }
     }
 
@@ -396,15 +418,28 @@ impl LayerStage {
     ) -> (LayerAnalysis, LayerMaps) {
         let s = &self.settings;
         let centres = droplet_centres(plan, s.droplet_width());
-        raster.rebuild(plan.index, plan.z, &centres, region, s);
+        if self.banded && Raster::can_band(s) {
+            let width = band_width(s);
+            let rate = self
+                .interior
+                .rates(s, plan.index, &self.grid, width)
+                .void_rate;
+            raster.rebuild_banded(plan.index, plan.z, &centres, region, s, width, rate);
+        } else {
+            raster.rebuild(plan.index, plan.z, &centres, region, s);
+        }
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
-        (analysis, self.maps_with(&centres, plan))
+        (analysis, self.maps_with(&centres, plan, Some(region)))
     }
 
-    /// A layer's spheroid maps given unit 0's droplet centres.
-    fn maps_with(&self, centres: &[Point], plan: &LayerPlan) -> LayerMaps {
-        let unit0 = HeightMap::new(centres, &self.grid, footprint_diameter(&self.settings));
+    /// A layer's spheroid maps given unit 0's droplet centres (banded with its `region`).
+    fn maps_with(&self, centres: &[Point], plan: &LayerPlan, region: Option<&Shapes>) -> LayerMaps {
+        let blocks = region
+            .filter(|_| self.banded)
+            .and_then(|r| Blocks::new(r, &self.grid, band_width(&self.settings)));
+        let d = footprint_diameter(&self.settings);
+        let unit0 = UnitMap::new(centres, &self.grid, d, blocks);
         let unit1 = self
             .unit1
             .as_ref()
@@ -415,7 +450,11 @@ impl LayerStage {
     /// A layer's spheroid maps alone (a layer next to a run of analysed layers, whose own
     /// figures are not wanted: [`SlabRun::finish`]).
     pub fn maps(&self, plan: &LayerPlan) -> LayerMaps {
-        self.maps_with(&droplet_centres(plan, self.settings.droplet_width()), plan)
+        self.maps_with(
+            &droplet_centres(plan, self.settings.droplet_width()),
+            plan,
+            None,
+        )
     }
 
     /// Slab `i`'s 3D estimate: per unit, its exact volume and its void volume (the void share
@@ -427,26 +466,31 @@ impl LayerStage {
         maps: [Option<&LayerMaps>; 3],
     ) -> SlabFigures {
         let s = &self.settings;
-        let (volume, void_volume) = slab_of(
-            analysis.region_area,
-            &regions.unit0,
-            &self.grid,
-            maps.map(|m| m.map(|m| &m.unit0)),
-            s,
-        );
+        let unit0 = maps.map(|m| m.map(|m| &m.unit0));
+        let (volume, void_volume) = slab_of(analysis.region_area, &regions.unit0, s, |r| {
+            let this = unit0[1]?;
+            Some(if self.banded {
+                let width = band_width(s);
+                let share = self
+                    .interior
+                    .rates(s, analysis.index, &self.grid, width)
+                    .share;
+                slab_voids_banded(r, &self.grid, unit0, s, share)
+            } else {
+                let (below, above) = (unit0[0].map(|m| &m.map), unit0[2].map(|m| &m.map));
+                slab_voids(r, &self.grid, below, &this.map, above, s)
+            })
+        });
         let unit1 = self.unit1.as_ref().map(|(s1, g1)| {
             let area = if regions.unit1.is_empty() {
                 0.0
             } else {
                 region_area(&regions.unit1)
             };
-            slab_of(
-                area,
-                &regions.unit1,
-                g1,
-                maps.map(|m| m.and_then(|m| m.unit1.as_ref())),
-                s1,
-            )
+            let unit1 = maps.map(|m| m.and_then(|m| m.unit1.as_ref()));
+            slab_of(area, &regions.unit1, s1, |r| {
+                Some(slab_voids(r, g1, unit1[0], unit1[1]?, unit1[2], s1))
+            })
         });
         SlabFigures {
             volume,
@@ -467,23 +511,31 @@ impl slabs::SlabStage for LayerStage {
     }
 }
 
+/// The width of the band a banded raster keeps around a layer's boundary, mm: the contours
+/// and the fill's margin (where the hatch ends), and 3 B more for the gaps around the hatch
+/// ends and the droplets' reach.
+fn band_width(s: &Settings) -> f64 {
+    let b = s.droplet_width();
+    let last = s.contours as f64 - 1.0;
+    let margin = s.outer_offset.max(s.inner_offset) + last + 1.0 - s.fill_overlap;
+    (margin.max(0.0) + 3.0) * b
+}
+
 /// A slab's (exact volume, void volume): `area` × H, and the void share of the region sampled
 /// on `grid` between the maps of the layers below, of its own and above.
 fn slab_of(
     area: f64,
     region: &Shapes,
-    grid: &Grid3,
-    maps: [Option<&HeightMap>; 3],
     s: &Settings,
+    voids: impl FnOnce(&Shapes) -> Option<(f64, f64)>,
 ) -> (f64, f64) {
     let exact = area * s.layer_height;
-    let Some(this) = maps[1] else {
-        return (exact, 0.0);
-    };
     if region.is_empty() {
         return (exact, 0.0);
     }
-    let (vol, void) = slab_voids(region, grid, maps[0], this, maps[2], s);
+    let Some((vol, void)) = voids(region) else {
+        return (exact, 0.0);
+    };
     let void = if vol > 0.0 { void / vol * exact } else { 0.0 };
     (exact, void)
 }
@@ -505,7 +557,17 @@ pub struct JobAnalysis {
 impl JobAnalysis {
     /// The analysis of a job of `grid.layers` layers, sliced with `settings`.
     pub fn new(grid: &AnalysisGrid, settings: &Settings) -> JobAnalysis {
-        let stage = Arc::new(LayerStage::new(grid, settings));
+        JobAnalysis::with_stage(grid, LayerStage::new(grid, settings))
+    }
+
+    /// The analysis with every layer rasterised whole ([`LayerStage::reference`]).
+    #[cfg(any(test, feature = "reference"))]
+    pub fn reference(grid: &AnalysisGrid, settings: &Settings) -> JobAnalysis {
+        JobAnalysis::with_stage(grid, LayerStage::reference(grid, settings))
+    }
+
+    fn with_stage(grid: &AnalysisGrid, stage: LayerStage) -> JobAnalysis {
+        let stage = Arc::new(stage);
         JobAnalysis {
             run: SlabRun::new(stage.clone()),
             stage,

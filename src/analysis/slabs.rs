@@ -3,7 +3,7 @@
 //! analysed one after another (the report's writing thread, a page worker's run of layers);
 //! [`Slabs`] lets the native slicing workers compute them in any order.
 
-use super::estimate3d::HeightMap;
+use super::estimate3d::{HeightMap, UnitMap};
 use super::raster::LayerAnalysis;
 use crate::base::geom::Shapes;
 use std::collections::BTreeMap;
@@ -20,7 +20,8 @@ pub struct UnitRegions {
 /// A layer's droplet spheroids on the 3D grid: unit 0's and, in a job with unit-1 parts,
 /// unit 1's (on its own grid, of B₁).
 pub struct LayerMaps {
-    pub unit0: HeightMap,
+    /// Unit 0's, without the droplets deep in a banded layer's interior (kept aside).
+    pub unit0: UnitMap,
     pub unit1: Option<HeightMap>,
 }
 

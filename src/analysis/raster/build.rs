@@ -12,8 +12,8 @@ use crate::slicing::plan::LayerPlan;
 const PHASES: usize = 256;
 /// Rows of the 2D grid per band of the sparse raster, and words (of 64 columns) per tile: tiles
 /// of 64 × 256 cells, 1.33 mm square with the default B.
-const BAND_ROWS: usize = 64;
-const TILE_WORDS: usize = 4;
+pub(super) const BAND_ROWS: usize = 64;
+pub(super) const TILE_WORDS: usize = 4;
 
 /// Band-averaged half-widths of a disc of radius `r` on rows of height `gy`: entry
 /// [phase][j] for the j-th row from the one holding the disc's lowest point, when that point
@@ -81,6 +81,7 @@ impl Raster {
             spans: Vec::new(),
             places: Vec::new(),
             scratch: Default::default(),
+            banding: None,
         }
     }
 
@@ -93,94 +94,21 @@ impl Raster {
         region: &Shapes,
         s: &Settings,
     ) {
-        let b = s.droplet_width();
-        let r = footprint_diameter(s) / 2.0;
-        let gy = b / ROWS_PER_B;
-        let gx = gy / COLS_PER_ROW;
-        let mut min = [f64::INFINITY; 2];
-        let mut max = [f64::NEG_INFINITY; 2];
-        for p in all_contours(region).flatten() {
-            for k in 0..2 {
-                min[k] = min[k].min(p[k]);
-                max[k] = max[k].max(p[k]);
-            }
-        }
-        for p in centres {
-            for k in 0..2 {
-                min[k] = min[k].min(p[k] - r);
-                max[k] = max[k].max(p[k] + r);
-            }
-        }
-        self.edges.clear();
-        for c in all_contours(region) {
-            for i in 0..c.len() {
-                self.edges.push((c[i], c[(i + 1) % c.len()]));
-            }
-        }
-        if !min[0].is_finite() {
-            min = [0.0, 0.0];
-            max = [0.0, 0.0];
-        }
-        let margin = 2.0 * gy;
-        let x0 = min[0] - margin;
-        let y0 = min[1] - margin;
-        let nx = ((max[0] + margin - x0) / gx).ceil() as usize + 1;
-        let ny = ((max[1] + margin - y0) / gy).ceil() as usize + 1;
-        let nw = nx.div_ceil(64);
-        let grid = Grid {
-            x0,
-            y0,
-            gx,
-            gy,
-            nx,
-            ny,
-        };
+        let prep = self.prepare(centres, region, s);
+        let Prep {
+            grid,
+            rows,
+            ref spans,
+            ref widest,
+        } = prep;
+        let (nx, ny) = (grid.nx, grid.ny);
         // First the tiles the region and the droplets touch, then their bits.
         let tiles = &mut self.tiles;
-        tiles.reset(ny, nw, BAND_ROWS, TILE_WORDS);
-        let spans = &mut self.spans;
-        spans.clear();
-        region_spans(region, y0, gy, ny, |k, xa, xb| {
-            if let Some((c0, c1)) = grid.cols(xa, xb) {
-                spans.push((k as u32, c0 as u32, c1 as u32));
-            }
-        });
-        for &(k, c0, c1) in spans.iter() {
+        for &(k, c0, c1) in self.spans.iter() {
             let k = k as usize;
             tiles.mark(k, k, c0 as usize >> 6, c1 as usize >> 6);
         }
-        let (rows, table) = half_width_table(r, gy);
-        // Per phase and row, the columns covered (n, and (n − 1)/2): the rounding carry
-        // depends only on the phase, not on the droplet.
-        let spans: Vec<(i64, f64)> = table
-            .chunks(rows)
-            .flat_map(|widths| {
-                let mut carry = 0.0;
-                widths.iter().map(move |&w| {
-                    let want = 2.0 * w / gx + carry;
-                    // Rounding by truncation: every value here is ≥ 0.
-                    let n = (want + 0.5) as i64;
-                    carry = want - n as f64;
-                    (n, (n - 1) as f64 / 2.0)
-                })
-            })
-            .collect();
-        // Per phase, the widest row: a droplet's columns in every row lie within its columns.
-        let widest: Vec<(i64, f64)> = spans
-            .chunks(rows)
-            .map(|c| c.iter().copied().max_by_key(|s| s.0).unwrap_or((0, 0.0)))
-            .collect();
-        // A droplet's first row, phase, and centre in column units (column c's centre at u = c).
-        let place = |p: &Point| {
-            let v = (p[1] - r - y0) / gy;
-            let k0 = v.floor();
-            let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
-            (k0 as usize, ph, (p[0] - x0) / gx - 0.5)
-        };
-        let places = &mut self.places;
-        places.clear();
-        places.extend(centres.iter().map(place));
-        for &(k0, ph, u) in places.iter() {
+        for &(k0, ph, u) in self.places.iter() {
             let (n, half) = widest[ph];
             if n >= 1 {
                 let c0 = (u - half + 0.5) as i64;
@@ -190,16 +118,10 @@ impl Raster {
                 tiles.mark(k0, k0 + rows - 1, w0, w1);
             }
         }
-        let len = tiles.build();
-        self.region_bits.clear();
-        self.region_bits.resize(len, 0);
-        self.drop_bits.clear();
-        self.drop_bits.resize(len, 0);
-        self.extent.clear();
-        self.extent.resize(tiles.row_slots(), (u32::MAX, 0));
+        self.allocate();
         let (region_bits, drop_bits, extent) =
             (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
-        let tiles = &*tiles;
+        let tiles = &self.tiles;
         // Where the last span or droplet row was stored (mostly where the next one is).
         let mut spot: Option<Spot> = None;
         for &(k, c0, c1) in self.spans.iter() {
@@ -257,11 +179,129 @@ impl Raster {
                 );
             }
         }
+        self.finish(index, z, centres.len(), region, s, grid);
+    }
+
+    /// The first half of a rebuild: the grid over the region and the droplets, the region's
+    /// edges, its spans (row, first column, last column) in `spans` and each droplet's place
+    /// in `places`, and the tables of columns a droplet covers per row; the tiles reset.
+    pub(super) fn prepare(&mut self, centres: &[Point], region: &Shapes, s: &Settings) -> Prep {
+        let b = s.droplet_width();
+        let r = footprint_diameter(s) / 2.0;
+        let gy = b / ROWS_PER_B;
+        let gx = gy / COLS_PER_ROW;
+        let mut min = [f64::INFINITY; 2];
+        let mut max = [f64::NEG_INFINITY; 2];
+        for p in all_contours(region).flatten() {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        for p in centres {
+            for k in 0..2 {
+                min[k] = min[k].min(p[k] - r);
+                max[k] = max[k].max(p[k] + r);
+            }
+        }
+        self.edges.clear();
+        for c in all_contours(region) {
+            for i in 0..c.len() {
+                self.edges.push((c[i], c[(i + 1) % c.len()]));
+            }
+        }
+        if !min[0].is_finite() {
+            min = [0.0, 0.0];
+            max = [0.0, 0.0];
+        }
+        let margin = 2.0 * gy;
+        let x0 = min[0] - margin;
+        let y0 = min[1] - margin;
+        let nx = ((max[0] + margin - x0) / gx).ceil() as usize + 1;
+        let ny = ((max[1] + margin - y0) / gy).ceil() as usize + 1;
+        let nw = nx.div_ceil(64);
+        let grid = Grid {
+            x0,
+            y0,
+            gx,
+            gy,
+            nx,
+            ny,
+        };
+        self.tiles.reset(ny, nw, BAND_ROWS, TILE_WORDS);
+        let spans = &mut self.spans;
+        spans.clear();
+        region_spans(region, y0, gy, ny, |k, xa, xb| {
+            if let Some((c0, c1)) = grid.cols(xa, xb) {
+                spans.push((k as u32, c0 as u32, c1 as u32));
+            }
+        });
+        let (rows, table) = half_width_table(r, gy);
+        // Per phase and row, the columns covered (n, and (n − 1)/2): the rounding carry
+        // depends only on the phase, not on the droplet.
+        let spans: Vec<(i64, f64)> = table
+            .chunks(rows)
+            .flat_map(|widths| {
+                let mut carry = 0.0;
+                widths.iter().map(move |&w| {
+                    let want = 2.0 * w / gx + carry;
+                    // Rounding by truncation: every value here is ≥ 0.
+                    let n = (want + 0.5) as i64;
+                    carry = want - n as f64;
+                    (n, (n - 1) as f64 / 2.0)
+                })
+            })
+            .collect();
+        // Per phase, the widest row: a droplet's columns in every row lie within its columns.
+        let widest: Vec<(i64, f64)> = spans
+            .chunks(rows)
+            .map(|c| c.iter().copied().max_by_key(|s| s.0).unwrap_or((0, 0.0)))
+            .collect();
+        // A droplet's first row, phase, and centre in column units (column c's centre at u = c).
+        let place = |p: &Point| {
+            let v = (p[1] - r - y0) / gy;
+            let k0 = v.floor();
+            let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
+            (k0 as usize, ph, (p[0] - x0) / gx - 0.5)
+        };
+        let places = &mut self.places;
+        places.clear();
+        places.extend(centres.iter().map(place));
+        self.banding = None;
+        Prep {
+            grid,
+            rows,
+            spans,
+            widest,
+        }
+    }
+
+    /// Lays out the marked tiles and clears the bitmaps and extents over them.
+    pub(super) fn allocate(&mut self) {
+        let len = self.tiles.build();
+        self.region_bits.clear();
+        self.region_bits.resize(len, 0);
+        self.drop_bits.clear();
+        self.drop_bits.resize(len, 0);
+        self.extent.clear();
+        self.extent.resize(self.tiles.row_slots(), (u32::MAX, 0));
+    }
+
+    /// The last of a rebuild: the layer's own figures.
+    pub(super) fn finish(
+        &mut self,
+        index: usize,
+        z: f64,
+        droplets: usize,
+        region: &Shapes,
+        s: &Settings,
+        grid: Grid,
+    ) {
         self.index = index;
         self.z = z;
-        self.droplets = centres.len() as u64;
+        self.droplets = droplets as u64;
         self.region_area = region_area(region);
-        self.b = b;
+        self.b = s.droplet_width();
         self.grid = grid;
     }
 
@@ -290,9 +330,18 @@ impl Raster {
     }
 }
 
+/// What [`Raster::prepare`] gives: the grid, the rows a droplet spans, per phase and row the
+/// columns it covers (n, (n − 1)/2), and per phase its widest row's.
+pub(super) struct Prep {
+    pub(super) grid: Grid,
+    pub(super) rows: usize,
+    pub(super) spans: Vec<(i64, f64)>,
+    pub(super) widest: Vec<(i64, f64)>,
+}
+
 /// Widens a row's extent (the words of its slice holding any bit) to columns c0..=c1.
 #[inline]
-fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
+pub(super) fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
     e.0 = e.0.min((c0 >> 6) as u32);
     e.1 = e.1.max((c1 >> 6) as u32 + 1);
 }
@@ -300,7 +349,7 @@ fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
 /// Sets grid columns c0..=c1 of row `k` in `bits` (laid out by `tiles`; `spot` where the last
 /// row set was stored) and widens the row's extent.
 #[inline]
-fn set_cols(
+pub(super) fn set_cols(
     tiles: &Tiles,
     spot: &mut Option<Spot>,
     bits: &mut [u64],

@@ -14,6 +14,7 @@ use crate::base::spatial::{Row, Tiles};
 use crate::slicing::plan::LayerPlan;
 use serde::Serialize;
 
+mod band;
 mod build;
 mod mask;
 #[cfg(any(test, feature = "reference"))]
@@ -201,6 +202,8 @@ pub struct Raster {
     places: Vec<(usize, usize, f64)>,
     /// The labelling's buffers, kept from layer to layer (a worker analyses many layers).
     scratch: std::sync::Mutex<Scratch>,
+    /// What a banded rebuild ([`Raster::rebuild_banded`]) left out and counted instead.
+    banding: Option<band::Banding>,
 }
 
 /// Buffers of [`Raster::voids_fast`].

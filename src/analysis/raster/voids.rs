@@ -156,7 +156,17 @@ impl Raster {
         let mut counts = [0u64; 3];
         let mut over_rows = Vec::new();
         let v = labelling(&index, &mut counts, &mut over_rows);
-        let [n_region, n_covered, n_over] = counts;
+        let [mut n_region, mut n_covered, n_over] = counts;
+        let (mut count, mut enclosed) = (v.count, v.enclosed);
+        // A banded raster's interior: its cells and its droplets' cells for the covered
+        // region stored there, its voids (all enclosed) added.
+        if let Some(b) = &self.banding {
+            n_region = n_region - b.stored_interior_cells + b.interior_cells;
+            n_covered = (n_covered - b.stored_interior_cells + b.interior_drop_cells).min(n_region);
+            let gaps = b.interior_cells.saturating_sub(b.interior_drop_cells);
+            enclosed += gaps;
+            count += (b.interior_cells as f64 * b.void_rate).round() as usize;
+        }
         let dev_in = v.dev_in;
         // Outward deviation: overfill runs.
         let mut dev_out = Deviation::default();
@@ -188,8 +198,8 @@ impl Raster {
             covered_area: n_covered as f64 * cell,
             coverage,
             void_area: (n_region - n_covered) as f64 * cell,
-            enclosed_void_area: v.enclosed as f64 * cell,
-            voids: v.count,
+            enclosed_void_area: enclosed as f64 * cell,
+            voids: count,
             largest_void: v.largest,
             overfill_area: n_over as f64 * cell,
             deviation_inward: dev_in.max,
