@@ -137,7 +137,24 @@ const APART_MM: f64 = 0.01;
 /// shapes by that vertex restores (shapes of different groups never share it). Tested against
 /// [`simplify_together`] on random island sets.
 pub fn simplify_apart(items: &[Paths], fill_rule: FillRule) -> Paths3 {
+    simplify_apart_known(items, fill_rule, |_| false)
+}
+
+/// [`simplify_apart`] told which items are known to give no shape of more than
+/// [`MIN_AREA_MM2`] alone (`vanishes(i)`; e.g. the raw offset curve of an island thinner than
+/// twice the offset): a group of such items only is not passed to the engine. Their points
+/// still make the adapter, so every other group's points go to the same grid as before, and
+/// the result differs from [`simplify_apart`]'s only by loops under [`MIN_AREA_MM2`] (which
+/// every caller drops) — none, where the caller's claim holds with a margin over the grid.
+pub fn simplify_apart_known(
+    items: &[Paths],
+    fill_rule: FillRule,
+    vanishes: impl Fn(usize) -> bool,
+) -> Paths3 {
     if items.len() < 2 {
+        if items.len() == 1 && vanishes(0) {
+            return Paths3::new();
+        }
         return simplify_together(items, fill_rule);
     }
     let points = items.iter().flatten().flatten();
@@ -145,12 +162,18 @@ pub fn simplify_apart(items: &[Paths], fill_rule: FillRule) -> Paths3 {
     let boxes = paths_boxes(items);
     let groups = apart_groups(&boxes, APART_MM);
     if groups.len() < 2 {
+        if groups.iter().flatten().all(|&i| vanishes(i)) {
+            return Paths3::new();
+        }
         return simplify_together(items, fill_rule);
     }
     let mut keyed: Vec<([f64; 2], Paths)> = Vec::new();
     let mut overlay = FloatOverlay::<[f64; 2], i32>::with_adapter(adapter.clone(), 0);
     let mut grid: Vec<IntPoint<i32>> = Vec::new();
     for group in groups {
+        if group.iter().all(|&i| vanishes(i)) {
+            continue;
+        }
         if let [i] = group[..]
             && let [path] = &items[i][..]
             && convex_on_grid(path, &adapter, &mut grid)
