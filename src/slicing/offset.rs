@@ -99,7 +99,7 @@ pub fn inset_with(
                     raw_offset(c, if hole { d_hole } else { d_outer }, tolerance, corners)
                 })
                 .filter(|r| r.len() >= 3)
-                .map(|r| r.iter().map(|p| p.to_array()).collect())
+                .map(|r| r.into_iter().map(|p| p.to_array()).collect())
                 .collect()
         })
         .collect();
@@ -270,6 +270,11 @@ const MIN_AREA_MM2: f64 = 1e-6;
 /// the offset engine can leave such a spike running back to the original boundary where two
 /// nearly opposite edges meet, and a droplet walk would follow it out of the loop.
 pub fn remove_spikes(mut c: Contour) -> Contour {
+    let n = c.len();
+    // Most loops have no spike: found without the pass' bookkeeping.
+    if n >= 3 && (0..n).all(|i| dist(c[(i + n - 1) % n], c[(i + 1) % n]) >= SPIKE_BASE_MM) {
+        return c;
+    }
     let mut changed = true;
     while changed && c.len() >= 3 {
         changed = false;
