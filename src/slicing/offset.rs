@@ -204,11 +204,19 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
             (DVec2::new((q[0] - p[0]) / len, (q[1] - p[1]) / len), len)
         })
         .collect();
-    // Chord step of the arcs: d·(1 − cos(step/2)) = tolerance.
-    let step = 2.0 * (1.0 - (tolerance / d).min(1.0)).acos();
-    // Largest turn of a reflex corner whose two moved edges may simply be extended to their
-    // crossing, at d / cos(turn/2) from the corner: within the tolerance of the arc.
-    let tangent_max = 2.0 * (d / (d + tolerance)).acos();
+    // For reflex corners only (a convex loop needs neither): the chord step of the arcs,
+    // d·(1 − cos(step/2)) = tolerance, and the largest turn of a reflex corner whose two moved
+    // edges may simply be extended to their crossing, at d / cos(turn/2) from the corner:
+    // within the tolerance of the arc.
+    let mut reflex: Option<(f64, f64)> = None;
+    let mut reflex_consts = || {
+        *reflex.get_or_insert_with(|| {
+            (
+                2.0 * (1.0 - (tolerance / d).min(1.0)).acos(),
+                2.0 * (d / (d + tolerance)).acos(),
+            )
+        })
+    };
     let mut out: Contour = Vec::with_capacity(2 * n);
     for i in 0..n {
         // The corner at pts[i], between edge i − 1 (in) and edge i (out).
@@ -223,17 +231,22 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
         if turn >= 0.0 {
             // Convex corner (or straight on): the moved edges cross d·tan(turn/2) back along
             // each of them, at the mitre point.
-            let back = d * (0.5 * turn).tan();
-            let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
-            let m = DVec2::new(p[0] + k * (n0[0] + n1[0]), p[1] + k * (n0[1] + n1[1]));
-            if corners == Corners::Miter && back <= l0 && back <= l1 && turn < MAX_MITER_TURN {
-                out.push(m);
+            let mitre = corners == Corners::Miter && {
+                let back = d * (0.5 * turn).tan();
+                back <= l0 && back <= l1 && turn < MAX_MITER_TURN
+            };
+            if mitre {
+                let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
+                out.push(DVec2::new(
+                    p[0] + k * (n0[0] + n1[0]),
+                    p[1] + k * (n0[1] + n1[1]),
+                ));
             } else if turn == 0.0 {
                 out.push(a);
             } else {
                 out.extend([a, p, b]);
             }
-        } else if -turn <= tangent_max {
+        } else if -turn <= reflex_consts().1 {
             // Reflex corner turning so little that the crossing of the moved edges' lines lies
             // within the tolerance outside the arc: that one point, not the arc's two ends
             // (which would double the vertices of a curve at every offset of a chain).
@@ -245,7 +258,7 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
         } else {
             // Reflex corner: the arc around p from a to b, turning clockwise by |turn|.
             out.push(a);
-            let parts = (-turn / step).ceil() as usize;
+            let parts = (-turn / reflex_consts().0).ceil() as usize;
             let start = n0[1].atan2(n0[0]);
             for k in 1..parts {
                 let ang = start + turn * k as f64 / parts as f64;
