@@ -1,12 +1,15 @@
-// The speed table of docs/performance.md in one run (`npm run bench`): on 3DBenchy, the CLI
-// against CuraEngine, support on against off, `--report` against plain, the page (file chosen
-// → every layer's G-code ready, the page's own clock) against the CLI, the page's longest
-// main-thread task while slicing; the 1M torus in the page against the CLI; 10⁵ separate
-// 0.5 mm cubes (scripts/many_parts.py fan 5) against 3DBenchy on the CLI and, with
-// BENCH_CUBES6=1, 10⁶ cubes (fan 6, a minute or more per run) against 10⁵. Every figure
-// is a median of BENCH_RUNS (default 5) runs after one untimed warm-up, the runs of the tools
-// compared interleaved (run k of each, then run k + 1), so a burst of other work on the machine
-// falls on all of them alike. Ratios are of wall times; CPU (user + sys) is printed beside.
+// The speed table of docs/performance.md (issue 40's table) in one run (`npm run bench`): on
+// 3DBenchy, the CLI against CuraEngine, support on against off, `--report` against plain, the
+// page (file chosen → every layer's G-code ready, the page's own clock) against the CLI in a
+// fresh page and on a second visit (a new page of the same browser profile), the page's longest
+// main-thread task while slicing; stanford_bunny `--report` against plain; the 1M torus in the
+// page against the CLI; 10⁵ separate 0.5 mm cubes (scripts/many_parts.py fan 5) against
+// 3DBenchy on the CLI and 10⁶ cubes (fan 6, a minute or more per run: BENCH_CUBES6_RUNS runs,
+// default 1, no warm-up) against 10⁵; then the peak memory (RSS) of every CLI run and of
+// CuraEngine. Every other figure is a median of BENCH_RUNS (default 5) runs after one untimed
+// warm-up, the runs of the tools compared interleaved (run k of each, then run k + 1), so a
+// burst of other work on the machine falls on all of them alike. Ratios are of wall times; CPU
+// (user + sys) is printed beside.
 //
 // Environment: BENCH_RUNS (5), BENCH_BUILD (1: cargo build --release --bin dropslice and
 // scripts/build.sh first; 0: use what is built), BENCH_PAGE (1; 0: CLI figures only),
@@ -16,13 +19,14 @@
 // shared/tools/gen_mesh.py; default target/pyenv's), DROPSLICE_SHARED (../shared), CURA_DEFS
 // (the folder of Cura's fdmprinter.def.json; else unpacked from Debian's `cura` package),
 // BENCH_INSTALL (1: install CuraEngine from Debian if it is missing; 0: do not), BENCH_CUBES6
-// (0; 1: also the 10⁶ cubes).
+// (1; 0: not the 10⁶ cubes), BENCH_CUBES6_RUNS (1).
 //
 // CuraEngine runs with shared/bench/peers.sh's matched FDM settings (its run_cura, read out of
 // that file): the same 240 layers, 100 % fill. Where CuraEngine is not installed (Debian
 // package cura-engine) the CLI's time is printed and the ratio is marked as not measured.
 import { execFileSync, spawnSync } from "node:child_process";
-import { copyFileSync, existsSync, mkdirSync, readFileSync, readdirSync, rmSync, statSync, writeFileSync } from "node:fs";
+import { copyFileSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, statSync, writeFileSync } from "node:fs";
+import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 
@@ -34,6 +38,7 @@ const build = process.env.BENCH_BUILD !== "0";
 const withPage = process.env.BENCH_PAGE !== "0";
 const profile = process.env.BENCH_PROFILE === "1";
 const benchy = join(shared, "models/3DBenchy.stl");
+const bunny = join(shared, "models/stanford_bunny.stl");
 mkdirSync(join(dir, "bin"), { recursive: true });
 mkdirSync(join(dir, "models"), { recursive: true });
 mkdirSync(join(dir, "out"), { recursive: true });
@@ -74,7 +79,8 @@ function cubes(levels) {
   return f;
 }
 const cubes5 = cubes(5);
-const cubes6 = process.env.BENCH_CUBES6 === "1" ? cubes(6) : null;
+const cubes6 = process.env.BENCH_CUBES6 !== "0" ? cubes(6) : null;
+const cubes6Runs = Math.max(1, Number(process.env.BENCH_CUBES6_RUNS ?? 1) | 0);
 
 // ------------------------------------------------------------------ CuraEngine
 function curaCommand() {
@@ -109,19 +115,22 @@ const cura = curaCommand();
 if (cura.missing) log(`CuraEngine: ${cura.missing}; the CLI/CuraEngine ratio cannot be measured here`);
 
 // ------------------------------------------------------------------ runs
-/** Runs argv under /usr/bin/time; returns { wall, cpu } in seconds (throws on failure). */
+/** Runs argv under /usr/bin/time; returns { wall, cpu } in seconds and the peak RSS in MB
+ *  (throws on failure). */
 function timed(argv) {
   const tf = join(dir, "out/time.txt");
-  const r = spawnSync("/usr/bin/time", ["-f", "%e %U %S", "-o", tf, ...argv], { encoding: "utf8", maxBuffer: 1 << 26 });
+  const r = spawnSync("/usr/bin/time", ["-f", "%e %U %S %M", "-o", tf, ...argv], { encoding: "utf8", maxBuffer: 1 << 26 });
   if (r.status !== 0) throw new Error(`${argv.join(" ")} failed (${r.status}): ${(r.stderr ?? "").slice(-500)}`);
-  const [wall, user, sys] = readFileSync(tf, "utf8").trim().split("\n").pop().split(" ").map(Number);
-  return { wall, cpu: user + sys };
+  const [wall, user, sys, kb] = readFileSync(tf, "utf8").trim().split("\n").pop().split(" ").map(Number);
+  return { wall, cpu: user + sys, rss: kb / 1024 };
 }
 const out = (name) => join(dir, `out/${name}`);
 const cli = {
   plain: () => timed([ds, "-q", benchy, "-o", out("benchy.gco")]),
   support: () => timed([ds, "-q", benchy, "-o", out("benchy_s.gco"), "--set", "support=unit1"]),
   report: () => timed([ds, "-q", benchy, "-o", out("benchy_r.gco"), "--report", out("benchy_r.json")]),
+  bunny: () => timed([ds, "-q", bunny, "-o", out("bunny.gco"), "--set", "allow_off_plate=true"]),
+  bunnyReport: () => timed([ds, "-q", bunny, "-o", out("bunny_r.gco"), "--set", "allow_off_plate=true", "--report", out("bunny_r.json")]),
   torus: () => timed([ds, "-q", torus, "-o", out("torus.gco")]),
   cubes5: () => timed([ds, "-q", cubes5, "-o", out("cubes5.gco")]),
   cubes6: () => timed([ds, "-q", cubes6, "-o", out("cubes6.gco")]),
@@ -187,7 +196,43 @@ async function pageRunner() {
       await context.close();
     }
   }
-  return { once, close: () => env.close() };
+  // A second visit: a new page of one browser profile kept for the whole run (its HTTP cache
+  // and the engine's code cache), as scripts/page_revisit_time.mjs measures it; the warm-up
+  // round's visit is that profile's first.
+  const { chromium } = await import("playwright-core");
+  const { chromiumPath } = await import(join(repo, "tests/e2e/helpers.mjs"));
+  const profileDir = mkdtempSync(join(tmpdir(), "dropslice-bench-profile-"));
+  const kept = await chromium.launchPersistentContext(profileDir, {
+    executablePath: chromiumPath,
+    headless: true,
+    viewport: { width: 1440, height: 900 },
+    args: ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+  });
+  /** Slices `file` in a new page of the kept profile; { seconds, longtask: 0, gap: 0, ... }. */
+  async function revisit(file) {
+    const p = await kept.newPage();
+    try {
+      await waitSettled(p);
+      await p.evaluate(() => (document.body.dataset.state = "picking"));
+      await p.setInputFiles("#file-input", file);
+      const s = await waitSettled(p, 900_000);
+      if (s.state !== "done") throw new Error(`${file}: the page ended in state ${s.state}`);
+      // the code cache is written after the load: give it time before the next visit
+      await p.waitForTimeout(3000);
+      return { seconds: s.seconds, longtask: 0, tasks: 0, gap: 0, layers: s.layers, workers: s.workers, stages: [] };
+    } finally {
+      await p.close();
+    }
+  }
+  return {
+    once,
+    revisit,
+    close: async () => {
+      await kept.close().catch(() => {});
+      rmSync(profileDir, { recursive: true, force: true });
+      await env.close();
+    },
+  };
 }
 
 const page = withPage ? await pageRunner() : null;
@@ -199,7 +244,10 @@ try {
     ["support", () => cli.support()],
     ["report", () => cli.report()],
     ...(page ? [["page", () => page.once(benchy)]] : []),
+    ...(page ? [["page_revisit", () => page.revisit(benchy)]] : []),
     ["cli2", () => cli.plain()],
+    ["bunny", () => cli.bunny()],
+    ["bunny_report", () => cli.bunnyReport()],
     ["torus_cli", () => cli.torus()],
     ...(page ? [["torus_page", () => page.once(torus)]] : []),
     ["cubes5", () => cli.cubes5()],
@@ -207,10 +255,11 @@ try {
   ];
   for (let k = 0; k <= runs; k++) {
     for (const [name, run] of steps) {
+      if (name === "cubes6" && (k === 0 || k > cubes6Runs)) continue;
       const l = load();
       const v = await run();
       if (k > 0) add(name, v);
-      const what = "wall" in v ? `${v.wall.toFixed(2)} s wall, ${v.cpu.toFixed(2)} s CPU` : `${v.seconds.toFixed(2)} s, longest task ${v.longtask.toFixed(0)} ms (${v.tasks} over 50 ms), timer gap ${v.gap.toFixed(0)} ms, ${v.workers} workers`;
+      const what = "wall" in v ? `${v.wall.toFixed(2)} s wall, ${v.cpu.toFixed(2)} s CPU, ${v.rss.toFixed(0)} MB` : `${v.seconds.toFixed(2)} s, longest task ${v.longtask.toFixed(0)} ms (${v.tasks} over 50 ms), timer gap ${v.gap.toFixed(0)} ms, ${v.workers} workers`;
       log(`${k ? `run ${k}` : "warm-up"} ${name}: ${what} (load ${l})`);
     }
   }
@@ -233,19 +282,35 @@ if (cli.cura) {
   rows.push(["CLI / CuraEngine 4.13 (3DBenchy)", `CLI ${f2(cliWall)} s (CPU ${f2(cliCpu)}); ${cura.missing}`, "–", "≤ 0.12", "not measured"]);
 }
 row("support on / off (3DBenchy, wall)", `${f2(med("support"))} / ${f2(cliWall)} s (CPU ${f2(med("support", "cpu"))} / ${f2(cliCpu)})`, med("support") / cliWall, 1.25);
-row("--report / plain (3DBenchy, wall)", `${f2(med("report"))} / ${f2(cliWall)} s (CPU ${f2(med("report", "cpu"))} / ${f2(cliCpu)})`, med("report") / cliWall, 2);
+row("--report / plain (3DBenchy, wall)", `${f2(med("report"))} / ${f2(cliWall)} s (CPU ${f2(med("report", "cpu"))} / ${f2(cliCpu)})`, med("report") / cliWall, 1.5);
+row("--report / plain (stanford_bunny, wall)", `${f2(med("bunny_report"))} / ${f2(med("bunny"))} s (CPU ${f2(med("bunny_report", "cpu"))} / ${f2(med("bunny", "cpu"))})`, med("bunny_report") / med("bunny"), 3);
 if (page) {
   const p = median(samples.page.map((v) => v.seconds));
-  row(`page / CLI (3DBenchy, ${samples.page[0].workers} workers)`, `${f2(p)} / ${f2(cliWall)} s`, p / cliWall, 2);
+  row(`page / CLI (3DBenchy, a fresh page, ${samples.page[0].workers} workers)`, `${f2(p)} / ${f2(cliWall)} s`, p / cliWall, 2);
+  const pr = median(samples.page_revisit.map((v) => v.seconds));
+  row("page / CLI (3DBenchy, a second visit: a new page of the same browser profile)", `${f2(pr)} / ${f2(cliWall)} s`, pr / cliWall, 1.5);
   const lt = Math.max(...samples.page.map((v) => v.longtask), ...samples.torus_page.map((v) => v.longtask));
   const gap = Math.max(...samples.page.map((v) => v.gap), ...samples.torus_page.map((v) => v.gap));
   rows.push(["page's longest main-thread task while slicing (both models, all runs)", `${lt > 0 ? `${lt.toFixed(0)} ms` : "none over 50 ms"} (longest 16 ms timer gap ${gap.toFixed(0)} ms)`, lt > 0 ? f2(lt / 1000) : "0", "≤ 50 ms", lt <= 50 ? "met" : "NOT met"]);
   const tp = median(samples.torus_page.map((v) => v.seconds));
   const tc = med("torus_cli");
-  row("page / CLI (1M torus)", `${f2(tp)} / ${f2(tc)} s (CLI CPU ${f2(med("torus_cli", "cpu"))})`, tp / tc, 1.5);
+  row("page / CLI (1M torus)", `${f2(tp)} / ${f2(tc)} s (CLI CPU ${f2(med("torus_cli", "cpu"))})`, tp / tc, 2);
 }
 row("10⁵ cubes / 3DBenchy (CLI, wall)", `${f2(med("cubes5"))} / ${f2(cliWall)} s (CPU ${f2(med("cubes5", "cpu"))} / ${f2(cliCpu)})`, med("cubes5") / cliWall, 2);
-if (cubes6) row("10⁶ cubes / 10⁵ cubes (CLI, wall)", `${f2(med("cubes6"))} / ${f2(med("cubes5"))} s (CPU ${f2(med("cubes6", "cpu"))} / ${f2(med("cubes5", "cpu"))})`, med("cubes6") / med("cubes5"), 10);
+if (cubes6) row(`10⁶ cubes / 10⁵ cubes (CLI, wall; 10⁶: ${cubes6Runs} run${cubes6Runs > 1 ? "s" : ""})`, `${f2(med("cubes6"))} / ${f2(med("cubes5"))} s (CPU ${f2(med("cubes6", "cpu"))} / ${f2(med("cubes5", "cpu"))})`, med("cubes6") / med("cubes5"), 10);
+else rows.push(["10⁶ cubes / 10⁵ cubes (CLI)", "skipped (BENCH_CUBES6=0)", "–", "≤ 10", "not measured"]);
+// peak memory of every CLI run (median of the runs' peak RSS)
+const memory = [
+  ["3DBenchy", "cli"],
+  ["3DBenchy, CuraEngine 4.13", "cura"],
+  ["3DBenchy, support on", "support"],
+  ["3DBenchy, --report", "report"],
+  ["stanford_bunny", "bunny"],
+  ["stanford_bunny, --report", "bunny_report"],
+  ["1M torus", "torus_cli"],
+  ["10⁵ cubes", "cubes5"],
+  ["10⁶ cubes", "cubes6"],
+].filter(([, k]) => samples[k]?.length);
 const meta = `commit ${execFileSync("git", ["-C", repo, "describe", "--always", "--dirty"], { encoding: "utf8" }).trim()}, ${new Date().toISOString().slice(0, 16)}Z, ${runs} runs each (median, interleaved), load now ${load()}`;
 const table = [
   meta,
@@ -253,6 +318,10 @@ const table = [
   "| figure | measured | ratio | target | verdict |",
   "|---|---|---:|---|---|",
   ...rows.map((r) => `| ${r[0]} | ${r[1]} | ${typeof r[2] === "number" ? f3(r[2]) : r[2]} | ${r[3]} | ${r[4]} |`),
+  "",
+  "| peak memory (RSS, median of the runs) | MB |",
+  "|---|---:|",
+  ...memory.map(([what, k]) => `| ${what} | ${med(k, "rss").toFixed(0)} |`),
 ].join("\n");
 console.log(table);
 writeFileSync(join(dir, "table.md"), `${table}\n`);

@@ -137,7 +137,24 @@ const APART_MM: f64 = 0.01;
 /// shapes by that vertex restores (shapes of different groups never share it). Tested against
 /// [`simplify_together`] on random island sets.
 pub fn simplify_apart(items: &[Paths], fill_rule: FillRule) -> Paths3 {
+    simplify_apart_known(items, fill_rule, |_| false)
+}
+
+/// [`simplify_apart`] told which items are known to give no shape of more than
+/// [`MIN_AREA_MM2`] alone (`vanishes(i)`; e.g. the raw offset curve of an island thinner than
+/// twice the offset): a group of such items only is not passed to the engine. Their points
+/// still make the adapter, so every other group's points go to the same grid as before, and
+/// the result differs from [`simplify_apart`]'s only by loops under [`MIN_AREA_MM2`] (which
+/// every caller drops) — none, where the caller's claim holds with a margin over the grid.
+pub fn simplify_apart_known(
+    items: &[Paths],
+    fill_rule: FillRule,
+    vanishes: impl Fn(usize) -> bool,
+) -> Paths3 {
     if items.len() < 2 {
+        if items.len() == 1 && vanishes(0) {
+            return Paths3::new();
+        }
         return simplify_together(items, fill_rule);
     }
     let points = items.iter().flatten().flatten();
@@ -145,12 +162,18 @@ pub fn simplify_apart(items: &[Paths], fill_rule: FillRule) -> Paths3 {
     let boxes = paths_boxes(items);
     let groups = apart_groups(&boxes, APART_MM);
     if groups.len() < 2 {
+        if groups.iter().flatten().all(|&i| vanishes(i)) {
+            return Paths3::new();
+        }
         return simplify_together(items, fill_rule);
     }
     let mut keyed: Vec<([f64; 2], Paths)> = Vec::new();
     let mut overlay = FloatOverlay::<[f64; 2], i32>::with_adapter(adapter.clone(), 0);
     let mut grid: Vec<IntPoint<i32>> = Vec::new();
     for group in groups {
+        if group.iter().all(|&i| vanishes(i)) {
+            continue;
+        }
         if let [i] = group[..]
             && let [path] = &items[i][..]
             && convex_on_grid(path, &adapter, &mut grid)
@@ -264,9 +287,10 @@ pub fn apart_groups(boxes: &[(DVec2, DVec2)], margin: f64) -> Vec<Vec<usize>> {
         .filter(|&i| grown[i].0.x <= grown[i].1.x && grown[i].0.y <= grown[i].1.y)
         .collect();
     let mut entries = cell_entries(&grown, &live);
-    entries.sort_unstable();
     let mut cell: Vec<usize> = Vec::new();
-    for run in entries.chunk_by(|a, b| a.0 == b.0) {
+    // The components do not depend on the order the cells are visited in (every root is its
+    // set's smallest item), so the entries need only be gathered by cell.
+    for run in by_cell(&mut entries).chunk_by(|a, b| a.0 == b.0) {
         cell.clear();
         cell.extend(run.iter().map(|e| e.1));
         sweep_unite(&grown, &mut cell, &mut parent);
@@ -330,6 +354,42 @@ fn cell_entries(grown: &[(DVec2, DVec2)], live: &[usize]) -> Vec<((i64, i64), us
         }
     }
     out
+}
+
+/// The entries gathered by cell: by a counting sort where the cells' range is dense (at most
+/// four cells per entry), else by a sort.
+fn by_cell(entries: &mut Vec<((i64, i64), usize)>) -> &[((i64, i64), usize)] {
+    let Some(first) = entries.first() else {
+        return entries;
+    };
+    let (mut lo, mut hi) = (first.0, first.0);
+    for &((x, y), _) in entries.iter() {
+        lo = (lo.0.min(x), lo.1.min(y));
+        hi = (hi.0.max(x), hi.1.max(y));
+    }
+    let (w, h) = (hi.0 - lo.0 + 1, hi.1 - lo.1 + 1);
+    if w.checked_mul(h)
+        .is_none_or(|cells| cells > 4 * entries.len() as i64)
+    {
+        entries.sort_unstable_by_key(|e| e.0);
+        return entries;
+    }
+    let index = |(x, y): (i64, i64)| ((y - lo.1) * w + (x - lo.0)) as usize;
+    let mut start = vec![0usize; (w * h) as usize + 1];
+    for e in entries.iter() {
+        start[index(e.0) + 1] += 1;
+    }
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    let mut sorted = vec![((0, 0), 0); entries.len()];
+    for &e in entries.iter() {
+        let at = &mut start[index(e.0)];
+        sorted[*at] = e;
+        *at += 1;
+    }
+    *entries = sorted;
+    entries
 }
 
 /// Unites the items of `cell` whose boxes meet: sorted by the start of their x range, each

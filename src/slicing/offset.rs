@@ -9,7 +9,7 @@
 //! no farther than [`CHORD_TOLERANCE_MM`] from the true arc. `tests/offset.rs` compares the
 //! result with i_overlay's own outline offset on every layer of the shared models.
 
-use crate::base::boolean::{Paths, simplify_apart};
+use crate::base::boolean::{Paths, simplify_apart_known};
 use crate::base::geom::{
     Contour, DVec2, Point, Shape, Shapes, all_contours, dist, segment_distance2, signed_area,
 };
@@ -99,11 +99,24 @@ pub fn inset_with(
                     raw_offset(c, if hole { d_hole } else { d_outer }, tolerance, corners)
                 })
                 .filter(|r| r.len() >= 3)
-                .map(|r| r.iter().map(|p| p.to_array()).collect())
+                .map(|r| r.into_iter().map(|p| p.to_array()).collect())
                 .collect()
         })
         .collect();
-    simplify_apart(&raw, FillRule::Positive)
+    // Through the vertices the winding rule is exact: an island that the offset provably
+    // erases leaves nothing, and its curve need not go through the engine.
+    let vanishes = |i: usize| {
+        corners == Corners::ThroughVertex
+            && region[i].holes.is_empty()
+            && convex_thinner_than(&region[i].outer, 2.0 * d_outer - VANISH_MARGIN_MM)
+    };
+    shapes_of(simplify_apart_known(&raw, FillRule::Positive, vanishes))
+}
+
+/// The engine's shapes as the offset's region: spikes removed, loops of less than
+/// [`MIN_AREA_MM2`] dropped (a shape with its outer loop).
+fn shapes_of(united: crate::base::boolean::Paths3) -> Shapes {
+    united
         .into_iter()
         .filter_map(|shape| {
             let mut contours = shape
@@ -118,6 +131,49 @@ pub fn inset_with(
             Some(Shape::new(outer, holes.collect()))
         })
         .collect()
+}
+
+/// How much thinner than twice the offset an island must be for [`inset_with`] to drop it
+/// unseen: far more than the boolean engine's grid (under 10⁻⁵ mm on a plate), so the
+/// engine's rounding cannot leave a loop of any size where the exact result is empty.
+const VANISH_MARGIN_MM: f64 = 1e-3;
+
+/// Largest loop (points) [`convex_thinner_than`] measures (its cost is quadratic).
+const VANISH_MAX_POINTS: usize = 32;
+
+/// Whether the closed loop `c` (counter-clockwise, material on the left) is convex and
+/// narrower than `width` across some edge: no disc of diameter `width` fits in it, so moving
+/// its boundary in by width / 2 leaves nothing. Convex: every corner turns left or runs
+/// straight on, and the points run up then down in (x, y) order exactly once. The narrowest
+/// width of a convex polygon is across one of its edges (the largest distance of a vertex
+/// from that edge's line).
+pub fn convex_thinner_than(c: &[Point], width: f64) -> bool {
+    let n = c.len();
+    if !(3..=VANISH_MAX_POINTS).contains(&n) || width <= 0.0 {
+        return false;
+    }
+    let up = |a: Point, b: Point| (b[0], b[1]) > (a[0], a[1]);
+    let mut changes = 0;
+    for k in 0..n {
+        let (a, b, d) = (c[k], c[(k + 1) % n], c[(k + 2) % n]);
+        let (u, v) = (b - a, d - b);
+        let cross = u[0] * v[1] - u[1] * v[0];
+        if a == b || cross < 0.0 || (cross == 0.0 && u.dot(v) <= 0.0) {
+            return false;
+        }
+        changes += usize::from(up(a, b) != up(b, d));
+    }
+    if changes != 2 {
+        return false;
+    }
+    (0..n).any(|k| {
+        let (a, b) = (c[k], c[(k + 1) % n]);
+        let len = dist(a, b);
+        c.iter().all(|&p| {
+            let (u, v) = (b - a, p - a);
+            (u[0] * v[1] - u[1] * v[0]) < width * len
+        })
+    })
 }
 
 /// The raw offset curve of one closed loop moved by `d` (≥ 0) to the left of its edges (the
@@ -148,11 +204,19 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
             (DVec2::new((q[0] - p[0]) / len, (q[1] - p[1]) / len), len)
         })
         .collect();
-    // Chord step of the arcs: d·(1 − cos(step/2)) = tolerance.
-    let step = 2.0 * (1.0 - (tolerance / d).min(1.0)).acos();
-    // Largest turn of a reflex corner whose two moved edges may simply be extended to their
-    // crossing, at d / cos(turn/2) from the corner: within the tolerance of the arc.
-    let tangent_max = 2.0 * (d / (d + tolerance)).acos();
+    // For reflex corners only (a convex loop needs neither): the chord step of the arcs,
+    // d·(1 − cos(step/2)) = tolerance, and the largest turn of a reflex corner whose two moved
+    // edges may simply be extended to their crossing, at d / cos(turn/2) from the corner:
+    // within the tolerance of the arc.
+    let mut reflex: Option<(f64, f64)> = None;
+    let mut reflex_consts = || {
+        *reflex.get_or_insert_with(|| {
+            (
+                2.0 * (1.0 - (tolerance / d).min(1.0)).acos(),
+                2.0 * (d / (d + tolerance)).acos(),
+            )
+        })
+    };
     let mut out: Contour = Vec::with_capacity(2 * n);
     for i in 0..n {
         // The corner at pts[i], between edge i − 1 (in) and edge i (out).
@@ -167,17 +231,22 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
         if turn >= 0.0 {
             // Convex corner (or straight on): the moved edges cross d·tan(turn/2) back along
             // each of them, at the mitre point.
-            let back = d * (0.5 * turn).tan();
-            let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
-            let m = DVec2::new(p[0] + k * (n0[0] + n1[0]), p[1] + k * (n0[1] + n1[1]));
-            if corners == Corners::Miter && back <= l0 && back <= l1 && turn < MAX_MITER_TURN {
-                out.push(m);
+            let mitre = corners == Corners::Miter && {
+                let back = d * (0.5 * turn).tan();
+                back <= l0 && back <= l1 && turn < MAX_MITER_TURN
+            };
+            if mitre {
+                let k = d / (1.0 + n0[0] * n1[0] + n0[1] * n1[1]);
+                out.push(DVec2::new(
+                    p[0] + k * (n0[0] + n1[0]),
+                    p[1] + k * (n0[1] + n1[1]),
+                ));
             } else if turn == 0.0 {
                 out.push(a);
             } else {
                 out.extend([a, p, b]);
             }
-        } else if -turn <= tangent_max {
+        } else if -turn <= reflex_consts().1 {
             // Reflex corner turning so little that the crossing of the moved edges' lines lies
             // within the tolerance outside the arc: that one point, not the arc's two ends
             // (which would double the vertices of a curve at every offset of a chain).
@@ -189,7 +258,7 @@ pub fn raw_offset(c: &[Point], d: f64, tolerance: f64, corners: Corners) -> Cont
         } else {
             // Reflex corner: the arc around p from a to b, turning clockwise by |turn|.
             out.push(a);
-            let parts = (-turn / step).ceil() as usize;
+            let parts = (-turn / reflex_consts().0).ceil() as usize;
             let start = n0[1].atan2(n0[0]);
             for k in 1..parts {
                 let ang = start + turn * k as f64 / parts as f64;
@@ -214,6 +283,11 @@ const MIN_AREA_MM2: f64 = 1e-6;
 /// the offset engine can leave such a spike running back to the original boundary where two
 /// nearly opposite edges meet, and a droplet walk would follow it out of the loop.
 pub fn remove_spikes(mut c: Contour) -> Contour {
+    let n = c.len();
+    // Most loops have no spike: found without the pass' bookkeeping.
+    if n >= 3 && (0..n).all(|i| dist(c[(i + n - 1) % n], c[(i + 1) % n]) >= SPIKE_BASE_MM) {
+        return c;
+    }
     let mut changed = true;
     while changed && c.len() >= 3 {
         changed = false;
@@ -242,4 +316,104 @@ pub fn remove_spikes(mut c: Contour) -> Contour {
         }
     }
     if c.len() < 3 { Vec::new() } else { c }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::base::boolean::simplify_apart;
+    use crate::base::testing::random;
+
+    /// A convex island around `c`: a square (its sides split at random points, straight on)
+    /// or the points of a circle of radius `r` at sorted random angles.
+    fn island(seed: &mut u64, c: Point, r: f64) -> Contour {
+        if random(seed) < 0.5 {
+            let corners = [[-r, -r], [r, -r], [r, r], [-r, r]].map(|p| c + DVec2::from(p));
+            let mut out = Vec::new();
+            for k in 0..4 {
+                let (a, b) = (corners[k], corners[(k + 1) % 4]);
+                out.push(a);
+                if random(seed) < 0.5 {
+                    out.push(a + (b - a) * (0.2 + 0.6 * random(seed)));
+                }
+            }
+            out
+        } else {
+            let k = 3 + (random(seed) * 12.0) as usize;
+            let mut angles: Vec<f64> = (0..k)
+                .map(|_| random(seed) * std::f64::consts::TAU)
+                .collect();
+            angles.sort_by(f64::total_cmp);
+            angles
+                .into_iter()
+                .map(|a| c + DVec2::new(a.cos(), a.sin()) * r)
+                .collect()
+        }
+    }
+
+    #[test]
+    fn islands_that_vanish_are_dropped_as_the_engine_drops_them() {
+        // Rows of convex islands, offset through their vertices by distances around half
+        // their width: the result is the one of every curve through the engine.
+        let mut seed = 0x51ed_270b_a3c4_d9e5u64;
+        let mut dropped = 0;
+        for case in 0..120 {
+            let n = 1 + (random(&mut seed) * 30.0) as usize;
+            let r = 0.1 + random(&mut seed);
+            let region: Shapes = (0..n)
+                .map(|i| {
+                    let c = DVec2::new((i % 6) as f64 * 3.0 * r, (i / 6) as f64 * 3.0 * r);
+                    let size = r * (0.5 + random(&mut seed));
+                    Shape::new(island(&mut seed, c, size), vec![])
+                })
+                .collect();
+            let d = r * (0.3 + 1.2 * random(&mut seed));
+            let tolerance = CHORD_TOLERANCE_MM;
+            let raw: Vec<Paths> = region
+                .iter()
+                .map(|shape| {
+                    let r = raw_offset(&shape.outer, d, tolerance, Corners::ThroughVertex);
+                    vec![r.iter().map(|p| p.to_array()).collect()]
+                })
+                .collect();
+            let want = shapes_of(simplify_apart(&raw, FillRule::Positive));
+            let got = inset_with(&region, d, d, tolerance, Corners::ThroughVertex);
+            assert_eq!(got, want, "case {case}");
+            dropped += region
+                .iter()
+                .filter(|s| convex_thinner_than(&s.outer, 2.0 * d - VANISH_MARGIN_MM))
+                .count();
+        }
+        assert!(dropped > 300, "{dropped}");
+    }
+
+    #[test]
+    fn only_convex_loops_count_as_thin() {
+        let sq = |w: f64| -> Contour {
+            [[0.0, 0.0], [w, 0.0], [w, w], [0.0, w]]
+                .map(DVec2::from)
+                .into()
+        };
+        assert!(convex_thinner_than(&sq(0.5), 0.51));
+        assert!(!convex_thinner_than(&sq(0.5), 0.5));
+        // Clockwise, or an L (a reflex corner), or a spike back along an edge: not measured.
+        let mut cw = sq(0.5);
+        cw.reverse();
+        assert!(!convex_thinner_than(&cw, 10.0));
+        let l: Contour = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 0.2],
+            [0.2, 0.2],
+            [0.2, 2.0],
+            [0.0, 2.0],
+        ]
+        .map(DVec2::from)
+        .into();
+        assert!(!convex_thinner_than(&l, 1.0));
+        let spike: Contour = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [1.5, 0.0], [1.0, 1.0]]
+            .map(DVec2::from)
+            .into();
+        assert!(!convex_thinner_than(&spike, 10.0));
+    }
 }
