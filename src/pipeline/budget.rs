@@ -9,6 +9,7 @@
 
 use crate::base::error::Error;
 use crate::base::settings::{Settings, Support};
+use crate::base::steps::{self, Budget};
 use crate::model::layout::Instance;
 use crate::model::mesh::Mesh;
 use crate::model::prepare::{FacetGroup, MAX_WIDTH_IN_DROPLETS};
@@ -105,27 +106,37 @@ pub struct Overhangs {
 }
 
 impl Overhangs {
-    /// The down-facing facets of `mesh` (oriented outward), sliced at the planes `zs`.
+    /// The down-facing facets of `mesh` (oriented outward), sliced at the planes `zs` (the
+    /// unit tests'; the preparation runs [`Overhangs::of_in_steps`]).
+    #[cfg(test)]
     pub fn of(mesh: &Mesh, zs: &[f64]) -> Overhangs {
+        steps::now(Overhangs::of_in_steps(mesh, zs, &steps::UNLIMITED))
+    }
+
+    /// [`Overhangs::of`] in resumable steps (its long loops in runs: [`steps::runs`]).
+    pub async fn of_in_steps(mesh: &Mesh, zs: &[f64], budget: &Budget) -> Overhangs {
         // The edges are visited in a fixed order (by their vertices), so the perimeter's sum
         // is the same to the last bit in every run.
         let count = |top: f64| zs.partition_point(|&z| z <= top) as u32;
         let mut o = Overhangs::default();
         // Each down-facing facet that counts for some layer: its corners and N.
         let mut down: Vec<([u32; 3], u32)> = Vec::new();
-        for f in &mesh.facets {
-            let v = |i: u32| mesh.vertices.get(i as usize).copied();
-            let (Some(a), Some(b), Some(c)) = (v(f[0]), v(f[1]), v(f[2])) else {
-                continue;
-            };
-            // Twice the projection's signed area: negative for a facet facing down.
-            let twice = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            let n = count(a[2].max(b[2]).max(c[2]));
-            if twice < 0.0 && n > 0 {
-                o.area += -0.5 * twice * n as f64;
-                down.push((*f, n));
+        steps::runs(mesh.facets.len(), budget, &mut |r| {
+            for f in &mesh.facets[r] {
+                let v = |i: u32| mesh.vertices.get(i as usize).copied();
+                let (Some(a), Some(b), Some(c)) = (v(f[0]), v(f[1]), v(f[2])) else {
+                    continue;
+                };
+                // Twice the projection's signed area: negative for a facet facing down.
+                let twice = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+                let n = count(a[2].max(b[2]).max(c[2]));
+                if twice < 0.0 && n > 0 {
+                    o.area += -0.5 * twice * n as f64;
+                    down.push((*f, n));
+                }
             }
-        }
+        })
+        .await;
         let top = down.iter().map(|d| d.1).max().unwrap_or(0) as usize;
         // Pairs of facets sharing an edge, by the layer count both reach.
         let mut joins: Vec<Vec<(u32, u32)>> = vec![Vec::new(); top + 1];
@@ -161,30 +172,33 @@ impl Overhangs {
             }
         }
         drop(fill);
-        for p in 0..nv {
-            let around = &mut uses[first[p] as usize..first[p + 1] as usize];
-            // Stable (the facets' order kept); O(k log k) however many facets share a vertex.
-            around.sort_by_key(|u| u.0);
-            for edge in around.chunk_by(|a, b| a.0 == b.0) {
-                let used = edge.len();
-                // The first two users (the first twice when it is alone: only it is read then).
-                let users = [edge[0], edge[used.min(2) - 1]].map(|u| (u.1, u.2));
-                let (a, b) = (mesh.vertices[p], mesh.vertices[edge[0].0 as usize]);
-                let len = (b[0] - a[0]).hypot(b[1] - a[1]);
-                let n = |u: (u32, bool)| down[u.0 as usize].1;
-                if used == 2 && users[0].1 != users[1].1 {
-                    o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;
-                } else {
-                    let stored: u32 = users[..used.min(2)].iter().map(|&u| n(u)).sum();
-                    o.perimeter +=
-                        len * (stored as f64 + used.saturating_sub(2) as f64 * top as f64);
-                }
-                if used >= 2 {
-                    let level = n(users[0]).min(n(users[1]));
-                    joins[level as usize].push((users[0].0, users[1].0));
+        let mut per_vertex = |r: std::ops::Range<usize>| {
+            for p in r {
+                let around = &mut uses[first[p] as usize..first[p + 1] as usize];
+                // Stable (the facets' order kept); O(k log k) however many facets share a vertex.
+                around.sort_by_key(|u| u.0);
+                for edge in around.chunk_by(|a, b| a.0 == b.0) {
+                    let used = edge.len();
+                    // The first two users (the first twice when it is alone: only it is read then).
+                    let users = [edge[0], edge[used.min(2) - 1]].map(|u| (u.1, u.2));
+                    let (a, b) = (mesh.vertices[p], mesh.vertices[edge[0].0 as usize]);
+                    let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+                    let n = |u: (u32, bool)| down[u.0 as usize].1;
+                    if used == 2 && users[0].1 != users[1].1 {
+                        o.perimeter += len * n(users[0]).abs_diff(n(users[1])) as f64;
+                    } else {
+                        let stored: u32 = users[..used.min(2)].iter().map(|&u| n(u)).sum();
+                        o.perimeter +=
+                            len * (stored as f64 + used.saturating_sub(2) as f64 * top as f64);
+                    }
+                    if used >= 2 {
+                        let level = n(users[0]).min(n(users[1]));
+                        joins[level as usize].push((users[0].0, users[1].0));
+                    }
                 }
             }
-        }
+        };
+        steps::runs(nv, budget, &mut per_vertex).await;
         drop(uses);
         let mut parent: Vec<u32> = (0..down.len() as u32).collect();
         fn root(parent: &mut [u32], mut i: u32) -> u32 {

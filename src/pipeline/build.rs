@@ -124,7 +124,7 @@ impl Job {
         }
         building.orientation = Some(orientation);
         let mut checked = building.checked()?;
-        let overhangs = checked.overhangs();
+        let overhangs = checked.overhangs_in_steps(b).await;
         let (made_stats, made_index) = (checked.stats.take(), checked.index.take());
         let repaired = match checked.zs.as_ref() {
             Ok(zs) => {
@@ -545,14 +545,21 @@ impl Checked {
     /// The support's overhang figures for the estimate (none when the support is off or the
     /// mesh is open).
     fn overhangs(&self) -> budget::Overhangs {
+        steps::now(self.overhangs_in_steps(&steps::UNLIMITED))
+    }
+
+    /// [`Checked::overhangs`] in resumable steps.
+    async fn overhangs_in_steps(&self, b: &Budget) -> budget::Overhangs {
         let support =
             self.shells.open == 0 && self.settings.support != crate::base::settings::Support::Off;
         if support {
             let h = self.settings.layer_height;
-            budget::Overhangs::of(
+            budget::Overhangs::of_in_steps(
                 &self.mesh,
                 &slice::layer_heights(self.size[2], h, self.settings.slice_plane),
+                b,
             )
+            .await
         } else {
             budget::Overhangs::default()
         }

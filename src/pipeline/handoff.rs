@@ -45,13 +45,14 @@ impl Sink for Vec<u8> {
 
 /// What [`Job::read_bytes`] reads: a length and bytes copied out at a place.
 pub trait Source {
-    fn len(&self) -> usize;
+    /// How many bytes there are.
+    fn size(&self) -> usize;
     /// Fills `out` with the bytes from `at` on (`at + out.len()` is within the length).
     fn read(&self, at: usize, out: &mut [u8]);
 }
 
 impl Source for &[u8] {
-    fn len(&self) -> usize {
+    fn size(&self) -> usize {
         <[u8]>::len(self)
     }
     fn read(&self, at: usize, out: &mut [u8]) {
@@ -176,7 +177,7 @@ fn read(bytes: &dyn Source) -> Result<Job, String> {
         let n = r.count(4)?;
         *row = r.get(n, u32::from_le_bytes);
     }
-    if r.at != bytes.len() {
+    if r.at != bytes.size() {
         return Err("bytes follow the facet index".into());
     }
     let [offsets, bucket_facets] = rows;
@@ -253,7 +254,7 @@ impl Reader<'_> {
         let end = self
             .at
             .checked_add(n)
-            .filter(|&e| e <= self.bytes.len())
+            .filter(|&e| e <= self.bytes.size())
             .ok_or("it ends early")?;
         self.buf.resize(n, 0);
         self.bytes.read(self.at, &mut self.buf);
@@ -264,7 +265,7 @@ impl Reader<'_> {
     /// A count of items of `size` bytes each that the bytes left can hold.
     fn count(&mut self, size: usize) -> Result<usize, String> {
         let n = u64::from_le_bytes(self.take(8)?.try_into().unwrap());
-        let left = (self.bytes.len() - self.at) as u64;
+        let left = (self.bytes.size() - self.at) as u64;
         if n > left / size as u64 {
             return Err("a length runs past its end".into());
         }

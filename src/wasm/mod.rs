@@ -315,7 +315,7 @@ impl crate::pipeline::handoff::Sink for JsBytes {
 }
 
 impl crate::pipeline::handoff::Source for JsBytes {
-    fn len(&self) -> usize {
+    fn size(&self) -> usize {
         self.0.length() as usize
     }
     fn read(&self, at: usize, out: &mut [u8]) {
