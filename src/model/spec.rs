@@ -214,7 +214,7 @@ impl PartSpec {
             place_angle: self.place_angle,
             place,
         }
-        .compensated(settings.shrink_factors(self.unit))
+        .compensated(settings.shrink_factors(crate::base::settings::UnitId(self.unit)))
     }
 
     /// The explicit placement, if any.
@@ -261,8 +261,8 @@ impl PartSpec {
         };
         for key in PART_KEYS {
             if let Some(x) = self.number(key)
-                && key != "place_x"
-                && key != "place_y"
+                && *key != "place_x"
+                && *key != "place_y"
             {
                 check(key, x)?;
             }

@@ -63,7 +63,7 @@ impl Job {
             drop(layers);
             // The droplet-level pass reads each layer's droplets from its moves when it needs
             // them (no list of all droplets is kept).
-            let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+            let (b, b1) = (s.droplet_width(), s.support_width());
             let (extra, figures) = stages::time(Stage::Support, || {
                 support_droplets::complete(
                     &|i, within, out: &mut Vec<support_droplets::Droplet>| {
