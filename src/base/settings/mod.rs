@@ -271,6 +271,19 @@ impl Settings {
         for (name, u) in named.chain(ordered) {
             self.check_unit(u, name)?;
         }
+        if let Some(u) = self.support.unit() {
+            check_sliced(u, "support")?;
+        }
+        // A unit's own setting set for a unit the machine does not have is a mistake (a
+        // material for unit 2 on a machine of two units).
+        for e in entries() {
+            if let Slot::Unit(u, _) = e.slot
+                && u.index() >= self.units as usize
+                && self.value_at(e.slot, e.spec.name) != e.spec.default
+            {
+                self.check_unit(u, e.spec.name)?;
+            }
+        }
         Ok(())
     }
 
@@ -366,6 +379,86 @@ impl Settings {
     }
 }
 
+/// The units this version prints with: 0 and 1. The settings name up to [`MAX_UNITS`] units
+/// (`units`, `unitN_…`, `unit_order`), but support and parts of a unit beyond 1 are refused
+/// until the planner prints more than two (docs/spec.md "Discharge units").
+pub const SLICED_UNITS: usize = 2;
+
+/// Refuses a unit this version does not print with ([`SLICED_UNITS`]).
+pub fn check_sliced(u: UnitId, what: &str) -> Result<(), Error> {
+    if u.index() < SLICED_UNITS {
+        return Ok(());
+    }
+    Err(Error::Setting {
+        name: what.to_string(),
+        message: format!(
+            "names discharge unit {u}: this version prints parts and support with units 0 and 1 only (docs/spec.md \"Discharge units\")"
+        ),
+    })
+}
+
+/// The page's TypeScript type of the settings, `www/core/settings.gen.ts`, made from the
+/// table (a test fails when the file is stale; `DROPSLICE_WRITE_GENERATED=1 cargo test --lib
+/// settings` writes it).
+pub fn typescript() -> String {
+    let mut out = String::from(
+        "// Generated from the core's settings table (src/base/settings/table.rs): do not edit.\n\
+         // `cargo test --release --lib settings` fails when it is stale; with\n\
+         // DROPSLICE_WRITE_GENERATED=1 it writes it again.\n\n",
+    );
+    out.push_str(&format!(
+        "/** The most discharge units a machine may have (the setting `units`). */\nexport const MAX_UNITS = {MAX_UNITS};\n\n"
+    ));
+    let list = |names: &[&str]| {
+        names
+            .iter()
+            .map(|n| format!("\"{n}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    out.push_str(&format!(
+        "/** The settings a part of a job carries itself. */\nexport const PART_KEYS = [{}] as const;\nexport type PartKey = (typeof PART_KEYS)[number];\n\n",
+        list(PART_KEYS)
+    ));
+    let unit_base: Vec<&str> = (entries().iter())
+        .filter_map(|e| match e.slot {
+            Slot::Unit(UnitId::FIRST, base) => Some(base),
+            _ => None,
+        })
+        .collect();
+    out.push_str(&format!(
+        "/** The settings each unit has (unit 0's names; unit N's are `unitN_` + the name). */\nexport const UNIT_KEYS = [{}] as const;\nexport type UnitKey = (typeof UNIT_KEYS)[number];\n\n",
+        list(&unit_base)
+    ));
+    out.push_str(
+        "/** Every setting (docs/spec.md \"Settings\"). */\nexport interface Settings {\n",
+    );
+    for e in entries() {
+        let spec = &e.spec;
+        let ty = match spec.kind {
+            Kind::Number | Kind::Integer => "number".to_string(),
+            Kind::Bool => "boolean".to_string(),
+            // `unit_order` also takes a list of units ("2,0,1").
+            Kind::Enum if spec.name == "unit_order" => "string".to_string(),
+            Kind::Enum => spec
+                .choices
+                .iter()
+                .map(|c| format!("\"{c}\""))
+                .collect::<Vec<_>>()
+                .join(" | "),
+        };
+        let unit = if spec.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", spec.unit)
+        };
+        let doc = format!("{}{unit}", spec.description).replace("*/", "* /");
+        out.push_str(&format!("  /** {doc} */\n  {}: {ty};\n", spec.name));
+    }
+    out.push_str("}\n\nexport type SettingName = keyof Settings;\n");
+    out
+}
+
 /// Whether the header of a job whose units `used` print lists the setting of `e` (`second`:
 /// a unit other than 0 prints, `beyond`: one beyond unit 1).
 fn shown(e: &Entry, used: &impl Fn(UnitId) -> bool, second: bool, beyond: bool) -> bool {
@@ -455,6 +548,20 @@ mod tests {
         let d = serde_json::to_value(Settings::default()).unwrap();
         assert!(d.get("units").is_none() && d.get("unit2_droplet_aspect").is_none());
         assert!(d.get("unit1_droplet_aspect").is_some());
+    }
+
+    #[test]
+    fn the_pages_settings_type_is_up_to_date() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/www/core/settings.gen.ts");
+        let made = typescript();
+        if std::env::var_os("DROPSLICE_WRITE_GENERATED").is_some() {
+            std::fs::write(path, &made).unwrap();
+        }
+        let file = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            file == made,
+            "www/core/settings.gen.ts is stale: run DROPSLICE_WRITE_GENERATED=1 cargo test --release --lib settings"
+        );
     }
 
     #[test]

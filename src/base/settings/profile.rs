@@ -280,6 +280,25 @@ impl Profile {
         Ok(())
     }
 
+    /// This profile with its material under unit `u`'s names (`unit2_droplet_aspect` for
+    /// `droplet_aspect`), for the command line's `--profile unit2=FILE.json`: refused for a
+    /// machine profile and for a profile of several units' materials ([`apply_to`](Self::apply_to)).
+    pub fn to_unit(&self, u: UnitId) -> Result<Profile, Error> {
+        let mut s = Settings::default();
+        self.apply_to(&mut s, Some(u))?;
+        let settings = (self.settings.iter())
+            .map(|(k, v)| match super::entry(k).map(|e| e.slot) {
+                Some(Slot::Unit(_, base)) => (u.name(base), v.clone()),
+                _ => (k.clone(), v.clone()),
+            })
+            .collect();
+        Ok(Profile {
+            name: self.name.clone(),
+            kind: self.kind,
+            settings,
+        })
+    }
+
     /// How the header names it: `name (kind)`.
     pub fn label(&self) -> String {
         format!("{} ({})", self.name, self.kind.word())
@@ -301,6 +320,59 @@ mod tests {
         let u0 = s.unit(UnitId::FIRST);
         assert_eq!((u0.shrink_xy, u0.material_density), (0.8, 1.2));
         assert_eq!(p.label(), "PC (material)");
+    }
+
+    #[test]
+    fn a_material_goes_to_the_unit_named_and_old_profiles_apply_as_before() {
+        let pc = Profile::from_json(
+            r#"{"name": "PC", "kind": "material", "settings": {"droplet_aspect": 1.3, "shrink_xy": 0.8}}"#,
+        )
+        .unwrap();
+        let mut s = Settings::default();
+        pc.apply_to(&mut s, Some(UnitId(2))).unwrap();
+        assert_eq!(s.unit(UnitId(2)).droplet_aspect, 1.3);
+        assert_eq!(s.unit(UnitId(2)).shrink_xy, 0.8);
+        assert_eq!(
+            s.unit(UnitId::FIRST),
+            Settings::default().unit(UnitId::FIRST)
+        );
+        assert_eq!(s.unit(UnitId(1)), Settings::default().unit(UnitId(1)));
+        let moved = pc.to_unit(UnitId(2)).unwrap();
+        assert_eq!(moved.settings["unit2_droplet_aspect"], 1.3);
+        assert_eq!(moved.settings.len(), 2);
+        // Applying a support material to unit 1 after a PC to unit 0 keeps both.
+        let pva = Profile::from_json(
+            r#"{"name": "PVA", "kind": "material", "settings": {"droplet_aspect": 1.6, "material_density": 1.19}}"#,
+        )
+        .unwrap();
+        let mut s = Settings::default();
+        pc.apply_to(&mut s, Some(UnitId::FIRST)).unwrap();
+        pva.apply_to(&mut s, Some(UnitId(1))).unwrap();
+        assert_eq!(s.unit(UnitId::FIRST).droplet_aspect, 1.3);
+        assert_eq!(s.unit(UnitId(1)).droplet_aspect, 1.6);
+        assert_eq!(s.unit(UnitId(1)).material_density, 1.19);
+        // A profile saved before, with unit 1's values: read, applied as before, not to one unit.
+        let old = Profile::from_json(
+            r#"{"name": "PC+PVA", "kind": "material", "settings": {"droplet_aspect": 1.1, "unit1_droplet_aspect": 1.5, "unit1_shrink_z": 0.2}}"#,
+        )
+        .unwrap();
+        let mut s = Settings::default();
+        old.apply(&mut s).unwrap();
+        assert_eq!(s.unit(UnitId::FIRST).droplet_aspect, 1.1);
+        assert_eq!(s.unit(UnitId(1)).droplet_aspect, 1.5);
+        assert_eq!(s.unit(UnitId(1)).shrink_z, 0.2);
+        let e = old
+            .apply_to(&mut s, Some(UnitId(2)))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unit1_droplet_aspect") && e.contains("as a whole"),
+            "{e}"
+        );
+        // A machine profile is the machine's.
+        let m = Profile::from_json(&machine("M")).unwrap();
+        let e = m.apply_to(&mut s, Some(UnitId(1))).unwrap_err().to_string();
+        assert!(e.contains("machine profile"), "{e}");
     }
 
     #[test]
