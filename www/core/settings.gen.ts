@@ -13,7 +13,7 @@ export type PartKey = (typeof PART_KEYS)[number];
 export const UNIT_KEYS = ["droplet_aspect", "droplet_rate", "material_density", "shrink_xy", "shrink_z"] as const;
 export type UnitKey = (typeof UNIT_KEYS)[number];
 
-/** Every setting (docs/spec.md "Settings"). */
+/** Every setting (docs/spec.md 5.4.1). */
 export interface Settings {
   /** Layer height H: the height of one droplet (mm) */
   layer_height: number;

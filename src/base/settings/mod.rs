@@ -430,9 +430,7 @@ pub fn typescript() -> String {
         "/** The settings each unit has (unit 0's names; unit N's are `unitN_` + the name). */\nexport const UNIT_KEYS = [{}] as const;\nexport type UnitKey = (typeof UNIT_KEYS)[number];\n\n",
         list(&unit_base)
     ));
-    out.push_str(
-        "/** Every setting (docs/spec.md \"Settings\"). */\nexport interface Settings {\n",
-    );
+    out.push_str("/** Every setting (docs/spec.md 5.4.1). */\nexport interface Settings {\n");
     for e in entries() {
         let spec = &e.spec;
         let ty = match spec.kind {

@@ -256,7 +256,7 @@ macro_rules! settings_table {
     (@go [$(($jn:ident : $jt:ty = $jd:expr))*] [$(($un:ident : $ut:ty = $ud:expr))*]
         [$($p:ident)*] [$(($rs:expr, $rn:expr, $rr:expr, $rd:expr))*]) => {
         /// Every parameter of a slice (the table in `table.rs`). `Default` gives the defaults
-        /// of docs/spec.md "Settings"; `per_unit` holds every unit's own settings
+        /// of docs/spec.md 5.4.1; `per_unit` holds every unit's own settings
         /// ([`MAX_UNITS`] of them, whatever `units` says), read with [`Settings::unit`].
         #[derive(Clone, Debug, PartialEq)]
         pub struct Settings {

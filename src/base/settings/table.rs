@@ -1,4 +1,4 @@
-//! The settings table: every setting once, in display order (docs/spec.md "Settings").
+//! The settings table: every setting once, in display order (docs/spec.md 5.4.1).
 //!
 //! A row is `scope name: type = default => row(…)`: `job` a setting of the job, `part` one a
 //! job file gives per part (its [`super::PART_KEYS`]), `unit` one each discharge unit has —
