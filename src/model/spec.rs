@@ -33,8 +33,8 @@ pub const MAX_COPIES: u32 = 100;
 pub const MAX_JOB_FILE_BYTES: usize = 1 << 20;
 /// Longest name kept for messages and the header (characters).
 pub const MAX_NAME_CHARS: usize = 80;
-/// Most discharge units (0 and 1).
-pub const UNITS: u8 = 2;
+/// Most discharge units a part may name (the setting `units` may allow fewer).
+pub const UNITS: u8 = crate::base::settings::MAX_UNITS as u8;
 
 /// The settings that belong to a part, not to the job (the settings schema flags them).
 pub use crate::base::settings::PART_KEYS;
@@ -214,7 +214,7 @@ impl PartSpec {
             place_angle: self.place_angle,
             place,
         }
-        .compensated(settings.shrink_factors(self.unit))
+        .compensated(settings.shrink_factors(crate::base::settings::UnitId(self.unit)))
     }
 
     /// The explicit placement, if any.
@@ -261,8 +261,8 @@ impl PartSpec {
         };
         for key in PART_KEYS {
             if let Some(x) = self.number(key)
-                && key != "place_x"
-                && key != "place_y"
+                && *key != "place_x"
+                && *key != "place_y"
             {
                 check(key, x)?;
             }
@@ -295,7 +295,7 @@ impl PartSpec {
         if self.unit >= UNITS {
             return bad(
                 "unit",
-                format!("{} is not a discharge unit: 0 or 1", self.unit),
+                format!("{} is not a discharge unit: 0 … {}", self.unit, UNITS - 1),
             );
         }
         if let Some(n) = &self.name
@@ -422,6 +422,10 @@ impl JobSpec {
         }
         for (i, p) in self.parts.iter().enumerate() {
             p.validate(i)?;
+            let u = crate::base::settings::UnitId(p.unit);
+            let at = format!("parts[{i}].unit");
+            self.settings.check_unit(u, &at)?;
+            crate::base::settings::check_sliced(u, &at)?;
         }
         let total: u64 = self.parts.iter().map(|p| p.copies as u64).sum();
         if total > MAX_INSTANCES as u64 {
@@ -499,7 +503,10 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
     if let Some(u) = map.get("unit").and_then(Value::as_u64)
         && u >= UNITS as u64
     {
-        return bad("unit", &format!("{u} is not a discharge unit: 0 or 1"));
+        return bad(
+            "unit",
+            &format!("{u} is not a discharge unit: 0 … {}", UNITS - 1),
+        );
     }
     let part: PartSpec = serde_json::from_value(Value::Object(map)).map_err(|e| {
         Error::Job(format!(
