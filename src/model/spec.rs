@@ -89,10 +89,11 @@ pub fn job_schema() -> JobSchema {
         1,
         "Copies of the part on the plate",
     ));
+    // The units this version prints parts with (the settings name more, see `units`).
     part_numbers.push(whole(
         "unit",
         0,
-        u32::from(UNITS) - 1,
+        crate::base::settings::SLICED_UNITS as u32 - 1,
         0,
         "The discharge unit that prints the part",
     ));
