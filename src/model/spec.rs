@@ -89,10 +89,11 @@ pub fn job_schema() -> JobSchema {
         1,
         "Copies of the part on the plate",
     ));
+    // The units this version prints parts with (the settings name more, see `units`).
     part_numbers.push(whole(
         "unit",
         0,
-        u32::from(UNITS) - 1,
+        crate::base::settings::SLICED_UNITS as u32 - 1,
         0,
         "The discharge unit that prints the part",
     ));
@@ -162,7 +163,7 @@ pub struct PartSpec {
     pub place_angle: f64,
     #[serde(default = "one_copy")]
     pub copies: u32,
-    /// The discharge unit that prints it (0 or 1).
+    /// The discharge unit that prints it (0 … `units` − 1).
     #[serde(default)]
     pub unit: u8,
     /// A name for the page and the header (default: the part's name in its file).
@@ -224,18 +225,11 @@ impl PartSpec {
 
     /// The value of a [`PART_KEYS`] key (`None` for an unplaced part's place, or another key).
     pub fn number(&self, key: &str) -> Option<f64> {
-        match key {
-            "rotate_x" => Some(self.rotate_x),
-            "rotate_y" => Some(self.rotate_y),
-            "rotate_z" => Some(self.rotate_z),
-            "scale_x" => Some(self.scale_x),
-            "scale_y" => Some(self.scale_y),
-            "scale_z" => Some(self.scale_z),
-            "place_x" => self.place_x,
-            "place_y" => self.place_y,
-            "place_angle" => Some(self.place_angle),
-            _ => None,
+        if !PART_KEYS.contains(&key) {
+            return None;
         }
+        // The fields are named as the keys (a place not given is `null`).
+        serde_json::to_value(self).ok()?.get(key)?.as_f64()
     }
 
     /// Checks every value (`i` names the part in messages).
