@@ -2,7 +2,7 @@
 //! row, under the heading of its group, with the schema's default, unit and range, in the
 //! schema's order (the header's), and the tables name no setting the schema does not have.
 
-use dropslice::base::settings::{Kind, SettingSpec, schema};
+use dropslice::base::settings::{Kind, MAX_UNITS, SettingSpec, schema};
 use std::collections::HashMap;
 
 /// One row of a parameter table: (group heading, name, default, unit, range).
@@ -17,25 +17,68 @@ fn rows(text: &str) -> Vec<Row> {
     let end = rest[3..].find("\n## ").map_or(rest.len(), |i| i + 3);
     let mut group = String::new();
     let mut out = Vec::new();
+    let mut per_unit: Vec<Row> = Vec::new();
     for line in rest[..end].lines() {
         if let Some(h) = line.strip_prefix("### ") {
             group = h.trim().to_string();
             continue;
         }
         let Some(cells) = line.strip_prefix("| `") else {
+            flush(&mut per_unit, &mut out);
             continue;
         };
         let cells: Vec<&str> = cells.split(" | ").collect();
         assert!(cells.len() >= 5, "a row of 5 cells: {line}");
-        out.push((
+        let row = (
             group.clone(),
             cells[0].trim_end_matches('`').to_string(),
             cells[1].trim().to_string(),
             cells[2].trim().to_string(),
-            cells[3].trim().to_string(),
-        ));
+            units_spelled_out(cells[3].trim()),
+        );
+        if row.1.starts_with("unitN_") {
+            per_unit.push(row);
+        } else {
+            flush(&mut per_unit, &mut out);
+            out.push(row);
+        }
     }
+    flush(&mut per_unit, &mut out);
     out
+}
+
+/// A run of `unitN_<name>` rows stands for every unit N ≥ 1's settings, unit by unit, each
+/// under the heading "Unit N" (the schema's order and groups).
+fn flush(per_unit: &mut Vec<Row>, out: &mut Vec<Row>) {
+    for n in 1..MAX_UNITS {
+        for (_, name, default, unit, range) in per_unit.iter() {
+            out.push((
+                format!("Unit {n}"),
+                name.replacen("unitN_", &format!("unit{n}_"), 1),
+                default.clone(),
+                unit.clone(),
+                range.clone(),
+            ));
+        }
+    }
+    per_unit.clear();
+}
+
+/// A range cell with the units written short (`unit1 … unit3`, `unitN_first`) spelled out as
+/// the schema lists its choices.
+fn units_spelled_out(cell: &str) -> String {
+    let last = MAX_UNITS - 1;
+    let all = |pattern: &dyn Fn(usize) -> String, from: usize| {
+        (from..MAX_UNITS)
+            .map(pattern)
+            .collect::<Vec<_>>()
+            .join(" / ")
+    };
+    cell.replace(
+        &format!("unit1 … unit{last}"),
+        &all(&|n| format!("unit{n}"), 1),
+    )
+    .replace("unitN_first", &all(&|n| format!("unit{n}_first"), 0))
 }
 
 /// A number as the tables write it: no ".0", a minus sign (−) for negative values.
@@ -107,7 +150,9 @@ fn every_setting_is_in_docs_spec_with_the_schemas_default_unit_and_range() {
                 unit(spec)
             ));
         }
-        if *range_cell != range(spec) {
+        // A cell may add what else the value takes (`unit_order`: a list of units).
+        let said = range_cell.split(", or ").next().unwrap_or_default();
+        if said != range(spec) {
             wrong.push(format!(
                 "{name}: range {range_cell}, the schema's is {}",
                 range(spec)
