@@ -7,7 +7,6 @@ use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
 use crate::base::parallel::in_runs;
 use crate::base::settings::Settings;
 use crate::base::steps::{self, Budget};
-pub use crate::model::weld::{WELD_RESERVE_BYTES, keeps_facet, reserve_entries};
 
 /// A welded triangle mesh in millimetres.
 #[derive(Clone, Debug, Default)]
