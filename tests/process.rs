@@ -30,6 +30,14 @@ fn write(dir: &TempDir, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap();
 }
 
+/// Asserts that `text` holds each of `lines`, naming the first it lacks.
+#[track_caller]
+fn assert_has(text: &str, lines: &[&str]) {
+    for line in lines {
+        assert!(text.contains(line), "no {line:?}");
+    }
+}
+
 /// [`cli`] that must succeed; the G-code it wrote to `out`.
 fn sliced(dir: &TempDir, words: &str, out: &str) -> String {
     let r = cli(dir, words);
@@ -473,11 +481,16 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
         "@cube_20mm_ascii.stl -q -o c.gco --set material_density=1.1 --profile pc.json --profile machine.json",
         "c.gco",
     );
-    assert!(text.contains("; profiles = PC test (material), Chamber (machine)\n"));
-    assert!(text.contains("; shrink_xy = 1.0 (%)"));
-    assert!(text.contains("; plate_z = 100.0 (mm)"));
-    // --set comes after the profiles whatever the order given.
-    assert!(text.contains("; material_density = 1.1 (g/cm³)"));
+    assert_has(
+        &text,
+        &[
+            "; profiles = PC test (material), Chamber (machine)\n",
+            "; shrink_xy = 1.0 (%)",
+            "; plate_z = 100.0 (mm)",
+            // --set comes after the profiles whatever the order given.
+            "; material_density = 1.1 (g/cm³)",
+        ],
+    );
     assert!(
         text.contains("; bounding box = X0.0000..20.2020 Y0.0000..20.2020 Z0.0000..20.0000 mm"),
         "compensated"
@@ -597,9 +610,14 @@ fn a_profile_applies_to_a_job_file_before_set() {
         "job.json -q -o j.gco --profile m.json --settings s.json",
         "j.gco",
     );
-    assert!(text.contains("; profiles = M (material)"));
-    // The profile over the job file's settings; a settings file keeps the profile.
-    assert!(text.contains("; material_density = 1.2 (g/cm³)"));
-    assert!(text.contains("; shrink_z = 2.0 (%)"));
-    assert!(text.contains("; droplet_rate = 90.0 (Hz)"));
+    assert_has(
+        &text,
+        &[
+            "; profiles = M (material)",
+            // The profile over the job file's settings; a settings file keeps the profile.
+            "; material_density = 1.2 (g/cm³)",
+            "; shrink_z = 2.0 (%)",
+            "; droplet_rate = 90.0 (Hz)",
+        ],
+    );
 }
