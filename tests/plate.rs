@@ -81,23 +81,24 @@ fn a_job_file_names_the_part_keys_and_a_placed_part_off_the_plate_is_refused() {
     let dir = TempDir::new("plate-job");
     box_file(&dir, "tall.stl", [95.5, 145.0, 3.0]);
     box_file(&dir, "cube.stl", [20.0, 20.0, 20.0]);
-    std::fs::write(
-        dir.join("job.json"),
+    // A job refused: its code not written.
+    let refused = |name: &str, job: &str, says: &str| {
+        std::fs::write(dir.join(format!("{name}.json")), job).unwrap();
+        let (file, out) = (format!("{name}.json"), format!("{name}.gco"));
+        cli(&[&file, "-o", &out], &dir).says(2, says);
+        assert!(!dir.join(&out).exists());
+    };
+    refused(
+        "job",
         r#"{"parts": [{"file": "cube.stl"}, {"file": "tall.stl"}]}"#,
-    )
-    .unwrap();
-    let r = cli(&["job.json", "-o", "job.gco"], &dir);
-    r.says(2, "Part 2 “tall.stl” (95.5 × 145 mm) is larger than the plate (154 × 134 mm); turned 90° about z it fits. Use parts[1].rotate_z = 90, or the setting allow_off_plate = true");
-    assert!(!dir.join("job.gco").exists());
+        "Part 2 “tall.stl” (95.5 × 145 mm) is larger than the plate (154 × 134 mm); turned 90° about z it fits. Use parts[1].rotate_z = 90, or the setting allow_off_plate = true",
+    );
     // A part placed past an edge: moving it (or the arrangement) helps.
-    std::fs::write(
-        dir.join("placed.json"),
+    refused(
+        "placed",
         r#"{"parts": [{"file": "cube.stl", "place_x": 140, "place_y": 0}]}"#,
-    )
-    .unwrap();
-    let r = cli(&["placed.json", "-o", "placed.gco"], &dir);
-    r.says(2, "Part 1 “cube.stl” reaches 6 mm past the plate's right edge — move it or press Arrange. Change parts[0].place_x/place_y, or leave them out to have it arranged");
-    assert!(!dir.join("placed.gco").exists());
+        "Part 1 “cube.stl” reaches 6 mm past the plate's right edge — move it or press Arrange. Change parts[0].place_x/place_y, or leave them out to have it arranged",
+    );
     // Allowed by the job's settings.
     std::fs::write(
         dir.join("allowed.json"),

@@ -30,6 +30,15 @@ fn write(dir: &TempDir, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap();
 }
 
+/// A new folder (named after `tag`) holding a shared model (`model.0`) as `model.1` and a
+/// `job.json` of `job`.
+fn job_folder(tag: &str, model_file: (&str, &str), job: &str) -> TempDir {
+    let dir = TempDir::new(tag);
+    std::fs::copy(model(model_file.0), dir.join(model_file.1)).unwrap();
+    write(&dir, "job.json", job);
+    dir
+}
+
 /// Asserts that `text` holds each of `lines`, naming the first it lacks.
 #[track_caller]
 fn assert_has(text: &str, lines: &[&str]) {
@@ -323,11 +332,9 @@ fn the_bridge_is_turned_over_and_the_upside_down_u_stood_or_laid_down() {
 
 #[test]
 fn orient_apply_writes_the_rotation_into_a_job_file_or_a_new_one() {
-    let dir = TempDir::new("orient-apply");
-    std::fs::copy(model("bridge.obj"), dir.join("bridge.obj")).unwrap();
-    write(
-        &dir,
-        "job.json",
+    let dir = job_folder(
+        "orient-apply",
+        ("bridge.obj", "bridge.obj"),
         r#"{"settings": {"layer_height": 0.2}, "parts": [{"file": "bridge.obj", "copies": 2, "name": "B"}]}"#,
     );
     let r = cli(&dir, "orient job.json --apply");
@@ -592,11 +599,9 @@ fn a_profile_is_read_by_one_rule_whatever_its_encoding() {
 
 #[test]
 fn a_profile_applies_to_a_job_file_before_set() {
-    let dir = TempDir::new("profile-job");
-    std::fs::copy(model("cube_20mm_ascii.stl"), dir.join("cube.stl")).unwrap();
-    write(
-        &dir,
-        "job.json",
+    let dir = job_folder(
+        "profile-job",
+        ("cube_20mm_ascii.stl", "cube.stl"),
         r#"{"settings": {"material_density": 1.3}, "parts": [{"file": "cube.stl"}]}"#,
     );
     write(

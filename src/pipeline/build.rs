@@ -31,27 +31,20 @@ impl Job {
     /// their relative positions and are sliced together.
     pub fn new(model_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
         settings.validate()?;
-        let Imported {
-            mesh,
-            format,
-            facets_in_file,
-            degenerate,
-            instance,
-            misfit,
-        } = import(model_bytes, file_name, &settings)?;
+        let part: Imported = import(model_bytes, file_name, &settings)?;
         let input = Input {
             file_name: file_name.to_string(),
-            format,
-            facets_in_file,
-            degenerate,
-            instances: vec![instance],
+            format: part.format,
+            facets_in_file: part.facets_in_file,
+            degenerate: part.degenerate,
+            instances: vec![part.instance],
             warnings: Vec::new(),
-            misfits: misfit.into_iter().collect(),
+            misfits: part.misfit.into_iter().collect(),
             hint: fit::Hint::Set,
             bodies: Bodies::Whole(job::clean_name(file_name)),
             groups: Vec::new(),
         };
-        Job::build(mesh, input, settings)
+        Job::build(part.mesh, input, settings)
     }
 
     /// A build job (docs/spec.md "Build jobs"): reads each file of `files` (name, bytes) once and
