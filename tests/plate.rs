@@ -83,8 +83,8 @@ fn a_job_file_names_the_part_keys_and_a_placed_part_off_the_plate_is_refused() {
     box_file(&dir, "cube.stl", [20.0, 20.0, 20.0]);
     // A job refused: its code not written.
     let refused = |name: &str, job: &str, says: &str| {
-        std::fs::write(dir.join(format!("{name}.json")), job).unwrap();
         let (file, out) = (format!("{name}.json"), format!("{name}.gco"));
+        std::fs::write(dir.join(&file), job).unwrap();
         cli(&[&file, "-o", &out], &dir).says(2, says);
         assert!(!dir.join(&out).exists());
     };
