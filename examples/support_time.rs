@@ -24,7 +24,7 @@ fn main() {
         .expect("usage: support_time MODEL.stl");
     let bytes = std::fs::read(&path).expect("read the model");
     let s = Settings {
-        support: dropslice::base::settings::Support::Unit1,
+        support: dropslice::base::settings::Support::Unit(dropslice::base::settings::UnitId(1)),
         ..Settings::default()
     };
     let job = Job::new(&bytes, &path, s.clone()).expect("job");
@@ -87,7 +87,7 @@ fn main() {
     });
     println!("part plans      {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+    let (b, b1) = (s.droplet_width(), s.support_width());
     let (_extra, pass) = dropslice::support::droplets::complete(
         &|i, within, out: &mut Vec<dropslice::support::droplets::Droplet>| {
             dropslice::support::droplets::droplets_of(&parts[i].moves, b, b1, within, out);

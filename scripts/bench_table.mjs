@@ -212,7 +212,8 @@ async function pageRunner() {
   async function revisit(file) {
     const p = await kept.newPage();
     try {
-      await waitSettled(p);
+      await p.goto(env.url);
+      await waitSettled(p); // the sample part
       await p.evaluate(() => (document.body.dataset.state = "picking"));
       await p.setInputFiles("#file-input", file);
       const s = await waitSettled(p, 900_000);

@@ -1,5 +1,5 @@
-// A page's first slice of a model against its next ones (docs/performance.md, "What is
-// left"): in each of PAGES fresh pages, after the sample part, MODEL is chosen SLICES times in
+// A page's first slice of a model against its next ones (docs/performance.md, "The
+// page's time, request by request"): in each of PAGES fresh pages, after the sample part, MODEL is chosen SLICES times in
 // a row; the page's own clock (file chosen → every layer's code ready) of each slice is
 // printed. The first slice runs while the engine still compiles the code the model needs;
 // the next ones run compiled code. Usage, after `bash scripts/build.sh`:

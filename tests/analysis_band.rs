@@ -7,7 +7,7 @@
 //!
 //! Not held: the largest void and its layer. The largest void is mostly a network of the
 //! channels between the fill's lines joined through the interior (the bunny's: 22.7 mm²
-//! across 74 × 73 mm of layer 235), which the band does not see: the banded report gives the
+//! across 74 × 73 mm of layer 234, counted from 1), which the band does not see: the banded report gives the
 //! band's largest void. The void count is estimated for the interior (within 3 % here).
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 

@@ -942,53 +942,14 @@ fn library_rejects_bad_files() {
 
 /// Sets a number setting directly (bypassing `Settings::set`, which rejects NaN itself).
 fn set_number(s: &mut Settings, name: &str, x: f64) {
-    let f = match name {
-        "layer_height" => &mut s.layer_height,
-        "droplet_aspect" => &mut s.droplet_aspect,
-        "outer_offset" => &mut s.outer_offset,
-        "inner_offset" => &mut s.inner_offset,
-        "fill_density" => &mut s.fill_density,
-        "fill_overlap" => &mut s.fill_overlap,
-        "hatch_angle" => &mut s.hatch_angle,
-        "hatch_angle_step" => &mut s.hatch_angle_step,
-        "start_jitter" => &mut s.start_jitter,
-        "rotate_x" => &mut s.rotate_x,
-        "rotate_y" => &mut s.rotate_y,
-        "rotate_z" => &mut s.rotate_z,
-        "scale_x" => &mut s.scale_x,
-        "scale_y" => &mut s.scale_y,
-        "scale_z" => &mut s.scale_z,
-        "place_x" => &mut s.place_x,
-        "place_y" => &mut s.place_y,
-        "place_angle" => &mut s.place_angle,
-        "droplet_rate" => &mut s.droplet_rate,
-        "travel_speed" => &mut s.travel_speed,
-        "material_density" => &mut s.material_density,
-        "shrink_xy" => &mut s.shrink_xy,
-        "shrink_z" => &mut s.shrink_z,
-        "plate_x" => &mut s.plate_x,
-        "plate_y" => &mut s.plate_y,
-        "plate_z" => &mut s.plate_z,
-        "part_spacing" => &mut s.part_spacing,
-        "overhang_limit" => &mut s.overhang_limit,
-        "support_gap_xy" => &mut s.support_gap_xy,
-        "support_density" => &mut s.support_density,
-        "unit1_droplet_aspect" => &mut s.unit1_droplet_aspect,
-        "unit1_droplet_rate" => &mut s.unit1_droplet_rate,
-        "unit1_material_density" => &mut s.unit1_material_density,
-        "unit1_shrink_xy" => &mut s.unit1_shrink_xy,
-        "unit1_shrink_z" => &mut s.unit1_shrink_z,
-        "support_gap_z" => {
-            s.support_gap_z = if x.is_nan() { 0 } else { x as u32 };
-            return;
-        }
-        "contours" => {
-            s.contours = if x.is_nan() { 0 } else { x as u32 };
-            return;
-        }
-        other => panic!("number setting '{other}' is not known to this test: add it"),
-    };
-    *f = x;
+    if let Some(f) = s.number_mut(name) {
+        *f = x;
+        return;
+    }
+    // A whole number (`contours`, `support_gap_z`): NaN as 0.
+    let n = if x.is_nan() { 0 } else { x as u32 };
+    s.set_value(name, n.into())
+        .unwrap_or_else(|e| panic!("number setting '{name}': {e}"));
 }
 
 /// The number settings with their range.

@@ -125,9 +125,11 @@ fn the_estimate_bounds_the_raster_a_layer_takes() {
     // `Raster::box_bytes` is a bound: for boxes of several sizes and droplet widths, the
     // raster of the box's layer takes no more.
     for (x, y, aspect) in [(40.0, 30.0, 1.04), (3.0, 70.0, 1.04), (25.0, 25.0, 0.4)] {
-        let s = dropslice::Settings {
-            droplet_aspect: aspect,
-            ..Default::default()
+        let s = {
+            let mut t = dropslice::Settings::default();
+            t.unit_mut(dropslice::base::settings::UnitId::FIRST)
+                .droplet_aspect = aspect;
+            t
         };
         let job = dropslice::Job::new(&box_stl(x, y, 0.4), "box.stl", s.clone()).unwrap();
         let bound = dropslice::analysis::Raster::box_bytes(x as f64, y as f64, &s);

@@ -163,7 +163,8 @@ fn random_settings(rng: &mut Rng) -> Settings {
     }
     // Keep cases small: at most 60 layers of droplets no smaller than 0.1 mm, few contours.
     s.layer_height = s.layer_height.max(0.5);
-    s.droplet_aspect = s.droplet_aspect.max(1.0);
+    let u0 = s.unit_mut(dropslice::base::settings::UnitId::FIRST);
+    u0.droplet_aspect = u0.droplet_aspect.max(1.0);
     s.contours = s.contours.min(4);
     s.scale_x = s.scale_x.clamp(0.2, 2.0);
     s.scale_y = s.scale_y.clamp(0.2, 2.0);
@@ -171,10 +172,16 @@ fn random_settings(rng: &mut Rng) -> Settings {
     // Droplet bombs of unit 1 and the support (issue 22): a tiny B₁ or B with support on must
     // be refused by the job's droplet estimate (or stay small), never run for minutes.
     if rng.pick(10) == 0 {
-        s.support = dropslice::base::settings::Support::Unit1;
+        s.support = dropslice::base::settings::Support::Unit(dropslice::base::settings::UnitId(1));
         match rng.pick(2) {
-            0 => s.unit1_droplet_aspect = 1e-3,
-            _ => s.droplet_aspect = 1e-3,
+            0 => {
+                s.unit_mut(dropslice::base::settings::UnitId(1))
+                    .droplet_aspect = 1e-3
+            }
+            _ => {
+                s.unit_mut(dropslice::base::settings::UnitId::FIRST)
+                    .droplet_aspect = 1e-3
+            }
         }
     }
     if s.validate().is_err() {

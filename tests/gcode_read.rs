@@ -4,6 +4,7 @@
 
 mod common;
 
+use dropslice::base::settings::UnitId;
 use dropslice::output::gcode_read::read_gcode;
 use dropslice::output::preview::PreviewLayer;
 use dropslice::{Job, Settings};
@@ -52,14 +53,14 @@ fn reads_back_the_droplets_of_the_plan() {
 /// mass as the slice that wrote it, and the time of its droplets and of the travel it holds.
 #[test]
 fn figures_come_from_the_header_settings() {
-    let s = Settings {
-        droplet_rate: 250.0,
-        unit1_droplet_rate: 40.0,
+    let mut s = Settings {
         travel_speed: 80.0,
-        material_density: 1.3,
-        support: dropslice::base::settings::Support::Unit1,
+        support: dropslice::base::settings::Support::Unit(UnitId(1)),
         ..Settings::default()
     };
+    s.unit_mut(UnitId::FIRST).droplet_rate = 250.0;
+    s.unit_mut(UnitId(1)).droplet_rate = 40.0;
+    s.unit_mut(UnitId::FIRST).material_density = 1.3;
     let model = "U_overhang.obj";
     let job = Job::new(&common::model_bytes(model), model, s.clone()).expect("job");
     let mut code = Vec::new();
@@ -110,17 +111,17 @@ fn finished_code(job: &Job) -> (String, dropslice::Summary) {
 /// computed again from the commands (whose travel and roles differ).
 #[test]
 fn a_finished_code_reads_back_the_figures_of_its_slice() {
-    let one = Settings {
-        droplet_aspect: 1.3,
+    let mut one = Settings {
         travel_speed: 70.0,
-        material_density: 1.17,
         ..Settings::default()
     };
-    let two = Settings {
-        support: dropslice::base::settings::Support::Unit1,
-        unit1_droplet_rate: 40.0,
+    one.unit_mut(UnitId::FIRST).droplet_aspect = 1.3;
+    one.unit_mut(UnitId::FIRST).material_density = 1.17;
+    let mut two = Settings {
+        support: dropslice::base::settings::Support::Unit(UnitId(1)),
         ..Settings::default()
     };
+    two.unit_mut(UnitId(1)).droplet_rate = 40.0;
     for (model, s) in [("cube_20mm_ascii.stl", one), ("U_overhang.obj", two)] {
         let job = Job::new(&common::model_bytes(model), model, s.clone()).expect("job");
         let (code, summary) = finished_code(&job);

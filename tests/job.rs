@@ -128,8 +128,12 @@ fn job_file_errors_name_the_part_and_key() {
             "parts[0].copies: must be a whole number",
         ),
         (
+            json!({"parts": [{"file": "a.stl", "unit": 4}]}),
+            "parts[0].unit: 4 is not a discharge unit",
+        ),
+        (
             json!({"parts": [{"file": "a.stl", "unit": 2}]}),
-            "parts[0].unit: 2 is not a discharge unit",
+            "parts[0].unit: names discharge unit 2, but the machine has 2 (units = 2",
         ),
         (
             json!({"parts": [{"file": "a.stl", "item": -1}]}),

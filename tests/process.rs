@@ -408,7 +408,9 @@ fn the_predicted_density_is_per_unit() {
         )
     };
     // Unit 1 alone prints the cube as unit 0 prints it with droplet_aspect = B₁ / H: the same
-    // droplets, so the same estimate to the bit.
+    // droplets, so the same volume, and the same void share within the banded report's bound
+    // (unit 0's interior is estimated from the band, unit 1's is the whole raster; issue 40's
+    // bound: 0.2 percentage points).
     write(
         &dir,
         "one.json",
@@ -421,14 +423,16 @@ fn the_predicted_density_is_per_unit() {
         "{one}"
     );
     let u1 = &one["unit1"];
-    for key in [
-        "volume",
-        "void_volume",
-        "void_fraction",
-        "predicted_density",
-    ] {
-        assert_eq!(u1[key], alone[key], "{key}: {u1} against {alone}");
-    }
+    assert_eq!(u1["volume"], alone["volume"], "{u1} against {alone}");
+    let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    assert!(
+        (f(u1, "void_fraction") - f(&alone, "void_fraction")).abs() <= 0.002,
+        "{u1} against {alone}"
+    );
+    assert!(
+        (f(u1, "predicted_density") - f(&alone, "predicted_density")).abs() <= 0.2,
+        "{u1} against {alone}"
+    );
     let d1 = u1["predicted_density"].as_f64().unwrap();
     assert!(
         stderr.contains(&format!("predicted density: unit 1's parts {d1:.1} %")),

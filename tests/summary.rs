@@ -107,12 +107,12 @@ fn figures_follow_the_estimate_settings() {
         f.print_seconds,
         f.droplets as f64 / 100.0 + s.travel_mm / 50.0
     ));
-    let other = Settings {
-        droplet_rate: 200.0,
+    let mut other = Settings {
         travel_speed: 100.0,
-        material_density: 2.08,
         ..Settings::default()
     };
+    let u0 = other.unit_mut(dropslice::base::settings::UnitId::FIRST);
+    (u0.droplet_rate, u0.material_density) = (200.0, 2.08);
     let g = s.figures(&other);
     assert!(close(g.print_seconds, f.print_seconds / 2.0));
     assert!(close(g.mass_g, 2.0 * f.mass_g));
@@ -126,11 +126,13 @@ fn figures_follow_the_estimate_settings() {
 /// layer estimate that ignored them would not add up.
 #[test]
 fn layer_times_add_up_to_the_print_time() {
-    let settings = Settings {
-        droplet_rate: 137.0,
+    let mut settings = Settings {
         travel_speed: 23.0,
         ..Settings::default()
     };
+    settings
+        .unit_mut(dropslice::base::settings::UnitId::FIRST)
+        .droplet_rate = 137.0;
     let job = Job::new(
         &common::model_bytes("3DBenchy.stl"),
         "3DBenchy.stl",

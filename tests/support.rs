@@ -271,7 +271,7 @@ fn the_overlay_marks_the_droplets_the_gcode_breaks_the_rule_with() {
             json.insert(k.into(), v.into());
         }
         let settings = dropslice::base::settings::Settings::from_value(json.into()).unwrap();
-        let (b, b1) = (settings.droplet_width(), settings.unit1_droplet_width());
+        let (b, b1) = (settings.droplet_width(), settings.support_width());
         let limit = settings.overhang_limit * b;
         let job = dropslice::Job::new(&common::model_bytes(name), name, settings).unwrap();
         assert_eq!(job.layer_count(), want.len(), "{name}");
@@ -366,7 +366,7 @@ fn the_lattice_need_agrees_with_the_region_form() {
     for name in ["3DBenchy.stl", "U_overhang.obj", "bridge.obj"] {
         let bytes = common::model_bytes(name);
         let s = dropslice::Settings {
-            support: dropslice::base::settings::Support::Unit1,
+            support: dropslice::base::settings::Support::Unit(dropslice::base::settings::UnitId(1)),
             ..dropslice::Settings::default()
         };
         let job = dropslice::Job::new(&bytes, name, s.clone()).unwrap();
@@ -441,10 +441,14 @@ fn the_lattice_need_agrees_with_the_region_form() {
 /// overhangs would take more than 10⁸).
 #[test]
 fn the_support_estimate_counts_only_under_overhangs() {
-    let settings = |aspect: f64| dropslice::Settings {
-        support: dropslice::base::settings::Support::Unit1,
-        unit1_droplet_aspect: aspect,
-        ..dropslice::Settings::default()
+    let settings = |aspect: f64| {
+        let mut t = dropslice::Settings {
+            support: dropslice::base::settings::Support::Unit(dropslice::base::settings::UnitId(1)),
+            ..dropslice::Settings::default()
+        };
+        t.unit_mut(dropslice::base::settings::UnitId(1))
+            .droplet_aspect = aspect;
+        t
     };
     let name = "cube_20mm_ascii.stl";
     let cube = common::model_bytes(name);

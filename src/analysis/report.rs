@@ -293,7 +293,13 @@ impl AnalysisGrid {
     /// ([`HeightMap::box_bytes`], a bound; unit 1's too in a job with unit-1 parts). The
     /// boxes are grown by the largest shrinkage compensation.
     pub fn layer_bytes(&self, s: &Settings) -> f64 {
-        let grow = 1.0 / (1.0 - s.shrink_xy.max(s.unit1_shrink_xy).clamp(0.0, 50.0) / 100.0);
+        let grow = 1.0
+            / (1.0
+                - s.per_unit
+                    .iter()
+                    .fold(0.0_f64, |m, u| m.max(u.shrink_xy))
+                    .clamp(0.0, 50.0)
+                    / 100.0);
         let b = s.droplet_width();
         let d = footprint_diameter(s);
         let per_mm2 = DROPLETS_PER_B2 * s.fill_density.max(1.0) / (b * b);

@@ -130,7 +130,8 @@ pub(crate) fn import(
     }
     let facets_in_file = tris.len();
     drop(tris);
-    let placement = mesh::Placement::of_settings(settings).compensated(settings.shrink_factors(0));
+    let placement = mesh::Placement::of_settings(settings)
+        .compensated(settings.shrink_factors(crate::base::settings::UnitId::FIRST));
     let frame = Frame::of(&mesh.vertices, |v| [*v], &placement)
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;

@@ -33,8 +33,8 @@ pub const MAX_COPIES: u32 = 100;
 pub const MAX_JOB_FILE_BYTES: usize = 1 << 20;
 /// Longest name kept for messages and the header (characters).
 pub const MAX_NAME_CHARS: usize = 80;
-/// Most discharge units (0 and 1).
-pub const UNITS: u8 = 2;
+/// Most discharge units a part may name (the setting `units` may allow fewer).
+pub const UNITS: u8 = crate::base::settings::MAX_UNITS as u8;
 
 /// The settings that belong to a part, not to the job (the settings schema flags them).
 pub use crate::base::settings::PART_KEYS;
@@ -89,10 +89,11 @@ pub fn job_schema() -> JobSchema {
         1,
         "Copies of the part on the plate",
     ));
+    // The units this version prints parts with (the settings name more, see `units`).
     part_numbers.push(whole(
         "unit",
         0,
-        u32::from(UNITS) - 1,
+        crate::base::settings::SLICED_UNITS as u32 - 1,
         0,
         "The discharge unit that prints the part",
     ));
@@ -162,7 +163,7 @@ pub struct PartSpec {
     pub place_angle: f64,
     #[serde(default = "one_copy")]
     pub copies: u32,
-    /// The discharge unit that prints it (0 or 1).
+    /// The discharge unit that prints it (0 … `units` − 1).
     #[serde(default)]
     pub unit: u8,
     /// A name for the page and the header (default: the part's name in its file).
@@ -214,7 +215,7 @@ impl PartSpec {
             place_angle: self.place_angle,
             place,
         }
-        .compensated(settings.shrink_factors(self.unit))
+        .compensated(settings.shrink_factors(crate::base::settings::UnitId(self.unit)))
     }
 
     /// The explicit placement, if any.
@@ -224,18 +225,11 @@ impl PartSpec {
 
     /// The value of a [`PART_KEYS`] key (`None` for an unplaced part's place, or another key).
     pub fn number(&self, key: &str) -> Option<f64> {
-        match key {
-            "rotate_x" => Some(self.rotate_x),
-            "rotate_y" => Some(self.rotate_y),
-            "rotate_z" => Some(self.rotate_z),
-            "scale_x" => Some(self.scale_x),
-            "scale_y" => Some(self.scale_y),
-            "scale_z" => Some(self.scale_z),
-            "place_x" => self.place_x,
-            "place_y" => self.place_y,
-            "place_angle" => Some(self.place_angle),
-            _ => None,
+        if !PART_KEYS.contains(&key) {
+            return None;
         }
+        // The fields are named as the keys (a place not given is `null`).
+        serde_json::to_value(self).ok()?.get(key)?.as_f64()
     }
 
     /// Checks every value (`i` names the part in messages).
@@ -261,8 +255,8 @@ impl PartSpec {
         };
         for key in PART_KEYS {
             if let Some(x) = self.number(key)
-                && key != "place_x"
-                && key != "place_y"
+                && *key != "place_x"
+                && *key != "place_y"
             {
                 check(key, x)?;
             }
@@ -295,7 +289,7 @@ impl PartSpec {
         if self.unit >= UNITS {
             return bad(
                 "unit",
-                format!("{} is not a discharge unit: 0 or 1", self.unit),
+                format!("{} is not a discharge unit: 0 … {}", self.unit, UNITS - 1),
             );
         }
         if let Some(n) = &self.name
@@ -422,6 +416,10 @@ impl JobSpec {
         }
         for (i, p) in self.parts.iter().enumerate() {
             p.validate(i)?;
+            let u = crate::base::settings::UnitId(p.unit);
+            let at = format!("parts[{i}].unit");
+            self.settings.check_unit(u, &at)?;
+            crate::base::settings::check_sliced(u, &at)?;
         }
         let total: u64 = self.parts.iter().map(|p| p.copies as u64).sum();
         if total > MAX_INSTANCES as u64 {
@@ -499,7 +497,10 @@ fn part_from_value(i: usize, v: serde_json::Value) -> Result<PartSpec, Error> {
     if let Some(u) = map.get("unit").and_then(Value::as_u64)
         && u >= UNITS as u64
     {
-        return bad("unit", &format!("{u} is not a discharge unit: 0 or 1"));
+        return bad(
+            "unit",
+            &format!("{u} is not a discharge unit: 0 … {}", UNITS - 1),
+        );
     }
     let part: PartSpec = serde_json::from_value(Value::Object(map)).map_err(|e| {
         Error::Job(format!(

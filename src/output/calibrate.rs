@@ -187,10 +187,16 @@ pub fn calibrate_read(
         return err("the code's header gives no layer_height: it is not a dropslice code".into());
     }
     let defaults = Settings::default();
-    let aspect = num("droplet_aspect").unwrap_or(defaults.droplet_aspect);
-    let density = density_g_cm3
-        .or_else(|| num("material_density"))
-        .unwrap_or(defaults.material_density);
+    let aspect = num("droplet_aspect").unwrap_or(
+        defaults
+            .unit(crate::base::settings::UnitId::FIRST)
+            .droplet_aspect,
+    );
+    let density = density_g_cm3.or_else(|| num("material_density")).unwrap_or(
+        defaults
+            .unit(crate::base::settings::UnitId::FIRST)
+            .material_density,
+    );
     let (droplets, source) = match reader.header_droplets() {
         Some(n) => (n, CountSource::Header),
         None => (reader.droplets(), CountSource::Commands),

@@ -245,7 +245,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
         let _ = writeln!(h, "; profiles = {}", names.join(", "));
     }
     let _ = writeln!(h, "; settings:");
-    for (name, value, unit) in s.entries_with(input.unit1_used) {
+    for (name, value, unit) in s.entries_with(|u| u.0 == 0 || (u.0 == 1 && input.unit1_used)) {
         if unit.is_empty() {
             let _ = writeln!(h, "; {name} = {value}");
         } else {

@@ -10,7 +10,7 @@
 
 use crate::analysis::{LayerAnalysis, PartAnalysis};
 use crate::base::error::Error;
-use crate::base::settings::Settings;
+use crate::base::settings::{Settings, UnitId};
 use crate::slicing::plan::{Counts, LayerPlan};
 use serde::{Deserialize, Serialize};
 
@@ -61,8 +61,8 @@ pub fn print_seconds(counts: &Counts, travel_mm: f64, settings: &Settings) -> f6
 /// The droplet time of each discharge unit, s.
 pub fn unit_seconds(counts: &Counts, settings: &Settings) -> (f64, f64) {
     (
-        counts.unit0() as f64 / settings.droplet_rate,
-        counts.unit1 as f64 / settings.unit1_droplet_rate,
+        counts.unit0() as f64 / settings.unit(UnitId::FIRST).droplet_rate,
+        counts.unit1 as f64 / settings.unit(UnitId(1)).droplet_rate,
     )
 }
 
@@ -228,13 +228,13 @@ impl Summary {
         let droplets = self.counts.total();
         let (d0, d1) = (self.counts.unit0(), self.counts.unit1);
         let b = settings.droplet_width();
-        let b1 = settings.unit1_droplet_width();
+        let b1 = settings.unit_width(UnitId(1));
         let h = settings.layer_height;
         let volume = d0 as f64 * b * b * h;
         let volume1 = d1 as f64 * b1 * b1 * h;
         let (t0, t1) = (
-            d0 as f64 / settings.droplet_rate,
-            d1 as f64 / settings.unit1_droplet_rate,
+            d0 as f64 / settings.unit(UnitId::FIRST).droplet_rate,
+            d1 as f64 / settings.unit(UnitId(1)).droplet_rate,
         );
         let a = &self.analysis;
         let analysed = a.layers > 0;
@@ -243,10 +243,10 @@ impl Summary {
             counts: self.counts,
             droplets,
             volume_mm3: volume,
-            mass_g: volume / 1000.0 * settings.material_density,
+            mass_g: volume / 1000.0 * settings.unit(UnitId::FIRST).material_density,
             unit1_droplets: d1,
             unit1_volume_mm3: volume1,
-            unit1_mass_g: volume1 / 1000.0 * settings.unit1_material_density,
+            unit1_mass_g: volume1 / 1000.0 * settings.unit(UnitId(1)).material_density,
             print_seconds: print_seconds(&self.counts, self.travel_mm, settings),
             unit0_seconds: t0,
             unit1_seconds: t1,

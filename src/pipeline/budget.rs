@@ -8,7 +8,7 @@
 //! [`MAX_DROPLETS_WITH_SUPPORT`] (the pass checks every droplet). docs/security.md *Droplet budget*.
 
 use crate::base::error::Error;
-use crate::base::settings::{Settings, Support};
+use crate::base::settings::Settings;
 use crate::base::steps::{self, Budget};
 use crate::model::layout::Instance;
 use crate::model::mesh::Mesh;
@@ -253,7 +253,10 @@ impl Overhangs {
     ///   r + w. (A droplet placed beside c, where c itself lies in the part or its gap below,
     ///   can come nearer an earlier one; those lie at the part's edges, a small share.)
     pub fn droplets(&self, s: &Settings) -> f64 {
-        let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+        let (b, b1) = (
+            s.droplet_width(),
+            s.unit_width(crate::base::settings::UnitId(1)),
+        );
         let rho = s.support_density;
         let r = crate::support::support_reach(s) + 2.0 * crate::support::SUPPORT_TOLERANCE_MM;
         let d = 0.5 * b1.hypot(b1 / rho);
@@ -305,7 +308,10 @@ impl Estimate {
         overhangs: &Overhangs,
         s: &Settings,
     ) -> Estimate {
-        let (b0, b1) = (s.droplet_width(), s.unit1_droplet_width());
+        let (b0, b1) = (
+            s.droplet_width(),
+            s.unit_width(crate::base::settings::UnitId(1)),
+        );
         let (unit0_volume, unit1_volume, unit1_extent) = match unit1 {
             None => (volume, 0.0, 0.0),
             Some(u) => {
@@ -362,7 +368,7 @@ impl Estimate {
         } else {
             footprint_bound.min(overhangs.droplets(s))
         };
-        if s.support == Support::Unit1 {
+        if s.support.is_on() {
             e.unit1_extent = size[0].max(size[1]) + 2.0 * grow;
         }
         e
@@ -372,8 +378,11 @@ impl Estimate {
     pub fn check(&self, s: &Settings) -> Result<(), Error> {
         check_droplets(self.unit0_volume, s)?;
         let h = s.layer_height;
-        let (b0, b1) = (s.droplet_width(), s.unit1_droplet_width());
-        let support = s.support == Support::Unit1;
+        let (b0, b1) = (
+            s.droplet_width(),
+            s.unit_width(crate::base::settings::UnitId(1)),
+        );
+        let support = s.support.is_on();
         let d0 = self.unit0_volume / (b0 * b0 * h);
         // Unit 1's droplets only where it prints: a B₁ that no part and no support uses is
         // never checked (its B₁² may be tiny).

@@ -2,7 +2,7 @@
 //! planned on any thread ([`Job::plan_layer`]), with both discharge units and the support.
 
 use crate::base::geom;
-use crate::base::settings::{self, Settings};
+use crate::base::settings::Settings;
 use crate::base::stages::{self, Stage};
 use crate::model::mesh::Mesh;
 use crate::model::prepare::JobInfo;
@@ -32,7 +32,7 @@ pub struct Job {
 impl Job {
     /// Whether discharge unit 1 prints in this job: support is on, or a part is unit 1's.
     pub fn uses_unit1(&self) -> bool {
-        self.settings.support == settings::Support::Unit1 || self.has_unit1_parts()
+        self.settings.support.is_on() || self.has_unit1_parts()
     }
 
     /// Whether a part of this job is printed by unit 1.
@@ -119,7 +119,7 @@ impl Job {
     /// [`plan_layer`](Self::plan_layer) and the region unit 0 prints in the layer (its section
     /// in a job without unit-1 parts), which the analysis needs.
     pub fn plan_layer_and_region(&self, i: usize) -> (LayerPlan, geom::Shapes) {
-        if self.settings.support == settings::Support::Unit1 {
+        if self.settings.support.is_on() {
             return self.supported_plans()[i].clone();
         }
         self.plan_layer_with(i, self.section(i), None)
@@ -128,7 +128,7 @@ impl Job {
     /// Layer `i`'s plan for the analysis of the layers next to it: its moves and unit 1's
     /// part region, without the overhang figure (which needs the section below).
     pub fn plan_for_analysis(&self, i: usize) -> LayerPlan {
-        if self.settings.support == settings::Support::Unit1 {
+        if self.settings.support.is_on() {
             return self.supported_plans()[i].0.clone();
         }
         self.plan_parts(i, &self.section(i)).0
@@ -137,7 +137,7 @@ impl Job {
     /// Whether planning a layer needs the section of the layer below (for the overhang
     /// figure: with support off; with support on it comes from [`Job::supported_plans`]).
     pub fn needs_below(&self) -> bool {
-        self.settings.support != settings::Support::Unit1
+        !self.settings.support.is_on()
     }
 
     /// [`plan_layer_and_region`](Self::plan_layer_and_region) given the layer's section and,
@@ -149,7 +149,7 @@ impl Job {
         section: Section,
         below: Option<&geom::Shapes>,
     ) -> (LayerPlan, geom::Shapes) {
-        if self.settings.support == settings::Support::Unit1 {
+        if self.settings.support.is_on() {
             return self.supported_plans()[i].clone();
         }
         let (mut plan, region) = stages::time(Stage::Plan, || self.plan_parts(i, &section));

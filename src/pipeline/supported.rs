@@ -148,7 +148,7 @@ fn droplet_pass(
     Vec<Vec<crate::base::geom::DVec2>>,
     support_droplets::PassFigures,
 ) {
-    let (b, b1) = (s.droplet_width(), s.unit1_droplet_width());
+    let (b, b1) = (s.droplet_width(), s.support_width());
     stages::time(Stage::Support, || {
         support_droplets::complete(
             &|i, within, out: &mut Vec<support_droplets::Droplet>| {

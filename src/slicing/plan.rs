@@ -268,20 +268,16 @@ pub fn count_units(moves: &[Move], b: f64, b1: f64) -> Counts {
 /// at `support_density`.
 pub fn support_settings(s: &Settings) -> Settings {
     Settings {
-        droplet_aspect: s.unit1_droplet_aspect,
         fill_density: s.support_density,
         contours: 1,
-        ..s.clone()
+        ..s.for_unit(s.support_unit())
     }
 }
 
 /// The settings unit 1 prints its parts with (docs/spec.md "Two discharge units"): the same
 /// contour and fill rules as unit 0, with unit 1's droplet width B₁ (`unit1_droplet_aspect`).
 pub fn unit1_part_settings(s: &Settings) -> Settings {
-    Settings {
-        droplet_aspect: s.unit1_droplet_aspect,
-        ..s.clone()
-    }
+    s.for_unit(crate::base::settings::UnitId(1))
 }
 
 /// Adds unit 1's moves to a planned layer, in the order `unit_order` gives: first the region
@@ -299,8 +295,9 @@ pub fn plan_unit1_layer(
     if parts.is_empty() && support.is_empty() {
         return;
     }
-    let b1 = s.unit1_droplet_width();
-    let unit0_first = s.unit_order == crate::base::settings::UnitOrder::Unit0First;
+    let b1 = s.unit_width(crate::base::settings::UnitId(1));
+    let unit0_first = s.unit_order.rank(crate::base::settings::UnitId::FIRST)
+        < s.unit_order.rank(crate::base::settings::UnitId(1));
     let start = if unit0_first {
         plan.moves.last().map_or(Point::ZERO, |m| m.to)
     } else {
@@ -350,7 +347,9 @@ pub fn plan_unit1_layer(
 /// Where unit 1 starts in a layer whose unit-0 moves are planned: after them, or at the origin
 /// with `unit_order = unit1_first`.
 pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
-    if s.unit_order == crate::base::settings::UnitOrder::Unit0First {
+    if s.unit_order.rank(crate::base::settings::UnitId::FIRST)
+        < s.unit_order.rank(crate::base::settings::UnitId(1))
+    {
         plan.moves.last().map_or(Point::ZERO, |m| m.to)
     } else {
         Point::ZERO
@@ -365,7 +364,8 @@ pub fn add_unit1(plan: &mut LayerPlan, mut moves: Vec<Move>, s: &Settings) {
         return;
     }
     let b1 = support_settings(s).droplet_width();
-    let unit0_first = s.unit_order == crate::base::settings::UnitOrder::Unit0First;
+    let unit0_first = s.unit_order.rank(crate::base::settings::UnitId::FIRST)
+        < s.unit_order.rank(crate::base::settings::UnitId(1));
     let mut at = unit1_start(plan, s);
     for m in &mut moves {
         m.unit = 1;

@@ -220,7 +220,7 @@ pub fn overhang(region: &Shapes, below: Option<&Shapes>, s: &Settings) -> Shapes
 /// and the support under an overhang's edge is wider. One whole B₁ measured worse: support
 /// then hangs beyond the edges of the part below (U_overhang.obj), see docs/support.md.
 pub fn support_reach(s: &Settings) -> f64 {
-    0.5 * s.unit1_droplet_width()
+    0.5 * s.support_width()
 }
 
 /// The droplet form of the rule: which droplets of a layer have no droplet of the layer below

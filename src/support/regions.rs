@@ -390,7 +390,7 @@ mod tests {
                 hatch_angle_step: step,
                 ..Settings::default()
             };
-            let b1 = s.unit1_droplet_width();
+            let b1 = s.support_width();
             let mut regions = vec![square(0.0, 0.0, 2.0); 5];
             regions.extend(vec![
                 union(&square(0.0, 0.0, 2.0), &square(2.0, 0.0, 4.0));

@@ -451,7 +451,7 @@ impl Session {
     /// make whole in one call; [`Job::supported_in_steps`]): true once it is made, at once
     /// when the support is off. The page calls it until true before it plans layers.
     pub fn support_step(&self, items: u32) -> bool {
-        if self.job.settings().support != settings::Support::Unit1 || self.job.supported_made() {
+        if !self.job.settings().support.is_on() || self.job.supported_made() {
             return true;
         }
         let mut pass = self.support_pass.borrow_mut();

@@ -6,12 +6,18 @@
 
 mod profile;
 mod schema;
+mod table;
+mod units;
 
 pub use profile::{
-    MACHINE_KEYS, MATERIAL_KEYS, MAX_PROFILE_BYTES, MAX_PROFILE_NAME_CHARS, Profile, ProfileKind,
-    invisible, profile_name, profile_text,
+    MAX_PROFILE_BYTES, MAX_PROFILE_NAME_CHARS, Profile, ProfileKind, invisible, profile_name,
+    profile_text,
 };
-pub use schema::{Kind, PART_KEYS, SettingSpec, names, schema, schema_json};
+pub use schema::{
+    Entry, Kind, SettingSpec, Shown, Slot, entries, entry, names, schema, schema_json,
+};
+pub use table::{MAX_UNITS, PART_KEYS, Settings, UnitSettings};
+pub use units::{Support, UnitId, UnitOrder};
 
 use crate::base::error::Error;
 use serde::{Deserialize, Serialize};
@@ -66,156 +72,6 @@ pub enum LoopSpacing {
     Even,
 }
 
-/// Whether support is printed under overhangs (docs/spec.md "Overhangs and support").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Support {
-    Off,
-    /// Support printed by discharge unit 1.
-    Unit1,
-}
-
-/// Which discharge unit prints first within a layer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum UnitOrder {
-    Unit0First,
-    Unit1First,
-}
-
-/// Every parameter of a slice. `Default` gives the defaults of docs/spec.md 5.4.1.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Settings {
-    pub layer_height: f64,
-    pub droplet_aspect: f64,
-    pub contours: u32,
-    pub outer_offset: f64,
-    pub inner_offset: f64,
-    pub fill_density: f64,
-    pub fill_overlap: f64,
-    pub hatch_angle: f64,
-    pub hatch_angle_step: f64,
-    pub start_jitter: f64,
-    /// Set each layer's droplets over the gaps of the layer below (loops by B/2 along the loop,
-    /// hatch lines by half the spacing where the hatch angle repeats).
-    pub stagger: bool,
-    pub contour_order: ContourOrder,
-    pub print_order: PrintOrder,
-    pub close_loops: bool,
-    /// Droplet spacing along loops (`exact`: the thesis; `even`: no repeated seam droplet).
-    pub loop_spacing: LoopSpacing,
-    pub rotate_x: f64,
-    pub rotate_y: f64,
-    pub rotate_z: f64,
-    pub scale_x: f64,
-    pub scale_y: f64,
-    pub scale_z: f64,
-    pub place_x: f64,
-    pub place_y: f64,
-    pub place_angle: f64,
-    pub slice_plane: SlicePlane,
-    /// Droplets the discharge unit sets per second (for the time estimate).
-    pub droplet_rate: f64,
-    /// Table speed for travel moves (for the time estimate).
-    pub travel_speed: f64,
-    /// Density of the material (for the mass estimate).
-    pub material_density: f64,
-    /// Linear shrinkage of unit 0's material in x and y (%): its parts are sliced scaled by
-    /// 1 / (1 − s/100) (docs/spec.md "Shrinkage compensation").
-    pub shrink_xy: f64,
-    /// Linear shrinkage of unit 0's material in z (%).
-    pub shrink_z: f64,
-    /// Droplet footprint model of the coverage analysis.
-    pub footprint: Footprint,
-    /// Build plate size in x and y (mm): parts are arranged on it.
-    pub plate_x: f64,
-    pub plate_y: f64,
-    /// Height of the build chamber (mm): a taller job is refused before slicing.
-    pub plate_z: f64,
-    /// Gap between the bounding boxes of arranged parts (mm).
-    pub part_spacing: f64,
-    /// Slice a job with a part larger than the plate or reaching past its edges (refused
-    /// unless set; docs/jobs.md "The plate rule").
-    pub allow_off_plate: bool,
-    /// A droplet is supported when the layer below has material within this many B.
-    pub overhang_limit: f64,
-    /// Support under overhangs, printed by discharge unit 1.
-    pub support: Support,
-    /// Support is kept this many B (of unit 0) away from the part within a layer.
-    pub support_gap_xy: f64,
-    /// Support ends this many layers below the overhang it carries.
-    pub support_gap_z: u32,
-    /// Hatch spacing of the support = B₁ / support_density.
-    pub support_density: f64,
-    /// Droplet width of unit 1 divided by the layer height (B₁ = aspect × H).
-    pub unit1_droplet_aspect: f64,
-    /// Droplets unit 1 sets per second (time estimate).
-    pub unit1_droplet_rate: f64,
-    /// Density of unit 1's material (mass estimate).
-    pub unit1_material_density: f64,
-    /// Linear shrinkage of unit 1's material in x and y (%), for unit 1's parts.
-    pub unit1_shrink_xy: f64,
-    /// Linear shrinkage of unit 1's material in z (%).
-    pub unit1_shrink_z: f64,
-    /// Which unit prints first within a layer.
-    pub unit_order: UnitOrder,
-}
-
-impl Default for Settings {
-    fn default() -> Self {
-        Settings {
-            layer_height: 0.20,
-            droplet_aspect: 1.04,
-            contours: 2,
-            outer_offset: 0.5,
-            inner_offset: 0.5,
-            fill_density: 1.0,
-            fill_overlap: 0.5,
-            hatch_angle: 45.0,
-            hatch_angle_step: 90.0,
-            start_jitter: 0.07,
-            stagger: false,
-            contour_order: ContourOrder::InsideOut,
-            print_order: PrintOrder::ContoursFirst,
-            close_loops: true,
-            loop_spacing: LoopSpacing::Exact,
-            rotate_x: 0.0,
-            rotate_y: 0.0,
-            rotate_z: 0.0,
-            scale_x: 1.0,
-            scale_y: 1.0,
-            scale_z: 1.0,
-            place_x: 0.0,
-            place_y: 0.0,
-            place_angle: 0.0,
-            slice_plane: SlicePlane::Middle,
-            droplet_rate: 100.0,
-            travel_speed: 50.0,
-            material_density: 1.04,
-            shrink_xy: 0.0,
-            shrink_z: 0.0,
-            footprint: Footprint::Disc,
-            plate_x: 154.0,
-            plate_y: 134.0,
-            plate_z: 230.0,
-            part_spacing: 5.0,
-            allow_off_plate: false,
-            overhang_limit: 0.5,
-            support: Support::Off,
-            support_gap_xy: 0.5,
-            support_gap_z: 0,
-            support_density: 1.0,
-            unit1_droplet_aspect: 1.04,
-            unit1_droplet_rate: 100.0,
-            unit1_material_density: 1.04,
-            unit1_shrink_xy: 0.0,
-            unit1_shrink_z: 0.0,
-            unit_order: UnitOrder::Unit0First,
-        }
-    }
-}
-
 /// Largest settings file the command-line tool reads (`--settings FILE.json`), checked before
 /// reading: 1 MiB, as a job file ([`crate::model::spec::MAX_JOB_FILE_BYTES`]); every setting with a
 /// long value takes a few kB.
@@ -256,9 +112,7 @@ impl Settings {
     pub fn set(&mut self, name: &str, value: &str) -> Result<(), Error> {
         let t = value.trim();
         // An enum's choices are words even where they look like booleans (`support = off`).
-        let is_enum = schema()
-            .iter()
-            .any(|spec| spec.name == name && spec.kind == Kind::Enum);
+        let is_enum = schema::entry(name).is_some_and(|e| e.spec.kind == Kind::Enum);
         let v = match t {
             _ if is_enum => serde_json::Value::String(t.to_string()),
             "true" | "yes" | "on" => serde_json::Value::Bool(true),
@@ -277,17 +131,29 @@ impl Settings {
     /// Sets one value given as JSON, with a message naming the setting when it does not fit.
     pub fn set_value(&mut self, name: &str, value: serde_json::Value) -> Result<(), Error> {
         use serde_json::Value;
-        let mut map = serde_json::to_value(&*self).expect("settings serialize");
-        let Some(spec) = schema().into_iter().find(|s| s.name == name) else {
+        let Some(entry) = schema::entry(name) else {
             let name = crate::base::error::quote(name);
             return Err(Error::Setting {
                 message: format!(
-                    "there is no setting named '{name}'; known settings: {}",
-                    names().join(", ")
+                    "there is no setting named '{name}'; known settings: {}; and of each unit N = 1 … {}: {}",
+                    (entries().iter())
+                        .filter(|e| !matches!(e.slot, Slot::Unit(u, _) if u.0 > 0))
+                        .map(|e| e.spec.name)
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    MAX_UNITS - 1,
+                    (entries().iter())
+                        .filter_map(|e| match e.slot {
+                            Slot::Unit(UnitId::FIRST, base) => Some(format!("unitN_{base}")),
+                            _ => None,
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 ),
                 name,
             });
         };
+        let spec = &entry.spec;
         let shown = match &value {
             Value::String(s) => crate::base::error::quote(s),
             other => crate::base::error::quote(&other.to_string()),
@@ -301,9 +167,8 @@ impl Settings {
             (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(1.0) => Value::Bool(true),
             (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(0.0) => Value::Bool(false),
             (Kind::Bool, _) => return Err(bad("true or false".into())),
-            (Kind::Enum, Value::String(s)) if spec.choices.contains(&s.as_str()) => {
-                Value::String(s)
-            }
+            // A word of the choices, or what the setting's own type reads (a `unit_order` list).
+            (Kind::Enum, Value::String(s)) => Value::String(s),
             (Kind::Enum, _) => return Err(bad(format!("one of: {}", spec.choices.join(", ")))),
             (Kind::Integer, Value::Number(n)) => match n.as_f64() {
                 Some(x) if x.fract() == 0.0 && x >= 0.0 && x <= u32::MAX as f64 => {
@@ -316,25 +181,53 @@ impl Settings {
             }
             (Kind::Integer | Kind::Number, _) => return Err(bad("a finite number".into())),
         };
-        map[name] = value;
-        *self = serde_json::from_value(map).map_err(|e| {
-            bad(format!(
+        let put = match entry.slot {
+            Slot::Job => self.put_job(name, value),
+            Slot::Unit(u, base) => self.per_unit[u.index()].put(base, value),
+        };
+        match put {
+            Some(Ok(())) => Ok(()),
+            Some(Err(e)) if spec.kind == Kind::Enum => Err(bad(format!(
+                "one of: {}{}",
+                spec.choices.join(", "),
+                if e.to_string().contains("list") {
+                    ", or a list of units such as 2,0,1"
+                } else {
+                    ""
+                }
+            ))),
+            Some(Err(e)) => Err(bad(format!(
                 "allowed: {}",
                 crate::base::error::quote(&e.to_string())
-            ))
-        })?;
-        Ok(())
+            ))),
+            None => Err(Error::Internal(format!("the setting {name} has no field"))),
+        }
     }
 
-    /// Checks every value against the schema's range.
+    /// The value of the setting at `slot` (named `name`) as JSON.
+    fn value_at(&self, slot: Slot, name: &str) -> serde_json::Value {
+        match slot {
+            Slot::Job => self.job_value(name),
+            Slot::Unit(u, base) => self.per_unit[u.index()].value(base),
+        }
+        .expect("every entry has a field")
+    }
+
+    /// The value of the setting `name` as JSON (`None`: no such setting).
+    pub fn value(&self, name: &str) -> Option<serde_json::Value> {
+        schema::entry(name).map(|e| self.value_at(e.slot, name))
+    }
+
+    /// Checks every value against the schema's range, and every unit named (by `support`,
+    /// `unit_order`) against `units`.
     pub fn validate(&self) -> Result<(), Error> {
-        let map = serde_json::to_value(self).expect("settings serialize");
-        for spec in schema() {
+        for entry in entries() {
+            let spec = &entry.spec;
             if !matches!(spec.kind, Kind::Number | Kind::Integer) {
                 continue;
             }
             // NaN and infinity serialize as null.
-            let Some(x) = map[spec.name].as_f64() else {
+            let Some(x) = self.value_at(entry.slot, spec.name).as_f64() else {
                 return Err(Error::Setting {
                     name: spec.name.to_string(),
                     message: "is not a finite number".into(),
@@ -369,61 +262,247 @@ impl Settings {
                 });
             }
         }
+        let named = self.support.unit().into_iter().map(|u| ("support", u));
+        let ordered = self
+            .unit_order
+            .named()
+            .into_iter()
+            .map(|u| ("unit_order", u));
+        for (name, u) in named.chain(ordered) {
+            self.check_unit(u, name)?;
+        }
+        if let Some(u) = self.support.unit() {
+            check_sliced(u, "support")?;
+        }
+        // A unit's own setting set for a unit the machine does not have is a mistake (a
+        // material for unit 2 on a machine of two units).
+        for e in entries() {
+            if let Slot::Unit(u, _) = e.slot
+                && u.index() >= self.units as usize
+                && self.value_at(e.slot, e.spec.name) != e.spec.default
+            {
+                self.check_unit(u, e.spec.name)?;
+            }
+        }
         Ok(())
     }
 
-    /// Droplet width B in mm.
-    pub fn droplet_width(&self) -> f64 {
-        self.layer_height * self.droplet_aspect
+    /// Refuses a unit the machine does not have (`what` names where it was given).
+    pub fn check_unit(&self, u: UnitId, what: &str) -> Result<(), Error> {
+        if u.index() < self.units as usize {
+            return Ok(());
+        }
+        Err(Error::Setting {
+            name: what.to_string(),
+            message: format!(
+                "names discharge unit {u}, but the machine has {} (units = {}: units 0 … {}); set units = {} or more",
+                self.units,
+                self.units,
+                self.units.saturating_sub(1),
+                u.0 + 1
+            ),
+        })
     }
 
-    /// Droplet width B₁ of discharge unit 1 in mm.
-    pub fn unit1_droplet_width(&self) -> f64 {
-        self.layer_height * self.unit1_droplet_aspect
+    /// The settings of discharge unit `u`.
+    pub fn unit(&self, u: UnitId) -> &UnitSettings {
+        &self.per_unit[u.index()]
+    }
+
+    pub fn unit_mut(&mut self, u: UnitId) -> &mut UnitSettings {
+        &mut self.per_unit[u.index()]
+    }
+
+    /// These settings as unit `u` prints with them: unit `u`'s own settings in unit 0's place
+    /// (the droplet width B_u, the rate, the density).
+    pub fn for_unit(&self, u: UnitId) -> Settings {
+        let mut s = self.clone();
+        s.per_unit[0] = self.per_unit[u.index()].clone();
+        s
+    }
+
+    /// Droplet width B in mm (unit 0's).
+    pub fn droplet_width(&self) -> f64 {
+        self.unit_width(UnitId::FIRST)
+    }
+
+    /// Droplet width B_u of discharge unit `u` in mm.
+    pub fn unit_width(&self, u: UnitId) -> f64 {
+        self.layer_height * self.unit(u).droplet_aspect
+    }
+
+    /// The unit that prints the support: `support`'s (unit 1 while support is off, so the
+    /// support's figures keep a width).
+    pub fn support_unit(&self) -> UnitId {
+        self.support.unit().unwrap_or(UnitId(1))
+    }
+
+    /// Droplet width of the support's unit, mm.
+    pub fn support_width(&self) -> f64 {
+        self.unit_width(self.support_unit())
     }
 
     /// The scale that compensates the shrinkage of discharge unit `unit`'s material: a part
     /// of shrinkage s (%) is sliced scaled by 1 / (1 − s/100) in that axis (exactly 1 for 0).
-    pub fn shrink_factors(&self, unit: u8) -> [f64; 3] {
-        let (xy, z) = if unit == 1 {
-            (self.unit1_shrink_xy, self.unit1_shrink_z)
-        } else {
-            (self.shrink_xy, self.shrink_z)
-        };
+    pub fn shrink_factors(&self, unit: UnitId) -> [f64; 3] {
+        let u = self.unit(unit);
         let f = |s: f64| 1.0 / (1.0 - s / 100.0);
-        [f(xy), f(xy), f(z)]
+        [f(u.shrink_xy), f(u.shrink_xy), f(u.shrink_z)]
     }
 
-    /// The settings as `(name, value)` pairs in schema order, values as they appear in the header.
+    /// The settings as `(name, value, unit)` in schema order, values as they appear in the
+    /// header.
     pub fn entries(&self) -> Vec<(&'static str, String, &'static str)> {
-        self.entries_with(true)
+        self.entries_with(|_| true)
     }
 
-    /// [`entries`](Self::entries) for the header: the settings of discharge unit 1 (those only
-    /// unit 1 uses, [`is_unit1_setting`]) only when unit 1 is used.
-    pub fn entries_with(&self, unit1_used: bool) -> Vec<(&'static str, String, &'static str)> {
-        let map = serde_json::to_value(self).expect("settings serialize");
-        schema()
-            .into_iter()
-            .filter(|spec| unit1_used || !is_unit1_setting(spec.name))
-            .map(|spec| {
-                let v = &map[spec.name];
-                let text = match v {
-                    serde_json::Value::String(s) => s.clone(),
+    /// [`entries`](Self::entries) for the header of a job whose units `used` print: a unit's
+    /// own settings only when it prints, the settings of support and the unit order only when
+    /// a unit other than 0 prints, `units` only when one beyond unit 1 does ([`Shown`]).
+    pub fn entries_with(
+        &self,
+        used: impl Fn(UnitId) -> bool,
+    ) -> Vec<(&'static str, String, &'static str)> {
+        let second = UnitId::all(MAX_UNITS).skip(1).any(&used);
+        let beyond = UnitId::all(MAX_UNITS).skip(2).any(&used);
+        entries()
+            .iter()
+            .filter(|e| shown(e, &used, second, beyond))
+            .map(|e| {
+                let text = match self.value_at(e.slot, e.spec.name) {
+                    serde_json::Value::String(s) => s,
                     other => other.to_string(),
                 };
-                (spec.name, text, spec.unit)
+                (e.spec.name, text, e.spec.unit)
             })
             .collect()
     }
 }
 
-/// Settings that only discharge unit 1 uses (listed in the header when unit 1 is used).
-pub fn is_unit1_setting(name: &str) -> bool {
-    // The four shrinkage values are always listed (docs/spec.md "Shrinkage compensation").
-    (name.starts_with("unit1_") && !name.starts_with("unit1_shrink_"))
-        || name == "unit_order"
-        || matches!(name, "support_gap_xy" | "support_gap_z" | "support_density")
+/// The units this version prints with: 0 and 1. The settings name up to [`MAX_UNITS`] units
+/// (`units`, `unitN_…`, `unit_order`), but support and parts of a unit beyond 1 are refused
+/// until the planner prints more than two (docs/spec.md "Discharge units").
+pub const SLICED_UNITS: usize = 2;
+
+/// Refuses a unit this version does not print with ([`SLICED_UNITS`]).
+pub fn check_sliced(u: UnitId, what: &str) -> Result<(), Error> {
+    if u.index() < SLICED_UNITS {
+        return Ok(());
+    }
+    Err(Error::Setting {
+        name: what.to_string(),
+        message: format!(
+            "names discharge unit {u}: this version prints parts and support with units 0 and 1 only (docs/spec.md \"Discharge units\")"
+        ),
+    })
+}
+
+/// The page's TypeScript type of the settings, `www/core/settings.gen.ts`, made from the
+/// table (a test fails when the file is stale; `DROPSLICE_WRITE_GENERATED=1 cargo test --lib
+/// settings` writes it).
+pub fn typescript() -> String {
+    let mut out = String::from(
+        "// Generated from the core's settings table (src/base/settings/table.rs): do not edit.\n\
+         // `cargo test --release --lib settings` fails when it is stale; with\n\
+         // DROPSLICE_WRITE_GENERATED=1 it writes it again.\n\n",
+    );
+    out.push_str(&format!(
+        "/** The most discharge units a machine may have (the setting `units`). */\nexport const MAX_UNITS = {MAX_UNITS};\n\n"
+    ));
+    let list = |names: &[&str]| {
+        names
+            .iter()
+            .map(|n| format!("\"{n}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    out.push_str(&format!(
+        "/** The settings a part of a job carries itself. */\nexport const PART_KEYS = [{}] as const;\nexport type PartKey = (typeof PART_KEYS)[number];\n\n",
+        list(PART_KEYS)
+    ));
+    let unit_base: Vec<&str> = (entries().iter())
+        .filter_map(|e| match e.slot {
+            Slot::Unit(UnitId::FIRST, base) => Some(base),
+            _ => None,
+        })
+        .collect();
+    out.push_str(&format!(
+        "/** The settings each unit has (unit 0's names; unit N's are `unitN_` + the name). */\nexport const UNIT_KEYS = [{}] as const;\nexport type UnitKey = (typeof UNIT_KEYS)[number];\n\n",
+        list(&unit_base)
+    ));
+    out.push_str("/** Every setting (docs/spec.md 5.4.1). */\nexport interface Settings {\n");
+    for e in entries() {
+        let spec = &e.spec;
+        let ty = match spec.kind {
+            Kind::Number | Kind::Integer => "number".to_string(),
+            Kind::Bool => "boolean".to_string(),
+            // `unit_order` also takes a list of units ("2,0,1").
+            Kind::Enum if spec.name == "unit_order" => "string".to_string(),
+            Kind::Enum => spec
+                .choices
+                .iter()
+                .map(|c| format!("\"{c}\""))
+                .collect::<Vec<_>>()
+                .join(" | "),
+        };
+        let unit = if spec.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", spec.unit)
+        };
+        let doc = format!("{}{unit}", spec.description).replace("*/", "* /");
+        out.push_str(&format!("  /** {doc} */\n  {}: {ty};\n", spec.name));
+    }
+    out.push_str("}\n\nexport type SettingName = keyof Settings;\n");
+    out
+}
+
+/// Whether the header of a job whose units `used` print lists the setting of `e` (`second`:
+/// a unit other than 0 prints, `beyond`: one beyond unit 1).
+fn shown(e: &Entry, used: &impl Fn(UnitId) -> bool, second: bool, beyond: bool) -> bool {
+    match (e.shown, e.slot) {
+        (Shown::SecondUnit, _) => second,
+        (Shown::BeyondTwo, _) => beyond,
+        (_, Slot::Job) => true,
+        (Shown::Always, Slot::Unit(u, _)) if u.0 < 2 => true,
+        (_, Slot::Unit(u, _)) => u.0 == 0 || used(u),
+    }
+}
+
+/// Whether a setting is one of those only a machine of more than two units has (`units`, the
+/// settings of units 2 and up): written only when they differ from their defaults, so
+/// settings written before read and write as they did.
+fn beyond_two(e: &Entry) -> bool {
+    e.shown == Shown::BeyondTwo || matches!(e.slot, Slot::Unit(u, _) if u.0 >= 2)
+}
+
+/// Written as one flat object `{"name": value, …}` in schema order.
+impl Serialize for Settings {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(None)?;
+        for e in entries() {
+            let v = self.value_at(e.slot, e.spec.name);
+            if beyond_two(e) && v == e.spec.default {
+                continue;
+            }
+            map.serialize_entry(e.spec.name, &v)?;
+        }
+        map.end()
+    }
+}
+
+/// Read from a flat object; missing names take their defaults, an unknown name is refused.
+/// Not range-checked ([`Settings::validate`]).
+impl<'de> Deserialize<'de> for Settings {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let map = serde_json::Map::<String, serde_json::Value>::deserialize(d)?;
+        let mut s = Settings::default();
+        for (k, v) in map {
+            s.set_value(&k, v).map_err(serde::de::Error::custom)?;
+        }
+        Ok(s)
+    }
 }
 
 impl fmt::Display for Settings {
@@ -442,14 +521,45 @@ mod tests {
 
     #[test]
     fn schema_covers_every_field() {
-        let map = serde_json::to_value(Settings::default()).unwrap();
-        let fields: Vec<_> = map.as_object().unwrap().keys().cloned().collect();
+        // Every name reads and writes its own field, and a settings object round-trips.
         let names = names();
-        assert_eq!(fields.len(), names.len());
-        for f in fields {
-            assert!(names.contains(&f.as_str()), "{f} missing in schema");
+        let mut s = Settings::default();
+        for (i, name) in names.iter().enumerate() {
+            assert_eq!(names.iter().filter(|n| *n == name).count(), 1, "{name}");
+            let spec = entry(name).unwrap();
+            let v = match spec.spec.kind {
+                Kind::Number => serde_json::json!(spec.spec.max.unwrap() - 1e-3 * i as f64),
+                Kind::Integer => serde_json::json!(spec.spec.max.unwrap() as u64),
+                _ => s.value(name).unwrap(),
+            };
+            s.set_value(name, v.clone()).unwrap();
+            assert_eq!(s.value(name).unwrap(), v, "{name}");
         }
+        let text = serde_json::to_string(&s).unwrap();
+        assert_eq!(serde_json::from_str::<Settings>(&text).unwrap(), s);
+        assert_eq!(
+            serde_json::to_value(&s).unwrap().as_object().unwrap().len(),
+            names.len()
+        );
         Settings::default().validate().unwrap();
+        // The settings of units 2 and up, and `units`, are written only when set.
+        let d = serde_json::to_value(Settings::default()).unwrap();
+        assert!(d.get("units").is_none() && d.get("unit2_droplet_aspect").is_none());
+        assert!(d.get("unit1_droplet_aspect").is_some());
+    }
+
+    #[test]
+    fn the_pages_settings_type_is_up_to_date() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/www/core/settings.gen.ts");
+        let made = typescript();
+        if std::env::var_os("DROPSLICE_WRITE_GENERATED").is_some() {
+            std::fs::write(path, &made).unwrap();
+        }
+        let file = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            file == made,
+            "www/core/settings.gen.ts is stale: run DROPSLICE_WRITE_GENERATED=1 cargo test --release --lib settings"
+        );
     }
 
     #[test]
@@ -486,7 +596,7 @@ mod tests {
         s.set("support", "off").unwrap();
         assert_eq!(s.support, Support::Off);
         s.set("support", "unit1").unwrap();
-        assert_eq!(s.support, Support::Unit1);
+        assert_eq!(s.support, Support::Unit(UnitId(1)));
         s.set("layer_height", "-1").unwrap();
         let e = s.validate().unwrap_err().to_string();
         assert!(

@@ -1,43 +1,25 @@
 //! Profiles (docs/spec.md "Profiles"): a named set of settings of one kind, stored as JSON
 //! `{"name": …, "kind": "machine" | "material", "settings": {…}}`.
 //!
-//! A machine profile holds the plate and the units' rates and speeds ([`MACHINE_KEYS`]); a
-//! material profile a unit's droplet aspect, density and shrinkage ([`MATERIAL_KEYS`], with
-//! `unit1_` names for unit 1). A key of the other kind, or of neither, is refused: a profile
-//! is meant to be swapped for another of its kind without touching the rest of the settings
-//! (the layer height, the contours, the support… belong to the job, `--set` or a settings
-//! file). Every value is checked by the schema as `--set` checks it.
+//! A machine profile holds the plate, the number of units, their rates and the travel speed
+//! (the rows of the table marked `machine`); a material profile one material — its droplet
+//! aspect, density and shrinkage under unit 0's names (`droplet_aspect`) — and applying it
+//! names the unit it goes to ([`Profile::apply_to`]). Material profiles saved before held
+//! both units' values (`unit1_droplet_aspect`): they still read, and apply as they did. A key
+//! of the other kind, or of neither, is refused: a profile is meant to be swapped for another
+//! of its kind without touching the rest of the settings (the layer height, the contours, the
+//! support… belong to the job, `--set` or a settings file). Every value is checked by the
+//! schema as `--set` checks it.
 
-use super::{Settings, schema};
+use super::{Settings, Slot, UnitId, entries, schema};
 use crate::base::error::{Error, quote};
 use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
 
-/// Largest profile file read (a profile holds at most a dozen settings).
+/// Largest profile file read (a profile holds at most a few dozen settings).
 pub const MAX_PROFILE_BYTES: usize = 64 << 10;
 /// Longest profile name, in characters.
 pub const MAX_PROFILE_NAME_CHARS: usize = 100;
-
-/// The settings a machine profile may hold.
-pub const MACHINE_KEYS: [&str; 6] = [
-    "plate_x",
-    "plate_y",
-    "plate_z",
-    "droplet_rate",
-    "unit1_droplet_rate",
-    "travel_speed",
-];
-
-/// The settings a material profile may hold.
-pub const MATERIAL_KEYS: [&str; 8] = [
-    "droplet_aspect",
-    "material_density",
-    "shrink_xy",
-    "shrink_z",
-    "unit1_droplet_aspect",
-    "unit1_material_density",
-    "unit1_shrink_xy",
-    "unit1_shrink_z",
-];
 
 /// What a profile describes.
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
@@ -49,12 +31,28 @@ pub enum ProfileKind {
 }
 
 impl ProfileKind {
-    /// The settings a profile of this kind may hold.
+    /// Every setting a profile of this kind may hold (a material profile: also the `unitN_`
+    /// forms profiles saved before held).
     pub fn keys(self) -> &'static [&'static str] {
-        match self {
-            ProfileKind::Machine => &MACHINE_KEYS,
-            ProfileKind::Material => &MATERIAL_KEYS,
-        }
+        static KEYS: [OnceLock<Vec<&'static str>>; 2] = [OnceLock::new(), OnceLock::new()];
+        KEYS[self as usize].get_or_init(|| {
+            (entries().iter())
+                .filter(|e| e.spec.profile == Some(self))
+                .map(|e| e.spec.name)
+                .collect()
+        })
+    }
+
+    /// The keys a profile of this kind is written with: a machine profile's all, a material
+    /// profile's those of one material (unit 0's names).
+    pub fn own_keys(self) -> Vec<&'static str> {
+        (entries().iter())
+            .filter(|e| e.spec.profile == Some(self))
+            .filter(|e| {
+                self == ProfileKind::Machine || e.slot == Slot::Unit(UnitId::FIRST, e.spec.name)
+            })
+            .map(|e| e.spec.name)
+            .collect()
     }
 
     fn word(self) -> &'static str {
@@ -229,7 +227,7 @@ impl Profile {
                     message: format!(
                         "a {} profile holds only {}; {why}",
                         kind.word(),
-                        kind.keys().join(", ")
+                        kind.own_keys().join(", ")
                     ),
                 });
             }
@@ -244,12 +242,61 @@ impl Profile {
         })
     }
 
-    /// Sets the profile's values in `settings` (checked when the profile was made).
+    /// Sets the profile's values in `settings` as written (checked when the profile was
+    /// made): [`apply_to`](Self::apply_to) without a unit.
     pub fn apply(&self, settings: &mut Settings) -> Result<(), Error> {
+        self.apply_to(settings, None)
+    }
+
+    /// Sets the profile's values in `settings`. With a unit, a material profile's material
+    /// goes to that unit (`droplet_aspect` to `unit2_droplet_aspect` for unit 2); without, each
+    /// value goes to the setting its key names (unit 0's, and in a profile saved before with
+    /// `unit1_` keys, unit 1's too). A machine profile applies to the machine, never to one
+    /// unit; a profile holding several units' values, never to one unit.
+    pub fn apply_to(&self, settings: &mut Settings, unit: Option<UnitId>) -> Result<(), Error> {
+        let refuse = |why: String| Error::Setting {
+            name: String::new(),
+            message: format!("the profile {} {why}", quote(&self.name)),
+        };
         for (key, value) in &self.settings {
-            settings.set_value(key, value.clone())?;
+            let name = match unit {
+                None => key.clone(),
+                Some(_) if self.kind == ProfileKind::Machine => {
+                    return Err(refuse(
+                        "is a machine profile: it applies to the whole machine, not to one unit (give it without unitN=)".into(),
+                    ));
+                }
+                Some(u) => match super::entry(key).map(|e| e.slot) {
+                    Some(Slot::Unit(UnitId::FIRST, base)) => u.name(base),
+                    _ => {
+                        return Err(refuse(format!(
+                            "holds {key}, a setting of one unit: a profile of several units' materials (saved before materials were per unit) applies only as a whole (give it without unitN=)"
+                        )));
+                    }
+                },
+            };
+            settings.set_value(&name, value.clone())?;
         }
         Ok(())
+    }
+
+    /// This profile with its material under unit `u`'s names (`unit2_droplet_aspect` for
+    /// `droplet_aspect`), for the command line's `--profile unit2=FILE.json`: refused for a
+    /// machine profile and for a profile of several units' materials ([`apply_to`](Self::apply_to)).
+    pub fn to_unit(&self, u: UnitId) -> Result<Profile, Error> {
+        let mut s = Settings::default();
+        self.apply_to(&mut s, Some(u))?;
+        let settings = (self.settings.iter())
+            .map(|(k, v)| match super::entry(k).map(|e| e.slot) {
+                Some(Slot::Unit(_, base)) => (u.name(base), v.clone()),
+                _ => (k.clone(), v.clone()),
+            })
+            .collect();
+        Ok(Profile {
+            name: self.name.clone(),
+            kind: self.kind,
+            settings,
+        })
     }
 
     /// How the header names it: `name (kind)`.
@@ -270,8 +317,62 @@ mod tests {
         .unwrap();
         let mut s = Settings::default();
         p.apply(&mut s).unwrap();
-        assert_eq!((s.shrink_xy, s.material_density), (0.8, 1.2));
+        let u0 = s.unit(UnitId::FIRST);
+        assert_eq!((u0.shrink_xy, u0.material_density), (0.8, 1.2));
         assert_eq!(p.label(), "PC (material)");
+    }
+
+    #[test]
+    fn a_material_goes_to_the_unit_named_and_old_profiles_apply_as_before() {
+        let pc = Profile::from_json(
+            r#"{"name": "PC", "kind": "material", "settings": {"droplet_aspect": 1.3, "shrink_xy": 0.8}}"#,
+        )
+        .unwrap();
+        let mut s = Settings::default();
+        pc.apply_to(&mut s, Some(UnitId(2))).unwrap();
+        assert_eq!(s.unit(UnitId(2)).droplet_aspect, 1.3);
+        assert_eq!(s.unit(UnitId(2)).shrink_xy, 0.8);
+        assert_eq!(
+            s.unit(UnitId::FIRST),
+            Settings::default().unit(UnitId::FIRST)
+        );
+        assert_eq!(s.unit(UnitId(1)), Settings::default().unit(UnitId(1)));
+        let moved = pc.to_unit(UnitId(2)).unwrap();
+        assert_eq!(moved.settings["unit2_droplet_aspect"], 1.3);
+        assert_eq!(moved.settings.len(), 2);
+        // Applying a support material to unit 1 after a PC to unit 0 keeps both.
+        let pva = Profile::from_json(
+            r#"{"name": "PVA", "kind": "material", "settings": {"droplet_aspect": 1.6, "material_density": 1.19}}"#,
+        )
+        .unwrap();
+        let mut s = Settings::default();
+        pc.apply_to(&mut s, Some(UnitId::FIRST)).unwrap();
+        pva.apply_to(&mut s, Some(UnitId(1))).unwrap();
+        assert_eq!(s.unit(UnitId::FIRST).droplet_aspect, 1.3);
+        assert_eq!(s.unit(UnitId(1)).droplet_aspect, 1.6);
+        assert_eq!(s.unit(UnitId(1)).material_density, 1.19);
+        // A profile saved before, with unit 1's values: read, applied as before, not to one unit.
+        let old = Profile::from_json(
+            r#"{"name": "PC+PVA", "kind": "material", "settings": {"droplet_aspect": 1.1, "unit1_droplet_aspect": 1.5, "unit1_shrink_z": 0.2}}"#,
+        )
+        .unwrap();
+        let mut s = Settings::default();
+        old.apply(&mut s).unwrap();
+        assert_eq!(s.unit(UnitId::FIRST).droplet_aspect, 1.1);
+        assert_eq!(s.unit(UnitId(1)).droplet_aspect, 1.5);
+        assert_eq!(s.unit(UnitId(1)).shrink_z, 0.2);
+        let e = old
+            .apply_to(&mut s, Some(UnitId(2)))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unit1_droplet_aspect") && e.contains("as a whole"),
+            "{e}"
+        );
+        // A machine profile is the machine's.
+        let m = Profile::from_json(&machine("M")).unwrap();
+        let e = m.apply_to(&mut s, Some(UnitId(1))).unwrap_err().to_string();
+        assert!(e.contains("machine profile"), "{e}");
     }
 
     #[test]

@@ -1,23 +1,9 @@
 //! The settings' schema: every key with its default, unit, range, choices, group and
-//! meaning; the page builds its form from it and [`super::Settings::validate`] checks every
-//! value against it.
+//! meaning, built from the one table (`table.rs`, through [`settings_table!`]); the page builds
+//! its form from it and [`super::Settings::validate`] checks every value against it.
 
 use super::*;
-
-/// The settings that belong to a part, not to a job: the schema flags them
-/// ([`SettingSpec::part`]) with their ranges, which a job file's parts are checked against
-/// (`crate::model::spec`); the page takes both from the schema.
-pub const PART_KEYS: [&str; 9] = [
-    "rotate_x",
-    "rotate_y",
-    "rotate_z",
-    "scale_x",
-    "scale_y",
-    "scale_z",
-    "place_x",
-    "place_y",
-    "place_angle",
-];
+use std::sync::OnceLock;
 
 /// The least layer height, mm (0.1 µm), the least droplet aspect (B/H, and B₁/H; also the
 /// least `support_density`), the least droplet rate and travel speed (Hz, mm/s) and the least
@@ -65,433 +51,414 @@ pub struct SettingSpec {
     pub default: serde_json::Value,
 }
 
-const NO_CHOICES: &[&str] = &[];
+/// How a row of the table is described: everything but its name, scope and default.
+#[derive(Clone, Copy, Debug)]
+pub struct Row {
+    pub kind: Kind,
+    pub unit: &'static str,
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub min_exclusive: bool,
+    pub choices: &'static [&'static str],
+    /// The choices go on with one per unit: `unitN` (N ≥ 1) after `off` for `support`,
+    /// `unitN_first` for `unit_order`.
+    pub unit_choices: bool,
+    pub group: &'static str,
+    pub description: &'static str,
+    pub profile: Option<ProfileKind>,
+    pub shown: Shown,
+}
 
-fn num(
-    name: &'static str,
+/// When the G-code's header lists a setting (docs/gcode.md): the settings that only matter
+/// with a second or a third unit are listed only when the job uses one, so a one-unit job's
+/// header reads as it always did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shown {
+    /// Always (a per-unit row: unit 0's always, unit N's when unit N prints).
+    Used,
+    /// A per-unit row listed for units 0 and 1 always, for unit N ≥ 2 when it prints (the
+    /// shrinkage: the headers of two-unit machines always listed both units').
+    Always,
+    /// When a unit other than 0 prints.
+    SecondUnit,
+    /// When a unit beyond 0 and 1 prints.
+    BeyondTwo,
+}
+
+/// A number in `[min, max]`.
+pub const fn num(
     unit: &'static str,
     min: f64,
     max: f64,
     group: &'static str,
     description: &'static str,
-) -> SettingSpec {
-    SettingSpec {
-        name,
+) -> Row {
+    Row {
         kind: Kind::Number,
         unit,
         min: Some(min),
         max: Some(max),
         min_exclusive: false,
-        choices: NO_CHOICES,
+        choices: &[],
+        unit_choices: false,
         group,
         description,
-        part: false,
         profile: None,
-        default: serde_json::Value::Null,
+        shown: Shown::Used,
     }
 }
 
-fn positive(spec: SettingSpec) -> SettingSpec {
-    SettingSpec {
+/// A whole number in `[min, max]`.
+pub const fn int(
+    unit: &'static str,
+    min: f64,
+    max: f64,
+    group: &'static str,
+    description: &'static str,
+) -> Row {
+    Row {
+        kind: Kind::Integer,
+        ..num(unit, min, max, group, description)
+    }
+}
+
+/// `min` itself not allowed.
+pub const fn positive(row: Row) -> Row {
+    Row {
         min_exclusive: true,
-        ..spec
+        ..row
     }
 }
 
-fn choice(
-    name: &'static str,
-    kind: Kind,
+/// true or false.
+pub const fn flag(group: &'static str, description: &'static str) -> Row {
+    Row {
+        kind: Kind::Bool,
+        min: None,
+        max: None,
+        ..num("", 0.0, 0.0, group, description)
+    }
+}
+
+/// One of `choices`.
+pub const fn pick(
     choices: &'static [&'static str],
     group: &'static str,
     description: &'static str,
-) -> SettingSpec {
-    SettingSpec {
-        name,
-        kind,
-        unit: "",
-        min: None,
-        max: None,
-        min_exclusive: false,
+) -> Row {
+    Row {
+        kind: Kind::Enum,
         choices,
-        group,
-        description,
-        part: false,
-        profile: None,
-        default: serde_json::Value::Null,
+        ..flag(group, description)
     }
+}
+
+pub const fn unit_choices(row: Row) -> Row {
+    Row {
+        unit_choices: true,
+        ..row
+    }
+}
+
+/// Held by a machine profile.
+pub const fn machine(row: Row) -> Row {
+    Row {
+        profile: Some(ProfileKind::Machine),
+        ..row
+    }
+}
+
+/// Held by a material profile.
+pub const fn material(row: Row) -> Row {
+    Row {
+        profile: Some(ProfileKind::Material),
+        ..row
+    }
+}
+
+pub const fn always(row: Row) -> Row {
+    Row {
+        shown: Shown::Always,
+        ..row
+    }
+}
+
+pub const fn second_unit(row: Row) -> Row {
+    Row {
+        shown: Shown::SecondUnit,
+        ..row
+    }
+}
+
+pub const fn beyond_two(row: Row) -> Row {
+    Row {
+        shown: Shown::BeyondTwo,
+        ..row
+    }
+}
+
+/// Where a row of the table stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    Job,
+    Part,
+    Unit,
+    /// `@units;`: the rows of units 1 … [`MAX_UNITS`] − 1 go here.
+    UnitBlock,
+}
+
+/// One row of the table as the macro lists it.
+pub struct TableRow {
+    pub scope: Scope,
+    pub name: &'static str,
+    pub row: Row,
+    /// Unit N's description (`{n}` its number), for per-unit rows.
+    pub unit_description: &'static str,
+}
+
+/// Where a setting's value lives: a field of the job, or unit N's field `base`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    Job,
+    Unit(UnitId, &'static str),
+}
+
+/// One setting as the schema lists it: its spec, where its value lives, when the header
+/// shows it.
+pub struct Entry {
+    pub spec: SettingSpec,
+    pub slot: Slot,
+    pub shown: Shown,
+}
+
+/// Declares every setting once (the table in `table.rs`): the [`Settings`] struct and
+/// [`UnitSettings`], their `Default`, the part keys, and the rows the schema is built from.
+macro_rules! settings_table {
+    (@go [$($j:tt)*] [$($u:tt)*] [$($p:tt)*] [$($r:tt)*]
+        job $name:ident : $ty:ty = $def:expr => $row:expr ; $($rest:tt)*) => {
+        settings_table!(@go [$($j)* ($name: $ty = $def)] [$($u)*] [$($p)*]
+            [$($r)* (Scope::Job, stringify!($name), $row, "")] $($rest)*);
+    };
+    (@go [$($j:tt)*] [$($u:tt)*] [$($p:tt)*] [$($r:tt)*]
+        part $name:ident : $ty:ty = $def:expr => $row:expr ; $($rest:tt)*) => {
+        settings_table!(@go [$($j)* ($name: $ty = $def)] [$($u)*] [$($p)* $name]
+            [$($r)* (Scope::Part, stringify!($name), $row, "")] $($rest)*);
+    };
+    (@go [$($j:tt)*] [$($u:tt)*] [$($p:tt)*] [$($r:tt)*]
+        unit $name:ident : $ty:ty = $def:expr => $row:expr, $ndesc:literal ; $($rest:tt)*) => {
+        settings_table!(@go [$($j)*] [$($u)* ($name: $ty = $def)] [$($p)*]
+            [$($r)* (Scope::Unit, stringify!($name), $row, $ndesc)] $($rest)*);
+    };
+    (@go [$($j:tt)*] [$($u:tt)*] [$($p:tt)*] [$($r:tt)*] @units ; $($rest:tt)*) => {
+        settings_table!(@go [$($j)*] [$($u)*] [$($p)*]
+            [$($r)* (Scope::UnitBlock, "", pick(&[], "", ""), "")] $($rest)*);
+    };
+    (@go [$(($jn:ident : $jt:ty = $jd:expr))*] [$(($un:ident : $ut:ty = $ud:expr))*]
+        [$($p:ident)*] [$(($rs:expr, $rn:expr, $rr:expr, $rd:expr))*]) => {
+        /// Every parameter of a slice (the table in `table.rs`). `Default` gives the defaults
+        /// of docs/spec.md 5.4.1; `per_unit` holds every unit's own settings
+        /// ([`MAX_UNITS`] of them, whatever `units` says), read with [`Settings::unit`].
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct Settings {
+            $(pub $jn: $jt,)*
+            pub per_unit: Vec<UnitSettings>,
+        }
+
+        /// The settings one discharge unit has: unit 0's under their plain names
+        /// (`droplet_aspect`), unit N's as `unitN_droplet_aspect`.
+        #[derive(Clone, Debug, PartialEq)]
+        pub struct UnitSettings {
+            $(pub $un: $ut,)*
+        }
+
+        impl Default for UnitSettings {
+            fn default() -> Self {
+                UnitSettings { $($un: $ud,)* }
+            }
+        }
+
+        impl Default for Settings {
+            fn default() -> Self {
+                Settings {
+                    $($jn: $jd,)*
+                    per_unit: vec![UnitSettings::default(); MAX_UNITS],
+                }
+            }
+        }
+
+        /// The settings that belong to a part, not to a job: the schema flags them
+        /// ([`SettingSpec::part`]) with their ranges, which a job file's parts are checked
+        /// against (`crate::model::spec`); the page takes both from the schema.
+        pub const PART_KEYS: &[&str] = &[$(stringify!($p)),*];
+
+        pub(super) fn table() -> Vec<TableRow> {
+            vec![$(TableRow { scope: $rs, name: $rn, row: $rr, unit_description: $rd }),*]
+        }
+
+        impl Settings {
+            pub(super) fn job_value(&self, name: &str) -> Option<serde_json::Value> {
+                match name {
+                    $(stringify!($jn) => Some(serde_json::to_value(&self.$jn).expect("a setting serializes")),)*
+                    _ => None,
+                }
+            }
+
+            /// The number setting `name` itself, for tests that put values no setter takes
+            /// (NaN); `None` for a setting that is not a number.
+            #[doc(hidden)]
+            pub fn number_mut(&mut self, name: &str) -> Option<&mut f64> {
+                if let Some(e) = entry(name) && let Slot::Unit(u, base) = e.slot {
+                    return self.per_unit[u.index()].number_mut(base);
+                }
+                match name {
+                    $(stringify!($jn) => NumberMut::number_mut(&mut self.$jn),)*
+                    _ => None,
+                }
+            }
+
+            pub(super) fn put_job(&mut self, name: &str, v: serde_json::Value) -> Option<Result<(), serde_json::Error>> {
+                match name {
+                    $(stringify!($jn) => Some(serde_json::from_value(v).map(|x| self.$jn = x)),)*
+                    _ => None,
+                }
+            }
+        }
+
+        impl UnitSettings {
+            pub(super) fn value(&self, name: &str) -> Option<serde_json::Value> {
+                match name {
+                    $(stringify!($un) => Some(serde_json::to_value(&self.$un).expect("a setting serializes")),)*
+                    _ => None,
+                }
+            }
+
+            fn number_mut(&mut self, name: &str) -> Option<&mut f64> {
+                match name {
+                    $(stringify!($un) => NumberMut::number_mut(&mut self.$un),)*
+                    _ => None,
+                }
+            }
+
+            pub(super) fn put(&mut self, name: &str, v: serde_json::Value) -> Option<Result<(), serde_json::Error>> {
+                match name {
+                    $(stringify!($un) => Some(serde_json::from_value(v).map(|x| self.$un = x)),)*
+                    _ => None,
+                }
+            }
+        }
+    };
+    ($($rows:tt)*) => { settings_table!(@go [] [] [] [] $($rows)*); };
+}
+pub(super) use settings_table;
+
+/// A setting's field as a number, if it is one ([`Settings::number_mut`]).
+pub trait NumberMut {
+    fn number_mut(&mut self) -> Option<&mut f64> {
+        None
+    }
+}
+
+impl NumberMut for f64 {
+    fn number_mut(&mut self) -> Option<&mut f64> {
+        Some(self)
+    }
+}
+
+impl NumberMut for u32 {}
+impl NumberMut for bool {}
+impl NumberMut for ContourOrder {}
+impl NumberMut for PrintOrder {}
+impl NumberMut for SlicePlane {}
+impl NumberMut for Footprint {}
+impl NumberMut for LoopSpacing {}
+impl NumberMut for Support {}
+impl NumberMut for UnitOrder {}
+
+fn leak(s: String) -> &'static str {
+    Box::leak(s.into_boxed_str())
+}
+
+/// The schema's entries in display order, built once from the table.
+pub fn entries() -> &'static [Entry] {
+    static ENTRIES: OnceLock<Vec<Entry>> = OnceLock::new();
+    ENTRIES.get_or_init(|| {
+        let rows = super::table::table();
+        let defaults = Settings::default();
+        let spec = |name: &'static str, row: &Row, description: &'static str, part: bool| {
+            let choices: &'static [&'static str] = if row.unit_choices {
+                let mut all: Vec<&'static str> = row.choices.to_vec();
+                if row.choices.is_empty() {
+                    all.extend((0..MAX_UNITS).map(|n| leak(format!("unit{n}_first"))));
+                } else {
+                    all.extend((1..MAX_UNITS).map(|n| leak(format!("unit{n}"))));
+                }
+                Box::leak(all.into_boxed_slice())
+            } else {
+                row.choices
+            };
+            SettingSpec {
+                name,
+                kind: row.kind,
+                unit: row.unit,
+                min: row.min,
+                max: row.max,
+                min_exclusive: row.min_exclusive,
+                choices,
+                group: row.group,
+                description,
+                part,
+                profile: row.profile,
+                default: serde_json::Value::Null,
+            }
+        };
+        let mut out = Vec::new();
+        for r in &rows {
+            match r.scope {
+                Scope::Job | Scope::Part => out.push(Entry {
+                    spec: spec(r.name, &r.row, r.row.description, r.scope == Scope::Part),
+                    slot: Slot::Job,
+                    shown: r.row.shown,
+                }),
+                Scope::Unit => out.push(Entry {
+                    spec: spec(r.name, &r.row, r.row.description, false),
+                    slot: Slot::Unit(UnitId(0), r.name),
+                    shown: r.row.shown,
+                }),
+                Scope::UnitBlock => {
+                    for n in 1..MAX_UNITS {
+                        for u in rows.iter().filter(|u| u.scope == Scope::Unit) {
+                            let mut e = spec(
+                                leak(UnitId(n as u8).name(u.name)),
+                                &u.row,
+                                leak(u.unit_description.replace("{n}", &n.to_string())),
+                                false,
+                            );
+                            e.group = leak(format!("Unit {n}"));
+                            out.push(Entry {
+                                spec: e,
+                                slot: Slot::Unit(UnitId(n as u8), u.name),
+                                shown: u.row.shown,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+        for e in &mut out {
+            e.spec.default = defaults.value_at(e.slot, e.spec.name);
+        }
+        out
+    })
 }
 
 /// The settings table in display order, with defaults filled in.
 pub fn schema() -> Vec<SettingSpec> {
-    let mut specs = vec![
-        num(
-            "layer_height",
-            "mm",
-            MIN_LAYER_HEIGHT,
-            5.0,
-            "Droplet",
-            "Layer height H: the height of one droplet",
-        ),
-        num(
-            "droplet_aspect",
-            "",
-            MIN_ASPECT,
-            10.0,
-            "Droplet",
-            "Droplet width B divided by its height H (B = aspect x H)",
-        ),
-        SettingSpec {
-            kind: Kind::Integer,
-            ..num(
-                "contours",
-                "",
-                0.0,
-                100.0,
-                "Contours",
-                "Contour loops printed along every boundary (0 = none)",
-            )
-        },
-        num(
-            "outer_offset",
-            "x B",
-            0.0,
-            10.0,
-            "Contours",
-            "Offset of the first loop from an outer boundary, inward, in droplet widths",
-        ),
-        num(
-            "inner_offset",
-            "x B",
-            0.0,
-            10.0,
-            "Contours",
-            "Offset of the first loop from a hole boundary, into the material, in droplet widths",
-        ),
-        num(
-            "start_jitter",
-            "mm",
-            0.0,
-            1000.0,
-            "Contours",
-            "Each layer's loops start this much further along than the layer below, so loop seams do not stack",
-        ),
-        choice(
-            "stagger",
-            Kind::Bool,
-            NO_CHOICES,
-            "Contours",
-            "Set droplets over the gaps of the layer below: every layer's loop droplets half a droplet along from the layer below's (the start moves by start_jitter rounded to an odd multiple of B/2), hatch lines half a spacing across from the last layer with the same hatch direction",
-        ),
-        choice(
-            "contour_order",
-            Kind::Enum,
-            &["inside_out", "outside_in"],
-            "Contours",
-            "inside_out: inner loops before the outermost; outside_in: outermost first",
-        ),
-        choice(
-            "close_loops",
-            Kind::Bool,
-            NO_CHOICES,
-            "Contours",
-            "Repeat a loop's first droplet at its end to close it",
-        ),
-        choice(
-            "loop_spacing",
-            Kind::Enum,
-            &["exact", "even"],
-            "Contours",
-            "exact: droplets B apart, the first repeated at the end (the thesis); even: n = ceil(L/B) droplets spaced evenly, no double droplet at the seam",
-        ),
-        num(
-            "fill_density",
-            "",
-            0.0,
-            2.0,
-            "Fill",
-            "Hatch spacing = B / fill_density (0 = no fill)",
-        ),
-        num(
-            "fill_overlap",
-            "x B",
-            0.0,
-            1.0,
-            "Fill",
-            "How far fill droplets reach into the innermost loop, in droplet widths",
-        ),
-        num(
-            "hatch_angle",
-            "deg",
-            -360.0,
-            360.0,
-            "Fill",
-            "Hatch direction of the first layer",
-        ),
-        num(
-            "hatch_angle_step",
-            "deg",
-            -360.0,
-            360.0,
-            "Fill",
-            "Added to the hatch direction from one layer to the next",
-        ),
-        choice(
-            "print_order",
-            Kind::Enum,
-            &["contours_first", "fill_first"],
-            "Fill",
-            "contours_first: fill binds to existing loops; fill_first: fill before contours",
-        ),
-        num(
-            "rotate_x",
-            "deg",
-            -360.0,
-            360.0,
-            "Part",
-            "Rotation of the part about x (applied first)",
-        ),
-        num(
-            "rotate_y",
-            "deg",
-            -360.0,
-            360.0,
-            "Part",
-            "Rotation of the part about y (applied second)",
-        ),
-        num(
-            "rotate_z",
-            "deg",
-            -360.0,
-            360.0,
-            "Part",
-            "Rotation of the part about z (applied third)",
-        ),
-        positive(num(
-            "scale_x",
-            "",
-            0.0,
-            1000.0,
-            "Part",
-            "Scale factor in x (25.4 turns inches into mm)",
-        )),
-        positive(num("scale_y", "", 0.0, 1000.0, "Part", "Scale factor in y")),
-        positive(num("scale_z", "", 0.0, 1000.0, "Part", "Scale factor in z")),
-        num(
-            "place_x",
-            "mm",
-            -10000.0,
-            10000.0,
-            "Part",
-            "Position of the part on the table in x, after its bounding box was moved to the origin",
-        ),
-        num(
-            "place_y",
-            "mm",
-            -10000.0,
-            10000.0,
-            "Part",
-            "Position of the part on the table in y, after its bounding box was moved to the origin",
-        ),
-        num(
-            "place_angle",
-            "deg",
-            -360.0,
-            360.0,
-            "Part",
-            "Rotation of the part on the table about z, around the origin, before place_x/place_y",
-        ),
-        choice(
-            "slice_plane",
-            Kind::Enum,
-            &["middle", "top"],
-            "Part",
-            "Cut each layer at its middle (more accurate) or at its top (the thesis)",
-        ),
-        num(
-            "droplet_rate",
-            "Hz",
-            MIN_RATE,
-            100000.0,
-            "Machine",
-            "Droplets the discharge unit sets per second (time estimate)",
-        ),
-        num(
-            "travel_speed",
-            "mm/s",
-            MIN_RATE,
-            10000.0,
-            "Machine",
-            "Table speed of travel moves (time estimate)",
-        ),
-        positive(num(
-            "material_density",
-            "g/cm³",
-            0.0,
-            30.0,
-            "Machine",
-            "Density of the material (mass estimate)",
-        )),
-        num(
-            "shrink_xy",
-            "%",
-            0.0,
-            5.0,
-            "Machine",
-            "Linear shrinkage of unit 0's material in x and y as it cools: its parts are sliced scaled by 1/(1 - s/100) about their footprint's corner nearest the origin, so the cooled part has the designed size (Mele et al. 2022); support is not scaled",
-        ),
-        num(
-            "shrink_z",
-            "%",
-            0.0,
-            5.0,
-            "Machine",
-            "Linear shrinkage of unit 0's material in z: its parts are sliced scaled by 1/(1 - s/100) in height, still resting on the plate",
-        ),
-        choice(
-            "footprint",
-            Kind::Enum,
-            &["disc", "spread"],
-            "Analysis",
-            "Droplet footprint in the coverage report: disc = diameter B; spread = diameter 2B/sqrt(pi), the area of a B x B cell",
-        ),
-        num(
-            "plate_x",
-            "mm",
-            MIN_PLATE,
-            100000.0,
-            "Plate",
-            "Build plate size in x: parts without a placement are arranged on it",
-        ),
-        num(
-            "plate_y",
-            "mm",
-            MIN_PLATE,
-            100000.0,
-            "Plate",
-            "Build plate size in y",
-        ),
-        num(
-            "plate_z",
-            "mm",
-            MIN_PLATE,
-            100000.0,
-            "Plate",
-            "Height of the build chamber: a job taller than this (after scale and shrinkage compensation) is refused before slicing",
-        ),
-        num(
-            "part_spacing",
-            "mm",
-            0.0,
-            1000.0,
-            "Plate",
-            "Gap between the bounding boxes of arranged parts",
-        ),
-        choice(
-            "allow_off_plate",
-            Kind::Bool,
-            NO_CHOICES,
-            "Plate",
-            "Slice a part larger than the plate or reaching past its edges anyway (off: such a job is refused, with the turn or the scale that fits)",
-        ),
-        num(
-            "overhang_limit",
-            "x B",
-            0.0,
-            10.0,
-            "Support",
-            "A droplet is supported when the layer below has material within this many droplet widths of its centre",
-        ),
-        choice(
-            "support",
-            Kind::Enum,
-            &["off", "unit1"],
-            "Support",
-            "off: no support; unit1: support under every overhang, printed by discharge unit 1",
-        ),
-        num(
-            "support_gap_xy",
-            "x B",
-            0.0,
-            10.0,
-            "Support",
-            "Support is kept this many droplet widths away from the part within a layer",
-        ),
-        SettingSpec {
-            kind: Kind::Integer,
-            ..num(
-                "support_gap_z",
-                "layers",
-                0.0,
-                100.0,
-                "Support",
-                "Support ends this many layers below the overhang (0: a soluble support touches the part)",
-            )
-        },
-        num(
-            "support_density",
-            "",
-            MIN_ASPECT,
-            1.0,
-            "Support",
-            "Hatch spacing of the support = B1 / support_density",
-        ),
-        num(
-            "unit1_droplet_aspect",
-            "",
-            MIN_ASPECT,
-            10.0,
-            "Unit 1",
-            "Droplet width B1 of discharge unit 1 divided by the layer height",
-        ),
-        num(
-            "unit1_droplet_rate",
-            "Hz",
-            MIN_RATE,
-            100000.0,
-            "Unit 1",
-            "Droplets unit 1 sets per second (time estimate)",
-        ),
-        positive(num(
-            "unit1_material_density",
-            "g/cm³",
-            0.0,
-            30.0,
-            "Unit 1",
-            "Density of unit 1's material (mass estimate)",
-        )),
-        num(
-            "unit1_shrink_xy",
-            "%",
-            0.0,
-            5.0,
-            "Unit 1",
-            "Linear shrinkage of unit 1's material in x and y: unit 1's parts are sliced scaled by 1/(1 - s/100) (support is not scaled)",
-        ),
-        num(
-            "unit1_shrink_z",
-            "%",
-            0.0,
-            5.0,
-            "Unit 1",
-            "Linear shrinkage of unit 1's material in z: unit 1's parts are sliced scaled by 1/(1 - s/100) in height",
-        ),
-        choice(
-            "unit_order",
-            Kind::Enum,
-            &["unit0_first", "unit1_first"],
-            "Unit 1",
-            "Which discharge unit prints first within a layer",
-        ),
-    ];
-    let defaults = serde_json::to_value(Settings::default()).expect("settings serialize");
-    for spec in &mut specs {
-        spec.default = defaults[spec.name].clone();
-        spec.part = PART_KEYS.contains(&spec.name);
-        spec.profile = [super::ProfileKind::Machine, super::ProfileKind::Material]
-            .into_iter()
-            .find(|k| k.keys().contains(&spec.name));
-    }
-    specs
+    entries().iter().map(|e| e.spec.clone()).collect()
+}
+
+/// The entry of the setting `name`.
+pub fn entry(name: &str) -> Option<&'static Entry> {
+    entries().iter().find(|e| e.spec.name == name)
 }
 
 /// The schema as JSON, for the page.
@@ -501,5 +468,5 @@ pub fn schema_json() -> String {
 
 /// Names of all settings, in schema order.
 pub fn names() -> Vec<&'static str> {
-    schema().into_iter().map(|s| s.name).collect()
+    entries().iter().map(|e| e.spec.name).collect()
 }

@@ -121,8 +121,9 @@ pub struct OrientArgs {
     #[arg(long, value_name = "NAME=VALUE", allow_hyphen_values = true)]
     pub set: Vec<String>,
     /// Apply a machine or material profile (JSON; repeatable, in order, before --set), as
-    /// slicing does: a material's droplet_aspect and shrinkage change the rule and the scale
-    #[arg(long, value_name = "FILE.json", allow_hyphen_values = true)]
+    /// slicing does (unitN=FILE.json: a material for unit N): a material's droplet_aspect
+    /// and shrinkage change the rule and the scale
+    #[arg(long, value_name = "[unitN=]FILE.json", allow_hyphen_values = true)]
     pub profile: Vec<PathBuf>,
 }
 
@@ -152,12 +153,14 @@ pub struct SliceArgs {
     /// Apply a machine or material profile (JSON; repeatable, in order, before --set)
     ///
     /// {"name": "...", "kind": "machine" | "material", "settings": {...}}: a machine
-    /// profile holds plate_x/y/z, droplet_rate, unit1_droplet_rate, travel_speed; a
-    /// material profile droplet_aspect, material_density, shrink_xy, shrink_z and their
-    /// unit1_ forms. The header names the profiles used (docs/process.md).
+    /// profile holds plate_x/y/z, units, droplet_rate, unitN_droplet_rate, travel_speed; a
+    /// material profile one material: droplet_aspect, material_density, shrink_xy,
+    /// shrink_z. unitN=FILE.json gives the material to unit N (--profile unit2=pva.json);
+    /// FILE.json alone sets the values as its keys name them (unit 0's, and in a profile
+    /// saved before, unit1_ keys unit 1's). The header names the profiles used.
     #[arg(
         long,
-        value_name = "FILE.json",
+        value_name = "[unitN=]FILE.json",
         allow_hyphen_values = true,
         verbatim_doc_comment
     )]

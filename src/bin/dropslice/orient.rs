@@ -78,7 +78,7 @@ impl Setup {
         let mut settings = Settings::default();
         let mut overrides = Vec::new();
         for p in &args.profile {
-            let profile = read_profile(p)?;
+            let (profile, _) = read_profile(p)?;
             profile.apply(&mut settings).map_err(|e| e.to_string())?;
             overrides.push(SettingsOverride::Profile(profile));
         }

@@ -8,7 +8,7 @@ use crate::files::{
 use crate::staged::{self, Staged};
 use dropslice::analysis::JobAnalysis;
 use dropslice::base::error::quote;
-use dropslice::base::settings::{MAX_PROFILE_BYTES, Profile};
+use dropslice::base::settings::{MAX_PROFILE_BYTES, MAX_UNITS, Profile, UnitId};
 use dropslice::base::stages;
 use dropslice::model::models::Model;
 use dropslice::model::models_job::{SettingsOverride, models_job_spec, override_settings};
@@ -80,9 +80,9 @@ impl Args {
         let mut overrides = Vec::new();
         let mut profiles = Vec::new();
         for path in &cli.profile {
-            let profile = read_profile(path)?;
+            let (profile, label) = read_profile(path)?;
             profile.apply(&mut settings).map_err(|e| e.to_string())?;
-            profiles.push(profile.label());
+            profiles.push(label);
             overrides.push(SettingsOverride::Profile(profile));
         }
         // What a settings file starts from: the defaults with the profiles.
@@ -152,8 +152,40 @@ impl Args {
     }
 }
 
-/// Reads and checks a profile file (`--profile`); the message names the file.
-pub fn read_profile(path: &Path) -> Result<Profile, String> {
+/// Reads and checks a profile given to `--profile`: `FILE.json`, or `unitN=FILE.json` (a
+/// material for unit N, its keys moved to unit N's names, [`Profile::to_unit`]); the
+/// message names the file. With its label for the header.
+pub fn read_profile(arg: &Path) -> Result<(Profile, String), String> {
+    let (unit, path) = match arg.to_str().and_then(|t| t.split_once('=')) {
+        Some((word, file)) if word.starts_with("unit") => {
+            let n = (word[4..].parse::<usize>().ok())
+                .filter(|&n| n < MAX_UNITS && word == format!("unit{n}"))
+                .ok_or_else(|| {
+                    format!(
+                        "--profile {}: '{}' is not a unit: give unit0 … unit{}=FILE.json, or the file alone",
+                        quote(&arg.display().to_string()),
+                        quote(word),
+                        MAX_UNITS - 1
+                    )
+                })?;
+            (Some(UnitId(n as u8)), Path::new(file))
+        }
+        _ => (None, arg),
+    };
+    let profile = read_profile_file(path)?;
+    let Some(u) = unit else {
+        let label = profile.label();
+        return Ok((profile, label));
+    };
+    let moved = profile
+        .to_unit(u)
+        .map_err(|e| format!("--profile {}: {e}", quote(&arg.display().to_string())))?;
+    let label = format!("{} (material, unit {u})", profile.name);
+    Ok((moved, label))
+}
+
+/// Reads and checks a profile file; the message names the file.
+fn read_profile_file(path: &Path) -> Result<Profile, String> {
     let shown = path.display();
     let bytes = read_regular(path, MAX_PROFILE_BYTES as u64, "a profile")
         .map_err(|e| format!("the profile: {e}"))?;

@@ -1,5 +1,6 @@
 //! Tests of the droplet estimate.
 use super::*;
+use crate::base::settings::{Support, UnitId};
 
 fn setting(r: Result<(), Error>) -> String {
     match r {
@@ -46,7 +47,7 @@ fn the_facet_sums_of_a_box() {
     assert!((o.perimeter - 80.0 * n).abs() < 1e-6, "{o:?}");
     assert_eq!(o.pieces, n);
     // The bound holds the hatch of that column: 400 mm² × 50 layers of B₁ = B.
-    let b1 = s.unit1_droplet_width();
+    let b1 = s.unit_width(crate::base::settings::UnitId(1));
     assert!(o.droplets(&s) >= 400.0 * n / (b1 * b1));
 }
 
@@ -224,7 +225,7 @@ fn each_unit_and_the_support_count_with_their_own_droplets() {
     let cube_check =
         |s: &Settings| Estimate::new(8000.0, None, false, &size, &[], &none, s).check(s);
     let with_support = |s: &Settings| Settings {
-        support: Support::Unit1,
+        support: Support::Unit(UnitId(1)),
         ..s.clone()
     };
     let e = Estimate::new(8000.0, None, false, &size, &[], &none, &s);
@@ -232,17 +233,19 @@ fn each_unit_and_the_support_count_with_their_own_droplets() {
     let on = with_support(&s);
     assert!(cube_check(&on).is_ok());
     // A tiny B₁ does not matter without unit 1, and is refused for the support with it.
-    let tiny = Settings {
-        unit1_droplet_aspect: 1e-3,
-        ..s.clone()
+    let tiny = {
+        let mut t = s.clone();
+        t.unit_mut(UnitId(1)).droplet_aspect = 1e-3;
+        t
     };
     assert!(e.check(&tiny).is_ok());
     let tiny_on = with_support(&tiny);
     // With no overhang, the cube needs no support: a B₁ = 0.01 mm whose hatch under the
     // whole footprint would be 4·10⁸ droplets is fine.
-    let fine_on = Settings {
-        unit1_droplet_aspect: 0.05,
-        ..on.clone()
+    let fine_on = {
+        let mut t = on.clone();
+        t.unit_mut(UnitId(1)).droplet_aspect = 0.05;
+        t
     };
     let flat = Overhangs::of(&cuboid([0.0; 3], size), &zs(&s));
     let e = Estimate::new(8000.0, None, false, &size, &[], &flat, &fine_on);
@@ -267,9 +270,10 @@ fn each_unit_and_the_support_count_with_their_own_droplets() {
     assert_eq!(setting(e.check(&tiny)), "unit1_droplet_aspect");
     assert!(e.check(&s).is_ok());
     // A small unit-0 B: fine alone, too many for the support's pass.
-    let small = Settings {
-        droplet_aspect: 0.09,
-        ..s.clone()
+    let small = {
+        let mut t = s.clone();
+        t.unit_mut(UnitId::FIRST).droplet_aspect = 0.09;
+        t
     };
     assert!(cube_check(&small).is_ok());
     assert_eq!(setting(cube_check(&with_support(&small))), "droplet_aspect");
@@ -280,9 +284,10 @@ fn a_b1_whose_square_underflows_counts_nothing_where_unit_1_prints_nothing() {
     // B₁ = 2·10⁻³⁰¹ mm: B₁² is 0, and 0 droplets / 0 was NaN, which refused every job ("0.0e0
     // droplets … NaN"). The range refuses such a B₁ now; the count holds without it too.
     let size = [20.0, 20.0, 20.0];
-    let s = Settings {
-        unit1_droplet_aspect: 1e-300,
-        ..Settings::default()
+    let s = {
+        let mut t = Settings::default();
+        t.unit_mut(UnitId(1)).droplet_aspect = 1e-300;
+        t
     };
     let e = Estimate::new(8000.0, None, false, &size, &[], &Overhangs::default(), &s);
     assert!(e.check(&s).is_ok(), "{:?}", e.check(&s));

@@ -146,7 +146,7 @@ struct Rule {
 impl Rule {
     fn new(s: &Settings) -> Rule {
         let b = s.droplet_width();
-        let b1 = s.unit1_droplet_width();
+        let b1 = s.support_width();
         let limit = s.overhang_limit * b;
         let mut rule = Rule {
             b,
@@ -364,7 +364,7 @@ mod tests {
     }
 
     fn b1_reach(s: &Settings) -> f64 {
-        s.unit1_droplet_width() / 2.0 + s.overhang_limit * s.droplet_width()
+        s.support_width() / 2.0 + s.overhang_limit * s.droplet_width()
     }
 
     #[test]
