@@ -2,7 +2,7 @@
 // sliced with analysis, `status().seconds` from the file chosen to every layer sliced and
 // analysed. Usage: node scripts/page_voids_time.mjs [RUNS] [MODEL.stl ...]; another build of
 // the page with DROPSLICE_DIST=DIR (tests/e2e/helpers.mjs). A warm-up run, then RUNS timed.
-import { start, openPage, waitSettled, benchy } from "../tests/e2e/helpers.mjs";
+import { start, timeVisits, waitSettled, benchy } from "../tests/e2e/helpers.mjs";
 
 const runs = Number(process.argv[2] ?? 5);
 const files = process.argv.length > 3 ? process.argv.slice(3) : [benchy];
@@ -11,10 +11,7 @@ const voids = process.env.VOIDS !== "0";
 const env = await start();
 try {
   for (const f of files) {
-    const times = [];
-    for (let i = 0; i <= runs; i++) {
-      const { page, context } = await openPage(env.browser, env.url);
-      await waitSettled(page); // the sample part of the first visit
+    const times = await timeVisits(env, runs, async (page, i) => {
       if (voids) {
         await page.check("#opt-voids");
         await waitSettled(page); // the sample part analysed
@@ -27,10 +24,9 @@ try {
       }, voids, { timeout: 600_000, polling: 50 });
       const s = await page.evaluate(() => window.dropslice.status());
       if (s.state !== "done") throw new Error(`${f}: page state ${s.state}`);
-      if (i > 0) times.push(s.seconds);
       console.log(`${f.split("/").pop()} run ${i}${i ? "" : " (warm-up)"}: ${s.seconds.toFixed(2)} s, ${s.analysed}/${s.layers} layers analysed, ${s.workers} worker(s)`);
-      await context.close();
-    }
+      return s.seconds;
+    });
     times.sort((a, b) => a - b);
     console.log(`${f.split("/").pop()}: best ${times[0].toFixed(2)} s, median ${times[times.length >> 1].toFixed(2)} s`);
   }

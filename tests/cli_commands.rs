@@ -4,20 +4,7 @@
 
 mod common;
 
-use common::TempDir;
-use std::time::Duration;
-
-fn cli(args: &[&str], dir: &TempDir) -> common::Run {
-    let r = common::run_cli(args, dir.path(), Duration::from_secs(120));
-    assert!(!r.timed_out, "{args:?} timed out");
-    r
-}
-
-fn ok(args: &[&str], dir: &TempDir) -> common::Run {
-    let r = cli(args, dir);
-    assert_eq!(r.code, Some(0), "{args:?}: {r:?}");
-    r
-}
+use common::{TempDir, cli, cli_ok};
 
 /// `dropslice MODEL...` and `dropslice slice MODEL...` write the same code, for one model
 /// and for a build job of two.
@@ -26,16 +13,16 @@ fn slice_is_the_default_command() {
     let dir = TempDir::new("commands");
     let cube = common::model("cube_20mm_ascii.stl").display().to_string();
     let bridge = common::model("bridge.obj").display().to_string();
-    ok(&[&cube, "-o", "a.gco", "-q"], &dir);
-    ok(&["slice", &cube, "-o", "b.gco", "-q"], &dir);
-    ok(&["-q", &cube, &bridge, "-o", "c.gco"], &dir);
-    ok(&["slice", &cube, &bridge, "-q", "-o", "d.gco"], &dir);
+    cli_ok(&[&cube, "-o", "a.gco", "-q"], &dir);
+    cli_ok(&["slice", &cube, "-o", "b.gco", "-q"], &dir);
+    cli_ok(&["-q", &cube, &bridge, "-o", "c.gco"], &dir);
+    cli_ok(&["slice", &cube, &bridge, "-q", "-o", "d.gco"], &dir);
     let read = |name: &str| std::fs::read(dir.join(name)).unwrap();
     assert_eq!(read("a.gco"), read("b.gco"));
     assert_eq!(read("c.gco"), read("d.gco"));
     assert_ne!(read("a.gco"), read("c.gco"));
     // The output default: the model's name in the current directory.
-    ok(&["slice", &cube, "-q"], &dir);
+    cli_ok(&["slice", &cube, "-q"], &dir);
     assert_eq!(read("cube_20mm_ascii.gco"), read("a.gco"));
 }
 
@@ -53,7 +40,7 @@ fn settings_options_apply_in_order() {
     let header = |args: &[&str]| {
         let mut all = vec![cube.as_str(), "-q", "-o", "x.gco", "-o", "out.gco"];
         all.extend(args);
-        ok(&all, &dir);
+        cli_ok(&all, &dir);
         let text = std::fs::read_to_string(dir.join("out.gco")).unwrap();
         let value = |key: &str| {
             text.lines()
@@ -114,7 +101,7 @@ fn help_and_version_go_to_stdout() {
         ),
         (&["calibrate", "-h"], &["--mass <GRAMS>"]),
     ] {
-        let r = ok(args, &dir);
+        let r = cli_ok(args, &dir);
         assert!(r.stderr.is_empty(), "{args:?}: {}", r.stderr);
         for w in wants {
             assert!(r.stdout.contains(w), "{args:?}: no {w:?} in {}", r.stdout);
@@ -122,9 +109,9 @@ fn help_and_version_go_to_stdout() {
     }
     let version = format!("dropslice {}\n", dropslice::VERSION);
     for args in [&["--version"][..], &["-V"], &["calibrate", "--version"]] {
-        assert_eq!(ok(args, &dir).stdout, version, "{args:?}");
+        assert_eq!(cli_ok(args, &dir).stdout, version, "{args:?}");
     }
-    let r = ok(&["--list-settings"], &dir);
+    let r = cli_ok(&["--list-settings"], &dir);
     for s in dropslice::base::settings::schema() {
         assert!(
             r.stdout.contains(&format!("\n{:<18} = ", s.name)) || r.stdout.starts_with(s.name),

@@ -10,25 +10,7 @@ use std::time::Duration;
 
 /// Slices `model` with `--report` and `sets`: (the run, the report if one was written).
 fn report(model: &std::path::Path, sets: &[&str]) -> (common::Run, Option<serde_json::Value>) {
-    let dir = TempDir::new("report");
-    let (out, rep) = (dir.join("out.gco"), dir.join("r.json"));
-    let mut args: Vec<String> = vec![
-        model.display().to_string(),
-        "-q".into(),
-        "-o".into(),
-        out.display().to_string(),
-        "--report".into(),
-        rep.display().to_string(),
-    ];
-    for s in sets {
-        args.push("--set".into());
-        args.push(s.to_string());
-    }
-    let r = run_cli(&args, dir.path(), Duration::from_secs(300));
-    let v = std::fs::read_to_string(&rep)
-        .ok()
-        .map(|t| serde_json::from_str(&t).expect("the report is JSON"));
-    (r, v)
+    common::report_cli(model, sets)
 }
 
 #[test]

@@ -6,14 +6,7 @@
 
 mod common;
 
-use common::TempDir;
-use std::time::Duration;
-
-fn cli(args: &[&str], dir: &TempDir) -> common::Run {
-    let r = common::run_cli(args, dir.path(), Duration::from_secs(120));
-    assert!(!r.timed_out, "{args:?} timed out");
-    r
-}
+use common::{TempDir, cli, cli_ok};
 
 /// A box `size` mm written as `name` into `dir`.
 fn box_file(dir: &TempDir, name: &str, size: [f32; 3]) -> String {
@@ -45,11 +38,10 @@ fn a_part_deeper_than_the_plate_is_refused_with_the_turn_that_fits() {
     assert!(!r.stderr.contains("Arrange"), "{}", r.stderr);
     assert_eq!(dir.files(), vec!["tall.stl".to_string()]);
     // The change it names fits.
-    let r = cli(
+    cli_ok(
         &[&big, "-q", "-o", "tall.gco", "--set", "rotate_z=90"],
         &dir,
     );
-    assert_eq!(r.code, Some(0), "{r:?}");
     assert!(dir.join("tall.gco").exists());
     // allow_off_plate slices it as it is, the sentence as a warning in the summary and header.
     let r = cli(
@@ -70,46 +62,18 @@ fn a_part_larger_than_the_plate_both_ways_is_refused_with_the_scale_that_fits() 
     let dir = TempDir::new("plate-scale");
     let big = box_file(&dir, "big.stl", [200.0, 150.0, 3.0]);
     let r = cli(&[&big, "-o", "big.gco"], &dir);
-    assert_eq!(r.code, Some(2), "{r:?}");
-    assert!(
-        r.stderr.contains(
-            "Part 1 “big.stl” (200 × 150 mm) is larger than the plate (154 × 134 mm); scaled to 77 % it fits. Use --set scale_x=0.77 --set scale_y=0.77 --set scale_z=0.77, or --set allow_off_plate=true"
-        ),
-        "{}",
-        r.stderr
-    );
+    r.says(2, "Part 1 “big.stl” (200 × 150 mm) is larger than the plate (154 × 134 mm); scaled to 77 % it fits. Use --set scale_x=0.77 --set scale_y=0.77 --set scale_z=0.77, or --set allow_off_plate=true");
     assert_eq!(dir.files(), vec!["big.stl".to_string()]);
-    let r = cli(
-        &[
-            &big,
-            "-q",
-            "-o",
-            "big.gco",
-            "--set",
-            "scale_x=0.77",
-            "--set",
-            "scale_y=0.77",
-            "--set",
-            "scale_z=0.77",
-        ],
-        &dir,
-    );
-    assert_eq!(r.code, Some(0), "{r:?}");
-    // A larger plate: it fits as it is.
-    let r = cli(
-        &[
-            &big,
-            "-q",
-            "-o",
-            "big.gco",
-            "--set",
-            "plate_x=200",
-            "--set",
-            "plate_y=150",
-        ],
-        &dir,
-    );
-    assert_eq!(r.code, Some(0), "{r:?}");
+    // The change it names fits; so does the part as it is on a larger plate.
+    let sliced_with = |sets: &[&str]| {
+        let mut args = vec![big.as_str(), "-q", "-o", "big.gco"];
+        for set in sets {
+            args.extend(["--set", set]);
+        }
+        cli_ok(&args, &dir);
+    };
+    sliced_with(&["scale_x=0.77", "scale_y=0.77", "scale_z=0.77"]);
+    sliced_with(&["plate_x=200", "plate_y=150"]);
 }
 
 #[test]
@@ -117,31 +81,31 @@ fn a_job_file_names_the_part_keys_and_a_placed_part_off_the_plate_is_refused() {
     let dir = TempDir::new("plate-job");
     box_file(&dir, "tall.stl", [95.5, 145.0, 3.0]);
     box_file(&dir, "cube.stl", [20.0, 20.0, 20.0]);
-    std::fs::write(
-        dir.join("job.json"),
+    // A job refused: its code not written.
+    let refused = |name: &str, job: &str, says: &str| {
+        let (file, out) = (format!("{name}.json"), format!("{name}.gco"));
+        std::fs::write(dir.join(&file), job).unwrap();
+        cli(&[&file, "-o", &out], &dir).says(2, says);
+        assert!(!dir.join(&out).exists());
+    };
+    refused(
+        "job",
         r#"{"parts": [{"file": "cube.stl"}, {"file": "tall.stl"}]}"#,
-    )
-    .unwrap();
-    let r = cli(&["job.json", "-o", "job.gco"], &dir);
-    r.says(2, "Part 2 “tall.stl” (95.5 × 145 mm) is larger than the plate (154 × 134 mm); turned 90° about z it fits. Use parts[1].rotate_z = 90, or the setting allow_off_plate = true");
-    assert!(!dir.join("job.gco").exists());
+        "Part 2 “tall.stl” (95.5 × 145 mm) is larger than the plate (154 × 134 mm); turned 90° about z it fits. Use parts[1].rotate_z = 90, or the setting allow_off_plate = true",
+    );
     // A part placed past an edge: moving it (or the arrangement) helps.
-    std::fs::write(
-        dir.join("placed.json"),
+    refused(
+        "placed",
         r#"{"parts": [{"file": "cube.stl", "place_x": 140, "place_y": 0}]}"#,
-    )
-    .unwrap();
-    let r = cli(&["placed.json", "-o", "placed.gco"], &dir);
-    r.says(2, "Part 1 “cube.stl” reaches 6 mm past the plate's right edge — move it or press Arrange. Change parts[0].place_x/place_y, or leave them out to have it arranged");
-    assert!(!dir.join("placed.gco").exists());
+        "Part 1 “cube.stl” reaches 6 mm past the plate's right edge — move it or press Arrange. Change parts[0].place_x/place_y, or leave them out to have it arranged",
+    );
     // Allowed by the job's settings.
     std::fs::write(
         dir.join("allowed.json"),
         r#"{"settings": {"allow_off_plate": true}, "parts": [{"file": "cube.stl", "place_x": 140, "place_y": 0}]}"#,
     )
     .unwrap();
-    let r = cli(&["allowed.json", "-q", "-o", "allowed.gco"], &dir);
-    assert_eq!(r.code, Some(0), "{r:?}");
+    cli_ok(&["allowed.json", "-q", "-o", "allowed.gco"], &dir);
 }
 
 #[test]
@@ -150,8 +114,7 @@ fn separate_bodies_are_warned_of_per_part_never_for_a_job_of_several() {
     let cube = common::model("cube_20mm_ascii.stl").display().to_string();
     let bridge = common::model("bridge.obj").display().to_string();
     // Two files: two parts, no "separate bodies".
-    let r = cli(&[&cube, &bridge, "-o", "two.gco"], &dir);
-    assert_eq!(r.code, Some(0), "{r:?}");
+    let r = cli_ok(&[&cube, &bridge, "-o", "two.gco"], &dir);
     assert!(!r.stderr.contains("separate bodies"), "{}", r.stderr);
     let text = std::fs::read_to_string(dir.join("two.gco")).unwrap();
     assert!(!text.contains("separate bodies"));
@@ -161,17 +124,14 @@ fn separate_bodies_are_warned_of_per_part_never_for_a_job_of_several() {
         format!(r#"{{"parts": [{{"file": {cube:?}, "copies": 2}}]}}"#),
     )
     .unwrap();
-    let r = cli(&["copies.json", "-o", "copies.gco"], &dir);
-    assert_eq!(r.code, Some(0), "{r:?}");
+    let r = cli_ok(&["copies.json", "-o", "copies.gco"], &dir);
     assert!(!r.stderr.contains("separate bodies"), "{}", r.stderr);
     // One file of two bodies: warned, naming the part, alone and beside another file.
     let pair = two_box_file(&dir, "pair.stl");
     let want = "warning: Part “pair.stl” has 2 separate bodies; where they overlap they are printed as one";
-    let r = cli(&[&pair, "-o", "pair.gco"], &dir);
-    assert_eq!(r.code, Some(0), "{r:?}");
+    let r = cli_ok(&[&pair, "-o", "pair.gco"], &dir);
     assert!(r.stderr.contains(want), "{}", r.stderr);
-    let r = cli(&[&pair, &cube, "-o", "both.gco"], &dir);
-    assert_eq!(r.code, Some(0), "{r:?}");
+    let r = cli_ok(&[&pair, &cube, "-o", "both.gco"], &dir);
     assert_eq!(
         r.stderr.matches("separate bodies").count(),
         1,

@@ -30,6 +30,23 @@ fn write(dir: &TempDir, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap();
 }
 
+/// A new folder (named after `tag`) holding a shared model (`model.0`) as `model.1` and a
+/// `job.json` of `job`.
+fn job_folder(tag: &str, model_file: (&str, &str), job: &str) -> TempDir {
+    let dir = TempDir::new(tag);
+    std::fs::copy(model(model_file.0), dir.join(model_file.1)).unwrap();
+    write(&dir, "job.json", job);
+    dir
+}
+
+/// Asserts that `text` holds each of `lines`, naming the first it lacks.
+#[track_caller]
+fn assert_has(text: &str, lines: &[&str]) {
+    for line in lines {
+        assert!(text.contains(line), "no {line:?}");
+    }
+}
+
 /// [`cli`] that must succeed; the G-code it wrote to `out`.
 fn sliced(dir: &TempDir, words: &str, out: &str) -> String {
     let r = cli(dir, words);
@@ -315,11 +332,9 @@ fn the_bridge_is_turned_over_and_the_upside_down_u_stood_or_laid_down() {
 
 #[test]
 fn orient_apply_writes_the_rotation_into_a_job_file_or_a_new_one() {
-    let dir = TempDir::new("orient-apply");
-    std::fs::copy(model("bridge.obj"), dir.join("bridge.obj")).unwrap();
-    write(
-        &dir,
-        "job.json",
+    let dir = job_folder(
+        "orient-apply",
+        ("bridge.obj", "bridge.obj"),
         r#"{"settings": {"layer_height": 0.2}, "parts": [{"file": "bridge.obj", "copies": 2, "name": "B"}]}"#,
     );
     let r = cli(&dir, "orient job.json --apply");
@@ -477,11 +492,16 @@ fn a_profile_applies_before_set_and_is_named_in_the_header() {
         "@cube_20mm_ascii.stl -q -o c.gco --set material_density=1.1 --profile pc.json --profile machine.json",
         "c.gco",
     );
-    assert!(text.contains("; profiles = PC test (material), Chamber (machine)\n"));
-    assert!(text.contains("; shrink_xy = 1.0 (%)"));
-    assert!(text.contains("; plate_z = 100.0 (mm)"));
-    // --set comes after the profiles whatever the order given.
-    assert!(text.contains("; material_density = 1.1 (g/cm³)"));
+    assert_has(
+        &text,
+        &[
+            "; profiles = PC test (material), Chamber (machine)\n",
+            "; shrink_xy = 1.0 (%)",
+            "; plate_z = 100.0 (mm)",
+            // --set comes after the profiles whatever the order given.
+            "; material_density = 1.1 (g/cm³)",
+        ],
+    );
     assert!(
         text.contains("; bounding box = X0.0000..20.2020 Y0.0000..20.2020 Z0.0000..20.0000 mm"),
         "compensated"
@@ -583,11 +603,9 @@ fn a_profile_is_read_by_one_rule_whatever_its_encoding() {
 
 #[test]
 fn a_profile_applies_to_a_job_file_before_set() {
-    let dir = TempDir::new("profile-job");
-    std::fs::copy(model("cube_20mm_ascii.stl"), dir.join("cube.stl")).unwrap();
-    write(
-        &dir,
-        "job.json",
+    let dir = job_folder(
+        "profile-job",
+        ("cube_20mm_ascii.stl", "cube.stl"),
         r#"{"settings": {"material_density": 1.3}, "parts": [{"file": "cube.stl"}]}"#,
     );
     write(
@@ -601,9 +619,14 @@ fn a_profile_applies_to_a_job_file_before_set() {
         "job.json -q -o j.gco --profile m.json --settings s.json",
         "j.gco",
     );
-    assert!(text.contains("; profiles = M (material)"));
-    // The profile over the job file's settings; a settings file keeps the profile.
-    assert!(text.contains("; material_density = 1.2 (g/cm³)"));
-    assert!(text.contains("; shrink_z = 2.0 (%)"));
-    assert!(text.contains("; droplet_rate = 90.0 (Hz)"));
+    assert_has(
+        &text,
+        &[
+            "; profiles = M (material)",
+            // The profile over the job file's settings; a settings file keeps the profile.
+            "; material_density = 1.2 (g/cm³)",
+            "; shrink_z = 2.0 (%)",
+            "; droplet_rate = 90.0 (Hz)",
+        ],
+    );
 }

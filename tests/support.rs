@@ -12,9 +12,8 @@
 
 mod common;
 
-use common::{Gcode, TempDir, deep_inside, model, parse_gcode, run_cli, slice_cli, unit_droplets};
+use common::{Gcode, deep_inside, model, parse_gcode, slice_cli, unit_droplets};
 use std::collections::HashMap;
-use std::time::Duration;
 
 type P = [f64; 2];
 
@@ -198,25 +197,9 @@ fn support_stays_out_of_the_part() {
 
 /// The report's unsupported areas of a model (per layer, total), with settings `sets`.
 fn report_areas_with(name: &str, sets: &[&str]) -> (Vec<f64>, f64) {
-    let dir = TempDir::new("support-report");
-    let out = dir.join("out.gco");
-    let rep = dir.join("report.json");
-    let mut args = vec![
-        model(name).display().to_string(),
-        "-q".into(),
-        "-o".into(),
-        out.display().to_string(),
-        "--report".into(),
-        rep.display().to_string(),
-    ];
-    for set in sets {
-        args.push("--set".into());
-        args.push(set.to_string());
-    }
-    let r = run_cli(&args, dir.path(), Duration::from_secs(300));
+    let (r, v) = common::report_cli(&model(name), sets);
     assert_eq!(r.code, Some(0), "{r:?}");
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&rep).unwrap()).unwrap();
+    let v = v.expect("a report");
     let per_layer = v["layers"]
         .as_array()
         .unwrap()

@@ -240,6 +240,43 @@ impl Fill {
         }
     }
 
+    /// `filled` plus the filled lengths of the columns `from..=to` of a stretch over which
+    /// each map (own, below, above: `pieces`) is one piece ([`MapRow::piece`]), added in the
+    /// reference's order, [`CHUNK`] columns at a time through `col`.
+    #[inline(always)]
+    fn stretch(
+        &self,
+        pieces: [(i64, &[f32]); 3],
+        from: i64,
+        to: i64,
+        col: &mut [f64; CHUNK],
+        mut filled: f64,
+    ) -> f64 {
+        let [pt, pb, pa] = pieces;
+        // No droplet reaches this stretch: its columns are empty (they would add +0).
+        let mut ix = if pt.1.is_empty() && pb.1.is_empty() && pa.1.is_empty() {
+            to + 1
+        } else {
+            from
+        };
+        while ix <= to {
+            let n = ((to - ix + 1) as usize).min(CHUNK);
+            let (t, b, a) = (cut(pt, ix, n), cut(pb, ix, n), cut(pa, ix, n));
+            for (((v, &t), &b), &a) in col[..n].iter_mut().zip(t).zip(b).zip(a) {
+                *v = self.column(t, b, a);
+            }
+            // In the reference's order (an empty column adds +0, which changes nothing),
+            // the running sum in a register.
+            let mut sum = filled;
+            for &v in &col[..n] {
+                sum += v;
+            }
+            filled = sum;
+            ix += n as i64;
+        }
+        filled
+    }
+
     /// The filled length of a cell's column (of height H) given the q of its own layer's map
     /// (`t`) and of the layers below (`b`) and above (`a`): the union of [0, lo] from below,
     /// [H/2 − a, H/2 + a] from its own droplet and [H − hi, H] from above, computed with the
@@ -334,31 +371,7 @@ pub fn slab_voids(
             let (xa, ra, ea) = above.piece(from);
             let to = c1.min(et).min(eb).min(ea);
             cells += (to - from + 1) as u64;
-            // No droplet reaches this stretch: its columns are empty (they would add +0).
-            let mut ix = if rt.is_empty() && rb.is_empty() && ra.is_empty() {
-                to + 1
-            } else {
-                from
-            };
-            while ix <= to {
-                let n = ((to - ix + 1) as usize).min(CHUNK);
-                let (t, b, a) = (
-                    cut((xt, rt), ix, n),
-                    cut((xb, rb), ix, n),
-                    cut((xa, ra), ix, n),
-                );
-                for (((v, &t), &b), &a) in col[..n].iter_mut().zip(t).zip(b).zip(a) {
-                    *v = fill.column(t, b, a);
-                }
-                // In the reference's order (an empty column adds +0, which changes nothing),
-                // the running sum in a register.
-                let mut sum = filled;
-                for &v in &col[..n] {
-                    sum += v;
-                }
-                filled = sum;
-                ix += n as i64;
-            }
+            filled = fill.stretch([(xt, rt), (xb, rb), (xa, ra)], from, to, &mut col, filled);
             from = to + 1;
         }
     });

@@ -7,7 +7,6 @@ use crate::base::geom::{DMat3, DVec3, greater, lesser, sin_cos_deg};
 use crate::base::parallel::in_runs;
 use crate::base::settings::Settings;
 use crate::base::steps::{self, Budget};
-pub use crate::model::weld::{WELD_RESERVE_BYTES, keeps_facet, reserve_entries};
 
 /// A welded triangle mesh in millimetres.
 #[derive(Clone, Debug, Default)]
@@ -160,12 +159,7 @@ impl Mesh {
             }
         })
         .await;
-        steps::runs(n, b, &mut |r| {
-            for v in r {
-                start[v + 1] += start[v];
-            }
-        })
-        .await;
+        counts_to_starts_in_steps(&mut start, b).await;
         let mut next = start.clone();
         let mut order = vec![0u32; canon.len()];
         steps::runs(canon.len(), b, &mut |r| {
@@ -448,12 +442,7 @@ impl<T: Copy + Default> CompressedRows<T> {
             }
         })
         .await;
-        steps::runs(n, b, &mut |run| {
-            for r in run {
-                start[r + 1] += start[r];
-            }
-        })
-        .await;
+        counts_to_starts_in_steps(&mut start, b).await;
         let mut next = start.clone();
         let mut items = vec![T::default(); start[n] as usize];
         steps::runs(facets.len(), b, &mut |run| {
@@ -542,6 +531,18 @@ pub fn rot(axis: usize, deg: f64) -> DMat3 {
     m[i][j] = -s;
     m[j][i] = s;
     DMat3::from_cols_array_2d(&m).transpose()
+}
+
+/// Counts to starts in resumable steps: `start[i + 1]` (the count of bucket `i`) becomes the
+/// start of bucket `i + 1`, `start[0]` staying 0.
+async fn counts_to_starts_in_steps(start: &mut [u32], b: &Budget) {
+    let n = start.len() - 1;
+    steps::runs(n, b, &mut |run| {
+        for r in run {
+            start[r + 1] += start[r];
+        }
+    })
+    .await;
 }
 
 #[cfg(test)]

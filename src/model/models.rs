@@ -4,8 +4,9 @@
 use crate::base::error::Error;
 use crate::model::import::stl::{self, Format};
 use crate::model::import::{self, Part};
-use crate::model::mesh::{Bounds, keeps_facet};
+use crate::model::mesh::Bounds;
 use crate::model::spec::{JobSpec, clean_name};
+use crate::model::weld::keeps_facet;
 use serde::Serialize;
 use std::borrow::Cow;
 

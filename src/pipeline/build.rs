@@ -31,27 +31,20 @@ impl Job {
     /// their relative positions and are sliced together.
     pub fn new(model_bytes: &[u8], file_name: &str, settings: Settings) -> Result<Job, Error> {
         settings.validate()?;
-        let Imported {
-            mesh,
-            format,
-            facets_in_file,
-            degenerate,
-            instance,
-            misfit,
-        } = import(model_bytes, file_name, &settings)?;
+        let part: Imported = import(model_bytes, file_name, &settings)?;
         let input = Input {
             file_name: file_name.to_string(),
-            format,
-            facets_in_file,
-            degenerate,
-            instances: vec![instance],
+            format: part.format,
+            facets_in_file: part.facets_in_file,
+            degenerate: part.degenerate,
+            instances: vec![part.instance],
             warnings: Vec::new(),
-            misfits: misfit.into_iter().collect(),
+            misfits: part.misfit.into_iter().collect(),
             hint: fit::Hint::Set,
             bodies: Bodies::Whole(job::clean_name(file_name)),
             groups: Vec::new(),
         };
-        Job::build(mesh, input, settings)
+        Job::build(part.mesh, input, settings)
     }
 
     /// A build job (docs/spec.md "Build jobs"): reads each file of `files` (name, bytes) once and
@@ -99,24 +92,27 @@ impl Job {
     ) -> Result<Job, Error> {
         let (mesh, input, settings) = Job::merged(models, spec, b).await?;
         let mut building = Building::new(mesh, input, settings)?;
-        let kept = building.mesh.unrepeated_in_steps(b).await;
+        let kept = building.made.mesh.unrepeated_in_steps(b).await;
         let all = kept.iter().all(|&k| k);
         let shells = match all {
-            true => Some(building.mesh.shells_in_steps(b).await),
+            true => Some(building.made.mesh.shells_in_steps(b).await),
             false => None,
         };
         building.unrepeated_in_steps(kept, shells, b).await;
         // the index of a mesh that dropped facets would be dropped unused
-        if all && let Ok(zs) = &building.zs {
-            building.index = Some(FacetBuckets::new_in_steps(&building.mesh, zs, b).await);
+        if all && let Ok(zs) = &building.made.zs {
+            building.made.index =
+                Some(FacetBuckets::new_in_steps(&building.made.mesh, zs, b).await);
         }
         building.close_cracks();
         let shells = building.shells.as_ref().expect("the shells were found");
-        let orientation = building.mesh.orientation_in_steps(shells, b).await;
+        let orientation = building.made.mesh.orientation_in_steps(shells, b).await;
         if orientation.1.is_empty() {
-            let (facets_in_file, dropped) = (building.input.facets_in_file, building.dropped());
-            building.stats = Some(
+            let (facets_in_file, dropped) =
+                (building.made.input.facets_in_file, building.dropped());
+            building.made.stats = Some(
                 building
+                    .made
                     .mesh
                     .stats_in_steps(facets_in_file, dropped, b)
                     .await,
@@ -125,14 +121,14 @@ impl Job {
         building.orientation = Some(orientation);
         let mut checked = building.checked()?;
         let overhangs = checked.overhangs_in_steps(b).await;
-        let (made_stats, made_index) = (checked.stats.take(), checked.index.take());
-        let repaired = match checked.zs.as_ref() {
+        let (made_stats, made_index) = (checked.made.stats.take(), checked.made.index.take());
+        let repaired = match checked.made.zs.as_ref() {
             Ok(zs) => {
-                let (mesh, input) = (&checked.mesh, &checked.input);
+                let (mesh, input) = (&checked.made.mesh, &checked.made.input);
                 let stats = match made_stats {
                     Some(s) => s,
                     None => {
-                        let dropped = input.degenerate + checked.weld.1;
+                        let dropped = input.degenerate + checked.made.weld.1;
                         mesh.stats_in_steps(input.facets_in_file, dropped, b).await
                     }
                 };
@@ -319,8 +315,8 @@ impl Job {
         // facets' numbers, which turning a shell keeps). Where facets are dropped, the cracks
         // closed or a shell is turned, they are made again from the changed mesh (the job is
         // checked before the index is used). [`Preparation`] runs the same passes one by one.
-        let mesh = &b.mesh;
-        let zs = &b.zs;
+        let mesh = &b.made.mesh;
+        let zs = &b.made.zs;
         let ((kept, mesh_shells), index) = both(
             || {
                 let kept = mesh.unrepeated_facets();
@@ -329,18 +325,18 @@ impl Job {
             },
             || zs.as_ref().ok().map(|zs| FacetBuckets::new(mesh, zs)),
         );
-        b.index = index;
+        b.made.index = index;
         b.unrepeated(kept, mesh_shells);
         b.close_cracks();
         let shells = b.shells.as_ref().expect("the shells were found");
-        let mesh = &b.mesh;
+        let mesh = &b.made.mesh;
         let dropped = b.dropped();
-        let facets_in_file = b.input.facets_in_file;
+        let facets_in_file = b.made.input.facets_in_file;
         let (orientation, stats) = both(
             || mesh.orientation(shells),
             || mesh.stats(facets_in_file, dropped),
         );
-        b.stats = (orientation.1.is_empty()).then_some(stats);
+        b.made.stats = (orientation.1.is_empty()).then_some(stats);
         b.orientation = Some(orientation);
         b.finish()
     }
@@ -373,8 +369,9 @@ impl Job {
     }
 }
 
-/// A job being prepared: the merged mesh and what the passes of [`Job::build`] found so far.
-struct Building {
+/// What a job being prepared carries through [`Building`] and [`Checked`]: the merged mesh,
+/// the job's input and settings, and what the passes found of them.
+struct Made {
     mesh: Mesh,
     input: Input,
     settings: Settings,
@@ -386,12 +383,17 @@ struct Building {
     duplicates: usize,
     /// The facet index of the mesh as it is (dropped when the mesh changes).
     index: Option<FacetBuckets>,
-    shells: Option<Shells>,
     /// What the tolerance weld did (see [`close_cracks`]).
     weld: (usize, usize),
-    orientation: Option<(ShellOrientation, Vec<bool>)>,
     /// The statistics of the mesh as it is, when no shell is to be turned.
     stats: Option<MeshStats>,
+}
+
+/// A job being prepared: the merged mesh and what the passes of [`Job::build`] found so far.
+struct Building {
+    made: Made,
+    shells: Option<Shells>,
+    orientation: Option<(ShellOrientation, Vec<bool>)>,
 }
 
 impl Building {
@@ -404,19 +406,21 @@ impl Building {
         let zs = plane_heights(&size, &settings);
         let groups = std::mem::take(&mut input.groups);
         Ok(Building {
-            mesh,
-            input,
-            settings,
-            groups,
-            bounds,
-            size,
-            zs,
-            duplicates: 0,
-            index: None,
+            made: Made {
+                mesh,
+                input,
+                settings,
+                groups,
+                bounds,
+                size,
+                zs,
+                duplicates: 0,
+                index: None,
+                weld: (0, 0),
+                stats: None,
+            },
             shells: None,
-            weld: (0, 0),
             orientation: None,
-            stats: None,
         })
     }
 
@@ -428,31 +432,31 @@ impl Building {
 
     /// [`Building::unrepeated`] in resumable steps.
     async fn unrepeated_in_steps(&mut self, kept: Vec<bool>, shells: Option<Shells>, b: &Budget) {
-        self.duplicates = kept.iter().filter(|&&k| !k).count();
+        self.made.duplicates = kept.iter().filter(|&&k| !k).count();
         self.shells = Some(match shells {
             Some(shells) => shells,
             None => {
-                self.index = None;
-                self.mesh.keep_facets(&kept);
-                keep_groups(&mut self.groups, &kept);
-                self.mesh.shells_in_steps(b).await
+                self.made.index = None;
+                self.made.mesh.keep_facets(&kept);
+                keep_groups(&mut self.made.groups, &kept);
+                self.made.mesh.shells_in_steps(b).await
             }
         });
     }
 
     fn close_cracks(&mut self) {
         let shells = self.shells.take().expect("the shells were found");
-        let (shells, weld) = close_cracks(&mut self.mesh, shells, &mut self.groups);
+        let (shells, weld) = close_cracks(&mut self.made.mesh, shells, &mut self.made.groups);
         self.shells = Some(shells);
-        self.weld = weld;
+        self.made.weld = weld;
         if weld != (0, 0) {
-            self.index = None;
+            self.made.index = None;
         }
     }
 
     /// Facets dropped: degenerate ones and those the weld dropped.
     fn dropped(&self) -> usize {
-        self.input.degenerate + self.weld.1
+        self.made.input.degenerate + self.made.weld.1
     }
 
     /// Turns the shells, checks the volume and the droplets, and makes what was not made
@@ -461,14 +465,14 @@ impl Building {
         let mut c = self.checked()?;
         // The support's overhang figures for the estimate beside what is left of the
         // statistics and the facet index.
-        let (stats, index) = (c.stats.take(), c.index.take());
+        let (stats, index) = (c.made.stats.take(), c.made.index.take());
         let (overhangs, repaired) = both(
             || c.overhangs(),
             || {
-                let zs = c.zs.as_ref().ok()?;
-                let dropped = c.input.degenerate + c.weld.1;
-                let mesh = &c.mesh;
-                let facets_in_file = c.input.facets_in_file;
+                let zs = c.made.zs.as_ref().ok()?;
+                let dropped = c.made.input.degenerate + c.made.weld.1;
+                let mesh = &c.made.mesh;
+                let facets_in_file = c.made.input.facets_in_file;
                 let (stats, buckets) = both(
                     || stats.unwrap_or_else(|| mesh.stats(facets_in_file, dropped)),
                     || index.unwrap_or_else(|| FacetBuckets::new(mesh, zs)),
@@ -483,41 +487,21 @@ impl Building {
     /// finishes.
     fn checked(self) -> Result<Checked, Error> {
         let Building {
-            mut mesh,
-            input,
-            settings,
-            groups,
-            bounds,
-            size,
-            zs,
-            duplicates,
-            index,
+            mut made,
             shells: mesh_shells,
-            weld,
             orientation,
-            stats,
         } = self;
         let mesh_shells = mesh_shells.expect("the shells were found");
         let open_edges = mesh_shells.open_edges;
         let (shells, flip) = orientation.expect("the shells were oriented");
-        mesh.turn(&mesh_shells, &flip);
+        made.mesh.turn(&mesh_shells, &flip);
         drop(mesh_shells);
-        let volume = check_volume(&mesh, &shells, &size)?;
+        let volume = check_volume(&made.mesh, &shells, &made.size)?;
         // A triangle soup is refused before any section of it is made.
-        check_surface(open_edges, mesh.facets.len())?;
+        check_surface(open_edges, made.mesh.facets.len())?;
         Ok(Checked {
-            mesh,
-            input,
-            settings,
-            groups,
-            bounds,
-            size,
-            zs,
-            duplicates,
-            index,
-            weld,
+            made,
             shells,
-            stats,
             volume,
         })
     }
@@ -526,18 +510,8 @@ impl Building {
 /// A job whose mesh is turned and checked ([`Building::checked`]): what is left to make is
 /// the overhang figures, the statistics and the facet index (those not made yet).
 struct Checked {
-    mesh: Mesh,
-    input: Input,
-    settings: Settings,
-    groups: Vec<FacetGroup>,
-    bounds: mesh::Bounds,
-    size: [f64; 3],
-    zs: Result<Vec<f64>, Error>,
-    duplicates: usize,
-    index: Option<FacetBuckets>,
-    weld: (usize, usize),
+    made: Made,
     shells: ShellOrientation,
-    stats: Option<MeshStats>,
     volume: f64,
 }
 
@@ -550,13 +524,13 @@ impl Checked {
 
     /// [`Checked::overhangs`] in resumable steps.
     async fn overhangs_in_steps(&self, b: &Budget) -> budget::Overhangs {
-        let support =
-            self.shells.open == 0 && self.settings.support != crate::base::settings::Support::Off;
+        let support = self.shells.open == 0
+            && self.made.settings.support != crate::base::settings::Support::Off;
         if support {
-            let h = self.settings.layer_height;
+            let h = self.made.settings.layer_height;
             budget::Overhangs::of_in_steps(
-                &self.mesh,
-                &slice::layer_heights(self.size[2], h, self.settings.slice_plane),
+                &self.made.mesh,
+                &slice::layer_heights(self.made.size[2], h, self.made.settings.slice_plane),
                 b,
             )
             .await
@@ -573,18 +547,21 @@ impl Checked {
         repaired: Option<(FacetBuckets, MeshStats)>,
     ) -> Result<Job, Error> {
         let Checked {
-            mesh,
-            input,
-            settings,
-            groups,
-            bounds,
-            size,
-            zs,
-            duplicates,
-            weld,
+            made:
+                Made {
+                    mesh,
+                    input,
+                    settings,
+                    groups,
+                    bounds,
+                    size,
+                    zs,
+                    duplicates,
+                    weld,
+                    ..
+                },
             shells,
             volume,
-            ..
         } = self;
         let repaired = repaired.map(|(b, s)| (b, with_repairs(s, &shells, weld, duplicates)));
         // One droplet estimate for the whole job: every unit and the support.

@@ -167,20 +167,57 @@ pub fn run_cli<S: AsRef<OsStr>>(args: &[S], cwd: &Path, timeout: Duration) -> Ru
     }
 }
 
-/// Slices `model` through the CLI with `--set` options and returns the G-code text.
-pub fn slice_cli(model: &Path, sets: &[&str]) -> String {
-    let dir = TempDir::new("slice");
-    let out = dir.join("out.gco");
+/// Runs the CLI in `dir` (at most 120 s), asserting that it did not time out.
+#[track_caller]
+pub fn cli(args: &[&str], dir: &TempDir) -> Run {
+    let r = run_cli(args, dir.path(), Duration::from_secs(120));
+    assert!(!r.timed_out, "{args:?} timed out");
+    r
+}
+
+/// [`cli`], asserting that it succeeded.
+#[track_caller]
+pub fn cli_ok(args: &[&str], dir: &TempDir) -> Run {
+    let r = cli(args, dir);
+    assert_eq!(r.code, Some(0), "{args:?}: {r:?}");
+    r
+}
+
+/// The CLI's words to slice `model` quietly into `out`, then `extra`, then `--set` for each of
+/// `sets`.
+pub fn slice_args(model: &Path, out: &Path, extra: &[&str], sets: &[&str]) -> Vec<String> {
     let mut args: Vec<String> = vec![
         model.display().to_string(),
         "-q".into(),
         "-o".into(),
         out.display().to_string(),
     ];
+    args.extend(extra.iter().map(|s| s.to_string()));
     for s in sets {
         args.push("--set".into());
         args.push((*s).into());
     }
+    args
+}
+
+/// Slices `model` through the CLI with `--report` and `--set` options in a new temporary
+/// directory: (the run, the report if one was written).
+pub fn report_cli(model: &Path, sets: &[&str]) -> (Run, Option<serde_json::Value>) {
+    let dir = TempDir::new("report");
+    let (out, rep) = (dir.join("out.gco"), dir.join("r.json"));
+    let args = slice_args(model, &out, &["--report", &rep.display().to_string()], sets);
+    let r = run_cli(&args, dir.path(), Duration::from_secs(300));
+    let v = std::fs::read_to_string(&rep)
+        .ok()
+        .map(|t| serde_json::from_str(&t).expect("the report is JSON"));
+    (r, v)
+}
+
+/// Slices `model` through the CLI with `--set` options and returns the G-code text.
+pub fn slice_cli(model: &Path, sets: &[&str]) -> String {
+    let dir = TempDir::new("slice");
+    let out = dir.join("out.gco");
+    let args = slice_args(model, &out, &[], sets);
     let r = run_cli(&args, dir.path(), Duration::from_secs(120));
     assert_eq!(
         r.code,

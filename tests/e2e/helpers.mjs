@@ -117,7 +117,6 @@ export async function slicedPage(env, { width, height, files = benchy, check = [
 
 export const status = (page) => page.evaluate(() => window.dropslice.status());
 
-/** Waits until the page has finished a slice (or failed); returns its status. */
 /** Saves the page's picture at $SCREENSHOT, else at `path` in the repository; returns where. */
 export async function screenshotTo(page, path) {
   const out = process.env.SCREENSHOT ?? join(repo, path);
@@ -125,6 +124,7 @@ export async function screenshotTo(page, path) {
   return out;
 }
 
+/** Waits until the page has finished a slice (or failed); returns its status. */
 export async function waitSettled(page, timeout = 240_000) {
   await page.waitForFunction(
     () => ["done", "error", "cancelled"].includes(document.body.dataset.state ?? ""),
@@ -132,6 +132,23 @@ export async function waitSettled(page, timeout = 240_000) {
     { timeout, polling: 100 },
   );
   return status(page);
+}
+
+/**
+ * Times `file` in the page (for the timing scripts): a warm-up visit and `runs` timed ones,
+ * each in a new page whose sample part has settled. `visit(page, i)` (i = 0: the warm-up)
+ * does the work and returns its seconds; returns the timed visits' seconds.
+ */
+export async function timeVisits(env, runs, visit) {
+  const times = [];
+  for (let i = 0; i <= runs; i++) {
+    const { page, context } = await openPage(env.browser, env.url);
+    await waitSettled(page); // the sample part of the first visit
+    const seconds = await visit(page, i);
+    if (i > 0) times.push(seconds);
+    await context.close();
+  }
+  return times;
 }
 
 /** The page answers page.evaluate within 2 s, `times` times in a row (150 ms apart). */

@@ -4,7 +4,7 @@
 //! kind of layer ([`crate::analysis::InteriorRates`]). The other cells are filled exactly, from
 //! maps holding every droplet that reaches them (the left-out droplets near them restored).
 
-use super::{CHUNK, Fill, Grid3, HeightMap, MapRow, ceil_i64, cut, slab_rows};
+use super::{CHUNK, Fill, Grid3, HeightMap, MapRow, ceil_i64, slab_rows};
 use crate::analysis::raster::region_spans;
 use crate::base::geom::{Point, Shapes, all_contours, dist};
 use crate::base::settings::Settings;
@@ -305,28 +305,7 @@ pub fn slab_voids_banded(
             let (xa, ra, ea) = above.piece(from);
             let to = c1.min(et).min(eb).min(ea).min(block_end);
             cells += (to - from + 1) as u64;
-            let mut ix = if rt.is_empty() && rb.is_empty() && ra.is_empty() {
-                to + 1
-            } else {
-                from
-            };
-            while ix <= to {
-                let n = ((to - ix + 1) as usize).min(CHUNK);
-                let (t, b, a) = (
-                    cut((xt, rt), ix, n),
-                    cut((xb, rb), ix, n),
-                    cut((xa, ra), ix, n),
-                );
-                for (((v, &t), &b), &a) in col[..n].iter_mut().zip(t).zip(b).zip(a) {
-                    *v = fill.column(t, b, a);
-                }
-                let mut sum = filled;
-                for &v in &col[..n] {
-                    sum += v;
-                }
-                filled = sum;
-                ix += n as i64;
-            }
+            filled = fill.stretch([(xt, rt), (xb, rb), (xa, ra)], from, to, &mut col, filled);
             if inside {
                 sampled += (to - from + 1) as u64;
                 sampled_fill += filled - before;

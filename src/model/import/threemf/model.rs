@@ -16,9 +16,10 @@ use super::{
 use crate::base::error::{Error, quote};
 use crate::model::import::MAX_TRIANGLES;
 
-/// A `<component>`: an object (in this model part, or in the part `path`) and its transform.
+/// A `<component>` or a build `<item>`: an object (in this model part, or in the part `path`)
+/// and its transform.
 #[derive(Debug)]
-pub(super) struct Component {
+pub(super) struct ObjectRef {
     pub(super) path: Option<String>,
     pub(super) id: u32,
     pub(super) transform: Affine,
@@ -32,7 +33,7 @@ pub(super) enum Content {
         triangles: Vec<[u32; 3]>,
         beams: bool,
     },
-    Components(Vec<Component>),
+    Components(Vec<ObjectRef>),
     /// Neither: the other extension's element it holds instead, if any.
     None(Option<String>),
 }
@@ -45,18 +46,11 @@ pub(super) struct Object {
     pub(super) content: Content,
 }
 
-/// A build `<item>`.
-pub(super) struct Item {
-    pub(super) path: Option<String>,
-    pub(super) id: u32,
-    pub(super) transform: Affine,
-}
-
 /// One parsed model part (the XML document of one `.model` entry).
 #[derive(Default)]
 pub(super) struct Document {
     pub(super) objects: HashMap<u32, Object>,
-    pub(super) items: Vec<Item>,
+    pub(super) items: Vec<ObjectRef>,
 }
 
 /// Millimetres per unit of a `<model unit>`.
@@ -446,7 +440,7 @@ impl Reader<'_> {
                     "the 3MF part '/{p}' has an object with more than {MAX_ITEMS} components; at most that many are accepted"
                 )));
             }
-            cs.push(Component {
+            cs.push(ObjectRef {
                 path,
                 id,
                 transform: tr,
@@ -463,7 +457,7 @@ impl Reader<'_> {
                 "the 3MF build has more than {MAX_ITEMS} items; at most that many are accepted"
             )));
         }
-        self.doc.items.push(Item {
+        self.doc.items.push(ObjectRef {
             id: index(attr(attrs, "objectid"), "a build <item> objectid", p)?,
             transform: transform(attr(attrs, "transform"), self.scale, p)?,
             path: attr_ns(attrs, PRODUCTION_NS, "path").map(|s| part_key(&s)),
