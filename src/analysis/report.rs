@@ -453,6 +453,16 @@ impl LayerStage {
         LayerMaps { unit0, unit1 }
     }
 
+    /// A layer's spheroid maps alone, banded with its unit-0 `region` as the report's are (the
+    /// page's layers and their neighbours: the same slabs, so the same predicted density).
+    pub fn maps_in(&self, plan: &LayerPlan, region: &Shapes) -> LayerMaps {
+        self.maps_with(
+            &droplet_centres(plan, self.settings.droplet_width()),
+            plan,
+            Some(region),
+        )
+    }
+
     /// A layer's spheroid maps alone (a layer next to a run of analysed layers, whose own
     /// figures are not wanted: [`SlabRun::finish`]).
     pub fn maps(&self, plan: &LayerPlan) -> LayerMaps {

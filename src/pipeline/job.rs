@@ -134,6 +134,14 @@ impl Job {
         self.plan_parts(i, &self.section(i)).0
     }
 
+    /// [`Job::plan_for_analysis`] with the region of unit 0's parts the analysis bands.
+    pub fn plan_and_region_for_analysis(&self, i: usize) -> (LayerPlan, geom::Shapes) {
+        if self.settings.support.is_on() {
+            return self.supported_plans()[i].clone();
+        }
+        self.plan_parts(i, &self.section(i))
+    }
+
     /// Whether planning a layer needs the section of the layer below (for the overhang
     /// figure: with support off; with support on it comes from [`Job::supported_plans`]).
     pub fn needs_below(&self) -> bool {

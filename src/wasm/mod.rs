@@ -509,7 +509,7 @@ impl Session {
             index: i,
             analysis: a.clone(),
             regions: self.stage.regions(&region, &plan),
-            maps: stages::time(Stage::Sink, || self.stage.maps(&plan)),
+            maps: stages::time(Stage::Sink, || self.stage.maps_in(&plan, &region)),
             stage: self.stage.clone(),
         }));
         r.analysis = Some(a);

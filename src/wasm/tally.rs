@@ -93,7 +93,10 @@ impl Session {
         let Some((first, end)) = run.span() else {
             return;
         };
-        let maps = |i: usize| self.stage.maps(&self.job.plan_for_analysis(i));
+        let maps = |i: usize| {
+            let (plan, region) = self.job.plan_and_region_for_analysis(i);
+            self.stage.maps_in(&plan, &region)
+        };
         let below = first.checked_sub(1).map(maps);
         let above = (end < self.job.layer_count()).then(|| maps(end));
         let f = run.finish(below, above);

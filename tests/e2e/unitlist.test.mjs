@@ -137,6 +137,10 @@ test("one unit hides unit 1's controls; three give unit 2 its choice and group",
   assert.equal(await page.isVisible("#part-unit"), false, "no unit to choose");
   assert.equal(await page.isVisible("#support-switch"), false, "no unit for support");
   assert.ok(!(await groups(page)).includes("Unit 1"));
+  // The statistics describe the slice: sliced with one unit, no row of unit 1.
+  await page.click("#btn-slice");
+  const one = await waitDone(page);
+  assert.equal(one.units, 1);
   assert.equal(await page.locator("#stat-unit1").count(), 0);
 
   await setField(page, "units", 3);
