@@ -1,5 +1,6 @@
 //! One layer from mesh to plan: slice → offset/contours → droplets and fill (hatch) → plan.
 
+pub mod close;
 pub mod contours;
 pub mod droplets;
 pub mod fill;
