@@ -454,22 +454,13 @@ impl LayerStage {
     }
 
     /// A layer's spheroid maps alone, banded with its unit-0 `region` as the report's are (the
-    /// page's layers and their neighbours: the same slabs, so the same predicted density).
+    /// page's layers, and the layers next to a run of them whose own figures are not wanted,
+    /// [`SlabRun::finish`]: the same slabs, so the same predicted density).
     pub fn maps_in(&self, plan: &LayerPlan, region: &Shapes) -> LayerMaps {
         self.maps_with(
             &droplet_centres(plan, self.settings.droplet_width()),
             plan,
             Some(region),
-        )
-    }
-
-    /// A layer's spheroid maps alone (a layer next to a run of analysed layers, whose own
-    /// figures are not wanted: [`SlabRun::finish`]).
-    pub fn maps(&self, plan: &LayerPlan) -> LayerMaps {
-        self.maps_with(
-            &droplet_centres(plan, self.settings.droplet_width()),
-            plan,
-            None,
         )
     }
 

@@ -125,16 +125,9 @@ impl Job {
         self.plan_layer_with(i, self.section(i), None)
     }
 
-    /// Layer `i`'s plan for the analysis of the layers next to it: its moves and unit 1's
-    /// part region, without the overhang figure (which needs the section below).
-    pub fn plan_for_analysis(&self, i: usize) -> LayerPlan {
-        if self.settings.support.is_on() {
-            return self.supported_plans()[i].0.clone();
-        }
-        self.plan_parts(i, &self.section(i)).0
-    }
-
-    /// [`Job::plan_for_analysis`] with the region of unit 0's parts the analysis bands.
+    /// Layer `i`'s plan for the analysis of the layers next to it (its moves and unit 1's part
+    /// region, without the overhang figure, which needs the section below) and the region of
+    /// unit 0's parts the analysis bands.
     pub fn plan_and_region_for_analysis(&self, i: usize) -> (LayerPlan, geom::Shapes) {
         if self.settings.support.is_on() {
             return self.supported_plans()[i].clone();
