@@ -5,7 +5,7 @@
 //! maps holding every droplet that reaches them (the left-out droplets near them restored).
 
 use super::{CHUNK, Fill, Grid3, HeightMap, MapRow, ceil_i64, slab_rows};
-use crate::analysis::raster::region_spans;
+use crate::analysis::raster::{dilate2, region_spans};
 use crate::base::geom::{Point, Shapes, all_contours, dist};
 use crate::base::settings::Settings;
 use crate::base::spatial::floor_i64;
@@ -44,34 +44,6 @@ pub struct Blocks {
     w: usize,
     h: usize,
     kind: Vec<u8>,
-}
-
-/// Whether any of `flags` within `r` places along one axis is set, per place (`at(line, i)`:
-/// the index of place i of a line).
-fn dilate(
-    flags: &[bool],
-    lines: usize,
-    len: usize,
-    r: usize,
-    at: impl Fn(usize, usize) -> usize,
-) -> Vec<bool> {
-    let mut out = vec![false; flags.len()];
-    let mut prefix = vec![0u32; len + 1];
-    for line in 0..lines {
-        for i in 0..len {
-            prefix[i + 1] = prefix[i] + flags[at(line, i)] as u32;
-        }
-        for i in 0..len {
-            let (a, b) = (i.saturating_sub(r), (i + r + 1).min(len));
-            out[at(line, i)] = prefix[b] > prefix[a];
-        }
-    }
-    out
-}
-
-fn dilate2(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
-    let across = dilate(flags, h, w, r, |row, c| row * w + c);
-    dilate(&across, w, h, r, |col, row| row * w + col)
 }
 
 impl Blocks {

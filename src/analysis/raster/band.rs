@@ -41,8 +41,8 @@ const OUTSIDE: u8 = 0;
 const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 
-/// Whether any of `flags` within `r` places of each index is set, per index (a dilation
-/// along one axis of a grid of `n` lines of `len`, `stride` apart and `step` between places).
+/// Whether any of `flags` within `r` places along one axis is set, per place (`at(line, i)`:
+/// the index of place i of a line).
 fn dilate(
     flags: &[bool],
     lines: usize,
@@ -62,6 +62,13 @@ fn dilate(
         }
     }
     out
+}
+
+/// A `w` × `h` grid of `flags` (row by row) dilated by `r` places along both axes (a square
+/// of 2r + 1): the band's blocks here and in the 3D estimate's.
+pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
+    let across = dilate(flags, h, w, r, |row, c| row * w + c);
+    dilate(&across, w, h, r, |col, row| row * w + col)
 }
 
 /// Sets grid columns c0..=c1 of row `k` in `bits` where they are stored (any segments).
@@ -165,8 +172,7 @@ impl Raster {
             }
         }
         let r = (width / bh.min(bw)).ceil().max(1.0) as usize;
-        let across = dilate(&edge, nr, nc, r, |row, c| row * nc + c);
-        let band = dilate(&across, nc, nr, r, |col, row| row * nc + col);
+        let band = dilate2(&edge, nc, nr, r);
         let mut kind: Vec<u8> = band
             .iter()
             .map(|&b| if b { BAND } else { OUTSIDE })
@@ -208,8 +214,7 @@ impl Raster {
         // The tiles holding band blocks, or interior blocks next to one (which the band's
         // voids must find covered, not outside the region).
         let band: Vec<bool> = kind.iter().map(|&k| k == BAND).collect();
-        let across = dilate(&band, nr, nc, 1, |row, c| row * nc + c);
-        let near = dilate(&across, nc, nr, 1, |col, row| row * nc + col);
+        let near = dilate2(&band, nc, nr, 1);
         let mut stored = vec![false; tr * tc];
         for (i, (&k, &near)) in kind.iter().zip(&near).enumerate() {
             if k == BAND || (k == INTERIOR && near) {

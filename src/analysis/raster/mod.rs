@@ -15,6 +15,7 @@ use crate::slicing::plan::LayerPlan;
 use serde::Serialize;
 
 mod band;
+pub(in crate::analysis) use band::dilate2;
 mod build;
 mod mask;
 #[cfg(any(test, feature = "reference"))]
