@@ -525,3 +525,28 @@ fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
 
 #[cfg(test)]
 mod tests;
+
+/// Layers sampled by [`sampled_volume`].
+const VOLUME_SAMPLES: usize = 24;
+
+/// The volume the slicer will print, estimated from the sliced area of up to
+/// [`VOLUME_SAMPLES`] evenly spaced layers (their mean area × the part's height).
+pub(crate) fn sampled_volume(
+    mesh: &Mesh,
+    buckets: &crate::slicing::slice::FacetBuckets,
+    zs: &[f64],
+    h: f64,
+) -> f64 {
+    let n = zs.len();
+    let samples = n.min(VOLUME_SAMPLES);
+    let rims = std::sync::OnceLock::new();
+    let total: f64 = (0..samples)
+        .map(|k| {
+            let i = (2 * k + 1) * n / (2 * samples);
+            crate::base::geom::region_area(
+                &crate::slicing::slice::slice_layer(mesh, buckets.layer(i), zs[i], &rims).region,
+            )
+        })
+        .sum();
+    total / samples as f64 * n as f64 * h
+}

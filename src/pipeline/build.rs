@@ -3,7 +3,6 @@
 //! droplets, the droplet estimate).
 
 use crate::base::error::Error;
-use crate::base::geom;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
 use crate::base::steps::{self, Budget, Stepped};
@@ -585,7 +584,7 @@ impl Checked {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
             let h = settings.layer_height;
-            estimate.unit0_volume = sampled_volume(&mesh, &buckets, &zs, h);
+            estimate.unit0_volume = budget::sampled_volume(&mesh, &buckets, &zs, h);
             estimate.check(&settings)?;
         }
         // The plate rule (after the checks of the job's size and droplets, so those speak first).
@@ -689,22 +688,4 @@ fn with_repairs(
         unchecked_shells: shells.unchecked,
         ..stats
     }
-}
-
-/// Layers sampled by [`sampled_volume`].
-const VOLUME_SAMPLES: usize = 24;
-
-/// The volume the slicer will print, estimated from the sliced area of up to
-/// [`VOLUME_SAMPLES`] evenly spaced layers (their mean area × the part's height).
-fn sampled_volume(mesh: &Mesh, buckets: &FacetBuckets, zs: &[f64], h: f64) -> f64 {
-    let n = zs.len();
-    let samples = n.min(VOLUME_SAMPLES);
-    let rims = std::sync::OnceLock::new();
-    let total: f64 = (0..samples)
-        .map(|k| {
-            let i = (2 * k + 1) * n / (2 * samples);
-            geom::region_area(&slice::slice_layer(mesh, buckets.layer(i), zs[i], &rims).region)
-        })
-        .sum();
-    total / samples as f64 * n as f64 * h
 }
