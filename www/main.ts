@@ -235,8 +235,6 @@ window.dropslice = {
       layer: store.current,
       droplets: slice?.droplets ?? 0,
       counts: slice ? { ...slice.figures.totals } : null,
-      /** Unit 1's droplets (support and unit-1 parts; a .gco file's after T1). */
-      unit1: slice?.figures.units(2)[1].droplets ?? 0,
       /** The units shown, and each one's droplets (its parts' and, for the unit that prints
        *  it, the support's). */
       units: slice?.unitCount ?? null,
@@ -275,7 +273,7 @@ window.dropslice = {
   },
   show: (i: number) => show(page, i),
   /** Per layer of the slice: support droplets, unit-1 droplets (null: not in yet). */
-  layerUnits: () => store.slice?.counts.map((c) => (c ? [c.support ?? 0, c.unit1 ?? 0] : null)) ?? [],
+  layerUnits: () => store.slice?.counts.map((c) => (c ? [c.support ?? 0, ...(c.units ?? []).slice(1)] : null)) ?? [],
   /** The 3D tab: draws it now and returns {parts, selected, slice, frames, width, height}
    *  (null until the tab was first opened). Its pixels: the canvas in #view3d. */
   view3d: () => page.view3d.testState(),

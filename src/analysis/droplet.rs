@@ -2,7 +2,7 @@
 //! where a layer's droplets are.
 
 use crate::base::geom::{Point, line_droplets};
-use crate::base::settings::{Footprint, Settings};
+use crate::base::settings::{Footprint, Settings, UnitId};
 use crate::slicing::plan::{LayerPlan, Move, MoveKind, Role};
 use std::f64::consts::PI;
 
@@ -23,17 +23,19 @@ pub fn spheroid_half_height(s: &Settings) -> f64 {
 }
 
 /// Every droplet centre of a layer's part (each droplet of a `G25` line too), in print order:
-/// unit 0's droplets (support, printed by unit 1, is not the part the analysis measures).
+/// unit 0's droplets (the support, printed by another unit, is not the part the analysis
+/// measures).
 pub fn droplet_centres(plan: &LayerPlan, b: f64) -> Vec<Point> {
-    centres_where(plan, b, plan.counts.unit0() as usize, |m| m.unit == 0)
+    let n = plan.counts.unit(UnitId::FIRST) as usize;
+    centres_where(plan, b, n, |m| m.unit == 0)
 }
 
-/// Every droplet centre unit 1 prints for its parts in a layer (a second material, droplets
-/// of B₁ = `plan.unit1_width`; not the support), in print order.
-pub fn unit1_part_centres(plan: &LayerPlan) -> Vec<Point> {
-    let n = plan.counts.unit1.saturating_sub(plan.counts.support) as usize;
-    centres_where(plan, plan.unit1_width, n, |m| {
-        m.unit == 1 && m.role != Role::Support
+/// Every droplet centre unit `u` (not 0) prints for its parts in a layer (another material,
+/// droplets of B_u = `plan.unit_widths[u]`; not the support), in print order.
+pub fn unit_part_centres(plan: &LayerPlan, u: UnitId) -> Vec<Point> {
+    let n = plan.counts.unit(u) as usize;
+    centres_where(plan, plan.unit_widths[u.index()], n, |m| {
+        m.unit == u.0 && m.role != Role::Support
     })
 }
 

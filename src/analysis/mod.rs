@@ -101,7 +101,7 @@ mod report;
 mod slabs;
 
 pub use cut::{CUT_BANDS, CutLine, CutVoid, MAX_CUT_LENGTH, Near, slab_section_voids};
-pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres};
+pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height, unit_part_centres};
 #[cfg(any(test, feature = "reference"))]
 pub use estimate3d::slab_voids_reference;
 pub use estimate3d::{

@@ -2,7 +2,7 @@
 //! workers run with its ordered half ([`JobAnalysis`], a [`crate::slicing::sink::LayerSink`]).
 
 use super::droplet::{
-    droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres,
+    droplet_centres, footprint_diameter, spheroid_half_height, unit_part_centres,
 };
 use super::estimate3d::{
     Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
@@ -11,9 +11,9 @@ use super::interior::InteriorCache;
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
 use super::slabs::{self, LayerMaps, SlabFigures, SlabRun, Slabs, UnitRegions};
 use crate::base::geom::{DVec2, Point, Shapes, region_area};
-use crate::base::settings::Settings;
+use crate::base::settings::{MAX_UNITS, Settings, UnitId};
 use crate::slicing::plan::LayerPlan;
-use crate::slicing::plan::unit1_part_settings;
+use crate::slicing::plan::part_settings;
 use serde::Serialize;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
@@ -55,11 +55,12 @@ pub struct PartAnalysis {
     pub max_unsupported_area: f64,
     #[serde(default)]
     pub max_unsupported_area_layer: Option<usize>,
-    /// The 3D estimate of unit 1's parts (a second material, droplets of B₁): its volume,
-    /// void volume and predicted density; `None` in a job without unit-1 parts (the fields
-    /// above are unit 0's; the support is not a part and is not measured).
-    #[serde(default)]
-    pub unit1: Option<UnitDensity>,
+    /// The 3D estimate of the parts of each other unit (other materials, droplets of B_u),
+    /// indexed by unit: its volume, void volume and predicted density; `None` for unit 0 (the
+    /// fields above are its own) and for a unit without parts; empty in a job whose parts are
+    /// all unit 0's. The support is not a part and is not measured.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub units: Vec<Option<UnitDensity>>,
 }
 
 impl PartAnalysis {
@@ -104,20 +105,41 @@ impl PartAnalysis {
     pub fn add_slab(&mut self, f: SlabFigures) {
         self.volume += f.volume;
         self.void_volume += f.void_volume;
-        if let Some((volume, void_volume)) = f.unit1 {
-            let u = self.unit1.get_or_insert_default();
-            u.volume += volume;
-            u.void_volume += void_volume;
+        for (k, figures) in f.units.iter().enumerate() {
+            if let Some((volume, void_volume)) = *figures {
+                let u = self.unit_mut(k);
+                u.volume += volume;
+                u.void_volume += void_volume;
+            }
         }
         self.update_fraction();
     }
 
-    /// `void_fraction` and `predicted_density` from the volumes (unit 1's too).
+    /// Unit `k`'s 3D estimate, made (empty) if it is not there yet.
+    pub fn unit_mut(&mut self, k: usize) -> &mut UnitDensity {
+        if self.units.len() <= k {
+            self.units.resize(k + 1, None);
+        }
+        self.units[k].get_or_insert_default()
+    }
+
+    /// `void_fraction` and `predicted_density` from the volumes (the other units' too).
     pub fn update_fraction(&mut self) {
         (self.void_fraction, self.predicted_density) = density(self.volume, self.void_volume);
-        if let Some(u) = &mut self.unit1 {
+        for u in self.units.iter_mut().flatten() {
             (u.void_fraction, u.predicted_density) = density(u.volume, u.void_volume);
         }
+    }
+
+    /// The predicted density of each unit's parts, indexed by unit, for a machine of `units`
+    /// units (unit 0's: `predicted_density`).
+    pub fn unit_densities(&self, units: usize) -> Vec<Option<f64>> {
+        (0..units.max(1))
+            .map(|k| match k {
+                0 => self.predicted_density,
+                _ => self.units.get(k).copied().flatten()?.predicted_density,
+            })
+            .collect()
     }
 }
 
@@ -234,8 +256,8 @@ impl Model {
 pub struct LayerStage {
     settings: Settings,
     grid: Grid3,
-    /// Unit 1's part settings and grid, in a job with unit-1 parts.
-    unit1: Option<(Settings, Grid3)>,
+    /// The other units that print parts: each one's number, part settings and grid.
+    others: Vec<(UnitId, Settings, Grid3)>,
     /// Whether the 2D analysis rasterises only a band around each layer's boundary
     /// ([`Raster::rebuild_banded`]), and the 3D estimate fills only the cells near a
     /// boundary of the slab's three layers ([`slab_voids_banded`]); the whole layer (the
@@ -267,8 +289,8 @@ pub struct AnalysisGrid {
     /// so bodies far apart in one box are not taken as filling it.
     pub volume: f64,
     pub layers: usize,
-    /// Whether the job has unit-1 parts (a second material), measured on their own.
-    pub unit1_parts: bool,
+    /// The units other than 0 that print parts (another material), each measured on its own.
+    pub part_units: Vec<UnitId>,
     pub file_name: String,
 }
 
@@ -287,6 +309,11 @@ const BYTES_PER_DROPLET: f64 = 72.0;
 const DROPLETS_PER_B2: f64 = 1.25;
 
 impl AnalysisGrid {
+    /// Whether unit `u` prints parts in the job.
+    pub fn has_unit(&self, u: UnitId) -> bool {
+        self.part_units.contains(&u)
+    }
+
     /// An estimate of the most memory one layer's analysis takes, bytes, before any of it is
     /// taken: each part's box as if a layer filled it — the raster's bitmaps over the box
     /// ([`Raster::box_bytes`], a bound), its droplets' buffers, and its spheroid maps
@@ -303,7 +330,9 @@ impl AnalysisGrid {
         let b = s.droplet_width();
         let d = footprint_diameter(s);
         let per_mm2 = DROPLETS_PER_B2 * s.fill_density.max(1.0) / (b * b);
-        let unit1 = self.unit1_parts.then(|| unit1_part_settings(s));
+        let others: Vec<Settings> = (self.part_units.iter())
+            .map(|&u| part_settings(s, u))
+            .collect();
         let boxes_area: f64 = (self.boxes.iter())
             .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0) * grow * grow)
             .sum();
@@ -319,10 +348,12 @@ impl AnalysisGrid {
                 let w = (hi[0] - lo[0]).max(0.0) * grow * k;
                 let h = (hi[1] - lo[1]).max(0.0) * grow * k;
                 let maps = HeightMap::box_bytes(w, h, b / GRID3_PER_B, d)
-                    + unit1.as_ref().map_or(0.0, |s1| {
-                        let d1 = footprint_diameter(s1);
-                        HeightMap::box_bytes(w, h, s1.droplet_width() / GRID3_PER_B, d1)
-                    });
+                    + (others.iter())
+                        .map(|su| {
+                            let du = footprint_diameter(su);
+                            HeightMap::box_bytes(w, h, su.droplet_width() / GRID3_PER_B, du)
+                        })
+                        .sum::<f64>();
                 Raster::box_bytes(w, h, s) + BYTES_PER_DROPLET * per_mm2 * w * h + maps
             })
             .sum()
@@ -369,15 +400,17 @@ impl AnalysisGrid {
 
 impl LayerStage {
     pub fn new(grid: &AnalysisGrid, settings: &Settings) -> LayerStage {
-        let unit1 = grid.unit1_parts.then(|| {
-            let s1 = unit1_part_settings(settings);
-            let g1 = grid.grid3(&s1);
-            (s1, g1)
-        });
+        let others = (grid.part_units.iter())
+            .map(|&u| {
+                let su = part_settings(settings, u);
+                let gu = grid.grid3(&su);
+                (u, su, gu)
+            })
+            .collect();
         LayerStage {
             settings: settings.clone(),
             grid: grid.grid3(settings),
-            unit1,
+            others,
             banded: true,
             interior: Arc::default(),
         }
@@ -407,11 +440,9 @@ impl LayerStage {
     pub fn regions(&self, region: &Shapes, plan: &LayerPlan) -> UnitRegions {
         UnitRegions {
             unit0: region.clone(),
-            unit1: if self.unit1.is_some() {
-                plan.unit1_region.clone()
-            } else {
-                Shapes::new()
-            },
+            others: (self.others.iter())
+                .map(|(u, _, _)| plan.unit_region(*u).cloned().unwrap_or_default())
+                .collect(),
         }
     }
 
@@ -446,11 +477,12 @@ impl LayerStage {
             .and_then(|r| Blocks::new(r, &self.grid, band_width(&self.settings)));
         let d = footprint_diameter(&self.settings);
         let unit0 = UnitMap::new(centres, &self.grid, d, blocks);
-        let unit1 = self
-            .unit1
-            .as_ref()
-            .map(|(s1, g1)| HeightMap::new(&unit1_part_centres(plan), g1, footprint_diameter(s1)));
-        LayerMaps { unit0, unit1 }
+        let others = (self.others.iter())
+            .map(|(u, su, gu)| {
+                HeightMap::new(&unit_part_centres(plan, *u), gu, footprint_diameter(su))
+            })
+            .collect();
+        LayerMaps { unit0, others }
     }
 
     /// A layer's spheroid maps alone, banded with its unit-0 `region` as the report's are (the
@@ -488,21 +520,24 @@ impl LayerStage {
                 slab_voids(r, &self.grid, below, &this.map, above, s)
             })
         });
-        let unit1 = self.unit1.as_ref().map(|(s1, g1)| {
-            let area = if regions.unit1.is_empty() {
+        let mut units = [None; MAX_UNITS];
+        for (k, (u, su, gu)) in self.others.iter().enumerate() {
+            let empty = Shapes::new();
+            let region = regions.others.get(k).unwrap_or(&empty);
+            let area = if region.is_empty() {
                 0.0
             } else {
-                region_area(&regions.unit1)
+                region_area(region)
             };
-            let unit1 = maps.map(|m| m.and_then(|m| m.unit1.as_ref()));
-            slab_of(area, &regions.unit1, s1, |r| {
-                Some(slab_voids(r, g1, unit1[0], unit1[1]?, unit1[2], s1))
-            })
-        });
+            let theirs = maps.map(|m| m.and_then(|m| m.others.get(k)));
+            units[u.index()] = Some(slab_of(area, region, su, |r| {
+                Some(slab_voids(r, gu, theirs[0], theirs[1]?, theirs[2], su))
+            }));
+        }
         SlabFigures {
             volume,
             void_volume,
-            unit1,
+            units,
         }
     }
 }

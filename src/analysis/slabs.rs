@@ -6,45 +6,49 @@
 use super::estimate3d::{HeightMap, UnitMap};
 use super::raster::LayerAnalysis;
 use crate::base::geom::Shapes;
+use crate::base::settings::MAX_UNITS;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-/// The regions of a layer each unit prints as parts: unit 0's and, in a job with unit-1 parts
-/// (a second material), unit 1's (else empty).
+/// The regions of a layer each unit prints as parts: unit 0's and, in a job with parts of
+/// other units (other materials), theirs, in the order of the analysis' part units.
 #[derive(Clone, Debug, Default)]
 pub struct UnitRegions {
     pub unit0: Shapes,
-    pub unit1: Shapes,
+    pub others: Vec<Shapes>,
 }
 
-/// A layer's droplet spheroids on the 3D grid: unit 0's and, in a job with unit-1 parts,
-/// unit 1's (on its own grid, of B₁).
+/// A layer's droplet spheroids on the 3D grid: unit 0's and, in a job with parts of other
+/// units, theirs (each on its own grid, of its B_u), in the order of the part units.
 pub struct LayerMaps {
     /// Unit 0's, without the droplets deep in a banded layer's interior (kept aside).
     pub unit0: UnitMap,
-    pub unit1: Option<HeightMap>,
+    pub others: Vec<HeightMap>,
 }
 
 /// One slab's 3D figures, mm³: its exact volume and its void volume, for unit 0 and (in a job
-/// with unit-1 parts) unit 1.
+/// with parts of other units) for each of them, indexed by unit.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SlabFigures {
     pub volume: f64,
     pub void_volume: f64,
-    pub unit1: Option<(f64, f64)>,
+    pub units: [Option<(f64, f64)>; MAX_UNITS],
 }
 
 impl SlabFigures {
     /// The sum of two (disjoint) slabs' figures.
     pub fn plus(self, o: SlabFigures) -> SlabFigures {
-        let unit1 = match (self.unit1, o.unit1) {
-            (Some(a), Some(b)) => Some((a.0 + b.0, a.1 + b.1)),
-            (a, b) => a.or(b),
-        };
+        let mut units = self.units;
+        for (mine, theirs) in units.iter_mut().zip(o.units) {
+            *mine = match (*mine, theirs) {
+                (Some(a), Some(b)) => Some((a.0 + b.0, a.1 + b.1)),
+                (a, b) => a.or(b),
+            };
+        }
         SlabFigures {
             volume: self.volume + o.volume,
             void_volume: self.void_volume + o.void_volume,
-            unit1,
+            units,
         }
     }
 }

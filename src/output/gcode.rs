@@ -6,7 +6,7 @@
 //! the slice is done (same length, so a file can be patched in place).
 
 use crate::base::geom::{OUTPUT_DECIMALS, OUTPUT_SCALE};
-use crate::base::settings::Settings;
+use crate::base::settings::{MAX_UNITS, Settings, UnitId};
 pub use crate::output::summary::Summary;
 use crate::slicing::plan::{LayerPlan, MoveKind};
 use std::fmt::Write;
@@ -22,8 +22,9 @@ pub struct HeaderInput<'a> {
     pub warnings: &'a [String],
     /// Every copy of every part (one line each).
     pub instances: &'a [crate::model::layout::Instance],
-    /// Whether discharge unit 1 prints anything (its settings are listed only then).
-    pub unit1_used: bool,
+    /// The discharge units that print in the job, by number (unit 0 among them): a unit's
+    /// own settings and figures are listed only when it prints.
+    pub units_used: &'a [UnitId],
     /// The profiles applied to the settings, in order (one line when there are some).
     pub profiles: &'a [String],
 }
@@ -34,79 +35,114 @@ const COUNT_WIDTH: usize = 12;
 /// Width of a figure's field in the header: [`exact`] writes at most 24 characters.
 const FIGURE_WIDTH: usize = 24;
 
-/// Which figure a header line carries ([`FIGURE_LINES`]).
+/// Which figure a header line carries ([`figure_lines`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FigureField {
     /// `Figures::print_seconds`, s.
     PrintSeconds,
     /// `Figures::travel_mm`, mm.
     Travel,
-    /// `Figures::volume_mm3` (unit 0), mm³.
-    Volume,
-    /// `Figures::mass_g` (unit 0), g.
-    Mass,
-    /// `Figures::unit0_seconds`, s (two units only).
-    Unit0Seconds,
-    /// `Figures::unit1_seconds`, s (two units only).
-    Unit1Seconds,
-    /// `Figures::unit1_volume_mm3`, mm³ (two units only).
-    Unit1Volume,
-    /// `Figures::unit1_mass_g`, g (two units only).
-    Unit1Mass,
+    /// `Figures::unit_seconds` of a unit, s (written when more than one unit prints).
+    UnitSeconds(UnitId),
+    /// `Figures::unit_volume_mm3` of a unit (unit 0's: `volume_mm3`), mm³.
+    UnitVolume(UnitId),
+    /// `Figures::unit_mass_g` of a unit (unit 0's: `mass_g`), g.
+    UnitMass(UnitId),
 }
 
-/// The header's figure lines: label (padded as the droplet lines), field, unit, and whether
-/// the line is written only when unit 1 prints (then `volume`/`mass` name unit 0's).
-pub const FIGURE_LINES: [(&str, FigureField, &str, Option<bool>); 10] = [
-    ("print time", FigureField::PrintSeconds, "s", None),
-    (
-        "droplet time unit 0",
-        FigureField::Unit0Seconds,
-        "s",
-        Some(true),
-    ),
-    (
-        "droplet time unit 1",
-        FigureField::Unit1Seconds,
-        "s",
-        Some(true),
-    ),
-    ("travel", FigureField::Travel, "mm", None),
-    ("volume", FigureField::Volume, "mm³", Some(false)),
-    ("mass", FigureField::Mass, "g", Some(false)),
-    ("volume unit 0", FigureField::Volume, "mm³", Some(true)),
-    ("mass unit 0", FigureField::Mass, "g", Some(true)),
-    ("volume unit 1", FigureField::Unit1Volume, "mm³", Some(true)),
-    ("mass unit 1", FigureField::Unit1Mass, "g", Some(true)),
-];
+/// The header's figure lines of a job whose units `used` print (by number; unit 0 among
+/// them): label, field and unit. With unit 0 alone, `volume` and `mass` are its own; with
+/// more, each unit has its droplet time, volume and mass (`volume unit 0`, …).
+pub fn figure_lines(used: &[UnitId]) -> Vec<(String, FigureField, &'static str)> {
+    let several = used.len() > 1;
+    let mut lines = vec![("print time".to_string(), FigureField::PrintSeconds, "s")];
+    if several {
+        for &u in used {
+            lines.push((
+                format!("droplet time unit {u}"),
+                FigureField::UnitSeconds(u),
+                "s",
+            ));
+        }
+    }
+    lines.push(("travel".into(), FigureField::Travel, "mm"));
+    if several {
+        for &u in used {
+            lines.push((
+                format!("volume unit {u}"),
+                FigureField::UnitVolume(u),
+                "mm³",
+            ));
+            lines.push((format!("mass unit {u}"), FigureField::UnitMass(u), "g"));
+        }
+    } else {
+        let first = UnitId::FIRST;
+        lines.push(("volume".into(), FigureField::UnitVolume(first), "mm³"));
+        lines.push(("mass".into(), FigureField::UnitMass(first), "g"));
+    }
+    lines
+}
 
 impl FigureField {
-    /// This figure of `f`.
+    /// The field a header line's label names ([`figure_lines`]), for any unit up to
+    /// [`MAX_UNITS`].
+    pub fn of_label(label: &str) -> Option<FigureField> {
+        let unit = |rest: &str| -> Option<UnitId> {
+            let n: u8 = rest.parse().ok()?;
+            (usize::from(n) < MAX_UNITS && rest == n.to_string()).then_some(UnitId(n))
+        };
+        Some(match label {
+            "print time" => FigureField::PrintSeconds,
+            "travel" => FigureField::Travel,
+            "volume" => FigureField::UnitVolume(UnitId::FIRST),
+            "mass" => FigureField::UnitMass(UnitId::FIRST),
+            _ => {
+                if let Some(r) = label.strip_prefix("droplet time unit ") {
+                    FigureField::UnitSeconds(unit(r)?)
+                } else if let Some(r) = label.strip_prefix("volume unit ") {
+                    FigureField::UnitVolume(unit(r)?)
+                } else {
+                    FigureField::UnitMass(unit(label.strip_prefix("mass unit ")?)?)
+                }
+            }
+        })
+    }
+
+    /// This figure of `f` (0 for a unit `f` has no entry for).
     pub fn of(self, f: &crate::output::summary::Figures) -> f64 {
+        let at = |v: &[f64], u: UnitId| v.get(u.index()).copied().unwrap_or(0.0);
         match self {
             FigureField::PrintSeconds => f.print_seconds,
             FigureField::Travel => f.travel_mm,
-            FigureField::Volume => f.volume_mm3,
-            FigureField::Mass => f.mass_g,
-            FigureField::Unit0Seconds => f.unit0_seconds,
-            FigureField::Unit1Seconds => f.unit1_seconds,
-            FigureField::Unit1Volume => f.unit1_volume_mm3,
-            FigureField::Unit1Mass => f.unit1_mass_g,
+            FigureField::UnitSeconds(u) => at(&f.unit_seconds, u),
+            FigureField::UnitVolume(u) => at(&f.unit_volume_mm3, u),
+            FigureField::UnitMass(u) => at(&f.unit_mass_g, u),
         }
     }
 
-    /// Sets this figure of `f`.
+    /// Sets this figure of `f` (unit 0's volume and mass in both their places; nothing for a
+    /// unit `f` has no entry for).
     pub fn set(self, f: &mut crate::output::summary::Figures, v: f64) {
-        *match self {
-            FigureField::PrintSeconds => &mut f.print_seconds,
-            FigureField::Travel => &mut f.travel_mm,
-            FigureField::Volume => &mut f.volume_mm3,
-            FigureField::Mass => &mut f.mass_g,
-            FigureField::Unit0Seconds => &mut f.unit0_seconds,
-            FigureField::Unit1Seconds => &mut f.unit1_seconds,
-            FigureField::Unit1Volume => &mut f.unit1_volume_mm3,
-            FigureField::Unit1Mass => &mut f.unit1_mass_g,
-        } = v;
+        let slot = match self {
+            FigureField::PrintSeconds => Some(&mut f.print_seconds),
+            FigureField::Travel => Some(&mut f.travel_mm),
+            FigureField::UnitSeconds(u) => f.unit_seconds.get_mut(u.index()),
+            FigureField::UnitVolume(u) => {
+                if u == UnitId::FIRST {
+                    f.volume_mm3 = v;
+                }
+                f.unit_volume_mm3.get_mut(u.index())
+            }
+            FigureField::UnitMass(u) => {
+                if u == UnitId::FIRST {
+                    f.mass_g = v;
+                }
+                f.unit_mass_g.get_mut(u.index())
+            }
+        };
+        if let Some(slot) = slot {
+            *slot = v;
+        }
     }
 }
 
@@ -206,13 +242,16 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
     let _ = writeln!(h, "; droplets outer loops = {}", field(c.map(|c| c.outer)));
     let _ = writeln!(h, "; droplets inner loops = {}", field(c.map(|c| c.inner)));
     let _ = writeln!(h, "; droplets fill        = {}", field(c.map(|c| c.fill)));
-    if input.unit1_used {
+    if input.units_used.len() > 1 {
         let _ = writeln!(
             h,
             "; droplets support     = {}",
             field(c.map(|c| c.support))
         );
-        let _ = writeln!(h, "; droplets of unit 1   = {}", field(c.map(|c| c.unit1)));
+        for &u in &input.units_used[1..] {
+            let label = format!("droplets of unit {u}");
+            let _ = writeln!(h, "; {label:<20} = {}", field(c.map(|c| c.unit(u))));
+        }
     }
     let _ = writeln!(
         h,
@@ -221,10 +260,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
     );
     // The figures the CLI prints and the page shows, of the same summary and settings.
     let figures = summary.map(|sum| sum.figures(s));
-    for (label, f, unit, two) in FIGURE_LINES {
-        if two.is_some_and(|two| two != input.unit1_used) {
-            continue;
-        }
+    for (label, f, unit) in figure_lines(input.units_used) {
         let value = figures
             .as_ref()
             .map_or("pending".into(), |g| exact(f.of(g)));
@@ -245,7 +281,7 @@ pub fn header(s: &Settings, input: &HeaderInput, summary: Option<&Summary>) -> S
         let _ = writeln!(h, "; profiles = {}", names.join(", "));
     }
     let _ = writeln!(h, "; settings:");
-    for (name, value, unit) in s.entries_with(|u| u.0 == 0 || (u.0 == 1 && input.unit1_used)) {
+    for (name, value, unit) in s.entries_with(|u| input.units_used.contains(&u)) {
         if unit.is_empty() {
             let _ = writeln!(h, "; {name} = {value}");
         } else {
@@ -339,8 +375,9 @@ pub fn insert_unit_line(text: &mut String, unit: u8) {
     text.insert_str(at, &format!("T{unit}\n"));
 }
 
-/// Closing comments: the totals and what slicing repaired.
-pub fn footer(summary: &Summary) -> String {
+/// Closing comments: the totals, each unit's droplets beyond unit 0 (`support`: the unit that
+/// printed the support) and what slicing repaired.
+pub fn footer(summary: &Summary, support: Option<UnitId>) -> String {
     let mut f = format!(
         "; end of code: {} layers, {} droplets ({} outer loops, {} inner loops, {} fill)\n",
         summary.layers,
@@ -349,12 +386,19 @@ pub fn footer(summary: &Summary) -> String {
         summary.counts.inner,
         summary.counts.fill
     );
-    if summary.counts.unit1 > 0 {
-        let _ = writeln!(
-            f,
-            "; unit 1: {} droplets ({} of them support)",
-            summary.counts.unit1, summary.counts.support
-        );
+    for u in UnitId::all(MAX_UNITS).skip(1) {
+        if summary.counts.unit(u) > 0 {
+            let support = if support == Some(u) {
+                summary.counts.support
+            } else {
+                0
+            };
+            let _ = writeln!(
+                f,
+                "; unit {u}: {} droplets ({support} of them support)",
+                summary.counts.unit(u)
+            );
+        }
     }
     for r in summary.repairs() {
         let _ = writeln!(f, "; repaired: {r}");

@@ -49,21 +49,20 @@ pub struct WorstLayer {
     pub area: f64,
 }
 
-/// The estimated print time, s: unit 0's droplets / droplet_rate + unit 1's droplets /
-/// unit1_droplet_rate + travel / travel_speed. The one estimate of the job's figures
+/// The estimated print time, s: each unit's droplets / its `…droplet_rate`, summed over the
+/// units, + travel / travel_speed. The one estimate of the job's figures
 /// ([`Figures::print_seconds`]) and of each layer ([`layer_seconds`]), so the layers' times
 /// add up to the job's.
 pub fn print_seconds(counts: &Counts, travel_mm: f64, settings: &Settings) -> f64 {
-    let (t0, t1) = unit_seconds(counts, settings);
-    t0 + t1 + travel_mm / settings.travel_speed
+    let droplets: f64 = unit_seconds(counts, settings).iter().sum();
+    droplets + travel_mm / settings.travel_speed
 }
 
-/// The droplet time of each discharge unit, s.
-pub fn unit_seconds(counts: &Counts, settings: &Settings) -> (f64, f64) {
-    (
-        counts.unit0() as f64 / settings.unit(UnitId::FIRST).droplet_rate,
-        counts.unit1 as f64 / settings.unit(UnitId(1)).droplet_rate,
-    )
+/// The droplet time of each discharge unit the machine has, s (indexed by unit).
+pub fn unit_seconds(counts: &Counts, settings: &Settings) -> Vec<f64> {
+    UnitId::all(settings.units.max(1) as usize)
+        .map(|u| counts.unit(u) as f64 / settings.unit(u).droplet_rate)
+        .collect()
 }
 
 /// The estimated print time of one planned layer, s (the page's per-layer plot).
@@ -99,19 +98,18 @@ pub struct Figures {
     pub volume_mm3: f64,
     /// volume × material_density, g.
     pub mass_g: f64,
-    /// Droplets printed by unit 1 (its parts and the support).
-    pub unit1_droplets: u64,
-    /// Unit 1's droplets × B₁²H, mm³.
-    pub unit1_volume_mm3: f64,
-    /// unit-1 volume × unit1_material_density, g.
-    pub unit1_mass_g: f64,
-    /// unit-0 droplets / droplet_rate + unit-1 droplets / unit1_droplet_rate
-    /// + travel / travel_speed, s ([`print_seconds`]).
+    /// The droplets each unit prints (its parts' and, for the support's unit, the support),
+    /// indexed by unit, one entry per unit the machine has (`units`).
+    pub unit_droplets: Vec<u64>,
+    /// Each unit's droplets × B_u²H, mm³ (unit 0's: `volume_mm3`).
+    pub unit_volume_mm3: Vec<f64>,
+    /// Each unit's volume × its `…material_density`, g (unit 0's: `mass_g`).
+    pub unit_mass_g: Vec<f64>,
+    /// Each unit's droplets / its `…droplet_rate`, summed, + travel / travel_speed, s
+    /// ([`print_seconds`]).
     pub print_seconds: f64,
-    /// Unit 0's droplets / droplet_rate, s.
-    pub unit0_seconds: f64,
-    /// Unit 1's droplets / unit1_droplet_rate, s.
-    pub unit1_seconds: f64,
+    /// Each unit's droplets / its `…droplet_rate`, s.
+    pub unit_seconds: Vec<f64>,
     /// Overhang area summed over the layers, mm² (support on or off: what would be printed
     /// in the air without support).
     pub unsupported_area: f64,
@@ -129,9 +127,9 @@ pub struct Figures {
     /// without the 3D estimate. A geometric estimate from the droplet model, not a measured
     /// density.
     pub predicted_density: Option<f64>,
-    /// The same of unit 1's parts (a second material); `None` without them or without the 3D
-    /// estimate.
-    pub unit1_predicted_density: Option<f64>,
+    /// The same of each unit's parts (another material), indexed by unit (unit 0's:
+    /// `predicted_density`); `None` without parts of the unit or without the 3D estimate.
+    pub unit_predicted_density: Vec<Option<f64>>,
     /// What slicing repaired, in plain language.
     pub repairs: Vec<String>,
 }
@@ -226,30 +224,30 @@ impl Summary {
     /// The figures shown to the user, with the estimates of `settings`.
     pub fn figures(&self, settings: &Settings) -> Figures {
         let droplets = self.counts.total();
-        let (d0, d1) = (self.counts.unit0(), self.counts.unit1);
-        let b = settings.droplet_width();
-        let b1 = settings.unit_width(UnitId(1));
+        let units: Vec<UnitId> = UnitId::all(settings.units.max(1) as usize).collect();
         let h = settings.layer_height;
-        let volume = d0 as f64 * b * b * h;
-        let volume1 = d1 as f64 * b1 * b1 * h;
-        let (t0, t1) = (
-            d0 as f64 / settings.unit(UnitId::FIRST).droplet_rate,
-            d1 as f64 / settings.unit(UnitId(1)).droplet_rate,
-        );
+        let volume: Vec<f64> = (units.iter())
+            .map(|&u| {
+                let b = settings.unit_width(u);
+                self.counts.unit(u) as f64 * b * b * h
+            })
+            .collect();
+        let mass: Vec<f64> = (units.iter())
+            .map(|&u| volume[u.index()] / 1000.0 * settings.unit(u).material_density)
+            .collect();
         let a = &self.analysis;
         let analysed = a.layers > 0;
         Figures {
             layers: self.layers,
             counts: self.counts,
             droplets,
-            volume_mm3: volume,
-            mass_g: volume / 1000.0 * settings.unit(UnitId::FIRST).material_density,
-            unit1_droplets: d1,
-            unit1_volume_mm3: volume1,
-            unit1_mass_g: volume1 / 1000.0 * settings.unit(UnitId(1)).material_density,
+            volume_mm3: volume[0],
+            mass_g: mass[0],
+            unit_droplets: units.iter().map(|&u| self.counts.unit(u)).collect(),
+            unit_volume_mm3: volume,
+            unit_mass_g: mass,
             print_seconds: print_seconds(&self.counts, self.travel_mm, settings),
-            unit0_seconds: t0,
-            unit1_seconds: t1,
+            unit_seconds: unit_seconds(&self.counts, settings),
             unsupported_area: self.unsupported_area,
             worst_overhang: self.worst_overhang,
             travel_mm: self.travel_mm,
@@ -264,7 +262,7 @@ impl Summary {
                 _ => None,
             },
             predicted_density: a.predicted_density,
-            unit1_predicted_density: a.unit1.and_then(|u| u.predicted_density),
+            unit_predicted_density: a.unit_densities(units.len()),
             repairs: self.repairs(),
         }
     }
@@ -343,10 +341,12 @@ impl PartAnalysis {
         );
         self.volume += o.volume;
         self.void_volume += o.void_volume;
-        if let Some(theirs) = &o.unit1 {
-            let u = self.unit1.get_or_insert_default();
-            u.volume += theirs.volume;
-            u.void_volume += theirs.void_volume;
+        for (k, theirs) in o.units.iter().enumerate() {
+            if let Some(theirs) = theirs {
+                let u = self.unit_mut(k);
+                u.volume += theirs.volume;
+                u.void_volume += theirs.void_volume;
+            }
         }
         self.update_fraction();
     }

@@ -2,7 +2,7 @@
 //! planned on any thread ([`Job::plan_layer`]), with both discharge units and the support.
 
 use crate::base::geom;
-use crate::base::settings::Settings;
+use crate::base::settings::{Settings, UnitId};
 use crate::base::stages::{self, Stage};
 use crate::model::mesh::Mesh;
 use crate::model::prepare::JobInfo;
@@ -22,7 +22,7 @@ pub struct Job {
     pub(crate) info: JobInfo,
     /// The facet runs of [`JobInfo::groups`] as ranges of facet numbers (empty: all unit 0).
     pub(crate) groups: Vec<(std::ops::Range<u32>, u8)>,
-    /// Every layer's plan with support (`support = unit1`), computed on first use: the
+    /// Every layer's plan with support (`support = unitN`), computed on first use: the
     /// droplet-level pass needs all layers' droplets (see [`Job::supported_plans`]).
     pub(crate) supported: std::sync::OnceLock<SupportedPlans>,
     /// The mesh's open boundary, found when a layer first has an open section.
@@ -30,22 +30,39 @@ pub struct Job {
 }
 
 impl Job {
-    /// Whether discharge unit 1 prints in this job: support is on, or a part is unit 1's.
-    pub fn uses_unit1(&self) -> bool {
-        self.settings.support.is_on() || self.has_unit1_parts()
+    /// The discharge units that print in this job, by number: unit 0, the support's unit
+    /// when support is on, and the unit of every part.
+    pub fn units_used(&self) -> Vec<UnitId> {
+        let mut used = vec![UnitId::FIRST];
+        used.extend(self.settings.support.unit());
+        used.extend(self.part_units());
+        used.sort();
+        used.dedup();
+        used
     }
 
-    /// Whether a part of this job is printed by unit 1.
-    pub fn has_unit1_parts(&self) -> bool {
-        self.groups.iter().any(|(_, u)| *u == 1)
+    /// Whether a unit other than 0 prints in this job (support, or parts of another unit).
+    pub fn uses_other_units(&self) -> bool {
+        self.units_used().len() > 1
+    }
+
+    /// The units other than 0 that print parts in this job, by number.
+    pub fn part_units(&self) -> Vec<UnitId> {
+        let mut units: Vec<UnitId> = (self.groups.iter())
+            .map(|(_, u)| UnitId(*u))
+            .filter(|&u| u != UnitId::FIRST)
+            .collect();
+        units.sort();
+        units.dedup();
+        units
     }
 
     /// The unit selected when layer `i` starts: the unit of the last move of the nearest
-    /// layer below that has moves (0 at the start of the file). Without unit 1, 0 at once;
+    /// layer below that has moves (0 at the start of the file). With unit 0 alone, 0 at once;
     /// otherwise that layer is planned again (the page's workers ask this once per run of
     /// layers, [`crate::wasm`]).
     pub fn unit_before(&self, i: usize) -> u8 {
-        if !self.uses_unit1() {
+        if !self.uses_other_units() {
             return 0;
         }
         for j in (0..i.min(self.layer_count())).rev() {
@@ -89,7 +106,7 @@ impl Job {
             boxes,
             volume: self.info.mesh.signed_volume.abs(),
             layers: self.layer_count(),
-            unit1_parts: !self.groups.is_empty(),
+            part_units: self.part_units(),
             file_name: self.info.file_name.clone(),
         }
     }
@@ -125,8 +142,8 @@ impl Job {
         self.plan_layer_with(i, self.section(i), None)
     }
 
-    /// Layer `i`'s plan for the analysis of the layers next to it (its moves and unit 1's part
-    /// region, without the overhang figure, which needs the section below) and the region of
+    /// Layer `i`'s plan for the analysis of the layers next to it (its moves and the other
+    /// units' part regions, without the overhang figure, which needs the section below) and the region of
     /// unit 0's parts the analysis bands.
     pub fn plan_and_region_for_analysis(&self, i: usize) -> (LayerPlan, geom::Shapes) {
         if self.settings.support.is_on() {
@@ -170,44 +187,44 @@ impl Job {
         (plan, region)
     }
 
-    /// Layer `i`'s plan without support: unit 0's region, then unit 1's parts (with B₁, in
-    /// the order `unit_order` gives), and the region unit 0 prints.
+    /// Layer `i`'s plan without support: unit 0's region, then the other units' parts (each
+    /// with its B_u, in the order `unit_order` gives), and the region unit 0 prints.
     pub(crate) fn plan_parts(&self, i: usize, section: &Section) -> (LayerPlan, geom::Shapes) {
         let (mut plan, own) = if self.groups.is_empty() {
             (plan::plan_layer(&section.region, i, &self.settings), None)
         } else {
-            let [r0, r1] = self.unit_regions(i);
-            (plan::plan_layer(&r0, i, &self.settings), Some((r0, r1)))
+            let mut regions = self.unit_regions(i);
+            let r0 = std::mem::take(&mut regions[0]);
+            (
+                plan::plan_layer(&r0, i, &self.settings),
+                Some((r0, regions)),
+            )
         };
         plan.open_chains = section.open_chains;
         plan.reoriented_loops = section.reoriented_loops;
         match own {
             None => (plan, section.region.clone()),
-            Some((r0, r1)) => {
-                plan::plan_unit1_layer(
-                    &mut plan,
-                    &r1,
-                    &geom::Shapes::new(),
-                    plan::Role::Support,
-                    &self.settings,
-                );
-                plan.unit1_region = r1;
+            Some((r0, regions)) => {
+                plan::plan_unit_parts(&mut plan, regions, &self.settings);
                 (plan, r0)
             }
         }
     }
 
-    /// The regions units 0 and 1 print in layer `i` (docs/spec.md "Two discharge units"): each
-    /// run of consecutive parts of one unit ([`JobInfo::groups`]) is sliced on its own, and
-    /// keeps its section less the sections of the runs listed before it (where parts of
-    /// different units overlap, the part listed first keeps the overlap). A job without
-    /// unit-1 parts: unit 0 prints the whole section.
-    pub fn unit_regions(&self, i: usize) -> [geom::Shapes; 2] {
+    /// The region each unit prints as parts in layer `i`, indexed by unit (docs/spec.md
+    /// "Discharge units"): each run of consecutive parts of one unit ([`JobInfo::groups`]) is
+    /// sliced on its own, and keeps its section less the sections of the runs listed before it
+    /// (where parts of different units overlap, the part listed first keeps the overlap). A job
+    /// whose parts are all unit 0's: unit 0 prints the whole section.
+    pub fn unit_regions(&self, i: usize) -> Vec<geom::Shapes> {
+        let units = (self.settings.units as usize).max(1);
         if self.groups.is_empty() {
-            return [self.section(i).region, geom::Shapes::new()];
+            let mut regions = vec![geom::Shapes::new(); units];
+            regions[0] = self.section(i).region;
+            return regions;
         }
         let facets = self.buckets.layer(i);
-        let mut regions = [geom::Shapes::new(), geom::Shapes::new()];
+        let mut regions = vec![geom::Shapes::new(); units];
         let mut covered = geom::Shapes::new();
         for (k, (range, unit)) in self.groups.iter().enumerate() {
             let mine: Vec<u32> = facets
@@ -223,7 +240,7 @@ impl Job {
             if k + 1 < self.groups.len() {
                 covered = crate::base::boolean::union(&covered, &section);
             }
-            let r = &mut regions[usize::from(*unit).min(1)];
+            let r = &mut regions[usize::from(*unit).min(units - 1)];
             *r = crate::base::boolean::union(r, &own);
         }
         regions
@@ -246,7 +263,7 @@ impl Job {
                 bounds: (b.min, b.max),
                 warnings: &self.info.warnings,
                 instances: &self.info.instances,
-                unit1_used: self.uses_unit1(),
+                units_used: &self.units_used(),
                 profiles: &self.info.profiles,
             },
             summary,

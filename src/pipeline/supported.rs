@@ -1,8 +1,9 @@
-//! The supported pass (`support = unit1`): every layer's plan with unit 1's support, computed
+//! The supported pass (`support = unitN`): every layer's plan with the support, computed
 //! once per job because the droplet-level pass needs all layers' droplets.
 
 use crate::base::geom;
 use crate::base::parallel::{both, par_map, par_map_owned};
+use crate::base::settings::MAX_UNITS;
 use crate::base::stages::{self, Stage};
 use crate::base::steps::Budget;
 use crate::pipeline::Job;
@@ -17,10 +18,10 @@ pub struct SupportedPlans {
 }
 
 impl Job {
-    /// Every layer's plan with support on (`support = unit1`), computed once per job on first
-    /// use: each layer's part planned as without support, its support region hatched by unit 1
+    /// Every layer's plan with support on (`support = unitN`), computed once per job on first
+    /// use: each layer's part planned as without support, its support region hatched by unit N
     /// ([`moves::support_moves`]), then the droplet-level pass over all layers
-    /// ([`support_droplets::complete`]) adds unit-1 droplets under every droplet the layer
+    /// ([`support_droplets::complete`]) adds the support unit's droplets under every droplet the layer
     /// below leaves unsupported. Natively the layers are planned in parallel; in the page each
     /// worker's job plans them all once (docs/support.md).
     pub fn supported_plans(&self) -> &[(LayerPlan, geom::Shapes)] {
@@ -59,7 +60,7 @@ impl Job {
         b.spend(1).await;
         let mut hatches = Vec::with_capacity(n);
         for i in 0..n {
-            let start = plan::unit1_start(&parts[i].0, s);
+            let start = plan::support_start(&parts[i].0, s);
             hatches.push(stages::time(Stage::Support, || {
                 support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
             }));
@@ -98,9 +99,9 @@ impl Job {
                 },
             );
             drop(sections);
-            // Unit 1's hatch moves of each layer, after its part plan.
+            // The support's hatch moves of each layer, after its part plan.
             let hatches = par_map(n, &|i| {
-                let start = plan::unit1_start(&parts[i].0, s);
+                let start = plan::support_start(&parts[i].0, s);
                 stages::time(Stage::Support, || {
                     support::moves::support_moves(&layers[i].lines, &regions[i], &[], i, s, start)
                 })
@@ -108,7 +109,7 @@ impl Job {
             let planned = with_hatches(parts, hatches, &layers);
             drop(layers);
             let (extra, figures) = droplet_pass(&planned, &regions, s);
-            // Each layer's added droplets and unit 1's moves into its plan (on all cores).
+            // Each layer's added droplets and the support's moves into its plan (on all cores).
             let plans = par_map_owned(planned, &|i, layer| final_plan(i, layer, &extra, s));
             SupportedPlans {
                 layers: plans,
@@ -118,10 +119,10 @@ impl Job {
     }
 }
 
-/// A layer's part plan, its own region and unit 1's hatch moves.
+/// A layer's part plan, its own region and the support's hatch moves.
 type Planned = (LayerPlan, geom::Shapes, Vec<plan::Move>);
 
-/// Each layer's part plan with its overhang figure and unit 1's hatch moves.
+/// Each layer's part plan with its overhang figure and the support's hatch moves.
 fn with_hatches(
     parts: Vec<(LayerPlan, geom::Shapes)>,
     hatches: Vec<Vec<plan::Move>>,
@@ -148,12 +149,13 @@ fn droplet_pass(
     Vec<Vec<crate::base::geom::DVec2>>,
     support_droplets::PassFigures,
 ) {
-    let (b, b1) = (s.droplet_width(), s.support_width());
+    let (b, bs) = (s.droplet_width(), s.support_width());
     stages::time(Stage::Support, || {
         support_droplets::complete(
             &|i, within, out: &mut Vec<support_droplets::Droplet>| {
-                support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
-                support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
+                let parts = planned[i].0.widths(b);
+                support_droplets::droplets_of(&planned[i].0.moves, &parts, within, out);
+                support_droplets::droplets_of(&planned[i].2, &[bs; MAX_UNITS], within, out);
             },
             regions,
             s,
@@ -161,7 +163,7 @@ fn droplet_pass(
     })
 }
 
-/// Layer `i`'s added droplets and unit 1's moves into its plan.
+/// Layer `i`'s added droplets and the support's moves into its plan.
 fn final_plan(
     i: usize,
     (mut p, region, mut moves): Planned,
@@ -169,7 +171,7 @@ fn final_plan(
     s: &crate::base::settings::Settings,
 ) -> (LayerPlan, geom::Shapes) {
     if !extra[i].is_empty() {
-        let start = moves.last().map_or(plan::unit1_start(&p, s), |m| m.to);
+        let start = moves.last().map_or(plan::support_start(&p, s), |m| m.to);
         let none = geom::Shapes::new();
         moves.extend(support::moves::support_moves(
             &[],
@@ -180,6 +182,6 @@ fn final_plan(
             start,
         ));
     }
-    plan::add_unit1(&mut p, moves, s);
+    plan::add_support(&mut p, moves, s);
     (p, region)
 }

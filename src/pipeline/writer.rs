@@ -64,7 +64,7 @@ where
         queue.stop();
         result
     })?;
-    out.write_all(gcode::footer(&summary).as_bytes())
+    out.write_all(gcode::footer(&summary, job.settings().support.unit()).as_bytes())
         .map_err(io)?;
     Ok(summary)
 }
@@ -235,7 +235,7 @@ fn plan_one<K: LayerSink>(
     let extra = stages::time(Stage::Sink, || K::per_layer(state, i, &region, &p));
     let units = (p.first_unit(), p.moves.last().map(|m| m.unit));
     p.moves = Vec::new();
-    p.unit1_region = geom::Shapes::new();
+    p.unit_regions = Vec::new();
     (text, p, extra, units.0, units.1)
 }
 

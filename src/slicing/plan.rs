@@ -3,7 +3,7 @@
 
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
 use crate::base::nearest::nearest_walk;
-use crate::base::settings::{ContourOrder, PrintOrder, Settings};
+use crate::base::settings::{ContourOrder, MAX_UNITS, PrintOrder, Settings, UnitId};
 use crate::slicing::contours::{Loop, contours};
 use crate::slicing::droplets::loop_droplets_spaced;
 use crate::slicing::fill::{FillParams, FillPattern};
@@ -32,7 +32,7 @@ pub enum Role {
     Inner = 1,
     /// Hatch fill.
     Fill = 2,
-    /// Support under overhangs (discharge unit 1, see [`crate::support`]).
+    /// Support under overhangs (by the unit `support` names, see [`crate::support`]).
     Support = 3,
 }
 
@@ -41,25 +41,25 @@ pub struct Move {
     pub kind: MoveKind,
     pub role: Role,
     pub to: Point,
-    /// The discharge unit that prints it (0 or 1; docs/spec.md "Two discharge units"). A travel
-    /// belongs to the unit whose droplets follow it.
+    /// The discharge unit that prints it (0 … `units` − 1; docs/spec.md "Discharge units"). A
+    /// travel belongs to the unit whose droplets follow it.
     pub unit: u8,
 }
 
-/// Droplet counts by role (the roles partition the droplets), and how many of them discharge
-/// unit 1 prints.
+/// Droplet counts by role and by discharge unit (each partitions the droplets).
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Counts {
     pub outer: u64,
     pub inner: u64,
     pub fill: u64,
-    /// Support droplets (all printed by unit 1).
+    /// Support droplets (all printed by the support's unit).
     #[serde(default)]
     pub support: u64,
-    /// Droplets of any role printed by unit 1 (its parts' and the support).
+    /// Droplets of any role by the unit that prints them (its parts' and, for the support's
+    /// unit, the support), indexed by unit.
     #[serde(default)]
-    pub unit1: u64,
+    pub units: [u64; MAX_UNITS],
 }
 
 impl Counts {
@@ -67,9 +67,9 @@ impl Counts {
         self.outer + self.inner + self.fill + self.support
     }
 
-    /// Droplets printed by unit 0.
-    pub fn unit0(&self) -> u64 {
-        self.total() - self.unit1
+    /// Droplets printed by unit `u`.
+    pub fn unit(&self, u: UnitId) -> u64 {
+        self.units[u.index()]
     }
 
     pub fn add(&mut self, o: &Counts) {
@@ -77,7 +77,9 @@ impl Counts {
         self.inner += o.inner;
         self.fill += o.fill;
         self.support += o.support;
-        self.unit1 += o.unit1;
+        for (mine, theirs) in self.units.iter_mut().zip(o.units) {
+            *mine += theirs;
+        }
     }
 }
 
@@ -99,17 +101,30 @@ pub struct LayerPlan {
     /// The layer's overhang area, mm² (its region farther than `overhang_limit`·B from the
     /// region below, [`crate::support::overhang`]).
     pub unsupported_area: f64,
-    /// Droplet width B₁ of the unit-1 moves (0 when there are none).
-    pub unit1_width: f64,
-    /// The region unit 1 prints as parts (a second material) in this layer; empty in a job
-    /// without unit-1 parts. The analysis measures it as it measures unit 0's.
-    pub unit1_region: Shapes,
+    /// The droplet width B_u of each unit's moves but unit 0's (0 where a unit has none).
+    pub unit_widths: [f64; MAX_UNITS],
+    /// The regions the units but unit 0 print as parts (another material) in this layer,
+    /// indexed by unit (unit 0's place empty; none in a job whose parts are all unit 0's).
+    /// The analysis measures them as it measures unit 0's.
+    pub unit_regions: Vec<Shapes>,
 }
 
 impl LayerPlan {
-    /// The droplet width of a move's unit.
+    /// The droplet width of a move's unit (`b`: unit 0's).
     pub fn width_of(&self, m: &Move, b: f64) -> f64 {
-        if m.unit == 1 { self.unit1_width } else { b }
+        self.widths(b)[usize::from(m.unit)]
+    }
+
+    /// Every unit's droplet width, unit 0's `b`.
+    pub fn widths(&self, b: f64) -> [f64; MAX_UNITS] {
+        let mut w = self.unit_widths;
+        w[0] = b;
+        w
+    }
+
+    /// The region unit `u` (not 0) prints as parts in this layer, if any.
+    pub fn unit_region(&self, u: UnitId) -> Option<&Shapes> {
+        self.unit_regions.get(u.index()).filter(|r| !r.is_empty())
     }
 
     /// The unit of the first move, if any.
@@ -144,7 +159,7 @@ pub fn plan_layer(region: &Shapes, index: usize, s: &Settings) -> LayerPlan {
 }
 
 /// Plans one layer's region with the droplet width of `s`, starting at `start`; every move is
-/// unit 0's (see [`plan_unit1_layer`]).
+/// unit 0's (see [`plan_unit_parts`]).
 pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point) -> LayerPlan {
     let b = s.droplet_width();
     let layer = contours(region, s);
@@ -235,19 +250,18 @@ pub fn plan_layer_from(region: &Shapes, index: usize, s: &Settings, start: Point
 
 /// Droplet counts of a move list of one droplet width.
 pub fn count(moves: &[Move], b: f64) -> Counts {
-    count_units(moves, b, b)
+    count_units(moves, &[b; MAX_UNITS])
 }
 
-/// Droplet counts of a move list: unit 0's droplets `b` apart on `G25` lines, unit 1's `b1`.
-pub fn count_units(moves: &[Move], b: f64, b1: f64) -> Counts {
+/// Droplet counts of a move list: each unit's droplets `widths[unit]` apart on `G25` lines.
+pub fn count_units(moves: &[Move], widths: &[f64; MAX_UNITS]) -> Counts {
     let mut c = Counts::default();
     let mut at = DVec2::ZERO;
     for m in moves {
-        let w = if m.unit == 1 { b1 } else { b };
         let n = match m.kind {
             MoveKind::Travel => 0,
             MoveKind::Droplet => 1,
-            MoveKind::Line => line_droplet_count(dist(at, m.to), w),
+            MoveKind::Line => line_droplet_count(dist(at, m.to), widths[usize::from(m.unit)]),
         };
         match m.role {
             Role::Outer => c.outer += n,
@@ -255,17 +269,14 @@ pub fn count_units(moves: &[Move], b: f64, b1: f64) -> Counts {
             Role::Fill => c.fill += n,
             Role::Support => c.support += n,
         }
-        if m.unit == 1 {
-            c.unit1 += n;
-        }
+        c.units[usize::from(m.unit)] += n;
         at = m.to;
     }
     c
 }
 
-/// The settings unit 1 prints a support region with: droplet width B₁
-/// (`unit1_droplet_aspect`), one contour loop by the same rules as unit 0's, and hatch fill
-/// at `support_density`.
+/// The settings the support's unit prints a support region with: its droplet width B_s, one
+/// contour loop by the same rules as unit 0's, and hatch fill at `support_density`.
 pub fn support_settings(s: &Settings) -> Settings {
     Settings {
         fill_density: s.support_density,
@@ -274,117 +285,128 @@ pub fn support_settings(s: &Settings) -> Settings {
     }
 }
 
-/// The settings unit 1 prints its parts with (docs/spec.md "Two discharge units"): the same
-/// contour and fill rules as unit 0, with unit 1's droplet width B₁ (`unit1_droplet_aspect`).
-pub fn unit1_part_settings(s: &Settings) -> Settings {
-    s.for_unit(crate::base::settings::UnitId(1))
+/// The settings unit `u` prints its parts with (docs/spec.md "Discharge units"): the same
+/// contour and fill rules as unit 0, with the unit's own droplet width B_u
+/// (`unitN_droplet_aspect`).
+pub fn part_settings(s: &Settings, u: UnitId) -> Settings {
+    s.for_unit(u)
 }
 
-/// Adds unit 1's moves to a planned layer, in the order `unit_order` gives: first the region
-/// of its parts (`parts`, contours and fill as unit 0's with B₁, roles outer/inner/fill),
-/// then `support` (one loop and hatch at `support_density`, [`support_settings`], as
-/// `support_role`). Unit 0's droplets stay exactly as planned; only the travel between the
-/// two units' moves changes.
-pub fn plan_unit1_layer(
+/// Adds the moves of the units other than 0 to a layer whose unit-0 moves are planned (from
+/// the origin), in the order `unit_order` gives. `plan_unit(u, start)` plans unit `u`'s moves
+/// from `start` (the end of the unit before it in the order, the origin for the first) and
+/// gives them with their travel, or nothing. Unit 0's moves stay exactly as planned; only the
+/// travel into them changes. Each unit's moves are counted with its width `widths[u]`.
+fn add_units(
     plan: &mut LayerPlan,
-    parts: &Shapes,
-    support: &Shapes,
-    support_role: Role,
     s: &Settings,
+    widths: &[f64; MAX_UNITS],
+    mut plan_unit: impl FnMut(UnitId, Point) -> Option<(Vec<Move>, f64)>,
 ) {
-    if parts.is_empty() && support.is_empty() {
-        return;
-    }
-    let b1 = s.unit_width(crate::base::settings::UnitId(1));
-    let unit0_first = s.unit_order.rank(crate::base::settings::UnitId::FIRST)
-        < s.unit_order.rank(crate::base::settings::UnitId(1));
-    let start = if unit0_first {
-        plan.moves.last().map_or(Point::ZERO, |m| m.to)
-    } else {
-        Point::ZERO
-    };
-    let mut moves: Vec<Move> = Vec::new();
-    let mut travel = 0.0;
-    let mut at = start;
-    for (region, role, s1) in [
-        (parts, None, unit1_part_settings(s)),
-        (support, Some(support_role), support_settings(s)),
-    ] {
-        if region.is_empty() {
+    let mut unit0 = Some(std::mem::take(&mut plan.moves));
+    let mut at = Point::ZERO;
+    for &u in s.unit_order.units() {
+        if u.index() >= s.units as usize && u != UnitId::FIRST {
             continue;
         }
-        let p1 = plan_layer_from(region, plan.index, &s1, at);
-        travel += p1.travel_mm;
-        for mut m in p1.moves {
-            m.unit = 1;
-            if let Some(r) = role {
-                m.role = r;
+        if u == UnitId::FIRST {
+            let own = unit0.take().unwrap_or_default();
+            if let Some(first) = own.first()
+                && at != Point::ZERO
+            {
+                // Unit 0 was planned from the origin; it now starts where the unit before ends.
+                plan.travel_mm += dist(at, first.to) - dist(Point::ZERO, first.to);
             }
-            moves.push(m);
+            at = own.last().map_or(at, |m| m.to);
+            plan.moves.extend(own);
+            continue;
         }
+        let Some((mut moves, travel)) = plan_unit(u, at) else {
+            continue;
+        };
+        if moves.is_empty() {
+            continue;
+        }
+        for m in &mut moves {
+            m.unit = u.0;
+        }
+        plan.counts.add(&count_units(&moves, widths));
+        plan.unit_widths[u.index()] = widths[u.index()];
+        plan.travel_mm += travel;
         at = moves.last().map_or(at, |m| m.to);
-    }
-    if moves.is_empty() {
-        return;
-    }
-    let c1 = count_units(&moves, b1, b1);
-    plan.counts.add(&c1);
-    plan.unit1_width = b1;
-    plan.travel_mm += travel;
-    if unit0_first {
         plan.moves.extend(moves);
-    } else {
-        // Unit 0 was planned from the origin; it now starts where unit 1 ends.
-        let end = moves.last().map_or(Point::ZERO, |m| m.to);
-        if let Some(first) = plan.moves.first() {
-            plan.travel_mm += dist(end, first.to) - dist(Point::ZERO, first.to);
-        }
-        moves.append(&mut plan.moves);
-        plan.moves = moves;
     }
 }
 
-/// Where unit 1 starts in a layer whose unit-0 moves are planned: after them, or at the origin
-/// with `unit_order = unit1_first`.
-pub fn unit1_start(plan: &LayerPlan, s: &Settings) -> Point {
-    if s.unit_order.rank(crate::base::settings::UnitId::FIRST)
-        < s.unit_order.rank(crate::base::settings::UnitId(1))
-    {
-        plan.moves.last().map_or(Point::ZERO, |m| m.to)
-    } else {
-        Point::ZERO
+/// Adds the parts of the units other than 0 to a planned layer (unit 0's, from the origin), in
+/// the order `unit_order` gives: each unit's region `regions[u]` (contours and fill as unit
+/// 0's, with its own B_u; roles outer/inner/fill). Unit 0's droplets stay exactly as planned;
+/// only the travel between the units' moves changes. The regions are kept in the plan.
+pub fn plan_unit_parts(plan: &mut LayerPlan, regions: Vec<Shapes>, s: &Settings) {
+    let mut widths = [0.0; MAX_UNITS];
+    for u in UnitId::all(s.units as usize) {
+        widths[u.index()] = s.unit_width(u);
+    }
+    let index = plan.index;
+    add_units(plan, s, &widths, |u, at| {
+        let region = regions.get(u.index()).filter(|r| !r.is_empty())?;
+        let p = plan_layer_from(region, index, &part_settings(s, u), at);
+        Some((p.moves, p.travel_mm))
+    });
+    plan.unit_regions = regions;
+    if let Some(r) = plan.unit_regions.first_mut() {
+        *r = Shapes::new();
     }
 }
 
-/// Adds unit-1 moves (planned from [`unit1_start`]) to a layer planned for unit 0, in the
-/// order `unit_order` gives: the counts, B₁ and the travel follow. Unit 0's moves stay
-/// exactly as planned; only the travel between the two units' moves changes.
-pub fn add_unit1(plan: &mut LayerPlan, mut moves: Vec<Move>, s: &Settings) {
+/// Where the support starts in a layer whose parts are planned (docs/spec.md "Overhangs and
+/// support"): the support's unit prints it at the start of the layer when it is the first
+/// unit of `unit_order`, else after its own parts, where the units before it in the order
+/// end (the origin when none of them has moves).
+pub fn support_start(plan: &LayerPlan, s: &Settings) -> Point {
+    support_at(plan, s).1
+}
+
+/// Where the support's moves go in the layer's moves, and the point they start from.
+fn support_at(plan: &LayerPlan, s: &Settings) -> (usize, Point) {
+    let su = s.support_unit();
+    if s.unit_order.units().first() == Some(&su) {
+        return (0, Point::ZERO);
+    }
+    let rank = s.unit_order.rank(su);
+    let n = plan
+        .moves
+        .iter()
+        .rposition(|m| s.unit_order.rank(UnitId(m.unit)) <= rank)
+        .map_or(0, |k| k + 1);
+    let at = n.checked_sub(1).map_or(Point::ZERO, |k| plan.moves[k].to);
+    (n, at)
+}
+
+/// Adds the support's moves (planned from [`support_start`]) to a layer whose parts are
+/// planned: the counts, the support unit's width and the travel follow. The parts' moves stay
+/// exactly as planned; only the travel into the moves after the support changes.
+pub fn add_support(plan: &mut LayerPlan, mut moves: Vec<Move>, s: &Settings) {
     if moves.is_empty() {
         return;
     }
-    let b1 = support_settings(s).droplet_width();
-    let unit0_first = s.unit_order.rank(crate::base::settings::UnitId::FIRST)
-        < s.unit_order.rank(crate::base::settings::UnitId(1));
-    let mut at = unit1_start(plan, s);
+    let su = s.support_unit();
+    let bs = support_settings(s).droplet_width();
+    let (n, start) = support_at(plan, s);
+    let mut at = start;
     for m in &mut moves {
-        m.unit = 1;
+        m.unit = su.0;
         if m.kind != MoveKind::Line {
             plan.travel_mm += dist(at, m.to);
         }
         at = m.to;
     }
-    let c1 = count_units(&moves, b1, b1);
-    plan.counts.add(&c1);
-    plan.unit1_width = b1;
-    if unit0_first {
-        plan.moves.extend(moves);
-    } else {
-        // Unit 0 was planned from the origin; it now starts where unit 1 ends.
-        if let Some(first) = plan.moves.first() {
-            plan.travel_mm += dist(at, first.to) - dist(Point::ZERO, first.to);
-        }
-        moves.append(&mut plan.moves);
-        plan.moves = moves;
+    plan.counts.add(&count_units(&moves, &[bs; MAX_UNITS]));
+    plan.unit_widths[su.index()] = bs;
+    if let Some(next) = plan.moves.get(n) {
+        // The moves after the support were planned from where it starts; they now start where
+        // it ends.
+        plan.travel_mm += dist(at, next.to) - dist(start, next.to);
     }
+    plan.moves.splice(n..n, moves);
 }

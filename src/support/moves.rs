@@ -1,5 +1,5 @@
-//! Unit 1's moves for a support region (docs/spec.md "Overhangs and support"): the region's hatch
-//! segments on unit 1's lattice, split where the part is within `support_gap_xy`·B, then the
+//! The support unit's moves for a support region (docs/spec.md "Overhangs and support"): the region's hatch
+//! segments on the support unit's lattice, split where the part is within `support_gap_xy`·B, then the
 //! single droplets of the droplet-level pass, nearest first.
 
 use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
@@ -8,7 +8,7 @@ use crate::base::settings::Settings;
 use crate::slicing::hatch::{HatchLine, order_greedy};
 use crate::slicing::plan::{Move, MoveKind, Role, hatch_angle, support_settings};
 
-/// Unit 1's moves for a support region (docs/spec.md "Overhangs and support": hatch only, lines
+/// The support unit's moves for a support region (docs/spec.md "Overhangs and support": hatch only, lines
 /// B₁ / `support_density` apart), from `start`: the region's hatch segments `lines` (lines
 /// B₁ / `support_density` apart at the layer's hatch angle, every line's droplets on a
 /// lattice of pitch B₁ along it, [`crate::support::support_layers`]), without the droplets
@@ -25,6 +25,7 @@ pub fn support_moves(
 ) -> Vec<Move> {
     let s1 = support_settings(s);
     let b1 = s1.droplet_width();
+    let su = s.support_unit().0;
     let mut moves = Vec::new();
     let mut at = start;
     if s1.fill_density > 0.0 && !lines.is_empty() {
@@ -99,20 +100,20 @@ pub fn support_moves(
                     kind: MoveKind::Droplet,
                     role: Role::Support,
                     to: round_output(l.a),
-                    unit: 1,
+                    unit: su,
                 });
             } else {
                 moves.push(Move {
                     kind: MoveKind::Travel,
                     role: Role::Support,
                     to: round_output(l.a),
-                    unit: 1,
+                    unit: su,
                 });
                 moves.push(Move {
                     kind: MoveKind::Line,
                     role: Role::Support,
                     to: round_output(l.b),
-                    unit: 1,
+                    unit: su,
                 });
             }
             at = l.b;
@@ -124,7 +125,7 @@ pub fn support_moves(
             kind: MoveKind::Droplet,
             role: Role::Support,
             to: round_output(p),
-            unit: 1,
+            unit: su,
         });
     }
     moves

@@ -98,12 +98,12 @@ impl LayerResult {
     pub fn droplets(&self) -> Float32Array {
         Float32Array::from(&self.preview.droplets[..])
     }
-    /// Role per droplet: 0 outermost loop, 1 inner loops, 2 fill, 3 support (unit 1).
+    /// Role per droplet: 0 outermost loop, 1 inner loops, 2 fill, 3 support.
     #[wasm_bindgen(getter)]
     pub fn roles(&self) -> Uint8Array {
         Uint8Array::from(&self.preview.roles[..])
     }
-    /// Discharge unit per droplet (0 or 1), in the order of `roles`.
+    /// Discharge unit per droplet (0 … `units` − 1), in the order of `roles`.
     #[wasm_bindgen(getter)]
     pub fn units(&self) -> Uint8Array {
         Uint8Array::from(&self.preview.units[..])
@@ -119,15 +119,17 @@ impl LayerResult {
     pub fn unsupported_area(&self) -> f64 {
         self.unsupported_area
     }
-    /// Support droplets (unit 1).
+    /// Support droplets (of the unit `support` names).
     #[wasm_bindgen(getter)]
     pub fn support(&self) -> f64 {
         self.counts.support as f64
     }
-    /// Droplets printed by unit 1 (support and unit-1 parts).
+    /// Droplets each unit prints (its parts' and, for the support's unit, the support),
+    /// indexed by unit (`MAX_UNITS` entries).
     #[wasm_bindgen(getter)]
-    pub fn unit1(&self) -> f64 {
-        self.counts.unit1 as f64
+    pub fn unit_droplets(&self) -> Float64Array {
+        let n: Vec<f64> = self.counts.units.iter().map(|&n| n as f64).collect();
+        Float64Array::from(&n[..])
     }
     /// The layer's void analysis (`analysis::LayerAnalysis`: coverage, void_area,
     /// largest_void {area, centroid, min, max, at_boundary}, overfill_area,

@@ -546,7 +546,7 @@ impl Session {
         #[wasm_bindgen(unchecked_param_type = "Summary")] summary: JsValue,
     ) -> Result<String, JsValue> {
         let summary: Summary = from_js(summary, "summary")?;
-        Ok(gcode::footer(&summary))
+        Ok(gcode::footer(&summary, self.job.settings().support.unit()))
     }
 
     /// Merges `parts` (summaries of units, in any order) and computes the figures with this

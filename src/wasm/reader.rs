@@ -2,7 +2,7 @@
 //! with decoded text, giving finished layers as flat typed arrays.
 
 use crate::output::gcode_read::{GcodeReader, ReadLayer};
-use js_sys::{Float32Array, Uint8Array};
+use js_sys::{Float32Array, Float64Array, Uint8Array};
 use wasm_bindgen::prelude::*;
 
 /// A `.gco` file being read: `feed` pieces of text, `take_layer` the finished layers, then
@@ -180,15 +180,16 @@ impl GcodeLayer {
         Uint8Array::from(&self.layer.preview.roles[..])
     }
 
-    /// Discharge unit per droplet (0 or 1; `T1` selects unit 1), in the order of `roles`.
+    /// Discharge unit per droplet (0 … 3; `T2` selects unit 2), in the order of `roles`.
     pub fn units(&self) -> Uint8Array {
         Uint8Array::from(&self.layer.units[..])
     }
 
-    /// Droplets printed by unit 1.
+    /// Droplets each unit prints, indexed by unit (`MAX_UNITS` entries).
     #[wasm_bindgen(getter)]
-    pub fn unit1(&self) -> f64 {
-        self.layer.counts.unit1 as f64
+    pub fn unit_droplets(&self) -> Float64Array {
+        let n: Vec<f64> = self.layer.counts.units.iter().map(|&n| n as f64).collect();
+        Float64Array::from(&n[..])
     }
 
     pub fn travel(&self) -> Float32Array {

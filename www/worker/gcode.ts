@@ -112,7 +112,7 @@ export class GcodeReader {
       this.emit({
         index: l.index,
         z: l.z,
-        counts: { outer, inner, fill, support: 0, unit1: l.unit1, parts: partsByUnit(roles, units) },
+        counts: { outer, inner, fill, support: 0, units: Array.from(l.unit_droplets), parts: partsByUnit(roles, units) },
         travelMm: l.travel_mm,
         droplets: l.droplets(),
         roles,

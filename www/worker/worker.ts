@@ -126,7 +126,7 @@ function layerOf(s: Session, index: number, unit: { tally: Tally } | null, analy
     const layer: LayerData = {
       index: r.index,
       z: r.z,
-      counts: { outer: r.outer, inner: r.inner, fill: r.fill, support: r.support, unit1: r.unit1, parts: partsByUnit(roles, units) },
+      counts: { outer: r.outer, inner: r.inner, fill: r.fill, support: r.support, units: Array.from(r.unit_droplets), parts: partsByUnit(roles, units) },
       travelMm: r.travel_mm,
       seconds: r.seconds,
       droplets: r.droplets,

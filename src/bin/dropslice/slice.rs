@@ -347,10 +347,7 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             100.0 * report.part.coverage,
             path.display()
         );
-        density = Some((
-            report.part.predicted_density,
-            report.part.unit1.and_then(|u| u.predicted_density),
-        ));
+        density = Some(report.part.unit_densities(job.settings().units as usize));
         report_done = Some(staged);
     }
     // Everything is written: only now are the files put in place.
@@ -381,8 +378,8 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
         );
         eprintln!("dropslice: {}", overhang_line(&f));
         match density {
-            Some((d0, d1)) => {
-                if let Some(line) = density_line(d0, d1) {
+            Some(by_unit) => {
+                if let Some(line) = density_line(&by_unit) {
                     eprintln!("dropslice: {line}");
                 }
             }
@@ -391,15 +388,23 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
                 "dropslice: predicted density: not estimated (--report FILE.json runs the 3D void analysis, about 3 times the slicing's time)"
             ),
         }
-        if f.unit1_droplets > 0 {
+        let support = job.settings().support.unit();
+        for u in UnitId::all(f.unit_droplets.len()).skip(1) {
+            let n = f.unit_droplets[u.index()];
+            if n == 0 {
+                continue;
+            }
+            let s = if support == Some(u) {
+                f.counts.support
+            } else {
+                0
+            };
             eprintln!(
-                "dropslice: unit 1: {} droplets ({} support), {:.2} cm³, {:.2} g, {} of unit 1 and {} of unit 0",
-                f.unit1_droplets,
-                f.counts.support,
-                f.unit1_volume_mm3 / 1000.0,
-                f.unit1_mass_g,
-                duration(f.unit1_seconds),
-                duration(f.unit0_seconds)
+                "dropslice: unit {u}: {n} droplets ({s} support), {:.2} cm³, {:.2} g, {} of unit {u} and {} of unit 0",
+                f.unit_volume_mm3[u.index()] / 1000.0,
+                f.unit_mass_g[u.index()],
+                duration(f.unit_seconds[u.index()]),
+                duration(f.unit_seconds[0])
             );
         }
     }
@@ -438,17 +443,22 @@ fn timed_stages<T>(layers: usize, write: impl FnOnce() -> T) -> T {
     result
 }
 
-fn density_line(unit0: Option<f64>, unit1: Option<f64>) -> Option<String> {
+/// The predicted density line of the summary, of each unit's parts (`by_unit`, indexed by
+/// unit; `None` where a unit has no parts or no figure).
+fn density_line(by_unit: &[Option<f64>]) -> Option<String> {
     const WHAT: &str = "100 % − the 3D void fraction: a geometric estimate from the droplet model, not a measured density";
-    Some(match (unit0, unit1) {
-        (Some(d0), Some(d1)) => {
-            format!(
-                "predicted density: unit 0's parts {d0:.1} %, unit 1's parts {d1:.1} % ({WHAT})"
-            )
+    let known: Vec<(usize, f64)> = (by_unit.iter().enumerate())
+        .filter_map(|(u, d)| Some((u, (*d)?)))
+        .collect();
+    Some(match known[..] {
+        [] => return None,
+        [(0, d)] => format!("predicted density {d:.1} % ({WHAT})"),
+        _ => {
+            let parts: Vec<String> = (known.iter())
+                .map(|(u, d)| format!("unit {u}'s parts {d:.1} %"))
+                .collect();
+            format!("predicted density: {} ({WHAT})", parts.join(", "))
         }
-        (Some(d), None) => format!("predicted density {d:.1} % ({WHAT})"),
-        (None, Some(d)) => format!("predicted density: unit 1's parts {d:.1} % ({WHAT})"),
-        (None, None) => return None,
     })
 }
 

@@ -6,30 +6,37 @@
 use super::{GcodeError, GcodeReader, shown};
 use crate::base::error::Error;
 use crate::base::error::grouped;
-use crate::base::settings::{Settings, schema};
-use crate::output::gcode::{FIGURE_LINES, FigureField};
+use crate::base::settings::{MAX_UNITS, Settings, UnitId, schema};
+use crate::output::gcode::{FigureField, figure_lines};
 use crate::output::summary::{Figures, Summary};
 use crate::slicing::plan::Counts;
 
-/// The header's droplet count lines, in the order of [`GcodeReader::header_counts`]: outer,
-/// inner, fill, support, unit 1.
-const COUNT_LINES: [&str; 5] = [
+/// The header's droplet count lines by role, in the order of [`GcodeReader::header_counts`]:
+/// outer, inner, fill, support (then `droplets of unit N` for each unit but 0 that prints).
+const COUNT_LINES: [&str; 4] = [
     "droplets outer loops",
     "droplets inner loops",
     "droplets fill",
     "droplets support",
-    "droplets of unit 1",
 ];
 
-/// The header's droplet size must lie within the settings' ranges: (least, greatest, unit).
+/// The unit a `droplets of unit N` line counts (1 … [`MAX_UNITS`] − 1).
+fn unit_count_line(label: &str) -> Option<UnitId> {
+    let n = label.strip_prefix("droplets of unit ")?;
+    let u: u8 = n.parse().ok()?;
+    (u > 0 && usize::from(u) < MAX_UNITS && n == u.to_string()).then_some(UnitId(u))
+}
+
+/// The header's droplet sizes (`layer_height`, each unit's `…droplet_aspect`) must lie within
+/// the settings' ranges: (least, greatest, unit).
 fn header_range(name: &str) -> Option<(f64, f64, &'static str)> {
-    let spec = crate::base::settings::schema().into_iter().find(|s| {
-        s.name == name
-            && matches!(
-                name,
-                "layer_height" | "droplet_aspect" | "unit1_droplet_aspect"
-            )
-    })?;
+    let aspect = UnitId::all(MAX_UNITS).any(|u| u.name("droplet_aspect") == name);
+    if name != "layer_height" && !aspect {
+        return None;
+    }
+    let spec = crate::base::settings::schema()
+        .into_iter()
+        .find(|s| s.name == name)?;
     Some((spec.min?, spec.max?, spec.unit))
 }
 
@@ -51,11 +58,15 @@ impl GcodeReader {
                 self.header_counts[i] = value.parse::<u64>().ok();
                 return Ok(());
             }
-            if let Some((_, field, _, _)) = FIGURE_LINES.iter().find(|l| l.0 == label) {
+            if let Some(u) = unit_count_line(label) {
+                self.header_units[u.index()] = value.parse::<u64>().ok();
+                return Ok(());
+            }
+            if let Some(field) = FigureField::of_label(label) {
                 match value.parse::<f64>() {
                     Ok(v) if v.is_finite() && v >= 0.0 => {
-                        self.header_figures.retain(|(f, _)| f != field);
-                        self.header_figures.push((*field, v));
+                        self.header_figures.retain(|(f, _)| *f != field);
+                        self.header_figures.push((field, v));
                     }
                     _ if value == "pending" => {
                         self.header_figures_problem = Some(
@@ -117,13 +128,17 @@ impl GcodeReader {
                 .map(|v| v.parse::<f64>().unwrap_or(f64::NAN))
         };
         let h = num("layer_height").unwrap_or(f64::NAN);
-        let a = num("droplet_aspect").unwrap_or(1.04);
-        let a1 = num("unit1_droplet_aspect").unwrap_or(1.04);
-        if h > 0.0 && a > 0.0 {
-            self.width = h * a;
+        let default = Settings::default();
+        let aspects = UnitId::all(MAX_UNITS)
+            .map(|u| num(&u.name("droplet_aspect")).unwrap_or(default.unit(u).droplet_aspect));
+        let aspects: Vec<f64> = aspects.collect();
+        for (w, a) in self.widths.iter_mut().zip(aspects) {
+            if h > 0.0 && a > 0.0 {
+                *w = h * a;
+            }
         }
-        if h > 0.0 && a1 > 0.0 {
-            self.width1 = h * a1;
+        if h > 0.0 {
+            self.width = self.widths[0];
         }
         Ok(())
     }
@@ -211,40 +226,51 @@ impl GcodeReader {
                     .into(),
             );
         }
-        let [outer, inner, fill, support, unit1] = self.header_counts;
+        let [outer, inner, fill, support] = self.header_counts;
         let (Some(outer), Some(inner), Some(fill), Some(total)) =
             (outer, inner, fill, self.header_droplets)
         else {
             return Err("the header's droplet counts are missing".into());
         };
-        let two = unit1.is_some();
-        let counts = Counts {
+        let used: Vec<UnitId> = UnitId::all(MAX_UNITS)
+            .filter(|u| u.index() == 0 || self.header_units[u.index()].is_some())
+            .collect();
+        let mut counts = Counts {
             outer,
             inner,
             fill,
             support: support.unwrap_or(0),
-            unit1: unit1.unwrap_or(0),
+            ..Counts::default()
         };
+        for u in &used[1..] {
+            counts.units[u.index()] = self.header_units[u.index()].unwrap_or(0);
+        }
         let sum = [inner, fill, counts.support]
             .into_iter()
             .try_fold(outer, u64::checked_add);
-        if sum != Some(total) || counts.unit1 > total {
-            return Err("the header's droplet counts do not add up to its total".into());
+        let others = (counts.units[1..].iter()).try_fold(0u64, |a, &n| a.checked_add(n));
+        match (sum, others) {
+            (Some(sum), Some(others)) if sum == total && others <= total => {
+                counts.units[0] = total - others;
+            }
+            _ => return Err("the header's droplet counts do not add up to its total".into()),
         }
         let read = &self.totals.counts;
-        if read.total() != total || read.unit1 != counts.unit1 {
+        if read.total() != total || read.units[1..] != counts.units[1..] {
+            let of_units = |c: &Counts| -> String {
+                (used[1..].iter())
+                    .map(|&u| format!(", {} of unit {u}", grouped(c.unit(u))))
+                    .collect()
+            };
             return Err(format!(
-                "the header's droplets ({} in all, {} of unit 1) are not those of the commands ({}, {}): the code was changed after slicing",
+                "the header's droplets ({} in all{}) are not those of the commands ({}{}): the code was changed after slicing",
                 grouped(total),
-                grouped(counts.unit1),
+                of_units(&counts),
                 grouped(read.total()),
-                grouped(read.unit1)
+                of_units(read)
             ));
         }
-        for (label, field, _, only) in FIGURE_LINES {
-            if only.is_some_and(|o| o != two) {
-                continue;
-            }
+        for (label, field, _) in figure_lines(&used) {
             if !self.header_figures.iter().any(|(f, _)| *f == field) {
                 return Err(format!("the header has no {label}"));
             }

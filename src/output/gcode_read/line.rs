@@ -9,6 +9,7 @@ use super::{
 };
 use crate::base::error::grouped;
 use crate::base::geom::{DVec2, dist, line_droplet_count_f64, line_droplets};
+use crate::base::settings::MAX_UNITS;
 
 impl GcodeReader {
     /// Reads one line.
@@ -35,10 +36,10 @@ impl GcodeReader {
         let to = DVec2::new(x, y);
         // What this line adds, checked before anything is stored.
         let len = dist(self.at, to);
-        let width = if self.unit == 1 {
-            self.width1
-        } else {
+        let width = if self.unit == 0 {
             self.width
+        } else {
+            self.widths[usize::from(self.unit)]
         };
         let n = self.droplets_of(no, &code, len, width)?;
         self.droplets = self.droplets.saturating_add(n);
@@ -49,16 +50,17 @@ impl GcodeReader {
         Ok(())
     }
 
-    /// `T0`/`T1` (`n`: what follows the `T`): the discharge unit of the commands that follow.
+    /// `T0` … `T3` (`n`: what follows the `T`): the discharge unit of the commands that
+    /// follow.
     fn select_unit(&mut self, no: usize, line: &str, n: &str) -> Result<(), GcodeError> {
         let n = n.split(';').next().unwrap_or("").trim();
-        self.unit = match n {
-            "0" => 0,
-            "1" => 1,
+        self.unit = match n.parse::<u8>() {
+            Ok(u) if usize::from(u) < MAX_UNITS && n == u.to_string() => u,
             _ => {
                 return Err(GcodeError(format!(
-                    "line {no}: \"{}\" selects a discharge unit this slicer does not have: only T0 and T1 are known",
-                    shown(line)
+                    "line {no}: \"{}\" selects a discharge unit this slicer does not have: only T0 … T{} are known",
+                    shown(line),
+                    MAX_UNITS - 1
                 )));
             }
         };
@@ -242,9 +244,8 @@ impl GcodeReader {
                 }
             }
         }
-        if unit == 1 {
-            l.counts.unit1 = l.counts.unit1.saturating_add(n);
-        }
+        let of_unit = &mut l.counts.units[usize::from(unit)];
+        *of_unit = of_unit.saturating_add(n);
     }
 }
 

@@ -27,6 +27,7 @@ mod line;
 
 use crate::base::error::grouped;
 use crate::base::geom::DVec2;
+use crate::base::settings::MAX_UNITS;
 use crate::output::gcode::FigureField;
 use crate::output::preview::PreviewLayer;
 use crate::output::summary::Summary;
@@ -64,7 +65,7 @@ pub struct ReadLayer {
     pub travel_mm: f64,
     /// Droplet centres, roles and travel moves, as the slicer's preview gives them.
     pub preview: PreviewLayer,
-    /// The discharge unit of each droplet (0 or 1), in the order of `preview.roles` (empty
+    /// The discharge unit of each droplet (0 … 3), in the order of `preview.roles` (empty
     /// when [counting](GcodeReader::counting)).
     pub units: Vec<u8>,
 }
@@ -75,8 +76,8 @@ pub struct GcodeReader {
     /// The header's `name = value` lines before the first command, in file order.
     pub header: Vec<(String, String)>,
     width: f64,
-    /// B₁, unit 1's droplet width.
-    width1: f64,
+    /// Each unit's droplet width B_u (unit 0's: `width`).
+    widths: [f64; MAX_UNITS],
     /// The selected discharge unit.
     unit: u8,
     at: DVec2,
@@ -97,7 +98,9 @@ pub struct GcodeReader {
     totals: Summary,
     /// The header's droplet counts (`; droplets outer loops = N`, …), by role; `None` for a
     /// line it does not have or the placeholder `pending`.
-    header_counts: [Option<u64>; 5],
+    header_counts: [Option<u64>; 4],
+    /// The header's `; droplets of unit N = …` (units 1 and on; unit 0's place unused).
+    header_units: [Option<u64>; MAX_UNITS],
     /// The header's figures (`; print time = S s`, …), as read.
     header_figures: Vec<(FigureField, f64)>,
     /// Why the header's figures cannot be used (a line that is not a number ≥ 0, `pending`).
@@ -150,7 +153,7 @@ impl GcodeReader {
     pub fn new() -> GcodeReader {
         GcodeReader {
             width: f64::NAN,
-            width1: f64::NAN,
+            widths: [f64::NAN; MAX_UNITS],
             ..GcodeReader::default()
         }
     }

@@ -11,7 +11,7 @@
 use crate::base::geom::{
     DVec2, Point, Shapes, dist, line_droplets, line_droplets_in, round_output,
 };
-use crate::base::settings::Settings;
+use crate::base::settings::{MAX_UNITS, Settings};
 use crate::slicing::plan::{Move, MoveKind};
 use gaps::inside;
 use grid::{Added, Below};
@@ -34,20 +34,19 @@ mod grid;
 
 pub use gaps::{Clearance, LineGaps, edges_of};
 
-/// Every droplet a layer's moves set, with its width (B, or B₁ for unit 1's moves), in the
+/// Every droplet a layer's moves set, with its width (its unit's, `widths[unit]`), in the
 /// order they are set; with `within = Some((lo, hi))` only those in that box (a line whose
 /// box misses it is not walked).
 pub fn droplets_of(
     moves: &[Move],
-    b: f64,
-    b1: f64,
+    widths: &[f64; MAX_UNITS],
     within: Option<Bounds>,
     out: &mut Vec<Droplet>,
 ) {
     let mut at = Point::ZERO;
     let inside = |p: Point| within.is_none_or(|(lo, hi)| p.cmpge(lo).all() && p.cmple(hi).all());
     for m in moves {
-        let w = if m.unit == 1 { b1 } else { b };
+        let w = widths[usize::from(m.unit)];
         match m.kind {
             MoveKind::Droplet if inside(m.to) => out.push((m.to, w)),
             MoveKind::Line => match within {
