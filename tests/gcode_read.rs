@@ -71,14 +71,15 @@ fn figures_come_from_the_header_settings() {
     assert!(want.counts.support > 0, "the model needs support");
     // the code does not tell loops from fill or support: G26 droplets count as loops, G25 as fill
     assert_eq!(got.droplets, want.droplets);
-    assert_eq!(got.unit1_droplets, want.unit1_droplets);
+    assert_eq!(got.unit_droplets, want.unit_droplets);
     assert_eq!(got.layers, layers.len());
     assert!((got.volume_mm3 - want.volume_mm3).abs() < 1e-9 * want.volume_mm3);
     assert!((got.mass_g - want.mass_g).abs() < 1e-9 * want.mass_g);
-    assert!((got.unit1_mass_g - want.unit1_mass_g).abs() < 1e-9 * want.unit1_mass_g);
+    assert!((got.unit_mass_g[1] - want.unit_mass_g[1]).abs() < 1e-9 * want.unit_mass_g[1]);
     let travel: f64 = layers.iter().map(|l| l.travel_mm).sum();
     let c = &want.counts;
-    let seconds = (c.total() - c.unit1) as f64 / 250.0 + c.unit1 as f64 / 40.0 + travel / 80.0;
+    let (d0, d1) = (c.unit(UnitId::FIRST), c.unit(UnitId(1)));
+    let seconds = d0 as f64 / 250.0 + d1 as f64 / 40.0 + travel / 80.0;
     assert!(
         (got.print_seconds - seconds).abs() < 1e-6 * seconds,
         "{} vs {seconds}",
@@ -122,7 +123,20 @@ fn a_finished_code_reads_back_the_figures_of_its_slice() {
         ..Settings::default()
     };
     two.unit_mut(UnitId(1)).droplet_rate = 40.0;
-    for (model, s) in [("cube_20mm_ascii.stl", one), ("U_overhang.obj", two)] {
+    // Support from the third unit of three, with its own rate and droplet size.
+    let mut three = Settings {
+        units: 3,
+        support: dropslice::base::settings::Support::Unit(UnitId(2)),
+        ..Settings::default()
+    };
+    three.unit_mut(UnitId(2)).droplet_rate = 30.0;
+    three.unit_mut(UnitId(2)).droplet_aspect = 1.2;
+    let cases = [
+        ("cube_20mm_ascii.stl", one),
+        ("U_overhang.obj", two),
+        ("U_overhang.obj", three),
+    ];
+    for (model, s) in cases {
         let job = Job::new(&common::model_bytes(model), model, s.clone()).expect("job");
         let (code, summary) = finished_code(&job);
         let want = summary.figures(&s);
@@ -136,13 +150,19 @@ fn a_finished_code_reads_back_the_figures_of_its_slice() {
         exact(got.travel_mm, want.travel_mm, "travel");
         exact(got.volume_mm3, want.volume_mm3, "volume");
         exact(got.mass_g, want.mass_g, "mass");
-        exact(got.unit0_seconds, want.unit0_seconds, "unit 0 time");
-        exact(got.unit1_seconds, want.unit1_seconds, "unit 1 time");
-        exact(got.unit1_volume_mm3, want.unit1_volume_mm3, "unit 1 volume");
-        exact(got.unit1_mass_g, want.unit1_mass_g, "unit 1 mass");
+        assert_eq!(got.unit_seconds.len(), s.units as usize);
+        for u in 0..s.units as usize {
+            exact(got.unit_seconds[u], want.unit_seconds[u], "a unit's time");
+            exact(
+                got.unit_volume_mm3[u],
+                want.unit_volume_mm3[u],
+                "a unit's volume",
+            );
+            exact(got.unit_mass_g[u], want.unit_mass_g[u], "a unit's mass");
+        }
         assert_eq!(got.counts, want.counts, "{model}: droplets by role");
         assert_eq!(got.droplets, want.droplets);
-        assert_eq!(got.unit1_droplets, want.unit1_droplets);
+        assert_eq!(got.unit_droplets, want.unit_droplets);
         // the commands alone give another travel (and loops and fill only)
         let unfilled = read_gcode(&code.replacen("; print time", "; print tim", 1))
             .expect("read")
@@ -154,8 +174,11 @@ fn a_finished_code_reads_back_the_figures_of_its_slice() {
         let moves = unfilled.figures().expect("figures");
         assert_ne!(moves.travel_mm.to_bits(), want.travel_mm.to_bits());
         assert_eq!(moves.counts.inner, 0);
-        if model.starts_with('U') {
-            assert!(want.unit1_droplets > 0 && code.contains("; volume unit 1"));
+        if s.units == 3 {
+            assert!(want.unit_droplets[2] > 0 && code.contains("; volume unit 2"));
+            assert!(code.contains("\nT2\n") && !code.contains("; volume unit 1"));
+        } else if model.starts_with('U') {
+            assert!(want.unit_droplets[1] > 0 && code.contains("; volume unit 1"));
         } else {
             assert!(code.contains("; droplet_aspect = 1.3") && !code.contains("unit 1"));
         }

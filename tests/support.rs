@@ -29,7 +29,7 @@ fn all_droplets(g: &Gcode) -> Vec<Vec<(P, u8)>> {
     let mut at = [0.0, 0.0];
     g.layers
         .iter()
-        .map(|l| unit_droplets(l, &mut at, [h * a, h * a1]))
+        .map(|l| unit_droplets(l, &mut at, &[h * a, h * a1]))
         .collect()
 }
 

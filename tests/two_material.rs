@@ -1,14 +1,17 @@
-//! Two-material jobs (docs/spec.md "Two discharge units": parts of unit 1), checked on the G-code
-//! the CLI writes, read here (tests/common's parser), against the independent oracle
-//! (`../shared/tools/oracle_sections.py`) and the test's own cut of the parts it placed:
+//! Jobs of several materials (docs/spec.md "Discharge units": parts of units 1 … 3, support
+//! by any unit but 0), checked on the G-code the CLI writes, read here (tests/common's parser),
+//! against the independent oracle (`../shared/tools/oracle_sections.py`) and the test's own
+//! cut of the parts it placed:
 //!
 //! * each unit's droplets lie inside its own part's section, and cover it: every point of the
 //!   section deeper than B_u has a droplet of its unit within B_u·0.75, and the droplets'
 //!   cells (N·B_u²) add up to the oracle's area of that part's section;
+//! * with three units (two materials and support from unit 2), the support's droplets lie
+//!   outside every part, and are the droplets unit 1 sets as support in a job of two units;
 //! * where parts of different units overlap, the part listed first keeps the overlap (three
 //!   boxes in a row, units 0, 1, 0: the regions are known exactly);
-//! * `T` lines only where the unit changes, unit 0 first within a layer, the unit-1 settings
-//!   in the header.
+//! * `T` lines only where the unit changes, the units within a layer in `unit_order`, each
+//!   printing unit's settings in the header.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
@@ -23,14 +26,15 @@ use std::time::Duration;
 type P = [f64; 2];
 type Tri = [[f64; 3]; 3];
 
-/// H, B and B₁ from the header.
-fn widths(g: &Gcode) -> (f64, [f64; 2]) {
-    let num = |k: &str| -> f64 { g.get(k).unwrap_or_else(|| panic!("{k}")).parse().unwrap() };
-    let h = num("layer_height");
-    (
-        h,
-        [h * num("droplet_aspect"), h * num("unit1_droplet_aspect")],
-    )
+/// H and every unit's B_u from the header (a unit whose settings it does not list: B).
+fn widths(g: &Gcode) -> (f64, Vec<f64>) {
+    let num = |k: &str| -> Option<f64> { g.get(k).map(|v| v.parse().unwrap()) };
+    let h = num("layer_height").expect("layer_height");
+    let b = h * num("droplet_aspect").expect("droplet_aspect");
+    let all = (0..4)
+        .map(|u| num(&format!("unit{u}_droplet_aspect")).map_or(b, |a| h * a))
+        .collect();
+    (h, all)
 }
 
 /// Slices the job file `job` (its files in `dir`) through the CLI.
@@ -99,15 +103,21 @@ fn oracle_areas(stl: &std::path::Path, h: f64) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// `T` lines only where the unit changes, each followed by a command; unit 0 before unit 1
-/// within every layer.
-fn check_unit_lines(text: &str, g: &Gcode) {
+/// `T` lines only where the unit changes, each followed by a command; within every layer the
+/// units in `order` (unit 0 first, then by number, by default).
+fn check_unit_lines(text: &str, g: &Gcode, order: &[u8]) {
     common::assert_unit_changes(text, "");
+    let rank = |u: u8| {
+        order
+            .iter()
+            .position(|&x| x == u)
+            .expect("a unit of the order")
+    };
     for l in &g.layers {
-        let units: Vec<u8> = l.cmds.iter().map(|c| c.unit).collect();
+        let units: Vec<usize> = l.cmds.iter().map(|c| rank(c.unit)).collect();
         assert!(
             units.windows(2).all(|w| w[0] <= w[1]),
-            "layer at z {}: unit 1 before unit 0",
+            "layer at z {}: the units out of their order {order:?}",
             l.z
         );
     }
@@ -134,14 +144,14 @@ fn each_unit_prints_its_own_part_and_covers_it() {
     let (text, g) = slice_job(&dir, &job);
     let (h, b) = widths(&g);
     assert!((b[1] - 1.6 * h).abs() < 1e-9 && (b[0] - b[1]).abs() > 0.05);
-    check_unit_lines(&text, &g);
+    check_unit_lines(&text, &g, &[0, 1]);
     assert!(!g.unit_lines.is_empty());
     assert!(g.get("unit1_material_density").is_some());
     let mut at = [0.0, 0.0];
     let layers: Vec<Vec<(P, u8)>> = g
         .layers
         .iter()
-        .map(|l| unit_droplets(l, &mut at, b))
+        .map(|l| unit_droplets(l, &mut at, &b))
         .collect();
     // The header's unit-1 count is the droplets of unit 1 read here.
     let ones = layers.iter().flatten().filter(|d| d.1 == 1).count();
@@ -152,7 +162,21 @@ fn each_unit_prints_its_own_part_and_covers_it() {
         .parse()
         .unwrap();
     assert_eq!(header, ones);
-    let mut compared = [0usize; 2];
+    check_own_parts(&dir, &g, &layers, &parts, h, &b);
+}
+
+/// Each part's droplets of its unit lie inside the part's section, cover it, and their cells
+/// add up to the oracle's area of its section (`parts`: file, place, unit; `layers`: every
+/// layer's droplets with their unit).
+fn check_own_parts(
+    dir: &TempDir,
+    g: &Gcode,
+    layers: &[Vec<(P, u8)>],
+    parts: &[(&str, P, u8)],
+    h: f64,
+    b: &[f64],
+) {
+    let mut compared = vec![0usize; parts.len()];
     for (k, (f, at, u)) in parts.iter().enumerate() {
         let tris = placed(f, *at);
         let stl = dir.join(&format!("part{k}.stl"));
@@ -277,7 +301,7 @@ fn box_job(boxes: &[([f64; 4], u8)], h_box: f64) -> (String, Gcode, Vec<Vec<(P, 
     let layers = g
         .layers
         .iter()
-        .map(|l| unit_droplets(l, &mut at, b))
+        .map(|l| unit_droplets(l, &mut at, &b))
         .collect();
     (text, g, layers)
 }
@@ -293,7 +317,7 @@ fn the_part_listed_first_keeps_the_overlap() {
         ([12.0, 0.0, 22.0, 10.0], 0),
     ];
     let (text, g, layers) = box_job(&boxes, 2.0);
-    check_unit_lines(&text, &g);
+    check_unit_lines(&text, &g, &[0, 1]);
     let (_, b) = widths(&g);
     assert!(layers.len() >= 9);
     for (n, l) in layers.iter().enumerate() {
@@ -351,4 +375,135 @@ fn the_part_listed_first_keeps_the_overlap() {
         }
         assert!(l.iter().any(|d| d.1 == 0) && l.iter().any(|d| d.1 == 1));
     }
+}
+
+/// Every layer's droplets with their unit.
+fn droplets_by_unit(g: &Gcode, b: &[f64]) -> Vec<Vec<(P, u8)>> {
+    let mut at = [0.0, 0.0];
+    g.layers
+        .iter()
+        .map(|l| unit_droplets(l, &mut at, b))
+        .collect()
+}
+
+/// Whether p lies outside the section, at least d from its boundary.
+fn clear_of(segs: &[(P, P)], p: P, d: f64) -> bool {
+    let near = segs.iter().any(|&(a, b)| {
+        let (ab, ap) = ([b[0] - a[0], b[1] - a[1]], [p[0] - a[0], p[1] - a[1]]);
+        let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+        let t = if len2 > 0.0 {
+            ((ap[0] * ab[0] + ap[1] * ab[1]) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (ex, ey) = (ap[0] - t * ab[0], ap[1] - t * ab[1]);
+        ex * ex + ey * ey < d * d
+    });
+    !near && !deep_inside(segs, p, 0.0)
+}
+
+/// The header's `droplets of unit N`.
+fn header_count(g: &Gcode, u: u8) -> usize {
+    g.get(&format!("droplets of unit {u}"))
+        .unwrap_or_else(|| panic!("no count of unit {u}"))
+        .trim()
+        .parse()
+        .unwrap()
+}
+
+#[test]
+fn three_units_print_two_materials_and_the_support_from_unit_2() {
+    let dir = TempDir::new("three-units");
+    // Unit 0: 3DBenchy (its bow and cabin roof need support); unit 1: a 20 mm cube beside it,
+    // with wider droplets; the support from unit 2, with droplets of its own size, printed
+    // between them (`unit_order = 1,2,0`).
+    let parts = [
+        ("3DBenchy.stl", [5.0, 5.0], 0u8),
+        ("cube_20mm_ascii.stl", [75.0, 5.0], 1u8),
+    ];
+    for (f, _, _) in &parts {
+        std::fs::copy(common::model(f), dir.join(f)).unwrap();
+    }
+    let settings = json!({
+        "units": 3, "support": "unit2", "unit_order": "1,2,0",
+        "unit1_droplet_aspect": 1.6, "unit2_droplet_aspect": 1.3,
+        "unit2_material_density": 1.5
+    });
+    let job = json!({
+        "settings": settings,
+        "parts": parts.iter().map(|(f, at, u)| json!({
+            "file": f, "place_x": at[0], "place_y": at[1], "unit": u
+        })).collect::<Vec<_>>()
+    });
+    let (text, g) = slice_job(&dir, &job);
+    let (h, b) = widths(&g);
+    assert!((b[2] - 1.3 * h).abs() < 1e-9 && (b[1] - 1.6 * h).abs() < 1e-9);
+    check_unit_lines(&text, &g, &[1, 2, 0]);
+    for key in ["unit2_droplet_aspect", "unit2_material_density", "units"] {
+        assert!(g.get(key).is_some(), "{key} in the header");
+    }
+    assert!(g.unit_lines.iter().any(|l| l.1 == 2), "T2 lines");
+    let layers = droplets_by_unit(&g, &b);
+    // The header's counts are the droplets read here, unit by unit; unit 2's are the support.
+    for u in [1u8, 2] {
+        let read = layers.iter().flatten().filter(|d| d.1 == u).count();
+        assert_eq!(header_count(&g, u), read, "unit {u}");
+    }
+    let support: usize = g.get("droplets support").unwrap().trim().parse().unwrap();
+    assert!(support > 1000, "{support} support droplets");
+    assert_eq!(header_count(&g, 2), support);
+    // Each material in its own part, covering it, against the oracle.
+    check_own_parts(&dir, &g, &layers, &parts, h, &b);
+    // The support lies outside every part (at least support_gap_xy·B = B/2 from it, less
+    // the rounding of the code).
+    let cuts: Vec<Vec<Tri>> = parts.iter().map(|(f, at, _)| placed(f, *at)).collect();
+    for (n, l) in g.layers.iter().enumerate() {
+        let i = common::layer_index(l.z, h);
+        let z = (i as f64 + 0.5) * h;
+        let sections: Vec<_> = cuts.iter().map(|t| cut(t, z)).collect();
+        for &(p, u) in &layers[n] {
+            if u != 2 {
+                continue;
+            }
+            for segs in &sections {
+                assert!(
+                    clear_of(segs, p, 0.45 * b[0]),
+                    "layer {}: support droplet at {p:?} within B/2 of a part",
+                    i + 1
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_support_of_any_unit_is_the_same_support() {
+    // One part, the support from unit 1 (of two) or from unit 3 (of four), with the same
+    // droplet size: the same commands, only the `T` lines name the other unit.
+    let dir = TempDir::new("support-unit");
+    std::fs::copy(common::model("U_overhang.obj"), dir.join("U_overhang.obj")).unwrap();
+    let slice = |settings: Value| {
+        let job = json!({"settings": settings, "parts": [{"file": "U_overhang.obj"}]});
+        slice_job(&dir, &job)
+    };
+    let (one, g1) = slice(json!({"support": "unit1", "unit1_droplet_aspect": 1.3}));
+    let (three, g3) = slice(json!({
+        "units": 4, "support": "unit3", "unit3_droplet_aspect": 1.3
+    }));
+    let commands = |text: &str, unit: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| !l.starts_with(';'))
+            .map(|l| {
+                if l == unit {
+                    "T*".into()
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect()
+    };
+    assert_eq!(commands(&one, "T1"), commands(&three, "T3"));
+    assert!(g3.unit_lines.iter().all(|l| l.1 == 0 || l.1 == 3));
+    assert_eq!(header_count(&g1, 1), header_count(&g3, 3));
+    assert!(g3.get("droplets of unit 1").is_none());
 }

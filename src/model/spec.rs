@@ -89,11 +89,11 @@ pub fn job_schema() -> JobSchema {
         1,
         "Copies of the part on the plate",
     ));
-    // The units this version prints parts with (the settings name more, see `units`).
+    // Any unit up to the most a machine may have; the job's `units` bounds it further.
     part_numbers.push(whole(
         "unit",
         0,
-        crate::base::settings::SLICED_UNITS as u32 - 1,
+        crate::base::settings::MAX_UNITS as u32 - 1,
         0,
         "The discharge unit that prints the part",
     ));
@@ -201,7 +201,7 @@ impl PartSpec {
     }
 
     /// Its transform with the bounding box minimum moved by `place`, its scale compensating
-    /// the shrinkage of its unit's material (`settings`' `shrink_*` or `unit1_shrink_*`); a
+    /// the shrinkage of its unit's material (`settings`' `shrink_*` or `unitN_shrink_*`); a
     /// mirrored axis is a negative scale ([`Placement::mirrors`]).
     pub fn placement(&self, place: [f64; 2], settings: &Settings) -> Placement {
         let sign = |m: bool| if m { -1.0 } else { 1.0 };
@@ -419,7 +419,6 @@ impl JobSpec {
             let u = crate::base::settings::UnitId(p.unit);
             let at = format!("parts[{i}].unit");
             self.settings.check_unit(u, &at)?;
-            crate::base::settings::check_sliced(u, &at)?;
         }
         let total: u64 = self.parts.iter().map(|p| p.copies as u64).sum();
         if total > MAX_INSTANCES as u64 {

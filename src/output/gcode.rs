@@ -342,7 +342,7 @@ pub fn layer_text(plan: &LayerPlan) -> String {
 
 /// One layer's commands after a layer that left unit `before` selected: a `T` line (right
 /// after the layer's comment line) wherever the unit of the next move differs from the one
-/// selected, and nowhere else (docs/spec.md "Two discharge units").
+/// selected, and nowhere else (docs/spec.md "Discharge units").
 pub fn layer_text_after(plan: &LayerPlan, before: u8) -> String {
     let mut t = String::with_capacity(plan.moves.len() * 34 + 40);
     let z = coord(plan.z);
@@ -457,7 +457,21 @@ mod tests {
     fn the_filled_header_has_the_length_of_the_placeholders() {
         use crate::slicing::plan::Counts;
         let settings = Settings::default();
-        for unit1_used in [false, true] {
+        let units = Settings {
+            units: 3,
+            ..Settings::default()
+        };
+        let used: [&[UnitId]; 3] = [
+            &[UnitId(0)],
+            &[UnitId(0), UnitId(1)],
+            &[UnitId(0), UnitId(2)],
+        ];
+        for units_used in used {
+            let settings = if units_used.len() > 1 && units_used[1].0 == 2 {
+                &units
+            } else {
+                &settings
+            };
             let input = HeaderInput {
                 file_name: "part.stl",
                 facets: 12,
@@ -465,32 +479,40 @@ mod tests {
                 bounds: ([0.0; 3], [1.0; 3]),
                 warnings: &[],
                 instances: &[],
-                unit1_used,
+                units_used,
                 profiles: &[],
             };
-            let pending = header(&settings, &input, None);
+            let other = units_used.get(1).copied();
+            let pending = header(settings, &input, None);
             for (outer, travel) in [(0, 0.0), (7, 1.0 / 3.0), (u32::MAX as u64, 1e300)] {
+                let mut counts = Counts {
+                    outer,
+                    fill: 5,
+                    ..Counts::default()
+                };
+                if let Some(u) = other {
+                    counts.units[u.index()] = 1;
+                }
                 let summary = Summary {
                     layers: 3,
-                    counts: Counts {
-                        outer,
-                        fill: 5,
-                        unit1: u64::from(unit1_used),
-                        ..Counts::default()
-                    },
+                    counts,
                     travel_mm: travel,
                     ..Summary::default()
                 };
-                let filled = header(&settings, &input, Some(&summary));
+                let filled = header(settings, &input, Some(&summary));
                 assert_eq!(filled.len(), pending.len(), "{filled}");
-                let f = summary.figures(&settings);
+                let f = summary.figures(settings);
                 let line = filled.lines().find(|l| l.starts_with("; travel")).unwrap();
                 assert_eq!(
                     line,
                     format!("; travel               = {:>24} mm", exact(travel))
                 );
                 assert!(filled.contains(&format!("= {:>24} s\n", exact(f.print_seconds))));
-                assert_eq!(filled.contains("; volume unit 1"), unit1_used);
+                for u in [1, 2] {
+                    let named = filled.contains(&format!("; volume unit {u}"))
+                        && filled.contains(&format!("; droplets of unit {u}   = "));
+                    assert_eq!(named, other == Some(UnitId(u)), "{filled}");
+                }
             }
         }
     }

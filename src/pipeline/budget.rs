@@ -1,14 +1,15 @@
 //! The droplet estimate of a whole job, checked when the job is built (before a layer is
 //! sliced or a byte written; the page's `Session` builds the same [`crate::Job`]): the parts
-//! of unit 0 by their volume and B, the parts of unit 1 by theirs and B₁, and the support by a
-//! bound of its region, each against [`MAX_DROPLETS`] in all; the width of unit 1's region in
-//! droplets of B₁ against [`MAX_WIDTH_IN_DROPLETS`]; and with support on, the droplets one
+//! of unit 0 by their volume and B, the parts of every other unit N by theirs and B_N, and the
+//! support by a bound of its region (droplets of its unit's B_N), each against
+//! [`MAX_DROPLETS`] in all; the width of each other unit's region in its droplets against
+//! [`MAX_WIDTH_IN_DROPLETS`]; and with support on, the droplets one
 //! layer can hold against [`MAX_LAYER_DROPLETS_WITH_SUPPORT`] (the support's droplet-level
 //! pass lists a layer's droplets at once) and the whole job against
 //! [`MAX_DROPLETS_WITH_SUPPORT`] (the pass checks every droplet). docs/security.md *Droplet budget*.
 
 use crate::base::error::Error;
-use crate::base::settings::Settings;
+use crate::base::settings::{MAX_UNITS, Settings, UnitId};
 use crate::base::steps::{self, Budget};
 use crate::model::layout::Instance;
 use crate::model::mesh::Mesh;
@@ -27,45 +28,48 @@ pub const MAX_LAYER_DROPLETS_WITH_SUPPORT: f64 = 1e7;
 /// 10⁸ droplets natively, more in the page, where each worker runs it).
 pub const MAX_DROPLETS_WITH_SUPPORT: f64 = 1e8;
 
-/// The facets unit 1 prints (its parts): their signed volume and bounding box.
+/// The facets one unit other than 0 prints (its parts): their signed volume and bounding box.
 #[derive(Clone, Copy, Debug)]
-pub struct Unit1Parts {
+pub struct UnitParts {
     signed_volume: f64,
     min: [f64; 3],
     max: [f64; 3],
 }
 
-impl Unit1Parts {
-    /// The facets of `groups`' unit-1 runs (`None`: no unit-1 facet).
-    pub fn of(mesh: &Mesh, groups: &[FacetGroup]) -> Option<Unit1Parts> {
-        let mut out = Unit1Parts {
-            signed_volume: 0.0,
-            min: [f64::INFINITY; 3],
-            max: [f64::NEG_INFINITY; 3],
-        };
-        let mut any = false;
+/// Each unit's parts, indexed by unit (`None` for unit 0 and for a unit without a facet).
+pub type PartsByUnit = [Option<UnitParts>; MAX_UNITS];
+
+impl UnitParts {
+    /// The facets of `groups`' runs of each unit but 0.
+    pub fn of(mesh: &Mesh, groups: &[FacetGroup]) -> PartsByUnit {
+        let mut out: PartsByUnit = [None; MAX_UNITS];
         let mut at = 0usize;
         for g in groups {
             let end = (at + g.facets).min(mesh.facets.len());
-            if g.unit == 1 {
+            let unit = usize::from(g.unit);
+            if unit > 0 && unit < MAX_UNITS && end > at {
+                let u = out[unit].get_or_insert(UnitParts {
+                    signed_volume: 0.0,
+                    min: [f64::INFINITY; 3],
+                    max: [f64::NEG_INFINITY; 3],
+                });
                 for f in &mesh.facets[at..end] {
                     let [a, b, c] = f.map(|i| mesh.vertices[i as usize]);
-                    out.signed_volume += (a[0] * (b[1] * c[2] - b[2] * c[1])
+                    u.signed_volume += (a[0] * (b[1] * c[2] - b[2] * c[1])
                         - a[1] * (b[0] * c[2] - b[2] * c[0])
                         + a[2] * (b[0] * c[1] - b[1] * c[0]))
                         / 6.0;
                     for p in [a, b, c] {
-                        for ((lo, hi), x) in out.min.iter_mut().zip(&mut out.max).zip(p) {
+                        for ((lo, hi), x) in u.min.iter_mut().zip(&mut u.max).zip(p) {
                             *lo = lo.min(x);
                             *hi = hi.max(x);
                         }
                     }
-                    any = true;
                 }
             }
             at = end;
         }
-        any.then_some(out)
+        out
     }
 
     fn size(&self) -> [f64; 3] {
@@ -253,10 +257,7 @@ impl Overhangs {
     ///   r + w. (A droplet placed beside c, where c itself lies in the part or its gap below,
     ///   can come nearer an earlier one; those lie at the part's edges, a small share.)
     pub fn droplets(&self, s: &Settings) -> f64 {
-        let (b, b1) = (
-            s.droplet_width(),
-            s.unit_width(crate::base::settings::UnitId(1)),
-        );
+        let (b, b1) = (s.droplet_width(), s.support_width());
         let rho = s.support_density;
         let r = crate::support::support_reach(s) + 2.0 * crate::support::SUPPORT_TOLERANCE_MM;
         let d = 0.5 * b1.hypot(b1 / rho);
@@ -277,67 +278,74 @@ impl Overhangs {
 /// The volumes and areas the estimate counts droplets in.
 #[derive(Clone, Debug)]
 pub struct Estimate {
-    /// Unit 0's parts (mm³).
-    pub unit0_volume: f64,
-    /// Unit 1's parts (mm³).
-    pub unit1_volume: f64,
-    /// A bound of the support's droplets (of B₁): the lesser of [`Overhangs::droplets`] (under
-    /// the down-facing facets) and the hatch under each instance's footprint grown by the
-    /// support's reach, from the plate to the instance's top (that alone for open shells).
+    /// Each unit's parts (mm³), indexed by unit.
+    pub unit_volumes: [f64; MAX_UNITS],
+    /// A bound of the support's droplets (of its unit's B_N): the lesser of
+    /// [`Overhangs::droplets`] (under the down-facing facets) and the hatch under each
+    /// instance's footprint grown by the support's reach, from the plate to the instance's top
+    /// (that alone for open shells).
     pub support_droplets: f64,
     /// A bound of the area one layer covers (mm²): the instances' footprints, grown.
     pub footprint: f64,
-    /// The width of the region unit 1 prints (mm): its parts', or with support the job's grown.
-    pub unit1_extent: f64,
+    /// The width of the region each unit but 0 prints (mm): its parts', or for the support's
+    /// unit with support on the job's grown; indexed by unit.
+    pub unit_extents: [f64; MAX_UNITS],
     /// The job's size (mm), for the messages.
     size: [f64; 3],
 }
 
+/// B, B₁, B₂, B₃: unit `u`'s droplet width in a message.
+fn b_of(u: usize) -> &'static str {
+    ["B", "B₁", "B₂", "B₃"].get(u).copied().unwrap_or("B")
+}
+
 impl Estimate {
     /// The estimate of a job of `size` (mm) whose mesh encloses `volume` (mm³), of which
-    /// `unit1` is unit 1's (`open`: some shell is not closed, so unit 1's signed volume means
-    /// nothing and its bounding box is taken, and the support is bounded by the footprints
-    /// alone), placed as `instances` say; `overhangs`: the mesh's down-facing facets (every
-    /// unit's: support goes under either).
+    /// `parts` are the other units' (`open`: some shell is not closed, so their signed volumes
+    /// mean nothing and their bounding boxes are taken, and the support is bounded by the
+    /// footprints alone), placed as `instances` say; `overhangs`: the mesh's down-facing
+    /// facets (every unit's: support goes under any).
     pub fn new(
         volume: f64,
-        unit1: Option<Unit1Parts>,
+        parts: &PartsByUnit,
         open: bool,
         size: &[f64; 3],
         instances: &[Instance],
         overhangs: &Overhangs,
         s: &Settings,
     ) -> Estimate {
-        let (b0, b1) = (
-            s.droplet_width(),
-            s.unit_width(crate::base::settings::UnitId(1)),
-        );
-        let (unit0_volume, unit1_volume, unit1_extent) = match unit1 {
-            None => (volume, 0.0, 0.0),
-            Some(u) => {
+        let (b0, bs) = (s.droplet_width(), s.support_width());
+        let mut unit_volumes = [0.0; MAX_UNITS];
+        let mut unit_extents = [0.0; MAX_UNITS];
+        let mut others = None;
+        for (k, p) in parts.iter().enumerate().skip(1) {
+            if let Some(u) = p {
                 let [x, y, z] = u.size();
                 let bbox = x * y * z;
-                let v1 = if open {
+                unit_volumes[k] = if open {
                     bbox
                 } else {
                     u.signed_volume.abs().min(bbox)
                 };
-                let v0 = if open { volume } else { (volume - v1).max(0.0) };
-                (v0, v1, x.max(y))
+                unit_extents[k] = x.max(y);
+                *others.get_or_insert(0.0) += unit_volumes[k];
             }
+        }
+        unit_volumes[0] = match others {
+            Some(v) if !open => (volume - v).max(0.0),
+            _ => volume,
         };
         let mut e = Estimate {
-            unit0_volume,
-            unit1_volume,
+            unit_volumes,
             support_droplets: 0.0,
             footprint: 0.0,
-            unit1_extent,
+            unit_extents,
             size: *size,
         };
-        // Support lies under overhangs grown by B₁/2 (its droplets on lattice lines B₁ /
+        // Support lies under overhangs grown by B_N/2 (its droplets on lattice lines B_N /
         // support_density apart), and the droplet-level pass adds droplets within
-        // B₁/2 + overhang_limit × B of a droplet: all within `grow` of the parts' footprints.
-        let grow = 2.0 * b1 / s.support_density + s.overhang_limit * b0;
+        // B_N/2 + overhang_limit × B of a droplet: all within `grow` of the parts' footprints.
+        let grow = 2.0 * bs / s.support_density + s.overhang_limit * b0;
         let grown = |w: f64, d: f64| (w.min(size[0]) + 2.0 * grow) * (d.min(size[1]) + 2.0 * grow);
         let whole = grown(size[0], size[1]);
         let (mut area, mut under) = (0.0, 0.0);
@@ -361,118 +369,154 @@ impl Estimate {
         } else {
             whole * size[2]
         };
-        let footprint_bound = s.support_density * under / (b1 * b1 * s.layer_height);
+        let footprint_bound = s.support_density * under / (bs * bs * s.layer_height);
         e.support_droplets = if open {
             // The slicer closes open sections itself: down-facing facets may be missing.
             footprint_bound
         } else {
             footprint_bound.min(overhangs.droplets(s))
         };
-        if s.support.is_on() {
-            e.unit1_extent = size[0].max(size[1]) + 2.0 * grow;
+        if let Some(su) = s.support.unit() {
+            e.unit_extents[su.index()] = size[0].max(size[1]) + 2.0 * grow;
         }
         e
     }
 
     /// Refuses a job beyond the limits (module doc), naming the unit and the setting to change.
     pub fn check(&self, s: &Settings) -> Result<(), Error> {
-        check_droplets(self.unit0_volume, s)?;
+        check_droplets(self.unit_volumes[0], s)?;
         let h = s.layer_height;
-        let (b0, b1) = (
-            s.droplet_width(),
-            s.unit_width(crate::base::settings::UnitId(1)),
-        );
+        let b: Vec<f64> = UnitId::all(MAX_UNITS).map(|u| s.unit_width(u)).collect();
+        let aspect = |u: usize| UnitId(u as u8).name("droplet_aspect");
+        let su = s.support_unit().index();
         let support = s.support.is_on();
-        let d0 = self.unit0_volume / (b0 * b0 * h);
-        // Unit 1's droplets only where it prints: a B₁ that no part and no support uses is
-        // never checked (its B₁² may be tiny).
-        let d1 = if self.unit1_volume > 0.0 {
-            self.unit1_volume / (b1 * b1 * h)
-        } else {
-            0.0
-        };
+        // A unit's droplets only where it prints: a B_N that no part and no support uses is
+        // never checked (its B_N² may be tiny).
+        let d: Vec<f64> = (0..MAX_UNITS)
+            .map(|u| match u {
+                0 => self.unit_volumes[0] / (b[0] * b[0] * h),
+                _ if self.unit_volumes[u] > 0.0 => self.unit_volumes[u] / (b[u] * b[u] * h),
+                _ => 0.0,
+            })
+            .collect();
         let ds = if support { self.support_droplets } else { 0.0 };
-        let total = d0 + d1 + ds;
+        let total = d.iter().sum::<f64>() + ds;
+        // The other unit whose parts take the most droplets.
+        let most = (1..MAX_UNITS)
+            .max_by(|&x, &y| d[x].total_cmp(&d[y]))
+            .unwrap_or(1);
         let [x, y, z] = self.size;
         if over(total, MAX_DROPLETS) {
-            let (name, message) = if over(d1, ds) && self.unit1_volume > 0.0 {
+            let (name, message) = if over(d[most], ds) && self.unit_volumes[most] > 0.0 {
                 (
-                    "unit1_droplet_aspect",
+                    aspect(most),
                     format!(
-                        "the parts of unit 1 ({:.0} mm³) would take about {d1:.1e} droplets of B₁ = {} mm ({total:.1e} for the whole job), more than the {MAX_DROPLETS:.0e} allowed; raise unit1_droplet_aspect (or layer_height)",
-                        self.unit1_volume,
-                        mm(b1)
+                        "the parts of unit {most} ({:.0} mm³) would take about {:.1e} droplets of {} = {} mm ({total:.1e} for the whole job), more than the {MAX_DROPLETS:.0e} allowed; raise {} (or layer_height)",
+                        self.unit_volumes[most],
+                        d[most],
+                        b_of(most),
+                        mm(b[most]),
+                        aspect(most)
                     ),
                 )
             } else {
                 (
-                    "support",
+                    "support".to_string(),
                     format!(
-                        "support under the parts ({x:.0} × {y:.0} × {z:.0} mm) could take up to {ds:.1e} droplets of B₁ = {} mm ({total:.1e} for the whole job), more than the {MAX_DROPLETS:.0e} allowed; raise unit1_droplet_aspect (or layer_height), or set support = off",
-                        mm(b1)
+                        "support under the parts ({x:.0} × {y:.0} × {z:.0} mm) could take up to {ds:.1e} droplets of {} = {} mm ({total:.1e} for the whole job), more than the {MAX_DROPLETS:.0e} allowed; raise {} (or layer_height), or set support = off",
+                        b_of(su),
+                        mm(b[su]),
+                        aspect(su)
                     ),
                 )
             };
-            return Err(Error::setting(name, message));
+            return Err(Error::setting(&name, message));
         }
         if support && over(total, MAX_DROPLETS_WITH_SUPPORT) {
-            let (name, what) = if d0 >= d1.max(ds) {
+            let (name, what) = if d[0] >= d[most].max(ds) {
                 (
-                    "droplet_aspect",
-                    format!("{d0:.1e} of unit 0's B = {} mm", mm(b0)),
+                    aspect(0),
+                    format!("{:.1e} of unit 0's B = {} mm", d[0], mm(b[0])),
                 )
-            } else if d1 >= ds {
+            } else if d[most] >= ds {
                 (
-                    "unit1_droplet_aspect",
-                    format!("{d1:.1e} of unit 1's parts, B₁ = {} mm", mm(b1)),
+                    aspect(most),
+                    format!(
+                        "{:.1e} of unit {most}'s parts, {} = {} mm",
+                        d[most],
+                        b_of(most),
+                        mm(b[most])
+                    ),
                 )
             } else {
                 (
-                    "unit1_droplet_aspect",
-                    format!("up to {ds:.1e} of support, B₁ = {} mm", mm(b1)),
+                    aspect(su),
+                    format!("up to {ds:.1e} of support, {} = {} mm", b_of(su), mm(b[su])),
                 )
             };
             let figure = format!("the job could take up to {total:.1e} droplets");
             return Err(too_many_with_support(
-                name,
+                &name,
                 &figure,
                 &what,
                 MAX_DROPLETS_WITH_SUPPORT,
             ));
         }
-        let used = support || self.unit1_volume > 0.0;
-        let lines = self.unit1_extent / b1;
-        if used && over(lines, MAX_WIDTH_IN_DROPLETS) {
-            return Err(Error::setting(
-                "unit1_droplet_aspect",
-                format!(
-                    "unit 1's region would be {:.0} mm wide{}, more than {MAX_WIDTH_IN_DROPLETS} droplets of B₁ = {} mm; raise unit1_droplet_aspect{}",
-                    self.unit1_extent,
-                    if support { " (support)" } else { "" },
-                    mm(b1),
-                    if support { " or set support = off" } else { "" }
-                ),
-            ));
+        for u in 1..MAX_UNITS {
+            let prints_support = support && u == su;
+            let used = prints_support || self.unit_volumes[u] > 0.0;
+            let lines = self.unit_extents[u] / b[u];
+            if used && over(lines, MAX_WIDTH_IN_DROPLETS) {
+                return Err(Error::setting(
+                    &aspect(u),
+                    format!(
+                        "unit {u}'s region would be {:.0} mm wide{}, more than {MAX_WIDTH_IN_DROPLETS} droplets of {} = {} mm; raise {}{}",
+                        self.unit_extents[u],
+                        if prints_support { " (support)" } else { "" },
+                        b_of(u),
+                        mm(b[u]),
+                        aspect(u),
+                        if prints_support {
+                            " or set support = off"
+                        } else {
+                            ""
+                        }
+                    ),
+                ));
+            }
         }
         if support {
             let a = self.footprint;
-            let p0 = a / (b0 * b0);
-            let p1 = a * (s.support_density + if self.unit1_volume > 0.0 { 1.0 } else { 0.0 })
-                / (b1 * b1);
-            let per_layer = p0 + p1;
+            let per: Vec<f64> = (0..MAX_UNITS)
+                .map(|u| {
+                    let layers = match u {
+                        0 => 1.0,
+                        _ => {
+                            (if u == su { s.support_density } else { 0.0 })
+                                + if self.unit_volumes[u] > 0.0 { 1.0 } else { 0.0 }
+                        }
+                    };
+                    a * layers / (b[u] * b[u])
+                })
+                .collect();
+            let per_layer: f64 = per.iter().sum();
             if over(per_layer, MAX_LAYER_DROPLETS_WITH_SUPPORT) {
-                let (name, what) = if p0 >= p1 {
-                    ("droplet_aspect", format!("unit 0's B = {} mm", mm(b0)))
+                let worst = (1..MAX_UNITS)
+                    .max_by(|&x, &y| per[x].total_cmp(&per[y]))
+                    .unwrap_or(1);
+                let others: f64 = per[1..].iter().sum();
+                let (name, what) = if per[0] >= others {
+                    (aspect(0), format!("unit 0's B = {} mm", mm(b[0])))
                 } else {
                     (
-                        "unit1_droplet_aspect",
-                        format!("unit 1's B₁ = {} mm", mm(b1)),
+                        aspect(worst),
+                        format!("unit {worst}'s {} = {} mm", b_of(worst), mm(b[worst])),
                     )
                 };
                 let figure =
                     format!("a layer of {a:.0} mm² could hold up to {per_layer:.1e} droplets");
                 return Err(too_many_with_support(
-                    name,
+                    &name,
                     &figure,
                     &what,
                     MAX_LAYER_DROPLETS_WITH_SUPPORT,

@@ -155,7 +155,7 @@ impl Job {
         let by_part = models_of(models, spec)?;
         // Before any part is welded: a small 3MF may instance millions of triangles per part.
         check_job_triangles(models, spec)?;
-        // Runs of consecutive parts of one unit (docs/spec.md "Two discharge units": where
+        // Runs of consecutive parts of one unit (docs/spec.md "Discharge units": where
         // parts of different units overlap, the part listed first keeps the overlap).
         let mut run_of = Vec::with_capacity(spec.parts.len());
         for (i, p) in spec.parts.iter().enumerate() {
@@ -564,11 +564,11 @@ impl Checked {
         } = self;
         let repaired = repaired.map(|(b, s)| (b, with_repairs(s, &shells, weld, duplicates)));
         // One droplet estimate for the whole job: every unit and the support.
-        let unit1 = budget::Unit1Parts::of(&mesh, &groups);
+        let parts = budget::UnitParts::of(&mesh, &groups);
         let open = shells.open > 0;
         let mut estimate = budget::Estimate::new(
             volume,
-            unit1,
+            &parts,
             open,
             &size,
             &input.instances,
@@ -584,7 +584,7 @@ impl Checked {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
             let h = settings.layer_height;
-            estimate.unit0_volume = budget::sampled_volume(&mesh, &buckets, &zs, h);
+            estimate.unit_volumes[0] = budget::sampled_volume(&mesh, &buckets, &zs, h);
             estimate.check(&settings)?;
         }
         // The plate rule (after the checks of the job's size and droplets, so those speak first).

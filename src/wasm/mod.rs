@@ -446,7 +446,7 @@ impl Session {
         Ok(Session::with(job))
     }
 
-    /// Works through about `items` layers' worth of the supported pass (`support = unit1`:
+    /// Works through about `items` layers' worth of the supported pass (`support = unitN`:
     /// every layer's plan with the support, which the first layer planned would otherwise
     /// make whole in one call; [`Job::supported_in_steps`]): true once it is made, at once
     /// when the support is off. The page calls it until true before it plans layers.

@@ -238,7 +238,7 @@ pub struct Cmd {
     pub x: f64,
     pub y: f64,
     pub z: f64,
-    /// The discharge unit selected by the last `T0`/`T1` line before it (0 at the start).
+    /// The discharge unit selected by the last `T0` … `T3` line before it (0 at the start).
     pub unit: u8,
 }
 
@@ -251,7 +251,7 @@ impl Cmd {
 /// Droplet centres of a layer with their unit: `G26` one, `G25` one every B of its unit
 /// (`b[unit]`) from the current position (`at`: the position before the layer's first
 /// command, left at the layer's last).
-pub fn unit_droplets(layer: &Layer, at: &mut Point, b: [f64; 2]) -> Vec<(Point, u8)> {
+pub fn unit_droplets(layer: &Layer, at: &mut Point, b: &[f64]) -> Vec<(Point, u8)> {
     let mut out = Vec::new();
     for c in &layer.cmds {
         let to = c.p();
@@ -382,9 +382,9 @@ pub struct Gcode {
     pub header: Vec<(String, String)>,
     pub layers: Vec<Layer>,
     /// Lines that break docs/spec.md 4.5's format (not a comment, not `G01/G25/G26 Xx Yy Zz` with
-    /// exactly 4 decimals, nor `T0`/`T1`), with their line numbers.
+    /// exactly 4 decimals, nor `T0` … `T3`), with their line numbers.
     pub bad_lines: Vec<String>,
-    /// `T0`/`T1` lines: (line number from 1, unit).
+    /// `T0` … `T3` lines: (line number from 1, unit).
     pub unit_lines: Vec<(usize, u8)>,
 }
 
@@ -430,6 +430,8 @@ pub fn parse_gcode(text: &str) -> Gcode {
         if let Some(u) = match line {
             "T0" => Some(0),
             "T1" => Some(1),
+            "T2" => Some(2),
+            "T3" => Some(3),
             _ => None,
         } {
             unit = u;
@@ -483,7 +485,7 @@ pub fn parse_gcode(text: &str) -> Gcode {
     g
 }
 
-/// `T` lines (docs/spec.md "Two discharge units") stand only where the unit changes, from T0,
+/// `T` lines (docs/spec.md "Discharge units") stand only where the unit changes, from T0,
 /// and
 /// each is followed by a command (comments aside). `what` prefixes failure messages.
 pub fn assert_unit_changes(text: &str, what: &str) {

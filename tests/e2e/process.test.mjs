@@ -184,7 +184,7 @@ test("the predicted density per unit in the statistics is the command line's", a
   const report = join(dir, "two-units.report.json");
   execFileSync(cli, [jobFile, "-o", join(dir, "two-units.gco"), "--report", report, "-q"]);
   const part = JSON.parse(readFileSync(report, "utf8")).part;
-  const expected = [`${part.predicted_density.toFixed(1)} %`, `${part.unit1.predicted_density.toFixed(1)} %`];
+  const expected = [`${part.predicted_density.toFixed(1)} %`, `${part.units[1].predicted_density.toFixed(1)} %`];
 
   const { page, errors } = await openPage(env.browser, env.url);
   await waitDone(page, 60_000);

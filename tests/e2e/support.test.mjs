@@ -149,7 +149,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
   await page.click("#btn-slice");
   s = await waitDone(page);
   assert.ok(s.counts.support > 0, `support droplets ${s.counts.support}`);
-  assert.equal(s.unit1, s.counts.support, "all unit-1 droplets are support");
+  assert.equal(s.unitDroplets[1], s.counts.support, "all unit-1 droplets are support");
   const shown = Number((await page.locator("#stat-support").innerText()).replace(/[^\d]/g, ""));
   assert.equal(shown, s.counts.support);
   assert.equal(await page.isVisible("#unit-stats"), true);
@@ -210,7 +210,7 @@ test("a two-material job: two colours on the canvas, T lines in the download", a
   await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 1);
   await page.click("#btn-slice");
   const s = await waitDone(page);
-  assert.ok(s.unit1 > 0, "unit-1 droplets");
+  assert.ok(s.unitDroplets[1] > 0, "unit-1 droplets");
   assert.equal(s.counts.support ?? 0, 0);
   await page.evaluate((i) => window.dropslice.show(i), Math.floor(s.layers / 2));
   await page.click("#mode-layer");
@@ -221,7 +221,7 @@ test("a two-material job: two colours on the canvas, T lines in the download", a
   assert.equal(await page.isVisible("#legend-unit1"), true);
   const g = readBack(await downloadText(page));
   assert.ok(g.tLines > 0, "T lines");
-  assert.equal(g.unit1, s.unit1);
+  assert.equal(g.unit1, s.unitDroplets[1]);
   // each unit's droplets lie in its part's box on the plate (the core's layout)
   const { layout } = await page.evaluate(() => window.dropslice.job());
   const box = (unit) => layout.instances.find((x) => x.unit === unit);

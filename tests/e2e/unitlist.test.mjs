@@ -10,7 +10,7 @@ import { copyFileSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs"
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { pathToFileURL } from "node:url";
-import { benchy, countPixels, pick, repo, startWithPage, stop, waitDone } from "./helpers.mjs";
+import { benchy, countPixels, downloadText, pick, repo, startWithPage, stop, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
@@ -152,9 +152,9 @@ test("one unit hides unit 1's controls; three give unit 2 its choice and group",
   assert.deepEqual(errors, []);
 });
 
-// The core takes `units` up to 4 but prints parts and support with units 0 and 1 only so far
-// (issue 41 item 3): a part of unit 2 is refused with that sentence. This half waits for it.
-test("three units print a unit-2 part with its droplets and colour", { skip: "the core prints with units 0 and 1 only so far (issue 41)" }, async () => {
+// Every unit prints: a part of unit 2 on a machine of three units, then two materials and
+// the support from unit 2.
+test("three units print a unit-2 part with its droplets and colour", async () => {
   const { page, errors } = main;
   await setField(page, "units", 3);
   await page.waitForFunction(() => document.querySelectorAll("#part-unit option").length === 3);
@@ -192,5 +192,22 @@ test("three units print a unit-2 part with its droplets and colour", { skip: "th
   // unit 2's droplets in its colour (#6b4226, within a few levels: the selected part is tinted)
   const unit2 = "Math.abs(r - 0x6b) < 12 && Math.abs(g - 0x42) < 12 && Math.abs(b - 0x26) < 12";
   assert.ok((await countPixels(page, unit2)) > 300, "the unit-2 part in its colour");
+
+  // two materials (3DBenchy by unit 0, the cube by unit 1) and the support from unit 2
+  await pick(page, [benchy, a]);
+  await waitDone(page);
+  await page.click(".part-item:nth-child(2)");
+  await page.selectOption("#part-unit", "1");
+  await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 1);
+  await page.selectOption("#set-support", "unit2");
+  await page.click("#btn-slice");
+  const t = await waitDone(page);
+  assert.ok(t.counts.support > 0, `support droplets ${t.counts.support}`);
+  assert.equal(t.unitDroplets[2], t.counts.support, "unit 2 prints the support and nothing else");
+  assert.ok(t.unitDroplets[1] > 0 && t.unitDroplets[0] > 0, `${t.unitDroplets}`);
+  const code = await downloadText(page);
+  assert.ok(code.includes("\nT2\n") && code.includes("\nT1\n"), "T1 and T2 lines");
+  assert.match(code, new RegExp(`; droplets of unit 2 += +${t.unitDroplets[2]}\\n`));
+  assert.match(code, new RegExp(`; droplets of unit 1 += +${t.unitDroplets[1]}\\n`));
   assert.deepEqual(errors, []);
 });

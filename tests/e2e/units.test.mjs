@@ -58,7 +58,7 @@ test("G-code reader: G25 lines expand to droplets every B, layers split on Z", (
   );
   assert.equal(reader.dropletWidth, B);
   assert.equal(layers.length, 2);
-  assert.deepEqual(layers[0].counts, { outer: 2, inner: 0, fill: 11, support: 0, unit1: 0, parts: [13] });
+  assert.deepEqual(layers[0].counts, { outer: 2, inner: 0, fill: 11, support: 0, units: [13, 0, 0, 0], parts: [13] });
   assert.equal(layers[0].roles.length, 13);
   assert.ok(Math.abs(layers[0].droplets[2 * 12] - 10 * B) < 1e-4, "last droplet at the line's end");
   assert.ok(Math.abs(layers[0].droplets[2 * 3] - B) < 1e-6, "second droplet one B along");
@@ -75,7 +75,7 @@ test("G-code reader: after T1 droplets are unit 1's, every B₁ along a G25 line
       `G25 X${(3 * B1).toFixed(4)} Y1.0000 Z0.2000\nT0\nG26 X0.0000 Y2.0000 Z0.2000\n`,
   );
   assert.deepEqual([...layers[0].units], [0, 1, 1, 1, 1, 0]);
-  assert.equal(layers[0].counts.unit1, 4);
+  assert.equal(layers[0].counts.units[1], 4);
   assert.deepEqual(layers[0].counts.parts, [2, 4], "each unit's droplets, from the droplets' units");
   assert.ok(Math.abs(layers[0].droplets[2 * 2] - B1) < 1e-4, "unit 1's droplets B₁ apart");
 });
@@ -212,8 +212,8 @@ test("units: each unit's figures from the core's two-unit fields, or its per-uni
   assert.deepEqual(f.units(3).map((u) => [u.droplets, u.seconds, u.density]), [[1, 4, null], [2, 5, 98], [3, 6, null]]);
   // a .gco file: each unit's droplets as read
   const g = new figures.Figures();
-  g.addReadLayer({ counts: { outer: 2, inner: 0, fill: 3, support: 0, unit1: 1, parts: [4, 1] }, travelMm: 0 });
-  g.addReadLayer({ counts: { outer: 1, inner: 0, fill: 0, support: 0, unit1: 0, parts: [1] }, travelMm: 0 });
+  g.addReadLayer({ counts: { outer: 2, inner: 0, fill: 3, support: 0, units: [4, 1, 0, 0], parts: [4, 1] }, travelMm: 0 });
+  g.addReadLayer({ counts: { outer: 1, inner: 0, fill: 0, support: 0, units: [1, 0, 0, 0], parts: [1] }, travelMm: 0 });
   assert.deepEqual(g.units(2).map((u) => u.droplets), [5, 1]);
   assert.equal(g.units(2)[1].volume, null);
 });
@@ -268,7 +268,7 @@ test("units: each unit's colour class in the layer view and the cut, each unit's
   assert.deepEqual([...CLASS_ORDER].sort(), [0, 1, 2, 3, 4, 5, 6], "every class drawn once");
   // a layer's stack: each unit's parts, then the support; with fewer units shown than the
   // droplets name, the rest go to the last unit shown
-  const c = { outer: 5, inner: 0, fill: 6, support: 4, unit1: 6, parts: [7, 2, 2] };
+  const c = { outer: 5, inner: 0, fill: 6, support: 4, units: [7, 6, 2, 0], parts: [7, 2, 2] };
   assert.deepEqual(plot.stackOf(c, 3), [7, 2, 2, 4]);
   assert.deepEqual(plot.stackOf(c, 4), [7, 2, 2, 0, 4]);
   assert.deepEqual(plot.stackOf(c, 2), [7, 4, 4]);

@@ -20,33 +20,18 @@ export interface UnitFigures {
   density: number | null;
 }
 
-/** The core's per-unit figures as arrays indexed by unit, where the core gives them so (a core
- *  of N units); else its two-unit fields (`unit1_droplets`, …) are read. */
-const UNIT_ARRAYS = {
-  droplets: "unit_droplets",
-  volume: "unit_volume_mm3",
-  mass: "unit_mass_g",
-  seconds: "unit_seconds",
-  density: "unit_predicted_density",
-} as const;
-
 const finiteOr = (v: unknown, or: number | null): number | null => (typeof v === "number" && Number.isFinite(v) ? v : or);
 
-/** Unit u's figures of the core's `c`, of a job of `n` units. */
+/** Unit u's figures of the core's `c` (its per-unit arrays, indexed by unit; a unit beyond
+ *  them prints nothing). */
 function coreUnit(c: CoreFigures, u: number): UnitFigures {
-  const arrays = c as unknown as Record<string, unknown>;
-  const at = (key: keyof typeof UNIT_ARRAYS): unknown => {
-    const a = arrays[UNIT_ARRAYS[key]];
-    return Array.isArray(a) ? a[u] : undefined;
+  return {
+    droplets: finiteOr(c.unit_droplets?.[u], 0)!,
+    volume: finiteOr(c.unit_volume_mm3?.[u], 0),
+    mass: finiteOr(c.unit_mass_g?.[u], 0),
+    seconds: finiteOr(c.unit_seconds?.[u], 0),
+    density: finiteOr(c.unit_predicted_density?.[u], null),
   };
-  if (Array.isArray(arrays[UNIT_ARRAYS.droplets])) {
-    return { droplets: finiteOr(at("droplets"), 0)!, volume: finiteOr(at("volume"), 0), mass: finiteOr(at("mass"), 0), seconds: finiteOr(at("seconds"), 0), density: finiteOr(at("density"), null) };
-  }
-  // a core of two units: unit 0's volume and mass are the job's, its droplets the rest
-  const unit1 = c.unit1_droplets ?? 0;
-  if (u === 0) return { droplets: Math.max(0, c.droplets - unit1), volume: c.volume_mm3, mass: c.mass_g, seconds: finiteOr(c.unit0_seconds, null), density: finiteOr(c.predicted_density, null) };
-  if (u === 1) return { droplets: unit1, volume: c.unit1_volume_mm3 ?? 0, mass: c.unit1_mass_g ?? 0, seconds: finiteOr(c.unit1_seconds, null), density: finiteOr(c.unit1_predicted_density, null) };
-  return { droplets: 0, volume: 0, mass: 0, seconds: 0, density: null };
 }
 
 export class Figures {
@@ -60,7 +45,7 @@ export class Figures {
   /** Set by the core when every layer is in and not one droplet fits. */
   nothingToPrint: ErrorValue | null = null;
   /** A .gco file's droplets and travel, as read. */
-  private read: Counts = { outer: 0, inner: 0, fill: 0, support: 0, unit1: 0 };
+  private read: Counts = { outer: 0, inner: 0, fill: 0, support: 0, units: [0, 0, 0, 0] };
   private readTravel = 0;
   /** A .gco file's droplets per unit (after `T0`, `T1`, …), as read. */
   private readUnits: number[] = [0];
@@ -91,7 +76,7 @@ export class Figures {
     this.read.outer += l.counts.outer;
     this.read.inner += l.counts.inner;
     this.read.fill += l.counts.fill;
-    this.read.unit1 = (this.read.unit1 ?? 0) + (l.counts.unit1 ?? 0);
+    l.counts.units?.forEach((d, u) => (this.read.units[u] = (this.read.units[u] ?? 0) + d));
     l.counts.parts.forEach((d, u) => (this.readUnits[u] = (this.readUnits[u] ?? 0) + d));
     this.readTravel += l.travelMm;
   }

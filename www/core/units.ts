@@ -1,4 +1,4 @@
-// The machine's discharge units (docs/spec.md "Two discharge units", as a list): how many there are (the setting
+// The machine's discharge units (docs/spec.md "Discharge units", as a list): how many there are (the setting
 // `units`, 1 … 4; 2 when the settings have no `units`, as a core before that setting), each
 // unit's settings (`unitN_<name>` for unit N ≥ 1, the plain name for unit 0), the unit that
 // prints the support (`support = unitN`) and each unit's colours. Every view that shows

@@ -103,7 +103,7 @@ function yieldToQueue(): Promise<void> {
 /** Layers per call of the supported pass. */
 const SUPPORT_ITEMS = 4;
 
-/** With `support = unit1`: the supported pass (every layer's plan with the support) in short
+/** With `support = unitN`: the supported pass (every layer's plan with the support) in short
  *  calls, before the first layer is planned (which would otherwise make it in one call). */
 function supported(s: Session): void {
   while (!timedCall("core: the supported pass, the longest call", () => s.support_step(SUPPORT_ITEMS)));

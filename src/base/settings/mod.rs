@@ -271,9 +271,6 @@ impl Settings {
         for (name, u) in named.chain(ordered) {
             self.check_unit(u, name)?;
         }
-        if let Some(u) = self.support.unit() {
-            check_sliced(u, "support")?;
-        }
         // A unit's own setting set for a unit the machine does not have is a mistake (a
         // material for unit 2 on a machine of two units).
         for e in entries() {
@@ -377,24 +374,6 @@ impl Settings {
             })
             .collect()
     }
-}
-
-/// The units this version prints with: 0 and 1. The settings name up to [`MAX_UNITS`] units
-/// (`units`, `unitN_…`, `unit_order`), but support and parts of a unit beyond 1 are refused
-/// until the planner prints more than two (docs/spec.md "Discharge units").
-pub const SLICED_UNITS: usize = 2;
-
-/// Refuses a unit this version does not print with ([`SLICED_UNITS`]).
-pub fn check_sliced(u: UnitId, what: &str) -> Result<(), Error> {
-    if u.index() < SLICED_UNITS {
-        return Ok(());
-    }
-    Err(Error::Setting {
-        name: what.to_string(),
-        message: format!(
-            "names discharge unit {u}: this version prints parts and support with units 0 and 1 only (docs/spec.md \"Discharge units\")"
-        ),
-    })
 }
 
 /// The page's TypeScript type of the settings, `www/core/settings.gen.ts`, made from the

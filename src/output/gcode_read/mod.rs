@@ -6,10 +6,10 @@
 //! travels and sets one droplet. B = `layer_height` × `droplet_aspect`, read from the header's
 //! `; name = value` lines before the first command. G-code does not say which loop a droplet
 //! belongs to: every `G26` droplet counts as a loop droplet (role 0), every `G25` droplet as
-//! fill (role 2). A new layer starts where Z changes by more than 1e-6 mm. `T0`/`T1` select
+//! fill (role 2). A new layer starts where Z changes by more than 1e-6 mm. `T0` … `T3` select
 //! the discharge unit of the commands that follow (a file starts with unit 0); every droplet
-//! is tagged with its unit ([`ReadLayer::units`]), and unit 1's `G25` lines set droplets every
-//! B₁ = `layer_height` × `unit1_droplet_aspect` (default 1.04).
+//! is tagged with its unit ([`ReadLayer::units`]), and unit N's `G25` lines set droplets every
+//! B_N = `layer_height` × `unitN_droplet_aspect` (default: unit 0's default aspect).
 //!
 //! A file may come from anyone: the bounds below keep a crafted file from freezing the page or
 //! filling its memory, and every refusal names the line and the reason. G-code of another kind
@@ -352,15 +352,22 @@ mod tests {
         let (layers, _) = read_gcode(&text).unwrap();
         // Unit 1's line: droplets every 0.4 mm (4); unit 0's: every 0.2 mm (5).
         assert_eq!(layers[0].units, vec![0, 1, 1, 1, 1, 0, 0, 0, 0, 0]);
-        assert_eq!(layers[0].counts.unit1, 4);
+        assert_eq!(layers[0].counts.units, [6, 4, 0, 0]);
         assert_eq!(layers[0].counts.total(), 10);
-        let err = read_gcode(&format!("{head}T2\nG26 X0 Y0 Z0.2\n"))
-            .unwrap_err()
-            .0;
-        assert_eq!(
-            err,
-            "line 4: \"T2\" selects a discharge unit this slicer does not have: only T0 and T1 are known"
-        );
+        // Unit 3 (the last a machine may have) with the default aspect of its own setting.
+        let (layers, _) = read_gcode(&format!("{head}T3\nG25 X1.0400 Y0 Z0.2\n")).unwrap();
+        assert_eq!((layers[0].units.len(), layers[0].counts.units[3]), (5, 5));
+        for bad in ["T4", "T01", "T-1"] {
+            let err = read_gcode(&format!("{head}{bad}\nG26 X0 Y0 Z0.2\n"))
+                .unwrap_err()
+                .0;
+            assert_eq!(
+                err,
+                format!(
+                    "line 4: \"{bad}\" selects a discharge unit this slicer does not have: only T0 … T3 are known"
+                )
+            );
+        }
     }
 
     /// A filament printer's code (PrusaSlicer, Cura) is named as such, with its first

@@ -2,6 +2,9 @@
 use super::*;
 use crate::base::settings::{Support, UnitId};
 
+/// No parts of units other than 0.
+const NONE: PartsByUnit = [None; MAX_UNITS];
+
 fn setting(r: Result<(), Error>) -> String {
     match r {
         Err(Error::Setting { name, .. }) => name,
@@ -223,12 +226,12 @@ fn each_unit_and_the_support_count_with_their_own_droplets() {
     let none = Overhangs::default();
     // The 20 mm cube by unit 0, with and without support: well within every limit.
     let cube_check =
-        |s: &Settings| Estimate::new(8000.0, None, false, &size, &[], &none, s).check(s);
+        |s: &Settings| Estimate::new(8000.0, &NONE, false, &size, &[], &none, s).check(s);
     let with_support = |s: &Settings| Settings {
         support: Support::Unit(UnitId(1)),
         ..s.clone()
     };
-    let e = Estimate::new(8000.0, None, false, &size, &[], &none, &s);
+    let e = Estimate::new(8000.0, &NONE, false, &size, &[], &none, &s);
     assert!(e.check(&s).is_ok());
     let on = with_support(&s);
     assert!(cube_check(&on).is_ok());
@@ -248,26 +251,55 @@ fn each_unit_and_the_support_count_with_their_own_droplets() {
         t
     };
     let flat = Overhangs::of(&cuboid([0.0; 3], size), &zs(&s));
-    let e = Estimate::new(8000.0, None, false, &size, &[], &flat, &fine_on);
+    let e = Estimate::new(8000.0, &NONE, false, &size, &[], &flat, &fine_on);
     assert!(e.check(&fine_on).is_ok());
     // An open mesh keeps the footprint bound.
-    let e = Estimate::new(8000.0, None, true, &size, &[], &flat, &fine_on);
+    let e = Estimate::new(8000.0, &NONE, true, &size, &[], &flat, &fine_on);
     assert_eq!(setting(e.check(&fine_on)), "unit1_droplet_aspect");
     // A box lifted 10 mm off the plate: support under its bottom, refused with a tiny B₁.
     let lifted = Overhangs::of(&cuboid([0.0, 0.0, 10.0], [20.0, 20.0, 20.0]), &zs(&s));
-    let e = Estimate::new(4000.0, None, false, &size, &[], &lifted, &tiny_on);
+    let e = Estimate::new(4000.0, &NONE, false, &size, &[], &lifted, &tiny_on);
     assert_eq!(setting(e.check(&tiny_on)), "support");
-    let e = Estimate::new(4000.0, None, false, &size, &[], &lifted, &on);
+    let e = Estimate::new(4000.0, &NONE, false, &size, &[], &lifted, &on);
     assert!(e.check(&on).is_ok());
     // A unit-1 part of the whole cube: its droplets are of B₁.
-    let cube = Unit1Parts {
+    let cube = UnitParts {
         signed_volume: 8000.0,
         min: [0.0; 3],
         max: size,
     };
-    let e = Estimate::new(8000.0, Some(cube), false, &size, &[], &none, &tiny);
-    assert_eq!(e.unit0_volume, 0.0);
+    let mut parts = NONE;
+    parts[1] = Some(cube);
+    let e = Estimate::new(8000.0, &parts, false, &size, &[], &none, &tiny);
+    assert_eq!(e.unit_volumes[0], 0.0);
     assert_eq!(setting(e.check(&tiny)), "unit1_droplet_aspect");
+    // The same cube as a part of unit 2 (of three): its droplets are of B₂, and a tiny B₁
+    // that nothing prints is never checked.
+    let mut three = Settings {
+        units: 3,
+        ..tiny.clone()
+    };
+    three.unit_mut(UnitId(2)).droplet_aspect = three.unit(UnitId(1)).droplet_aspect;
+    three.unit_mut(UnitId(1)).droplet_aspect = 1.0;
+    let mut parts = NONE;
+    parts[2] = Some(cube);
+    let e = Estimate::new(8000.0, &parts, false, &size, &[], &none, &three);
+    assert_eq!(setting(e.check(&three)), "unit2_droplet_aspect");
+    three.unit_mut(UnitId(1)).droplet_aspect = tiny.unit(UnitId(1)).droplet_aspect;
+    three.unit_mut(UnitId(2)).droplet_aspect = 1.0;
+    assert!(e.check(&three).is_ok());
+    // Support from unit 3 with a tiny B₃ under a lifted box: refused naming unit 3.
+    let mut four = Settings {
+        units: 4,
+        support: Support::Unit(UnitId(3)),
+        ..Settings::default()
+    };
+    four.unit_mut(UnitId(3)).droplet_aspect = tiny.unit(UnitId(1)).droplet_aspect;
+    let e = Estimate::new(4000.0, &NONE, false, &size, &[], &lifted, &four);
+    assert_eq!(setting(e.check(&four)), "support");
+    four.unit_mut(UnitId(3)).droplet_aspect = 1.0;
+    let e = Estimate::new(4000.0, &NONE, false, &size, &[], &lifted, &four);
+    assert!(e.check(&four).is_ok());
     assert!(e.check(&s).is_ok());
     // A small unit-0 B: fine alone, too many for the support's pass.
     let small = {
@@ -289,7 +321,7 @@ fn a_b1_whose_square_underflows_counts_nothing_where_unit_1_prints_nothing() {
         t.unit_mut(UnitId(1)).droplet_aspect = 1e-300;
         t
     };
-    let e = Estimate::new(8000.0, None, false, &size, &[], &Overhangs::default(), &s);
+    let e = Estimate::new(8000.0, &NONE, false, &size, &[], &Overhangs::default(), &s);
     assert!(e.check(&s).is_ok(), "{:?}", e.check(&s));
     assert!(s.validate().is_err());
 }
