@@ -233,7 +233,7 @@ fn slabs_from_the_workers_give_the_report_of_the_ordered_slabs() {
         }
         assert_eq!(workers.part.volume.to_bits(), volume.to_bits(), "{model}");
         assert!(workers.part.void_volume > 0.0 && workers.part.void_fraction < 0.5);
-        assert!(workers.part.unit1.is_none(), "{model}");
+        assert!(workers.part.units.is_empty(), "{model}");
     }
 }
 
@@ -255,7 +255,8 @@ fn a_second_material_has_its_own_estimate_from_the_workers_and_in_order() {
     let workers = analysis.finish();
     let ordered = report_in_order(&job);
     assert_eq!(workers.part, ordered.part);
-    let u1 = workers.part.unit1.expect("unit 1's estimate");
+    let u1 = workers.part.units[1].expect("unit 1's estimate");
+    assert!(workers.part.units[0].is_none(), "unit 0's figures are the part's own");
     // the cube (8 cm³, 20 mm high) ends below the boat's top: its slabs are all in
     assert!((u1.volume - 8000.0).abs() < 1.0, "{u1:?}");
     assert!(u1.void_volume > 0.0 && u1.void_fraction < 0.5, "{u1:?}");

@@ -79,7 +79,7 @@ fn a_build_job_with_a_unit_1_part_and_support_reads_back_alike() {
     )
     .unwrap();
     let job = Job::from_models(&[benchy, screw], &spec).unwrap();
-    assert!(job.has_unit1_parts());
+    assert!(!job.part_units().is_empty());
     assert!(!job.info().groups.is_empty());
     assert_same(&job, "boat and two unit-1 screws");
 }

@@ -10,6 +10,7 @@ use dropslice::model::display::display_mesh;
 use dropslice::model::layout::{Rect, arrange, lay_flat, layout};
 use dropslice::model::models::Model;
 use dropslice::model::spec::{self as job, JobSpec};
+use dropslice::base::settings::UnitId;
 use dropslice::{Error, Job, Settings};
 use serde_json::{Value, json};
 use std::time::Duration;
@@ -486,10 +487,10 @@ fn unit_1_parts_are_printed_and_files_must_be_known() {
     let models = [box_model("a.stl", 10.0, 10.0, 5.0)];
     let s = spec(json!({"parts": [{"file": "a.stl", "unit": 1}]})).unwrap();
     let j = Job::from_models(&models, &s).unwrap();
-    assert!(j.uses_unit1());
+    assert!(j.uses_other_units() && j.part_units() == [UnitId(1)]);
     // All of the box is unit 1's: every droplet of a layer is printed by unit 1.
     let p = j.plan_layer(3);
-    assert!(p.counts.total() > 0 && p.counts.unit1 == p.counts.total());
+    assert!(p.counts.total() > 0 && p.counts.unit(UnitId(1)) == p.counts.total());
     assert!(p.moves.iter().all(|m| m.unit == 1));
     let s = spec(json!({"parts": [{"file": "b.stl"}]})).unwrap();
     let e = Job::from_models(&models, &s).err().unwrap();

@@ -422,7 +422,7 @@ fn the_predicted_density_is_per_unit() {
         one["predicted_density"].is_null() && one["volume"] == 0.0,
         "{one}"
     );
-    let u1 = &one["unit1"];
+    let u1 = &one["units"][1];
     assert_eq!(u1["volume"], alone["volume"], "{u1} against {alone}");
     let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
     assert!(
@@ -445,7 +445,7 @@ fn the_predicted_density_is_per_unit() {
         r#"{"settings": {"part_spacing": 5, "unit1_droplet_aspect": 1.5}, "parts": [{"file": "cube.stl"}, {"file": "cube.stl", "unit": 1}]}"#,
     );
     let (two, stderr) = report("two", "two.json");
-    let (d0, u1) = (two["predicted_density"].as_f64().unwrap(), &two["unit1"]);
+    let (d0, u1) = (two["predicted_density"].as_f64().unwrap(), &two["units"][1]);
     let d1 = u1["predicted_density"].as_f64().unwrap();
     for (v, fraction, density) in [
         (&two["volume"], &two["void_fraction"], d0),
@@ -467,7 +467,7 @@ fn the_predicted_density_is_per_unit() {
     r.says(0, "predicted density: not estimated (--report FILE.json");
     // Support is not a part: a job with support on has no unit-1 density.
     let (supported, _) = report("supported", "@bridge.obj --set support=unit1");
-    assert!(supported["unit1"].is_null(), "{supported}");
+    assert!(supported.get("units").is_none(), "{supported}");
     assert!(supported["predicted_density"].as_f64().is_some());
 }
 

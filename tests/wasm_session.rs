@@ -613,7 +613,7 @@ fn a_job_with_a_unit_1_part_slices_the_same_in_every_worker() {
     assert_eq!(summary, json(tb.summary().unwrap()));
     // Unit 1 prints b less the overlap: 6 × 10 mm² on each of its 15 layers (B₁ = 0.3 mm
     // cells), and b alone on the top 5.
-    let unit1 = summary["counts"]["unit1"].as_f64().unwrap();
+    let unit1 = summary["counts"]["units"][1].as_f64().unwrap();
     let b1: f64 = 0.2 * 1.5;
     let want = (10.0 * 60.0 + 5.0 * 100.0) / (b1 * b1);
     assert!((unit1 - want).abs() < 0.1 * want, "{unit1} vs {want}");
@@ -1014,7 +1014,8 @@ fn the_predicted_density_per_unit_is_the_same_in_any_runs_of_layers() {
     let n = s.layer_count();
     let whole = density_in_runs(&s, &[(0, n)]);
     let d0 = whole["predicted_density"].as_f64().unwrap();
-    let d1 = whole["unit1_predicted_density"].as_f64().unwrap();
+    assert_eq!(whole["unit_predicted_density"][0].as_f64(), Some(d0));
+    let d1 = whole["unit_predicted_density"][1].as_f64().unwrap();
     assert!(
         (50.0..100.0).contains(&d0) && (50.0..100.0).contains(&d1),
         "{whole}"
@@ -1027,9 +1028,10 @@ fn the_predicted_density_per_unit_is_the_same_in_any_runs_of_layers() {
         vec![(5, n), (0, 5)],
     ] {
         let f = density_in_runs(&s, &runs);
-        for key in ["predicted_density", "unit1_predicted_density"] {
-            let (a, b) = (f[key].as_f64().unwrap(), whole[key].as_f64().unwrap());
-            assert!((a - b).abs() < 1e-9, "{runs:?} {key}: {a} against {b}");
+        for u in 0..2 {
+            let key = "unit_predicted_density";
+            let (a, b) = (f[key][u].as_f64().unwrap(), whole[key][u].as_f64().unwrap());
+            assert!((a - b).abs() < 1e-9, "{runs:?} unit {u}: {a} against {b}");
         }
     }
     // a layer analysed alone (not in a tally's run) leaves no density
