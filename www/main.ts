@@ -6,6 +6,7 @@ import { Cancelled, MAX_WORKERS, Pool } from "./core/client";
 import { checkLine } from "./core/cutline";
 import { History, sameSnapshot } from "./core/history";
 import { jobOffPlate } from "./core/plate";
+import type { SettingName } from "./core/settings";
 import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
@@ -364,7 +365,7 @@ async function main(): Promise<void> {
   // lay the job out again (at most
   // every 200 ms while typing)
   let plateTimer = 0;
-  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "units"].map((k) => page.form?.get(k)));
+  const plate = () => JSON.stringify(LAYOUT_SETTINGS.map((k) => page.form?.get(k)));
   let lastPlate = "";
   page.form = new SettingsForm(
     $("settings"),
@@ -403,6 +404,10 @@ async function main(): Promise<void> {
   }
   lastPlate = plate();
 }
+
+/** The settings the core's layout reads besides the parts (`Models.layout`): a change lays the
+ *  job out again. */
+const LAYOUT_SETTINGS = ["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "units"] as const satisfies readonly SettingName[];
 
 registerOffline();
 void main();
