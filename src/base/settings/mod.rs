@@ -397,9 +397,10 @@ pub fn check_sliced(u: UnitId, what: &str) -> Result<(), Error> {
     })
 }
 
-/// The page's TypeScript type of the settings, `www/core/settings.gen.ts`, made from the
-/// table (a test fails when the file is stale; `DROPSLICE_WRITE_GENERATED=1 cargo test --lib
-/// settings` writes it).
+/// The page's TypeScript of the settings, `www/core/settings.gen.ts`, made from the table: the
+/// `Settings` type, every name (`SETTING_NAMES`), the part keys, the units' own keys and every
+/// default, so that the page lists no setting itself (a test fails when the file is stale;
+/// `DROPSLICE_WRITE_GENERATED=1 cargo test --lib settings` writes it).
 pub fn typescript() -> String {
     let mut out = String::from(
         "// Generated from the core's settings table (src/base/settings/table.rs): do not edit.\n\
