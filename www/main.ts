@@ -6,6 +6,8 @@ import { Cancelled, MAX_WORKERS, Pool } from "./core/client";
 import { checkLine } from "./core/cutline";
 import { History, sameSnapshot } from "./core/history";
 import { jobOffPlate } from "./core/plate";
+import { SETTING_NAMES, type SettingName } from "./core/settings";
+import { plainSetting } from "./core/units";
 import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
@@ -358,11 +360,10 @@ async function main(): Promise<void> {
     return;
   }
   $("version").textContent = page.init.version;
-  // the plate's settings (and whether a part may be off it, and the units that may print it)
-  // lay the job out again (at most
-  // every 200 ms while typing)
+  // the settings the layout reads (LAYOUT_SETTINGS) lay the job out again (at most every
+  // 200 ms while typing)
   let plateTimer = 0;
-  const plate = () => JSON.stringify(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "units"].map((k) => page.form?.get(k)));
+  const plate = () => JSON.stringify(LAYOUT_SETTINGS.map((k) => page.form?.get(k)));
   let lastPlate = "";
   page.form = new SettingsForm(
     $("settings"),
@@ -401,6 +402,12 @@ async function main(): Promise<void> {
   }
   lastPlate = plate();
 }
+
+/** The settings the core's layout reads besides the parts (`Models.layout`: the plate, the gap,
+ *  whether a part may be off it, the units, and each unit's shrinkage compensation, which
+ *  scales its parts): a change lays the job out again. */
+const LAYOUT_READS: ReadonlySet<string> = new Set(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "units", "shrink_xy", "shrink_z"] satisfies SettingName[]);
+const LAYOUT_SETTINGS = SETTING_NAMES.filter((n) => LAYOUT_READS.has(plainSetting(n)));
 
 registerOffline();
 void main();

@@ -216,6 +216,8 @@ test("save job → open job.json with its files in a fresh page: same layout, sa
   assert.deepEqual(saved.parts.map((p) => p.file), ["cube_20mm_ascii.stl", "extruder_idler_quads.obj"]);
   assert.equal(saved.parts[1].copies, 2);
   assert.equal(saved.parts[1].place_x, 40);
+  // the settings that differ from the defaults only: none here (not `units`, nor units 2 and 3's)
+  assert.deepEqual(saved.settings, {});
 
   // the job file first, its models later (asked for by name)
   const other = await openPage(env.browser, env.url);

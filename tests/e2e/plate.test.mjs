@@ -124,3 +124,24 @@ test("a job of two files has no separate-bodies warning", async () => {
   assert.ok(!w.some((t) => /separate bodies/.test(t)), w.join(" | "));
   assert.deepEqual(errors, []);
 });
+
+test("a material's shrinkage lays the job out again: a part that no longer fits is named at once", async () => {
+  const { page, errors } = main;
+  // 150 × 120 mm fits the 154 × 134 mm plate; compensated for 5 % shrinkage it is 157.9 mm long
+  await pick(page, { name: "wide.stl", mimeType: "model/stl", buffer: boxStl(150, 120, 3) });
+  await waitDone(page, 120_000);
+  assert.equal((await job(page)).offPlate.length, 0);
+  const setText = async (name, text) => {
+    await page.$eval(`#set-${name}`, (el) => {
+      for (let d = el.closest("details"); d; d = d.parentElement?.closest("details")) d.open = true;
+    });
+    await page.fill(`#set-${name}`, text);
+  };
+  await setText("shrink_xy", "5");
+  await page.waitForFunction(() => window.dropslice.job().offPlate.length === 1, null, { timeout: 10_000 });
+  assert.match((await job(page)).offPlate[0].message, /wide\.stl/);
+  assert.equal(await disabled(page, "btn-slice"), true);
+  await setText("shrink_xy", "0");
+  await page.waitForFunction(() => window.dropslice.job().offPlate.length === 0, null, { timeout: 10_000 });
+  assert.deepEqual(errors, []);
+});

@@ -14,8 +14,8 @@ const out = mkdtempSync(join(tmpdir(), "dropslice-units-"));
 let gcode, share, form, sample, units, profiles, figures, forms, render, plot;
 /** The core's job schema: a link's parts are checked against it. */
 let jobSchema;
-/** The core's settings schema. */
-let schema;
+/** The core's settings schema and its default settings. */
+let schema, coreDefaults;
 
 before(async () => {
   const names = ["worker/gcode", "core/share", "core/settings", "core/sample", "core/units", "core/profiles", "core/figures", "views/form", "views/canvas/render", "views/plot"];
@@ -34,6 +34,7 @@ before(async () => {
   await core.default({ module_or_path: readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")) });
   jobSchema = core.job_schema();
   schema = core.settings_schema();
+  coreDefaults = core.default_settings();
 });
 
 after(() => rmSync(out, { recursive: true, force: true }));
@@ -216,6 +217,31 @@ test("units: each unit's figures from the core's per-unit arrays", () => {
   g.addReadLayer({ counts: { outer: 1, inner: 0, fill: 0, support: 0, units: [1, 0, 0, 0], parts: [1] }, travelMm: 0 });
   assert.deepEqual(g.units(2).map((u) => u.droplets), [5, 1]);
   assert.equal(g.units(2)[1].volume, null);
+});
+
+test("settings: the page's table is the core's (checkInit); what differs from the defaults is all a file keeps", () => {
+  const settings = form;
+  const init = settings.checkInit({ version: "test", schema, job: jobSchema, defaults: coreDefaults });
+  assert.deepEqual(init.schema.map((s) => s.name), [...settings.SETTING_NAMES]);
+  assert.deepEqual(Object.keys(settings.DEFAULTS), [...settings.SETTING_NAMES]);
+  for (const s of schema) assert.equal(settings.DEFAULTS[s.name], s.default, s.name);
+  // the core's settings as it writes them leave out `units` and units 2 and 3's own: their
+  // defaults are the table's all the same
+  for (const [k, v] of Object.entries(coreDefaults)) assert.equal(settings.DEFAULTS[k], v, k);
+  assert.equal(init.defaults.units, 2);
+  assert.equal(init.defaults.unit2_droplet_aspect, init.defaults.droplet_aspect);
+  // a core of another build is refused, naming the setting
+  const without = schema.filter((s) => s.name !== "fill_density");
+  assert.throws(() => settings.checkInit({ version: "x", schema: without, job: jobSchema, defaults: coreDefaults }), /different builds.*fill_density/);
+  const extra = [...schema, { ...schema[0], name: "new_setting" }];
+  assert.throws(() => settings.checkInit({ version: "x", schema: extra, job: jobSchema, defaults: coreDefaults }), /different builds.*new_setting/);
+  const changed = schema.map((s) => (s.name === "contours" ? { ...s, default: 3 } : s));
+  assert.throws(() => settings.checkInit({ version: "x", schema: changed, job: jobSchema, defaults: coreDefaults }), /default of contours/);
+  // a job file, a link and the remembered settings keep only what differs, in the table's order
+  assert.deepEqual(settings.nonDefault({ ...settings.DEFAULTS }), {});
+  const some = settings.nonDefault({ ...settings.DEFAULTS, units: 3, layer_height: 0.25, unit2_droplet_aspect: 1.2 });
+  assert.deepEqual(Object.entries(some), [["layer_height", 0.25], ["units", 3], ["unit2_droplet_aspect", 1.2]]);
+  assert.ok(settings.isSettingName("unit3_shrink_z") && !settings.isSettingName("unit4_shrink_z") && !settings.isSettingName("copies"));
 });
 
 test("profiles: a material profile holds one material, used for the unit picked; older ones with unit1_ keys as before", () => {

@@ -195,6 +195,9 @@ test("a link made in 3D opens in 3D with its camera, overlays and the note of th
   assert.equal(await other.page.isChecked("#opt-below"), false, "the overlay toggles travel with the link");
   assert.equal(await other.page.isVisible("#link-from"), true);
   assert.match(await other.page.locator("#link-from").innerText(), /Opened from a preview link\.[\s\S]*layer height 0\.25 mm \(default 0\.2\)/);
+  // the link carries the one setting changed, and no other differs (every default, those of
+  // units 2 and 3 and `units` too, is the table's)
+  assert.equal(await other.page.locator("#link-from-text").innerText(), "Settings that differ from the defaults: layer height 0.25 mm (default 0.2).");
   await other.page.click("#link-from-close");
   assert.equal(await other.page.isVisible("#link-from"), false);
   assert.deepEqual(other.errors, []);

@@ -16,7 +16,6 @@
 
 import type {
   GcodeParseResult,
-  InitResult,
   JobFile,
   Layout,
   ModelInfo,
@@ -31,6 +30,7 @@ import type {
   SliceUnit,
   Summary,
 } from "./protocol";
+import { checkInit, type PageInit } from "./settings";
 import { StageClock, publish } from "./stages";
 
 /** The page's side of the per-stage profile (core/stages.ts). */
@@ -382,9 +382,11 @@ export class Pool {
     }
   }
 
-  init(): Promise<InitResult> {
+  /** The core's version, schema and defaults, checked against the page's settings table
+ *  (core/settings.ts `checkInit`). */
+  init(): Promise<PageInit> {
     this.heal();
-    return this.guarded(() => this.handles[0].call("init", null));
+    return this.guarded(async () => checkInit(await this.handles[0].call("init", null)));
   }
 
   /** Slices a job of `files`: opens it (see [[openAll]]) and streams all layers through

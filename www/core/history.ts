@@ -3,7 +3,7 @@
 // the buttons can say what they undo. No DOM.
 
 import type { Job, JobModel, Part } from "./job";
-import type { Value } from "./settings";
+import type { Settings } from "./settings";
 
 /** A state left behind and the change that left it. */
 export interface Entry<S> {
@@ -88,12 +88,12 @@ export interface Snapshot {
   models: JobModel[];
   parts: Part[];
   selected: number | null;
-  settings: Record<string, Value>;
+  settings: Settings;
   /** Parts (ids and specs) and settings as text: equal keys are the same state. */
   key: string;
 }
 
-export function snapshotOf(job: Job | null, settings: Record<string, Value>): Snapshot {
+export function snapshotOf(job: Job | null, settings: Settings): Snapshot {
   const parts = job ? [...job.parts] : [];
   const key = JSON.stringify({ parts: parts.map((p) => [p.id, p.spec]), settings });
   return { job, models: job ? [...job.models.values()] : [], parts, selected: job?.selected ?? null, settings: { ...settings }, key };

@@ -4,21 +4,31 @@
 // computes no placement of its own: every matrix and box comes from the core's layout. No DOM.
 
 import type { JobFileRef } from "./client";
-import type { JobFile, JobSchema, Layout, ModelInfo, PartSpec, SettingSpec, Settings } from "./protocol";
+import type { JobFile, JobSchema, Layout, ModelInfo, PartSpec, SettingSpec } from "./protocol";
+import { DEFAULTS, isPartKey, PART_KEYS, type PartKey, type RawSettings, type Settings, type SomeSettings } from "./settings";
 
-/** The keys of a part (rotate_*, scale_*, place_*): the core's settings schema flags them
- *  `part`. The core refuses them in a job's settings, so the settings form hides them and the
- *  page keeps them in each part's spec. */
-export function partKeys(schema: readonly SettingSpec[]): string[] {
-  return schema.filter((s) => s.part).map((s) => s.name);
-}
+/** The keys of a part (rotate_*, scale_*, place_*: the settings table's `part` rows,
+ *  settings.gen.ts `PART_KEYS`). The core refuses them in a job's settings, so the settings
+ *  form hides them and the page keeps them in each part's spec. */
+export { PART_KEYS };
+
+/** A job's settings: every setting but the part keys. */
+export type JobSettings = Omit<Settings, PartKey>;
 
 /** The settings the core takes for a job: `values` without the part keys (the one place the
  *  page drops them). */
-export function jobSettings(values: Settings, schema: readonly SettingSpec[]): Settings {
-  const part = new Set(partKeys(schema));
-  const out: Settings = {};
-  for (const [k, v] of Object.entries(values)) if (!part.has(k)) out[k] = v;
+export function jobSettings(values: Settings): JobSettings;
+export function jobSettings(values: SomeSettings): Partial<JobSettings>;
+export function jobSettings(values: SomeSettings): Partial<JobSettings> {
+  const out: SomeSettings = { ...values };
+  for (const k of PART_KEYS) delete out[k];
+  return out;
+}
+
+/** The part keys among settings from outside (an older link's `rotate_z`, …), as a part's. */
+export function partKeysOf(settings: RawSettings): Partial<Pick<PartSpec, PartKey>> {
+  const out: Partial<Record<PartKey, number>> = {};
+  for (const [k, v] of Object.entries(settings)) if (isPartKey(k) && typeof v === "number") out[k] = v;
   return out;
 }
 
@@ -80,12 +90,16 @@ export interface DisplayMesh {
   budget: number;
 }
 
+/** The part keys a part always has (its place is both numbers or absent: arranged). */
+type HeldKey = Exclude<PartKey, "place_x" | "place_y">;
+const HELD_KEYS = PART_KEYS.filter((k): k is HeldKey => k !== "place_x" && k !== "place_y");
+
 /** One part: a stable id (the 3D view's ids are `${id}:${copy}`), its file and its spec. Its
  *  display mesh is the job's (`Job.meshOf`), never the part's: undo snapshots keep parts, and
  *  a mesh in each would keep every mesh ever fetched (megabytes an edit). */
 export interface Part {
   id: number;
-  spec: Required<Pick<PartSpec, "file" | "rotate_x" | "rotate_y" | "rotate_z" | "scale_x" | "scale_y" | "scale_z" | "mirror_x" | "mirror_y" | "mirror_z" | "place_angle" | "copies" | "unit">> & {
+  spec: Required<Pick<PartSpec, "file" | HeldKey | "mirror_x" | "mirror_y" | "mirror_z" | "copies" | "unit">> & {
     /** Absent, never null: the whole file, unplaced (arranged), the file's name. */
     [K in "item" | "place_x" | "place_y" | "name"]?: NonNullable<PartSpec[K]>;
   };
@@ -98,21 +112,13 @@ export type Changes = Partial<Omit<Spec, "file">> & { place?: null };
 
 /** A spec with every default filled in (the core's defaults, docs/jobs.md). */
 export function fullSpec(p: PartSpec): Spec {
-  const s: Spec = {
-    file: p.file,
-    rotate_x: p.rotate_x ?? 0,
-    rotate_y: p.rotate_y ?? 0,
-    rotate_z: p.rotate_z ?? 0,
-    scale_x: p.scale_x ?? 1,
-    scale_y: p.scale_y ?? 1,
-    scale_z: p.scale_z ?? 1,
-    mirror_x: p.mirror_x === true,
-    mirror_y: p.mirror_y === true,
-    mirror_z: p.mirror_z === true,
-    place_angle: p.place_angle ?? 0,
-    copies: p.copies ?? 1,
-    unit: p.unit ?? 0,
-  };
+  const s = { file: p.file } as Spec;
+  for (const k of HELD_KEYS) s[k] = p[k] ?? DEFAULTS[k];
+  s.mirror_x = p.mirror_x === true;
+  s.mirror_y = p.mirror_y === true;
+  s.mirror_z = p.mirror_z === true;
+  s.copies = p.copies ?? 1;
+  s.unit = p.unit ?? 0;
   if (p.item !== undefined && p.item !== null) s.item = p.item;
   if (typeof p.place_x === "number" && typeof p.place_y === "number" && Number.isFinite(p.place_x) && Number.isFinite(p.place_y)) {
     s.place_x = p.place_x;
@@ -127,8 +133,7 @@ export function fullSpec(p: PartSpec): Spec {
 export function specOut(s: Spec): PartSpec {
   const out: PartSpec = { file: s.file };
   if (s.item !== undefined) out.item = s.item;
-  for (const k of ["rotate_x", "rotate_y", "rotate_z", "place_angle"] as const) if (s[k] !== 0) out[k] = s[k];
-  for (const k of ["scale_x", "scale_y", "scale_z"] as const) if (s[k] !== 1) out[k] = s[k];
+  for (const k of HELD_KEYS) if (s[k] !== DEFAULTS[k]) out[k] = s[k];
   for (const k of MIRRORS) if (s[k]) out[k] = true;
   if (s.place_x !== undefined && s.place_y !== undefined && Number.isFinite(s.place_x) && Number.isFinite(s.place_y)) {
     out.place_x = s.place_x;
@@ -174,7 +179,7 @@ export class Job {
   }
 
   /** The job as the core reads it: `settings` and the parts (every default written out). */
-  file(settings: Settings, parts: Part[] = this.parts): JobFile {
+  file(settings: Partial<JobSettings>, parts: Part[] = this.parts): JobFile {
     return { settings, parts: parts.map((p) => ({ ...p.spec })) };
   }
 
@@ -210,7 +215,7 @@ export class Job {
   }
 
   /** What the slice shown was made of: settings and parts (to tell when it is out of date). */
-  key(settings: Settings): string {
+  key(settings: Partial<JobSettings>): string {
     return JSON.stringify({ settings, parts: this.parts.map((p) => p.spec), files: this.refs().map((r) => r.name) });
   }
 }

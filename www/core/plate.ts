@@ -6,7 +6,7 @@
 
 import type { Job } from "./job";
 import type { Layout, Misfit } from "./protocol";
-import type { Value } from "./settings";
+import type { Settings } from "./settings";
 
 /** An instance off the plate: its part (index in the job), its copy, the core's sentence, and
  *  what fits (`turn`: the part's rotate_z turned 90° about z; `scale`: the whole percent,
@@ -42,13 +42,13 @@ export function offPlate(layout: Layout | null, allow: boolean): OffPlate[] {
 }
 
 /** Every misfit of the page's `job` with the settings `values`, blocking or not. */
-export function jobMisfits(job: Job | null, values: Record<string, Value> | undefined): OffPlate[] {
+export function jobMisfits(job: Job | null, values: Pick<Settings, "allow_off_plate"> | undefined): OffPlate[] {
   if (!job || !values) return [];
   return offPlate(job.layout, values.allow_off_plate === true);
 }
 
 /** The instances of the page's `job` off the plate that keep it from being sliced. */
-export function jobOffPlate(job: Job | null, values: Record<string, Value> | undefined): OffPlate[] {
+export function jobOffPlate(job: Job | null, values: Pick<Settings, "allow_off_plate"> | undefined): OffPlate[] {
   return jobMisfits(job, values).filter((o) => o.blocks);
 }
 

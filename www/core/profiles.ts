@@ -8,9 +8,8 @@
 // A material profile saved before the units were a list holds both units' keys (`unit1_…`
 // beside unit 0's): it is used as it is, its values where they went before.
 
-import type { SettingSpec } from "./protocol";
 import { checkSettings } from "./remember";
-import type { Value } from "./settings";
+import { isSettingName, isUnitKey, put, type SettingName, type SomeSettings, type Spec } from "./settings";
 import { plainSetting, unitOfSetting, unitSetting } from "./units";
 
 export const PROFILES_KEY = "dropslice.profiles.v1";
@@ -25,13 +24,13 @@ export type ProfileKind = "machine" | "material";
 
 /** The settings a profile of `kind` holds: the core's schema flags them (`SettingSpec.profile`,
  *  from src/base/settings/profile.rs); the core refuses any other key when it checks one. */
-export const profileKeys = (kind: ProfileKind, schema: readonly SettingSpec[]): string[] =>
+export const profileKeys = (kind: ProfileKind, schema: readonly Spec[]): SettingName[] =>
   schema.filter((s) => s.profile === kind).map((s) => s.name);
 
 export interface StoredProfile {
   name: string;
   kind: ProfileKind;
-  settings: Record<string, Value>;
+  settings: SomeSettings;
 }
 
 const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "object" && v !== null && !Array.isArray(v);
@@ -57,27 +56,27 @@ export function nameProblem(raw: string): string | null {
 
 /** Whether a profile of `kind` may hold `key`: a key of its kind's, or a unit's own name of
  *  one (`unitN_<key>`, a setting of the schema: an older material profile's `unit1_…`). */
-function allowedKey(key: string, keys: readonly string[], schema: readonly SettingSpec[]): boolean {
+function allowedKey(key: string, keys: readonly string[]): boolean {
   if (keys.includes(key)) return true;
-  return unitOfSetting(key) !== null && keys.includes(plainSetting(key)) && schema.some((s) => s.name === key);
+  return unitOfSetting(key) !== null && keys.includes(plainSetting(key)) && isSettingName(key);
 }
 
 /** `raw` as a profile: every setting of its kind's, known to the schema and in range, none
  *  else (null: not a profile, or a value the schema refuses). */
-export function checkProfile(raw: unknown, schema: readonly SettingSpec[]): StoredProfile | null {
+export function checkProfile(raw: unknown, schema: readonly Spec[]): StoredProfile | null {
   if (!isObject(raw) || typeof raw.name !== "string" || nameProblem(raw.name) !== null) return null;
   if (raw.kind !== "machine" && raw.kind !== "material") return null;
   if (!isObject(raw.settings)) return null;
   const keys = profileKeys(raw.kind, schema);
   const given = Object.keys(raw.settings);
-  if (given.some((k) => !allowedKey(k, keys, schema))) return null;
+  if (given.some((k) => !allowedKey(k, keys))) return null;
   const settings = checkSettings(raw.settings, schema);
   if (Object.keys(settings).length !== given.length) return null;
   return { name: trimName(raw.name), kind: raw.kind, settings };
 }
 
 /** The profiles kept in `text` (the storage's entry): the good ones, names unique. */
-export function readProfiles(text: string | null, schema: readonly SettingSpec[]): StoredProfile[] {
+export function readProfiles(text: string | null, schema: readonly Spec[]): StoredProfile[] {
   if (!text) return [];
   let raw: unknown;
   try {
@@ -98,14 +97,15 @@ export const profilesText = (list: readonly StoredProfile[]): string => JSON.str
 
 /** A profile of `kind` with the current `values` of its settings: a material profile the
  *  material of `unit` (its values under names without a unit), a machine profile every unit's. */
-export function profileOf(name: string, kind: ProfileKind, values: Record<string, Value>, schema: readonly SettingSpec[], unit = 0): StoredProfile {
-  const settings: Record<string, Value> = {};
+export function profileOf(name: string, kind: ProfileKind, values: SomeSettings, schema: readonly Spec[], unit = 0): StoredProfile {
+  const settings: SomeSettings = {};
   for (const k of profileKeys(kind, schema)) {
     if (kind === "material") {
-      if (unitOfSetting(k) !== null) continue;
+      // a material setting a unit has (unit 0's name); unit N's own names are skipped
+      if (!isUnitKey(k)) continue;
       const v = values[unitSetting(k, unit)];
-      if (v !== undefined) settings[k] = v;
-    } else if (values[k] !== undefined) settings[k] = values[k];
+      if (v !== undefined) put(settings, k, v);
+    } else if (values[k] !== undefined) put(settings, k, values[k]);
   }
   return { name: trimName(name), kind, settings };
 }
@@ -118,13 +118,13 @@ export function needsUnit(p: StoredProfile): boolean {
 /** The settings `p` sets used for `unit` (a material profile of one material: its keys become
  *  that unit's), or as they are (a machine profile, an older material profile with `unit1_`
  *  keys); `missing`: keys the schema has not for that unit (a unit the core does not know). */
-export function profileSettings(p: StoredProfile, unit: number, schema: readonly SettingSpec[]): { settings: Record<string, Value>; missing: string[] } {
+export function profileSettings(p: StoredProfile, unit: number): { settings: SomeSettings; missing: string[] } {
   if (!needsUnit(p)) return { settings: { ...p.settings }, missing: [] };
-  const settings: Record<string, Value> = {};
+  const settings: SomeSettings = {};
   const missing: string[] = [];
   for (const [k, v] of Object.entries(p.settings)) {
-    const name = unitSetting(k, unit);
-    if (schema.some((s) => s.name === name)) settings[name] = v;
+    const name = isUnitKey(k) ? unitSetting(k, unit) : unit === 0 ? k : `unit${unit}_${k}`;
+    if (isSettingName(name) && v !== undefined) put(settings, name, v);
     else missing.push(name);
   }
   return { settings, missing };

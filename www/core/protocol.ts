@@ -29,12 +29,14 @@ import type {
   Summary,
 } from "../pkg/dropslice.js";
 
+import type { RawSettings } from "./settings";
+
 // Every type the core generates (tsify) is part of the protocol.
 export type * from "../pkg/dropslice.js";
 
 /** A job file (docs/jobs.md): the job's settings (no part keys) and its parts. */
 export interface JobFile {
-  settings: Settings;
+  settings: RawSettings;
   parts: PartSpec[];
 }
 
@@ -124,8 +126,6 @@ export function coverageMaskOf(r: {
  *  io, internal, …) and as a worker replies it; `crash` and `link` are the page's own kinds. */
 export type ErrorValue = ErrorReport;
 
-/** Settings as the form gives them: `{name: value}`; the core validates them. */
-export type Settings = Record<string, number | boolean | string>;
 
 /** The result of a "slice" request: what belongs to its run of layers as a whole. */
 export interface SliceUnit {
@@ -142,7 +142,7 @@ export interface InitResult {
   schema: SettingSpec[];
   /** The numbers a job's part carries, their ranges and the job's counts. */
   job: JobSchema;
-  defaults: Settings;
+  defaults: RawSettings;
 }
 
 export interface OpenResult {
@@ -166,7 +166,7 @@ export interface GcodeParseResult {
   figuresNote: string | null;
   /** The settings the header names, typed and checked by the core (`GcodeStream.header_settings`),
    *  or null and the reason. */
-  settings: Record<string, number | boolean | string> | null;
+  settings: RawSettings | null;
   settingsError: string | null;
 }
 
@@ -208,7 +208,7 @@ export interface Calls {
    *  within the rule (src/wasm/mod.rs `unsupported_droplets`); `below` null for the first layer. */
   unsupported: { data: UnsupportedRequest; result: Uint8Array };
   /** The 3D view's overhang tint: faces with normal z below minus this overhang. */
-  overhang_face: { data: { settings: Settings }; result: number };
+  overhang_face: { data: { settings: RawSettings }; result: number };
   /** The vertical cut of layers [from, to) (flows/cut.ts, src/wasm/cut.rs `Session.cut`). */
   cut: { data: CutRequest; result: CutReply };
   /** The droplet size from a printed part's mass (views/calibrate.ts, src/output/calibrate.rs). */

@@ -3,8 +3,8 @@
 // checked like any input from outside: a setting must be one of the schema's, of its kind and
 // in its range; anything else is dropped, and an entry that is not ours at all is ignored. No DOM.
 
-import type { SettingSpec } from "./protocol";
-import { parse, type Value } from "./settings";
+import { jobSettings } from "./job";
+import { nonDefault, parse, put, type Settings, type SomeSettings, type Spec } from "./settings";
 
 /** The storage key (a new shape of entry gets a new key). */
 export const REMEMBER_KEY = "dropslice.page.v1";
@@ -24,7 +24,7 @@ export interface RememberedView {
 
 export interface Remembered {
   /** Only settings that differ from the defaults. */
-  settings: Record<string, Value>;
+  settings: SomeSettings;
   view: RememberedView;
 }
 
@@ -34,8 +34,8 @@ const isObject = (v: unknown): v is Record<string, unknown> => typeof v === "obj
 
 /** The settings of `raw` that the schema knows, of their kind and in range (part keys are not
  *  remembered: they belong to the parts). */
-export function checkSettings(raw: unknown, schema: readonly SettingSpec[]): Record<string, Value> {
-  const out: Record<string, Value> = {};
+export function checkSettings(raw: unknown, schema: readonly Spec[]): SomeSettings {
+  const out: SomeSettings = {};
   if (!isObject(raw)) return out;
   for (const spec of schema) {
     if (spec.part || !Object.hasOwn(raw, spec.name)) continue;
@@ -43,7 +43,7 @@ export function checkSettings(raw: unknown, schema: readonly SettingSpec[]): Rec
     const ok = spec.kind === "bool" ? typeof v === "boolean" : spec.kind === "enum" ? typeof v === "string" : typeof v === "number" && Number.isFinite(v);
     if (!ok) continue;
     const r = parse(spec, v as string | boolean);
-    if (r.value !== undefined && r.error === undefined) out[spec.name] = r.value;
+    if (r.value !== undefined && r.error === undefined) put(out, spec.name, r.value);
   }
   return out;
 }
@@ -58,7 +58,7 @@ function checkView(raw: unknown): RememberedView {
 }
 
 /** The remembered state in `text` (null: none, or not an entry of this page). */
-export function readRemembered(text: string | null, schema: readonly SettingSpec[]): Remembered | null {
+export function readRemembered(text: string | null, schema: readonly Spec[]): Remembered | null {
   if (text === null || text.length > TEXT_MAX) return null;
   let raw: unknown;
   try {
@@ -70,12 +70,8 @@ export function readRemembered(text: string | null, schema: readonly SettingSpec
   return { settings: checkSettings(raw.settings, schema), view: checkView(raw.view) };
 }
 
-/** The entry to store: the settings that differ from `defaults`, and the view. */
-export function rememberedText(values: Record<string, Value>, defaults: Record<string, Value>, schema: readonly SettingSpec[], view: RememberedView): string {
-  const settings: Record<string, Value> = {};
-  for (const spec of schema) {
-    const v = values[spec.name];
-    if (!spec.part && v !== undefined && v !== defaults[spec.name]) settings[spec.name] = v;
-  }
-  return JSON.stringify({ settings, view });
+/** The entry to store: the settings that differ from the defaults (the part keys are the
+ *  parts'), and the view. */
+export function rememberedText(values: Settings, view: RememberedView): string {
+  return JSON.stringify({ settings: nonDefault(jobSettings(values)), view });
 }

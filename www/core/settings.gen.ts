@@ -13,8 +13,12 @@ export type PartKey = (typeof PART_KEYS)[number];
 export const UNIT_KEYS = ["droplet_aspect", "droplet_rate", "material_density", "shrink_xy", "shrink_z"] as const;
 export type UnitKey = (typeof UNIT_KEYS)[number];
 
+/** Every setting's name, in the table's (the form's) order. */
+export const SETTING_NAMES = ["layer_height", "droplet_aspect", "contours", "outer_offset", "inner_offset", "start_jitter", "stagger", "contour_order", "close_loops", "loop_spacing", "fill_density", "fill_overlap", "hatch_angle", "hatch_angle_step", "print_order", "rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "slice_plane", "units", "droplet_rate", "travel_speed", "material_density", "shrink_xy", "shrink_z", "footprint", "plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "overhang_limit", "support", "support_gap_xy", "support_gap_z", "support_density", "unit1_droplet_aspect", "unit1_droplet_rate", "unit1_material_density", "unit1_shrink_xy", "unit1_shrink_z", "unit2_droplet_aspect", "unit2_droplet_rate", "unit2_material_density", "unit2_shrink_xy", "unit2_shrink_z", "unit3_droplet_aspect", "unit3_droplet_rate", "unit3_material_density", "unit3_shrink_xy", "unit3_shrink_z", "unit_order"] as const;
+export type SettingName = (typeof SETTING_NAMES)[number];
+
 /** Every setting (docs/spec.md 5.4.1). */
-export interface Settings {
+export type Settings = {
   /** Layer height H: the height of one droplet (mm) */
   layer_height: number;
   /** Droplet width B divided by its height H (B = aspect x H) */
@@ -131,6 +135,66 @@ export interface Settings {
   unit3_shrink_z: number;
   /** Which discharge unit prints first within a layer: unitN_first (then the others by number), or a list of units such as 2,0,1 */
   unit_order: string;
-}
+};
 
-export type SettingName = keyof Settings;
+/** Every setting's default (the core's `Settings::default()`). */
+export const DEFAULTS: Readonly<Settings> = {
+  layer_height: 0.2,
+  droplet_aspect: 1.04,
+  contours: 2,
+  outer_offset: 0.5,
+  inner_offset: 0.5,
+  start_jitter: 0.07,
+  stagger: false,
+  contour_order: "inside_out",
+  close_loops: true,
+  loop_spacing: "exact",
+  fill_density: 1.0,
+  fill_overlap: 0.5,
+  hatch_angle: 45.0,
+  hatch_angle_step: 90.0,
+  print_order: "contours_first",
+  rotate_x: 0.0,
+  rotate_y: 0.0,
+  rotate_z: 0.0,
+  scale_x: 1.0,
+  scale_y: 1.0,
+  scale_z: 1.0,
+  place_x: 0.0,
+  place_y: 0.0,
+  place_angle: 0.0,
+  slice_plane: "middle",
+  units: 2,
+  droplet_rate: 100.0,
+  travel_speed: 50.0,
+  material_density: 1.04,
+  shrink_xy: 0.0,
+  shrink_z: 0.0,
+  footprint: "disc",
+  plate_x: 154.0,
+  plate_y: 134.0,
+  plate_z: 230.0,
+  part_spacing: 5.0,
+  allow_off_plate: false,
+  overhang_limit: 0.5,
+  support: "off",
+  support_gap_xy: 0.5,
+  support_gap_z: 0,
+  support_density: 1.0,
+  unit1_droplet_aspect: 1.04,
+  unit1_droplet_rate: 100.0,
+  unit1_material_density: 1.04,
+  unit1_shrink_xy: 0.0,
+  unit1_shrink_z: 0.0,
+  unit2_droplet_aspect: 1.04,
+  unit2_droplet_rate: 100.0,
+  unit2_material_density: 1.04,
+  unit2_shrink_xy: 0.0,
+  unit2_shrink_z: 0.0,
+  unit3_droplet_aspect: 1.04,
+  unit3_droplet_rate: 100.0,
+  unit3_material_density: 1.04,
+  unit3_shrink_xy: 0.0,
+  unit3_shrink_z: 0.0,
+  unit_order: "unit0_first",
+};

@@ -14,6 +14,7 @@
 import { checkLine, type Line } from "./cutline";
 import { fitsPart, partNumber } from "./job";
 import type { JobSchema, PartSpec } from "./protocol";
+import type { RawSettings, Value } from "./settings";
 import { MAX_CENTRE_MM, MAX_SCALE, MIN_SCALE, type View } from "./view";
 
 export const EMBED_LIMIT = 256 * 1024;
@@ -42,8 +43,9 @@ const SETTINGS_MAX = 500;
 const FEED_BYTES = 4096;
 
 export interface ShareState {
-  /** Settings that differ from the defaults. */
-  settings: Record<string, number | boolean | string>;
+  /** Settings that differ from the defaults (from outside: any names; the page checks each
+   *  against the core's schema, flows/open.ts). */
+  settings: RawSettings;
   /** Absent when the link's layer was unusable. */
   layer?: number;
   /** Absent when the link's view was unusable (the part is then fitted). */
@@ -234,7 +236,7 @@ export function checkState(raw: unknown, job: JobSchema): { state: ShareState; i
   if (typeof raw.name !== "string") throw new LinkError("its model's name is missing");
   const name = raw.name.length > NAME_MAX ? `${raw.name.slice(0, NAME_MAX)}…` : raw.name;
 
-  const settings: Record<string, number | boolean | string> = {};
+  const settings: Record<string, Value> = {};
   if (raw.settings !== undefined) {
     if (!isObject(raw.settings)) throw new LinkError("its settings are not a list of settings");
     const entries = Object.entries(raw.settings);

@@ -3,7 +3,7 @@
 // that was replaced. No DOM here.
 
 import type { JobFileRef } from "./client";
-import type { Value } from "./settings";
+import type { RawSettings, Settings } from "./settings";
 import { Figures } from "./figures";
 import type { Job } from "./job";
 import type { JobFile, JobInfo, LayerAnalysis, LayerCounts, LayerData, SliceUnit } from "./protocol";
@@ -86,14 +86,15 @@ export class Slice {
   /** An opened .gco file and its header (source "gco"), for the calibration (views/calibrate.ts);
    *  the settings its header names (typed, checked by the core), or why there are none, for
    *  the form (views/controls.ts). */
-  gcodeFile: { file: Blob; header: Record<string, string>; settings: Record<string, Value> | null; settingsError: string | null } | null = null;
+  gcodeFile: { file: Blob; header: Record<string, string>; settings: RawSettings | null; settingsError: string | null } | null = null;
 
   constructor(
     readonly source: "stl" | "gco",
     readonly name: string,
     public dropletWidth: number,
     public layerHeight: number,
-    readonly settings: Record<string, Value>,
+    /** The form's settings the slice was made with (a .gco file's: the form's when opened). */
+    readonly settings: Settings,
     readonly job: SlicedJob | null,
     /** Bytes of layers the cache keeps ([[cacheBudgetBytes]]). */
     readonly cacheBudget: number,
@@ -220,7 +221,7 @@ export class Store {
   constructor(readonly cacheBudget: number) {}
 
   /** A new, empty slice with this store's cache budget. */
-  newSlice(source: "stl" | "gco", name: string, dropletWidth: number, layerHeight: number, settings: Record<string, Value>, job: SlicedJob | null): Slice {
+  newSlice(source: "stl" | "gco", name: string, dropletWidth: number, layerHeight: number, settings: Settings, job: SlicedJob | null): Slice {
     return new Slice(source, name, dropletWidth, layerHeight, settings, job, this.cacheBudget);
   }
 }

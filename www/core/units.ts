@@ -4,10 +4,12 @@
 // prints the support (`support = unitN`) and each unit's colours. Every view that shows
 // something per unit loops over `unitIndices(n)`; nothing here touches the DOM.
 
-/** Most discharge units a machine has (the core's range of `units`). */
-export const MAX_UNITS = 4;
+import { DEFAULTS, MAX_UNITS, type SettingName, type UnitKey } from "./settings";
+
+/** Most discharge units a machine has (the core's range of `units`, from its table). */
+export { MAX_UNITS };
 /** The units of a job whose settings do not say (today's machine: unit 0 and unit 1). */
-export const DEFAULT_UNITS = 2;
+export const DEFAULT_UNITS = DEFAULTS.units;
 
 /** The number of units the settings give (`units`), else [[DEFAULT_UNITS]]; a value out of
  *  1 … [[MAX_UNITS]] (the core refuses it) counts as the default. */
@@ -28,9 +30,11 @@ export function unitOfSetting(name: string): number | null {
   return m ? Number(m[1]) : null;
 }
 
-/** The name of unit `u`'s own value of the setting `name` (unit 0's is the plain name). */
-export function unitSetting(name: string, u: number): string {
-  return u === 0 ? name : `unit${u}_${name}`;
+/** The name of unit `u`'s own value of the setting `name` (unit 0's is the plain name). A
+ *  setting of the table for u < [[MAX_UNITS]]; beyond, a name no setting has (nothing found
+ *  under it: `isSettingName` tells). */
+export function unitSetting(name: UnitKey, u: number): SettingName {
+  return (u === 0 ? name : `unit${u}_${name}`) as SettingName;
 }
 
 /** `unitN_<name>` → `<name>` (any other name as it is). */

@@ -6,6 +6,7 @@
 import type { Page } from "../views/page";
 import { DISPLAY_BUDGET, Job, jobSettings, layFlatAngles, meshKey, partName, specOut, uniqueName, type Changes, type DisplayMesh, type JobModel, type Part, type Spec } from "../core/job";
 import type { Orientation, Orientations, PartSpec } from "../core/protocol";
+import { nonDefault } from "../core/settings";
 import { errorBanner, hideBanner } from "../views/banner";
 import { updateButtons } from "../views/controls";
 import { saveFile } from "../views/download";
@@ -80,7 +81,7 @@ export function adoptJob(page: Page, job: Job): void {
 }
 
 export function settingsOf(page: Page) {
-  return jobSettings(page.form!.values(), page.init!.schema);
+  return jobSettings(page.form!.values());
 }
 
 /**
@@ -285,8 +286,7 @@ export async function ensureMeshes(page: Page): Promise<void> {
 export function jobFileText(page: Page): string | null {
   const job = page.store.job;
   if (!job) return null;
-  const settings: Record<string, number | boolean | string> = {};
-  for (const [k, v] of Object.entries(settingsOf(page))) if (page.init!.defaults[k] !== v) settings[k] = v;
+  const settings = nonDefault(settingsOf(page));
   return JSON.stringify({ settings, parts: job.parts.map((p) => specOut(p.spec)) }, null, 2) + "\n";
 }
 

@@ -4,6 +4,7 @@
 
 import { Cancelled } from "../core/client";
 import type { Slice } from "../core/store";
+import type { SettingName } from "../core/settings";
 import { unitIndices, unitSetting } from "../core/units";
 import { overhangsShown, showLayerNumber } from "../views/layer";
 import type { Page } from "../views/page";
@@ -40,7 +41,7 @@ export function show(page: Page, i: number): void {
  *  defaults where it says nothing). */
 function overhangRule(page: Page, s: Slice): { widths: number[]; limitMm: number } | null {
   const header = s.gcodeFile?.header ?? {};
-  const get = (k: string) => {
+  const get = (k: SettingName) => {
     const v = Number(s.source === "gco" ? (header[k] ?? page.init?.defaults[k]) : s.settings[k]);
     return Number.isFinite(v) ? v : NaN;
   };

@@ -4,14 +4,14 @@
 // job file, a link too big for them) takes the files dropped next: by name for a job file, by
 // SHA-256 for a link. Each ends in a flow of slice.ts.
 
-import type { Value } from "../core/settings";
+import { DEFAULTS, type RawSettings, type SomeSettings, type Spec, type Value } from "../core/settings";
 import { dropSlice, openGcode, startSlice, type Target } from "./slice";
 import { record } from "./record";
-import { jobSettings, partKeys } from "../core/job";
+import { jobSettings, partKeysOf } from "../core/job";
 import { jobOffPlate } from "../core/plate";
 import { adoptJob, newJob, type NewFile } from "./job";
 import type { Page } from "../views/page";
-import type { JobFile, JobSchema, PartSpec, SettingSpec } from "../core/protocol";
+import type { JobFile, JobSchema, PartSpec } from "../core/protocol";
 import { sampleStl } from "../core/sample";
 import { LinkError, readLink, type Overlays, type ShareState, type SharedLink } from "../core/share";
 import type { PendingJob } from "../core/store";
@@ -126,7 +126,7 @@ async function readJobFile(file: File, limits: JobSchema): Promise<JobFile | str
   if (bad >= 0) return `“${file.name}”: parts[${bad}] has no "file" (the model's file name, at most ${FILE_NAME_MAX} characters).`;
   const settings = obj.settings === undefined || obj.settings === null ? {} : obj.settings;
   if (typeof settings !== "object" || Array.isArray(settings)) return `“${file.name}”: "settings" must be an object {"name": value, …}.`;
-  return { settings: settings as Record<string, Value>, parts: parts as PartSpec[] };
+  return { settings: settings as RawSettings, parts: parts as PartSpec[] };
 }
 
 function pendingOf(job: JobFile, link?: ShareState): PendingJob {
@@ -200,7 +200,7 @@ const baseOf = (path: string) => path.replace(/^.*[\\/]/, "");
 function applyJobSettings(page: Page, settings: JobFile["settings"]): void {
   const clean: Record<string, Value> = {};
   for (const [k, v] of Object.entries(settings)) if (typeof v === "number" || typeof v === "boolean" || typeof v === "string") clean[k] = v;
-  const unknown = page.form!.set({ ...page.init!.defaults, ...clean });
+  const unknown = page.form!.setRaw({ ...DEFAULTS, ...clean });
   if (unknown.length) note(`Settings unknown here were ignored: ${unknown.join(", ")}.`, "warn");
 }
 
@@ -214,7 +214,7 @@ export async function openSample(page: Page, target: Target = {}): Promise<void>
 }
 
 /** What a link's settings must be for each kind of setting (the form checks the ranges). */
-const KIND_TYPE: Record<string, { type: string; words: string }> = {
+const KIND_TYPE: Record<Spec["kind"], { type: string; words: string }> = {
   number: { type: "number", words: "a number" },
   integer: { type: "number", words: "a whole number" },
   bool: { type: "boolean", words: "yes or no (true/false)" },
@@ -223,7 +223,7 @@ const KIND_TYPE: Record<string, { type: string; words: string }> = {
 
 /** The link's settings whose type fits their kind; the others named in `ignored`. Unknown
  *  names are kept (the form ignores them and the page says so). */
-function linkSettings(page: Page, settings: Record<string, Value>, ignored: string[]): Record<string, Value> {
+function linkSettings(page: Page, settings: RawSettings, ignored: string[]): RawSettings {
   const out: Record<string, Value> = {};
   for (const [name, v] of Object.entries(settings)) {
     const spec = page.init!.schema.find((x) => x.name === name);
@@ -240,14 +240,11 @@ function linkSettings(page: Page, settings: Record<string, Value>, ignored: stri
 
 /** The job of a link: its parts, or (a link of one model from an older page) one part of its
  *  model, which takes the link's part settings (rotate_z, scale_x, …) as its own. */
-function linkJob(state: ShareState, settings: Record<string, Value>, schema: readonly SettingSpec[]): JobFile {
-  const part: PartSpec = { file: state.name };
-  for (const k of partKeys(schema)) {
-    const v = settings[k];
-    if (typeof v === "number") (part as unknown as Record<string, number>)[k] = v;
-  }
+function linkJob(state: ShareState, settings: RawSettings): JobFile {
+  const part: PartSpec = { file: state.name, ...partKeysOf(settings) };
   if ((part.place_x === undefined) !== (part.place_y === undefined)) (part.place_x === undefined ? (part.place_x = 0) : (part.place_y = 0));
-  return { settings: jobSettings(settings, schema), parts: state.parts ?? [part] };
+  // unknown names stay (the form names them), the part keys go to the part
+  return { settings: jobSettings(settings as SomeSettings) as RawSettings, parts: state.parts ?? [part] };
 }
 
 /** A link's stage once its job is sliced: the 3D view and its camera, or the layer view with
@@ -260,11 +257,11 @@ function linkStage(page: Page, state: ShareState): void {
 
 /** The settings of a link that differ from the defaults, in words: "layer height 0.2 mm
  *  (default 0.25)". */
-function differing(page: Page, settings: Record<string, Value>): string[] {
+function differing(page: Page, settings: SomeSettings): string[] {
   const out: string[] = [];
   for (const spec of page.init!.schema) {
     const v = settings[spec.name];
-    const d = page.init!.defaults[spec.name];
+    const d = DEFAULTS[spec.name];
     if (v === undefined || v === d || spec.part) continue;
     const unit = spec.unit && typeof v === "number" ? ` ${spec.unit}` : "";
     out.push(`${spec.name.replace(/_/g, " ")} ${String(v)}${unit} (default ${String(d)})`);
@@ -286,8 +283,8 @@ export async function openLink(page: Page): Promise<boolean> {
   }
   if (!link) return false;
   const ignored = [...link.ignored];
-  const job = linkJob(link.state, linkSettings(page, link.state.settings, ignored), page.init!.schema);
-  const unknown = page.form!.set({ ...page.init!.defaults, ...job.settings });
+  const job = linkJob(link.state, linkSettings(page, link.state.settings, ignored));
+  const unknown = page.form!.setRaw({ ...DEFAULTS, ...job.settings });
   job.settings = {};
   const extra = unknown.length
     ? ` The link comes from another version: its settings ${unknown.join(", ")} are unknown here and were ignored, so the slice may differ.`

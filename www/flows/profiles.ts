@@ -78,7 +78,7 @@ export function useProfile(page: Page, name: string, unit = 0): void {
   const p = load(page).find((q) => q.name === name);
   const form = page.form;
   if (!p || !form) return profileMessage(`There is no profile “${name}” any more.`, true);
-  const { settings, missing } = profileSettings(p, unit, page.init!.schema);
+  const { settings, missing } = profileSettings(p, unit);
   if (missing.length) return profileMessage(`The profile “${p.name}” was not used: this version has no ${missing.join(", ")}.`, true);
   const forUnit = needsUnit(p) ? ` for unit ${unit}` : "";
   form.set(settings);

@@ -5,7 +5,7 @@
 // browser, flows/persist.ts) is wired by main.ts through `whenRecorded`.
 
 import { snapshotOf } from "../core/history";
-import type { Value } from "../core/settings";
+import { SETTING_NAMES, type SettingName, type Settings } from "../core/settings";
 import { updateButtons } from "../views/controls";
 import { updateUndo } from "../views/notices";
 import type { Page } from "../views/page";
@@ -53,8 +53,8 @@ export function record(page: Page, label: string, kind: "edit" | "open" | "setti
 }
 
 /** The names of the settings that differ between `a` and `b`. */
-function changedNames(a: Record<string, Value>, b: Record<string, Value>): string[] {
-  return Object.keys(b).filter((k) => a[k] !== b[k]);
+function changedNames(a: Settings, b: Settings): SettingName[] {
+  return SETTING_NAMES.filter((k) => a[k] !== b[k]);
 }
 
 /** A setting was changed in the form (called on every input): recorded, or amended while the

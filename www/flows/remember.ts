@@ -60,7 +60,7 @@ export function saveNow(page: Page): void {
     overhangs: renderer.showOverhangs,
   };
   try {
-    localStorage.setItem(REMEMBER_KEY, rememberedText(form.values(), init.defaults, init.schema, view));
+    localStorage.setItem(REMEMBER_KEY, rememberedText(form.values(), view));
   } catch {
     // storage full or blocked: the settings are simply not remembered
   }

@@ -99,7 +99,7 @@ export async function startSlice(page: Page, target: Target = {}): Promise<void>
   if (target.notice) showBanner(target.notice.title, target.notice.message, target.notice.tone, true);
   const gen = ++store.generation;
   const values = form.values();
-  const settings = jobSettings(values, page.init!.schema);
+  const settings = jobSettings(values);
   const refs = job.refs();
   const sliced: SlicedJob = { refs, file: job.file(settings), sha256: refs.map((r) => job.models.get(r.name)?.sha256 ?? "") };
   const key = job.key(settings);
@@ -284,7 +284,7 @@ export async function openGcode(page: Page, file: File): Promise<void> {
     s.gcodeFile = { file, header: r.header, settings: r.settings, settingsError: r.settingsError };
     s.figures.setRead(r.figures, r.figuresError, r.figuresNote);
     // the form shows the file's settings (views/controls.ts says so, or how it differs)
-    if (r.settings) page.form!.set(r.settings);
+    if (r.settings) page.form!.setRaw(r.settings);
     s.complete = true;
     store.slice = s;
     const before = store.job;

@@ -6,6 +6,7 @@
 // where it was (or to what `back` finds then: the list is drawn again after an edit).
 
 import { MIRRORS, type Changes, type Part } from "../core/job";
+import { DEFAULTS } from "../core/settings";
 import { orientPart } from "./orient";
 import type { Page } from "./page";
 
@@ -15,8 +16,9 @@ export function mirrorChange(p: Part, axis: "x" | "y" | "z"): Changes {
   return { [k]: !p.spec[k] };
 }
 
-/** The rotation, scale and mirror of the file itself. */
-export const RESET = { rotate_x: 0, rotate_y: 0, rotate_z: 0, scale_x: 1, scale_y: 1, scale_z: 1, mirror_x: false, mirror_y: false, mirror_z: false } satisfies Changes;
+/** The rotation, scale and mirror of the file itself (the part keys' defaults). */
+const { rotate_x, rotate_y, rotate_z, scale_x, scale_y, scale_z } = DEFAULTS;
+export const RESET = { rotate_x, rotate_y, rotate_z, scale_x, scale_y, scale_z, mirror_x: false, mirror_y: false, mirror_z: false } satisfies Changes;
 
 /** Whether the part already has the file's own rotation, scale and mirror. */
 function isReset(p: Part): boolean {

@@ -6,7 +6,7 @@
 
 import { jobSettings } from "../core/job";
 import { jobOffPlate } from "../core/plate";
-import type { Value } from "../core/settings";
+import { isSettingName, type Settings } from "../core/settings";
 import { supportUnit, unitsOf } from "../core/units";
 import type { Page } from "./page";
 import { $ } from "./dom";
@@ -19,7 +19,7 @@ export function sliceState(page: Page): "current" | "stale" | "none" {
   if (!s || s.source !== "stl" || store.busy) return "none";
   const job = store.job;
   if (!job || !form || !init) return "stale";
-  return s.key === job.key(jobSettings(form.values(), init.schema)) ? "current" : "stale";
+  return s.key === job.key(jobSettings(form.values())) ? "current" : "stale";
 }
 
 /** The derived figures (statistics, plot, layer figures, calibration) marked out of date. */
@@ -71,13 +71,14 @@ function formSource(page: Page): void {
     el.dataset.state = "none";
     return;
   }
-  const differ = Object.entries(g.settings).filter(([k, v]) => form.get(k) !== undefined && form.get(k) !== v);
+  // a name the form does not know is not compared
+  const differ = Object.entries(g.settings).flatMap(([k, v]) => (isSettingName(k) && form.get(k) !== v ? [{ k, v }] : []));
   if (differ.length === 0) {
     el.textContent = `The settings form shows the settings of ${name} (from its header).`;
     el.dataset.state = "file";
     return;
   }
-  const shown = differ.slice(0, 3).map(([k, v]) => `${k} is ${String(form.get(k))} here, ${String(v)} in the file`);
+  const shown = differ.slice(0, 3).map(({ k, v }) => `${k} is ${String(form.get(k))} here, ${String(v)} in the file`);
   const more = differ.length > 3 ? ` and ${differ.length - 3} more` : "";
   el.textContent = `The settings form differs from ${name}: ${shown.join("; ")}${more}.`;
   el.dataset.state = "differs";
@@ -100,10 +101,9 @@ function settingsStatus(page: Page, stale: boolean, offPlate: string[]): void {
   const job = store.job;
   if (job && !job.layout && !store.busy) return bad("The parts do not fit on the plate together: remove, scale or make fewer copies of some.");
   const slice = store.slice;
-  const schema = page.init!.schema;
-  const settings = jobSettings(form.values(), schema);
+  const settings = jobSettings(form.values());
   const unsliced = job !== null && !store.busy && slice?.source !== "stl";
-  const settingsChanged = slice?.source === "stl" && JSON.stringify(settings) !== JSON.stringify(jobSettings(slice.settings, schema));
+  const settingsChanged = slice?.source === "stl" && JSON.stringify(settings) !== JSON.stringify(jobSettings(slice.settings));
   st.className = "hint";
   st.textContent = !(stale || unsliced) ? "" : settingsChanged ? "Settings changed: press Slice (or Enter) to update." : "The parts changed: press Slice (or Enter) to update.";
   btn.classList.toggle("attention", stale || unsliced);
@@ -115,13 +115,13 @@ let supportBy = 1;
 let shownUnits = 0;
 
 /** The switch's `support` value when it is turned on (main.ts). */
-export const supportOn = (): string => `unit${supportBy}`;
+export const supportOn = (): Settings["support"] => `unit${supportBy}` as Settings["support"];
 
 /** What follows the machine's units (the form's `units`) and the support's unit: the support
  *  switch (a link, a job file or the form may have set `support`; with one unit there is no
  *  unit to print support), and, when the count changed, the form's unit groups, the parts
  *  panel's unit choice and the 3D view's legend. */
-function writeUnits(page: Page, values: Record<string, Value>): void {
+function writeUnits(page: Page, values: Settings): void {
   const n = unitsOf(values);
   const by = supportUnit(values.support);
   if (by !== null) supportBy = by;

@@ -2,8 +2,7 @@
 // text input ("0,2", " 3 ") is translated into the strict values the core expects in one place
 // (core/settings.ts parse), and invalid values are flagged before anything is sliced.
 
-import type { SettingSpec } from "../core/protocol";
-import { parse, type Value } from "../core/settings";
+import { isSettingName, parse, put, type RawSettings, type SettingName, type Settings, type SomeSettings, type Spec, type Value } from "../core/settings";
 import { unitOfSetting } from "../core/units";
 
 const OPEN_GROUPS = new Set(["Droplet", "Contours", "Fill"]);
@@ -13,7 +12,7 @@ function fmt(v: Value): string {
 }
 
 interface Field {
-  spec: SettingSpec;
+  spec: Spec;
   input: HTMLInputElement | HTMLSelectElement;
   row: HTMLElement;
   message: HTMLElement;
@@ -23,7 +22,7 @@ interface Field {
 
 /** The group a setting is shown in: a unit's own settings (`unitN_<name>`) under "Unit N",
  *  whatever group the schema gives them; the others in the schema's. */
-export function groupOf(spec: SettingSpec): string {
+export function groupOf(spec: Spec): string {
   const u = unitOfSetting(spec.name);
   return u === null ? spec.group : `Unit ${u}`;
 }
@@ -35,13 +34,13 @@ const groupUnit = (group: string): number | null => {
 };
 
 export class SettingsForm {
-  private fields = new Map<string, Field>();
+  private fields = new Map<SettingName, Field>();
   /** The groups' `<details>`, by name. */
   private groups = new Map<string, HTMLDetailsElement>();
 
   constructor(
     container: HTMLElement,
-    readonly schema: SettingSpec[],
+    readonly schema: readonly Spec[],
     private onChange: () => void,
   ) {
     container.replaceChildren();
@@ -86,7 +85,7 @@ export class SettingsForm {
     }
   }
 
-  private build(spec: SettingSpec): HTMLElement {
+  private build(spec: Spec): HTMLElement {
     const row = document.createElement("div");
     row.className = "field";
     row.title = spec.description;
@@ -159,16 +158,18 @@ export class SettingsForm {
     return [...this.fields.values()].filter((f) => f.error).map((f) => ({ name: f.spec.name, message: f.error! }));
   }
 
-  values(): Record<string, Value> {
-    const out: Record<string, Value> = {};
-    for (const [name, f] of this.fields) out[name] = f.value;
-    return out;
+  /** Every setting, in the schema's order (the core checked at init that it is the table's:
+   *  core/settings.ts `checkInit`). */
+  values(): Settings {
+    const out: SomeSettings = {};
+    for (const [name, f] of this.fields) put(out, name, f.value);
+    return out as Settings;
   }
 
   /** Only the settings that differ from the defaults (for links). */
-  changed(): Record<string, Value> {
-    const out: Record<string, Value> = {};
-    for (const [name, f] of this.fields) if (f.value !== f.spec.default) out[name] = f.value;
+  changed(): SomeSettings {
+    const out: SomeSettings = {};
+    for (const [name, f] of this.fields) if (f.value !== f.spec.default) put(out, name, f.value);
     return out;
   }
 
@@ -177,10 +178,18 @@ export class SettingsForm {
   }
 
   /** Applies values (unknown names are ignored and returned). */
-  set(values: Record<string, Value>): string[] {
+  set(values: SomeSettings): void {
+    for (const [name, v] of Object.entries(values)) {
+      const f = isSettingName(name) ? this.fields.get(name) : undefined;
+      if (f && v !== undefined) this.write(f, v);
+    }
+  }
+
+  /** Applies values from outside (unknown names are ignored and returned). */
+  setRaw(values: RawSettings): string[] {
     const unknown: string[] = [];
     for (const [name, v] of Object.entries(values)) {
-      const f = this.fields.get(name);
+      const f = isSettingName(name) ? this.fields.get(name) : undefined;
       if (f) this.write(f, v);
       else unknown.push(name);
     }
@@ -192,8 +201,9 @@ export class SettingsForm {
     this.onChange();
   }
 
-  get(name: string): Value | undefined {
-    return this.fields.get(name)?.value;
+  /** A setting's value (every name of the table has a field). */
+  get<K extends SettingName>(name: K): Settings[K] {
+    return this.fields.get(name)!.value as Settings[K];
   }
 
   focusFirstError(): void {

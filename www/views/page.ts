@@ -7,8 +7,8 @@ import type { Pool } from "../core/client";
 import type { History, Snapshot } from "../core/history";
 import type { Changes } from "../core/job";
 import type { ProfileKind } from "../core/profiles";
-import type { CalibrateRequest, Calibration, InitResult, LayerData, Orientation, Orientations, Settings } from "../core/protocol";
-import type { Value } from "../core/settings";
+import type { CalibrateRequest, Calibration, LayerData, Orientation, Orientations } from "../core/protocol";
+import type { PageInit, RawSettings, SettingName, Settings, SomeSettings } from "../core/settings";
 import type { Store } from "../core/store";
 import type { Bounds, Camera3D, CutView, View } from "../core/view";
 import type { Line } from "../core/cutline";
@@ -31,7 +31,7 @@ export interface Page {
   /** The settings form, once init has answered. */
   form?: SettingsView;
   /** The core's version, settings schema and defaults, once init has answered. */
-  init?: InitResult;
+  init?: PageInit;
 }
 
 /** What a view asks for when the user acts (main.ts wires each to its flow). */
@@ -74,7 +74,7 @@ export interface Actions {
   /** The display meshes the 3D view lacks are fetched (only while it is shown). */
   meshes(): void;
   /** The 3D tint's threshold (the face normal's z) for `settings`. */
-  overhangFace(settings: Settings): Promise<number>;
+  overhangFace(settings: SomeSettings): Promise<number>;
   /** The cut line set (null: no cut); `refit` fits the cut's canvas to it. */
   setCutLine(line: Line | null, refit: boolean): void;
   /** Keeps the cut in step with the page (a new slice, layers that arrived, the layer shown). */
@@ -170,10 +170,14 @@ export interface PartsView {
 
 /** The settings form (views/form.ts). */
 export interface SettingsView {
-  values(): Record<string, Value>;
-  get(name: string): Value | undefined;
-  /** Sets the values given; returns the names it did not know. */
-  set(values: Record<string, Value>): string[];
+  /** Every setting as the form holds it (a field in error keeps its last good value). */
+  values(): Settings;
+  get<K extends SettingName>(name: K): Settings[K];
+  /** Sets the values given. */
+  set(values: SomeSettings): void;
+  /** Sets values from outside (a job file's, a link's, a .gco header's: any names); returns
+   *  the names it did not know (ignored). */
+  setRaw(values: RawSettings): string[];
   reset(): void;
   errors(): { name: string; message: string }[];
   focusFirstError(): void;

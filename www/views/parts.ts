@@ -11,11 +11,14 @@ import { jobMisfits, plainJobMessage, type OffPlate } from "../core/plate";
 import type { JobSchema } from "../core/protocol";
 import type { Page, PartsView } from "./page";
 import { $, nf } from "./dom";
+import { PART_KEYS } from "../core/settings";
 import { MAX_UNITS, unitIndices, unitRole, unitsOf } from "../core/units";
 import { cancelOrient, orientEditorShows, orientPart } from "./orient";
 import { mirrorChange, openPartMenu } from "./contextmenu";
 
-const NUMBER_FIELDS = ["rotate_x", "rotate_y", "rotate_z", "scale_x", "scale_y", "scale_z", "place_x", "place_y", "place_angle", "copies"] as const;
+/** The panel's number fields (index.html `#part-<key>`): the part keys of the settings table,
+ *  and `copies`. */
+const NUMBER_FIELDS = [...PART_KEYS, "copies"] as const;
 type NumberField = (typeof NUMBER_FIELDS)[number];
 
 const fmt = (v: number) => String(+v.toFixed(4));
@@ -312,18 +315,9 @@ export class PartsPanel implements PartsView {
     $("part-editor-title").textContent = partName(job, p);
     const at = this.at(p);
     const auto = p.spec.place_x === undefined || p.spec.place_y === undefined;
-    const values: Record<NumberField, number> = {
-      rotate_x: p.spec.rotate_x,
-      rotate_y: p.spec.rotate_y,
-      rotate_z: p.spec.rotate_z,
-      scale_x: p.spec.scale_x,
-      scale_y: p.spec.scale_y,
-      scale_z: p.spec.scale_z,
-      place_x: auto ? (at?.[0] ?? 0) : p.spec.place_x!,
-      place_y: auto ? (at?.[1] ?? 0) : p.spec.place_y!,
-      place_angle: p.spec.place_angle,
-      copies: p.spec.copies,
-    };
+    // an arranged part shows where the core put it
+    const place = { place_x: auto ? (at?.[0] ?? 0) : p.spec.place_x!, place_y: auto ? (at?.[1] ?? 0) : p.spec.place_y! };
+    const values: Record<NumberField, number> = { ...p.spec, ...place };
     for (const k of NUMBER_FIELDS) {
       const input = $<HTMLInputElement>(`part-${k}`);
       const text = k.startsWith("place_") && k !== "place_angle" ? values[k].toFixed(2) : fmt(values[k]);

@@ -1,6 +1,6 @@
 // The share dialog: makes the preview link of the slice shown, copies it, and shows it.
 
-import type { Value } from "../core/settings";
+import { nonDefault } from "../core/settings";
 import type { Page } from "./page";
 import { fullSpec, jobSettings, specOut } from "../core/job";
 import { makeLink } from "../core/share";
@@ -18,7 +18,8 @@ export async function share(page: Page): Promise<void> {
   // the job as it was sliced: its files (embedded in this order when they fit) and parts
   const files = job.refs.map((r, i) => ({ name: r.name, sha256: job.sha256[i], bytes: r.file.size }));
   const { url, embedded } = await makeLink(location.href, {
-    settings: changedFrom(page, s.settings),
+    // the settings that differ from the defaults (the link carries only those)
+    settings: nonDefault(jobSettings(s.settings)),
     layer: store.current,
     view: { ...renderer.view },
     name: files[0].name,
@@ -53,11 +54,4 @@ export async function share(page: Page): Promise<void> {
   input.value = url;
   $<HTMLDialogElement>("share-dialog").showModal();
   input.select();
-}
-
-/** The settings that differ from the core's defaults (the link carries only those). */
-function changedFrom(page: Page, values: Record<string, Value>): Record<string, Value> {
-  const out: Record<string, Value> = {};
-  for (const [k, v] of Object.entries(jobSettings(values, page.init!.schema))) if (page.init!.defaults[k] !== v) out[k] = v;
-  return out;
 }

@@ -376,9 +376,10 @@ impl Settings {
     }
 }
 
-/// The page's TypeScript type of the settings, `www/core/settings.gen.ts`, made from the
-/// table (a test fails when the file is stale; `DROPSLICE_WRITE_GENERATED=1 cargo test --lib
-/// settings` writes it).
+/// The page's TypeScript of the settings, `www/core/settings.gen.ts`, made from the table: the
+/// `Settings` type, every name (`SETTING_NAMES`), the part keys, the units' own keys and every
+/// default, so that the page lists no setting itself (a test fails when the file is stale;
+/// `DROPSLICE_WRITE_GENERATED=1 cargo test --lib settings` writes it).
 pub fn typescript() -> String {
     let mut out = String::from(
         "// Generated from the core's settings table (src/base/settings/table.rs): do not edit.\n\
@@ -409,7 +410,14 @@ pub fn typescript() -> String {
         "/** The settings each unit has (unit 0's names; unit N's are `unitN_` + the name). */\nexport const UNIT_KEYS = [{}] as const;\nexport type UnitKey = (typeof UNIT_KEYS)[number];\n\n",
         list(&unit_base)
     ));
-    out.push_str("/** Every setting (docs/spec.md 5.4.1). */\nexport interface Settings {\n");
+    let all: Vec<&str> = entries().iter().map(|e| e.spec.name).collect();
+    out.push_str(&format!(
+        "/** Every setting's name, in the table's (the form's) order. */\nexport const SETTING_NAMES = [{}] as const;\nexport type SettingName = (typeof SETTING_NAMES)[number];\n\n",
+        list(&all)
+    ));
+    // A type, not an interface: a `Settings` is then also a `{name: value}` record (what the
+    // core's functions and a job file take).
+    out.push_str("/** Every setting (docs/spec.md 5.4.1). */\nexport type Settings = {\n");
     for e in entries() {
         let spec = &e.spec;
         let ty = match spec.kind {
@@ -432,7 +440,14 @@ pub fn typescript() -> String {
         let doc = format!("{}{unit}", spec.description).replace("*/", "* /");
         out.push_str(&format!("  /** {doc} */\n  {}: {ty};\n", spec.name));
     }
-    out.push_str("}\n\nexport type SettingName = keyof Settings;\n");
+    out.push_str("};\n\n");
+    let defaults: Vec<String> = (entries().iter())
+        .map(|e| format!("  {}: {},\n", e.spec.name, e.spec.default))
+        .collect();
+    out.push_str(&format!(
+        "/** Every setting's default (the core's `Settings::default()`). */\nexport const DEFAULTS: Readonly<Settings> = {{\n{}}};\n",
+        defaults.concat()
+    ));
     out
 }
 

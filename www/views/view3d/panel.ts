@@ -9,6 +9,7 @@
 // worker like the rest of the page.
 
 import { jobSettings } from "../../core/job";
+import type { SettingName, Settings } from "../../core/settings";
 import { supportColumns } from "../../core/supportcolumns";
 import { jobOffPlate } from "../../core/plate";
 import { errorBanner } from "../banner";
@@ -21,6 +22,10 @@ import type { View3D, View3DPart, View3DSlice } from "./view3d";
 
 /** The 3D view's id of an instance, and back. */
 export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
+
+/** The settings the core's overhang threshold reads (`overhang_face_normal_z`): asked again
+ *  when one of them changes. */
+const OVERHANG_SETTINGS = ["overhang_limit", "droplet_aspect", "layer_height"] as const satisfies readonly SettingName[];
 export function parseInstanceId(id: string): { part: number; copy: number } | null {
   const m = /^(\d+):(\d+)$/.exec(id);
   return m ? { part: Number(m[1]), copy: Number(m[2]) } : null;
@@ -84,7 +89,7 @@ export class View3DPanel implements View3DView {
     if (px > 0 && py > 0 && Number.isFinite(px + py)) this.plate = { x: px, y: py, z: pz >= 0 && Number.isFinite(pz) ? pz : 0 };
     this.syncOverhang(page, values);
     const s = store.slice;
-    const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values, page.init!.schema));
+    const current = job && values && s?.source === "stl" && s.key === job.key(jobSettings(values));
     this.slice = current && s.layers > 0 && s.layerHeight > 0 ? { layerHeight: s.layerHeight, layers: s.layers, current: store.current } : null;
     // the support hides the overhanging faces under it: not drawn while they are tinted
     this.support = this.slice && s && !page.renderer.showOverhangs ? supportColumns(s) : null;
@@ -97,14 +102,14 @@ export class View3DPanel implements View3DView {
 
   /** With the overhang overlay on, the core's threshold for the form's settings (asked again
    *  when the settings it depends on change). */
-  private syncOverhang(page: Page, values: Record<string, unknown> | undefined): void {
+  private syncOverhang(page: Page, values: Settings | undefined): void {
     if (!page.renderer.showOverhangs || !values || !page.form || page.form.errors().length) {
       this.overhang = null;
       this.overhangFor = "";
       return;
     }
-    const settings = jobSettings(page.form.values(), page.init!.schema);
-    const key = JSON.stringify(["overhang_limit", "droplet_aspect", "layer_height"].map((k) => settings[k]));
+    const settings = jobSettings(page.form.values());
+    const key = JSON.stringify(OVERHANG_SETTINGS.map((k) => settings[k]));
     if (key === this.overhangFor) return;
     this.overhangFor = key;
     this.overhang = null;
