@@ -110,18 +110,24 @@ impl Job {
     ) -> Result<Job, Error> {
         let (mesh, input, settings) = Job::merged(models, spec, b).await?;
         let mut building = Building::new(mesh, input, settings)?;
-        // The draft: the mesh as merged, its planes and units' facet runs. The passes below
-        // change the mesh only where they drop repeated facets, close cracks or turn shells.
+        // The facet index of the mesh as merged (dropped below if facets are); with it the
+        // draft: the mesh, its planes, index and units' facet runs. The passes below change
+        // the mesh only where they drop repeated facets, close cracks or turn shells.
         let mut draft_of = None;
-        if let (Some(hand), Ok(zs)) = (draft, &building.made.zs) {
+        if let Ok(zs) = &building.made.zs {
             let m = &building.made;
-            hand(&Draft {
-                settings: &m.settings,
-                info: m.provisional_info(zs.len()),
-                mesh: &m.mesh,
-                zs,
-            });
-            draft_of = Some((zs.clone(), m.groups.clone()));
+            let index = FacetBuckets::new_in_steps(&m.mesh, zs, b).await;
+            if let Some(hand) = draft {
+                hand(&Draft {
+                    settings: &m.settings,
+                    info: m.provisional_info(zs.len()),
+                    mesh: &m.mesh,
+                    zs,
+                    index: &index,
+                });
+                draft_of = Some((zs.clone(), m.groups.clone()));
+            }
+            building.made.index = Some(index);
         }
         let mut changed = false;
         let kept = building.made.mesh.unrepeated_in_steps(b).await;
@@ -132,11 +138,6 @@ impl Job {
             false => None,
         };
         building.unrepeated_in_steps(kept, shells, b).await;
-        // the index of a mesh that dropped facets would be dropped unused
-        if all && let Ok(zs) = &building.made.zs {
-            building.made.index =
-                Some(FacetBuckets::new_in_steps(&building.made.mesh, zs, b).await);
-        }
         building.close_cracks();
         changed |= building.made.weld != (0, 0);
         let shells = building.shells.as_ref().expect("the shells were found");

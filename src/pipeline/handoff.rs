@@ -8,10 +8,10 @@
 //! left before anything is allocated, every number and index is checked, so damaged bytes are
 //! refused with a message, never a panic or a job that slices wrongly.
 //!
-//! A *draft* ([`Draft`], [`Job::from_draft`]) is the same bytes without the facet index, made
-//! as soon as the job's parts are merged, before the passes that need the whole mesh (the
-//! shells and their orientation, the repairs, the checks): the other workers build the index
-//! themselves and slice their first layers while the job worker finishes. The job worker then
+//! A *draft* ([`Draft`], [`Job::from_draft`]) is the same bytes with a provisional info, made
+//! as soon as the job's parts are merged and indexed, before the passes that need the whole
+//! mesh (the shells and their orientation, the repairs, the checks): the other workers slice
+//! their first layers from it while the job worker finishes. The job worker then
 //! sends a *confirmation* ([`Job::confirmation`], [`Job::confirm`]: the final settings and
 //! info, a few kB) when its repairs left the mesh as drafted, else the whole prepared job.
 //!
@@ -30,7 +30,7 @@ use crate::slicing::slice::FacetBuckets;
 
 /// The first bytes: the format and its version.
 const MAGIC: &[u8; 8] = b"DSJOB\0\0\x01";
-/// The first bytes of a draft (the job's bytes without the facet index).
+/// The first bytes of a draft (the job's bytes with a provisional info).
 const DRAFT_MAGIC: &[u8; 8] = b"DSDRAFT\x01";
 /// The first bytes of a confirmation (the final settings and info of a drafted job).
 const CONFIRM_MAGIC: &[u8; 8] = b"DSCONF\0\x01";
@@ -105,8 +105,7 @@ impl Job {
         read(bytes, MAGIC).map_err(damaged)
     }
 
-    /// The job of a [`Draft`]'s bytes, its facet index built here: it slices as the finished
-    /// job does if [`Job::confirm`] takes the job worker's confirmation, and is not to be
+    /// The job of a [`Draft`]'s bytes: it slices as the finished job does if [`Job::confirm`] takes the job worker's confirmation, and is not to be
     /// used otherwise (its info is provisional). Damaged bytes are refused as by
     /// [`Job::read_bytes`].
     pub fn from_draft(bytes: &dyn Source) -> Result<Job, Error> {
@@ -160,13 +159,15 @@ impl Job {
 }
 
 /// A job as its parts were merged, before the passes that need the whole mesh: its
-/// settings, the merged mesh, the plane heights and a provisional info (no mesh statistics,
-/// no warnings). [`Draft::bytes_writer`] writes the bytes of [`Job::from_draft`].
+/// settings, the merged mesh, the plane heights, the facet index and a provisional info (no
+/// mesh statistics, no warnings). [`Draft::bytes_writer`] writes the bytes of
+/// [`Job::from_draft`].
 pub struct Draft<'a> {
     pub(crate) settings: &'a Settings,
     pub(crate) info: JobInfo,
     pub(crate) mesh: &'a Mesh,
     pub(crate) zs: &'a [f64],
+    pub(crate) index: &'a FacetBuckets,
 }
 
 impl Draft<'_> {
@@ -178,7 +179,7 @@ impl Draft<'_> {
             &self.info,
             self.mesh,
             self.zs,
-            None,
+            Some(self.index.rows()),
         )
     }
 }
@@ -214,8 +215,8 @@ fn with_shifts(meta: Meta) -> Result<(Settings, JobInfo), String> {
     Ok((settings, info))
 }
 
-/// The length of a job's bytes (`index`: the facet index' rows, none in a draft) and what
-/// writes them into a sink of that length.
+/// The length of a job's bytes (`index`: the facet index' rows) and what writes them into a
+/// sink of that length.
 fn writer<'a>(
     magic: &'static [u8; 8],
     settings: &Settings,
@@ -255,8 +256,7 @@ fn writer<'a>(
     (size, write)
 }
 
-/// The job of `magic`'s bytes: [`MAGIC`] (with the facet index) or [`DRAFT_MAGIC`] (the
-/// index built here).
+/// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
 fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
     let mut r = Reader {
         bytes,
@@ -307,24 +307,23 @@ fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
         return Err("the units' facet runs do not cover the mesh".into());
     }
     let mut rows = [Vec::new(), Vec::new()];
-    if magic == MAGIC {
-        for row in &mut rows {
-            let n = r.count(4)?;
-            *row = r.get(n, u32::from_le_bytes);
-        }
+    for row in &mut rows {
+        let n = r.count(4)?;
+        *row = r.get(n, u32::from_le_bytes);
     }
     if r.at != bytes.size() {
         return Err("bytes follow the facet index".into());
     }
+    let [offsets, bucket_facets] = rows;
+    let buckets = FacetBuckets::from_rows(offsets, bucket_facets, zs.len(), facets.len())?;
     let (settings, info) = with_shifts(meta)?;
-    let mesh = Mesh { vertices, facets };
-    let buckets = if magic == MAGIC {
-        let [offsets, bucket_facets] = rows;
-        FacetBuckets::from_rows(offsets, bucket_facets, zs.len(), mesh.facets.len())?
-    } else {
-        FacetBuckets::new(&mesh, &zs)
-    };
-    Ok(Job::assemble(settings, mesh, buckets, zs, info))
+    Ok(Job::assemble(
+        settings,
+        Mesh { vertices, facets },
+        buckets,
+        zs,
+        info,
+    ))
 }
 
 /// Writes the bytes in order into a [`Sink`], a run of items at a time.
