@@ -4,7 +4,7 @@
 // (`Session.prepared`); the other worker takes them (`Session.from_prepared`). Then the same
 // with a draft, as the page slices (fresh instances): the job worker prepares with
 // `Session.begin_drafted` and hands out the draft as soon as it is made; the other worker
-// takes it (`Session.from_draft`, its own facet index) and the job worker's confirmation
+// takes it (`Session.from_draft`) and the job worker's confirmation
 // (`Session.confirm`). Prints each worker's module memory (it never shrinks: the most it ever
 // held) after each of these.
 // Usage: node scripts/worker_memory.mjs [MODEL.stl] [PKG_DIR]   (`bash scripts/build.sh` first)

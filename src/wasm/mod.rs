@@ -493,7 +493,7 @@ impl Session {
     }
 
     /// A session of the job worker's draft ([`Session::begin_drafted`]), read a run at a time
-    /// out of the message's buffer, its facet index built here. It plans layers as the
+    /// out of the message's buffer (never copied whole into the module's memory). It plans layers as the
     /// finished job will if [`Session::confirm`] takes the job worker's confirmation; until
     /// then it answers nothing that needs the job's info (header, figures, the analysis).
     /// Throws `{kind: "internal", message}` if the bytes are damaged.

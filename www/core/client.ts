@@ -487,7 +487,7 @@ export class Pool {
 
   /** [[slice]] with the preparation off the critical path: the job worker hands out a draft
    *  of the job as soon as its parts are merged (`open_job` with `draft`), and every other
-   *  worker takes it (`adopt_draft`, its own facet index) and slices units of layers while the
+   *  worker takes it (`adopt_draft`) and slices units of layers while the
    *  job worker finds the shells, turns them, repairs and checks the job. What they send is
    *  held ([[Speculation]]) until the job worker confirms the job is the draft's
    *  (`confirm_job`, a few kB); if it is not (a repair changed the mesh) or the job is

@@ -204,7 +204,7 @@ export interface Calls {
    *  job is the draft's, n confirmations (`confirm`, for `confirm_job`) instead of `prepared`. */
   open_job: { data: { job: JobFile; share?: number; draft?: boolean }; result: OpenResult & { prepared?: Uint8Array[]; confirm?: Uint8Array[] } };
   /** Takes the job worker's draft of the job (`Session.from_draft`: the job as its parts were
-   *  merged, its facet index built here), to slice layers from before the job is made; the
+   *  merged and indexed), to slice layers from before the job is made; the
    *  page keeps those layers until `confirm_job`. */
   adopt_draft: { data: { prepared: Uint8Array }; result: { layers: number } };
   /** Takes the job worker's confirmation that the job is the draft's (`Session.confirm`):
