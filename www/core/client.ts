@@ -3,7 +3,8 @@
 // Files, read and imported there), answers layout, display meshes and lay-flat, and prepares a
 // slice (`Session.from_models`: place, merge, weld, checks, repair); the other workers hold no
 // files: they take the job worker's prepared job as bytes (`adopt_job`), so nothing is read or
-// prepared twice (see [[openAll]]). The pool
+// prepared twice (see [[openAll]]); a slice starts them on the job worker's draft before the
+// job is made (see [[Pool.sliceDrafted]]). The pool
 // remembers which Files the job worker holds and adds them again to a fresh worker (after a
 // cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
