@@ -1,7 +1,10 @@
 //! The prepared job handed from the page's job worker to the others (src/pipeline/handoff.rs):
 //! a job read back from its bytes writes the same G-code as the job itself (a plain STL, a
 //! 3MF build, an OBJ, a build job with a unit-1 part and support on), has the same info and
-//! settings, and damaged bytes are refused with a message, never a panic.
+//! settings, and damaged bytes are refused with a message, never a panic. A draft (the job as
+//! merged, before the repairs: `Job::prepare_drafted`) confirmed by the finished job is that
+//! job, byte for byte, whenever the preparation says the job is the draft's, and it says so
+//! exactly when no repair changed the mesh.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
@@ -10,6 +13,9 @@ use common::Rng;
 use dropslice::model::models::Model;
 use dropslice::model::spec::JobSpec;
 use dropslice::{Job, Settings};
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::Arc;
 
 fn gcode(job: &Job) -> Vec<u8> {
     let mut out = Vec::new();
@@ -166,6 +172,259 @@ fn random_damage_never_panics() {
         }
         // Taken or refused; a job taken plans its layers.
         if let Ok(job) = Job::from_bytes(&b) {
+            let _ = gcode(&job);
+        }
+    }
+}
+
+type Tri = [[f32; 3]; 3];
+
+fn box_tris(o: [f32; 3], w: f32, d: f32, h: f32) -> Vec<Tri> {
+    let p = |x: f32, y: f32, z: f32| [o[0] + x, o[1] + y, o[2] + z];
+    let quads = [
+        [p(0., 0., 0.), p(0., d, 0.), p(w, d, 0.), p(w, 0., 0.)],
+        [p(0., 0., h), p(w, 0., h), p(w, d, h), p(0., d, h)],
+        [p(0., 0., 0.), p(w, 0., 0.), p(w, 0., h), p(0., 0., h)],
+        [p(w, 0., 0.), p(w, d, 0.), p(w, d, h), p(w, 0., h)],
+        [p(w, d, 0.), p(0., d, 0.), p(0., d, h), p(w, d, h)],
+        [p(0., d, 0.), p(0., 0., 0.), p(0., 0., h), p(0., d, h)],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect()
+}
+
+fn stl(tris: &[Tri]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend_from_slice(&(tris.len() as u32).to_le_bytes());
+    for t in tris {
+        b.extend_from_slice(&[0u8; 12]);
+        for v in t {
+            for c in v {
+                b.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        b.extend_from_slice(&[0u8; 2]);
+    }
+    b
+}
+
+/// The job of `spec` prepared in steps with a draft: the job (or the refusal), the draft's
+/// bytes (if one was made) and whether the job is the draft's.
+fn drafted(
+    models: &[Model],
+    spec: &JobSpec,
+) -> (Result<Job, String>, Option<Vec<u8>>, Option<bool>) {
+    let draft: Rc<RefCell<Option<Vec<u8>>>> = Rc::default();
+    let d = draft.clone();
+    let hook: dropslice::pipeline::DraftHook = Box::new(move |draft| {
+        let (size, write) = draft.bytes_writer();
+        let mut out = vec![0u8; size];
+        write(&mut out);
+        *d.borrow_mut() = Some(out);
+    });
+    let mut prep = Job::prepare_drafted(Arc::new(models.to_vec()), spec, Some(hook));
+    let job = loop {
+        match prep.step(20_000) {
+            Ok(Some(job)) => break Ok(job),
+            Ok(None) => {}
+            Err(e) => break Err(e.to_string()),
+        }
+    };
+    let bytes = draft.borrow_mut().take();
+    (job, bytes, prep.as_drafted())
+}
+
+/// Prepares `spec` with a draft; when the preparation says the job is the draft's, the draft
+/// confirmed is the job (the same bytes, so the same layers); else the draft's mesh, planes
+/// or units differ from the job's. Returns whether the job was the draft's.
+fn assert_draft(models: &[Model], spec: &str, what: &str) -> Option<bool> {
+    let spec = JobSpec::from_json(spec).unwrap();
+    let whole = Job::from_models(models, &spec).map_err(|e| e.to_string());
+    let (job, draft, as_drafted) = drafted(models, &spec);
+    let job = match (job, whole) {
+        (Ok(job), Ok(whole)) => {
+            assert!(job.to_bytes() == whole.to_bytes(), "{what}: another job");
+            job
+        }
+        (Err(a), Err(b)) => {
+            assert_eq!(a, b, "{what}: another refusal");
+            assert_eq!(as_drafted, None, "{what}: a refused job is no draft's");
+            return None;
+        }
+        (a, b) => panic!("{what}: {:?} against {:?}", a.err(), b.err()),
+    };
+    let draft = draft.unwrap_or_else(|| panic!("{what}: no draft"));
+    let mut from_draft =
+        Job::from_draft(&draft.as_slice()).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let confirmed = from_draft.confirm(&job.confirmation().as_slice());
+    match as_drafted {
+        Some(true) => {
+            confirmed.unwrap_or_else(|e| panic!("{what}: {e}"));
+            assert!(
+                from_draft.to_bytes() == job.to_bytes(),
+                "{what}: the confirmed draft is not the job"
+            );
+            assert_eq!(from_draft.header(None), job.header(None), "{what}: header");
+        }
+        Some(false) => {
+            let differs = from_draft.mesh().facets != job.mesh().facets
+                || from_draft.mesh().vertices != job.mesh().vertices
+                || from_draft.layer_count() != job.layer_count()
+                || from_draft.info().groups != job.info().groups;
+            assert!(
+                differs,
+                "{what}: said to differ from its draft, but is the same"
+            );
+        }
+        None => panic!("{what}: a draft was made, but not told whether the job is its"),
+    }
+    as_drafted
+}
+
+#[test]
+fn a_draft_confirmed_is_the_job_when_no_repair_changed_the_mesh() {
+    for file in std::fs::read_dir(common::shared_dir().join("models")).unwrap() {
+        let path = file.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !(name.ends_with(".stl") || name.ends_with(".3mf") || name.ends_with(".obj")) {
+            continue;
+        }
+        let Ok(m) = Model::read(&std::fs::read(&path).unwrap(), &name) else {
+            continue;
+        };
+        let spec = format!(
+            r#"{{"settings": {{"allow_off_plate": true}}, "parts": [{{"file": "{name}"}}]}}"#
+        );
+        assert_draft(&[m], &spec, &name);
+    }
+    let benchy = Model::read(&common::model_bytes("3DBenchy.stl"), "boat.stl").unwrap();
+    let screw = Model::read(&common::model_bytes("M3x10_screw.stl"), "screw.stl").unwrap();
+    let two = r#"{"settings": {"support": "unit1"},
+        "parts": [{"file": "boat.stl"}, {"file": "screw.stl", "unit": 1, "copies": 2}]}"#;
+    assert_eq!(assert_draft(&[benchy, screw], two, "two units"), Some(true));
+    let model = |tris: &[Tri], name: &str| Model::read(&stl(tris), name).unwrap();
+    let cube = box_tris([0.; 3], 10., 10., 10.);
+    let one = |name: &str| format!(r#"{{"parts": [{{"file": "{name}"}}]}}"#);
+    assert_eq!(
+        assert_draft(&[model(&cube, "a.stl")], &one("a.stl"), "a cube"),
+        Some(true)
+    );
+    // repeated facets dropped
+    let mut repeated = cube.clone();
+    repeated.extend_from_slice(&cube[..3]);
+    assert_eq!(
+        assert_draft(&[model(&repeated, "r.stl")], &one("r.stl"), "repeats"),
+        Some(false)
+    );
+    // an inside-out box: its shell turned
+    let inside_out: Vec<Tri> = cube.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    assert_eq!(
+        assert_draft(&[model(&inside_out, "i.stl")], &one("i.stl"), "inside out"),
+        Some(false)
+    );
+    // a crack closed (a corner moved by 0.05 µm, within the tolerance weld)
+    let mut cracked = cube.clone();
+    cracked[4][1][0] += 0.00005;
+    assert_eq!(
+        assert_draft(&[model(&cracked, "k.stl")], &one("k.stl"), "a crack"),
+        Some(false)
+    );
+    // an open box: nothing to repair
+    let open: Vec<Tri> = (cube.iter().enumerate())
+        .filter(|(i, _)| *i / 2 != 1)
+        .map(|(_, t)| *t)
+        .collect();
+    assert_eq!(
+        assert_draft(&[model(&open, "o.stl")], &one("o.stl"), "open"),
+        Some(true)
+    );
+    // refused after the draft (taller than the chamber)
+    let tall = r#"{"settings": {"plate_z": 5}, "parts": [{"file": "t.stl"}]}"#;
+    assert_eq!(
+        assert_draft(&[model(&cube, "t.stl")], tall, "too tall"),
+        None
+    );
+}
+
+#[test]
+fn a_damaged_draft_or_confirmation_is_refused() {
+    let m = Model::read(&common::model_bytes("M3x10_screw.stl"), "s.stl").unwrap();
+    let spec = JobSpec::from_json(r#"{"parts": [{"file": "s.stl"}]}"#).unwrap();
+    let (job, draft, as_drafted) = drafted(&[m], &spec);
+    let (job, draft) = (job.unwrap(), draft.unwrap());
+    assert_eq!(as_drafted, Some(true));
+    let refused = |e: dropslice::Error, what: &str| {
+        assert_eq!(e.kind(), "internal", "{what}");
+        assert!(e.to_string().contains("prepared job"), "{what}: {e}");
+    };
+    // a draft is not a prepared job, nor the other way round
+    refused(Job::from_bytes(&draft).err().unwrap(), "a draft as a job");
+    refused(
+        Job::from_draft(&job.to_bytes().as_slice()).err().unwrap(),
+        "a job as a draft",
+    );
+    for n in (0..draft.len()).step_by(11) {
+        refused(
+            Job::from_draft(&&draft[..n]).err().unwrap(),
+            &format!("a draft cut to {n}"),
+        );
+    }
+    let table = job.confirmation();
+    let mut from_draft = Job::from_draft(&draft.as_slice()).unwrap();
+    let before = from_draft.to_bytes();
+    for n in 0..table.len() {
+        refused(
+            from_draft.confirm(&&table[..n]).err().unwrap(),
+            &format!("cut to {n}"),
+        );
+    }
+    let mut longer = table.clone();
+    longer.push(b' ');
+    refused(
+        from_draft.confirm(&longer.as_slice()).err().unwrap(),
+        "a byte more",
+    );
+    // another job's confirmation: other settings, other layers
+    let mut s = Settings::default();
+    s.set("layer_height", "0.1").unwrap();
+    let other = Job::new(&common::model_bytes("M3x10_screw.stl"), "s.stl", s).unwrap();
+    refused(
+        from_draft
+            .confirm(&other.confirmation().as_slice())
+            .err()
+            .unwrap(),
+        "another job's",
+    );
+    let benchy = Job::new(
+        &common::model_bytes("3DBenchy.stl"),
+        "s.stl",
+        Settings::default(),
+    )
+    .unwrap();
+    refused(
+        from_draft
+            .confirm(&benchy.confirmation().as_slice())
+            .err()
+            .unwrap(),
+        "another model's",
+    );
+    assert!(
+        from_draft.to_bytes() == before,
+        "a refused confirmation changed the draft"
+    );
+    from_draft.confirm(&table.as_slice()).unwrap();
+    assert!(from_draft.to_bytes() == job.to_bytes());
+    // random damage to a draft: taken or refused, never a panic
+    let mut rng = Rng::new(26);
+    for _ in 0..200 {
+        let mut b = draft.clone();
+        for _ in 0..1 + rng.below(4) {
+            let at = rng.below(b.len() as u64) as usize;
+            b[at] = rng.below(256) as u8;
+        }
+        if let Ok(job) = Job::from_draft(&b.as_slice()) {
             let _ = gcode(&job);
         }
     }

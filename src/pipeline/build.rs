@@ -19,8 +19,10 @@ use crate::model::prepare::{
 };
 use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
+use crate::pipeline::handoff::Draft;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
+use std::cell::Cell;
 use std::rc::Rc;
 use std::sync::Arc;
 
@@ -71,41 +73,76 @@ impl Job {
     /// vertices) a call, every pass in turn, and hands out the job after the last. The job (or
     /// the refusal) is the one [`Job::from_models`] makes, whatever the budgets.
     pub fn prepare_in_steps(models: Arc<Vec<Model>>, spec: &job::JobSpec) -> Preparation {
+        Job::prepare_drafted(models, spec, None)
+    }
+
+    /// [`Job::prepare_in_steps`] that also hands `draft` the job's [`Draft`] as soon as its
+    /// parts are merged (when the plane heights are known), before the passes that need the
+    /// whole mesh: the page's other workers slice from it while this preparation goes on.
+    /// [`Preparation::as_drafted`] then tells whether the job is the draft's.
+    pub fn prepare_drafted(
+        models: Arc<Vec<Model>>,
+        spec: &job::JobSpec,
+        draft: Option<DraftHook>,
+    ) -> Preparation {
         let budget = Rc::new(Budget::new(0));
-        let b = budget.clone();
+        let drafted = Rc::new(Cell::new(None));
+        let (b, d) = (budget.clone(), drafted.clone());
         let spec = spec.clone();
         Preparation {
             budget,
+            drafted,
             pass: Some(Stepped::new(async move {
-                Job::build_in_steps(&models, &spec, &b).await
+                Job::build_in_steps(&models, &spec, &b, draft, &d).await
             })),
         }
     }
 
     /// [`Job::from_models`] as a pass of `b`'s budget: the passes of [`Job::build`] one after
-    /// the other (not side by side), each in runs of items.
+    /// the other (not side by side), each in runs of items; the draft handed to `draft`, and
+    /// whether the job is the draft's set into `drafted` at the end.
     async fn build_in_steps(
         models: &[Model],
         spec: &job::JobSpec,
         b: &Budget,
+        draft: Option<DraftHook>,
+        drafted: &Cell<Option<bool>>,
     ) -> Result<Job, Error> {
         let (mesh, input, settings) = Job::merged(models, spec, b).await?;
         let mut building = Building::new(mesh, input, settings)?;
+        // The facet index of the mesh as merged (dropped below if facets are); with it the
+        // draft: the mesh, its planes, index and units' facet runs. The passes below change
+        // the mesh only where they drop repeated facets, close cracks or turn shells.
+        let mut draft_of = None;
+        if let Ok(zs) = &building.made.zs {
+            let m = &building.made;
+            let index = FacetBuckets::new_in_steps(&m.mesh, zs, b).await;
+            if let Some(hand) = draft {
+                hand(&Draft {
+                    settings: &m.settings,
+                    info: m.provisional_info(zs.len()),
+                    mesh: &m.mesh,
+                    zs,
+                    index: &index,
+                });
+                draft_of = Some((zs.clone(), m.groups.clone()));
+            }
+            building.made.index = Some(index);
+        }
+        let mut changed = false;
         let kept = building.made.mesh.unrepeated_in_steps(b).await;
+        changed |= kept.iter().any(|&k| !k);
         let all = kept.iter().all(|&k| k);
         let shells = match all {
             true => Some(building.made.mesh.shells_in_steps(b).await),
             false => None,
         };
         building.unrepeated_in_steps(kept, shells, b).await;
-        // the index of a mesh that dropped facets would be dropped unused
-        if all && let Ok(zs) = &building.made.zs {
-            building.made.index =
-                Some(FacetBuckets::new_in_steps(&building.made.mesh, zs, b).await);
-        }
         building.close_cracks();
+        changed |= building.made.weld != (0, 0);
         let shells = building.shells.as_ref().expect("the shells were found");
         let orientation = building.made.mesh.orientation_in_steps(shells, b).await;
+        changed |= orientation.1.iter().any(|&f| f);
         if orientation.1.is_empty() {
             let (facets_in_file, dropped) =
                 (building.made.input.facets_in_file, building.dropped());
@@ -139,7 +176,11 @@ impl Job {
             }
             Err(_) => None,
         };
-        checked.conclude(overhangs, repaired)
+        let job = checked.conclude(overhangs, repaired)?;
+        if let Some((zs, groups)) = draft_of {
+            drafted.set(Some(!changed && job.zs == zs && job.info.groups == groups));
+        }
+        Ok(job)
     }
 
     /// The parts of `spec` welded, placed and merged into one mesh: what [`Job::build`]
@@ -388,6 +429,26 @@ struct Made {
     stats: Option<MeshStats>,
 }
 
+impl Made {
+    /// The info of a [`Draft`] of `layers` layers: what its layers need (the box, the
+    /// instances, the units' facet runs); no mesh statistics, warnings or profiles yet.
+    fn provisional_info(&self, layers: usize) -> JobInfo {
+        JobInfo {
+            file_name: self.input.file_name.clone(),
+            format: self.input.format,
+            warnings: Vec::new(),
+            suggested_scale: None,
+            mesh: MeshStats::default(),
+            bounds: self.bounds,
+            layers,
+            droplet_width: self.settings.droplet_width(),
+            instances: self.input.instances.clone(),
+            groups: self.groups.clone(),
+            profiles: Vec::new(),
+        }
+    }
+}
+
 /// A job being prepared: the merged mesh and what the passes of [`Job::build`] found so far.
 struct Building {
     made: Made,
@@ -622,6 +683,8 @@ impl Checked {
 pub struct Preparation {
     /// The items the next step may work through.
     budget: Rc<Budget>,
+    /// Whether the job is its draft's, once made (`None`: no draft was made).
+    drafted: Rc<Cell<Option<bool>>>,
     /// `None` once the job was handed out (or a step failed).
     pass: Option<Stepped<Result<Job, Error>>>,
 }
@@ -646,7 +709,18 @@ impl Preparation {
             }
         }
     }
+
+    /// Once the job is made: whether it is the one its [`Draft`] slices (the same mesh,
+    /// planes and units' facet runs: no facet dropped, no crack closed, no shell turned), so
+    /// that the draft's workers need only its [`Job::confirmation`]; `None` when no draft was
+    /// made (or the job is not made yet).
+    pub fn as_drafted(&self) -> Option<bool> {
+        self.drafted.get()
+    }
 }
+
+/// What [`Job::prepare_drafted`] hands its [`Draft`] to (once).
+pub type DraftHook = Box<dyn FnOnce(&Draft<'_>)>;
 
 /// Checks the width in droplets; the plane heights of the layers (at least one).
 fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {

@@ -8,6 +8,13 @@
 //! left before anything is allocated, every number and index is checked, so damaged bytes are
 //! refused with a message, never a panic or a job that slices wrongly.
 //!
+//! A *draft* ([`Draft`], [`Job::from_draft`]) is the same bytes with a provisional info, made
+//! as soon as the job's parts are merged and indexed, before the passes that need the whole
+//! mesh (the shells and their orientation, the repairs, the checks): the other workers slice
+//! their first layers from it while the job worker finishes. The job worker then
+//! sends a *confirmation* ([`Job::confirmation`], [`Job::confirm`]: the final settings and
+//! info, a few kB) when its repairs left the mesh as drafted, else the whole prepared job.
+//!
 //! The bytes are written to a [`Sink`] and read from a [`Source`] a run of items at a time
 //! through a small buffer: in the page, the sink and the source are the message's buffer
 //! itself (outside the module's memory), so a worker never holds the job twice — once as its
@@ -23,6 +30,10 @@ use crate::slicing::slice::FacetBuckets;
 
 /// The first bytes: the format and its version.
 const MAGIC: &[u8; 8] = b"DSJOB\0\0\x01";
+/// The first bytes of a draft (the job's bytes with a provisional info).
+const DRAFT_MAGIC: &[u8; 8] = b"DSDRAFT\x01";
+/// The first bytes of a confirmation (the final settings and info of a drafted job).
+const CONFIRM_MAGIC: &[u8; 8] = b"DSCONF\0\x01";
 
 #[derive(serde::Serialize, serde::Deserialize)]
 struct Meta {
@@ -72,38 +83,14 @@ impl Job {
 
     /// The length of [`Job::to_bytes`] and what writes them into a sink of that length.
     pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
-        let meta = serde_json::to_vec(&Meta {
-            settings: self.settings.clone(),
-            info: self.info.clone(),
-            shifts: self.info.instances.iter().map(|i| i.shift).collect(),
-        })
-        .expect("settings and job info serialise");
-        let (offsets, bucket_facets) = self.buckets.rows();
-        let size = MAGIC.len()
-            + 6 * 8
-            + meta.len()
-            + self.mesh.vertices.len() * 24
-            + self.mesh.facets.len() * 12
-            + self.zs.len() * 8
-            + (offsets.len() + bucket_facets.len()) * 4;
-        let write = move |sink: &mut dyn Sink| {
-            let mut out = Writer { sink, at: 0 };
-            out.bytes(MAGIC);
-            out.count(meta.len());
-            out.bytes(&meta);
-            out.count(self.mesh.vertices.len());
-            out.put(self.mesh.vertices.as_flattened(), f64::to_le_bytes);
-            out.count(self.mesh.facets.len());
-            out.put(self.mesh.facets.as_flattened(), u32::to_le_bytes);
-            out.count(self.zs.len());
-            out.put(&self.zs, f64::to_le_bytes);
-            for row in [offsets, bucket_facets] {
-                out.count(row.len());
-                out.put(row, u32::to_le_bytes);
-            }
-            debug_assert_eq!(out.at, size);
-        };
-        (size, write)
+        writer(
+            MAGIC,
+            &self.settings,
+            &self.info,
+            &self.mesh,
+            &self.zs,
+            Some(self.buckets.rows()),
+        )
     }
 
     /// The job [`Job::to_bytes`] wrote. Bytes that are not such a job (truncated, of another
@@ -115,21 +102,168 @@ impl Job {
 
     /// [`Job::from_bytes`] from any source of the bytes, read a run of items at a time.
     pub fn read_bytes(bytes: &dyn Source) -> Result<Job, Error> {
-        read(bytes).map_err(|e| {
-            Error::Internal(format!(
-                "the prepared job handed over is damaged: {e}; slice again"
-            ))
-        })
+        read(bytes, MAGIC).map_err(damaged)
+    }
+
+    /// The job of a [`Draft`]'s bytes: it slices as the finished job does if [`Job::confirm`] takes the job worker's confirmation, and is not to be
+    /// used otherwise (its info is provisional). Damaged bytes are refused as by
+    /// [`Job::read_bytes`].
+    pub fn from_draft(bytes: &dyn Source) -> Result<Job, Error> {
+        read(bytes, DRAFT_MAGIC).map_err(damaged)
+    }
+
+    /// The confirmation of a drafted job for [`Job::confirm`]: its final settings and info
+    /// (the facets, planes and index are the draft's).
+    pub fn confirmation(&self) -> Vec<u8> {
+        let meta = meta_json(&self.settings, &self.info);
+        let mut out = Vec::with_capacity(CONFIRM_MAGIC.len() + 8 + meta.len());
+        out.extend_from_slice(CONFIRM_MAGIC);
+        out.extend_from_slice(&(meta.len() as u64).to_le_bytes());
+        out.extend_from_slice(&meta);
+        out
+    }
+
+    /// Takes the job worker's [`Job::confirmation`] into a job made by [`Job::from_draft`]:
+    /// its final info. Refused (the job left as it was) unless the settings, the layers, the
+    /// box and the units' facet runs are the draft's: those made its layers.
+    pub fn confirm(&mut self, table: &dyn Source) -> Result<(), Error> {
+        let confirm = |job: &mut Job| -> Result<(), String> {
+            let mut r = Reader {
+                bytes: table,
+                at: 0,
+                buf: Vec::new(),
+            };
+            if r.take(CONFIRM_MAGIC.len())? != CONFIRM_MAGIC {
+                return Err("not a confirmation of this version".into());
+            }
+            let n = r.count(1)?;
+            let meta: Meta =
+                serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+            if r.at != table.size() {
+                return Err("bytes follow the confirmation".into());
+            }
+            let same_settings = serde_json::to_value(&meta.settings).ok()
+                == serde_json::to_value(&job.settings).ok();
+            if !same_settings {
+                return Err("its settings are not the draft's".into());
+            }
+            let (old, new) = (&job.info, &meta.info);
+            if new.layers != job.zs.len() || new.bounds != old.bounds || new.groups != old.groups {
+                return Err("its layers, box or units' facets are not the draft's".into());
+            }
+            job.info = with_shifts(meta)?.1;
+            Ok(())
+        };
+        confirm(self).map_err(damaged)
     }
 }
 
-fn read(bytes: &dyn Source) -> Result<Job, String> {
+/// A job as its parts were merged, before the passes that need the whole mesh: its
+/// settings, the merged mesh, the plane heights, the facet index and a provisional info (no
+/// mesh statistics, no warnings). [`Draft::bytes_writer`] writes the bytes of
+/// [`Job::from_draft`].
+pub struct Draft<'a> {
+    pub(crate) settings: &'a Settings,
+    pub(crate) info: JobInfo,
+    pub(crate) mesh: &'a Mesh,
+    pub(crate) zs: &'a [f64],
+    pub(crate) index: &'a FacetBuckets,
+}
+
+impl Draft<'_> {
+    /// The length of the draft's bytes and what writes them into a sink of that length.
+    pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
+        writer(
+            DRAFT_MAGIC,
+            self.settings,
+            &self.info,
+            self.mesh,
+            self.zs,
+            Some(self.index.rows()),
+        )
+    }
+}
+
+fn damaged(e: String) -> Error {
+    Error::Internal(format!(
+        "the prepared job handed over is damaged: {e}; slice again"
+    ))
+}
+
+fn meta_json(settings: &Settings, info: &JobInfo) -> Vec<u8> {
+    serde_json::to_vec(&Meta {
+        settings: settings.clone(),
+        info: info.clone(),
+        shifts: info.instances.iter().map(|i| i.shift).collect(),
+    })
+    .expect("settings and job info serialise")
+}
+
+/// The settings and the info with each instance's move put back.
+fn with_shifts(meta: Meta) -> Result<(Settings, JobInfo), String> {
+    let Meta {
+        settings,
+        mut info,
+        shifts,
+    } = meta;
+    if shifts.len() != info.instances.len() {
+        return Err("the instances' moves do not match the instances".into());
+    }
+    for (i, s) in info.instances.iter_mut().zip(shifts) {
+        i.shift = s;
+    }
+    Ok((settings, info))
+}
+
+/// The length of a job's bytes (`index`: the facet index' rows) and what writes them into a
+/// sink of that length.
+fn writer<'a>(
+    magic: &'static [u8; 8],
+    settings: &Settings,
+    info: &JobInfo,
+    mesh: &'a Mesh,
+    zs: &'a [f64],
+    index: Option<(&'a [u32], &'a [u32])>,
+) -> (usize, impl FnOnce(&mut dyn Sink) + 'a) {
+    let meta = meta_json(settings, info);
+    let rows = index.map_or(0, |(o, f)| 16 + (o.len() + f.len()) * 4);
+    let size = magic.len()
+        + 4 * 8
+        + meta.len()
+        + mesh.vertices.len() * 24
+        + mesh.facets.len() * 12
+        + zs.len() * 8
+        + rows;
+    let write = move |sink: &mut dyn Sink| {
+        let mut out = Writer { sink, at: 0 };
+        out.bytes(magic);
+        out.count(meta.len());
+        out.bytes(&meta);
+        out.count(mesh.vertices.len());
+        out.put(mesh.vertices.as_flattened(), f64::to_le_bytes);
+        out.count(mesh.facets.len());
+        out.put(mesh.facets.as_flattened(), u32::to_le_bytes);
+        out.count(zs.len());
+        out.put(zs, f64::to_le_bytes);
+        if let Some((offsets, bucket_facets)) = index {
+            for row in [offsets, bucket_facets] {
+                out.count(row.len());
+                out.put(row, u32::to_le_bytes);
+            }
+        }
+        debug_assert_eq!(out.at, size);
+    };
+    (size, write)
+}
+
+/// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
+fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
     let mut r = Reader {
         bytes,
         at: 0,
         buf: Vec::new(),
     };
-    if r.take(MAGIC.len())? != MAGIC {
+    if r.take(magic.len())? != magic {
         return Err("not a prepared job of this version".into());
     }
     let n = r.count(1)?;
@@ -182,17 +316,7 @@ fn read(bytes: &dyn Source) -> Result<Job, String> {
     }
     let [offsets, bucket_facets] = rows;
     let buckets = FacetBuckets::from_rows(offsets, bucket_facets, zs.len(), facets.len())?;
-    let Meta {
-        settings,
-        mut info,
-        shifts,
-    } = meta;
-    if shifts.len() != info.instances.len() {
-        return Err("the instances' moves do not match the instances".into());
-    }
-    for (i, s) in info.instances.iter_mut().zip(shifts) {
-        i.shift = s;
-    }
+    let (settings, info) = with_shifts(meta)?;
     Ok(Job::assemble(
         settings,
         Mesh { vertices, facets },

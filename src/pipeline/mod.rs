@@ -10,7 +10,7 @@ mod supported;
 mod writer;
 
 pub use budget::{MAX_DROPLETS, MAX_DROPLETS_WITH_SUPPORT, MAX_LAYER_DROPLETS_WITH_SUPPORT};
-pub use build::Preparation;
+pub use build::{DraftHook, Preparation};
 pub use job::Job;
 pub use supported::SupportedPlans;
 #[cfg(not(target_arch = "wasm32"))]

@@ -258,6 +258,19 @@ impl Session {
             job: std::rc::Rc::new(job),
             support_pass: std::cell::RefCell::new(None),
             settings,
+            draft: false,
+            as_drafted: None,
+        }
+    }
+
+    /// An internal error while this session is a draft not confirmed: `what` needs the job's
+    /// final info.
+    fn not_draft(&self, what: &str) -> Result<(), JsValue> {
+        match self.draft {
+            false => Ok(()),
+            true => Err(js_error(Error::Internal(format!(
+                "{what} asked of a draft of the job not confirmed yet"
+            )))),
         }
     }
 
@@ -331,6 +344,8 @@ pub struct Preparing {
     prep: crate::pipeline::Preparation,
     /// The job, once the last step made it.
     job: Option<Job>,
+    /// The draft's bytes ([`Session::begin_drafted`]), once made and until taken.
+    draft: std::rc::Rc<std::cell::RefCell<Option<Uint8Array>>>,
 }
 
 #[wasm_bindgen]
@@ -347,6 +362,13 @@ impl Preparing {
             stages::time(Stage::Prepare, || self.prep.step(items as usize)).map_err(js_error)?;
         self.job = made;
         Ok(self.job.is_some())
+    }
+
+    /// The draft's bytes ([`Session::begin_drafted`]: the job as its parts were merged, for
+    /// [`Session::from_draft`] in the other workers) once a step made it, then `undefined`:
+    /// each draft is handed out once.
+    pub fn take_draft(&self) -> Option<Uint8Array> {
+        self.draft.borrow_mut().take()
     }
 }
 
@@ -370,6 +392,11 @@ pub struct Session {
     /// Why the job's layers are not analysed (too large for the analysis' memory,
     /// [`analysis::AnalysisGrid::check`]), if they are not.
     analysis_refused: Option<Error>,
+    /// A draft's job not confirmed yet ([`Session::from_draft`]): its layers are the job's,
+    /// its info is not.
+    draft: bool,
+    /// Whether the job is its draft's ([`Session::begin_drafted`]; `None`: no draft made).
+    as_drafted: Option<bool>,
 }
 
 #[wasm_bindgen]
@@ -411,18 +438,89 @@ impl Session {
     pub fn begin(models: &Models, job: JsValue) -> Result<Preparing, JsValue> {
         let spec = job_of(job)?;
         let prep = Job::prepare_in_steps(models.models.clone(), &spec);
-        Ok(Preparing { prep, job: None })
+        Ok(Preparing {
+            prep,
+            job: None,
+            draft: Default::default(),
+        })
+    }
+
+    /// [`Session::begin`] that also makes a draft of the job as soon as its parts are merged
+    /// (before the shells, their orientation, the repairs and the checks):
+    /// [`Preparing::take_draft`] hands it out, written a run at a time straight into a buffer
+    /// outside the module's memory; the other workers slice from it ([`Session::from_draft`])
+    /// while this preparation goes on. Once the job is made, [`Session::confirmation`] says
+    /// whether it is the draft's.
+    pub fn begin_drafted(models: &Models, job: JsValue) -> Result<Preparing, JsValue> {
+        let spec = job_of(job)?;
+        let draft: std::rc::Rc<std::cell::RefCell<Option<Uint8Array>>> = Default::default();
+        let into = draft.clone();
+        let hook: crate::pipeline::DraftHook = Box::new(move |d| {
+            let (size, write) = d.bytes_writer();
+            let out = Uint8Array::new_with_length(size as u32);
+            write(&mut JsBytes(out.clone()));
+            *into.borrow_mut() = Some(out);
+        });
+        let prep = Job::prepare_drafted(models.models.clone(), &spec, Some(hook));
+        Ok(Preparing {
+            prep,
+            job: None,
+            draft,
+        })
     }
 
     /// The session of a finished preparation ([`Session::begin`]); `internal` if it has not
     /// ended (every step returned false so far).
     pub fn from_preparation(preparing: Preparing) -> Result<Session, JsValue> {
+        let as_drafted = preparing.prep.as_drafted();
         match preparing.job {
-            Some(job) => Ok(Session::with(job)),
+            Some(job) => {
+                let mut s = Session::with(job);
+                s.as_drafted = as_drafted;
+                Ok(s)
+            }
             None => Err(js_error(Error::Internal(
                 "the job's preparation has not ended".into(),
             ))),
         }
+    }
+
+    /// When the job is its draft's ([`Session::begin_drafted`]: no repair changed the merged
+    /// mesh): the confirmation for the draft's workers ([`Session::confirm`], a few kB: the
+    /// final settings and info); else `undefined` (they need [`Session::prepared`]).
+    pub fn confirmation(&self) -> Option<Uint8Array> {
+        (self.as_drafted == Some(true)).then(|| Uint8Array::from(&self.job.confirmation()[..]))
+    }
+
+    /// A session of the job worker's draft ([`Session::begin_drafted`]), read a run at a time
+    /// out of the message's buffer (never copied whole into the module's memory). It plans layers as the
+    /// finished job will if [`Session::confirm`] takes the job worker's confirmation; until
+    /// then it answers nothing that needs the job's info (header, figures, the analysis).
+    /// Throws `{kind: "internal", message}` if the bytes are damaged.
+    pub fn from_draft(bytes: Uint8Array) -> Result<Session, JsValue> {
+        let source = JsBytes(bytes);
+        let job = stages::time(Stage::Prepare, || Job::from_draft(&source)).map_err(js_error)?;
+        let mut s = Session::with(job);
+        s.draft = true;
+        Ok(s)
+    }
+
+    /// Takes the job worker's confirmation ([`Session::confirmation`]) into a draft's
+    /// session: its final info; the layers planned so far stand. Throws `{kind: "internal"}`
+    /// (the session left as it was) if it is not this draft's.
+    pub fn confirm(&mut self, table: Uint8Array) -> Result<(), JsValue> {
+        let internal = |m: &str| js_error(Error::Internal(m.into()));
+        if !self.draft {
+            return Err(internal("a confirmation for a session that is no draft"));
+        }
+        let job = std::rc::Rc::get_mut(&mut self.job)
+            .ok_or_else(|| internal("a confirmation while the supported pass runs"))?;
+        job.confirm(&JsBytes(table)).map_err(js_error)?;
+        let (grid, settings) = (job.analysis_grid(), job.settings().clone());
+        self.stage = std::sync::Arc::new(analysis::LayerStage::new(&grid, &settings));
+        self.analysis_refused = grid.check(&settings).err();
+        self.draft = false;
+        Ok(())
     }
 
     /// The prepared job as bytes ([`Job::to_bytes`]), for [`Session::from_prepared`] in the
@@ -476,6 +574,7 @@ impl Session {
     /// Facets, bounds, layers, droplet width and mesh warnings (`JobInfo`).
     #[wasm_bindgen(unchecked_return_type = "JobInfo")]
     pub fn info(&self) -> Result<JsValue, JsValue> {
+        self.not_draft("the job's info")?;
         to_js(self.job.info(), "the job info")
     }
 
@@ -492,6 +591,7 @@ impl Session {
     /// times the work of planning the layer.
     pub fn slice_layer_analysed(&self, i: usize) -> Result<LayerResult, JsValue> {
         self.check_layer(i)?;
+        self.not_draft("the analysis")?;
         if let Some(e) = &self.analysis_refused {
             return Err(js_error(e.clone()));
         }
@@ -533,6 +633,7 @@ impl Session {
         &self,
         #[wasm_bindgen(unchecked_param_type = "Summary | null")] summary: JsValue,
     ) -> Result<String, JsValue> {
+        self.not_draft("the header")?;
         if summary.is_null() || summary.is_undefined() {
             return Ok(self.job.header(None));
         }
@@ -557,6 +658,7 @@ impl Session {
         &self,
         #[wasm_bindgen(unchecked_param_type = "Summary[]")] parts: JsValue,
     ) -> Result<JsValue, JsValue> {
+        self.not_draft("the figures")?;
         let parts: Vec<Summary> = from_js(parts, "summaries")?;
         let summary = Summary::merged(&parts);
         let complete = summary.layers == self.job.layer_count();

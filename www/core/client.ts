@@ -3,7 +3,8 @@
 // Files, read and imported there), answers layout, display meshes and lay-flat, and prepares a
 // slice (`Session.from_models`: place, merge, weld, checks, repair); the other workers hold no
 // files: they take the job worker's prepared job as bytes (`adopt_job`), so nothing is read or
-// prepared twice (see [[openAll]]). The pool
+// prepared twice (see [[openAll]]); a slice starts them on the job worker's draft before the
+// job is made (see [[Pool.sliceDrafted]]). The pool
 // remembers which Files the job worker holds and adds them again to a fresh worker (after a
 // cancel or a crash), so the page only ever says which files the job has. Each worker, as soon
 // as it holds the model, takes units of consecutive layers from a shared counter (two units in
@@ -94,6 +95,8 @@ interface Pending {
   resolve: (v: unknown) => void;
   reject: (e: Error) => void;
   progress?: (layer: LayerData) => void;
+  /** `open_job`'s drafts (protocol.ts, the "draft" reply). */
+  draft?: (drafts: Uint8Array[]) => void;
 }
 
 /** Workers started so far (the tests' hook: a cancel replaces which ones). */
@@ -137,13 +140,19 @@ class WorkerHandle {
 
   /** Sends request `kind` with its data (checked against protocol.ts `Calls`) and resolves
    *  with its typed result. */
-  call<K extends RequestKind>(kind: K, data: RequestData<K>, progress?: (layer: LayerData) => void, transfer: Transferable[] = []): Promise<ResultOf<K>> {
+  call<K extends RequestKind>(
+    kind: K,
+    data: RequestData<K>,
+    progress?: (layer: LayerData) => void,
+    transfer: Transferable[] = [],
+    draft?: (drafts: Uint8Array[]) => void,
+  ): Promise<ResultOf<K>> {
     const id = this.nextId++;
     // one member of protocol.ts `Request`, checked by the signature (no cast)
     const message: { id: number; kind: K; data: RequestData<K> } = { id, kind, data };
     return new Promise<ResultOf<K>>((resolve, reject) => {
       if (this.ended) return reject(this.ended);
-      this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, progress });
+      this.pending.set(id, { resolve: resolve as (v: unknown) => void, reject, progress, draft });
       // after the module (a `then` of the one promise runs in the order they were added)
       this.started.then(
         () => this.worker.postMessage(message, transfer),
@@ -163,6 +172,10 @@ class WorkerHandle {
     }
     if (reply.kind === "layers") {
       for (const l of reply.data) p.progress?.(l);
+      return;
+    }
+    if (reply.kind === "draft") {
+      p.draft?.(reply.data.drafts);
       return;
     }
     this.pending.delete(reply.id);
@@ -208,16 +221,74 @@ interface Unit {
 
 /** Hands out the units of layers [0, layers) in order, shared by all workers. A unit is small
  *  enough to share the work evenly and to show progress, and large enough that its round trip
- *  and its Blob cost little (a Blob costs about 0.5 ms, whatever its size). */
+ *  and its Blob cost little (a Blob costs about 0.5 ms, whatever its size). Units given back
+ *  (a draft's that did not stand, see [[Speculation]]) are handed out again first. */
+class UnitCounter {
+  private readonly size: number;
+  private at = 0;
+  private again: Unit[] = [];
+
+  constructor(
+    readonly layers: number,
+    workers: number,
+  ) {
+    this.size = Math.max(1, Math.min(16, Math.ceil(layers / (4 * workers))));
+  }
+
+  next(): Unit | null {
+    const back = this.again.shift();
+    if (back) return back;
+    if (this.at >= this.layers) return null;
+    const from = this.at;
+    this.at = Math.min(this.layers, from + this.size);
+    return { from, to: this.at };
+  }
+
+  giveBack(units: Unit[]): void {
+    this.again.push(...units);
+    this.again.sort((a, b) => a.from - b.from);
+  }
+}
+
 function unitCounter(layers: number, workers: number): () => Unit | null {
-  const size = Math.max(1, Math.min(16, Math.ceil(layers / (4 * workers))));
-  let next = 0;
-  return () => {
-    if (next >= layers) return null;
-    const from = next;
-    next = Math.min(layers, from + size);
-    return { from, to: next };
-  };
+  const c = new UnitCounter(layers, workers);
+  return () => c.next();
+}
+
+/** A worker slicing from the job worker's draft before the job is made (`adopt_draft`): what
+ *  it sends is held until the job worker confirms the job is the draft's (`confirm_job`), then
+ *  passed on in order; if the job is refused or not the draft's, it is dropped and the units
+ *  it took are given back. */
+class Speculation {
+  state: "draft" | "confirmed" | "dropped" = "draft";
+  /** What the worker sent while a draft, to pass on once confirmed. */
+  private held: (() => void)[] = [];
+  /** The units it took while a draft. */
+  readonly taken: Unit[] = [];
+  /** Its units' lanes: they end when the counter has no unit left (or it was dropped). */
+  lanes: Promise<void> = Promise.resolve();
+
+  constructor(readonly h: WorkerHandle) {}
+
+  pass(f: () => void): void {
+    if (this.state === "confirmed") f();
+    else if (this.state === "draft") this.held.push(f);
+  }
+
+  confirm(): void {
+    this.state = "confirmed";
+    const held = this.held;
+    this.held = [];
+    for (const f of held) f();
+  }
+
+  drop(counter: UnitCounter | null): void {
+    if (this.state === "dropped") return;
+    this.state = "dropped";
+    this.held = [];
+    this.lanes.catch(() => {}); // terminated: its calls reject
+    counter?.giveBack(this.taken);
+  }
 }
 
 /** A file of the job: its name in the job (the key in `Models`) and the File. */
@@ -264,9 +335,15 @@ async function addTo(h: WorkerHandle, files: JobFileRef[], hasher: WorkerHandle 
  *  other workers, see [[openAll]]): all its requests posted at once (it answers them in order;
  *  a round trip through the page's busy thread between them cost a worker tens of ms). A
  *  refusal of the files is reported before the job's. */
-async function syncThenOpen(h: WorkerHandle, files: JobFileRef[], job: JobFile, share: number): Promise<ResultOf<"open_job">> {
+async function syncThenOpen(
+  h: WorkerHandle,
+  files: JobFileRef[],
+  job: JobFile,
+  share: number,
+  draft?: (drafts: Uint8Array[]) => void,
+): Promise<ResultOf<"open_job">> {
   const synced = syncModels(h, files);
-  const opened = h.call("open_job", { job, share });
+  const opened = h.call("open_job", { job, share, draft: draft !== undefined }, undefined, [], draft);
   opened.catch(() => {}); // awaited below, after the files
   await synced;
   return opened;
@@ -390,13 +467,15 @@ export class Pool {
   }
 
   /** Slices a job of `files`: opens it (see [[openAll]]) and streams all layers through
-   *  `cb.layer`. */
+   *  `cb.layer`. With more than one worker and no analysis, the others slice from the job
+   *  worker's draft while it prepares the job ([[sliceDrafted]]). */
   slice(files: JobFileRef[], job: JobFile, cb: SliceCallbacks, analyse = false): Promise<OpenResult> {
     this.heal();
     return this.guarded(async () => {
       this.opening = null;
-      let nextUnit: () => Unit | null = () => null;
       const handles = this.handles;
+      if (!analyse && handles.length > 1) return this.sliceDrafted(handles, files, job, cb);
+      let nextUnit: () => Unit | null = () => null;
       return openAll(handles, files, job, async (h, r) => {
         if (h === handles[0]) {
           nextUnit = unitCounter(r.layers, handles.length);
@@ -407,6 +486,104 @@ export class Pool {
         await this.units(h, nextUnit, { analyse }, layer, unit);
       });
     });
+  }
+
+  /** [[slice]] with the preparation off the critical path: the job worker hands out a draft
+   *  of the job as soon as its parts are merged (`open_job` with `draft`), and every other
+   *  worker takes it (`adopt_draft`) and slices units of layers while the
+   *  job worker finds the shells, turns them, repairs and checks the job. What they send is
+   *  held ([[Speculation]]) until the job worker confirms the job is the draft's
+   *  (`confirm_job`, a few kB); if it is not (a repair changed the mesh) or the job is
+   *  refused, those workers are replaced, their units given back, and the fresh ones take the
+   *  prepared job as [[openAll]] does. */
+  private async sliceDrafted(handles: WorkerHandle[], files: JobFileRef[], job: JobFile, cb: SliceCallbacks): Promise<OpenResult> {
+    const [first, ...others] = handles;
+    const layer = (l: LayerData) => clock.time("page: layer arrived (store, draw)", () => cb.layer(l));
+    const unit = (u: SliceUnit) => clock.time("page: unit arrived (figures)", () => cb.unit(u));
+    // the others answer nothing of the slice shown from now on (see [[openAll]])
+    for (const h of others) h.hasModel = false;
+    let counter: UnitCounter | null = null;
+    const counterOf = (layers: number): UnitCounter => (counter ??= new UnitCounter(layers, handles.length));
+    const drafted = (): UnitCounter | null => counter;
+    const drafts: (Speculation | null)[] = others.map(() => null);
+    const onDraft = (copies: Uint8Array[]): void => {
+      others.forEach((h, k) => {
+        const copy = copies[k];
+        if (drafts[k] || !copy) return;
+        const sp = new Speculation(h);
+        drafts[k] = sp;
+        sp.lanes = (async () => {
+          const { layers } = await h.call("adopt_draft", { prepared: copy }, undefined, [copy.buffer]);
+          if (sp.state === "dropped") return;
+          const c = counterOf(layers);
+          if (c.layers !== layers) throw new SliceError("internal", "two drafts of one job differ in their layers");
+          const next = (): Unit | null => {
+            if (sp.state === "dropped") return null;
+            const u = c.next();
+            if (u && sp.state === "draft") sp.taken.push(u);
+            return u;
+          };
+          await this.units(h, next, { analyse: false }, (l) => sp.pass(() => layer(l)), (u) => sp.pass(() => unit(u)));
+        })();
+        sp.lanes.catch(() => {}); // awaited once confirmed
+      });
+    };
+    /** Drops a draft's worker: a fresh worker takes its place (none if it was replaced
+     *  meanwhile, by a cancel or a crash). */
+    const replace = (sp: Speculation): WorkerHandle | null => {
+      sp.drop(drafted());
+      const i = this.handles.indexOf(sp.h);
+      if (i < 0) return null;
+      const fresh = new WorkerHandle();
+      this.handles[i] = fresh;
+      sp.h.terminate(new SliceError("internal", "the job's draft did not stand"));
+      return fresh;
+    };
+    let r: ResultOf<"open_job">;
+    try {
+      r = await syncThenOpen(first, files, job, others.length, onDraft);
+    } catch (e) {
+      for (const sp of drafts) if (sp) replace(sp);
+      throw e;
+    }
+    first.hasModel = true;
+    const { prepared, confirm, ...opened } = r;
+    if ((drafted()?.layers ?? opened.layers) !== opened.layers) {
+      for (const sp of drafts) if (sp) replace(sp);
+      throw new SliceError("internal", "the job's draft and the job differ in their layers");
+    }
+    const c = counterOf(opened.layers);
+    cb.opened(opened);
+    const work: Promise<void>[] = [this.units(first, () => c.next(), { analyse: false }, layer, unit)];
+    others.forEach((h, k) => {
+      const sp = drafts[k];
+      const table = confirm?.[k];
+      if (sp && table) {
+        work.push(
+          (async () => {
+            await h.call("confirm_job", { table }, undefined, [table.buffer]);
+            h.hasModel = true;
+            sp.confirm();
+            await sp.lanes;
+          })(),
+        );
+        return;
+      }
+      const worker = sp ? replace(sp) : h;
+      const bytes = prepared?.[k];
+      work.push(
+        (async () => {
+          if (!worker) throw new Cancelled();
+          if (!bytes) throw new SliceError("internal", "the job worker handed over too few copies of the job");
+          await worker.call("adopt_job", { prepared: bytes }, undefined, [bytes.buffer]);
+          worker.hasModel = true;
+          await this.units(worker, () => c.next(), { analyse: false }, layer, unit);
+        })(),
+      );
+    });
+    for (const w of work) w.catch(() => {}); // awaited below
+    await Promise.all(work);
+    return opened;
   }
 
   /** Runs units from `nextUnit` on one worker, [[UNITS_IN_FLIGHT]] at a time, until it has none. */

@@ -199,8 +199,17 @@ export interface Calls {
   check_profile: { data: { bytes: Uint8Array }; result: Profile };
   /** Prepares the job `job` of the files added (Session.from_models), in the job worker;
    *  with `share: n`, also n copies of the prepared job as bytes (`Session.prepared`), one for
-   *  each other worker's `adopt_job`. */
-  open_job: { data: { job: JobFile; share?: number }; result: OpenResult & { prepared?: Uint8Array[] } };
+   *  each other worker's `adopt_job`. With `draft` too, n copies of the job's draft in a
+   *  "draft" reply as soon as its parts are merged (`Session.begin_drafted`), and then, if the
+   *  job is the draft's, n confirmations (`confirm`, for `confirm_job`) instead of `prepared`. */
+  open_job: { data: { job: JobFile; share?: number; draft?: boolean }; result: OpenResult & { prepared?: Uint8Array[]; confirm?: Uint8Array[] } };
+  /** Takes the job worker's draft of the job (`Session.from_draft`: the job as its parts were
+   *  merged and indexed), to slice layers from before the job is made; the
+   *  page keeps those layers until `confirm_job`. */
+  adopt_draft: { data: { prepared: Uint8Array }; result: { layers: number } };
+  /** Takes the job worker's confirmation that the job is the draft's (`Session.confirm`):
+   *  the draft's layers stand, the session has the job's info. */
+  confirm_job: { data: { table: Uint8Array }; result: OpenResult };
   /** Takes the job the job worker prepared (`Session.from_prepared`): no file is read, nothing
    *  prepared again. */
   adopt_job: { data: { prepared: Uint8Array }; result: OpenResult };
@@ -269,6 +278,8 @@ export type ToWorker = ModuleMessage | Request;
 export type Reply =
   | { id: number; kind: "progress"; data: LayerData }
   | { id: number; kind: "layers"; data: LayerData[] }
+  /** During `open_job` with `draft`: one copy of the job's draft per other worker. */
+  | { id: number; kind: "draft"; data: { drafts: Uint8Array[] } }
   | { id: number; kind: "result"; data: ResultOf<RequestKind> }
   | { id: number; kind: "error"; data: ErrorValue };
 

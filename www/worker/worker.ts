@@ -1,8 +1,8 @@
 // One worker = one wasm instance = at most one Session (one prepared slicing job). The job
 // worker, the pool's first, also holds the job's `Models` (its imported files), prepares the
 // job from them, hands it to the other workers as bytes (`open_job` with `share`; they
-// `adopt_job` it) and answers the layout and the 3D view's requests. Answers the requests of
-// core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred).
+// `adopt_job` it, or slice from its draft, `adopt_draft`, until `confirm_job`) and answers
+// the layout and the 3D view's requests. Answers the requests of core/protocol.ts; streams layers in batches ("layers" replies, their buffers transferred).
 // The model files arrive as Files and are read here (by the core, with FileReaderSync), never
 // on the page's thread. Everything from the core is a typed value; its errors are thrown as
 // `{kind, message, setting?}` and passed on as they are. The core's module comes compiled
@@ -152,12 +152,18 @@ const PREPARE_ITEMS = 16_384;
 
 /** `Session.from_models` in short calls (`Session.begin`, then a budget of items a call):
  *  the engine keeps a running call's first code to its end, so a call that ran the whole
- *  preparation ran it all in that code; later calls of a pass get the optimised code. */
-function prepare(m: Models, job: RequestData<"open_job">["job"]): Session {
-  const p = timedCall("core: preparation, the longest call", () => Session.begin(m, job));
+ *  preparation ran it all in that code; later calls of a pass get the optimised code. With
+ *  `draft`, the job's draft (`Session.begin_drafted`) goes to `draft` as soon as a step made
+ *  it, while the preparation goes on. */
+function prepare(m: Models, job: RequestData<"open_job">["job"], draft: ((d: Uint8Array) => void) | null): Session {
+  const p = timedCall("core: preparation, the longest call", () => (draft ? Session.begin_drafted(m, job) : Session.begin(m, job)));
   let done = false;
   try {
-    while (!done) done = timedCall("core: preparation, the longest call", () => p.step(PREPARE_ITEMS));
+    while (!done) {
+      done = timedCall("core: preparation, the longest call", () => p.step(PREPARE_ITEMS));
+      const d = draft ? p.take_draft() : undefined;
+      if (d && draft) draft(d);
+    }
   } catch (e) {
     p.free();
     throw e;
@@ -297,29 +303,55 @@ async function handle(req: Request): Promise<void> {
       return;
     case "open_job": {
       await load();
-      // the old session stays usable if the job is refused
-      const s = prepare(needModels(), req.data.job);
-      // one copy of the prepared job per other worker (at most the pool's), made here rather
-      // than on the page's thread, all transferred; made before the session is taken, so a
-      // failure keeps the old one
+      // one copy of the prepared job (or of its draft and the confirmation) per other worker
+      // (at most the pool's), made here rather than on the page's thread, all transferred
       const asked = req.data.share ?? 0;
       const n = Number.isFinite(asked) ? Math.min(Math.max(0, Math.floor(asked)), 8) : 0;
-      const prepared: Uint8Array[] = [];
+      const copies = (first: Uint8Array): Uint8Array[] => [first, ...Array.from({ length: n - 1 }, () => first.slice())];
+      const drafted =
+        n > 0 && req.data.draft
+          ? (d: Uint8Array) => {
+              const drafts = clock.time("worker: the draft's copies", () => copies(d));
+              post({ id: req.id, kind: "draft", data: { drafts } }, drafts.map((p) => p.buffer));
+            }
+          : null;
+      // the old session stays usable if the job is refused
+      const s = prepare(needModels(), req.data.job, drafted);
+      // made before the session is taken, so a failure keeps the old one
+      let shared: { prepared: Uint8Array[] } | { confirm: Uint8Array[] } | null = null;
       try {
-        if (n > 0) prepared.push(clock.time("core: the prepared job as bytes", () => timedCall("core: the prepared job as bytes, the longest call", () => s.prepared())));
-        for (let k = 1; k < n; k++) prepared.push(prepared[0].slice());
+        const table = drafted ? s.confirmation() : undefined;
+        if (table) shared = { confirm: copies(table) };
+        else if (n > 0) shared = { prepared: copies(clock.time("core: the prepared job as bytes", () => timedCall("core: the prepared job as bytes, the longest call", () => s.prepared()))) };
       } catch (e) {
         s.free();
         throw e;
       }
       const opened = adopt(s);
-      if (n < 1) answer(req.kind, req.id, opened);
-      else answer(req.kind, req.id, { ...opened, prepared }, prepared.map((p) => p.buffer));
+      if (!shared) answer(req.kind, req.id, opened);
+      else {
+        const buffers = ("confirm" in shared ? shared.confirm : shared.prepared).map((p) => p.buffer);
+        answer(req.kind, req.id, { ...opened, ...shared }, buffers);
+      }
       return;
     }
     case "adopt_job": {
       await load();
       answer(req.kind, req.id, adopt(timedCall("core: the prepared job taken, the longest call", () => Session.from_prepared(req.data.prepared))));
+      return;
+    }
+    case "adopt_draft": {
+      await load();
+      const s = timedCall("core: the draft taken, the longest call", () => Session.from_draft(req.data.prepared));
+      session?.free();
+      session = s;
+      answer(req.kind, req.id, { layers: s.layer_count() });
+      return;
+    }
+    case "confirm_job": {
+      const s = need();
+      s.confirm(req.data.table);
+      answer(req.kind, req.id, { layers: s.layer_count(), info: s.info() });
       return;
     }
     case "slice": {
@@ -432,6 +464,8 @@ function outOfMemory(req: Request | null): string {
     case "orient":
     case "open_job":
     case "adopt_job":
+    case "adopt_draft":
+    case "confirm_job":
       return `${limit} while reading and preparing the model: ${model}`;
     case "slice":
     case "preview":
