@@ -87,11 +87,13 @@ fn main() {
     });
     println!("part plans      {:.3} s", t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let (b, b1) = (s.droplet_width(), s.support_width());
+    let (b, bs) = (s.droplet_width(), s.support_width());
+    let support = [bs; dropslice::base::settings::MAX_UNITS];
     let (_extra, pass) = dropslice::support::droplets::complete(
         &|i, within, out: &mut Vec<dropslice::support::droplets::Droplet>| {
-            dropslice::support::droplets::droplets_of(&parts[i].moves, b, b1, within, out);
-            dropslice::support::droplets::droplets_of(&hatch[i], b, b1, within, out);
+            let widths = parts[i].widths(b);
+            dropslice::support::droplets::droplets_of(&parts[i].moves, &widths, within, out);
+            dropslice::support::droplets::droplets_of(&hatch[i], &support, within, out);
         },
         &regions,
         &s,

@@ -256,7 +256,10 @@ fn a_second_material_has_its_own_estimate_from_the_workers_and_in_order() {
     let ordered = report_in_order(&job);
     assert_eq!(workers.part, ordered.part);
     let u1 = workers.part.units[1].expect("unit 1's estimate");
-    assert!(workers.part.units[0].is_none(), "unit 0's figures are the part's own");
+    assert!(
+        workers.part.units[0].is_none(),
+        "unit 0's figures are the part's own"
+    );
     // the cube (8 cm³, 20 mm high) ends below the boat's top: its slabs are all in
     assert!((u1.volume - 8000.0).abs() < 1.0, "{u1:?}");
     assert!(u1.void_volume > 0.0 && u1.void_fraction < 0.5, "{u1:?}");

@@ -6,11 +6,11 @@
 mod common;
 
 use common::{Rng, TempDir, bounds, model, model_bytes, on_plate, run_cli};
+use dropslice::base::settings::UnitId;
 use dropslice::model::display::display_mesh;
 use dropslice::model::layout::{Rect, arrange, lay_flat, layout};
 use dropslice::model::models::Model;
 use dropslice::model::spec::{self as job, JobSpec};
-use dropslice::base::settings::UnitId;
 use dropslice::{Error, Job, Settings};
 use serde_json::{Value, json};
 use std::time::Duration;

@@ -462,19 +462,18 @@ impl Estimate {
                 MAX_DROPLETS_WITH_SUPPORT,
             ));
         }
-        for u in 1..MAX_UNITS {
+        let widths = (b.iter()).zip(self.unit_extents.iter().zip(&self.unit_volumes));
+        for (u, (&bu, (&extent, &volume))) in widths.enumerate().skip(1) {
             let prints_support = support && u == su;
-            let used = prints_support || self.unit_volumes[u] > 0.0;
-            let lines = self.unit_extents[u] / b[u];
-            if used && over(lines, MAX_WIDTH_IN_DROPLETS) {
+            let used = prints_support || volume > 0.0;
+            if used && over(extent / bu, MAX_WIDTH_IN_DROPLETS) {
                 return Err(Error::setting(
                     &aspect(u),
                     format!(
-                        "unit {u}'s region would be {:.0} mm wide{}, more than {MAX_WIDTH_IN_DROPLETS} droplets of {} = {} mm; raise {}{}",
-                        self.unit_extents[u],
+                        "unit {u}'s region would be {extent:.0} mm wide{}, more than {MAX_WIDTH_IN_DROPLETS} droplets of {} = {} mm; raise {}{}",
                         if prints_support { " (support)" } else { "" },
                         b_of(u),
-                        mm(b[u]),
+                        mm(bu),
                         aspect(u),
                         if prints_support {
                             " or set support = off"
