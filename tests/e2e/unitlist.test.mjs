@@ -199,7 +199,7 @@ test("three units print a unit-2 part with its droplets and colour", async () =>
   await page.click(".part-item:nth-child(2)");
   await page.selectOption("#part-unit", "1");
   await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 1);
-  await page.selectOption("#set-support", "unit2");
+  await setField(page, "support", "unit2");
   await page.click("#btn-slice");
   const t = await waitDone(page);
   assert.ok(t.counts.support > 0, `support droplets ${t.counts.support}`);

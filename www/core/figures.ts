@@ -45,7 +45,7 @@ export class Figures {
   /** Set by the core when every layer is in and not one droplet fits. */
   nothingToPrint: ErrorValue | null = null;
   /** A .gco file's droplets and travel, as read. */
-  private read: Counts = { outer: 0, inner: 0, fill: 0, support: 0, units: [0, 0, 0, 0] };
+  private read: Counts & { units: number[] } = { outer: 0, inner: 0, fill: 0, support: 0, units: [0, 0, 0, 0] };
   private readTravel = 0;
   /** A .gco file's droplets per unit (after `T0`, `T1`, …), as read. */
   private readUnits: number[] = [0];

@@ -293,7 +293,8 @@ mod tests {
                 outer: 2,
                 inner: 0,
                 fill: 11,
-                ..Counts::default()
+                support: 0,
+                units: [13, 0, 0, 0],
             }
         );
         assert_eq!(layers[0].preview.roles.len(), 13);
@@ -356,7 +357,7 @@ mod tests {
         assert_eq!(layers[0].counts.total(), 10);
         // Unit 3 (the last a machine may have) with the default aspect of its own setting.
         let (layers, _) = read_gcode(&format!("{head}T3\nG25 X1.0400 Y0 Z0.2\n")).unwrap();
-        assert_eq!((layers[0].units.len(), layers[0].counts.units[3]), (5, 5));
+        assert_eq!((layers[0].units.len(), layers[0].counts.units[3]), (6, 6));
         for bad in ["T4", "T01", "T-1"] {
             let err = read_gcode(&format!("{head}{bad}\nG26 X0 Y0 Z0.2\n"))
                 .unwrap_err()
