@@ -13,8 +13,8 @@ use crate::base::boolean::{Paths, simplify_apart_known};
 use crate::base::geom::{
     Contour, DVec2, Point, Shape, Shapes, all_contours, dist, segment_distance2, signed_area,
 };
-use std::cell::OnceCell;
 use i_overlay::core::fill_rule::FillRule;
+use std::cell::OnceCell;
 
 /// Largest distance between an arc and the chords that approximate it.
 pub const CHORD_TOLERANCE_MM: f64 = 0.001;
@@ -193,8 +193,8 @@ impl EdgeGrid {
         let (x0, x1, y0, y1) = self.cells(p - DVec2::splat(r), p + DVec2::splat(r));
         for y in y0..=y1 {
             let row = y * self.nx;
-            let run = &self.items
-                [self.offsets[row + x0] as usize..self.offsets[row + x1 + 1] as usize];
+            let run =
+                &self.items[self.offsets[row + x0] as usize..self.offsets[row + x1 + 1] as usize];
             for &(a, b, hole) in run {
                 // An edge whose box lies farther than r from p lies farther than r too.
                 if p.x + r < a.x.min(b.x)
