@@ -85,7 +85,13 @@ impl<'a> Boundary<'a> {
     /// `d_outer` from outer loops, `d_hole` from holes, less twice [`CHORD_TOLERANCE_MM`]
     /// (the chords and rounding).
     fn keeps_all(&self, offset: &Shapes, d_outer: f64, d_hole: f64) -> bool {
-        let mut points = all_contours(offset).flatten().peekable();
+        self.keeps(all_contours(offset).flatten().copied(), d_outer, d_hole)
+    }
+
+    /// Whether every point lies at least the allowed distance from the boundary, as
+    /// [`Boundary::keeps_all`] measures it.
+    fn keeps(&self, points: impl IntoIterator<Item = Point>, d_outer: f64, d_hole: f64) -> bool {
+        let mut points = points.into_iter().peekable();
         if points.peek().is_none() {
             return true;
         }
@@ -96,7 +102,7 @@ impl<'a> Boundary<'a> {
             d * d
         };
         let limits = [limit(d_outer), limit(d_hole)];
-        points.all(|&p| !grid.any_within(p, reach, limits))
+        points.all(|p| !grid.any_within(p, reach, limits))
     }
 }
 
@@ -517,6 +523,65 @@ mod tests {
                 .count();
         }
         assert!(dropped > 300, "{dropped}");
+    }
+
+    #[test]
+    fn the_edge_grid_finds_what_every_edge_finds() {
+        // Regions of random loops (outer loops and holes, long and short edges, some far
+        // outside the rest), points in and around them: the grid's answer is the one of
+        // testing every edge, for small and large reaches and either limit the smaller.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut hits = 0;
+        for case in 0..200 {
+            let loops = 1 + (random(&mut seed) * 6.0) as usize;
+            let scale = if case % 4 == 0 { 100.0 } else { 5.0 };
+            let region: Shapes = (0..loops)
+                .map(|_| {
+                    let c = DVec2::new(random(&mut seed), random(&mut seed)) * scale;
+                    let r = 0.05 + random(&mut seed) * 2.0;
+                    let outer = island(&mut seed, c, r);
+                    let holes = if random(&mut seed) < 0.5 {
+                        let mut h = island(&mut seed, c, r * 0.5);
+                        h.reverse();
+                        vec![h]
+                    } else {
+                        vec![]
+                    };
+                    Shape::new(outer, holes)
+                })
+                .collect();
+            let (d_outer, d_hole) = (random(&mut seed) * 0.6, random(&mut seed) * 0.6);
+            let reach = d_outer.max(d_hole);
+            let boundary = Boundary::new(&region);
+            for _ in 0..50 {
+                let p = DVec2::new(random(&mut seed), random(&mut seed)) * (scale + 4.0)
+                    - DVec2::splat(2.0);
+                let mut want = false;
+                for shape in &region {
+                    for (hole, c) in shape.contours_with_hole() {
+                        let d = (if hole { d_hole } else { d_outer } - 2.0 * CHORD_TOLERANCE_MM)
+                            .max(0.0);
+                        for k in 0..c.len() {
+                            want |= segment_distance2(p, c[k], c[(k + 1) % c.len()]) < d * d;
+                        }
+                    }
+                }
+                assert_eq!(boundary.keeps([p], d_outer, d_hole), !want, "case {case}");
+                hits += usize::from(want);
+            }
+            // The grid is made for the first reach; a larger one later still finds all.
+            let far = DVec2::new(random(&mut seed), random(&mut seed)) * scale;
+            let big = reach + 3.0;
+            let mut want = false;
+            for c in region.iter().flat_map(|s| s.contours()) {
+                for k in 0..c.len() {
+                    want |= segment_distance2(far, c[k], c[(k + 1) % c.len()])
+                        < (big - 2.0 * CHORD_TOLERANCE_MM).powi(2);
+                }
+            }
+            assert_eq!(boundary.keeps([far], big, big), !want, "case {case}");
+        }
+        assert!(hits > 500, "{hits}");
     }
 
     #[test]
