@@ -114,7 +114,17 @@ struct EdgeGrid {
     nx: usize,
     ny: usize,
     offsets: Vec<u32>,
-    items: Vec<(Point, Point, bool)>,
+    items: Vec<GridEdge>,
+}
+
+/// An edge in [`EdgeGrid`]: its ends, its bounding box, whether it bounds a hole.
+#[derive(Clone, Copy)]
+struct GridEdge {
+    a: Point,
+    b: Point,
+    lo: Point,
+    hi: Point,
+    hole: bool,
 }
 
 impl EdgeGrid {
@@ -164,10 +174,18 @@ impl EdgeGrid {
             grid.offsets[i] += grid.offsets[i - 1];
         }
         let mut fill = grid.offsets.clone();
-        grid.items = vec![(DVec2::ZERO, DVec2::ZERO, false); grid.offsets[nx * ny] as usize];
-        for &e in &edges {
-            let (a, b, _) = e;
-            let (x0, x1, y0, y1) = grid.cells(a.min(b), a.max(b));
+        let none = GridEdge {
+            a: DVec2::ZERO,
+            b: DVec2::ZERO,
+            lo: DVec2::ZERO,
+            hi: DVec2::ZERO,
+            hole: false,
+        };
+        grid.items = vec![none; grid.offsets[nx * ny] as usize];
+        for &(a, b, hole) in &edges {
+            let (lo, hi) = (a.min(b), a.max(b));
+            let e = GridEdge { a, b, lo, hi, hole };
+            let (x0, x1, y0, y1) = grid.cells(lo, hi);
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let slot = &mut fill[y * nx + x];
@@ -201,16 +219,12 @@ impl EdgeGrid {
             let row = y * self.nx;
             let run =
                 &self.items[self.offsets[row + x0] as usize..self.offsets[row + x1 + 1] as usize];
-            for &(a, b, hole) in run {
+            for e in run {
                 // An edge whose box lies farther than r from p lies farther than r too.
-                if p.x + r < a.x.min(b.x)
-                    || p.x - r > a.x.max(b.x)
-                    || p.y + r < a.y.min(b.y)
-                    || p.y - r > a.y.max(b.y)
-                {
+                if p.x + r < e.lo.x || p.x - r > e.hi.x || p.y + r < e.lo.y || p.y - r > e.hi.y {
                     continue;
                 }
-                if segment_distance2(p, a, b) < limits[usize::from(hole)] {
+                if segment_distance2(p, e.a, e.b) < limits[usize::from(e.hole)] {
                     return true;
                 }
             }
