@@ -91,13 +91,18 @@ impl Model {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct ModelInfo {
+    /// The file's name (one line, at most [`crate::model::spec::MAX_NAME_CHARS`] characters).
     pub name: String,
+    /// Binary or ASCII STL, OBJ or 3MF, as the file's bytes (for OBJ also its name) say.
     pub format: Format,
+    /// The triangles of all its items as read, before welding (degenerate ones included).
     pub triangles: usize,
     /// In the file's coordinates (mm, after its units and 3MF transforms).
     pub bounds: Bounds,
     /// The 3MF build items (one item for STL and OBJ).
     pub items: Vec<ItemInfo>,
+    /// Sentences for the page: a size that suggests other units than mm (see
+    /// `suggested_scale`); empty when nothing looks wrong.
     pub warnings: Vec<String>,
     /// See [`crate::model::prepare::suggested_scale`].
     pub suggested_scale: Option<f64>,
@@ -107,8 +112,11 @@ pub struct ModelInfo {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct ItemInfo {
+    /// The item's name in its file (an STL's or OBJ's: the file's stem), one line.
     pub name: String,
+    /// Its triangles as read, before welding.
     pub triangles: usize,
+    /// Its triangles' bounding box in the file's coordinates, mm.
     pub bounds: Bounds,
 }
 

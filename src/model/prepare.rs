@@ -20,11 +20,16 @@ pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct JobInfo {
+    /// The model's file name; for a job, its parts' files (each once, in the parts' order)
+    /// joined by ", ", cut after 320 characters with the number of files.
     pub file_name: String,
+    /// The model's format; for a job, its first part's.
     pub format: stl::Format,
+    /// What welding and checking found in the mesh of every part placed (all copies).
     pub mesh: MeshStats,
     /// Bounding box of the placed part, in mm.
     pub bounds: Bounds,
+    /// How many layers the job slices into (each `layer_height` thick), at least 1.
     pub layers: usize,
     /// Droplet width B in mm.
     pub droplet_width: f64,
