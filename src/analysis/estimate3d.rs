@@ -25,7 +25,8 @@ const MAP_TILE_COLS: usize = 32;
 /// The droplet spheroids of one layer on the 3D grid: per cell, the largest
 /// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
 /// droplets fill the cell's column within c·√q of the layer's mid-height. Stored only in the
-/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere.
+/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere. `Default`: the map of no droplets.
+#[derive(Default)]
 pub struct HeightMap {
     /// Grid indices of the map's cell (0, 0).
     x0: i64,
@@ -98,15 +99,10 @@ impl HeightMap {
     /// a table per column and per row, ⌊·⌋ without libm.
     pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
         let r = d / 2.0;
-        let mut tiles = Tiles::default();
         if centres.is_empty() {
-            return HeightMap {
-                x0: 0,
-                y0: 0,
-                tiles,
-                q: Vec::new(),
-            };
+            return HeightMap::default();
         }
+        let mut tiles = Tiles::default();
         let idx = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / grid.cell - 0.5);
         // A droplet's cells [ax, bx] × [ay, by], and the map's bounds.
         let mut min = [i64::MAX; 2];

@@ -149,16 +149,10 @@ impl Model {
         }
         let size = bounds.size();
         let suggested_scale = crate::model::prepare::suggested_scale(&size);
-        let largest = size[0].max(size[1]).max(size[2]);
-        let warnings = match suggested_scale {
-            Some(f) if f > 1.0 => vec![format!(
-                "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f}"
-            )],
-            Some(f) => vec![format!(
-                "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f}"
-            )],
-            None => Vec::new(),
-        };
+        let warnings = crate::model::prepare::scale_warning(&size)
+            .map(|(text, _)| text)
+            .into_iter()
+            .collect();
         ModelInfo {
             name: clean_name(&self.name),
             format: self.format,

@@ -376,15 +376,25 @@ pub(crate) fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
     if m.signed_volume < 0.0 && m.flipped_shells + m.flipped_open_shells == 0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
     }
-    let largest = size[0].max(size[1]).max(size[2]);
-    match suggested_scale(size) {
-        Some(f) if f > 1.0 => w.push(format!(
-            "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
-        )),
-        Some(f) => w.push(format!(
-            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
-        )),
-        None => {}
-    }
+    w.extend(scale_warning(size).map(|(text, f)| {
+        format!("{text} (--set scale_x={f} --set scale_y={f} --set scale_z={f})")
+    }));
     w
+}
+
+/// The warning of the unit rule ([`suggested_scale`]) for a part of `size` mm, and the scale
+/// it suggests; `None` when the size looks like millimetres.
+pub(crate) fn scale_warning(size: &[f64; 3]) -> Option<(String, f64)> {
+    let largest = size[0].max(size[1]).max(size[2]);
+    let f = suggested_scale(size)?;
+    let text = if f > 1.0 {
+        format!(
+            "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f}"
+        )
+    } else {
+        format!(
+            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f}"
+        )
+    };
+    Some((text, f))
 }
