@@ -255,3 +255,36 @@ pub fn check_job_triangles(models: &[Model], spec: &JobSpec) -> Result<(), Error
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An ASCII STL of one triangle `size` mm across.
+    fn triangle(size: f64) -> Vec<u8> {
+        format!(
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {size} 0 0\nvertex 0 {size} 1\nendloop\nendfacet\nendsolid t\n"
+        )
+        .into_bytes()
+    }
+
+    #[test]
+    fn a_files_info_warns_of_a_size_in_inches_or_micrometres_without_the_command_line() {
+        let info = |size: f64| Model::read(&triangle(size), "t.stl").unwrap().info();
+        let inches = info(1.0);
+        assert_eq!(inches.suggested_scale, Some(25.4));
+        assert_eq!(
+            inches.warnings,
+            ["the part is only 1.000 mm across: if the file is in inches, scale it by 25.4"]
+        );
+        let micrometres = info(3000.0);
+        assert_eq!(micrometres.suggested_scale, Some(0.001));
+        assert_eq!(
+            micrometres.warnings,
+            ["the part is 3000 mm across: if the file is in micrometres, scale it by 0.001"]
+        );
+        let mm = info(20.0);
+        assert_eq!((mm.suggested_scale, mm.warnings.len()), (None, 0));
+        assert_eq!((mm.triangles, mm.items.len()), (1, 1));
+    }
+}
