@@ -22,18 +22,30 @@ use std::sync::{Arc, Mutex};
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct PartAnalysis {
+    /// How many layers' figures were added (0: nothing analysed yet).
     pub layers: usize,
+    /// Unit 0's droplets over those layers (the support's and unit 1's are not counted).
     pub droplets: u64,
+    /// The part's sections (unit 0's region, exact) summed over the layers, mm².
     pub region_area: f64,
     /// Area-weighted coverage over all layers.
     pub coverage: f64,
+    /// Region no droplet covers, summed over the layers, mm² (on the analysis grid).
     pub void_area: f64,
+    /// The part of `void_area` in voids that do not reach a layer's boundary (enclosed air).
     pub enclosed_void_area: f64,
+    /// Droplet area outside the region, summed over the layers, mm².
     pub overfill_area: f64,
     /// The largest connected void of any layer, and its layer (from 0).
     pub largest_void: Option<Void>,
+    /// The layer of `largest_void` (from 0; the written report counts from 1); `None`: no
+    /// layer has a void.
     pub largest_void_layer: Option<usize>,
+    /// The largest boundary deviation of any layer, mm: the farther of an uncovered point
+    /// inside the boundary and a covered point outside it.
     pub max_boundary_deviation: f64,
+    /// The layer of `max_boundary_deviation` (from 0; written from 1); `None`: every layer's
+    /// deviation is 0.
     pub max_deviation_layer: Option<usize>,
     /// The part's volume: each layer's region (exact area) times H.
     pub volume: f64,
@@ -53,6 +65,8 @@ pub struct PartAnalysis {
     /// The largest overhang area of a layer, mm², and its layer (from 0).
     #[serde(default)]
     pub max_unsupported_area: f64,
+    /// The layer of `max_unsupported_area` (from 0; written from 1); `None`: no layer has an
+    /// overhang.
     #[serde(default)]
     pub max_unsupported_area_layer: Option<usize>,
     /// The 3D estimate of unit 1's parts (a second material, droplets of B₁): its volume,

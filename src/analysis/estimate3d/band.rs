@@ -4,7 +4,7 @@
 //! kind of layer ([`crate::analysis::InteriorRates`]). The other cells are filled exactly, from
 //! maps holding every droplet that reaches them (the left-out droplets near them restored).
 
-use super::{CHUNK, Fill, Grid3, HeightMap, MapRow, ceil_i64, slab_rows};
+use super::{CHUNK, Fill, Grid3, HeightMap, SlabRow, ceil_i64, slab_cells, slab_rows};
 use crate::analysis::raster::{dilate2, region_spans};
 use crate::base::geom::{Point, Shapes, all_contours, dist};
 use crate::base::settings::Settings;
@@ -14,14 +14,19 @@ use crate::base::spatial::floor_i64;
 const BLOCK_CELLS: i64 = 8;
 /// At most this many blocks over a layer's box (else it is not banded).
 const MAX_BLOCKS: usize = 4_000_000;
-/// A block within the band is 1; in the region beyond it 2; and 3 when every block within
-/// [`DEEP_MARGIN`] of it is too (its droplets are left out of the layer's map).
 /// Blocks between the band and the deep interior: a layer's boundary may move this far from
 /// the next layer's before a slab puts left-out droplets back.
 const DEEP_MARGIN: usize = 1;
+/// The kinds of block ([`Blocks::kind`]; 0: outside the region): a block within the band
+/// is [`BAND`]; in the region beyond it [`INTERIOR`]; and [`DEEP`] when every block within
+/// [`DEEP_MARGIN`] of it is too (its droplets are left out of the layer's map).
 const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 const DEEP: u8 = 3;
+/// One block in this many is a sample ([`sample`]).
+const SAMPLE_EVERY: i64 = 8;
+/// A slab with fewer sampled interior cells than this takes the job's lattice share instead.
+const MIN_SAMPLED_CELLS: u64 = 256;
 
 /// Whether block (bx, by) is one of the samples of the interior (one block in 8, the same in
 /// every layer): filled exactly, so that each slab's interior takes the void share measured on
@@ -31,18 +36,18 @@ fn sample(bx: i64, by: i64) -> bool {
     (bx + 3 * by).rem_euclid(SAMPLE_EVERY) == 0
 }
 
-/// One block in this many is a sample ([`sample`]).
-const SAMPLE_EVERY: i64 = 8;
-/// A slab with fewer sampled interior cells than this takes the job's lattice share instead.
-const MIN_SAMPLED_CELLS: u64 = 256;
-
 /// A layer's blocks on the 3D grid (fixed to the job, so the same for every layer), over the
 /// box of its region.
 pub struct Blocks {
+    /// Block indices (counted from the grid's origin, [`BLOCK_CELLS`] cells a block) of the
+    /// box's first block.
     bx0: i64,
     by0: i64,
+    /// Blocks across and down the box.
     w: usize,
     h: usize,
+    /// Each block's kind, row by row: 0 (outside the region), [`BAND`], [`INTERIOR`] or
+    /// [`DEEP`].
     kind: Vec<u8>,
 }
 
@@ -212,7 +217,7 @@ pub fn slab_voids_banded(
     let Some(this) = maps[1] else {
         return (0.0, 0.0);
     };
-    let Some((k0, ny, y0)) = slab_rows(region, grid) else {
+    let Some(rows) = slab_rows(region, grid) else {
         return (0.0, 0.0);
     };
     let blocks: [Option<&Blocks>; 3] = maps.map(|m| m.and_then(|m| m.blocks.as_ref()));
@@ -248,17 +253,9 @@ pub fn slab_voids_banded(
     // The interior's cells not sampled, and the sampled ones with their fill.
     let (mut unsampled, mut sampled, mut sampled_fill) = (0u64, 0u64, 0.0f64);
     let mut col = [0f64; CHUNK];
-    region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
-        let iy = k0 + k as i64;
-        let c0 = ceil_i64((xa - grid.origin[0]) / grid.cell - 0.5);
-        let c1 = floor_i64((xb - grid.origin[0]) / grid.cell - 0.5);
-        if c0 > c1 {
-            return;
-        }
+    slab_cells(region, grid, rows, |iy, c0, c1| {
         let by = iy.div_euclid(BLOCK_CELLS);
-        let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let this = this_map.row(iy);
+        let maps = SlabRow::new(iy, [below, Some(this_map), above]);
         let mut from = c0;
         while from <= c1 {
             let bx = from.div_euclid(BLOCK_CELLS);
@@ -272,12 +269,10 @@ pub fn slab_voids_banded(
                 continue;
             }
             let before = filled;
-            let (xt, rt, et) = this.piece(from);
-            let (xb, rb, eb) = below.piece(from);
-            let (xa, ra, ea) = above.piece(from);
-            let to = c1.min(et).min(eb).min(ea).min(block_end);
+            let (pieces, end) = maps.pieces(from);
+            let to = c1.min(end).min(block_end);
             cells += (to - from + 1) as u64;
-            filled = fill.stretch([(xt, rt), (xb, rb), (xa, ra)], from, to, &mut col, filled);
+            filled = fill.stretch(pieces, from, to, &mut col, filled);
             if inside {
                 sampled += (to - from + 1) as u64;
                 sampled_fill += filled - before;
