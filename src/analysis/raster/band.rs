@@ -41,34 +41,44 @@ const OUTSIDE: u8 = 0;
 const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 
-/// Whether any of `flags` within `r` places along one axis is set, per place (`at(line, i)`:
-/// the index of place i of a line).
-fn dilate(
-    flags: &[bool],
-    lines: usize,
-    len: usize,
-    r: usize,
-    at: impl Fn(usize, usize) -> usize,
-) -> Vec<bool> {
-    let mut out = vec![false; flags.len()];
-    let mut prefix = vec![0u32; len + 1];
-    for line in 0..lines {
-        for i in 0..len {
-            prefix[i + 1] = prefix[i] + flags[at(line, i)] as u32;
+/// A `w` × `h` grid of `flags` (row by row) dilated by `r` places along both axes (a square
+/// of 2r + 1): the band's blocks here and in the 3D estimate's. Counts of the flags in a
+/// window sliding along each row, then (row by row, a count per column) down the columns.
+pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
+    if w == 0 || h == 0 {
+        return vec![false; flags.len()];
+    }
+    let mut across = vec![0u32; flags.len()];
+    for (f, o) in flags.chunks_exact(w).zip(across.chunks_exact_mut(w)) {
+        let mut n: u32 = f[..r.min(w)].iter().map(|&x| x as u32).sum();
+        for i in 0..w {
+            if i + r < w {
+                n += f[i + r] as u32;
+            }
+            o[i] = (n > 0) as u32;
+            if i >= r {
+                n -= f[i - r] as u32;
+            }
         }
-        for i in 0..len {
-            let (a, b) = (i.saturating_sub(r), (i + r + 1).min(len));
-            out[at(line, i)] = prefix[b] > prefix[a];
+    }
+    let mut out = vec![false; flags.len()];
+    let mut count = vec![0u32; w];
+    for row in across.chunks_exact(w).take(r.min(h)) {
+        count.iter_mut().zip(row).for_each(|(c, &x)| *c += x);
+    }
+    for k in 0..h {
+        if k + r < h {
+            let row = &across[(k + r) * w..(k + r + 1) * w];
+            count.iter_mut().zip(row).for_each(|(c, &x)| *c += x);
+        }
+        let o = &mut out[k * w..(k + 1) * w];
+        o.iter_mut().zip(&count).for_each(|(o, &c)| *o = c > 0);
+        if k >= r {
+            let row = &across[(k - r) * w..(k - r + 1) * w];
+            count.iter_mut().zip(row).for_each(|(c, &x)| *c -= x);
         }
     }
     out
-}
-
-/// A `w` × `h` grid of `flags` (row by row) dilated by `r` places along both axes (a square
-/// of 2r + 1): the band's blocks here and in the 3D estimate's.
-pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
-    let across = dilate(flags, h, w, r, |row, c| row * w + c);
-    dilate(&across, w, h, r, |col, row| row * w + col)
 }
 
 /// Sets grid columns c0..=c1 of row `k` in `bits` where they are stored (any segments).
@@ -353,5 +363,30 @@ impl Raster {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::dilate2;
+
+    #[test]
+    fn dilation_is_the_square_around_each_flag() {
+        let mut random = crate::base::testing::rng(0x9e37_79b9_7f4a_7c15u64);
+        for case in 0..400 {
+            let (w, h, r) = (1 + case % 13, 1 + case / 13 % 11, case / 7 % 5);
+            let density = [0.02, 0.1, 0.5][case % 3];
+            let flags: Vec<bool> = (0..w * h).map(|_| random() < density).collect();
+            let want: Vec<bool> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as i64, (i / w) as i64);
+                    (0..w * h).any(|j| {
+                        let (a, b) = ((j % w) as i64, (j / w) as i64);
+                        flags[j] && (a - x).abs() <= r as i64 && (b - y).abs() <= r as i64
+                    })
+                })
+                .collect();
+            assert_eq!(dilate2(&flags, w, h, r), want, "case {case}: {w} × {h}, r {r}");
+        }
     }
 }
