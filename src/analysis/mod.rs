@@ -96,6 +96,7 @@ mod cut;
 mod droplet;
 mod estimate3d;
 mod interior;
+mod lines;
 mod raster;
 mod report;
 mod slabs;
@@ -108,6 +109,7 @@ pub use estimate3d::{
     Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
 };
 pub use interior::{InteriorCache, InteriorRates};
+pub use lines::DropletLines;
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,

@@ -6,6 +6,7 @@
 //! reach such cells).
 
 use super::{CHUNK, Fill, Grid3, HeightMap, MapRow, ceil_i64, slab_rows};
+use crate::analysis::lines::{DropletLines, SkipGrid};
 use crate::analysis::raster::{dilate2, region_spans};
 use crate::base::geom::{Point, Shapes, all_contours, dist};
 use crate::base::settings::Settings;
@@ -186,38 +187,59 @@ impl Blocks {
 }
 
 /// A layer's spheroid map for the banded estimate: its droplets but those deep in its
-/// interior, which are kept aside.
+/// interior, which are left out (walked over along their lines, [`SkipGrid::walk`]).
 pub struct UnitMap {
     pub(crate) map: HeightMap,
     blocks: Option<Blocks>,
-    /// The droplets left out of the map, and their footprint diameter.
-    skipped: Vec<Point>,
-    kept: Vec<Point>,
+    /// The layer's droplets (for [`patch`](Self::patch)), how many were left out of the map,
+    /// and their footprint diameter.
+    lines: DropletLines,
+    left_out: u64,
     d: f64,
 }
 
+impl Blocks {
+    /// The blocks as a [`SkipGrid`], flagged where `flag(index in the box)`.
+    fn skip_grid(&self, grid: &Grid3, flag: impl Fn(usize) -> bool) -> SkipGrid {
+        let bs = BLOCK_CELLS as f64 * grid.cell;
+        SkipGrid::new(
+            grid.origin,
+            Point::splat(bs),
+            (self.bx0, self.by0),
+            (self.w, self.h),
+            flag,
+        )
+    }
+}
+
 impl UnitMap {
-    /// The map of droplets at `centres` (footprint diameter `d`), without those in `blocks`'
-    /// deep blocks (all of them without `blocks`).
-    pub fn new(centres: &[Point], grid: &Grid3, d: f64, blocks: Option<Blocks>) -> UnitMap {
+    /// The map of the droplets on `lines` (footprint diameter `d`), without those in
+    /// `blocks`' deep blocks (all of them without `blocks`).
+    pub fn new(lines: &DropletLines, grid: &Grid3, d: f64, blocks: Option<Blocks>) -> UnitMap {
         let Some(bl) = blocks else {
             return UnitMap {
-                map: HeightMap::new(centres, grid, d),
+                map: HeightMap::new(&lines.centres(), grid, d),
                 blocks: None,
-                skipped: Vec::new(),
-                kept: Vec::new(),
+                lines: DropletLines::default(),
+                left_out: 0,
                 d,
             };
         };
         let (r, out) = (d / 2.0, bl.left_out());
-        let (skipped, kept): (Vec<Point>, Vec<Point>) = centres
-            .iter()
-            .partition(|&&p| bl.touches(grid, &out, p, r, true));
+        let mut kept = Vec::new();
+        let mut left_out = 0;
+        let walked = bl.skip_grid(grid, |i| out[i]).walk(lines, |p| {
+            if bl.touches(grid, &out, p, r, true) {
+                left_out += 1;
+            } else {
+                kept.push(p);
+            }
+        });
         UnitMap {
             map: HeightMap::new(&kept, grid, d),
             blocks: Some(bl),
-            skipped,
-            kept,
+            lines: lines.clone(),
+            left_out: left_out + walked,
             d,
         }
     }
@@ -233,11 +255,15 @@ impl UnitMap {
             return None;
         }
         let r = self.d / 2.0;
-        let near: Vec<Point> = (self.kept.iter().chain(&self.skipped))
-            .filter(|&&p| bl.touches(grid, needed, p, r, false))
-            .copied()
-            .collect();
-        Some(HeightMap::new(&near, grid, self.d))
+        // A droplet reaches only the blocks next to its own.
+        let near = dilate2(needed, bl.w, bl.h, 1);
+        let mut reach = Vec::new();
+        bl.skip_grid(grid, |i| !near[i]).walk(&self.lines, |p| {
+            if bl.touches(grid, needed, p, r, false) {
+                reach.push(p);
+            }
+        });
+        Some(HeightMap::new(&reach, grid, self.d))
     }
 }
 
@@ -274,7 +300,7 @@ pub fn slab_voids_banded(
         .map(|i| {
             let m = maps[i]?;
             let mb = m.blocks.as_ref()?;
-            if m.skipped.is_empty() {
+            if m.left_out == 0 {
                 return None;
             }
             let needed: Vec<bool> = (mb.kind.iter().enumerate())

@@ -8,6 +8,7 @@
 
 use super::build::{Prep, set_cols};
 use super::{Grid, Raster};
+use crate::analysis::lines::{DropletLines, SkipGrid};
 use crate::base::geom::{Point, Shapes, dist};
 use crate::base::settings::{Footprint, Settings};
 use crate::base::spatial::{Spot, Tiles};
@@ -129,29 +130,53 @@ impl Raster {
     /// `void_rate` per cell. [`analysis`](Self::analysis) then gives the layer's figures with
     /// the interior's added: coverage, void and enclosed areas as counted; the void count
     /// estimated; the largest void, the overfill and the boundary deviation the band's.
+    ///
+    /// The droplets come as their lines ([`DropletLines`]): those deep in the interior (2
+    /// blocks or more from any block not in it) are counted a stretch of a line at a time
+    /// and take the cells of an average droplet; the others are placed one by one.
     #[allow(clippy::too_many_arguments)]
     pub fn rebuild_banded(
         &mut self,
         index: usize,
         z: f64,
-        centres: &[Point],
+        lines: &DropletLines,
         region: &Shapes,
         s: &Settings,
         width: f64,
         void_rate: f64,
     ) {
+        let whole = |r: &mut Raster| r.rebuild(index, z, &lines.centres(), region, s);
         if !Raster::can_band(s) {
-            return self.rebuild(index, z, centres, region, s);
+            return whole(self);
         }
-        let prep = self.prepare(centres, region, s);
+        let prep = self.prepare_grid(lines.bounds(), region, s);
         let g = prep.grid;
         if g.ny.div_ceil(BLOCK_ROWS).saturating_mul(g.nx.div_ceil(64)) > MAX_BLOCKS {
             // Parts far apart in one layer: its sparse tiles, not a dense map of blocks.
-            return self.rebuild(index, z, centres, region, s);
+            return whole(self);
         }
         let kind = self.blocks(&prep.grid, width);
-        let banding = self.set_banded(&prep, &kind, void_rate);
-        self.finish(index, z, centres.len(), region, s, prep.grid);
+        let (nc, nr) = (g.nx.div_ceil(64), g.ny.div_ceil(BLOCK_ROWS));
+        let skip = SkipGrid::new(
+            Point::new(g.x0, g.y0),
+            Point::new(BLOCK_COLS as f64 * g.gx, BLOCK_ROWS as f64 * g.gy),
+            (0, 0),
+            (nc, nr),
+            |i| kind[i] == INTERIOR,
+        );
+        let places = &mut self.places;
+        let passed = skip.walk(lines, |p| places.push(prep.place(p)));
+        let mut banding = self.set_banded(&prep, &kind, void_rate);
+        // The droplets passed over: the cells of an average droplet each (a droplet covers
+        // its disc's area within half a cell wherever it lies).
+        let mean = prep
+            .spans
+            .iter()
+            .map(|&(n, _)| n.max(0) as f64)
+            .sum::<f64>()
+            / prep.widest.len().max(1) as f64;
+        banding.interior_drop_cells += (passed as f64 * mean).round() as u64;
+        self.finish(index, z, lines.count() as usize, region, s, prep.grid);
         self.banding = Some(banding);
     }
 
@@ -216,6 +241,7 @@ impl Raster {
             rows,
             ref spans,
             ref widest,
+            ..
         } = *prep;
         let (nx, ny) = (grid.nx, grid.ny);
         let nc = nx.div_ceil(64);
@@ -386,7 +412,11 @@ mod tests {
                     })
                 })
                 .collect();
-            assert_eq!(dilate2(&flags, w, h, r), want, "case {case}: {w} × {h}, r {r}");
+            assert_eq!(
+                dilate2(&flags, w, h, r),
+                want,
+                "case {case}: {w} × {h}, r {r}"
+            );
         }
     }
 }
