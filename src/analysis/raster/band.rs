@@ -6,8 +6,8 @@
 //! tiles are stored as covered region, so the band's voids end at the interior as at droplets
 //! (they are neither cut open nor taken for the boundary).
 
-use super::build::{Prep, set_cols};
-use super::{Grid, Raster};
+use super::build::{Prep, set_cols, widen};
+use super::{Grid, Raster, set_range};
 use crate::analysis::lines::{DropletLines, SkipGrid};
 use crate::base::geom::{Point, Shapes, dist};
 use crate::base::settings::{Footprint, Settings};
@@ -16,9 +16,10 @@ use crate::base::spatial::{Spot, Tiles};
 /// Rows of a block; a block is one word (64 columns) wide.
 const BLOCK_ROWS: usize = 16;
 const BLOCK_COLS: usize = 64;
-/// Blocks per storage tile, down and across (tiles of 64 rows × 4 words).
-const TILE_BLOCK_ROWS: usize = 4;
-const TILE_BLOCK_COLS: usize = 4;
+/// Blocks per storage tile, down and across (tiles of 32 rows × 2 words: a band stored
+/// with less of the interior around it than the whole raster's tiles would).
+const TILE_BLOCK_ROWS: usize = 2;
+const TILE_BLOCK_COLS: usize = 2;
 
 /// What a banded rebuild left out of the bitmaps and counted instead, in grid cells.
 #[derive(Clone, Copy, Debug, Default)]
@@ -156,6 +157,12 @@ impl Raster {
             return whole(self);
         }
         let kind = self.blocks(&prep.grid, width);
+        self.tiles.reset(
+            g.ny,
+            g.nx.div_ceil(64),
+            BLOCK_ROWS * TILE_BLOCK_ROWS,
+            BLOCK_COLS / 64 * TILE_BLOCK_COLS,
+        );
         let (nc, nr) = (g.nx.div_ceil(64), g.ny.div_ceil(BLOCK_ROWS));
         let skip = SkipGrid::new(
             Point::new(g.x0, g.y0),
@@ -366,6 +373,34 @@ impl Raster {
             };
             if inner {
                 out.interior_drop_cells += cells_of[ph];
+                continue;
+            }
+            // Wholly in band blocks (stored) and in one band and segment of the storage: its
+            // rows one step apart, as [`Raster::rebuild`] sets them.
+            let in_band = c0 >= 0 && c1 < nx as i64 && k1 < ny && {
+                let (r0, r1) = (k0 / BLOCK_ROWS * nc, k1 / BLOCK_ROWS * nc);
+                let (w0, w1) = (c0 as usize >> 6, c1 as usize >> 6);
+                kind[r0 + w0] == BAND
+                    && kind[r0 + w1] == BAND
+                    && kind[r1 + w0] == BAND
+                    && kind[r1 + w1] == BAND
+            };
+            if let Some(sp) = in_band
+                .then(|| tiles.spot_cached(&mut spot, k0, c0 as usize >> 6, c1 as usize >> 6))
+                .flatten()
+                .filter(|sp| k1 < sp.end_row)
+            {
+                let shift = 64 * sp.shift;
+                let mut at = 64 * sp.index(k0) as u64;
+                for (slot, &(n, half)) in (sp.slot(k0)..).zip(&spans[ph * rows..(ph + 1) * rows]) {
+                    if n >= 1 {
+                        let c0 = (u - half + 0.5) as i64 as usize - shift;
+                        let c1 = c0 + n as usize - 1;
+                        set_range(drop_bits, at + c0 as u64, at + c1 as u64);
+                        widen(&mut extent[slot], c0, c1);
+                    }
+                    at += 64 * sp.row_len as u64;
+                }
                 continue;
             }
             for (j, &(n, half)) in spans[ph * rows..(ph + 1) * rows].iter().enumerate() {
