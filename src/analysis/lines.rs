@@ -1,7 +1,7 @@
 //! A layer's droplets as the lines the plan lays them on, and walks along them that pass over
 //! the interior: the banded analysis visits the droplets near a boundary one by one and
-//! counts those deep in the interior a stretch of a line at a time (docs/spec.md, *Analysis*:
-//! the same droplets as [`super::droplet_centres`], at the same points).
+//! counts those deep in the interior a stretch of a line at a time (the same droplets as
+//! [`super::droplet_centres`], at the same points).
 
 use crate::base::geom::{DVec2, Point, dist, line_droplet_count};
 use crate::base::spatial::floor_i64;
