@@ -79,7 +79,8 @@
 //!   are left out of its map ([`UnitMap`]; walked over along their lines as in 2D). A slab's
 //!   cells in blocks that are interior in its own layer and both neighbours take the void
 //!   share measured on the slab's own sample blocks (every block of one row of blocks in 16,
-//!   whose droplets every map keeps and whose cells are filled exactly; the patch's share
+//!   or with `stagger` one block in 8 spread over rows and columns, whose droplets every map
+//!   keeps and whose cells are filled exactly; the patch's share
 //!   when fewer than 256 cells are sampled); every other cell is filled exactly, from maps
 //!   with every droplet that reaches it (where a left-out droplet reaches a block that is
 //!   deep in one layer but not interior in a neighbour, the slab reads a patch of that

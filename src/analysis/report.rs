@@ -445,9 +445,10 @@ impl LayerStage {
         plan: &LayerPlan,
         region: Option<&Shapes>,
     ) -> LayerMaps {
-        let blocks = region
-            .filter(|_| self.banded)
-            .and_then(|r| Blocks::new(r, &self.grid, band_width(&self.settings)));
+        let blocks = region.filter(|_| self.banded).and_then(|r| {
+            let s = &self.settings;
+            Blocks::new(r, &self.grid, band_width(s), s.stagger)
+        });
         let d = footprint_diameter(&self.settings);
         let unit0 = UnitMap::new(centres, &self.grid, d, blocks);
         let unit1 = self

@@ -25,17 +25,24 @@ const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 const DEEP: u8 = 3;
 
-/// Whether block (bx, by) is one of the samples of the interior (every block of one row of
-/// blocks in 16, the same in every layer): filled exactly, so that each slab's interior takes
-/// the void share measured on its own samples. Whole rows, so that a walk along a line
-/// ([`SkipGrid::walk`]) passes over the stretches between them.
+/// Whether block (bx, by) is one of the samples of the interior (the same in every layer):
+/// filled exactly, so that each slab's interior takes the void share measured on its own
+/// samples. Every block of one row of blocks in 16 (`rows`), so that a walk along a line
+/// ([`SkipGrid::walk`]) passes over the stretches between them; with `stagger` (every layer's
+/// fill one lattice fixed to the origin, whose phases whole rows would sample unevenly: 0.3
+/// points of void fraction on 3DBenchy) one block in 8, spread over rows and columns.
 #[inline]
-fn sample(_bx: i64, by: i64) -> bool {
-    by.rem_euclid(SAMPLE_EVERY) == 0
+fn sample(bx: i64, by: i64, rows: bool) -> bool {
+    if rows {
+        by.rem_euclid(SAMPLE_ROWS) == 0
+    } else {
+        (bx + 3 * by).rem_euclid(SAMPLE_EVERY) == 0
+    }
 }
 
-/// One row of blocks in this many is sampled ([`sample`]).
-const SAMPLE_EVERY: i64 = 16;
+/// One row of blocks in this many is sampled, or one block in this many ([`sample`]).
+const SAMPLE_ROWS: i64 = 16;
+const SAMPLE_EVERY: i64 = 8;
 /// A slab with fewer sampled interior cells than this takes the job's lattice share instead.
 const MIN_SAMPLED_CELLS: u64 = 256;
 
@@ -47,12 +54,15 @@ pub struct Blocks {
     w: usize,
     h: usize,
     kind: Vec<u8>,
+    /// Samples in whole rows of blocks ([`sample`]).
+    rows: bool,
 }
 
 impl Blocks {
-    /// The blocks of a layer's `region` with a band of `width` mm; `None` for an empty region
-    /// or one whose box holds too many blocks.
-    pub fn new(region: &Shapes, grid: &Grid3, width: f64) -> Option<Blocks> {
+    /// The blocks of a layer's `region` with a band of `width` mm, sampled as a job with
+    /// `stagger` or without ([`sample`]); `None` for an empty region or one whose box holds
+    /// too many blocks.
+    pub fn new(region: &Shapes, grid: &Grid3, width: f64, stagger: bool) -> Option<Blocks> {
         let bs = BLOCK_CELLS as f64 * grid.cell;
         let (mut min, mut max) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in all_contours(region).flatten() {
@@ -114,6 +124,7 @@ impl Blocks {
             w,
             h,
             kind,
+            rows: !stagger,
         })
     }
 
@@ -136,7 +147,7 @@ impl Blocks {
                     (at % self.w) as i64 + self.bx0,
                     (at / self.w) as i64 + self.by0,
                 );
-                k == DEEP && !sample(bx, by)
+                k == DEEP && !sample(bx, by, self.rows)
             })
             .collect()
     }
@@ -322,6 +333,29 @@ pub fn slab_voids_banded(
             .is_some_and(|(_, needed, mb)| mb.at(bx, by).is_some_and(|a| needed[a]))
     };
     let any_patch = patches.iter().any(Option::is_some);
+    // Per block of this layer's box that is interior in all three layers and not a sample
+    // (counted, not filled), where its run of such blocks along the row ends (the grid index
+    // of the first block after it); `i64::MIN` for other blocks. A row's span passes over a
+    // run at once.
+    let run_end: Vec<i64> = own.map_or_else(Vec::new, |o| {
+        let mut v = vec![i64::MIN; o.w * o.h];
+        for y in 0..o.h {
+            let by = y as i64 + o.by0;
+            let mut end = i64::MIN;
+            for x in (0..o.w).rev() {
+                let bx = x as i64 + o.bx0;
+                if inner(bx, by) && !sample(bx, by, o.rows) {
+                    if end == i64::MIN {
+                        end = bx + 1;
+                    }
+                    v[y * o.w + x] = end;
+                } else {
+                    end = i64::MIN;
+                }
+            }
+        }
+        v
+    });
     let (mut cells, mut filled) = (0u64, 0.0f64);
     // The interior's cells not sampled, and the sampled ones with their fill.
     let (mut unsampled, mut sampled, mut sampled_fill) = (0u64, 0u64, 0.0f64);
@@ -339,15 +373,18 @@ pub fn slab_voids_banded(
         let mut from = c0;
         while from <= c1 {
             let bx = from.div_euclid(BLOCK_CELLS);
-            let block_end = (bx + 1) * BLOCK_CELLS - 1;
-            let inside = inner(bx, by);
-            if inside && !sample(bx, by) {
-                let to = c1.min(block_end);
+            let end = own
+                .and_then(|o| o.at(bx, by))
+                .map_or(i64::MIN, |a| run_end[a]);
+            if end != i64::MIN {
+                let to = c1.min(end * BLOCK_CELLS - 1);
                 cells += (to - from + 1) as u64;
                 unsampled += (to - from + 1) as u64;
                 from = to + 1;
                 continue;
             }
+            let block_end = (bx + 1) * BLOCK_CELLS - 1;
+            let inside = inner(bx, by);
             let row_of = |i: usize| {
                 if any_patch && patched(i, bx, by) {
                     patch_rows[i]
