@@ -53,11 +53,11 @@ pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize)
     let mut across = vec![0u32; flags.len()];
     for (f, o) in flags.chunks_exact(w).zip(across.chunks_exact_mut(w)) {
         let mut n: u32 = f[..r.min(w)].iter().map(|&x| x as u32).sum();
-        for i in 0..w {
+        for (i, o) in o.iter_mut().enumerate() {
             if i + r < w {
                 n += f[i + r] as u32;
             }
-            o[i] = (n > 0) as u32;
+            *o = (n > 0) as u32;
             if i >= r {
                 n -= f[i - r] as u32;
             }
