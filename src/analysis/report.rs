@@ -1,13 +1,12 @@
 //! The job's report: part figures, the analysis model, and the per-layer stage the slicing
 //! workers run with its ordered half ([`JobAnalysis`], a [`crate::slicing::sink::LayerSink`]).
 
-use super::droplet::{
-    droplet_centres, footprint_diameter, spheroid_half_height, unit1_part_centres,
-};
+use super::droplet::{footprint_diameter, spheroid_half_height, unit1_part_centres};
 use super::estimate3d::{
     Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
 };
 use super::interior::InteriorCache;
+use super::lines::DropletLines;
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
 use super::slabs::{self, LayerMaps, SlabFigures, SlabRun, Slabs, UnitRegions};
 use crate::base::geom::{DVec2, Point, Shapes, region_area};
@@ -437,27 +436,33 @@ impl LayerStage {
         plan: &LayerPlan,
     ) -> (LayerAnalysis, LayerMaps) {
         let s = &self.settings;
-        let centres = droplet_centres(plan, s.droplet_width());
+        let lines = DropletLines::of(plan, s.droplet_width());
         if self.banded && Raster::can_band(s) {
             let width = band_width(s);
             let rate = self
                 .interior
                 .rates(s, plan.index, &self.grid, width)
                 .void_rate;
-            raster.rebuild_banded(plan.index, plan.z, &centres, region, s, width, rate);
+            raster.rebuild_banded(plan.index, plan.z, &lines, region, s, width, rate);
         } else {
-            raster.rebuild(plan.index, plan.z, &centres, region, s);
+            raster.rebuild(plan.index, plan.z, &lines.centres(), region, s);
         }
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
-        (analysis, self.maps_with(&centres, plan, Some(region)))
+        (analysis, self.maps_with(&lines, plan, Some(region)))
     }
 
-    /// A layer's spheroid maps given unit 0's droplet centres (banded with its `region`).
-    fn maps_with(&self, centres: &[Point], plan: &LayerPlan, region: Option<&Shapes>) -> LayerMaps {
-        let blocks = region
-            .filter(|_| self.banded)
-            .and_then(|r| Blocks::new(r, &self.grid, band_width(&self.settings)));
+    /// A layer's spheroid maps given unit 0's droplets (banded with its `region`).
+    fn maps_with(
+        &self,
+        centres: &DropletLines,
+        plan: &LayerPlan,
+        region: Option<&Shapes>,
+    ) -> LayerMaps {
+        let blocks = region.filter(|_| self.banded).and_then(|r| {
+            let s = &self.settings;
+            Blocks::new(r, &self.grid, band_width(s), s.stagger)
+        });
         let d = footprint_diameter(&self.settings);
         let unit0 = UnitMap::new(centres, &self.grid, d, blocks);
         let unit1 = self
@@ -472,7 +477,7 @@ impl LayerStage {
     /// [`SlabRun::finish`]: the same slabs, so the same predicted density).
     pub fn maps_in(&self, plan: &LayerPlan, region: &Shapes) -> LayerMaps {
         self.maps_with(
-            &droplet_centres(plan, self.settings.droplet_width()),
+            &DropletLines::of(plan, self.settings.droplet_width()),
             plan,
             Some(region),
         )
