@@ -25,7 +25,8 @@ const MAP_TILE_COLS: usize = 32;
 /// The droplet spheroids of one layer on the 3D grid: per cell, the largest
 /// q = 1 − (2ρ/D)² over its droplets (ρ: horizontal distance to the droplet's centre), so the
 /// droplets fill the cell's column within c·√q of the layer's mid-height. Stored only in the
-/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere.
+/// tiles the droplets touch ([`Tiles`]); q = 0 elsewhere. `Default`: the map of no droplets.
+#[derive(Default)]
 pub struct HeightMap {
     /// Grid indices of the map's cell (0, 0).
     x0: i64,
@@ -98,15 +99,10 @@ impl HeightMap {
     /// a table per column and per row, ⌊·⌋ without libm.
     pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
         let r = d / 2.0;
-        let mut tiles = Tiles::default();
         if centres.is_empty() {
-            return HeightMap {
-                x0: 0,
-                y0: 0,
-                tiles,
-                q: Vec::new(),
-            };
+            return HeightMap::default();
         }
+        let mut tiles = Tiles::default();
         let idx = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / grid.cell - 0.5);
         // A droplet's cells [ax, bx] × [ay, by], and the map's bounds.
         let mut min = [i64::MAX; 2];
@@ -316,6 +312,54 @@ impl Fill {
     }
 }
 
+/// Row `iy` of a slab's three maps: its own layer's and those of the layers below and above
+/// (empty where a layer has no map, or the map no row).
+struct SlabRow<'a> {
+    this: MapRow<'a>,
+    below: MapRow<'a>,
+    above: MapRow<'a>,
+}
+
+impl<'a> SlabRow<'a> {
+    /// Row `iy` of the maps [below, own, above].
+    fn new(iy: i64, [below, this, above]: [Option<&'a HeightMap>; 3]) -> SlabRow<'a> {
+        let row = |m: Option<&'a HeightMap>| m.map_or(MapRow::EMPTY, |m| m.row(iy));
+        SlabRow {
+            this: row(this),
+            below: row(below),
+            above: row(above),
+        }
+    }
+
+    /// From grid index `from` on, each map's piece ([`MapRow::piece`]: own, below, above, as
+    /// [`Fill::stretch`] takes them) and the grid index where the first of them ends.
+    #[inline]
+    fn pieces(&self, from: i64) -> ([(i64, &'a [f32]); 3], i64) {
+        let (xt, rt, et) = self.this.piece(from);
+        let (xb, rb, eb) = self.below.piece(from);
+        let (xa, ra, ea) = self.above.piece(from);
+        ([(xt, rt), (xb, rb), (xa, ra)], et.min(eb).min(ea))
+    }
+}
+
+/// The cells of a slab's region on the grid, span by span: `f(iy, c0, c1)` for the cells
+/// c0..=c1 of grid row `iy` whose centres lie in one span of the region (spans holding no
+/// centre are passed over). `rows`: the region's [`slab_rows`].
+fn slab_cells(
+    region: &Shapes,
+    grid: &Grid3,
+    (k0, ny, y0): (i64, usize, f64),
+    mut f: impl FnMut(i64, i64, i64),
+) {
+    region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
+        let c0 = ceil_i64((xa - grid.origin[0]) / grid.cell - 0.5);
+        let c1 = floor_i64((xb - grid.origin[0]) / grid.cell - 0.5);
+        if c0 <= c1 {
+            f(k0 + k as i64, c0, c1);
+        }
+    });
+}
+
 /// The grid rows a slab's region spans: (grid index of the first, how many, its lower edge
 /// in mm); `None` for an empty region.
 fn slab_rows(region: &Shapes, grid: &Grid3) -> Option<(i64, usize, f64)> {
@@ -348,30 +392,20 @@ pub fn slab_voids(
     s: &Settings,
 ) -> (f64, f64) {
     let fill = Fill::new(s);
-    let Some((k0, ny, y0)) = slab_rows(region, grid) else {
+    let Some(rows) = slab_rows(region, grid) else {
         return (0.0, 0.0);
     };
     let (mut cells, mut filled) = (0u64, 0.0f64);
     let mut col = [0f64; CHUNK];
-    region_spans(region, y0, grid.cell, ny, |k, xa, xb| {
-        let iy = k0 + k as i64;
-        let c0 = ceil_i64((xa - grid.origin[0]) / grid.cell - 0.5);
-        let c1 = floor_i64((xb - grid.origin[0]) / grid.cell - 0.5);
-        if c0 > c1 {
-            return;
-        }
-        let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let this = this.row(iy);
+    slab_cells(region, grid, rows, |iy, c0, c1| {
+        let maps = SlabRow::new(iy, [below, Some(this), above]);
         // Stretches of the span over which each map is one slice (or nothing).
         let mut from = c0;
         while from <= c1 {
-            let (xt, rt, et) = this.piece(from);
-            let (xb, rb, eb) = below.piece(from);
-            let (xa, ra, ea) = above.piece(from);
-            let to = c1.min(et).min(eb).min(ea);
+            let (pieces, end) = maps.pieces(from);
+            let to = c1.min(end);
             cells += (to - from + 1) as u64;
-            filled = fill.stretch([(xt, rt), (xb, rb), (xa, ra)], from, to, &mut col, filled);
+            filled = fill.stretch(pieces, from, to, &mut col, filled);
             from = to + 1;
         }
     });

@@ -2,8 +2,9 @@
 //! and kind of layer on a patch (a square planned as the job plans its layers, analysed
 //! whole), for the interior the banded raster and the banded 3D estimate do not compute.
 
-use super::droplet::{droplet_centres, footprint_diameter};
+use super::droplet::footprint_diameter;
 use super::estimate3d::{Grid3, HeightMap, slab_voids};
+use super::lines::DropletLines;
 use super::raster::Raster;
 use crate::base::geom::{DVec2, Shape, Shapes};
 use crate::base::settings::Settings;
@@ -94,29 +95,28 @@ fn measure(s: &Settings, j: usize, grid: &Grid3, width: f64) -> InteriorRates {
     let b = s.droplet_width();
     let radius = PATCH_B * b;
     let offsets = [(0.0, 0.0), (0.41, 0.23), (0.77, 0.59)];
-    let layers: Vec<(Shapes, Vec<DVec2>)> = (0..3)
+    let layers: Vec<(Shapes, DropletLines)> = (0..3)
         .map(|k| {
             let (ox, oy) = offsets[k];
             let region = disc(ox * b, oy * b, radius);
             let plan = plan_layer(&region, j + k - 1, s);
-            let centres = droplet_centres(&plan, b);
-            (region, centres)
+            (region, DropletLines::of(&plan, b))
         })
         .collect();
     let d = footprint_diameter(s);
     let maps: Vec<HeightMap> = layers
         .iter()
-        .map(|l| HeightMap::new(&l.1, grid, d))
+        .map(|l| HeightMap::new(&l.1.centres(), grid, d))
         .collect();
     let (ox, oy) = offsets[1];
     let half = (PATCH_B - MARGIN_B) * b / std::f64::consts::SQRT_2;
     let inner = square(ox * b - half, oy * b - half, 2.0 * half);
     let (vol, void) = slab_voids(&inner, grid, Some(&maps[0]), &maps[1], Some(&maps[2]), s);
     let share = if vol > 0.0 { void / vol } else { 0.0 };
-    let (region, centres) = &layers[1];
-    let whole = Raster::from_centres(j, 0.0, centres, region, s).analysis();
+    let (region, lines) = &layers[1];
+    let whole = Raster::from_centres(j, 0.0, &lines.centres(), region, s).analysis();
     let mut banded = Raster::empty();
-    banded.rebuild_banded(j, 0.0, centres, region, s, width, 0.0);
+    banded.rebuild_banded(j, 0.0, lines, region, s, width, 0.0);
     let cells = banded.interior_cells();
     let part = banded.analysis();
     let void_rate = if cells > 0 {

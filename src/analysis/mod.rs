@@ -65,7 +65,10 @@
 //!   cells are counted (discs of diameter B on lines B apart do not overlap, so their cells
 //!   add up; with `footprint = spread` or a fill density other than 1 the whole layer is
 //!   rasterised); interior blocks inside the stored tiles are stored as covered region, so
-//!   the band's voids end there as at a droplet. Coverage, void and enclosed areas, overfill
+//!   the band's voids end there as at a droplet. The droplets come as the plan's lines
+//!   ([`DropletLines`]): a walk along each (`lines.rs`) passes over a stretch of droplets at a
+//!   time where they lie 2 blocks or more inside the interior (counted, the cells of an
+//!   average droplet each) and places the others one by one. Coverage, void and enclosed areas, overfill
 //!   and the boundary deviation are so computed; the interior's void count is estimated at
 //!   the rate measured on a patch ([`InteriorCache`]: a disc of radius 32 B planned as the
 //!   job's layer, its voids by the whole raster against the band's); the **largest void is
@@ -73,12 +76,15 @@
 //!   interior into networks of several mm² that the band does not see.
 //! - **3D** ([`slab_voids_banded`]): blocks of 8 × 8 cells of the 3D grid, fixed to the job;
 //!   a layer's droplets whose cells all lie in its deep interior (2 blocks beyond the band)
-//!   are left out of its map ([`UnitMap`]). A slab's cells in blocks that are interior in its
-//!   own layer and both neighbours take the void share measured on the slab's own sample
-//!   blocks (one in 8, whose droplets every map keeps and whose cells are filled exactly; the
-//!   patch's share when fewer than 256 cells are sampled); every other cell is filled
-//!   exactly, from maps with every droplet that reaches it (a left-out droplet in a block that
-//!   is deep in one layer but not interior in a neighbour is put back for that slab).
+//!   are left out of its map ([`UnitMap`]; walked over along their lines as in 2D). A slab's
+//!   cells in blocks that are interior in its own layer and both neighbours take the void
+//!   share measured on the slab's own sample blocks (every block of one row of blocks in 16,
+//!   or with `stagger` one block in 8 spread over rows and columns, whose droplets every map
+//!   keeps and whose cells are filled exactly; the patch's share
+//!   when fewer than 256 cells are sampled); every other cell is filled exactly, from maps
+//!   with every droplet that reaches it (where a left-out droplet reaches a block that is
+//!   deep in one layer but not interior in a neighbour, the slab reads a patch of that
+//!   layer's map there, built from the droplets of the lines near those blocks).
 //!
 //! The whole raster and the exact fill stay as the reference ([`JobAnalysis::reference`],
 //! built for tests and with the `reference` feature); tests/analysis_band.rs holds the banded
@@ -96,6 +102,7 @@ mod cut;
 mod droplet;
 mod estimate3d;
 mod interior;
+mod lines;
 mod raster;
 mod report;
 mod slabs;
@@ -108,6 +115,7 @@ pub use estimate3d::{
     Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
 };
 pub use interior::{InteriorCache, InteriorRates};
+pub use lines::DropletLines;
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,

@@ -1,13 +1,12 @@
 //! The job's report: part figures, the analysis model, and the per-layer stage the slicing
 //! workers run with its ordered half ([`JobAnalysis`], a [`crate::slicing::sink::LayerSink`]).
 
-use super::droplet::{
-    droplet_centres, footprint_diameter, spheroid_half_height, unit_part_centres,
-};
+use super::droplet::{footprint_diameter, spheroid_half_height, unit_part_centres};
 use super::estimate3d::{
     Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
 };
 use super::interior::InteriorCache;
+use super::lines::DropletLines;
 use super::raster::{COLS_PER_ROW, LayerAnalysis, ROWS_PER_B, Raster, Void};
 use super::slabs::{self, LayerMaps, SlabFigures, SlabRun, Slabs, UnitRegions};
 use crate::base::geom::{DVec2, Point, Shapes, region_area};
@@ -22,18 +21,30 @@ use std::sync::{Arc, Mutex};
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct PartAnalysis {
+    /// How many layers' figures were added (0: nothing analysed yet).
     pub layers: usize,
+    /// Unit 0's droplets over those layers (the support's and unit 1's are not counted).
     pub droplets: u64,
+    /// The part's sections (unit 0's region, exact) summed over the layers, mm².
     pub region_area: f64,
     /// Area-weighted coverage over all layers.
     pub coverage: f64,
+    /// Region no droplet covers, summed over the layers, mm² (on the analysis grid).
     pub void_area: f64,
+    /// The part of `void_area` in voids that do not reach a layer's boundary (enclosed air).
     pub enclosed_void_area: f64,
+    /// Droplet area outside the region, summed over the layers, mm².
     pub overfill_area: f64,
     /// The largest connected void of any layer, and its layer (from 0).
     pub largest_void: Option<Void>,
+    /// The layer of `largest_void` (from 0; the written report counts from 1); `None`: no
+    /// layer has a void.
     pub largest_void_layer: Option<usize>,
+    /// The largest boundary deviation of any layer, mm: the farther of an uncovered point
+    /// inside the boundary and a covered point outside it.
     pub max_boundary_deviation: f64,
+    /// The layer of `max_boundary_deviation` (from 0; written from 1); `None`: every layer's
+    /// deviation is 0.
     pub max_deviation_layer: Option<usize>,
     /// The part's volume: each layer's region (exact area) times H.
     pub volume: f64,
@@ -53,6 +64,8 @@ pub struct PartAnalysis {
     /// The largest overhang area of a layer, mm², and its layer (from 0).
     #[serde(default)]
     pub max_unsupported_area: f64,
+    /// The layer of `max_unsupported_area` (from 0; written from 1); `None`: no layer has an
+    /// overhang.
     #[serde(default)]
     pub max_unsupported_area_layer: Option<usize>,
     /// The 3D estimate of the parts of each other unit (other materials, droplets of B_u),
@@ -454,27 +467,33 @@ impl LayerStage {
         plan: &LayerPlan,
     ) -> (LayerAnalysis, LayerMaps) {
         let s = &self.settings;
-        let centres = droplet_centres(plan, s.droplet_width());
+        let lines = DropletLines::of(plan, s.droplet_width());
         if self.banded && Raster::can_band(s) {
             let width = band_width(s);
             let rate = self
                 .interior
                 .rates(s, plan.index, &self.grid, width)
                 .void_rate;
-            raster.rebuild_banded(plan.index, plan.z, &centres, region, s, width, rate);
+            raster.rebuild_banded(plan.index, plan.z, &lines, region, s, width, rate);
         } else {
-            raster.rebuild(plan.index, plan.z, &centres, region, s);
+            raster.rebuild(plan.index, plan.z, &lines.centres(), region, s);
         }
         let mut analysis = raster.analysis();
         analysis.unsupported_area = plan.unsupported_area;
-        (analysis, self.maps_with(&centres, plan, Some(region)))
+        (analysis, self.maps_with(&lines, plan, Some(region)))
     }
 
-    /// A layer's spheroid maps given unit 0's droplet centres (banded with its `region`).
-    fn maps_with(&self, centres: &[Point], plan: &LayerPlan, region: Option<&Shapes>) -> LayerMaps {
-        let blocks = region
-            .filter(|_| self.banded)
-            .and_then(|r| Blocks::new(r, &self.grid, band_width(&self.settings)));
+    /// A layer's spheroid maps given unit 0's droplets (banded with its `region`).
+    fn maps_with(
+        &self,
+        centres: &DropletLines,
+        plan: &LayerPlan,
+        region: Option<&Shapes>,
+    ) -> LayerMaps {
+        let blocks = region.filter(|_| self.banded).and_then(|r| {
+            let s = &self.settings;
+            Blocks::new(r, &self.grid, band_width(s), s.stagger)
+        });
         let d = footprint_diameter(&self.settings);
         let unit0 = UnitMap::new(centres, &self.grid, d, blocks);
         let others = (self.others.iter())
@@ -490,7 +509,7 @@ impl LayerStage {
     /// [`SlabRun::finish`]: the same slabs, so the same predicted density).
     pub fn maps_in(&self, plan: &LayerPlan, region: &Shapes) -> LayerMaps {
         self.maps_with(
-            &droplet_centres(plan, self.settings.droplet_width()),
+            &DropletLines::of(plan, self.settings.droplet_width()),
             plan,
             Some(region),
         )

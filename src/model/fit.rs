@@ -38,6 +38,7 @@ pub struct Misfit {
     pub part: usize,
     /// The copy (from 0); a part larger than the plate is named once, for its first copy.
     pub copy: usize,
+    /// What is wrong: larger than the plate, taller than the chamber, or placed past an edge.
     pub kind: MisfitKind,
     /// One sentence: the part ("Part 1 “name”"), what is wrong, what fits.
     pub message: String,

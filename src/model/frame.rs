@@ -100,28 +100,39 @@ pub struct Instance {
     pub copy: usize,
     /// How many copies the part has.
     pub copies: usize,
+    /// The name the page and the header show: the part's `name`, else its name in its file
+    /// (one line, at most [`crate::model::spec::MAX_NAME_CHARS`] characters).
     pub name: String,
+    /// The part's `file` as the job names it (one line, shortened as `name`).
     pub file: String,
     /// The 3MF build item (from 0), `None`: the whole file.
     pub item: Option<usize>,
     /// For a 3MF item, the object it refers to.
     pub object: Option<String>,
+    /// The part's `rotate_x`, `rotate_y`, `rotate_z`: degrees about x, then y, then z.
     pub rotate: [f64; 3],
+    /// The part's `scale_x`, `scale_y`, `scale_z` (1: the file's size; before the shrinkage
+    /// compensation).
     pub scale: [f64; 3],
     /// Mirrored along the plate's x, y, z (the part's `mirror_*`).
     #[serde(default)]
     pub mirror: [bool; 3],
+    /// The part's `place_angle`: degrees about z on the plate, after the rotation and scale.
     pub place_angle: f64,
     /// Placed by the job (`place_x`, `place_y`) rather than arranged.
     pub placed: bool,
     /// The final move: `place_x`, `place_y` when placed; else where the arrangement put the
     /// bounding box minimum.
     pub at: [f64; 2],
+    /// The discharge unit that prints it (the part's `unit`, 0 … `units` − 1).
     pub unit: u8,
     /// Column-major 4×4: the part's model coordinates (after import) → plate coordinates, the
     /// exact transform applied before slicing.
     pub matrix: [f64; 16],
+    /// The placed copy's bounding box minimum on the plate, mm (its z is 0: every part
+    /// stands on the plate).
     pub min: [f64; 3],
+    /// The placed copy's bounding box maximum on the plate, mm (its z: the part's height).
     pub max: [f64; 3],
     /// The part's size (mm) along the axes its `scale_*` and `mirror_*` act on: after the
     /// rotation, the scale and the shrinkage compensation, before `place_angle` (the page's

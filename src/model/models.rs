@@ -91,13 +91,18 @@ impl Model {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct ModelInfo {
+    /// The file's name (one line, at most [`crate::model::spec::MAX_NAME_CHARS`] characters).
     pub name: String,
+    /// Binary or ASCII STL, OBJ or 3MF, as the file's bytes (for OBJ also its name) say.
     pub format: Format,
+    /// The triangles of all its items as read, before welding (degenerate ones included).
     pub triangles: usize,
     /// In the file's coordinates (mm, after its units and 3MF transforms).
     pub bounds: Bounds,
     /// The 3MF build items (one item for STL and OBJ).
     pub items: Vec<ItemInfo>,
+    /// Sentences for the page: a size that suggests other units than mm (see
+    /// `suggested_scale`); empty when nothing looks wrong.
     pub warnings: Vec<String>,
     /// See [`crate::model::prepare::suggested_scale`].
     pub suggested_scale: Option<f64>,
@@ -107,8 +112,11 @@ pub struct ModelInfo {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct ItemInfo {
+    /// The item's name in its file (an STL's or OBJ's: the file's stem), one line.
     pub name: String,
+    /// Its triangles as read, before welding.
     pub triangles: usize,
+    /// Its triangles' bounding box in the file's coordinates, mm.
     pub bounds: Bounds,
 }
 
@@ -141,16 +149,10 @@ impl Model {
         }
         let size = bounds.size();
         let suggested_scale = crate::model::prepare::suggested_scale(&size);
-        let largest = size[0].max(size[1]).max(size[2]);
-        let warnings = match suggested_scale {
-            Some(f) if f > 1.0 => vec![format!(
-                "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f}"
-            )],
-            Some(f) => vec![format!(
-                "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f}"
-            )],
-            None => Vec::new(),
-        };
+        let warnings = crate::model::prepare::scale_warning(&size)
+            .map(|(text, _)| text)
+            .into_iter()
+            .collect();
         ModelInfo {
             name: clean_name(&self.name),
             format: self.format,
@@ -252,4 +254,37 @@ pub fn check_job_triangles(models: &[Model], spec: &JobSpec) -> Result<(), Error
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An ASCII STL of one triangle `size` mm across.
+    fn triangle(size: f64) -> Vec<u8> {
+        format!(
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {size} 0 0\nvertex 0 {size} 1\nendloop\nendfacet\nendsolid t\n"
+        )
+        .into_bytes()
+    }
+
+    #[test]
+    fn a_files_info_warns_of_a_size_in_inches_or_micrometres_without_the_command_line() {
+        let info = |size: f64| Model::read(&triangle(size), "t.stl").unwrap().info();
+        let inches = info(1.0);
+        assert_eq!(inches.suggested_scale, Some(25.4));
+        assert_eq!(
+            inches.warnings,
+            ["the part is only 1.000 mm across: if the file is in inches, scale it by 25.4"]
+        );
+        let micrometres = info(3000.0);
+        assert_eq!(micrometres.suggested_scale, Some(0.001));
+        assert_eq!(
+            micrometres.warnings,
+            ["the part is 3000 mm across: if the file is in micrometres, scale it by 0.001"]
+        );
+        let mm = info(20.0);
+        assert_eq!((mm.suggested_scale, mm.warnings.len()), (None, 0));
+        assert_eq!((mm.triangles, mm.items.len()), (1, 1));
+    }
 }

@@ -20,11 +20,16 @@ pub const MAX_WIDTH_IN_DROPLETS: f64 = 2_000_000.0;
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct JobInfo {
+    /// The model's file name; for a job, its parts' files (each once, in the parts' order)
+    /// joined by ", ", cut after 320 characters with the number of files.
     pub file_name: String,
+    /// The model's format; for a job, its first part's.
     pub format: stl::Format,
+    /// What welding and checking found in the mesh of every part placed (all copies).
     pub mesh: MeshStats,
     /// Bounding box of the placed part, in mm.
     pub bounds: Bounds,
+    /// How many layers the job slices into (each `layer_height` thick), at least 1.
     pub layers: usize,
     /// Droplet width B in mm.
     pub droplet_width: f64,
@@ -371,15 +376,25 @@ pub(crate) fn warnings(m: &MeshStats, size: &[f64; 3]) -> Vec<String> {
     if m.signed_volume < 0.0 && m.flipped_shells + m.flipped_open_shells == 0 {
         w.push("the mesh is inside out (its facets face inward); it is sliced as the solid it encloses".into());
     }
-    let largest = size[0].max(size[1]).max(size[2]);
-    match suggested_scale(size) {
-        Some(f) if f > 1.0 => w.push(format!(
-            "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
-        )),
-        Some(f) => w.push(format!(
-            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f} (--set scale_x={f} --set scale_y={f} --set scale_z={f})"
-        )),
-        None => {}
-    }
+    w.extend(scale_warning(size).map(|(text, f)| {
+        format!("{text} (--set scale_x={f} --set scale_y={f} --set scale_z={f})")
+    }));
     w
+}
+
+/// The warning of the unit rule ([`suggested_scale`]) for a part of `size` mm, and the scale
+/// it suggests; `None` when the size looks like millimetres.
+pub(crate) fn scale_warning(size: &[f64; 3]) -> Option<(String, f64)> {
+    let largest = size[0].max(size[1]).max(size[2]);
+    let f = suggested_scale(size)?;
+    let text = if f > 1.0 {
+        format!(
+            "the part is only {largest:.3} mm across: if the file is in inches, scale it by {f}"
+        )
+    } else {
+        format!(
+            "the part is {largest:.0} mm across: if the file is in micrometres, scale it by {f}"
+        )
+    };
+    Some((text, f))
 }

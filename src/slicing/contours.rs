@@ -8,7 +8,7 @@
 
 use crate::base::geom::{Contour, Shapes};
 use crate::base::settings::Settings;
-use crate::slicing::offset::{CHORD_TOLERANCE_MM, inset_within};
+use crate::slicing::offset::{Boundary, CHORD_TOLERANCE_MM, inset_of, inset_within};
 
 /// One closed contour loop, in print direction (material on the left: outer loops
 /// counter-clockwise, loops around holes clockwise).
@@ -95,13 +95,15 @@ pub fn contours_with(region: &Shapes, s: &ContourParams) -> LayerContours {
         + usize::from(fill && s.contours > 0 && !direct(fill_d));
     let tolerance = CHORD_TOLERANCE_MM / (chained + 1) as f64;
     let mut loops = Vec::new();
+    // The offsets made from the region itself share its boundary's grid.
+    let boundary = Boundary::new(region);
     // The region of the last loop so far.
     let mut inner: Option<Shapes> = None;
     for k in 0..s.contours {
         let d = loop_d(k as f64);
         let shapes = match &inner {
             Some(prev) if !direct(d) => inset_within(prev, b, b, tolerance),
-            _ => inset_within(region, d.0, d.1, tolerance),
+            _ => inset_of(&boundary, d.0, d.1, tolerance),
         };
         for shape in &shapes {
             for (hole, points) in shape.contours_with_hole() {
@@ -117,7 +119,7 @@ pub fn contours_with(region: &Shapes, s: &ContourParams) -> LayerContours {
     let fill_region = match (&inner, fill) {
         (_, false) => Shapes::new(),
         (Some(prev), true) if !direct(fill_d) => inset_within(prev, extra, extra, tolerance),
-        _ => inset_within(region, fill_d.0, fill_d.1, tolerance),
+        _ => inset_of(&boundary, fill_d.0, fill_d.1, tolerance),
     };
     LayerContours { loops, fill_region }
 }

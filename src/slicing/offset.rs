@@ -13,8 +13,8 @@ use crate::base::boolean::{Paths, simplify_apart_known};
 use crate::base::geom::{
     Contour, DVec2, Point, Shape, Shapes, all_contours, dist, segment_distance2, signed_area,
 };
-use crate::base::spatial::EdgeIndex;
 use i_overlay::core::fill_rule::FillRule;
+use std::cell::OnceCell;
 
 /// Largest distance between an arc and the chords that approximate it.
 pub const CHORD_TOLERANCE_MM: f64 = 0.001;
@@ -49,35 +49,187 @@ pub fn inset(region: &Shapes, d_outer: f64, d_hole: f64) -> Shapes {
 /// [`inset`] with arcs approximated by chords no farther than `tolerance` from them (mm, > 0):
 /// a chain of n insets, each within [`CHORD_TOLERANCE_MM`] / n, stays within it.
 pub fn inset_within(region: &Shapes, d_outer: f64, d_hole: f64, tolerance: f64) -> Shapes {
+    inset_of(&Boundary::new(region), d_outer, d_hole, tolerance)
+}
+
+/// [`inset_within`] of `boundary`'s region: offsets of one region share its edges' grid.
+pub fn inset_of(boundary: &Boundary, d_outer: f64, d_hole: f64, tolerance: f64) -> Shapes {
+    let region = boundary.region;
     if region.is_empty() || (d_outer == 0.0 && d_hole == 0.0) {
         return region.clone();
     }
-    // Boundary edges and the distance each must keep (less the chord tolerance and rounding),
-    // squared.
-    let mut edges = Vec::new();
-    let mut limit = Vec::new();
-    for shape in region {
-        for (hole, c) in shape.contours_with_hole() {
-            let d = (if hole { d_hole } else { d_outer } - 2.0 * CHORD_TOLERANCE_MM).max(0.0);
-            for k in 0..c.len() {
-                edges.push((c[k], c[(k + 1) % c.len()]));
-                limit.push(d * d);
-            }
-        }
-    }
-    let reach = d_outer.max(d_hole);
-    let index = EdgeIndex::new(&edges, reach.max(1e-3));
-    let keeps = |p: Point| {
-        !index.any_near(p, reach, |e| {
-            let (a, b) = edges[e];
-            segment_distance2(p, a, b) < limit[e]
-        })
-    };
     let fast = inset_with(region, d_outer, d_hole, tolerance, Corners::Miter);
-    if all_contours(&fast).flatten().all(|&p| keeps(p)) {
+    if boundary.keeps_all(&fast, d_outer, d_hole) {
         fast
     } else {
         inset_with(region, d_outer, d_hole, tolerance, Corners::ThroughVertex)
+    }
+}
+
+/// A region and, made when first needed, a grid of its boundary edges: what the mitre check of
+/// [`inset_within`] searches, shared by every offset of the region (a layer's loops and fill).
+pub struct Boundary<'a> {
+    region: &'a Shapes,
+    grid: OnceCell<EdgeGrid>,
+}
+
+impl<'a> Boundary<'a> {
+    pub fn new(region: &'a Shapes) -> Boundary<'a> {
+        Boundary {
+            region,
+            grid: OnceCell::new(),
+        }
+    }
+
+    /// Whether every vertex of `offset` lies at least the allowed distance from the boundary:
+    /// `d_outer` from outer loops, `d_hole` from holes, less twice [`CHORD_TOLERANCE_MM`]
+    /// (the chords and rounding).
+    fn keeps_all(&self, offset: &Shapes, d_outer: f64, d_hole: f64) -> bool {
+        self.keeps(all_contours(offset).flatten().copied(), d_outer, d_hole)
+    }
+
+    /// Whether every point lies at least the allowed distance from the boundary, as
+    /// [`Boundary::keeps_all`] measures it.
+    fn keeps(&self, points: impl IntoIterator<Item = Point>, d_outer: f64, d_hole: f64) -> bool {
+        let mut points = points.into_iter().peekable();
+        if points.peek().is_none() {
+            return true;
+        }
+        let reach = d_outer.max(d_hole);
+        let grid = self.grid.get_or_init(|| EdgeGrid::new(self.region, reach));
+        let limit = |d: f64| {
+            let d = (d - 2.0 * CHORD_TOLERANCE_MM).max(0.0);
+            d * d
+        };
+        let limits = [limit(d_outer), limit(d_hole)];
+        points.all(|p| !grid.any_within(p, reach, limits))
+    }
+}
+
+/// Boundary edges binned to square cells: each edge (its ends, and whether it bounds a hole)
+/// stored in every cell its bounding box meets, the cells' runs one after the other.
+struct EdgeGrid {
+    min: DVec2,
+    inv_cell: f64,
+    nx: usize,
+    ny: usize,
+    offsets: Vec<u32>,
+    items: Vec<GridEdge>,
+}
+
+/// An edge in [`EdgeGrid`]: its ends, its bounding box, whether it bounds a hole.
+#[derive(Clone, Copy)]
+struct GridEdge {
+    a: Point,
+    b: Point,
+    lo: Point,
+    hi: Point,
+    hole: bool,
+}
+
+impl EdgeGrid {
+    /// Cells of about a third of the edges' mean spacing (√(box area / edges)), not smaller
+    /// than a quarter of `reach`: a search within `reach` meets few edges and few cells.
+    fn new(region: &Shapes, reach: f64) -> EdgeGrid {
+        let mut edges: Vec<(Point, Point, bool)> = Vec::new();
+        for shape in region {
+            for (hole, c) in shape.contours_with_hole() {
+                for k in 0..c.len() {
+                    edges.push((c[k], c[(k + 1) % c.len()], hole));
+                }
+            }
+        }
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &(a, b, _) in &edges {
+            lo = lo.min(a).min(b);
+            hi = hi.max(a).max(b);
+        }
+        if edges.is_empty() {
+            (lo, hi) = (DVec2::ZERO, DVec2::ZERO);
+        }
+        let size = hi - lo;
+        let spread = (size.x * size.y / edges.len().max(1) as f64).sqrt();
+        let cell = (spread / 3.0).max(reach / 4.0).max(1e-3);
+        let inv_cell = 1.0 / cell;
+        // Cells per axis, at most about 2¹⁵ each (a grid of a few edges over a large plate).
+        let count = |len: f64| ((len * inv_cell) as usize).min(1 << 15) + 1;
+        let (nx, ny) = (count(size.x), count(size.y));
+        let mut grid = EdgeGrid {
+            min: lo,
+            inv_cell,
+            nx,
+            ny,
+            offsets: vec![0; nx * ny + 1],
+            items: Vec::new(),
+        };
+        for &(a, b, _) in &edges {
+            let (x0, x1, y0, y1) = grid.cells(a.min(b), a.max(b));
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    grid.offsets[y * nx + x + 1] += 1;
+                }
+            }
+        }
+        for i in 1..grid.offsets.len() {
+            grid.offsets[i] += grid.offsets[i - 1];
+        }
+        let mut fill = grid.offsets.clone();
+        let none = GridEdge {
+            a: DVec2::ZERO,
+            b: DVec2::ZERO,
+            lo: DVec2::ZERO,
+            hi: DVec2::ZERO,
+            hole: false,
+        };
+        grid.items = vec![none; grid.offsets[nx * ny] as usize];
+        for &(a, b, hole) in &edges {
+            let (lo, hi) = (a.min(b), a.max(b));
+            let e = GridEdge { a, b, lo, hi, hole };
+            let (x0, x1, y0, y1) = grid.cells(lo, hi);
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let slot = &mut fill[y * nx + x];
+                    grid.items[*slot as usize] = e;
+                    *slot += 1;
+                }
+            }
+        }
+        grid
+    }
+
+    /// The cells (x from, x to, y from, y to) that the box `lo`..`hi` meets, clamped to the
+    /// grid. The same monotone map for edges and searches: a box that meets an edge's box
+    /// shares a cell with it.
+    fn cells(&self, lo: Point, hi: Point) -> (usize, usize, usize, usize) {
+        // `as` saturates (a negative or NaN value gives 0), so it floors every value ≥ 0.
+        let at = |v: f64, min: f64, n: usize| (((v - min) * self.inv_cell) as usize).min(n - 1);
+        (
+            at(lo.x, self.min.x, self.nx),
+            at(hi.x, self.min.x, self.nx),
+            at(lo.y, self.min.y, self.ny),
+            at(hi.y, self.min.y, self.ny),
+        )
+    }
+
+    /// Whether an edge lies closer to `p` than its limit (squared distances: `limits[0]` for
+    /// edges of outer loops, `limits[1]` for holes', both under `r`²).
+    fn any_within(&self, p: Point, r: f64, limits: [f64; 2]) -> bool {
+        let (x0, x1, y0, y1) = self.cells(p - DVec2::splat(r), p + DVec2::splat(r));
+        for y in y0..=y1 {
+            let row = y * self.nx;
+            let run =
+                &self.items[self.offsets[row + x0] as usize..self.offsets[row + x1 + 1] as usize];
+            for e in run {
+                // An edge whose box lies farther than r from p lies farther than r too.
+                if p.x + r < e.lo.x || p.x - r > e.hi.x || p.y + r < e.lo.y || p.y - r > e.hi.y {
+                    continue;
+                }
+                if segment_distance2(p, e.a, e.b) < limits[usize::from(e.hole)] {
+                    return true;
+                }
+            }
+        }
+        false
     }
 }
 
@@ -385,6 +537,65 @@ mod tests {
                 .count();
         }
         assert!(dropped > 300, "{dropped}");
+    }
+
+    #[test]
+    fn the_edge_grid_finds_what_every_edge_finds() {
+        // Regions of random loops (outer loops and holes, long and short edges, some far
+        // outside the rest), points in and around them: the grid's answer is the one of
+        // testing every edge, for small and large reaches and either limit the smaller.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut hits = 0;
+        for case in 0..200 {
+            let loops = 1 + (random(&mut seed) * 6.0) as usize;
+            let scale = if case % 4 == 0 { 100.0 } else { 5.0 };
+            let region: Shapes = (0..loops)
+                .map(|_| {
+                    let c = DVec2::new(random(&mut seed), random(&mut seed)) * scale;
+                    let r = 0.05 + random(&mut seed) * 2.0;
+                    let outer = island(&mut seed, c, r);
+                    let holes = if random(&mut seed) < 0.5 {
+                        let mut h = island(&mut seed, c, r * 0.5);
+                        h.reverse();
+                        vec![h]
+                    } else {
+                        vec![]
+                    };
+                    Shape::new(outer, holes)
+                })
+                .collect();
+            let (d_outer, d_hole) = (random(&mut seed) * 0.6, random(&mut seed) * 0.6);
+            let reach = d_outer.max(d_hole);
+            let boundary = Boundary::new(&region);
+            for _ in 0..50 {
+                let p = DVec2::new(random(&mut seed), random(&mut seed)) * (scale + 4.0)
+                    - DVec2::splat(2.0);
+                let mut want = false;
+                for shape in &region {
+                    for (hole, c) in shape.contours_with_hole() {
+                        let d = (if hole { d_hole } else { d_outer } - 2.0 * CHORD_TOLERANCE_MM)
+                            .max(0.0);
+                        for k in 0..c.len() {
+                            want |= segment_distance2(p, c[k], c[(k + 1) % c.len()]) < d * d;
+                        }
+                    }
+                }
+                assert_eq!(boundary.keeps([p], d_outer, d_hole), !want, "case {case}");
+                hits += usize::from(want);
+            }
+            // The grid is made for the first reach; a larger one later still finds all.
+            let far = DVec2::new(random(&mut seed), random(&mut seed)) * scale;
+            let big = reach + 3.0;
+            let mut want = false;
+            for c in region.iter().flat_map(|s| s.contours()) {
+                for k in 0..c.len() {
+                    want |= segment_distance2(far, c[k], c[(k + 1) % c.len()])
+                        < (big - 2.0 * CHORD_TOLERANCE_MM).powi(2);
+                }
+            }
+            assert_eq!(boundary.keeps([far], big, big), !want, "case {case}");
+        }
+        assert!(hits > 500, "{hits}");
     }
 
     #[test]

@@ -32,6 +32,7 @@ use crate::base::steps::{self, Budget};
 use crate::model::mesh::{Mesh, edge_key};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::float::simplify::SimplifyShape;
+use rustc_hash::FxHashMap;
 use std::sync::OnceLock;
 
 /// Points closer than this to their predecessor on a loop are dropped (docs/spec.md 5.3.2).
@@ -351,14 +352,27 @@ fn chain<'r>(
 /// of the chains that did not close.
 fn chain_directed(segs: &[Segment], section: &mut Section) -> (Vec<Contour>, Vec<usize>) {
     let mut used = vec![false; segs.len()];
-    let mut by_start: Vec<(u64, u32)> = segs
-        .iter()
-        .enumerate()
-        .map(|(i, s)| (s.start, i as u32))
-        .collect();
-    by_start.sort_unstable();
-    let find_start =
-        |key: u64, used: &[bool]| -> Option<usize> { first_of_key(&by_start, key, |i| !used[i]) };
+    // The segments starting on each edge, lowest index first: the first of a key in
+    // `first`, each one's next in `next` (a closed mesh has one a key).
+    const NONE: u32 = u32::MAX;
+    let mut first: FxHashMap<u64, u32> = FxHashMap::default();
+    first.reserve(segs.len());
+    let mut next = vec![NONE; segs.len()];
+    for (i, s) in segs.iter().enumerate().rev() {
+        if let Some(later) = first.insert(s.start, i as u32) {
+            next[i] = later;
+        }
+    }
+    let find_start = |key: u64, used: &[bool]| -> Option<usize> {
+        let mut i = first.get(&key).copied().unwrap_or(NONE);
+        while i != NONE {
+            if !used[i as usize] {
+                return Some(i as usize);
+            }
+            i = next[i as usize];
+        }
+        None
+    };
 
     let mut loops = Vec::new();
     let mut leftovers: Vec<usize> = Vec::new();
@@ -528,8 +542,9 @@ pub fn simplify_closed(c: &[Point], tol: f64) -> Contour {
     keep[0] = true;
     keep[far] = true;
     keep[n] = true;
-    // Index n stands for point 0 again (closing the loop).
-    let at = |i: usize| c[i % n];
+    // Index n stands for point 0 again (closing the loop); the points between two indices
+    // are below n.
+    let at = |i: usize| if i == n { c[0] } else { c[i] };
     let mut stack = vec![(0usize, far), (far, n)];
     while let Some((a, b)) = stack.pop() {
         if b <= a + 1 {
@@ -539,8 +554,8 @@ pub fn simplify_closed(c: &[Point], tol: f64) -> Contour {
         let d = q - p;
         let len = d[0].hypot(d[1]);
         let (mut worst, mut wd) = (0, -1.0);
-        for i in a + 1..b {
-            let r = at(i);
+        for (i, &r) in c[a + 1..b].iter().enumerate() {
+            let i = a + 1 + i;
             let e = if len > 0.0 {
                 ((r[0] - p[0]) * d[1] - (r[1] - p[1]) * d[0]).abs() / len
             } else {

@@ -4,7 +4,7 @@
 // for comparisons.
 import assert from "node:assert/strict";
 import { createHash } from "node:crypto";
-import { existsSync, readFileSync, rmSync } from "node:fs";
+import { existsSync, readFileSync, rmSync, writeFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { after, before } from "node:test";
 import { fileURLToPath } from "node:url";
@@ -187,6 +187,19 @@ export async function waitDone(page, timeout = 240_000) {
   const banner = s.state === "done" ? "" : await page.locator("#banner").innerText().catch(() => "");
   assert.equal(s.state, "done", `page state ${s.state}: ${banner}`);
   return s;
+}
+
+/** A two-material job: two copies of the 20 mm cube (written into `dir` as cube-a.stl and
+ *  cube-b.stl) opened and sliced, then the second part given to discharge unit `unit` in the
+ *  parts panel. The job is not sliced again: the caller clicks Slice. */
+export async function twoCubesSecondOnUnit(page, dir, unit, timeout = 240_000) {
+  const files = ["cube-a.stl", "cube-b.stl"].map((n) => join(dir, n));
+  for (const f of files) writeFileSync(f, cube);
+  await pick(page, files);
+  await waitDone(page, timeout);
+  await page.click(".part-item:nth-child(2)");
+  await page.selectOption("#part-unit", String(unit));
+  await page.waitForFunction((u) => window.dropslice.job().parts[1].unit === u, unit);
 }
 
 /** Opens a share link that does not embed its model (too big): the new page asks for the file,

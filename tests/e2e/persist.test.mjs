@@ -37,6 +37,14 @@ const storedModels = (page) =>
       }),
   );
 
+/** A new page (its own browser context; `query` added to the address) once its first slice is
+ *  done: the sample's, or the kept job's. openPage()'s { page, context, errors }. */
+async function sliced(query = "") {
+  const opened = await openPage(env.browser, env.url + query);
+  await waitDone(opened.page, 60_000);
+  return opened;
+}
+
 /** Waits until the job on screen is the one kept in the browser. */
 const kept = (page) => page.waitForFunction(() => window.dropslice.persist().state === "saved", null, { timeout: 30_000 });
 
@@ -66,8 +74,7 @@ async function asksOnLeaving(page, leave = false) {
 }
 
 test("two models, one rotated, a third opened over them, Undo, reload: the job is back with the notice; Start over gives the sample with the defaults", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   assert.match((await job(page)).name, /sample/);
   await page.locator("#set-layer_height").evaluate((e) => (e.closest("details").open = true));
   await page.fill("#set-layer_height", "0.15");
@@ -112,8 +119,7 @@ test("two models, one rotated, a third opened over them, Undo, reload: the job i
 });
 
 test("leaving asks while the job is not kept: after an edit and after an Undo; not once it is kept", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   await kept(page);
   // the writes held: each change stays pending
   await page.evaluate(() => window.dropslice.persistPause(true));
@@ -133,8 +139,7 @@ test("leaving asks while the job is not kept: after an edit and after an Undo; n
 });
 
 test("a crash loses nothing: the page that crashed after an edit comes back with the edited job", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   await pick(page, [cubeFile]);
   await waitDone(page);
   await editPart(page, 0, "rotate_z", 15);
@@ -157,8 +162,7 @@ test("a crash loses nothing: the page that crashed after an edit comes back with
 });
 
 test("a kept job that no longer fits the plate comes back as it was left, with the banner", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   await pick(page, [box("a.stl", 60, 60, 5), box("b.stl", 60, 60, 5)]);
   await waitDone(page);
   // a plate narrower than the parts: the job stays as it was, the banner says so
@@ -182,8 +186,7 @@ test("a kept job that no longer fits the plate comes back as it was left, with t
 });
 
 test("a job over the cap is said not to be kept, and leaving asks", async () => {
-  const { page, errors, context } = await openPage(env.browser, `${env.url}?jobcap=0`);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced("?jobcap=0");
   await page.waitForFunction(() => window.dropslice.persist().state === "over");
   assert.match(await page.locator("#persist-note").innerText(), /more than the 0 MB the page keeps in the browser: it will not come back after a reload/);
   await editPart(page, 0, "rotate_z", 10);
@@ -194,8 +197,7 @@ test("a job over the cap is said not to be kept, and leaving asks", async () => 
 
 test("a link page becomes the visitor's own at the first edit: the address drops the link, a reload brings back the edited job", async () => {
   // the link: the cube at scale 1.2 with 2 contours
-  const made = await openPage(env.browser, env.url);
-  await waitDone(made.page, 60_000);
+  const made = await sliced();
   await pick(made.page, [cubeFile]);
   await waitDone(made.page);
   await editPart(made.page, 0, "scale_x", 1.2);
@@ -207,8 +209,7 @@ test("a link page becomes the visitor's own at the first edit: the address drops
   const url = await shareLink(made.page);
   await made.context.close();
 
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   // the visitor's own job, kept
   await pick(page, [box("own.stl", 12, 12, 6)]);
   await waitDone(page);
@@ -252,8 +253,7 @@ test("a link page becomes the visitor's own at the first edit: the address drops
 });
 
 test("a damaged store is set aside with a word: the sample is shown", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   await kept(page);
   /** Changes the kept job with `change(record, models)` (its source run in the page), then
    *  reloads. The source goes into the evaluated text: the page's CSP refuses eval. */
@@ -295,8 +295,7 @@ test("a damaged store is set aside with a word: the sample is shown", async () =
 });
 
 test("undo snapshots keep no display meshes: 14 edits of the copies of a 600,000-facet part", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   await pick(page, [{ name: "torus.stl", mimeType: "model/stl", buffer: torusStl(1000, 300, 15, 5) }]);
   await waitDone(page);
   await page.click("#mode-3d");
@@ -327,8 +326,7 @@ test("undo snapshots keep no display meshes: 14 edits of the copies of a 600,000
 });
 
 test("the 201st profile is refused with a message; replacing one of the 200 is not", async () => {
-  const { page, errors, context } = await openPage(env.browser, env.url);
-  await waitDone(page, 60_000);
+  const { page, errors, context } = await sliced();
   await page.evaluate(() => {
     const list = Array.from({ length: 200 }, (_, i) => ({ name: `P${i}`, kind: "machine", settings: { plate_z: 100 + i } }));
     localStorage.setItem("dropslice.profiles.v1", JSON.stringify(list));

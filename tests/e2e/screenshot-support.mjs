@@ -3,10 +3,10 @@
 // the roof's layer below it with the overhang overlay (support off), and the 3D view with the
 // overhang tint. With TWO=1 also a two-material job (two cubes, the second printed by unit 1).
 // Usage: [OUT=dir] [TWO=1] node tests/e2e/screenshot-support.mjs
-import { copyFileSync, mkdtempSync, rmSync } from "node:fs";
+import { mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, openPage, pick, repo, start, waitDone, waitSettled } from "./helpers.mjs";
+import { benchy, openPage, pick, repo, start, twoCubesSecondOnUnit, waitDone, waitSettled } from "./helpers.mjs";
 
 const out = process.env.OUT ?? join(repo, "docs/images");
 const env = await start();
@@ -61,14 +61,7 @@ try {
 
   if (process.env.TWO) {
     await page.uncheck("#opt-support");
-    const cube = join(benchy, "../cube_20mm_ascii.stl");
-    const files = ["cube-a.stl", "cube-b.stl"].map((n) => join(tmp, n));
-    for (const f of files) copyFileSync(cube, f);
-    await pick(page, files);
-    await settle();
-    await page.click(".part-item:nth-child(2)");
-    await page.selectOption("#part-unit", "1");
-    await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 1);
+    await twoCubesSecondOnUnit(page, tmp, 1, 300_000);
     await page.click("#btn-slice");
     s = await settle();
     await page.evaluate((i) => window.dropslice.show(i), Math.floor(s.layers / 2));

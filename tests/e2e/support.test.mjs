@@ -4,10 +4,10 @@
 // download), the 3D view's overhang tint, and a two-material job. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { copyFileSync, mkdtempSync } from "node:fs";
+import { mkdtempSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, countPixels, downloadText, open3d, pick, pixels3d, startWithPage, status, stop, waitDone, waitSettled } from "./helpers.mjs";
+import { benchy, countPixels, downloadText, open3d, pick, pixels3d, startWithPage, status, stop, twoCubesSecondOnUnit, waitDone, waitSettled } from "./helpers.mjs";
 
 let env;
 let main;
@@ -198,16 +198,7 @@ test("3DBenchy: the overhang overlay on the cabin roof, then the support switch"
 
 test("a two-material job: two colours on the canvas, T lines in the download", async () => {
   const { page, errors } = main;
-  const cube = join(benchy, "../cube_20mm_ascii.stl");
-  const a = join(tmp, "cube-a.stl");
-  const b = join(tmp, "cube-b.stl");
-  copyFileSync(cube, a);
-  copyFileSync(cube, b);
-  await pick(page, [a, b]);
-  await waitDone(page);
-  await page.click(".part-item:nth-child(2)");
-  await page.selectOption("#part-unit", "1");
-  await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 1);
+  await twoCubesSecondOnUnit(page, tmp, 1);
   await page.click("#btn-slice");
   const s = await waitDone(page);
   assert.ok(s.unitDroplets[1] > 0, "unit-1 droplets");

@@ -6,11 +6,11 @@
 // choice, group, droplets, colour and legends. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { copyFileSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { pathToFileURL } from "node:url";
-import { benchy, countPixels, downloadText, pick, repo, startWithPage, stop, waitDone } from "./helpers.mjs";
+import { benchy, countPixels, downloadText, pick, repo, startWithPage, stop, twoCubesSecondOnUnit, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
@@ -159,16 +159,7 @@ test("three units print a unit-2 part with its droplets and colour", async () =>
   await setField(page, "units", 3);
   await page.waitForFunction(() => document.querySelectorAll("#part-unit option").length === 3);
   // two cubes, the second printed by unit 2
-  const cube = join(benchy, "../cube_20mm_ascii.stl");
-  const a = join(tmp, "cube-a.stl");
-  const b = join(tmp, "cube-b.stl");
-  copyFileSync(cube, a);
-  copyFileSync(cube, b);
-  await pick(page, [a, b]);
-  await waitDone(page);
-  await page.click(".part-item:nth-child(2)");
-  await page.selectOption("#part-unit", "2");
-  await page.waitForFunction(() => window.dropslice.job().parts[1].unit === 2);
+  await twoCubesSecondOnUnit(page, tmp, 2);
   await page.click("#btn-slice");
   const s = await waitDone(page);
   assert.equal(s.units, 3);
@@ -194,7 +185,7 @@ test("three units print a unit-2 part with its droplets and colour", async () =>
   assert.ok((await countPixels(page, unit2)) > 300, "the unit-2 part in its colour");
 
   // two materials (3DBenchy by unit 0, the cube by unit 1) and the support from unit 2
-  await pick(page, [benchy, a]);
+  await pick(page, [benchy, join(tmp, "cube-a.stl")]);
   await waitDone(page);
   await page.click(".part-item:nth-child(2)");
   await page.selectOption("#part-unit", "1");

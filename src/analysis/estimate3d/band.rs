@@ -2,9 +2,11 @@
 //! spheroid map, and a slab's cells in blocks that are interior in its own layer and in both
 //! neighbours take the void share of the fill's regular lattice, computed once per job and
 //! kind of layer ([`crate::analysis::InteriorRates`]). The other cells are filled exactly, from
-//! maps holding every droplet that reaches them (the left-out droplets near them restored).
+//! maps holding every droplet that reaches them (patches of the maps where left-out droplets
+//! reach such cells).
 
 use super::{CHUNK, Fill, Grid3, HeightMap, MapRow, ceil_i64, slab_rows};
+use crate::analysis::lines::{DropletLines, SkipGrid};
 use crate::analysis::raster::{dilate2, region_spans};
 use crate::base::geom::{Point, Shapes, all_contours, dist};
 use crate::base::settings::Settings;
@@ -23,15 +25,23 @@ const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 const DEEP: u8 = 3;
 
-/// Whether block (bx, by) is one of the samples of the interior (one block in 8, the same in
-/// every layer): filled exactly, so that each slab's interior takes the void share measured on
-/// its own samples.
+/// Whether block (bx, by) is one of the samples of the interior (the same in every layer):
+/// filled exactly, so that each slab's interior takes the void share measured on its own
+/// samples. Every block of one row of blocks in 16 (`rows`), so that a walk along a line
+/// ([`SkipGrid::walk`]) passes over the stretches between them; with `stagger` (every layer's
+/// fill one lattice fixed to the origin, whose phases whole rows would sample unevenly: 0.3
+/// points of void fraction on 3DBenchy) one block in 8, spread over rows and columns.
 #[inline]
-fn sample(bx: i64, by: i64) -> bool {
-    (bx + 3 * by).rem_euclid(SAMPLE_EVERY) == 0
+fn sample(bx: i64, by: i64, rows: bool) -> bool {
+    if rows {
+        by.rem_euclid(SAMPLE_ROWS) == 0
+    } else {
+        (bx + 3 * by).rem_euclid(SAMPLE_EVERY) == 0
+    }
 }
 
-/// One block in this many is a sample ([`sample`]).
+/// One row of blocks in this many is sampled, or one block in this many ([`sample`]).
+const SAMPLE_ROWS: i64 = 16;
 const SAMPLE_EVERY: i64 = 8;
 /// A slab with fewer sampled interior cells than this takes the job's lattice share instead.
 const MIN_SAMPLED_CELLS: u64 = 256;
@@ -44,12 +54,15 @@ pub struct Blocks {
     w: usize,
     h: usize,
     kind: Vec<u8>,
+    /// Samples in whole rows of blocks ([`sample`]).
+    rows: bool,
 }
 
 impl Blocks {
-    /// The blocks of a layer's `region` with a band of `width` mm; `None` for an empty region
-    /// or one whose box holds too many blocks.
-    pub fn new(region: &Shapes, grid: &Grid3, width: f64) -> Option<Blocks> {
+    /// The blocks of a layer's `region` with a band of `width` mm, sampled as a job with
+    /// `stagger` or without ([`sample`]); `None` for an empty region or one whose box holds
+    /// too many blocks.
+    pub fn new(region: &Shapes, grid: &Grid3, width: f64, stagger: bool) -> Option<Blocks> {
         let bs = BLOCK_CELLS as f64 * grid.cell;
         let (mut min, mut max) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in all_contours(region).flatten() {
@@ -111,6 +124,7 @@ impl Blocks {
             w,
             h,
             kind,
+            rows: !stagger,
         })
     }
 
@@ -124,83 +138,151 @@ impl Blocks {
         self.kind[y as usize * self.w + x as usize]
     }
 
-    /// Whether every block of the box `lo`..`hi` (mm) is deep and none is a sample.
-    fn deep(&self, grid: &Grid3, lo: Point, hi: Point) -> bool {
+    /// Per block of the box, whether a droplet may be left out of the map there: the block
+    /// is deep and not a sample.
+    fn left_out(&self) -> Vec<bool> {
+        (self.kind.iter().enumerate())
+            .map(|(at, &k)| {
+                let (bx, by) = (
+                    (at % self.w) as i64 + self.bx0,
+                    (at / self.w) as i64 + self.by0,
+                );
+                k == DEEP && !sample(bx, by, self.rows)
+            })
+            .collect()
+    }
+
+    /// Whether the box `p` ± `r` (mm) touches a block of the box flagged in `flags` (`all`:
+    /// whether every block it touches is flagged, blocks outside the box unflagged), the
+    /// blocks found as `⌊(v − origin) / size⌋`.
+    #[inline]
+    fn touches(&self, grid: &Grid3, flags: &[bool], p: Point, r: f64, all: bool) -> bool {
         let bs = BLOCK_CELLS as f64 * grid.cell;
         let b = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / bs);
-        (b(lo[1], 1)..=b(hi[1], 1)).all(|by| {
-            (b(lo[0], 0)..=b(hi[0], 0)).all(|bx| self.kind(bx, by) == DEEP && !sample(bx, by))
-        })
+        let (x0, x1) = (b(p[0] - r, 0) - self.bx0, b(p[0] + r, 0) - self.bx0);
+        let (y0, y1) = (b(p[1] - r, 1) - self.by0, b(p[1] + r, 1) - self.by0);
+        let (w, h) = (self.w as i64, self.h as i64);
+        if x0 < 0 || y0 < 0 || x1 >= w || y1 >= h {
+            // Partly outside the box (never when `all` holds: the box's rim is not deep).
+            let flag = |x: i64, y: i64| {
+                (0..w).contains(&x) && (0..h).contains(&y) && flags[(y * w + x) as usize]
+            };
+            return if all {
+                (y0..=y1).all(|y| (x0..=x1).all(|x| flag(x, y)))
+            } else {
+                (y0..=y1).any(|y| (x0..=x1).any(|x| flag(x, y)))
+            };
+        }
+        let (x0, x1, y0, y1) = (x0 as usize, x1 as usize, y0 as usize, y1 as usize);
+        let row = |y: usize| {
+            let f = &flags[y * self.w + x0..=y * self.w + x1];
+            if all {
+                f.iter().all(|&x| x)
+            } else {
+                f.iter().any(|&x| x)
+            }
+        };
+        if all {
+            (y0..=y1).all(row)
+        } else {
+            (y0..=y1).any(row)
+        }
+    }
+
+    /// The index in the box of block (bx, by), if it lies in it.
+    #[inline]
+    fn at(&self, bx: i64, by: i64) -> Option<usize> {
+        let (x, y) = (bx - self.bx0, by - self.by0);
+        (x >= 0 && y >= 0 && x < self.w as i64 && y < self.h as i64)
+            .then(|| y as usize * self.w + x as usize)
     }
 }
 
 /// A layer's spheroid map for the banded estimate: its droplets but those deep in its
-/// interior, which are kept aside.
+/// interior, which are left out (walked over along their lines, [`SkipGrid::walk`]).
 pub struct UnitMap {
     pub(crate) map: HeightMap,
     blocks: Option<Blocks>,
-    /// The droplets left out of the map, and their footprint diameter.
-    skipped: Vec<Point>,
-    kept: Vec<Point>,
+    /// The layer's droplets (for [`patch`](Self::patch)), how many were left out of the map,
+    /// and their footprint diameter.
+    lines: DropletLines,
+    left_out: u64,
     d: f64,
 }
 
+impl Blocks {
+    /// The blocks as a [`SkipGrid`], flagged where `flag(index in the box)`.
+    fn skip_grid(&self, grid: &Grid3, flag: impl Fn(usize) -> bool) -> SkipGrid {
+        let bs = BLOCK_CELLS as f64 * grid.cell;
+        SkipGrid::new(
+            grid.origin,
+            Point::splat(bs),
+            (self.bx0, self.by0),
+            (self.w, self.h),
+            flag,
+        )
+    }
+}
+
 impl UnitMap {
-    /// The map of droplets at `centres` (footprint diameter `d`), without those in `blocks`'
-    /// deep blocks (all of them without `blocks`).
-    pub fn new(centres: &[Point], grid: &Grid3, d: f64, blocks: Option<Blocks>) -> UnitMap {
+    /// The map of the droplets on `lines` (footprint diameter `d`), without those in
+    /// `blocks`' deep blocks (all of them without `blocks`).
+    pub fn new(lines: &DropletLines, grid: &Grid3, d: f64, blocks: Option<Blocks>) -> UnitMap {
         let Some(bl) = blocks else {
             return UnitMap {
-                map: HeightMap::new(centres, grid, d),
+                map: HeightMap::new(&lines.centres(), grid, d),
                 blocks: None,
-                skipped: Vec::new(),
-                kept: Vec::new(),
+                lines: DropletLines::default(),
+                left_out: 0,
                 d,
             };
         };
-        let r = Point::splat(d / 2.0);
-        let (skipped, kept): (Vec<Point>, Vec<Point>) =
-            centres.iter().partition(|&&p| bl.deep(grid, p - r, p + r));
+        let (r, out) = (d / 2.0, bl.left_out());
+        let mut kept = Vec::new();
+        let mut left_out = 0;
+        let walked = bl.skip_grid(grid, |i| out[i]).walk(lines, |p| {
+            if bl.touches(grid, &out, p, r, true) {
+                left_out += 1;
+            } else {
+                kept.push(p);
+            }
+        });
         UnitMap {
             map: HeightMap::new(&kept, grid, d),
             blocks: Some(bl),
-            skipped,
-            kept,
+            lines: lines.clone(),
+            left_out: left_out + walked,
             d,
         }
     }
 
-    /// The map with the droplets left out of it restored where `needed` (per block of this
-    /// layer's box, [`Blocks`]) says: itself (`None`) when no block is.
-    fn restored(&self, grid: &Grid3, needed: &[bool]) -> Option<HeightMap> {
+    /// For the blocks `needed` (per block of this layer's box, [`Blocks`]) flags, where
+    /// droplets left out of the map reach cells a slab fills exactly: a map of every droplet
+    /// that reaches them (those left out and those kept), exact there; `None` when no block is
+    /// flagged. The map itself stays exact elsewhere, so a slab reads this one in the flagged
+    /// blocks only, and the whole layer is not mapped again.
+    fn patch(&self, grid: &Grid3, needed: &[bool]) -> Option<HeightMap> {
         let bl = self.blocks.as_ref()?;
         if !needed.iter().any(|&n| n) {
             return None;
         }
-        let bs = BLOCK_CELLS as f64 * grid.cell;
-        let b = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / bs);
         let r = self.d / 2.0;
-        let at = |bx: i64, by: i64| {
-            let (x, y) = (bx - bl.bx0, by - bl.by0);
-            x >= 0
-                && y >= 0
-                && (x as usize) < bl.w
-                && (y as usize) < bl.h
-                && needed[y as usize * bl.w + x as usize]
-        };
-        let back = self.skipped.iter().filter(|p| {
-            (b(p[1] - r, 1)..=b(p[1] + r, 1))
-                .any(|by| (b(p[0] - r, 0)..=b(p[0] + r, 0)).any(|bx| at(bx, by)))
+        // A droplet reaches only the blocks next to its own.
+        let near = dilate2(needed, bl.w, bl.h, 1);
+        let mut reach = Vec::new();
+        bl.skip_grid(grid, |i| !near[i]).walk(&self.lines, |p| {
+            if bl.touches(grid, needed, p, r, false) {
+                reach.push(p);
+            }
         });
-        let all: Vec<Point> = self.kept.iter().chain(back).copied().collect();
-        Some(HeightMap::new(&all, grid, self.d))
+        Some(HeightMap::new(&reach, grid, self.d))
     }
 }
 
 /// [`super::slab_voids`] with the slab's cells in blocks that are interior in all three layers
 /// taking the void share `share` (of a slab of the fill's lattice); the maps are those of
-/// [`UnitMap`], and where a droplet left out of one reaches a cell filled exactly, that map is
-/// rebuilt with it for this slab. Without blocks for all three layers, every cell is exact.
+/// [`UnitMap`], and where a droplet left out of one reaches a cell filled exactly, that map's
+/// patch with it is read there ([`UnitMap::patch`]). Without blocks for all three layers, every cell is exact.
 pub fn slab_voids_banded(
     region: &Shapes,
     grid: &Grid3,
@@ -221,15 +303,16 @@ pub fn slab_voids_banded(
             .iter()
             .all(|b| b.is_some_and(|b| b.kind(bx, by) >= INTERIOR))
     };
-    // The maps for this slab: those whose left-out droplets lie in a block of the slab's
-    // region filled exactly (a deep block of one layer that is not interior in another),
-    // rebuilt with them. (A left-out droplet reaches only its own deep blocks.)
+    // Where a layer's left-out droplets reach a block of the slab's region filled exactly (a
+    // deep block of that layer that is not interior in another), a patch of that layer's map
+    // with them is read instead of its map. (A left-out droplet reaches only its own deep
+    // blocks.)
     let own = this.blocks.as_ref();
-    let restored: Vec<Option<HeightMap>> = (0..3)
+    let patches: Vec<Option<(HeightMap, Vec<bool>, &Blocks)>> = (0..3)
         .map(|i| {
             let m = maps[i]?;
             let mb = m.blocks.as_ref()?;
-            if m.skipped.is_empty() {
+            if m.left_out == 0 {
                 return None;
             }
             let needed: Vec<bool> = (mb.kind.iter().enumerate())
@@ -238,12 +321,41 @@ pub fn slab_voids_banded(
                     k == DEEP && own.is_none_or(|o| o.kind(bx, by) != 0) && !inner(bx, by)
                 })
                 .collect();
-            m.restored(grid, &needed)
+            Some((m.patch(grid, &needed)?, needed, mb))
         })
         .collect();
-    let map_of =
-        |i: usize| -> Option<&HeightMap> { restored[i].as_ref().or(maps[i].map(|m| &m.map)) };
-    let (below, this_map, above) = (map_of(0), map_of(1).expect("own map"), map_of(2));
+    let map_of = |i: usize| maps[i].map(|m| &m.map);
+    let patch_of = |i: usize| patches[i].as_ref().map(|p| &p.0);
+    // Whether map i reads its patch in block (bx, by).
+    let patched = |i: usize, bx: i64, by: i64| {
+        patches[i]
+            .as_ref()
+            .is_some_and(|(_, needed, mb)| mb.at(bx, by).is_some_and(|a| needed[a]))
+    };
+    let any_patch = patches.iter().any(Option::is_some);
+    // Per block of this layer's box that is interior in all three layers and not a sample
+    // (counted, not filled), where its run of such blocks along the row ends (the grid index
+    // of the first block after it); `i64::MIN` for other blocks. A row's span passes over a
+    // run at once.
+    let run_end: Vec<i64> = own.map_or_else(Vec::new, |o| {
+        let mut v = vec![i64::MIN; o.w * o.h];
+        for y in 0..o.h {
+            let by = y as i64 + o.by0;
+            let mut end = i64::MIN;
+            for x in (0..o.w).rev() {
+                let bx = x as i64 + o.bx0;
+                if inner(bx, by) && !sample(bx, by, o.rows) {
+                    if end == i64::MIN {
+                        end = bx + 1;
+                    }
+                    v[y * o.w + x] = end;
+                } else {
+                    end = i64::MIN;
+                }
+            }
+        }
+        v
+    });
     let (mut cells, mut filled) = (0u64, 0.0f64);
     // The interior's cells not sampled, and the sampled ones with their fill.
     let (mut unsampled, mut sampled, mut sampled_fill) = (0u64, 0u64, 0.0f64);
@@ -256,25 +368,34 @@ pub fn slab_voids_banded(
             return;
         }
         let by = iy.div_euclid(BLOCK_CELLS);
-        let below = below.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let above = above.map_or(MapRow::EMPTY, |m| m.row(iy));
-        let this = this_map.row(iy);
+        let rows = [0, 1, 2].map(|i| map_of(i).map_or(MapRow::EMPTY, |m| m.row(iy)));
+        let patch_rows = [0, 1, 2].map(|i| patch_of(i).map_or(MapRow::EMPTY, |m| m.row(iy)));
         let mut from = c0;
         while from <= c1 {
             let bx = from.div_euclid(BLOCK_CELLS);
-            let block_end = (bx + 1) * BLOCK_CELLS - 1;
-            let inside = inner(bx, by);
-            if inside && !sample(bx, by) {
-                let to = c1.min(block_end);
+            let end = own
+                .and_then(|o| o.at(bx, by))
+                .map_or(i64::MIN, |a| run_end[a]);
+            if end != i64::MIN {
+                let to = c1.min(end * BLOCK_CELLS - 1);
                 cells += (to - from + 1) as u64;
                 unsampled += (to - from + 1) as u64;
                 from = to + 1;
                 continue;
             }
+            let block_end = (bx + 1) * BLOCK_CELLS - 1;
+            let inside = inner(bx, by);
+            let row_of = |i: usize| {
+                if any_patch && patched(i, bx, by) {
+                    patch_rows[i]
+                } else {
+                    rows[i]
+                }
+            };
             let before = filled;
-            let (xt, rt, et) = this.piece(from);
-            let (xb, rb, eb) = below.piece(from);
-            let (xa, ra, ea) = above.piece(from);
+            let (xb, rb, eb) = row_of(0).piece(from);
+            let (xt, rt, et) = row_of(1).piece(from);
+            let (xa, ra, ea) = row_of(2).piece(from);
             let to = c1.min(et).min(eb).min(ea).min(block_end);
             cells += (to - from + 1) as u64;
             filled = fill.stretch([(xt, rt), (xb, rb), (xa, ra)], from, to, &mut col, filled);

@@ -21,15 +21,10 @@ impl HeightMap {
                 max[k] = max[k].max(idx(p[k] + r, k) + 1);
             }
         }
-        let mut tiles = Tiles::default();
         if centres.is_empty() {
-            return HeightMap {
-                x0: 0,
-                y0: 0,
-                tiles,
-                q: Vec::new(),
-            };
+            return HeightMap::default();
         }
+        let mut tiles = Tiles::default();
         let (w, h) = (
             (max[0] - min[0] + 1) as usize,
             (max[1] - min[1] + 1) as usize,

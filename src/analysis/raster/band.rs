@@ -6,8 +6,9 @@
 //! tiles are stored as covered region, so the band's voids end at the interior as at droplets
 //! (they are neither cut open nor taken for the boundary).
 
-use super::build::{Prep, set_cols};
-use super::{Grid, Raster};
+use super::build::{Prep, set_cols, widen};
+use super::{Grid, Raster, set_range};
+use crate::analysis::lines::{DropletLines, SkipGrid};
 use crate::base::geom::{Point, Shapes, dist};
 use crate::base::settings::{Footprint, Settings};
 use crate::base::spatial::{Spot, Tiles};
@@ -15,9 +16,10 @@ use crate::base::spatial::{Spot, Tiles};
 /// Rows of a block; a block is one word (64 columns) wide.
 const BLOCK_ROWS: usize = 16;
 const BLOCK_COLS: usize = 64;
-/// Blocks per storage tile, down and across (tiles of 64 rows × 4 words).
-const TILE_BLOCK_ROWS: usize = 4;
-const TILE_BLOCK_COLS: usize = 4;
+/// Blocks per storage tile, down and across (tiles of 32 rows × 2 words: a band stored
+/// with less of the interior around it than the whole raster's tiles would).
+const TILE_BLOCK_ROWS: usize = 2;
+const TILE_BLOCK_COLS: usize = 2;
 
 /// What a banded rebuild left out of the bitmaps and counted instead, in grid cells.
 #[derive(Clone, Copy, Debug, Default)]
@@ -41,34 +43,44 @@ const OUTSIDE: u8 = 0;
 const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 
-/// Whether any of `flags` within `r` places along one axis is set, per place (`at(line, i)`:
-/// the index of place i of a line).
-fn dilate(
-    flags: &[bool],
-    lines: usize,
-    len: usize,
-    r: usize,
-    at: impl Fn(usize, usize) -> usize,
-) -> Vec<bool> {
-    let mut out = vec![false; flags.len()];
-    let mut prefix = vec![0u32; len + 1];
-    for line in 0..lines {
-        for i in 0..len {
-            prefix[i + 1] = prefix[i] + flags[at(line, i)] as u32;
+/// A `w` × `h` grid of `flags` (row by row) dilated by `r` places along both axes (a square
+/// of 2r + 1): the band's blocks here and in the 3D estimate's. Counts of the flags in a
+/// window sliding along each row, then (row by row, a count per column) down the columns.
+pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
+    if w == 0 || h == 0 {
+        return vec![false; flags.len()];
+    }
+    let mut across = vec![0u32; flags.len()];
+    for (f, o) in flags.chunks_exact(w).zip(across.chunks_exact_mut(w)) {
+        let mut n: u32 = f[..r.min(w)].iter().map(|&x| x as u32).sum();
+        for (i, o) in o.iter_mut().enumerate() {
+            if i + r < w {
+                n += f[i + r] as u32;
+            }
+            *o = (n > 0) as u32;
+            if i >= r {
+                n -= f[i - r] as u32;
+            }
         }
-        for i in 0..len {
-            let (a, b) = (i.saturating_sub(r), (i + r + 1).min(len));
-            out[at(line, i)] = prefix[b] > prefix[a];
+    }
+    let mut out = vec![false; flags.len()];
+    let mut count = vec![0u32; w];
+    for row in across.chunks_exact(w).take(r.min(h)) {
+        count.iter_mut().zip(row).for_each(|(c, &x)| *c += x);
+    }
+    for k in 0..h {
+        if k + r < h {
+            let row = &across[(k + r) * w..(k + r + 1) * w];
+            count.iter_mut().zip(row).for_each(|(c, &x)| *c += x);
+        }
+        let o = &mut out[k * w..(k + 1) * w];
+        o.iter_mut().zip(&count).for_each(|(o, &c)| *o = c > 0);
+        if k >= r {
+            let row = &across[(k - r) * w..(k - r + 1) * w];
+            count.iter_mut().zip(row).for_each(|(c, &x)| *c -= x);
         }
     }
     out
-}
-
-/// A `w` × `h` grid of `flags` (row by row) dilated by `r` places along both axes (a square
-/// of 2r + 1): the band's blocks here and in the 3D estimate's.
-pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize) -> Vec<bool> {
-    let across = dilate(flags, h, w, r, |row, c| row * w + c);
-    dilate(&across, w, h, r, |col, row| row * w + col)
 }
 
 /// Sets grid columns c0..=c1 of row `k` in `bits` where they are stored (any segments).
@@ -119,29 +131,59 @@ impl Raster {
     /// `void_rate` per cell. [`analysis`](Self::analysis) then gives the layer's figures with
     /// the interior's added: coverage, void and enclosed areas as counted; the void count
     /// estimated; the largest void, the overfill and the boundary deviation the band's.
+    ///
+    /// The droplets come as their lines ([`DropletLines`]): those deep in the interior (2
+    /// blocks or more from any block not in it) are counted a stretch of a line at a time
+    /// and take the cells of an average droplet; the others are placed one by one.
     #[allow(clippy::too_many_arguments)]
     pub fn rebuild_banded(
         &mut self,
         index: usize,
         z: f64,
-        centres: &[Point],
+        lines: &DropletLines,
         region: &Shapes,
         s: &Settings,
         width: f64,
         void_rate: f64,
     ) {
+        let whole = |r: &mut Raster| r.rebuild(index, z, &lines.centres(), region, s);
         if !Raster::can_band(s) {
-            return self.rebuild(index, z, centres, region, s);
+            return whole(self);
         }
-        let prep = self.prepare(centres, region, s);
+        let prep = self.prepare_grid(lines.bounds(), region, s);
         let g = prep.grid;
         if g.ny.div_ceil(BLOCK_ROWS).saturating_mul(g.nx.div_ceil(64)) > MAX_BLOCKS {
             // Parts far apart in one layer: its sparse tiles, not a dense map of blocks.
-            return self.rebuild(index, z, centres, region, s);
+            return whole(self);
         }
         let kind = self.blocks(&prep.grid, width);
-        let banding = self.set_banded(&prep, &kind, void_rate);
-        self.finish(index, z, centres.len(), region, s, prep.grid);
+        self.tiles.reset(
+            g.ny,
+            g.nx.div_ceil(64),
+            BLOCK_ROWS * TILE_BLOCK_ROWS,
+            BLOCK_COLS / 64 * TILE_BLOCK_COLS,
+        );
+        let (nc, nr) = (g.nx.div_ceil(64), g.ny.div_ceil(BLOCK_ROWS));
+        let skip = SkipGrid::new(
+            Point::new(g.x0, g.y0),
+            Point::new(BLOCK_COLS as f64 * g.gx, BLOCK_ROWS as f64 * g.gy),
+            (0, 0),
+            (nc, nr),
+            |i| kind[i] == INTERIOR,
+        );
+        let places = &mut self.places;
+        let passed = skip.walk(lines, |p| places.push(prep.place(p)));
+        let mut banding = self.set_banded(&prep, &kind, void_rate);
+        // The droplets passed over: the cells of an average droplet each (a droplet covers
+        // its disc's area within half a cell wherever it lies).
+        let mean = prep
+            .spans
+            .iter()
+            .map(|&(n, _)| n.max(0) as f64)
+            .sum::<f64>()
+            / prep.widest.len().max(1) as f64;
+        banding.interior_drop_cells += (passed as f64 * mean).round() as u64;
+        self.finish(index, z, lines.count() as usize, region, s, prep.grid);
         self.banding = Some(banding);
     }
 
@@ -206,6 +248,7 @@ impl Raster {
             rows,
             ref spans,
             ref widest,
+            ..
         } = *prep;
         let (nx, ny) = (grid.nx, grid.ny);
         let nc = nx.div_ceil(64);
@@ -332,6 +375,34 @@ impl Raster {
                 out.interior_drop_cells += cells_of[ph];
                 continue;
             }
+            // Wholly in band blocks (stored) and in one band and segment of the storage: its
+            // rows one step apart, as [`Raster::rebuild`] sets them.
+            let in_band = c0 >= 0 && c1 < nx as i64 && k1 < ny && {
+                let (r0, r1) = (k0 / BLOCK_ROWS * nc, k1 / BLOCK_ROWS * nc);
+                let (w0, w1) = (c0 as usize >> 6, c1 as usize >> 6);
+                kind[r0 + w0] == BAND
+                    && kind[r0 + w1] == BAND
+                    && kind[r1 + w0] == BAND
+                    && kind[r1 + w1] == BAND
+            };
+            if let Some(sp) = in_band
+                .then(|| tiles.spot_cached(&mut spot, k0, c0 as usize >> 6, c1 as usize >> 6))
+                .flatten()
+                .filter(|sp| k1 < sp.end_row)
+            {
+                let shift = 64 * sp.shift;
+                let mut at = 64 * sp.index(k0) as u64;
+                for (slot, &(n, half)) in (sp.slot(k0)..).zip(&spans[ph * rows..(ph + 1) * rows]) {
+                    if n >= 1 {
+                        let c0 = (u - half + 0.5) as i64 as usize - shift;
+                        let c1 = c0 + n as usize - 1;
+                        set_range(drop_bits, at + c0 as u64, at + c1 as u64);
+                        widen(&mut extent[slot], c0, c1);
+                    }
+                    at += 64 * sp.row_len as u64;
+                }
+                continue;
+            }
             for (j, &(n, half)) in spans[ph * rows..(ph + 1) * rows].iter().enumerate() {
                 let k = k0 + j;
                 if n < 1 || k >= ny {
@@ -353,5 +424,34 @@ impl Raster {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::dilate2;
+
+    #[test]
+    fn dilation_is_the_square_around_each_flag() {
+        let mut random = crate::base::testing::rng(0x9e37_79b9_7f4a_7c15u64);
+        for case in 0..400 {
+            let (w, h, r) = (1 + case % 13, 1 + case / 13 % 11, case / 7 % 5);
+            let density = [0.02, 0.1, 0.5][case % 3];
+            let flags: Vec<bool> = (0..w * h).map(|_| random() < density).collect();
+            let want: Vec<bool> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as i64, (i / w) as i64);
+                    (0..w * h).any(|j| {
+                        let (a, b) = ((j % w) as i64, (j / w) as i64);
+                        flags[j] && (a - x).abs() <= r as i64 && (b - y).abs() <= r as i64
+                    })
+                })
+                .collect();
+            assert_eq!(
+                dilate2(&flags, w, h, r),
+                want,
+                "case {case}: {w} × {h}, r {r}"
+            );
+        }
     }
 }

@@ -100,6 +100,7 @@ impl Raster {
             rows,
             ref spans,
             ref widest,
+            ..
         } = prep;
         let (nx, ny) = (grid.nx, grid.ny);
         // First the tiles the region and the droplets touch, then their bits.
@@ -186,6 +187,26 @@ impl Raster {
     /// edges, its spans (row, first column, last column) in `spans` and each droplet's place
     /// in `places`, and the tables of columns a droplet covers per row; the tiles reset.
     pub(super) fn prepare(&mut self, centres: &[Point], region: &Shapes, s: &Settings) -> Prep {
+        let mut bounds = None;
+        for &p in centres {
+            let (lo, hi) = bounds.get_or_insert((p, p));
+            (*lo, *hi) = (lo.min(p), hi.max(p));
+        }
+        let prep = self.prepare_grid(bounds, region, s);
+        let places = &mut self.places;
+        places.clear();
+        places.extend(centres.iter().map(|&p| prep.place(p)));
+        prep
+    }
+
+    /// [`prepare`](Self::prepare) but the droplets' places: the grid over the region and the
+    /// droplets' centres within `bounds` (least, greatest corner).
+    pub(super) fn prepare_grid(
+        &mut self,
+        bounds: Option<(Point, Point)>,
+        region: &Shapes,
+        s: &Settings,
+    ) -> Prep {
         let b = s.droplet_width();
         let r = footprint_diameter(s) / 2.0;
         let gy = b / ROWS_PER_B;
@@ -198,7 +219,7 @@ impl Raster {
                 max[k] = max[k].max(p[k]);
             }
         }
-        for p in centres {
+        for p in bounds.into_iter().flat_map(|(lo, hi)| [lo, hi]) {
             for k in 0..2 {
                 min[k] = min[k].min(p[k] - r);
                 max[k] = max[k].max(p[k] + r);
@@ -257,22 +278,14 @@ impl Raster {
             .chunks(rows)
             .map(|c| c.iter().copied().max_by_key(|s| s.0).unwrap_or((0, 0.0)))
             .collect();
-        // A droplet's first row, phase, and centre in column units (column c's centre at u = c).
-        let place = |p: &Point| {
-            let v = (p[1] - r - y0) / gy;
-            let k0 = v.floor();
-            let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
-            (k0 as usize, ph, (p[0] - x0) / gx - 0.5)
-        };
-        let places = &mut self.places;
-        places.clear();
-        places.extend(centres.iter().map(place));
+        self.places.clear();
         self.banding = None;
         Prep {
             grid,
             rows,
             spans,
             widest,
+            r,
         }
     }
 
@@ -337,6 +350,20 @@ pub(super) struct Prep {
     pub(super) rows: usize,
     pub(super) spans: Vec<(i64, f64)>,
     pub(super) widest: Vec<(i64, f64)>,
+    /// The footprint's radius.
+    pub(super) r: f64,
+}
+
+impl Prep {
+    /// A droplet's first row, phase, and centre in column units (column c's centre at u = c).
+    #[inline]
+    pub(super) fn place(&self, p: Point) -> (usize, usize, f64) {
+        let g = &self.grid;
+        let v = (p[1] - self.r - g.y0) / g.gy;
+        let k0 = v.floor();
+        let ph = (((v - k0) * PHASES as f64) as usize).min(PHASES - 1);
+        (k0 as usize, ph, (p[0] - g.x0) / g.gx - 0.5)
+    }
 }
 
 /// Widens a row's extent (the words of its slice holding any bit) to columns c0..=c1.

@@ -97,12 +97,21 @@ pub struct CoverageMask {
 /// shares of cell (col + i, row + j) at index j·width + i.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct MaskTile {
+    /// The mask column (from 0, counted from the mask's origin) of the tile's first cells.
     pub col: usize,
+    /// The mask row (from 0) of the tile's first cells: a multiple of the 64 mask rows a tile
+    /// band holds.
     pub row: usize,
+    /// Cells across, at least 1.
     pub width: usize,
+    /// Cells down: 64, or fewer in the last band of the mask.
     pub height: usize,
+    /// Per cell, the share of it that is region no droplet covers: 0 (none) … 255 (all).
     pub void: Vec<u8>,
+    /// Per cell, the share of it that droplets cover outside the region: 0 … 255.
     pub overfill: Vec<u8>,
+    /// Per cell, the share of it that is region covered by droplets: 0 … 255; empty in the
+    /// page's mask, which draws only void and overfill.
     pub covered: Vec<u8>,
 }
 

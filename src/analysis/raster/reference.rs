@@ -3,7 +3,7 @@
 //! them against). Built for tests and with the `reference` feature only.
 
 use super::mask::{MaskLayout, RangeCounts, set_shares};
-use super::voids::{Acc, Deviation, Voids, find, interior, probe};
+use super::voids::{Acc, CellCounts, Deviation, Voids, find, interior, probe};
 use super::{
     COLS_PER_ROW, CoverageMask, Grid, LayerAnalysis, MIN_PASSAGE_COLS, Raster, Void, count_range,
 };
@@ -13,16 +13,16 @@ impl Raster {
     /// [`analysis`](Self::analysis) as it was before the fast paths (for tests comparing both).
     #[doc(hidden)]
     pub fn analysis_reference(&self) -> LayerAnalysis {
-        self.analysis_with(|index, counts, over_rows| {
-            self.count_cells(counts, over_rows);
+        self.analysis_with(|index, counts| {
+            self.count_cells(counts);
             self.voids_reference(index)
         })
     }
 
-    /// Adds the cells of the region, covered region and overfill to `counts`, and the rows
-    /// holding overfill to `over_rows` (the reference's pass; the fast path counts them as it
+    /// Counts the cells into `tally` (the reference's pass; the fast path counts them as it
     /// labels).
-    fn count_cells(&self, counts: &mut [u64; 3], over_rows: &mut Vec<usize>) {
+    fn count_cells(&self, tally: &mut CellCounts) {
+        let counts = &mut tally.cells;
         for (k, row, lo, hi) in self.filled_rows() {
             let range = row.offset + lo..row.offset + hi;
             let before = counts[2];
@@ -35,7 +35,7 @@ impl Raster {
                 counts[2] += (d & !r).count_ones() as u64;
             }
             if counts[2] > before {
-                over_rows.push(k);
+                tally.over_rows.push(k);
             }
         }
     }

@@ -129,7 +129,7 @@ impl Raster {
 
     /// The figures of the layer.
     pub fn analysis(&self) -> LayerAnalysis {
-        self.analysis_with(|index, counts, over_rows| self.voids_fast(index, counts, over_rows))
+        self.analysis_with(|index, counts| self.voids_fast(index, counts))
     }
 
     /// [`analysis`](Self::analysis) compiled without the popcount instruction, whichever CPU
@@ -137,26 +137,22 @@ impl Raster {
     #[cfg(any(test, feature = "reference"))]
     #[doc(hidden)]
     pub fn analysis_portable(&self) -> LayerAnalysis {
-        self.analysis_with(|index, counts, over_rows| {
-            self.voids_fast_with(index, counts, over_rows)
-        })
+        self.analysis_with(|index, counts| self.voids_fast_with(index, counts))
     }
 
     /// The figures of the layer, its voids by `labelling`: given the boundary's index, it
-    /// labels the voids and adds the cells of the region, covered region and overfill to the
-    /// counts and the rows holding overfill to the list.
+    /// labels the voids and counts the cells ([`CellCounts`]).
     pub(super) fn analysis_with(
         &self,
-        labelling: impl FnOnce(&EdgeIndex, &mut [u64; 3], &mut Vec<usize>) -> Voids,
+        labelling: impl FnOnce(&EdgeIndex, &mut CellCounts) -> Voids,
     ) -> LayerAnalysis {
         let g = self.grid;
         let tiles = &self.tiles;
         let cell = g.gx * g.gy;
         let index = EdgeIndex::new(&self.edges, self.b);
-        let mut counts = [0u64; 3];
-        let mut over_rows = Vec::new();
-        let v = labelling(&index, &mut counts, &mut over_rows);
-        let [mut n_region, mut n_covered, n_over] = counts;
+        let mut counts = CellCounts::default();
+        let v = labelling(&index, &mut counts);
+        let [mut n_region, mut n_covered, n_over] = counts.cells;
         let (mut count, mut enclosed) = (v.count, v.enclosed);
         // A banded raster's interior: its cells and its droplets' cells for the covered
         // region stored there, its voids (all enclosed) added.
@@ -171,7 +167,7 @@ impl Raster {
         // Outward deviation: overfill runs.
         let mut dev_out = Deviation::default();
         let mut buf = Vec::new();
-        for &k in &over_rows {
+        for &k in &counts.over_rows {
             buf.clear();
             if let Some(row) = tiles.row(k) {
                 self.runs(&row, |r, d| d & !r, &mut buf);
@@ -284,43 +280,27 @@ impl Raster {
     /// come in, so there are as many union-find nodes as runs that start a void, not as runs.
     /// The largest void's centroid and box are summed afterwards from its runs. Figures
     /// identical.
-    /// Also adds the cells of the region, covered region and overfill to `counts` and the rows
-    /// holding overfill to `over_rows`, as the reference's `count_cells` does, in the
+    /// Also counts the cells into `counts`, as the reference's `count_cells` does, in the
     /// same pass over the words. Natively on a CPU with a popcount instruction, compiled for
     /// it (the baseline x86-64 target counts bits by shifts and adds).
-    fn voids_fast(
-        &self,
-        index: &EdgeIndex,
-        counts: &mut [u64; 3],
-        over_rows: &mut Vec<usize>,
-    ) -> Voids {
+    fn voids_fast(&self, index: &EdgeIndex, counts: &mut CellCounts) -> Voids {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("popcnt") {
             // SAFETY: the CPU has the instruction, as the check above found.
-            return unsafe { self.voids_popcnt(index, counts, over_rows) };
+            return unsafe { self.voids_popcnt(index, counts) };
         }
-        self.voids_fast_with(index, counts, over_rows)
+        self.voids_fast_with(index, counts)
     }
 
     /// [`voids_fast_with`](Self::voids_fast_with) compiled with the popcount instruction.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "popcnt")]
-    fn voids_popcnt(
-        &self,
-        index: &EdgeIndex,
-        counts: &mut [u64; 3],
-        over_rows: &mut Vec<usize>,
-    ) -> Voids {
-        self.voids_fast_with(index, counts, over_rows)
+    fn voids_popcnt(&self, index: &EdgeIndex, counts: &mut CellCounts) -> Voids {
+        self.voids_fast_with(index, counts)
     }
 
     #[inline(always)]
-    fn voids_fast_with(
-        &self,
-        index: &EdgeIndex,
-        counts: &mut [u64; 3],
-        over_rows: &mut Vec<usize>,
-    ) -> Voids {
+    fn voids_fast_with(&self, index: &EdgeIndex, counts: &mut CellCounts) -> Voids {
         // A label's cells, with the boundary flag in the top bit.
         const TOP: u64 = 1 << 63;
         let g = self.grid;
@@ -344,8 +324,8 @@ impl Raster {
             }
             next_k = k + 1;
             let first = runs.len();
-            if self.void_runs(&row, k, &mut runs, around, counts) {
-                over_rows.push(k);
+            if self.void_runs(&row, k, &mut runs, around, &mut counts.cells) {
+                counts.over_rows.push(k);
             }
             // Each run takes the label of the first run above it joins (a new label when
             // none); the others it joins are united with it. Runs above that end before a
@@ -527,6 +507,15 @@ pub(super) struct Voids {
     pub(super) enclosed: u64,
     pub(super) largest: Option<Void>,
     pub(super) dev_in: Deviation,
+}
+
+/// What a labelling counts as it passes over the words: the cells of the region, of the
+/// covered region and of the overfill (droplets outside the region), and the rows holding
+/// overfill (in order), which the outward deviation probes.
+#[derive(Default)]
+pub(super) struct CellCounts {
+    pub(super) cells: [u64; 3],
+    pub(super) over_rows: Vec<usize>,
 }
 
 /// Probes the run [s, e) of row k (its ends and middle) for a larger distance to the

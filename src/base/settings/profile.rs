@@ -311,10 +311,7 @@ mod tests {
 
     #[test]
     fn a_profile_applies_its_values() {
-        let p = Profile::from_json(
-            r#"{"name": "PC", "kind": "material", "settings": {"shrink_xy": 0.8, "material_density": 1.2}}"#,
-        )
-        .unwrap();
+        let p = material("PC", r#""shrink_xy": 0.8, "material_density": 1.2"#);
         let mut s = Settings::default();
         p.apply(&mut s).unwrap();
         let u0 = s.unit(UnitId::FIRST);
@@ -324,10 +321,7 @@ mod tests {
 
     #[test]
     fn a_material_goes_to_the_unit_named_and_old_profiles_apply_as_before() {
-        let pc = Profile::from_json(
-            r#"{"name": "PC", "kind": "material", "settings": {"droplet_aspect": 1.3, "shrink_xy": 0.8}}"#,
-        )
-        .unwrap();
+        let pc = material("PC", r#""droplet_aspect": 1.3, "shrink_xy": 0.8"#);
         let mut s = Settings::default();
         pc.apply_to(&mut s, Some(UnitId(2))).unwrap();
         assert_eq!(s.unit(UnitId(2)).droplet_aspect, 1.3);
@@ -341,10 +335,7 @@ mod tests {
         assert_eq!(moved.settings["unit2_droplet_aspect"], 1.3);
         assert_eq!(moved.settings.len(), 2);
         // Applying a support material to unit 1 after a PC to unit 0 keeps both.
-        let pva = Profile::from_json(
-            r#"{"name": "PVA", "kind": "material", "settings": {"droplet_aspect": 1.6, "material_density": 1.19}}"#,
-        )
-        .unwrap();
+        let pva = material("PVA", r#""droplet_aspect": 1.6, "material_density": 1.19"#);
         let mut s = Settings::default();
         pc.apply_to(&mut s, Some(UnitId::FIRST)).unwrap();
         pva.apply_to(&mut s, Some(UnitId(1))).unwrap();
@@ -352,10 +343,10 @@ mod tests {
         assert_eq!(s.unit(UnitId(1)).droplet_aspect, 1.6);
         assert_eq!(s.unit(UnitId(1)).material_density, 1.19);
         // A profile saved before, with unit 1's values: read, applied as before, not to one unit.
-        let old = Profile::from_json(
-            r#"{"name": "PC+PVA", "kind": "material", "settings": {"droplet_aspect": 1.1, "unit1_droplet_aspect": 1.5, "unit1_shrink_z": 0.2}}"#,
-        )
-        .unwrap();
+        let old = material(
+            "PC+PVA",
+            r#""droplet_aspect": 1.1, "unit1_droplet_aspect": 1.5, "unit1_shrink_z": 0.2"#,
+        );
         let mut s = Settings::default();
         old.apply(&mut s).unwrap();
         assert_eq!(s.unit(UnitId::FIRST).droplet_aspect, 1.1);
@@ -423,6 +414,14 @@ mod tests {
                 .to_string()
                 .contains("bytes")
         );
+    }
+
+    /// A material profile `name` with `settings` (the JSON object's members), read.
+    fn material(name: &str, settings: &str) -> Profile {
+        Profile::from_json(&format!(
+            r#"{{"name": "{name}", "kind": "material", "settings": {{{settings}}}}}"#
+        ))
+        .unwrap()
     }
 
     fn machine(name: &str) -> String {

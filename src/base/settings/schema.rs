@@ -295,53 +295,42 @@ macro_rules! settings_table {
             vec![$(TableRow { scope: $rs, name: $rn, row: $rr, unit_description: $rd }),*]
         }
 
-        impl Settings {
-            pub(super) fn job_value(&self, name: &str) -> Option<serde_json::Value> {
-                match name {
-                    $(stringify!($jn) => Some(serde_json::to_value(&self.$jn).expect("a setting serializes")),)*
-                    _ => None,
-                }
-            }
+        settings_table!(@fields Settings [$($jn)*] job_value job_number_mut put_job);
+        settings_table!(@fields UnitSettings [$($un)*] value number_mut put);
 
+        impl Settings {
             /// The number setting `name` itself, for tests that put values no setter takes
             /// (NaN); `None` for a setting that is not a number.
             #[doc(hidden)]
             pub fn number_mut(&mut self, name: &str) -> Option<&mut f64> {
-                if let Some(e) = entry(name) && let Slot::Unit(u, base) = e.slot {
-                    return self.per_unit[u.index()].number_mut(base);
-                }
-                match name {
-                    $(stringify!($jn) => NumberMut::number_mut(&mut self.$jn),)*
-                    _ => None,
-                }
-            }
-
-            pub(super) fn put_job(&mut self, name: &str, v: serde_json::Value) -> Option<Result<(), serde_json::Error>> {
-                match name {
-                    $(stringify!($jn) => Some(serde_json::from_value(v).map(|x| self.$jn = x)),)*
-                    _ => None,
+                match entry(name).map(|e| e.slot) {
+                    Some(Slot::Unit(u, base)) => self.per_unit[u.index()].number_mut(base),
+                    _ => self.job_number_mut(name),
                 }
             }
         }
-
-        impl UnitSettings {
-            pub(super) fn value(&self, name: &str) -> Option<serde_json::Value> {
+    };
+    // A struct's fields by name (`$field`s, the names the table gives them): the value as
+    // JSON, the number itself, and a value put from JSON; `None` for a name it has not.
+    (@fields $ty:ident [$($field:ident)*] $value:ident $number_mut:ident $put:ident) => {
+        impl $ty {
+            pub(super) fn $value(&self, name: &str) -> Option<serde_json::Value> {
                 match name {
-                    $(stringify!($un) => Some(serde_json::to_value(&self.$un).expect("a setting serializes")),)*
+                    $(stringify!($field) => Some(serde_json::to_value(&self.$field).expect("a setting serializes")),)*
                     _ => None,
                 }
             }
 
-            fn number_mut(&mut self, name: &str) -> Option<&mut f64> {
+            fn $number_mut(&mut self, name: &str) -> Option<&mut f64> {
                 match name {
-                    $(stringify!($un) => NumberMut::number_mut(&mut self.$un),)*
+                    $(stringify!($field) => NumberMut::number_mut(&mut self.$field),)*
                     _ => None,
                 }
             }
 
-            pub(super) fn put(&mut self, name: &str, v: serde_json::Value) -> Option<Result<(), serde_json::Error>> {
+            pub(super) fn $put(&mut self, name: &str, v: serde_json::Value) -> Option<Result<(), serde_json::Error>> {
                 match name {
-                    $(stringify!($un) => Some(serde_json::from_value(v).map(|x| self.$un = x)),)*
+                    $(stringify!($field) => Some(serde_json::from_value(v).map(|x| self.$field = x)),)*
                     _ => None,
                 }
             }

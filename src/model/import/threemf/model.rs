@@ -8,7 +8,7 @@ use std::collections::{HashMap, HashSet};
 use quick_xml::name::{NamespaceResolver, QName, ResolveResult};
 
 use super::transform::{Affine, transform};
-use super::xml::{Xml, XmlEvent, attr, attr_ns, index, number};
+use super::xml::{Attr, Xml, XmlEvent, attr, attr_ns, index, number};
 use super::{
     CORE_NS, MAX_ITEMS, MAX_UNCOMPRESSED, MAX_VERTICES, PRODUCTION_NS, Totals, Zip, err,
     open_entry, part_key,
@@ -176,7 +176,7 @@ struct Element<'e> {
     /// The local name of a core element, "" for others.
     name: &'e str,
     local: &'e str,
-    attrs: &'e [(String, String, String)],
+    attrs: &'e [Attr],
 }
 
 /// The state of [`parse_model`] between elements.
@@ -270,11 +270,7 @@ impl Reader<'_> {
     }
 
     /// The root `<model>`: its unit and required extensions.
-    fn model(
-        &mut self,
-        attrs: &[(String, String, String)],
-        resolver: &NamespaceResolver,
-    ) -> Result<(), Error> {
+    fn model(&mut self, attrs: &[Attr], resolver: &NamespaceResolver) -> Result<(), Error> {
         self.saw_model = true;
         let unit = attr(attrs, "unit").unwrap_or_else(|| "millimeter".into());
         self.scale = unit_scale(&unit).ok_or_else(|| {
@@ -345,11 +341,7 @@ impl Reader<'_> {
     }
 
     /// A `<vertex>` of the object's mesh, in mm.
-    fn vertex(
-        &mut self,
-        attrs: &[(String, String, String)],
-        totals: &mut Totals,
-    ) -> Result<(), Error> {
+    fn vertex(&mut self, attrs: &[Attr], totals: &mut Totals) -> Result<(), Error> {
         let p = self.part;
         count(&mut totals.vertices, MAX_VERTICES, "vertices")?;
         let mut v = [0f32; 3];
@@ -395,11 +387,7 @@ impl Reader<'_> {
     }
 
     /// A `<triangle>` of the object's mesh: three indices of vertices listed before it.
-    fn triangle(
-        &mut self,
-        attrs: &[(String, String, String)],
-        totals: &mut Totals,
-    ) -> Result<(), Error> {
+    fn triangle(&mut self, attrs: &[Attr], totals: &mut Totals) -> Result<(), Error> {
         let p = self.part;
         count(&mut totals.triangles, MAX_TRIANGLES, "triangles")?;
         let t = [
@@ -422,7 +410,7 @@ impl Reader<'_> {
     }
 
     /// A `<component>` of the object.
-    fn component(&mut self, attrs: &[(String, String, String)]) -> Result<(), Error> {
+    fn component(&mut self, attrs: &[Attr]) -> Result<(), Error> {
         let p = self.part;
         let id = index(attr(attrs, "objectid"), "a <component> objectid", p)?;
         let tr = transform(attr(attrs, "transform"), self.scale, p)?;
@@ -450,7 +438,7 @@ impl Reader<'_> {
     }
 
     /// A build `<item>` (of the start part).
-    fn item(&mut self, attrs: &[(String, String, String)]) -> Result<(), Error> {
+    fn item(&mut self, attrs: &[Attr]) -> Result<(), Error> {
         let p = self.part;
         if self.doc.items.len() >= MAX_ITEMS {
             return Err(err(format!(

@@ -10,8 +10,12 @@ use quick_xml::name::ResolveResult;
 use super::{CORE_NS, Limited, MAX_NAMESPACES, MAX_XML_DEPTH, err};
 use crate::base::error::{Error, quote};
 
+/// An attribute of an element: its namespace (empty when unbound), local name and unescaped
+/// value.
+pub(super) type Attr = (String, String, String);
+
 /// An attribute without a namespace.
-pub(super) fn attr(attrs: &[(String, String, String)], name: &str) -> Option<String> {
+pub(super) fn attr(attrs: &[Attr], name: &str) -> Option<String> {
     attrs
         .iter()
         .find(|(ns, l, _)| ns.is_empty() && l == name)
@@ -19,7 +23,7 @@ pub(super) fn attr(attrs: &[(String, String, String)], name: &str) -> Option<Str
 }
 
 /// An attribute in namespace `ns`.
-pub(super) fn attr_ns(attrs: &[(String, String, String)], ns: &str, name: &str) -> Option<String> {
+pub(super) fn attr_ns(attrs: &[Attr], ns: &str, name: &str) -> Option<String> {
     attrs
         .iter()
         .find(|(n, l, _)| n == ns && l == name)
@@ -28,11 +32,11 @@ pub(super) fn attr_ns(attrs: &[(String, String, String)], ns: &str, name: &str) 
 
 pub(super) enum XmlEvent {
     /// A start or empty element: its namespace (empty when unbound), local name and
-    /// attributes (namespace, local name, unescaped value).
+    /// attributes.
     Start {
         ns: String,
         local: String,
-        attrs: Vec<(String, String, String)>,
+        attrs: Vec<Attr>,
         empty: bool,
     },
     End,
@@ -309,15 +313,13 @@ fn declarations(s: &BytesStart, part: &str) -> Result<usize, Error> {
     Ok(decls)
 }
 
-/// The attributes of an element (namespace, local name, unescaped value), namespace
-/// declarations left out.
-#[allow(clippy::type_complexity)]
+/// The attributes of an element, namespace declarations left out.
 fn attributes(
     resolver: &quick_xml::name::NamespaceResolver,
     s: &BytesStart,
     local: &str,
     part: &str,
-) -> Result<Vec<(String, String, String)>, Error> {
+) -> Result<Vec<Attr>, Error> {
     let mut attrs = Vec::new();
     for a in s.attributes().with_checks(false) {
         let a = a.map_err(|e| broken_attribute(local, e, part))?;
