@@ -148,16 +148,8 @@ fn droplet_pass(
     Vec<Vec<crate::base::geom::DVec2>>,
     support_droplets::PassFigures,
 ) {
-    let (b, b1) = (s.droplet_width(), s.support_width());
     stages::time(Stage::Support, || {
-        support_droplets::complete(
-            &|i, within, out: &mut Vec<support_droplets::Droplet>| {
-                support_droplets::droplets_of(&planned[i].0.moves, b, b1, within, out);
-                support_droplets::droplets_of(&planned[i].2, b, b1, within, out);
-            },
-            regions,
-            s,
-        )
+        support_droplets::complete(&|i| [&planned[i].0.moves, &planned[i].2], regions, s)
     })
 }
 
