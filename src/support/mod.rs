@@ -71,5 +71,6 @@ async fn map_in_steps<R: Send>(
 
 pub use overhang::{overhang, overhang_face_normal_z, support_reach, unsupported_droplets};
 pub use regions::{
-    LayerSupport, SUPPORT_TOLERANCE_MM, grow, grow_fast, support_layers, support_regions,
+    LayerSupport, SUPPORT_TOLERANCE_MM, grow, grow_fast, support_layers, support_layers_in_steps,
+    support_regions,
 };
