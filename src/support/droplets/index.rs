@@ -588,6 +588,14 @@ mod tests {
                 let scan = all
                     .iter()
                     .any(|&(q, w)| (p - q).length_squared() <= reach(w).powi(2));
+                // The raster covers only points within reach of a droplet.
+                if index.covers(p) {
+                    assert!(
+                        scan,
+                        "query {k} at {p}: covered, but no droplet within reach"
+                    );
+                    covered += 1;
+                }
                 for which in [0, 1] {
                     let got = index.find_within(p, which, reach);
                     assert_eq!(got.is_some(), scan, "query {k} at {p}");
