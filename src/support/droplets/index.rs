@@ -170,7 +170,7 @@ impl Listed {
         frames: &Frames,
         b: f64,
         b1: f64,
-        mut ask: Option<(&Index, &mut dyn FnMut(&At, u8))>,
+        mut ask: Option<Ask>,
     ) {
         self.runs.clear();
         self.others.clear();
@@ -225,6 +225,9 @@ impl Listed {
         }
     }
 }
+
+/// The layer below and what to do with a droplet it does not cover ([`Listed::list`]).
+pub(super) type Ask<'a> = (&'a Index, &'a mut dyn FnMut(&At, u8));
 
 /// A droplet as [`Listed::list`] gives it: where it lies within 10⁻⁹ mm (`near`, without a
 /// division), and how to compute it exactly ([`At::exact`]).
@@ -352,7 +355,7 @@ impl Rows {
         let runs = self.row(j)?;
         let dy = q.y - (j as f64 + f.phase) * f.spacing;
         let h2 = rr * rr - dy * dy;
-        if !(h2 >= 0.0) {
+        if h2.is_nan() || h2 < 0.0 {
             return None;
         }
         let h = h2.sqrt();
@@ -431,7 +434,7 @@ impl Index {
                 continue;
             };
             let (p, r) = (g.pitch, reach(rows.width) - SLACK - EPS);
-            if !(r > 0.5 * p) || rows.runs.is_empty() {
+            if r.is_nan() || r <= 0.5 * p || rows.runs.is_empty() {
                 continue;
             }
             let half = (r * r - 0.25 * p * p).sqrt();
