@@ -8,6 +8,8 @@
 // Also the file's import (`Models.add_bytes`), the hand-off to another worker
 // (`Session.prepared`, `Session.from_prepared`) and, with SETTINGS, a job of other settings
 // (`'{"support":"unit1"}'`: its first layer runs the supported pass).
+// The supported pass runs SUPPORT_ITEMS (environment, 4 as the page) layers' worth a call; its
+// calls over 10 ms are listed (call number: ms).
 // Usage: node scripts/wasm_call_time.mjs [PASSES] [MODEL.stl] [PKG_DIR] [ITEMS] [SETTINGS]
 // (`bash scripts/build.sh` first; PKG_DIR: the wasm-bindgen output to time, www/pkg by
 // default; ITEMS: the preparation's items per call, 16384 as the page)
@@ -62,8 +64,9 @@ for (let k = 0; k < passes; k++) {
   const hand = { sum: 0, max: 0, calls: 0 };
   const bytesOut = timed(hand, () => s.prepared());
   timed(hand, () => core.Session.from_prepared(bytesOut)).free();
-  const support = { sum: 0, max: 0, calls: 0 };
-  if (typeof s.support_step === "function") while (!timed(support, () => s.support_step(4)));
+  const support = { sum: 0, max: 0, calls: 0, each: [] };
+  const supportItems = Number(process.env.SUPPORT_ITEMS || 4);
+  if (typeof s.support_step === "function") while (!timed(support, () => s.support_step(supportItems)));
   const layers = { sum: 0, max: 0, calls: 0, each: [] };
   for (let i = 0; i < s.layer_count(); i++) timed(layers, () => s.slice_layer(i)).free();
   s.free();
@@ -73,5 +76,7 @@ for (let k = 0; k < passes; k++) {
     return `layer ${i}`;
   };
   const shown = prep.each.length > 24 ? `${prep.each.slice(0, 24).map((t) => t.toFixed(0)).join(", ")}, …` : prep.each.map((t) => t.toFixed(0)).join(", ");
+  const over = support.each.flatMap((t, i) => (t > 10 ? [`${i}: ${t.toFixed(0)}`] : []));
+  if (over.length > 0) console.log(`pass ${k + 1}: supported pass' calls over 10 ms (${over.length}): ${over.join(", ")}`);
   console.log(`pass ${k + 1}: preparation ${f(prep)} (${shown}); hand-off (prepared, from_prepared) ${f(hand)}; supported pass ${f(support)}; layers ${f(layers)} (${longest(layers)})`);
 }

@@ -147,7 +147,7 @@ pub fn line_droplets(from: Point, to: Point, b: f64) -> impl Iterator<Item = Poi
 /// Droplet `j` of the line from `from` to `to` of length `l`: the one point of it that
 /// [`line_droplets`] and [`line_droplets_in`] both compute.
 #[inline]
-fn line_droplet(from: Point, to: Point, l: f64, b: f64, j: u64) -> Point {
+pub fn line_droplet(from: Point, to: Point, l: f64, b: f64, j: u64) -> Point {
     let t = if l > 0.0 { j as f64 * b / l } else { 0.0 };
     DVec2::new(
         from[0] + t * (to[0] - from[0]),

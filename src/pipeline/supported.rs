@@ -3,7 +3,6 @@
 
 use crate::base::geom;
 use crate::base::parallel::{both, par_map, par_map_owned};
-use crate::base::settings::MAX_UNITS;
 use crate::base::stages::{self, Stage};
 use crate::base::steps::Budget;
 use crate::pipeline::Job;
@@ -35,8 +34,8 @@ impl Job {
 
     /// [`Job::supported_pass`] in resumable steps (the page's short calls): the same plans,
     /// each layer's section, part plan, hatch and final plan a step's item, one layer after
-    /// the other. The support regions' top-down pass and the droplet-level pass are one item
-    /// each (not divided). Keeps the plans in the job (as [`Job::supported_pass`] would),
+    /// the other; the support regions' pass and the droplet-level pass about a layer an item
+    /// ([`support::support_layers_in_steps`], [`support_droplets::complete_in_steps`]). Keeps the plans in the job (as [`Job::supported_pass`] would),
     /// unless it already has them.
     pub async fn supported_in_steps(&self, b: &Budget) {
         if self.supported_made() {
@@ -56,8 +55,7 @@ impl Job {
             b.spend(1).await;
         }
         drop(sections);
-        let layers = stages::time(Stage::Support, || support::support_layers(&regions, s));
-        b.spend(1).await;
+        let layers = support::support_layers_in_steps(&regions, s, b).await;
         let mut hatches = Vec::with_capacity(n);
         for i in 0..n {
             let start = plan::support_start(&parts[i].0, s);
@@ -68,8 +66,13 @@ impl Job {
         }
         let planned = with_hatches(parts, hatches, &layers);
         drop(layers);
-        let (extra, figures) = droplet_pass(&planned, &regions, s);
-        b.spend(1).await;
+        let (extra, figures) = support_droplets::complete_in_steps(
+            &|i| [&planned[i].0.moves, &planned[i].2],
+            &regions,
+            s,
+            b,
+        )
+        .await;
         let mut plans = Vec::with_capacity(n);
         for (i, layer) in planned.into_iter().enumerate() {
             plans.push(final_plan(i, layer, &extra, s));
@@ -149,17 +152,8 @@ fn droplet_pass(
     Vec<Vec<crate::base::geom::DVec2>>,
     support_droplets::PassFigures,
 ) {
-    let (b, bs) = (s.droplet_width(), s.support_width());
     stages::time(Stage::Support, || {
-        support_droplets::complete(
-            &|i, within, out: &mut Vec<support_droplets::Droplet>| {
-                let parts = planned[i].0.widths(b);
-                support_droplets::droplets_of(&planned[i].0.moves, &parts, within, out);
-                support_droplets::droplets_of(&planned[i].2, &[bs; MAX_UNITS], within, out);
-            },
-            regions,
-            s,
-        )
+        support_droplets::complete(&|i| [&planned[i].0.moves, &planned[i].2], regions, s)
     })
 }
 

@@ -38,7 +38,39 @@ pub mod orient;
 pub mod overhang;
 pub mod regions;
 
+use crate::base::stages::{self, Stage};
+use crate::base::steps::Budget;
+
+/// `f()`, timed as the support's stage when the pass runs in steps (natively the caller
+/// times the whole pass).
+fn timed<T>(budget: &Budget, f: impl FnOnce() -> T) -> T {
+    if budget.limited() {
+        stages::time(Stage::Support, f)
+    } else {
+        f()
+    }
+}
+
+/// `f(i)` for `i` in `0..n`: on all cores with an unlimited budget (natively), else one after
+/// the other, each one item of `budget` (the pass may pause after each, [`crate::base::steps`]).
+async fn map_in_steps<R: Send>(
+    n: usize,
+    budget: &Budget,
+    f: &(dyn Fn(usize) -> R + Sync),
+) -> Vec<R> {
+    if !budget.limited() {
+        return crate::base::parallel::par_map(n, f);
+    }
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        out.push(timed(budget, || f(i)));
+        budget.spend(1).await;
+    }
+    out
+}
+
 pub use overhang::{overhang, overhang_face_normal_z, support_reach, unsupported_droplets};
 pub use regions::{
-    LayerSupport, SUPPORT_TOLERANCE_MM, grow, grow_fast, support_layers, support_regions,
+    LayerSupport, SUPPORT_TOLERANCE_MM, grow, grow_fast, support_layers, support_layers_in_steps,
+    support_regions,
 };

@@ -4,13 +4,14 @@
 
 use crate::base::boolean::{bounds, cleaned, difference, grow_within, nested, overlap};
 use crate::base::geom::{DVec2, Shape, Shapes, segment_distance2};
-use crate::base::parallel::par_map;
 use crate::base::settings::Settings;
 use crate::base::spatial::EdgeIndex;
+use crate::base::steps::{Budget, UNLIMITED, now};
 use crate::slicing::fill::{FillParams, FillPattern, hatch_angle};
 use crate::slicing::hatch::HatchLine;
 use crate::slicing::offset::{CHORD_TOLERANCE_MM, Corners, raw_offset};
 use crate::support::lattice::{Bits, Lattices, Runs};
+use crate::support::map_in_steps;
 use crate::support::overhang::{overhang_figure, support_reach};
 use i_overlay::core::fill_rule::FillRule;
 use i_overlay::core::overlay_rule::OverlayRule;
@@ -158,26 +159,38 @@ pub struct LayerSupport {
 /// carried on unit 1's lattices ([`crate::support::lattice`]), or, for more hatch directions
 /// than it carries, as regions ([`support_regions`]).
 pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
+    now(support_layers_in_steps(regions, s, &UNLIMITED))
+}
+
+/// [`support_layers`] in resumable steps (the page's short calls, [`crate::base::steps`]):
+/// each layer's overhang, growth and crossings one item of `budget`, the top-down carry one
+/// item a layer; with [`UNLIMITED`], on all cores. The same result whatever the budget.
+pub async fn support_layers_in_steps(
+    regions: &[Shapes],
+    s: &Settings,
+    budget: &Budget,
+) -> Vec<LayerSupport> {
     let s1 = crate::slicing::plan::support_settings(s);
     let b1 = s1.droplet_width();
     if s1.fill_density.is_nan() || s1.fill_density <= 0.0 {
         // No support hatch: the overhang areas only.
-        return par_map(regions.len(), &|i| LayerSupport {
+        return map_in_steps(regions.len(), budget, &|i| LayerSupport {
             unsupported_area: crate::support::overhang::overhang_area(
                 &regions[i],
                 i.checked_sub(1).map(|j| &regions[j]),
                 s,
             ),
             lines: Vec::new(),
-        });
+        })
+        .await;
     }
     let spacing = b1 / s1.fill_density;
     let reach = support_reach(s) + SUPPORT_TOLERANCE_MM;
     match Lattices::new(regions, s, spacing, b1, reach) {
-        Some(lattices) => lattice_layers(regions, s, &lattices),
+        Some(lattices) => lattice_layers(regions, s, &lattices, budget).await,
         None => {
-            let areas_regions = support_regions(regions, s);
-            par_map(regions.len(), &|i| LayerSupport {
+            let areas_regions = support_regions_in_steps(regions, s, budget).await;
+            map_in_steps(regions.len(), budget, &|i| LayerSupport {
                 unsupported_area: areas_regions[i].0,
                 lines: FillPattern::Lines.new_from_type().fill(
                     &areas_regions[i].1,
@@ -189,6 +202,7 @@ pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
                     },
                 ),
             })
+            .await
         }
     }
 }
@@ -198,7 +212,12 @@ pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
 /// the block by word operations. need(n) = (need(n + 1) ∪ grown overhang(n + 1)) − region(n);
 /// the support of layer n is its need less the grown overhangs of the `support_gap_z` layers
 /// directly above, on the layer's own lattice.
-fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<LayerSupport> {
+async fn lattice_layers(
+    regions: &[Shapes],
+    s: &Settings,
+    lat: &Lattices,
+    budget: &Budget,
+) -> Vec<LayerSupport> {
     /// Layers whose crossings are held at once (memory stays that of a block).
     const BLOCK: usize = 32;
     let n = regions.len();
@@ -211,7 +230,7 @@ fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<Layer
     let mut top = n;
     while top > 0 {
         let bottom = top.saturating_sub(BLOCK);
-        let block = par_map(top - bottom, &|k| {
+        let block = map_in_steps(top - bottom, budget, &|k| {
             let i = bottom + k;
             let o = crate::support::overhang::overhang_region(
                 &regions[i],
@@ -221,7 +240,8 @@ fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<Layer
             let grown = grow_fast(&o, reach, SUPPORT_TOLERANCE_MM);
             let on = |r: &Shapes| -> Vec<Runs> { lat.lattices.iter().map(|l| l.runs(r)).collect() };
             (overhang_figure(&o), on(&grown), on(&regions[i]))
-        });
+        })
+        .await;
         for (k, (area, grown, part)) in block.into_iter().enumerate().rev() {
             let i = bottom + k;
             out[i].unsupported_area = area;
@@ -246,6 +266,8 @@ fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<Layer
             above.push_front(grown);
             above.truncate(gap_z.max(1));
         }
+        // The block's carry: word operations, about one layer's item.
+        budget.spend(1).await;
         top = bottom;
     }
     out
@@ -255,41 +277,55 @@ fn lattice_layers(regions: &[Shapes], s: &Settings, lat: &Lattices) -> Vec<Layer
 /// layer's overhang area and support region, the need carried top-down by a sequential union
 /// of outlines.
 pub fn support_regions(regions: &[Shapes], s: &Settings) -> Vec<(f64, Shapes)> {
+    now(support_regions_in_steps(regions, s, &UNLIMITED))
+}
+
+/// [`support_regions`] in resumable steps: each layer's passes one item of `budget`, the
+/// top-down union one item a layer.
+async fn support_regions_in_steps(
+    regions: &[Shapes],
+    s: &Settings,
+    budget: &Budget,
+) -> Vec<(f64, Shapes)> {
     let n = regions.len();
-    let overhangs = par_map(n, &|i| {
+    let overhangs = map_in_steps(n, budget, &|i| {
         crate::support::overhang::overhang_region(
             &regions[i],
             i.checked_sub(1).map(|j| &regions[j]),
             s,
         )
-    });
+    })
+    .await;
     let reach = support_reach(s);
     // Simplified within the support's tolerance here, on all cores: the sequential union
     // below then works on fewer points.
-    let grown: Vec<Shapes> = par_map(n, &|i| {
+    let grown: Vec<Shapes> = map_in_steps(n, budget, &|i| {
         simplified(&grow_fast(&overhangs[i], reach, SUPPORT_TOLERANCE_MM))
-    });
+    })
+    .await;
     // The part as it clips the need, outlines simplified within the support's tolerance
     // (fewer points for the sequential union below; the gap to the true part is kept droplet
     // by droplet when the support is planned).
-    let clips = par_map(n, &|i| simplified(&regions[i]));
+    let clips = map_in_steps(n, budget, &|i| simplified(&regions[i])).await;
     // Top-down: what the layers above still need carried (the part below carries what it
     // covers).
     let mut needs = vec![Shapes::new(); n];
     for i in (0..n.saturating_sub(1)).rev() {
-        needs[i] = carried(&needs[i + 1], &grown[i + 1], &clips[i]);
+        needs[i] = super::timed(budget, || carried(&needs[i + 1], &grown[i + 1], &clips[i]));
+        budget.spend(1).await;
     }
     let gap_z = s.support_gap_z as usize;
     let supports = if gap_z == 0 {
         needs
     } else {
-        par_map(n, &|i| {
+        map_in_steps(n, budget, &|i| {
             let mut region = needs[i].clone();
             for k in 1..=gap_z.min(n - 1 - i) {
                 region = difference(&region, &grown[i + k]);
             }
             region
         })
+        .await
     };
     overhangs
         .iter()

@@ -6,15 +6,21 @@
 //! The region form ([`crate::support`]) leaves a few droplets unsupported: where a support
 //! region is a sliver, or where a part droplet lies beyond the edge of the part below by less
 //! than the limit but the droplets below sit B/2 inside that edge. The pass works on droplet
-//! centres only (hash grids of the layers' droplets), so it is cheap.
+//! centres only, so it is cheap: each layer's droplets are listed from its moves once, unit 1's
+//! hatch lines as runs of their lattice (looked up by row and column), the rest in a hash grid
+//! ([`index`]). It runs in resumable steps ([`complete_in_steps`], the page's short calls):
+//! a layer an item.
 
 use crate::base::geom::{
     DVec2, Point, Shapes, dist, line_droplets, line_droplets_in, round_output,
 };
-use crate::base::settings::{MAX_UNITS, Settings};
+use crate::base::parallel::par_map;
+use crate::base::settings::{MAX_UNITS, Settings, UnitId};
+use crate::base::steps::{Budget, UNLIMITED, now};
 use crate::slicing::plan::{Move, MoveKind};
 use gaps::inside;
 use grid::{Added, Below};
+use index::{Frame, Frames, Index, Listed};
 
 /// A droplet centre and its width (B or B₁).
 pub type Droplet = (Point, f64);
@@ -22,15 +28,18 @@ pub type Droplet = (Point, f64);
 /// An axis-aligned box: its least and greatest corners.
 pub type Bounds = (Point, Point);
 
-/// `f(i, within, out)` appends layer i's droplets (in the box `within` if given) to `out`.
-pub type LayerDroplets<'a> = &'a (dyn Fn(usize, Option<Bounds>, &mut Vec<Droplet>) + Sync);
+/// `f(i)`: layer i's planned moves, each list from the origin (the part's, both units, then
+/// unit 1's support); their droplets are [`droplets_of`] each list.
+pub type LayerMoves<'a> = &'a (dyn Fn(usize) -> [&'a [Move]; 2] + Sync);
 
 /// Centres kept this much inside the rule's distance, so rounding the written positions
 /// cannot break it (positions are rounded to 0.05 µm).
 pub(crate) const MARGIN_MM: f64 = 1e-3;
 
+mod cover;
 mod gaps;
 mod grid;
+mod index;
 
 pub use gaps::{Clearance, LineGaps, edges_of};
 
@@ -87,17 +96,30 @@ pub struct PassFigures {
 }
 
 /// The unit-1 droplets to add to each layer so that every droplet above the first layer is
-/// supported: `droplets(i, within, out)` appends layer i's planned droplets (both units; in
-/// the box `within` if given, [`droplets_of`]) to `out` (about once per layer, in runs of
-/// layers on all cores; again for a layer under added droplets), so that no layer's droplets
-/// need be kept; `regions[i]` is its part's region. Works top-down; an added droplet needs
-/// support from the layer below as any other. Support droplets keep `support_gap_xy`·B from the part's region; a droplet with
-/// no such place within the rule stays unsupported (counted). With `support_gap_z` > 0 the
-/// support deliberately stops below overhangs, and the pass adds nothing.
+/// supported: `moves(i)` gives layer i's planned moves ([`LayerMoves`]: their droplets are
+/// listed from them, about once per layer, in runs of layers on all cores; again near added
+/// droplets), so that no layer's droplets need be kept; `regions[i]` is its part's region.
+/// Works top-down; an added droplet needs support from the layer below as any other. Support
+/// droplets keep `support_gap_xy`·B from the part's region; a droplet with no such place
+/// within the rule stays unsupported (counted). With `support_gap_z` > 0 the support
+/// deliberately stops below overhangs, and the pass adds nothing.
 pub fn complete(
-    droplets: LayerDroplets,
+    moves: LayerMoves,
     regions: &[Shapes],
     s: &Settings,
+) -> (Vec<Vec<Point>>, PassFigures) {
+    now(complete_in_steps(moves, regions, s, &UNLIMITED))
+}
+
+/// [`complete`] in resumable steps (the page's short calls, [`crate::base::steps`]): each
+/// layer's check against the layer below, then each layer's placing, one item of `budget`
+/// each, one after the other; with [`UNLIMITED`], the checks on all cores. The same result
+/// whatever the budget.
+pub async fn complete_in_steps(
+    moves: LayerMoves<'_>,
+    regions: &[Shapes],
+    s: &Settings,
+    budget: &Budget,
 ) -> (Vec<Vec<Point>>, PassFigures) {
     let n = regions.len();
     let mut extra: Vec<Vec<Point>> = vec![Vec::new(); n];
@@ -106,32 +128,53 @@ pub fn complete(
         return (extra, figures);
     }
     let rule = Rule::new(s);
-    let open = unsupported_by_planned(droplets, n, &rule);
+    // Each layer's hatch rows: the part's fill and unit 1's support.
+    let frames: Vec<Frames> = (0..n)
+        .map(|i| {
+            let fill = crate::slicing::fill::FillParams::from_settings(s, i);
+            let angle = crate::slicing::plan::hatch_angle(s, i);
+            Frames::new(
+                Frame::new(fill.angle_deg, fill.spacing, fill.phase, rule.b),
+                Frame::new(angle, rule.spacing, 0.5, rule.b1),
+                s.support_unit().0,
+            )
+        })
+        .collect();
+    let open = unsupported_by_planned(moves, &frames, &rule, budget).await;
     let mut buf = Vec::new();
     // Top-down: layer i's unsupported droplets (planned or added) get droplets in layer i − 1.
     for i in (1..n).rev() {
-        let mut todo: Vec<Droplet> = open[i].clone();
-        if !extra[i].is_empty() {
-            unsupported_added(droplets, i, &extra[i], &rule, &mut buf, &mut todo);
-        }
-        if todo.is_empty() {
-            continue;
-        }
-        place_under(
-            &todo,
-            &regions[i - 1],
-            &rule,
-            &mut extra[i - 1],
-            &mut figures,
-        );
+        super::timed(budget, || {
+            let mut todo: Vec<Droplet> = open[i].clone();
+            if !extra[i].is_empty() {
+                unsupported_added(moves, i, &extra[i], &rule, &mut buf, &mut todo);
+            }
+            if !todo.is_empty() {
+                place_under(
+                    &todo,
+                    &regions[i - 1],
+                    &rule,
+                    &mut extra[i - 1],
+                    &mut figures,
+                );
+            }
+        });
+        budget.spend(1).await;
     }
     (extra, figures)
 }
 
 /// The overhang rule's distances for the pass.
 struct Rule {
+    /// Unit 0's droplet width B.
     b: f64,
+    /// The support's unit's droplet width (its droplets added here are of it).
     b1: f64,
+    /// Every unit's droplet width B_u (of a unit the machine lacks: B).
+    widths: [f64; MAX_UNITS],
+    /// The least and the greatest of them.
+    narrow: f64,
+    wide: f64,
     /// `overhang_limit`·B.
     limit: f64,
     /// The grids' cells: the reach of the wider droplets.
@@ -140,6 +183,8 @@ struct Rule {
     gap: f64,
     /// How far from a droplet to support an added droplet may be placed.
     place: f64,
+    /// The spacing of unit 1's hatch lines.
+    spacing: f64,
 }
 
 impl Rule {
@@ -147,15 +192,26 @@ impl Rule {
         let b = s.droplet_width();
         let b1 = s.support_width();
         let limit = s.overhang_limit * b;
+        let s1 = crate::slicing::plan::support_settings(s);
+        let mut widths = [b; MAX_UNITS];
+        for u in UnitId::all(s.units as usize) {
+            widths[u.index()] = s.unit_width(u);
+        }
+        let narrow = widths.iter().copied().fold(f64::INFINITY, f64::min);
+        let wide = widths.iter().copied().fold(0.0, f64::max);
         let mut rule = Rule {
             b,
             b1,
+            widths,
+            narrow,
+            wide,
             limit,
             cell: 0.0,
             gap: s.support_gap_xy * b,
             place: 0.0,
+            spacing: s1.droplet_width() / s1.fill_density,
         };
-        rule.cell = rule.reach(b.max(b1));
+        rule.cell = rule.reach(wide);
         rule.place = rule.reach(b1) - MARGIN_MM;
         rule
     }
@@ -167,47 +223,121 @@ impl Rule {
 }
 
 /// Each layer's planned droplets that the layer below's planned droplets leave unsupported
-/// (none for layer 0): runs of consecutive layers on all cores, each layer's droplets listed
-/// and put in a grid once within a run (the grid of layer i then checks layer i + 1).
-fn unsupported_by_planned(droplets: LayerDroplets, n: usize, rule: &Rule) -> Vec<Vec<Droplet>> {
+/// (none for layer 0), in the order they are listed: natively runs of consecutive layers on
+/// all cores, each layer's droplets listed and indexed once within a run (the index of layer
+/// i then checks layer i + 1); with a limited budget one layer an item, one after the other.
+async fn unsupported_by_planned(
+    moves: LayerMoves<'_>,
+    frames: &[Frames],
+    rule: &Rule,
+    budget: &Budget,
+) -> Vec<Vec<Droplet>> {
     const RUN: usize = 8;
-    let (b, b1) = (rule.b, rule.b1);
-    let reach = |w: f64| rule.reach(w);
-    let runs = crate::base::parallel::par_map((n - 1).div_ceil(RUN), &|r| {
-        let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
-        let mut buf = Vec::new();
-        droplets(first - 1, None, &mut buf);
-        let mut below = Below::new(b, b1, reach, &buf);
-        let mut out = Vec::with_capacity(end - first);
-        for i in first..end {
-            buf.clear();
-            droplets(i, None, &mut buf);
-            // Consecutive droplets are neighbours: the droplet below that supported the last
-            // one most often supports the next.
-            let mut last: Option<Droplet> = None;
-            let mut open = Vec::new();
-            for &(p, w) in &buf {
-                if let Some((q, wq)) = last {
-                    let r = reach(wq);
-                    if (p - q).length_squared() <= r * r {
-                        continue;
-                    }
-                }
-                match below.find_within(p, reach) {
-                    Some(d) => last = Some(d),
-                    None => open.push((p, w)),
-                }
-            }
-            out.push(open);
-            if i + 1 < end {
-                below.fill(reach, &buf);
-            }
+    let n = frames.len();
+    let mut out = vec![Vec::new()];
+    if budget.limited() {
+        let mut pass = Pass::new(moves, frames, rule, 0);
+        for i in 1..n {
+            out.push(super::timed(budget, || pass.next(i + 1 < n)));
+            budget.spend(1).await;
         }
-        out
+        return out;
+    }
+    let runs = par_map((n - 1).div_ceil(RUN), &|r| {
+        let (first, end) = (1 + r * RUN, (1 + (r + 1) * RUN).min(n));
+        let mut pass = Pass::new(moves, frames, rule, first - 1);
+        (first..end)
+            .map(|i| pass.next(i + 1 < end))
+            .collect::<Vec<_>>()
     });
-    std::iter::once(Vec::new())
-        .chain(runs.into_iter().flatten())
-        .collect()
+    out.extend(runs.into_iter().flatten());
+    out
+}
+
+/// Consecutive layers checked against the layer below ([`Pass::next`]).
+struct Pass<'a, 'm> {
+    moves: LayerMoves<'m>,
+    frames: &'a [Frames],
+    rule: &'a Rule,
+    /// The layer `below` holds.
+    layer: usize,
+    below: Index,
+    listed: Listed,
+}
+
+impl<'a, 'm> Pass<'a, 'm> {
+    /// A pass holding layer `layer`.
+    fn new(
+        moves: LayerMoves<'m>,
+        frames: &'a [Frames],
+        rule: &'a Rule,
+        layer: usize,
+    ) -> Pass<'a, 'm> {
+        let reach = |w: f64| rule.reach(w);
+        let mut pass = Pass {
+            moves,
+            frames,
+            rule,
+            layer,
+            below: Index::new(rule.narrow, rule.wide, reach),
+            listed: Listed::default(),
+        };
+        pass.listed
+            .list(moves(layer), &frames[layer], &rule.widths, None);
+        pass.below.fill(&pass.listed, &frames[layer], reach);
+        pass
+    }
+
+    /// The droplets of the next layer that the layer held leaves unsupported; then holds that
+    /// layer if `keep`.
+    fn next(&mut self, keep: bool) -> Vec<Droplet> {
+        let rule = self.rule;
+        let reach = |w: f64| rule.reach(w);
+        let i = self.layer + 1;
+        // Consecutive droplets are neighbours: the droplet below that supported the last one
+        // looked for most often supports the next.
+        let mut last: Option<Droplet> = None;
+        let mut open = Vec::new();
+        let below = &self.below;
+        self.listed.list(
+            (self.moves)(i),
+            &self.frames[i],
+            &rule.widths,
+            Some((below, &mut |at, which| {
+                look_below(below, at, which, rule, &mut last, &mut open)
+            })),
+        );
+        if keep {
+            self.below.fill(&self.listed, &self.frames[i], reach);
+        }
+        self.layer = i;
+        open
+    }
+}
+
+/// Whether a droplet `at` (of frame `which`) that the layer below's raster does not cover has
+/// a droplet of that layer within reach (`last` first, the one found last); else appends it
+/// to `open`.
+fn look_below(
+    below: &Index,
+    at: &index::At,
+    which: u8,
+    rule: &Rule,
+    last: &mut Option<Droplet>,
+    open: &mut Vec<Droplet>,
+) {
+    let reach = |w: f64| rule.reach(w);
+    let p = at.exact();
+    if let Some((q, wq)) = *last {
+        let r = reach(wq);
+        if (p - q).length_squared() <= r * r {
+            return;
+        }
+    }
+    match below.find_within(p, which, reach) {
+        Some(d) => *last = Some(d),
+        None => open.push((p, at.w)),
+    }
 }
 
 /// Appends to `todo` the droplets `added` to layer i that layer i − 1's planned droplets leave
@@ -216,7 +346,7 @@ fn unsupported_by_planned(droplets: LayerDroplets, n: usize, rule: &Rule) -> Vec
 /// droplets of the box of all of them, which may span the layer); more than 16 list the
 /// droplets of their common box once, in a grid.
 fn unsupported_added(
-    droplets: LayerDroplets,
+    moves: LayerMoves,
     i: usize,
     added: &[Point],
     rule: &Rule,
@@ -224,6 +354,11 @@ fn unsupported_added(
     todo: &mut Vec<Droplet>,
 ) {
     let reach = |w: f64| rule.reach(w);
+    let droplets = |within: Option<Bounds>, out: &mut Vec<Droplet>| {
+        for list in moves(i - 1) {
+            droplets_of(list, &rule.widths, within, out);
+        }
+    };
     let adds: Vec<Droplet> = added.iter().map(|&p| (p, rule.b1)).collect();
     let cell = DVec2::splat(rule.cell);
     let held: Vec<bool> = if adds.len() <= 16 {
@@ -232,7 +367,7 @@ fn unsupported_added(
         adds.iter()
             .map(|&(p, _)| {
                 buf.clear();
-                droplets(i - 1, Some((p - cell, p + cell)), buf);
+                droplets(Some((p - cell, p + cell)), buf);
                 buf.iter().any(|&(q, w)| {
                     let r = reach(w);
                     (p - q).length_squared() <= r * r
@@ -246,8 +381,8 @@ fn unsupported_added(
             hi = hi.max(*p);
         }
         buf.clear();
-        droplets(i - 1, Some((lo - cell, hi + cell)), buf);
-        let below = Below::new(rule.b, rule.b1, reach, buf);
+        droplets(Some((lo - cell, hi + cell)), buf);
+        let below = Below::new(rule.narrow, rule.wide, reach, buf);
         adds.iter()
             .map(|&(p, _)| below.find_within(p, reach).is_some())
             .collect()
@@ -316,15 +451,21 @@ mod tests {
         s: &Settings,
     ) -> (Vec<Vec<Point>>, PassFigures) {
         assert_eq!(droplets.len(), regions.len());
-        complete(
-            &|i, within: Option<Bounds>, out: &mut Vec<Droplet>| {
-                out.extend(droplets[i].iter().filter(|(p, _)| {
-                    within.is_none_or(|(lo, hi)| p.cmpge(lo).all() && p.cmple(hi).all())
-                }))
-            },
-            regions,
-            s,
-        )
+        // Each droplet a move of its own (unit 1 for B₁ where it differs from B).
+        let moves: Vec<Vec<Move>> = droplets
+            .iter()
+            .map(|l| {
+                l.iter()
+                    .map(|&(to, w)| Move {
+                        kind: MoveKind::Droplet,
+                        role: crate::slicing::plan::Role::Fill,
+                        to,
+                        unit: (w != s.droplet_width()) as u8,
+                    })
+                    .collect()
+            })
+            .collect();
+        complete(&|i| [&moves[i][..], &[][..]], regions, s)
     }
 
     #[test]
