@@ -78,9 +78,9 @@
 //!   a layer's droplets whose cells all lie in its deep interior (2 blocks beyond the band)
 //!   are left out of its map ([`UnitMap`]; walked over along their lines as in 2D). A slab's
 //!   cells in blocks that are interior in its own layer and both neighbours take the void
-//!   share measured on the slab's own sample blocks (every block of one row of blocks in 16,
-//!   or with `stagger` one block in 8 spread over rows and columns, whose droplets every map
-//!   keeps and whose cells are filled exactly; the patch's share
+//!   share measured on the slab's own sample blocks (one block in 8 spread over rows and
+//!   columns, `estimate3d/band.rs` `WHOLE_ROWS`, whose droplets every map keeps and whose
+//!   cells are filled exactly; the patch's share
 //!   when fewer than 256 cells are sampled); every other cell is filled exactly, from maps
 //!   with every droplet that reaches it (where a left-out droplet reaches a block that is
 //!   deep in one layer but not interior in a neighbour, the slab reads a patch of that
@@ -103,6 +103,7 @@ mod droplet;
 mod estimate3d;
 mod interior;
 mod lines;
+mod part;
 mod raster;
 mod report;
 mod slabs;
@@ -116,11 +117,10 @@ pub use estimate3d::{
 };
 pub use interior::{InteriorCache, InteriorRates};
 pub use lines::DropletLines;
+pub use part::{PartAnalysis, UnitDensity};
 pub use raster::{
     COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
     Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,
 };
-pub use report::{
-    AnalysedLayer, AnalysisGrid, JobAnalysis, LayerStage, Model, PartAnalysis, Report, UnitDensity,
-};
+pub use report::{AnalysedLayer, AnalysisGrid, JobAnalysis, LayerStage, Model, Report};
 pub use slabs::{LayerMaps, SlabFigures, SlabRun, UnitRegions};

@@ -1,0 +1,167 @@
+//! The part-level figures of a job's analysis ([`PartAnalysis`]): areas summed over layers,
+//! the 3D estimate's volumes and predicted density, per unit that prints parts.
+
+use super::raster::{LayerAnalysis, Void};
+use super::slabs::SlabFigures;
+use serde::Serialize;
+
+/// Part-level figures. Areas in mm² summed over layers; volumes in mm³.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct PartAnalysis {
+    /// How many layers' figures were added (0: nothing analysed yet).
+    pub layers: usize,
+    /// Unit 0's droplets over those layers (the support's and unit 1's are not counted).
+    pub droplets: u64,
+    /// The part's sections (unit 0's region, exact) summed over the layers, mm².
+    pub region_area: f64,
+    /// Area-weighted coverage over all layers.
+    pub coverage: f64,
+    /// Region no droplet covers, summed over the layers, mm² (on the analysis grid).
+    pub void_area: f64,
+    /// The part of `void_area` in voids that do not reach a layer's boundary (enclosed air).
+    pub enclosed_void_area: f64,
+    /// Droplet area outside the region, summed over the layers, mm².
+    pub overfill_area: f64,
+    /// The largest connected void of any layer, and its layer (from 0).
+    pub largest_void: Option<Void>,
+    /// The layer of `largest_void` (from 0; the written report counts from 1); `None`: no
+    /// layer has a void.
+    pub largest_void_layer: Option<usize>,
+    /// The largest boundary deviation of any layer, mm: the farther of an uncovered point
+    /// inside the boundary and a covered point outside it.
+    pub max_boundary_deviation: f64,
+    /// The layer of `max_boundary_deviation` (from 0; written from 1); `None`: every layer's
+    /// deviation is 0.
+    pub max_deviation_layer: Option<usize>,
+    /// The part's volume: each layer's region (exact area) times H.
+    pub volume: f64,
+    /// Volume of the part no droplet spheroid fills (3D estimate: each slab's void share, sampled
+    /// on the 3D grid, times its exact volume).
+    pub void_volume: f64,
+    /// void_volume / volume.
+    pub void_fraction: f64,
+    /// The predicted density, %: 100 × (1 − void_fraction), once the 3D estimate has a
+    /// volume (`None` for a 2D analysis alone). A geometric estimate from the droplet model
+    /// (docs/process.md), not a measured density.
+    #[serde(default)]
+    pub predicted_density: Option<f64>,
+    /// Overhang area summed over the layers, mm².
+    #[serde(default)]
+    pub unsupported_area: f64,
+    /// The largest overhang area of a layer, mm², and its layer (from 0).
+    #[serde(default)]
+    pub max_unsupported_area: f64,
+    /// The layer of `max_unsupported_area` (from 0; written from 1); `None`: no layer has an
+    /// overhang.
+    #[serde(default)]
+    pub max_unsupported_area_layer: Option<usize>,
+    /// The 3D estimate of the parts of each other unit (other materials, droplets of B_u),
+    /// indexed by unit: its volume, void volume and predicted density; `None` for unit 0 (the
+    /// fields above are its own) and for a unit without parts; empty in a job whose parts are
+    /// all unit 0's. The support is not a part and is not measured.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub units: Vec<Option<UnitDensity>>,
+}
+
+impl PartAnalysis {
+    /// Adds one layer's figures and its 3D slab's.
+    pub fn add(&mut self, l: &LayerAnalysis, slab: SlabFigures) {
+        self.add_2d(l);
+        self.add_slab(slab);
+    }
+
+    /// Adds one layer's 2D figures.
+    pub fn add_2d(&mut self, l: &LayerAnalysis) {
+        self.layers += 1;
+        self.droplets += l.droplets;
+        let covered = self.coverage * self.region_area + l.coverage * l.region_area;
+        self.region_area += l.region_area;
+        self.coverage = if self.region_area > 0.0 {
+            covered / self.region_area
+        } else {
+            0.0
+        };
+        self.void_area += l.void_area;
+        self.enclosed_void_area += l.enclosed_void_area;
+        self.overfill_area += l.overfill_area;
+        if let Some(v) = l.largest_void
+            && self.largest_void.is_none_or(|b| v.area > b.area)
+        {
+            self.largest_void = Some(v);
+            self.largest_void_layer = Some(l.index);
+        }
+        if l.boundary_deviation > self.max_boundary_deviation {
+            self.max_boundary_deviation = l.boundary_deviation;
+            self.max_deviation_layer = Some(l.index);
+        }
+        self.unsupported_area += l.unsupported_area;
+        if l.unsupported_area > self.max_unsupported_area {
+            self.max_unsupported_area = l.unsupported_area;
+            self.max_unsupported_area_layer = Some(l.index);
+        }
+    }
+
+    /// Adds a slab's 3D figures (of any layer, in any order).
+    pub fn add_slab(&mut self, f: SlabFigures) {
+        self.volume += f.volume;
+        self.void_volume += f.void_volume;
+        for (k, figures) in f.units.iter().enumerate() {
+            if let Some((volume, void_volume)) = *figures {
+                let u = self.unit_mut(k);
+                u.volume += volume;
+                u.void_volume += void_volume;
+            }
+        }
+        self.update_fraction();
+    }
+
+    /// Unit `k`'s 3D estimate, made (empty) if it is not there yet.
+    pub fn unit_mut(&mut self, k: usize) -> &mut UnitDensity {
+        if self.units.len() <= k {
+            self.units.resize(k + 1, None);
+        }
+        self.units[k].get_or_insert_default()
+    }
+
+    /// `void_fraction` and `predicted_density` from the volumes (the other units' too).
+    pub fn update_fraction(&mut self) {
+        (self.void_fraction, self.predicted_density) = density(self.volume, self.void_volume);
+        for u in self.units.iter_mut().flatten() {
+            (u.void_fraction, u.predicted_density) = density(u.volume, u.void_volume);
+        }
+    }
+
+    /// The predicted density of each unit's parts, indexed by unit, for a machine of `units`
+    /// units (unit 0's: `predicted_density`).
+    pub fn unit_densities(&self, units: usize) -> Vec<Option<f64>> {
+        (0..units.max(1))
+            .map(|k| match k {
+                0 => self.predicted_density,
+                _ => self.units.get(k).copied().flatten()?.predicted_density,
+            })
+            .collect()
+    }
+}
+
+/// (void fraction, predicted density %) of a volume and its void volume; no density without
+/// a volume.
+fn density(volume: f64, void_volume: f64) -> (f64, Option<f64>) {
+    let some = volume > 0.0;
+    let fraction = if some { void_volume / volume } else { 0.0 };
+    (fraction, some.then_some(100.0 * (1.0 - fraction)))
+}
+
+/// The 3D estimate of the parts one unit prints: as [`PartAnalysis`] holds it for unit 0.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct UnitDensity {
+    /// The parts' volume, mm³.
+    pub volume: f64,
+    /// Volume no droplet spheroid fills, mm³.
+    pub void_volume: f64,
+    /// void_volume / volume.
+    pub void_fraction: f64,
+    /// 100 × (1 − void_fraction), %; `None` without a volume.
+    pub predicted_density: Option<f64>,
+}
