@@ -59,6 +59,27 @@ fn slice_job(dir: &TempDir, job: &Value) -> (String, Gcode) {
     (text, g)
 }
 
+/// 3DBenchy by unit 0 and a 20 mm cube beside it by unit 1: file, place, unit.
+const BENCHY_AND_CUBE: [(&str, P, u8); 2] = [
+    ("3DBenchy.stl", [5.0, 5.0], 0),
+    ("cube_20mm_ascii.stl", [75.0, 5.0], 1),
+];
+
+/// Slices a job of `parts` (file, place, unit; the files copied from the shared models into
+/// `dir`) with `settings`.
+fn slice_parts(dir: &TempDir, parts: &[(&str, P, u8)], settings: Value) -> (String, Gcode) {
+    for (f, _, _) in parts {
+        std::fs::copy(common::model(f), dir.join(f)).unwrap();
+    }
+    let job = json!({
+        "settings": settings,
+        "parts": parts.iter().map(|(f, at, u)| json!({
+            "file": f, "place_x": at[0], "place_y": at[1], "unit": u
+        })).collect::<Vec<_>>()
+    });
+    slice_job(dir, &job)
+}
+
 /// The 12 triangles of the box [x0,x1]×[y0,y1]×[0,h], facing outward.
 fn box_tris(x0: f64, y0: f64, x1: f64, y1: f64, h: f64) -> Vec<Tri> {
     let quads = [
@@ -128,20 +149,8 @@ fn each_unit_prints_its_own_part_and_covers_it() {
     let dir = TempDir::new("two-material");
     // Unit 0: 3DBenchy (one body: the test's parity rule is its section); unit 1: a 20 mm
     // cube beside it, with wider droplets.
-    let parts = [
-        ("3DBenchy.stl", [5.0, 5.0], 0u8),
-        ("cube_20mm_ascii.stl", [75.0, 5.0], 1u8),
-    ];
-    for (f, _, _) in &parts {
-        std::fs::copy(common::model(f), dir.join(f)).unwrap();
-    }
-    let job = json!({
-        "settings": {"unit1_droplet_aspect": 1.6},
-        "parts": parts.iter().map(|(f, at, u)| json!({
-            "file": f, "place_x": at[0], "place_y": at[1], "unit": u
-        })).collect::<Vec<_>>()
-    });
-    let (text, g) = slice_job(&dir, &job);
+    let parts = BENCHY_AND_CUBE;
+    let (text, g) = slice_parts(&dir, &parts, json!({"unit1_droplet_aspect": 1.6}));
     let (h, b) = widths(&g);
     assert!((b[1] - 1.6 * h).abs() < 1e-9 && (b[0] - b[1]).abs() > 0.05);
     check_unit_lines(&text, &g, &[0, 1]);
@@ -417,25 +426,13 @@ fn three_units_print_two_materials_and_the_support_from_unit_2() {
     // Unit 0: 3DBenchy (its bow and cabin roof need support); unit 1: a 20 mm cube beside it,
     // with wider droplets; the support from unit 2, with droplets of its own size, printed
     // between them (`unit_order = 1,2,0`).
-    let parts = [
-        ("3DBenchy.stl", [5.0, 5.0], 0u8),
-        ("cube_20mm_ascii.stl", [75.0, 5.0], 1u8),
-    ];
-    for (f, _, _) in &parts {
-        std::fs::copy(common::model(f), dir.join(f)).unwrap();
-    }
+    let parts = BENCHY_AND_CUBE;
     let settings = json!({
         "units": 3, "support": "unit2", "unit_order": "1,2,0",
         "unit1_droplet_aspect": 1.6, "unit2_droplet_aspect": 1.3,
         "unit2_material_density": 1.5
     });
-    let job = json!({
-        "settings": settings,
-        "parts": parts.iter().map(|(f, at, u)| json!({
-            "file": f, "place_x": at[0], "place_y": at[1], "unit": u
-        })).collect::<Vec<_>>()
-    });
-    let (text, g) = slice_job(&dir, &job);
+    let (text, g) = slice_parts(&dir, &parts, settings);
     let (h, b) = widths(&g);
     assert!((b[2] - 1.3 * h).abs() < 1e-9 && (b[1] - 1.6 * h).abs() < 1e-9);
     check_unit_lines(&text, &g, &[1, 2, 0]);

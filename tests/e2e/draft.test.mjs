@@ -103,9 +103,9 @@ test("3DBenchy inside out: the draft does not stand, a fresh worker takes the pr
   const { to, text } = await sliceOnTwo(file);
   assert.equal(to.adopt_draft?.length, 1, "one draft taken");
   assert.equal(to.confirm_job, undefined, "not confirmed");
-  assert.ok(to.slice.includes(to.adopt_draft[0]), "the draft's worker took units (given back when it was dropped)");
+  // Whether the draft's worker took units before it was dropped (they are given back), and
+  // how many the fresh worker gets, depends on the machine's load; the bytes must not.
   assert.equal(to.adopt_job?.length, 1, "the prepared job handed over");
   assert.notEqual(to.adopt_job[0], to.adopt_draft[0], "to a fresh worker");
-  assert.ok(to.slice.includes(to.adopt_job[0]), "the fresh worker sliced");
   assertSameText(text, cliText(file));
 });
