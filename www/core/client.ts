@@ -32,6 +32,7 @@ import type {
   Summary,
 } from "./protocol";
 import { checkInit, type PageInit } from "./settings";
+import { type Unit, Speculation, UnitCounter, unitCounter } from "./layerwork";
 import { StageClock, publish } from "./stages";
 
 /** The page's side of the per-stage profile (core/stages.ts). */
@@ -211,84 +212,6 @@ export interface SliceCallbacks {
   layer(layer: LayerData): void;
   /** A run of layers is complete: its G-code and summary (after all its layers). */
   unit(unit: SliceUnit): void;
-}
-
-/** A run of consecutive layers [from, to). */
-interface Unit {
-  from: number;
-  to: number;
-}
-
-/** Hands out the units of layers [0, layers) in order, shared by all workers. A unit is small
- *  enough to share the work evenly and to show progress, and large enough that its round trip
- *  and its Blob cost little (a Blob costs about 0.5 ms, whatever its size). Units given back
- *  (a draft's that did not stand, see [[Speculation]]) are handed out again first. */
-class UnitCounter {
-  private readonly size: number;
-  private at = 0;
-  private again: Unit[] = [];
-
-  constructor(
-    readonly layers: number,
-    workers: number,
-  ) {
-    this.size = Math.max(1, Math.min(16, Math.ceil(layers / (4 * workers))));
-  }
-
-  next(): Unit | null {
-    const back = this.again.shift();
-    if (back) return back;
-    if (this.at >= this.layers) return null;
-    const from = this.at;
-    this.at = Math.min(this.layers, from + this.size);
-    return { from, to: this.at };
-  }
-
-  giveBack(units: Unit[]): void {
-    this.again.push(...units);
-    this.again.sort((a, b) => a.from - b.from);
-  }
-}
-
-function unitCounter(layers: number, workers: number): () => Unit | null {
-  const c = new UnitCounter(layers, workers);
-  return () => c.next();
-}
-
-/** A worker slicing from the job worker's draft before the job is made (`adopt_draft`): what
- *  it sends is held until the job worker confirms the job is the draft's (`confirm_job`), then
- *  passed on in order; if the job is refused or not the draft's, it is dropped and the units
- *  it took are given back. */
-class Speculation {
-  state: "draft" | "confirmed" | "dropped" = "draft";
-  /** What the worker sent while a draft, to pass on once confirmed. */
-  private held: (() => void)[] = [];
-  /** The units it took while a draft. */
-  readonly taken: Unit[] = [];
-  /** Its units' lanes: they end when the counter has no unit left (or it was dropped). */
-  lanes: Promise<void> = Promise.resolve();
-
-  constructor(readonly h: WorkerHandle) {}
-
-  pass(f: () => void): void {
-    if (this.state === "confirmed") f();
-    else if (this.state === "draft") this.held.push(f);
-  }
-
-  confirm(): void {
-    this.state = "confirmed";
-    const held = this.held;
-    this.held = [];
-    for (const f of held) f();
-  }
-
-  drop(counter: UnitCounter | null): void {
-    if (this.state === "dropped") return;
-    this.state = "dropped";
-    this.held = [];
-    this.lanes.catch(() => {}); // terminated: its calls reject
-    counter?.giveBack(this.taken);
-  }
 }
 
 /** A file of the job: its name in the job (the key in `Models`) and the File. */
@@ -505,7 +428,7 @@ export class Pool {
     let counter: UnitCounter | null = null;
     const counterOf = (layers: number): UnitCounter => (counter ??= new UnitCounter(layers, handles.length));
     const drafted = (): UnitCounter | null => counter;
-    const drafts: (Speculation | null)[] = others.map(() => null);
+    const drafts: (Speculation<WorkerHandle> | null)[] = others.map(() => null);
     const onDraft = (copies: Uint8Array[]): void => {
       others.forEach((h, k) => {
         const copy = copies[k];
@@ -530,7 +453,7 @@ export class Pool {
     };
     /** Drops a draft's worker: a fresh worker takes its place (none if it was replaced
      *  meanwhile, by a cancel or a crash). */
-    const replace = (sp: Speculation): WorkerHandle | null => {
+    const replace = (sp: Speculation<WorkerHandle>): WorkerHandle | null => {
       sp.drop(drafted());
       const i = this.handles.indexOf(sp.h);
       if (i < 0) return null;
