@@ -5,7 +5,7 @@
 use crate::base::error::Error;
 use crate::base::parallel::both;
 use crate::base::settings::Settings;
-use crate::base::steps::{self, Budget, Stepped};
+use crate::base::steps::{self, Budget};
 use crate::model::fit;
 use crate::model::layout::{Frame, Instance, at_part, place_instances, shown_name};
 use crate::model::mesh::{self, Mesh, MeshStats};
@@ -23,8 +23,6 @@ use crate::pipeline::handoff::Draft;
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
 use std::cell::Cell;
-use std::rc::Rc;
-use std::sync::Arc;
 
 impl Job {
     /// Reads the model (STL, OBJ or a 3MF build, see [`import`]), validates the settings and
@@ -67,41 +65,10 @@ impl Job {
         Job::build(mesh, input, settings)
     }
 
-    /// [`Job::from_models`] in resumable steps (the page's engine keeps a running call's
-    /// first code to its end, so the preparation is a series of short calls): nothing is done
-    /// until [`Preparation::step`], which works through a budget of items (facets, corners,
-    /// vertices) a call, every pass in turn, and hands out the job after the last. The job (or
-    /// the refusal) is the one [`Job::from_models`] makes, whatever the budgets.
-    pub fn prepare_in_steps(models: Arc<Vec<Model>>, spec: &job::JobSpec) -> Preparation {
-        Job::prepare_drafted(models, spec, None)
-    }
-
-    /// [`Job::prepare_in_steps`] that also hands `draft` the job's [`Draft`] as soon as its
-    /// parts are merged (when the plane heights are known), before the passes that need the
-    /// whole mesh: the page's other workers slice from it while this preparation goes on.
-    /// [`Preparation::as_drafted`] then tells whether the job is the draft's.
-    pub fn prepare_drafted(
-        models: Arc<Vec<Model>>,
-        spec: &job::JobSpec,
-        draft: Option<DraftHook>,
-    ) -> Preparation {
-        let budget = Rc::new(Budget::new(0));
-        let drafted = Rc::new(Cell::new(None));
-        let (b, d) = (budget.clone(), drafted.clone());
-        let spec = spec.clone();
-        Preparation {
-            budget,
-            drafted,
-            pass: Some(Stepped::new(async move {
-                Job::build_in_steps(&models, &spec, &b, draft, &d).await
-            })),
-        }
-    }
-
     /// [`Job::from_models`] as a pass of `b`'s budget: the passes of [`Job::build`] one after
     /// the other (not side by side), each in runs of items; the draft handed to `draft`, and
     /// whether the job is the draft's set into `drafted` at the end.
-    async fn build_in_steps(
+    pub(super) async fn build_in_steps(
         models: &[Model],
         spec: &job::JobSpec,
         b: &Budget,
@@ -675,47 +642,6 @@ impl Checked {
             profiles: Vec::new(),
         };
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
-    }
-}
-
-/// [`Job::from_models`] in resumable steps: [`Job::prepare_in_steps`], then
-/// [`Preparation::step`] until it hands out the job.
-pub struct Preparation {
-    /// The items the next step may work through.
-    budget: Rc<Budget>,
-    /// Whether the job is its draft's, once made (`None`: no draft was made).
-    drafted: Rc<Cell<Option<bool>>>,
-    /// `None` once the job was handed out (or a step failed).
-    pass: Option<Stepped<Result<Job, Error>>>,
-}
-
-impl Preparation {
-    /// Works through about `items` items of the preparation (at least one run of them, see
-    /// [`steps::runs`]; a few passes between the long ones are not divided): `Ok(None)`
-    /// while there is more, the job at the end. After the job or an error there is nothing
-    /// left: an `Internal` error.
-    pub fn step(&mut self, items: usize) -> Result<Option<Job>, Error> {
-        let Some(pass) = self.pass.as_mut() else {
-            return Err(Error::Internal(
-                "the job's preparation has already ended".into(),
-            ));
-        };
-        self.budget.refill(items);
-        match pass.step() {
-            None => Ok(None),
-            Some(made) => {
-                self.pass = None;
-                made.map(Some)
-            }
-        }
-    }
-
-    /// Once the job is made: whether it is the one its [`Draft`] slices (the same mesh,
-    /// planes and units' facet runs: no facet dropped, no crack closed, no shell turned), so
-    /// that the draft's workers need only its [`Job::confirmation`]; `None` when no draft was
-    /// made (or the job is not made yet).
-    pub fn as_drafted(&self) -> Option<bool> {
-        self.drafted.get()
     }
 }
 
