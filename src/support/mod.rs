@@ -1,9 +1,9 @@
 //! Overhangs and support (docs/spec.md "Overhangs and support"; docs/support.md): layer regions →
-//! each layer's overhang (area for the figures) and the support region unit 1 prints.
+//! each layer's overhang (area for the figures) and the support region the support's unit prints.
 //!
 //! **The rule.** A droplet is *supported* when the layer below has material within
 //! `overhang_limit`·B of its centre. Material is the droplets' footprints: discs of diameter B
-//! (B₁ for unit-1 droplets) around their centres. So a droplet centre c of layer n is supported
+//! (B₁, the support unit's width, for its droplets) around their centres. So a droplet centre c of layer n is supported
 //! iff some droplet centre d of layer n − 1 lies within B_d/2 + `overhang_limit`·B of c, where
 //! B_d is d's droplet width (with the defaults: within B). Layer 1 rests on the plate.
 //!
@@ -18,7 +18,7 @@
 //! `support_gap_z` layers directly above. The overhang is grown by B₁/2 before it is carried
 //! down so that the support reaches under the overhang's edge. The overhangs come from the one
 //! pass of [`crate::support::overhang::overhang_region`], their growth from the fast offset
-//! ([`grow_fast`]). The need is carried as bits on the lattices unit 1 hatches on
+//! ([`grow_fast`]). The need is carried as bits on the lattices the support is hatched on
 //! ([`crate::support::lattice`]: union and clip by word operations, exact at every point a
 //! support droplet can take); for unusual hatch steps as outlines by a sequential union
 //! ([`support_regions`], which hands the boolean engine only the shapes whose boxes meet,

@@ -1,6 +1,6 @@
-//! The support regions unit 1 prints (docs/spec.md "Overhangs and support"; the rule and the
+//! The support regions the support's unit prints (docs/spec.md "Overhangs and support"; the rule and the
 //! construction are described in [`crate::support`]): every layer's overhang grown by the
-//! support's reach and carried down, on unit 1's lattices or as outlines.
+//! support's reach and carried down, on the support's lattices or as outlines.
 
 use crate::base::boolean::{bounds, cleaned, difference, grow_within, nested, overlap};
 use crate::base::geom::{DVec2, Shape, Shapes, segment_distance2};
@@ -143,7 +143,7 @@ fn carried(a: &Shapes, b: &Shapes, c: &Shapes) -> Shapes {
     out
 }
 
-/// One layer's overhang area and the support unit 1 prints in it.
+/// One layer's overhang area and the support its unit prints in it.
 #[derive(Clone, Debug, Default)]
 pub struct LayerSupport {
     /// Area of the layer's overhang, mm².
@@ -156,7 +156,7 @@ pub struct LayerSupport {
 }
 
 /// Every layer's overhang and support from all layers' regions (bottom first): the need
-/// carried on unit 1's lattices ([`crate::support::lattice`]), or, for more hatch directions
+/// carried on the support's lattices ([`crate::support::lattice`]), or, for more hatch directions
 /// than it carries, as regions ([`support_regions`]).
 pub fn support_layers(regions: &[Shapes], s: &Settings) -> Vec<LayerSupport> {
     now(support_layers_in_steps(regions, s, &UNLIMITED))

@@ -1,5 +1,5 @@
 //! A layer's droplets indexed for the droplet-level pass' question "is there one within
-//! reach". Most of a layer's droplets lie on hatch lines: the part's fill and unit 1's support
+//! reach". Most of a layer's droplets lie on hatch lines: the part's fill and the support (of the unit `support` names)
 //! are lines (j + phase)·spacing across the layer's hatch direction, their droplets a pitch
 //! apart along them ([`crate::slicing::hatch`], [`crate::support::lattice`]). Such a line is a
 //! run of one row of its [`Frame`]: a question looks at the rows within reach, finds the runs
@@ -393,7 +393,7 @@ pub(super) struct Index {
     grid: Below,
     /// The grid's droplets (kept for the next fill).
     others: Vec<Droplet>,
-    /// The runs of the part's frame and of unit 1's.
+    /// The runs of the part's frame and of the support's.
     rows: [Rows; 2],
     cover: Cover,
     /// The raster's rectangles (kept for the next fill).

@@ -1,13 +1,14 @@
-//! The support's droplet-level pass (docs/spec.md "Overhangs and support"; docs/support.md): after
-//! every layer is planned with its support region, find the droplets the layer below does not
-//! support by the overhang rule and add single unit-1 droplets under them, top-down, so that
-//! the rule holds for every droplet of the code (the added droplets need support too).
+//! The support's droplet-level pass (docs/spec.md "Overhangs and support"; docs/support.md):
+//! after every layer is planned with its support region, find the droplets the layer below does
+//! not support by the overhang rule and add single droplets of the support's unit under them,
+//! top-down, so that the rule holds for every droplet of the code (the added droplets need
+//! support too).
 //!
 //! The region form ([`crate::support`]) leaves a few droplets unsupported: where a support
 //! region is a sliver, or where a part droplet lies beyond the edge of the part below by less
 //! than the limit but the droplets below sit B/2 inside that edge. The pass works on droplet
-//! centres only, so it is cheap: each layer's droplets are listed from its moves once, unit 1's
-//! hatch lines as runs of their lattice (looked up by row and column), the rest in a hash grid
+//! centres only, so it is cheap: each layer's droplets are listed from its moves once, the
+//! support's hatch lines as runs of their lattice (looked up by row and column), the rest in a hash grid
 //! ([`index`]). It runs in resumable steps ([`complete_in_steps`], the page's short calls):
 //! a layer an item.
 
@@ -22,14 +23,14 @@ use gaps::inside;
 use grid::{Added, Below};
 use index::{Frame, Frames, Index, Listed};
 
-/// A droplet centre and its width (B or B₁).
+/// A droplet centre and its width (its unit's B_u).
 pub type Droplet = (Point, f64);
 
 /// An axis-aligned box: its least and greatest corners.
 pub type Bounds = (Point, Point);
 
 /// `f(i)`: layer i's planned moves, each list from the origin (the part's, both units, then
-/// unit 1's support); their droplets are [`droplets_of`] each list.
+/// the support (of the unit `support` names)); their droplets are [`droplets_of`] each list.
 pub type LayerMoves<'a> = &'a (dyn Fn(usize) -> [&'a [Move]; 2] + Sync);
 
 /// Centres kept this much inside the rule's distance, so rounding the written positions
@@ -95,7 +96,7 @@ pub struct PassFigures {
     pub unplaceable: usize,
 }
 
-/// The unit-1 droplets to add to each layer so that every droplet above the first layer is
+/// The support's droplets to add to each layer so that every droplet above the first layer is
 /// supported: `moves(i)` gives layer i's planned moves ([`LayerMoves`]: their droplets are
 /// listed from them, about once per layer, in runs of layers on all cores; again near added
 /// droplets), so that no layer's droplets need be kept; `regions[i]` is its part's region.
@@ -128,7 +129,7 @@ pub async fn complete_in_steps(
         return (extra, figures);
     }
     let rule = Rule::new(s);
-    // Each layer's hatch rows: the part's fill and unit 1's support.
+    // Each layer's hatch rows: the part's fill and the support (of the unit `support` names).
     let frames: Vec<Frames> = (0..n)
         .map(|i| {
             let fill = crate::slicing::fill::FillParams::from_settings(s, i);
@@ -183,7 +184,7 @@ struct Rule {
     gap: f64,
     /// How far from a droplet to support an added droplet may be placed.
     place: f64,
-    /// The spacing of unit 1's hatch lines.
+    /// The spacing of the support's hatch lines.
     spacing: f64,
 }
 
@@ -395,7 +396,7 @@ fn unsupported_added(
     );
 }
 
-/// Places a unit-1 droplet in the layer below (whose part's region is `region`) under each
+/// Places a droplet of the support's unit in the layer below (whose part's region is `region`) under each
 /// droplet of `todo` that no droplet placed so far supports, appending it to `out`: outside
 /// the part and its gap, failing that outside the part (in the gap); counted in `figures`.
 fn place_under(
