@@ -179,37 +179,6 @@ fn random_damage_never_panics() {
 
 type Tri = [[f32; 3]; 3];
 
-fn box_tris(o: [f32; 3], w: f32, d: f32, h: f32) -> Vec<Tri> {
-    let p = |x: f32, y: f32, z: f32| [o[0] + x, o[1] + y, o[2] + z];
-    let quads = [
-        [p(0., 0., 0.), p(0., d, 0.), p(w, d, 0.), p(w, 0., 0.)],
-        [p(0., 0., h), p(w, 0., h), p(w, d, h), p(0., d, h)],
-        [p(0., 0., 0.), p(w, 0., 0.), p(w, 0., h), p(0., 0., h)],
-        [p(w, 0., 0.), p(w, d, 0.), p(w, d, h), p(w, 0., h)],
-        [p(w, d, 0.), p(0., d, 0.), p(0., d, h), p(w, d, h)],
-        [p(0., d, 0.), p(0., 0., 0.), p(0., 0., h), p(0., d, h)],
-    ];
-    quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect()
-}
-
-fn stl(tris: &[Tri]) -> Vec<u8> {
-    let mut b = vec![0u8; 80];
-    b.extend_from_slice(&(tris.len() as u32).to_le_bytes());
-    for t in tris {
-        b.extend_from_slice(&[0u8; 12]);
-        for v in t {
-            for c in v {
-                b.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        b.extend_from_slice(&[0u8; 2]);
-    }
-    b
-}
-
 /// The job of `spec` prepared in steps with a draft: the job (or the refusal), the draft's
 /// bytes (if one was made) and whether the job is the draft's.
 fn drafted(
@@ -304,8 +273,8 @@ fn a_draft_confirmed_is_the_job_when_no_repair_changed_the_mesh() {
     let two = r#"{"settings": {"support": "unit1"},
         "parts": [{"file": "boat.stl"}, {"file": "screw.stl", "unit": 1, "copies": 2}]}"#;
     assert_eq!(assert_draft(&[benchy, screw], two, "two units"), Some(true));
-    let model = |tris: &[Tri], name: &str| Model::read(&stl(tris), name).unwrap();
-    let cube = box_tris([0.; 3], 10., 10., 10.);
+    let model = |tris: &[Tri], name: &str| Model::read(&common::stl_bytes(tris), name).unwrap();
+    let cube = common::cuboid([0.; 3], [10., 10., 10.]);
     let one = |name: &str| format!(r#"{{"parts": [{{"file": "{name}"}}]}}"#);
     assert_eq!(
         assert_draft(&[model(&cube, "a.stl")], &one("a.stl"), "a cube"),

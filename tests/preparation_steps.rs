@@ -19,22 +19,6 @@ const BUDGETS: [usize; 3] = [1, 20_000, usize::MAX];
 
 type Tri = [[f32; 3]; 3];
 
-fn box_tris(o: [f32; 3], w: f32, d: f32, h: f32) -> Vec<Tri> {
-    let p = |x: f32, y: f32, z: f32| [o[0] + x, o[1] + y, o[2] + z];
-    let quads = [
-        [p(0., 0., 0.), p(0., d, 0.), p(w, d, 0.), p(w, 0., 0.)],
-        [p(0., 0., h), p(w, 0., h), p(w, d, h), p(0., d, h)],
-        [p(0., 0., 0.), p(w, 0., 0.), p(w, 0., h), p(0., 0., h)],
-        [p(w, 0., 0.), p(w, d, 0.), p(w, d, h), p(w, 0., h)],
-        [p(w, d, 0.), p(0., d, 0.), p(0., d, h), p(w, d, h)],
-        [p(0., d, 0.), p(0., 0., 0.), p(0., 0., h), p(0., d, h)],
-    ];
-    quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect()
-}
-
 fn gcode(job: &Job) -> Vec<u8> {
     let mut out = Vec::new();
     dropslice::pipeline::write_gcode(job, &mut out, |_, _| {}).unwrap();
@@ -143,7 +127,7 @@ fn a_build_job_with_a_unit_1_part_and_support_prepares_alike_in_steps() {
 
 #[test]
 fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
-    let cube = box_tris([0.; 3], 10., 10., 10.);
+    let cube = common::cuboid([0.; 3], [10., 10., 10.]);
     // repeated facets: dropped, the index not built beside the shells
     let mut repeated = cube.clone();
     repeated.extend_from_slice(&cube[..3]);
@@ -155,12 +139,12 @@ fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
     // an inside-out cavity box inside a box: one shell turned
     let mut cavity = cube.clone();
     cavity.extend(
-        box_tris([3., 3., 3.], 4., 4., 4.)
+        common::cuboid([3., 3., 3.], [7.0, 7.0, 7.0])
             .into_iter()
             .map(|[a, b, c]| [a, c, b]),
     );
     cavity.extend(
-        box_tris([20., 0., 0.], 5., 5., 5.)
+        common::cuboid([20., 0., 0.], [25.0, 5.0, 5.0])
             .into_iter()
             .map(|[a, b, c]| [a, c, b]),
     );
@@ -191,7 +175,7 @@ fn every_branch_of_the_preparation_is_taken_alike_in_steps() {
     );
     // refusals: a part taller than the chamber, far too many droplets
     assert_same(
-        &[model(&box_tris([0.; 3], 10., 10., 10.), "t.stl")],
+        &[model(&common::cuboid([0.; 3], [10., 10., 10.]), "t.stl")],
         r#"{"settings": {"plate_z": 5}, "parts": [{"file": "t.stl"}]}"#,
         "too tall",
     );
