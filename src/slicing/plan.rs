@@ -341,7 +341,8 @@ fn add_units(
 /// Adds the parts of the units other than 0 to a planned layer (unit 0's, from the origin), in
 /// the order `unit_order` gives: each unit's region `regions[u]` (contours and fill as unit
 /// 0's, with its own B_u; roles outer/inner/fill). Unit 0's droplets stay exactly as planned;
-/// only the travel between the units' moves changes. The regions are kept in the plan.
+/// only the travel between the units' moves changes. The regions are kept in the plan (unit
+/// 0's place empty: its region is planned by the caller).
 pub fn plan_unit_parts(plan: &mut LayerPlan, regions: Vec<Shapes>, s: &Settings) {
     let mut widths = [0.0; MAX_UNITS];
     for u in UnitId::all(s.units as usize) {
@@ -354,9 +355,6 @@ pub fn plan_unit_parts(plan: &mut LayerPlan, regions: Vec<Shapes>, s: &Settings)
         Some((p.moves, p.travel_mm))
     });
     plan.unit_regions = regions;
-    if let Some(r) = plan.unit_regions.first_mut() {
-        *r = Shapes::new();
-    }
 }
 
 /// Where the support starts in a layer whose parts are planned (docs/spec.md "Overhangs and
