@@ -19,6 +19,27 @@ before(async () => {
 
 after(() => stop(env));
 
+/** Clicks Fit once the 3D view's size has settled (the same size on three polls 150 ms apart:
+ *  the side plot's height settles after a slice and resizes the canvas, and Fit frames for the
+ *  size it sees), then waits for the view to draw a frame after it and reads its pixels. */
+async function fitAndDraw(page) {
+  const size = () => page.evaluate(() => {
+    const s = window.dropslice.view3d();
+    const c = document.querySelector("#view3d");
+    return `${s.width}x${s.height}/${c.clientWidth}x${c.clientHeight}`;
+  });
+  let [last, same] = [await size(), 0];
+  for (let i = 0; i < 100 && same < 3; i++) {
+    await page.waitForTimeout(150);
+    const now = await size();
+    [last, same] = [now, now === last ? same + 1 : 0];
+  }
+  const frames = (await page.evaluate(() => window.dropslice.view3d())).frames;
+  await page.click("#btn-fit");
+  await page.waitForFunction((f) => window.dropslice.view3d().frames > f, frames, { timeout: 10_000 });
+  return pixels3d(page);
+}
+
 test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbited by a drag", async () => {
   const { page, errors } = main;
   await waitDone(page, 60_000);
@@ -69,8 +90,7 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   // The framing to come back to is Fit's own, taken now: the first framing was made while the
   // page was still laying out (the per-layer plot's height settles after the slice), so under
   // load the canvas may have been resized since.
-  await page.click("#btn-fit");
-  const framed = await pixels3d(page);
+  const framed = await fitAndDraw(page);
   const from = await clientPoint3d(page, whole.width * 0.85, whole.height * 0.15);
   await page.mouse.move(from.x, from.y);
   await page.mouse.down();
@@ -79,9 +99,9 @@ test("3DBenchy in 3D: drawn, cut at the slider's layer, picked by a click, orbit
   const orbited = await pixels3d(page);
   assert.equal(orbited.state.selected, null, "an orbit is not a click");
   assert.ok(Math.hypot(orbited.part.x - framed.part.x, orbited.part.y - framed.part.y) > 20, "the view turned");
-  await page.click("#btn-fit");
-  const fitted = await pixels3d(page);
-  assert.ok(Math.hypot(fitted.part.x - framed.part.x, fitted.part.y - framed.part.y) < 2, `Fit restores the framing: ${JSON.stringify([framed.part, fitted.part, fitted.selected])}`);
+  const fitted = await fitAndDraw(page);
+  const sizes = [framed, fitted].map((p) => `${p.width}×${p.height}`);
+  assert.ok(Math.hypot(fitted.part.x - framed.part.x, fitted.part.y - framed.part.y) < 2, `Fit restores the framing: ${JSON.stringify([framed.part, fitted.part, fitted.selected, sizes])}`);
 
   // a low layer: the boat cut at 4 mm (of 48): far fewer part pixels, none high up, a cap
   await page.locator("#layer").fill("19");
