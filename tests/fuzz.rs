@@ -137,7 +137,7 @@ fn random_settings(rng: &mut Rng) -> Settings {
         }
         let value = match spec.kind {
             Kind::Bool => ["true", "false"][rng.pick(2)].to_string(),
-            Kind::Enum => spec.choices[rng.pick(spec.choices.len())].into(),
+            Kind::Enum | Kind::Order => spec.choices[rng.pick(spec.choices.len())].into(),
             _ => {
                 let (Some(lo), Some(hi)) = (spec.min, spec.max) else {
                     continue;

@@ -91,7 +91,7 @@ fn number(x: f64) -> String {
 fn range(spec: &SettingSpec) -> String {
     match spec.kind {
         Kind::Bool => "true / false".into(),
-        Kind::Enum => spec.choices.join(" / "),
+        Kind::Enum | Kind::Order => spec.choices.join(" / "),
         Kind::Number | Kind::Integer => {
             let (lo, hi) = (spec.min.expect("a minimum"), spec.max.expect("a maximum"));
             let gt = if spec.min_exclusive { "> " } else { "" };

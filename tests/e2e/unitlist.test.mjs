@@ -6,11 +6,12 @@
 // choice, group, droplets, colour and legends. Needs dist/ (scripts/build.sh).
 import { after, before, test } from "node:test";
 import assert from "node:assert/strict";
-import { mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { copyFileSync, existsSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
+import { execFileSync } from "node:child_process";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { pathToFileURL } from "node:url";
-import { benchy, countPixels, downloadText, pick, repo, startWithPage, stop, twoCubesSecondOnUnit, waitDone } from "./helpers.mjs";
+import { benchy, countPixels, downloadText, pick, repo, shared, startWithPage, stop, twoCubesSecondOnUnit, waitDone } from "./helpers.mjs";
 
 let env;
 let main;
@@ -200,5 +201,42 @@ test("three units print a unit-2 part with its droplets and colour", async () =>
   assert.ok(code.includes("\nT2\n") && code.includes("\nT1\n"), "T1 and T2 lines");
   assert.match(code, new RegExp(`; droplets of unit 2 += +${t.unitDroplets[2]}\\n`));
   assert.match(code, new RegExp(`; droplets of unit 1 += +${t.unitDroplets[1]}\\n`));
+  assert.deepEqual(errors, []);
+});
+
+// The three-unit job of tests/two_material.rs (3DBenchy by unit 0, a cube by unit 1 with wider
+// droplets, the support from unit 2 with droplets of its own, `unit_order = 1,2,0`), opened in
+// the page as a job file: the page's .gco is the command line's, byte for byte. That test holds
+// the command line's code to the oracle's sections unit by unit, so the page's is held to them
+// too.
+test("a three-unit job file: the page's .gco is the command line's, byte for byte", async (t) => {
+  const cli = join(repo, "target/release/dropslice");
+  if (!existsSync(cli)) return t.skip("target/release/dropslice not built");
+  if (!hasUnits) return t.skip("the core has no setting `units`");
+  const { page, errors } = main;
+  const job = {
+    settings: { units: 3, support: "unit2", unit_order: "1,2,0", unit1_droplet_aspect: 1.6, unit2_droplet_aspect: 1.3, unit2_material_density: 1.5 },
+    parts: [
+      { file: "3DBenchy.stl", place_x: 5, place_y: 5, unit: 0 },
+      { file: "cube_20mm_ascii.stl", place_x: 75, place_y: 5, unit: 1 },
+    ],
+  };
+  const jobFile = join(tmp, "three-units.json");
+  writeFileSync(jobFile, JSON.stringify(job));
+  for (const f of ["3DBenchy.stl", "cube_20mm_ascii.stl"]) copyFileSync(join(shared, "models", f), join(tmp, f));
+  const out = join(tmp, "three-units.gco");
+  execFileSync(cli, [jobFile, "-o", out, "-q"], { stdio: "inherit" });
+  const theirs = readFileSync(out, "utf8");
+
+  await pick(page, [jobFile, join(tmp, "3DBenchy.stl"), join(tmp, "cube_20mm_ascii.stl")]);
+  const s = await waitDone(page, 240_000);
+  assert.equal(s.units, 3);
+  assert.ok(s.unitDroplets.every((n) => n > 0), `every unit prints: ${s.unitDroplets}`);
+  const mine = await downloadText(page);
+  if (mine !== theirs) {
+    const [a, b] = [mine.split("\n"), theirs.split("\n")];
+    const i = a.findIndex((l, k) => l !== b[k]);
+    assert.fail(`the page's .gco differs from the command line's at line ${i + 1}: ${JSON.stringify(a[i])} against ${JSON.stringify(b[i])}`);
+  }
   assert.deepEqual(errors, []);
 });

@@ -14,6 +14,8 @@ const out = mkdtempSync(join(tmpdir(), "dropslice-units-"));
 let gcode, share, form, sample, units, profiles, figures, forms, render, plot;
 /** The core's job schema: a link's parts are checked against it. */
 let jobSchema;
+/** The core's own check of settings (what it reads a value as). */
+let checkSettings;
 /** The core's settings schema and its default settings. */
 let schema, coreDefaults;
 
@@ -33,6 +35,7 @@ before(async () => {
   const core = await import(pathToFileURL(join(repo, "www", "pkg", "dropslice.js")).href);
   await core.default({ module_or_path: readFileSync(join(repo, "www", "pkg", "dropslice_bg.wasm")) });
   jobSchema = core.job_schema();
+  checkSettings = core.check_settings;
   schema = core.settings_schema();
   coreDefaults = core.default_settings();
 });
@@ -134,6 +137,23 @@ test("settings: relaxed input becomes strict values, with messages", () => {
   assert.deepEqual(form.parse(en, "b"), { value: "b" });
   assert.ok(form.parse(en, "c").error);
   assert.deepEqual(form.parse({ ...spec, kind: "bool" }, true), { value: true });
+});
+
+test("settings: an order of units reads as the core reads it, a choice or a list such as 2,0,1", () => {
+  const spec = schema.find((s) => s.name === "unit_order");
+  assert.equal(spec.kind, "order");
+  const core = (text) => {
+    try {
+      return checkSettings({ units: 4, unit_order: text }).unit_order;
+    } catch {
+      return undefined;
+    }
+  };
+  for (const text of ["unit0_first", "unit2_first", "1,2,0", " 2, 0 ,1 ", "3", "1,0", "0,1,2,3", "3,2,1,0", "2,0", "1,1", "4,0", "a", "", "1,,2", "-1", "1.5", "01", "+2", "2 0"]) {
+    const mine = form.parse(spec, text);
+    assert.equal(mine.value, core(text), `"${text}": the page reads ${JSON.stringify(mine)}`);
+    if (mine.value === undefined) assert.match(mine.error, /such as 2,0,1/, `"${text}"`);
+  }
 });
 
 test("sample part: a closed binary STL (every edge shared by exactly two facets, opposite ways)", () => {

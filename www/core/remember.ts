@@ -40,7 +40,7 @@ export function checkSettings(raw: unknown, schema: readonly Spec[]): SomeSettin
   for (const spec of schema) {
     if (spec.part || !Object.hasOwn(raw, spec.name)) continue;
     const v = raw[spec.name];
-    const ok = spec.kind === "bool" ? typeof v === "boolean" : spec.kind === "enum" ? typeof v === "string" : typeof v === "number" && Number.isFinite(v);
+    const ok = spec.kind === "bool" ? typeof v === "boolean" : spec.kind === "enum" || spec.kind === "order" ? typeof v === "string" : typeof v === "number" && Number.isFinite(v);
     if (!ok) continue;
     const r = parse(spec, v as string | boolean);
     if (r.value !== undefined && r.error === undefined) put(out, spec.name, r.value);

@@ -76,6 +76,7 @@ export function parse(spec: SettingSpec, raw: string | boolean): { value?: Value
   if (spec.kind === "enum") {
     return spec.choices.includes(String(raw)) ? { value: String(raw) } : { error: `choose one of ${spec.choices.join(", ")}` };
   }
+  if (spec.kind === "order") return parseOrder(spec.choices, String(raw));
   const text = String(raw).trim().replace(",", ".");
   if (text === "") return { error: "a value is needed" };
   const x = Number(text);
@@ -87,4 +88,22 @@ export function parse(spec: SettingSpec, raw: string | boolean): { value?: Value
   }
   if (spec.max !== null && x > spec.max) return { error: `must be at most ${spec.max}${unit}` };
   return { value: x };
+}
+
+/** An order of units (`unit_order`): one of `choices` (`unitN_first`, one per unit the core
+ *  knows) or a list of different units such as "2, 0, 1", written as the core writes it
+ *  (src/base/settings/units.rs `UnitOrder::word`): the whole order, the others following by
+ *  number, and `unitN_first` where it is one. */
+export function parseOrder(choices: readonly string[], raw: string): { value?: string; error?: string } {
+  const text = raw.trim();
+  if (choices.includes(text)) return { value: text };
+  const all = choices.length;
+  const list = text.split(",").map((t) => t.trim());
+  const order = list.map((t) => (/^\+?[0-9]+$/.test(t) ? Number(t) : NaN));
+  if (!order.every((u) => u < all) || new Set(order).size !== order.length) {
+    return { error: `choose one of ${choices.join(", ")}, or list different units 0 … ${all - 1} such as 2,0,1` };
+  }
+  for (let u = 0; u < all; u++) if (!order.includes(u)) order.push(u);
+  const first = order.slice(1).every((u, i, rest) => i === 0 || rest[i - 1] < u) ? `unit${order[0]}_first` : null;
+  return { value: first !== null && choices.includes(first) ? first : order.join(",") };
 }

@@ -219,6 +219,7 @@ const KIND_TYPE: Record<Spec["kind"], { type: string; words: string }> = {
   integer: { type: "number", words: "a whole number" },
   bool: { type: "boolean", words: "yes or no (true/false)" },
   enum: { type: "string", words: "one of the choices" },
+  order: { type: "string", words: "an order of units (unit0_first, or a list such as 2,0,1)" },
 };
 
 /** The link's settings whose type fits their kind; the others named in `ignored`. Unknown

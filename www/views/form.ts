@@ -100,10 +100,18 @@ export class SettingsForm {
       input = sel;
     } else {
       const inp = document.createElement("input");
+      if (spec.kind === "order") {
+        // a choice from the list, or an order typed ("2,0,1")
+        const list = document.createElement("datalist");
+        list.id = `choices-${spec.name}`;
+        for (const c of spec.choices) list.append(new Option(c.replace(/_/g, " "), c));
+        row.append(list);
+        inp.setAttribute("list", list.id);
+      }
       if (spec.kind === "bool") inp.type = "checkbox";
       else {
         inp.type = "text";
-        inp.inputMode = spec.kind === "integer" ? "numeric" : "decimal";
+        inp.inputMode = spec.kind === "integer" ? "numeric" : spec.kind === "order" ? "text" : "decimal";
         inp.autocomplete = "off";
         inp.spellcheck = false;
       }

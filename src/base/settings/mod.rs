@@ -112,7 +112,8 @@ impl Settings {
     pub fn set(&mut self, name: &str, value: &str) -> Result<(), Error> {
         let t = value.trim();
         // An enum's choices are words even where they look like booleans (`support = off`).
-        let is_enum = schema::entry(name).is_some_and(|e| e.spec.kind == Kind::Enum);
+        let is_enum =
+            schema::entry(name).is_some_and(|e| matches!(e.spec.kind, Kind::Enum | Kind::Order));
         let v = match t {
             _ if is_enum => serde_json::Value::String(t.to_string()),
             "true" | "yes" | "on" => serde_json::Value::Bool(true),
@@ -168,8 +169,10 @@ impl Settings {
             (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(0.0) => Value::Bool(false),
             (Kind::Bool, _) => return Err(bad("true or false".into())),
             // A word of the choices, or what the setting's own type reads (a `unit_order` list).
-            (Kind::Enum, Value::String(s)) => Value::String(s),
-            (Kind::Enum, _) => return Err(bad(format!("one of: {}", spec.choices.join(", ")))),
+            (Kind::Enum | Kind::Order, Value::String(s)) => Value::String(s),
+            (Kind::Enum | Kind::Order, _) => {
+                return Err(bad(format!("one of: {}", spec.choices.join(", "))));
+            }
             (Kind::Integer, Value::Number(n)) => match n.as_f64() {
                 Some(x) if x.fract() == 0.0 && x >= 0.0 && x <= u32::MAX as f64 => {
                     Value::from(x as u64)
@@ -187,7 +190,7 @@ impl Settings {
         };
         match put {
             Some(Ok(())) => Ok(()),
-            Some(Err(e)) if spec.kind == Kind::Enum => Err(bad(format!(
+            Some(Err(e)) if matches!(spec.kind, Kind::Enum | Kind::Order) => Err(bad(format!(
                 "one of: {}{}",
                 spec.choices.join(", "),
                 if e.to_string().contains("list") {
@@ -423,8 +426,8 @@ pub fn typescript() -> String {
         let ty = match spec.kind {
             Kind::Number | Kind::Integer => "number".to_string(),
             Kind::Bool => "boolean".to_string(),
-            // `unit_order` also takes a list of units ("2,0,1").
-            Kind::Enum if spec.name == "unit_order" => "string".to_string(),
+            // a list of units ("2,0,1") as well as the choices
+            Kind::Order => "string".to_string(),
             Kind::Enum => spec
                 .choices
                 .iter()

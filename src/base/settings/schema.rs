@@ -24,6 +24,9 @@ pub enum Kind {
     Integer,
     Bool,
     Enum,
+    /// An order of the units: one of the choices (`unitN_first`) or a list of different units
+    /// such as `2,0,1` (the others follow by number).
+    Order,
 }
 
 /// One row of the settings table: name, unit, range, description.
@@ -150,6 +153,14 @@ pub const fn pick(
         kind: Kind::Enum,
         choices,
         ..flag(group, description)
+    }
+}
+
+/// An order of units: `unitN_first` (the choices, one per unit) or a list such as `2,0,1`.
+pub const fn order(group: &'static str, description: &'static str) -> Row {
+    Row {
+        kind: Kind::Order,
+        ..unit_choices(pick(&[], group, description))
     }
 }
 

@@ -61,5 +61,5 @@ settings_table! {
     job support_gap_z: u32 = 0 => second_unit(int("layers", 0.0, 100.0, "Support", "Support ends this many layers below the overhang (0: a soluble support touches the part)"));
     job support_density: f64 = 1.0 => second_unit(num("", MIN_ASPECT, 1.0, "Support", "Hatch spacing of the support = B1 / support_density"));
     @units;
-    job unit_order: UnitOrder = UnitOrder::unit_first(UnitId(0)) => second_unit(unit_choices(pick(&[], "Units", "Which discharge unit prints first within a layer: unitN_first (then the others by number), or a list of units such as 2,0,1")));
+    job unit_order: UnitOrder = UnitOrder::unit_first(UnitId(0)) => second_unit(order("Units", "Which discharge unit prints first within a layer: unitN_first (then the others by number), or a list of units such as 2,0,1"));
 }
