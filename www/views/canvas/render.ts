@@ -124,6 +124,7 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
 
   fit(b: Bounds | null): void {
     if (!b || !(b.maxX > b.minX) || !(b.maxY > b.minY)) return;
+    this.sized();
     const margin = 28;
     const sx = (this.cssW - 2 * margin) / (b.maxX - b.minX);
     const sy = (this.cssH - 2 * margin) / (b.maxY - b.minY);
