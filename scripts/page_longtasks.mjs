@@ -20,7 +20,7 @@ import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 
 const repo = resolve(dirname(fileURLToPath(import.meta.url)), "..");
-const { start, openPage, waitSettled, benchy } = await import(join(repo, "tests/e2e/helpers.mjs"));
+const { start, openPage, waitSettled, benchy, watchLongTasks, longTasks } = await import(join(repo, "tests/e2e/helpers.mjs"));
 const dist = resolve(process.env.DROPSLICE_DIST ?? join(repo, "dist"));
 const models = process.argv.slice(2).length ? process.argv.slice(2) : [benchy];
 const runs = Number(process.env.RUNS ?? 2);
@@ -294,31 +294,16 @@ try {
         const cdp = trace ? await context.newCDPSession(page) : null;
         if (cdp) await cdp.send("Tracing.start", { transferMode: "ReturnAsStream", traceConfig: { includedCategories: CATEGORIES, recordMode: "recordAsMuchAsPossible" } });
         // as scripts/bench_table.mjs: long tasks and the longest gap of a 16 ms timer from here on
-        await page.evaluate(() => {
-          performance.mark("dropslice:watched");
-          const w = (window.__long = { tasks: [], gap: 0, last: performance.now(), from: performance.now() });
-          w.observer = new PerformanceObserver((list) => {
-            for (const e of list.getEntries()) w.tasks.push([e.startTime, e.duration]);
-          });
-          w.observer.observe({ type: "longtask" });
-          w.timer = setInterval(() => {
-            const now = performance.now();
-            w.gap = Math.max(w.gap, now - w.last);
-            w.last = now;
-          }, 16);
-          document.body.dataset.state = "picking";
+        await watchLongTasks(page);
+        // the file chosen: a mark for the trace's clock, and the observer's time of it
+        const chosenAt = await page.evaluate(() => {
+          performance.mark("dropslice:chosen");
+          return performance.now() - window.__longTasks.from;
         });
-        // the trace's clock at the file chosen
-        await page.evaluate(() => performance.mark("dropslice:chosen"));
-        await page.evaluate(() => (window.__long.chosen = performance.now()));
         await page.setInputFiles("#file-input", model);
         const s = await waitSettled(page, 900_000);
-        const w = await page.evaluate(() => {
-          const b = window.__long;
-          clearInterval(b.timer);
-          b.observer.disconnect();
-          return { tasks: b.tasks.filter(([t]) => t >= b.from).map(([t, d]) => [t - b.chosen, d]), gap: b.gap };
-        });
+        const watched = await longTasks(page);
+        const w = { tasks: watched.tasks.map(([t, d]) => [t - chosenAt, d]), gap: watched.gap };
         const name = model.split("/").pop();
         const over = w.tasks.filter(([, d]) => d > limit);
         const longest = w.tasks.reduce((m, [, d]) => Math.max(m, d), 0);
@@ -329,8 +314,8 @@ try {
         const { stream } = await done;
         const events = await readStream(cdp, stream);
         const chosen = events.find((e) => e.name === "dropslice:chosen");
-        const watched = events.find((e) => e.name === "dropslice:watched");
-        const { tasks, cpuMax, totals } = analyse(events, watched?.ts ?? 0, chosen?.ts ?? 0);
+        const watchMark = events.find((e) => e.name === "dropslice:watched");
+        const { tasks, cpuMax, totals } = analyse(events, watchMark?.ts ?? 0, chosen?.ts ?? 0);
         const phaseText = (phases) => phases.map(([k, [w, c]]) => `${k} ${c.toFixed(1)} (${w.toFixed(1)})`).join(", ");
         console.log(`  the page's thread from the file chosen: ${totals.tasks} tasks, CPU ${totals.cpu.toFixed(0)} ms; phases, CPU (wall) ms: ${phaseText(totals.phases)}`);
         console.log(`    the page's own functions, all tasks: ${totals.own.map(([f, ms]) => `${f} ${ms.toFixed(0)}`).join("; ")}`);
