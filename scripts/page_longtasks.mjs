@@ -1,20 +1,26 @@
 // The page's long main-thread tasks while it slices a model, and what runs in each
-// (docs/performance.md, "What is left": the page's longest main-thread task). For every run: a
-// fresh page settles on the sample part; then, as `npm run bench` does, a `PerformanceObserver`
-// for `longtask` and a 16 ms timer are installed, and a Chromium trace is recorded (the
-// timeline, V8's sampling profiler) from the file chosen until every layer's G-code is ready.
-// Each task of the page's main thread over the limit is printed with when it ran (ms from the
-// file chosen; before it: what followed the sample part), the page's state then (`body[data-state]`), the events that started it (a
-// worker's message, a timer, a frame), the time in layout, style, paint and GC, and its top
-// functions by self time and by the page's own code (named from the source maps of dist/).
+// (docs/performance.md, "The page's long tasks"). For every run: a fresh page settles on the
+// sample part; then, as `npm run bench` does, a `PerformanceObserver` for `longtask` and a
+// 16 ms timer watch the page's thread (tests/e2e/helpers.mjs `watchLongTasks`) while a
+// Chromium trace is recorded (the timeline, V8's sampling profiler) until every layer's G-code
+// is ready. Printed per run: the observer's figures; the page's thread from the file chosen on
+// (its tasks, their CPU, the time by phase: script, style, layout, paint, commit, GC; the
+// page's own functions over all of it); then every task over LIMIT_MS of wall time or CPU_MS
+// of CPU: when it ran (ms from the file chosen; before it: what followed the sample part), its
+// wall time and its thread's CPU, the page's state then (`body[data-state]`), its phases (CPU
+// and wall), the callbacks it ran (an animation frame, a timer, a worker's message, a
+// `ResizeObserver`, named by function), and its functions by self time and by the page's own
+// code with what they called ("(program)": the browser's own work outside script), named
+// through the source maps of dist/.
 //
 // Usage, after `bash scripts/build.sh`:
 //   node scripts/page_longtasks.mjs [MODEL ...]   (default: 3DBenchy)
-// Environment: RUNS (per model, default 2), LIMIT_MS (default 50), TRACE=0 (the observer and
-// the timer alone, as the bench measures them: no trace's overhead), TOP (functions a task,
-// default 6), CPU_MS (a task using this much CPU is listed too, whatever its wall time;
-// default 20: on a loaded machine wall times say little), DROPSLICE_DIST (another build). The trace slows the page's thread a little:
-// its tasks are somewhat longer than the observer's without it.
+// Environment: RUNS (per model, default 2); LIMIT_MS (default 50); CPU_MS (default 20: on a
+// loaded machine a task's wall time is mostly waiting for a core, its CPU is what it costs);
+// TRACE=0 (the observer and the timer alone, as the bench measures: no trace); TOP (functions
+// a task, default 6); CATEGORIES (more trace categories, comma-separated); DEBUG=1 (every event
+// over 1 ms in each task listed); DROPSLICE_DIST (another build). The trace slows the page's
+// thread a little.
 import { readFileSync } from "node:fs";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
