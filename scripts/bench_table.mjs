@@ -146,28 +146,15 @@ const median = (xs) => {
 };
 
 async function pageRunner() {
-  const { start, openPage, waitSettled } = await import(join(repo, "tests/e2e/helpers.mjs"));
+  const { start, openPage, waitSettled, watchLongTasks, longTasks } = await import(join(repo, "tests/e2e/helpers.mjs"));
   const env = await start();
   /** Slices `file` in a fresh page; { seconds, longtask, gap, layers, workers, stages }. */
   async function once(file) {
     const { page, context } = await openPage(env.browser, env.url);
     try {
       await waitSettled(page); // the sample part of the first visit
-      // The page's long tasks (over 50 ms on its main thread) from here on, and the longest gap
-      // between ticks of a 16 ms timer (a coarser check of the same).
-      await page.evaluate(() => {
-        const w = (window.__bench = { tasks: [], gap: 0, last: performance.now(), from: performance.now() });
-        w.observer = new PerformanceObserver((list) => {
-          for (const e of list.getEntries()) w.tasks.push([e.startTime, e.duration]);
-        });
-        w.observer.observe({ type: "longtask" });
-        w.timer = setInterval(() => {
-          const now = performance.now();
-          w.gap = Math.max(w.gap, now - w.last);
-          w.last = now;
-        }, 16);
-        document.body.dataset.state = "picking";
-      });
+      // the page's long tasks and the longest gap of a 16 ms timer from here on
+      await watchLongTasks(page);
       if (profile) {
         await page.evaluate(() => globalThis.__dropsliceStages?.reset());
         for (const wk of page.workers()) await wk.evaluate(() => globalThis.__dropsliceStages?.reset()).catch(() => {});
@@ -175,12 +162,7 @@ async function pageRunner() {
       await page.setInputFiles("#file-input", file);
       const s = await waitSettled(page, 900_000);
       if (s.state !== "done") throw new Error(`${file}: the page ended in state ${s.state}`);
-      const w = await page.evaluate(() => {
-        const b = window.__bench;
-        clearInterval(b.timer);
-        b.observer.disconnect();
-        return { tasks: b.tasks.filter(([t]) => t >= b.from), gap: b.gap };
-      });
+      const w = await longTasks(page);
       // the page's counters, then each worker's (the core's counters among them)
       const stages = [];
       if (profile) {

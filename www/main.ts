@@ -267,7 +267,7 @@ window.dropslice = {
   },
   crash: () => pool.crash().catch(error),
   /** Draws now (synchronously), for timing. */
-  redraw: () => renderer.draw(),
+  redraw: () => renderer.drawNow(),
   setView: (v: View) => {
     renderer.view = { ...v };
     store.viewTouched = true;
@@ -296,7 +296,7 @@ window.dropslice = {
       page.cut.setView(v);
       page.cut.request();
     },
-    redraw: () => page.cut.draw(),
+    redraw: () => page.cut.drawNow(),
   }),
   /** The build job: its parts (specs), the core's layout and the selected part's id. */
   job: () => {

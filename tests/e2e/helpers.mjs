@@ -134,6 +134,39 @@ export async function waitSettled(page, timeout = 240_000) {
   return status(page);
 }
 
+/** For the timing scripts: from now on, the page's long tasks (over 50 ms on its main thread:
+ *  a `PerformanceObserver` for `longtask`) and the longest gap between ticks of a 16 ms timer
+ *  (a coarser check of the same); a user-timing mark "dropslice:watched" says when (for a
+ *  trace), and the page's state is set to "picking" (waitSettled then waits for what comes).
+ *  [[longTasks]] stops them and returns what they saw. */
+export async function watchLongTasks(page) {
+  await page.evaluate(() => {
+    performance.mark("dropslice:watched");
+    const w = (window.__longTasks = { tasks: [], gap: 0, last: performance.now(), from: performance.now() });
+    w.observer = new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) w.tasks.push([e.startTime, e.duration]);
+    });
+    w.observer.observe({ type: "longtask" });
+    w.timer = setInterval(() => {
+      const now = performance.now();
+      w.gap = Math.max(w.gap, now - w.last);
+      w.last = now;
+    }, 16);
+    document.body.dataset.state = "picking";
+  });
+}
+
+/** Stops [[watchLongTasks]]' watch: { tasks: [[start, duration]] (ms; start from the watch),
+ *  gap (ms) }. */
+export function longTasks(page) {
+  return page.evaluate(() => {
+    const b = window.__longTasks;
+    clearInterval(b.timer);
+    b.observer.disconnect();
+    return { tasks: b.tasks.filter(([t]) => t >= b.from).map(([t, d]) => [t - b.from, d]), gap: b.gap };
+  });
+}
+
 /**
  * Times `file` in the page (for the timing scripts): a warm-up visit and `runs` timed ones,
  * each in a new page whose sample part has settled. `visit(page, i)` (i = 0: the warm-up)

@@ -121,7 +121,8 @@ export interface LayerCanvas extends PanZoom {
   onDraw: (() => void) | null;
   fit(b: Bounds | null): void;
   request(): void;
-  draw(): void;
+  /** Draws now (synchronously, sized first): the tests' hook. */
+  drawNow(): void;
   toMm(px: number, py: number): [number, number];
   toPx(x: number, y: number): [number, number];
 }
@@ -139,7 +140,8 @@ export interface CutCanvas extends PanZoom {
   touched: boolean;
   fit(): void;
   request(): void;
-  draw(): void;
+  /** Draws now (synchronously, sized first): the tests' hook. */
+  drawNow(): void;
   cutView(): CutView;
   setView(v: CutView): void;
 }

@@ -154,8 +154,9 @@ function writeKey(kinds: boolean[]): void {
 export function drawPlot(): void {
   if (!page || !canvas) return;
   lastDraw = performance.now();
-  writeLabel();
+  // sized before the label changes: reading the box then forces no layout of the page
   const { cssW, cssH, dpr } = sizeCanvas(canvas);
+  writeLabel();
   const W = canvas.width;
   const H = canvas.height;
   const g = canvas.getContext("2d");

@@ -65,6 +65,7 @@ export class CutRenderer extends PanZoomCanvas implements CutCanvas {
   fit(): void {
     const top = this.z.reduce((m, z) => (z > m ? z : m), 0);
     if (!(this.length > 0) || !(top > 0)) return;
+    this.sized();
     const w = this.cssW - MARGIN_LEFT - 24;
     const h = this.cssH - MARGIN_BOTTOM - 24;
     this.setView({ scale: Math.min(w / this.length, h / top), ct: this.length / 2, cz: top / 2 });

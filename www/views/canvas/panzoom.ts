@@ -23,17 +23,41 @@ export abstract class PanZoomCanvas {
   protected cssH = 1;
   protected dpr = 1;
   private frame = 0;
+  /** The canvas' box (or the pixel ratio) changed since the backing store was sized. */
+  private stale = true;
 
   constructor(readonly canvas: HTMLCanvasElement) {
-    watchCanvas(canvas, () => this.resize());
+    // Sized and drawn in the next frame, not in the observer's callback: that runs inside the
+    // frame whose layout moved the canvas (its style, layout, paint and commit), and a draw
+    // there made that frame the page's longest task while slicing (a banner shown as a file
+    // is chosen). Meanwhile the browser shows the last picture scaled to the new box.
+    watchCanvas(canvas, () => {
+      this.stale = true;
+      this.request();
+    });
   }
 
   /** Sizes the backing store, then draws. A subclass calls it at the end of its constructor
    *  (its own fields are set only after this class' constructor). */
   protected resize(): void {
+    this.sized();
+    this.frameDraw();
+  }
+
+  /** Sizes the backing store when the box changed since (setting it clears the canvas: a draw
+   *  is asked for). Whatever reads the size calls it first. */
+  protected sized(): void {
+    if (!this.stale) return;
+    this.stale = false;
     ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
     this.resized();
-    this.frameDraw();
+    this.request();
+  }
+
+  /** Draws now (synchronously), sized first: the tests' hook. */
+  drawNow(): void {
+    this.sized();
+    this.draw();
   }
 
   /** A draw for the next frame (a resize, a request): by default `draw()`; a subclass may
@@ -56,6 +80,7 @@ export abstract class PanZoomCanvas {
   request(): void {
     if (this.frame) return;
     this.frame = requestAnimationFrame(() => {
+      this.sized(); // while `frame` is set: no second frame asked for
       this.frame = 0;
       this.frameDraw();
     });
@@ -63,6 +88,7 @@ export abstract class PanZoomCanvas {
 
   /** Zooms by `factor` keeping the mm under the CSS pixel (px, py) in place. */
   zoomAt(px: number, py: number, factor: number): void {
+    this.sized();
     const [mx, my] = this.toMm(px, py);
     const scale = Math.min(MAX_SCALE, Math.max(MIN_SCALE, this.view.scale * factor));
     if (!Number.isFinite(scale)) return;
@@ -81,6 +107,7 @@ export abstract class PanZoomCanvas {
 
   /** mm of the CSS pixel (px, py). */
   toMm(px: number, py: number): [number, number] {
+    this.sized();
     const [ox, oy] = this.centre();
     const v = this.view;
     return [v.cx + (px - ox) / v.scale, v.cy - (py - oy) / v.scale];
@@ -88,6 +115,7 @@ export abstract class PanZoomCanvas {
 
   /** CSS pixels of the point (x, y) in mm (the inverse of `toMm`). */
   toPx(x: number, y: number): [number, number] {
+    this.sized();
     const [ox, oy] = this.centre();
     const v = this.view;
     return [(x - v.cx) * v.scale + ox, -(y - v.cy) * v.scale + oy];

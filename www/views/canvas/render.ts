@@ -124,6 +124,7 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
 
   fit(b: Bounds | null): void {
     if (!b || !(b.maxX > b.minX) || !(b.maxY > b.minY)) return;
+    this.sized();
     const margin = 28;
     const sx = (this.cssW - 2 * margin) / (b.maxX - b.minX);
     const sy = (this.cssH - 2 * margin) / (b.maxY - b.minY);
@@ -181,16 +182,18 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
    *  it draws (compared item by item, the kind of painting first), its steps, and where it
    *  stands. */
   private painting: { key: unknown[]; steps: Step[]; step: number; next: number } | null = null;
-  /** The time the current draw may spend painting (ms): a frame's draw has FRAME_BUDGET_MS,
-   *  a direct `draw()` (the tests, a PNG export) all it needs. */
-  private budget = Infinity;
+  /** When the current draw stops painting (a `performance.now()`): a frame's draw
+   *  FRAME_BUDGET_MS after it began, a direct `draw()` (the tests, a PNG export) never. */
+  private deadline = Infinity;
 
   protected frameDraw(): void {
-    this.budget = FRAME_BUDGET_MS;
+    // from the draw's start: a new picture's set-up (its buffer cleared, its disc stamps, the
+    // droplets placed) counts against the frame's budget too
+    this.deadline = performance.now() + FRAME_BUDGET_MS;
     try {
       this.draw();
     } finally {
-      this.budget = Infinity;
+      this.deadline = Infinity;
     }
   }
 
@@ -261,7 +264,7 @@ export class Renderer extends PanZoomCanvas implements LayerCanvas {
       this.pixelBuffer();
       job = this.painting = { key, steps: steps(), step: 0, next: 0 };
     }
-    const deadline = performance.now() + this.budget;
+    const deadline = this.deadline;
     while (job.step < job.steps.length) {
       const st = job.steps[job.step];
       job.next = st.run(job.next, deadline);
