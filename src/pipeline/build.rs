@@ -574,37 +574,23 @@ impl Checked {
         repaired: Option<(FacetBuckets, MeshStats)>,
     ) -> Result<Job, Error> {
         let Checked {
-            made:
-                Made {
-                    mesh,
-                    input,
-                    settings,
-                    groups,
-                    bounds,
-                    size,
-                    zs,
-                    duplicates,
-                    weld,
-                    ..
-                },
+            made,
             shells,
             volume,
         } = self;
-        let repaired = repaired.map(|(b, s)| (b, with_repairs(s, &shells, weld, duplicates)));
+        let repaired = repaired.map(|(b, s)| {
+            let s = with_repairs(s, &shells, made.weld, made.duplicates);
+            (b, s)
+        });
         // One droplet estimate for the whole job: every unit and the support.
-        let parts = budget::UnitParts::of(&mesh, &groups);
+        let (mesh, settings, size) = (&made.mesh, &made.settings, &made.size);
+        let parts = budget::UnitParts::of(mesh, &made.groups);
         let open = shells.open > 0;
-        let mut estimate = budget::Estimate::new(
-            volume,
-            &parts,
-            open,
-            &size,
-            &input.instances,
-            &overhangs,
-            &settings,
-        );
-        estimate.check(&settings)?;
-        let zs = zs?;
+        let instances = &made.input.instances;
+        let mut estimate =
+            budget::Estimate::new(volume, &parts, open, size, instances, &overhangs, settings);
+        estimate.check(settings)?;
+        let zs = made.zs?;
         let (buckets, stats) = repaired.ok_or_else(|| {
             Error::Internal("the facet index was not built though the layers are known".into())
         })?;
@@ -612,14 +598,15 @@ impl Checked {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
             let h = settings.layer_height;
-            estimate.unit_volumes[0] = budget::sampled_volume(&mesh, &buckets, &zs, h);
-            estimate.check(&settings)?;
+            estimate.unit_volumes[0] = budget::sampled_volume(mesh, &buckets, &zs, h);
+            estimate.check(settings)?;
         }
+        let input = made.input;
         // The plate rule (after the checks of the job's size and droplets, so those speak first).
-        if let Some(e) = fit::refusal(&input.misfits, &settings, input.hint) {
+        if let Some(e) = fit::refusal(&input.misfits, &made.settings, input.hint) {
             return Err(e);
         }
-        check_chamber(&size, &settings)?;
+        check_chamber(&made.size, &made.settings)?;
         let mut all_warnings = input.warnings;
         all_warnings.extend(input.misfits.into_iter().map(|m| m.message));
         let bodies = match input.bodies {
@@ -627,21 +614,21 @@ impl Checked {
             Bodies::Parts(parts) => parts,
         };
         all_warnings.extend(bodies.iter().filter_map(|(n, b)| bodies_warning(n, *b)));
-        all_warnings.extend(warnings(&stats, &size));
+        all_warnings.extend(warnings(&stats, &made.size));
         let info = JobInfo {
             file_name: input.file_name,
             format: input.format,
             warnings: all_warnings,
-            suggested_scale: suggested_scale(&size),
+            suggested_scale: suggested_scale(&made.size),
             mesh: stats,
-            bounds,
+            bounds: made.bounds,
             layers: zs.len(),
-            droplet_width: settings.droplet_width(),
+            droplet_width: made.settings.droplet_width(),
             instances: input.instances,
-            groups,
+            groups: made.groups,
             profiles: Vec::new(),
         };
-        Ok(Job::assemble(settings, mesh, buckets, zs, info))
+        Ok(Job::assemble(made.settings, made.mesh, buckets, zs, info))
     }
 }
 
