@@ -156,18 +156,10 @@ pub const fn num(
     }
 }
 
-/// A whole number in `[min, max]`.
-pub const fn int(
-    unit: &'static str,
-    min: f64,
-    max: f64,
-    group: &'static str,
-    description: &'static str,
-) -> Row {
-    Row {
-        domain: Domain::whole(unit, min, max),
-        ..num(unit, min, max, group, description)
-    }
+/// A whole number (in the range of `row`, a [`num`]).
+pub const fn int(mut row: Row) -> Row {
+    row.domain.kind = Kind::Integer;
+    row
 }
 
 /// `min` itself not allowed.
