@@ -10,7 +10,7 @@ import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 
 const repo = resolve(dirname(fileURLToPath(import.meta.url)), "..");
-const { start, openPage, waitSettled } = await import(join(repo, "tests/e2e/helpers.mjs"));
+const { start, openPage, waitSettled, recordWorkerMessages, workerLog, clearWorkerLog } = await import(join(repo, "tests/e2e/helpers.mjs"));
 const model = process.argv[2] || join(repo, "../shared/models/3DBenchy.stl");
 const runs = Number(process.argv[3] ?? 2);
 // PAUSE_MS: wait this long after the sample part settles before choosing the file (as a user
@@ -60,25 +60,7 @@ try {
   for (let r = 0; r < runs; r++) {
     const { page, context } = await openPage(env.browser, env.url);
     try {
-      await page.addInitScript(() => {
-        const Base = window.Worker;
-        let n = 0;
-        window.__timeline = [];
-        window.Worker = class extends Base {
-          constructor(...args) {
-            super(...args);
-            const worker = n++;
-            const post = this.postMessage.bind(this);
-            this.postMessage = (m, t) => {
-              window.__timeline.push([performance.now(), worker, "→", m?.kind, m?.id, m?.data?.from ?? ""]);
-              return post(m, t);
-            };
-            this.addEventListener("message", (e) => {
-              if (e.data?.kind !== "layers") window.__timeline.push([performance.now(), worker, "←", e.data?.kind, e.data?.id, e.data?.data?.from ?? ""]);
-            });
-          }
-        };
-      });
+      await recordWorkerMessages(page);
       await page.reload();
       await waitSettled(page); // the sample part
       if (pause > 0) {
@@ -86,12 +68,12 @@ try {
         await new Promise((r) => setTimeout(r, pause));
         console.log(`  CPU in the ${pause} ms pause after the sample part: ${summary(quiet, cpuByThread())}`);
       }
-      await page.evaluate(() => (window.__timeline = []));
+      await clearWorkerLog(page);
       const before = cpuByThread();
       await page.setInputFiles("#file-input", model);
       const s = await waitSettled(page, 900_000);
       const after = cpuByThread();
-      const log = await page.evaluate(() => window.__timeline);
+      const log = await workerLog(page);
       const t0 = log.length ? log[0][0] : 0;
       console.log(`run ${r + 1}: every layer's code ready after ${s.seconds.toFixed(2)} s (the page's clock); requests in ms from the first one sent:`);
       for (const [t, w, dir, kind, id, from] of log) {

@@ -319,11 +319,15 @@ fn rows() -> Vec<Row> {
 
     // Every number setting out of range, NaN, infinite, not a number.
     for spec in schema() {
-        if !matches!(spec.kind, Kind::Number | Kind::Integer) {
+        if !matches!(spec.domain.kind, Kind::Number | Kind::Integer) {
             continue;
         }
-        let (min, max) = (spec.min.unwrap(), spec.max.unwrap());
-        let below = if spec.min_exclusive { min } else { min - 1.0 };
+        let (min, max) = (spec.domain.min.unwrap(), spec.domain.max.unwrap());
+        let below = if spec.domain.min_exclusive {
+            min
+        } else {
+            min - 1.0
+        };
         let n = spec.name;
         for (what, value) in [
             ("below min", format!("{below}")),
@@ -956,14 +960,14 @@ fn set_number(s: &mut Settings, name: &str, x: f64) {
 fn number_specs() -> Vec<(&'static str, f64, f64, bool, bool)> {
     schema()
         .into_iter()
-        .filter(|s| matches!(s.kind, Kind::Number | Kind::Integer))
+        .filter(|s| matches!(s.domain.kind, Kind::Number | Kind::Integer))
         .map(|s| {
             (
                 s.name,
-                s.min.unwrap(),
-                s.max.unwrap(),
-                s.min_exclusive,
-                s.kind == Kind::Integer,
+                s.domain.min.unwrap(),
+                s.domain.max.unwrap(),
+                s.domain.min_exclusive,
+                s.domain.kind == Kind::Integer,
             )
         })
         .collect()

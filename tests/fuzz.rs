@@ -135,11 +135,13 @@ fn random_settings(rng: &mut Rng) -> Settings {
         if rng.pick(4) != 0 {
             continue;
         }
-        let value = match spec.kind {
+        let value = match spec.domain.kind {
             Kind::Bool => ["true", "false"][rng.pick(2)].to_string(),
-            Kind::Enum | Kind::Order => spec.choices[rng.pick(spec.choices.len())].into(),
+            Kind::Enum | Kind::Order => {
+                spec.domain.choices[rng.pick(spec.domain.choices.len())].into()
+            }
             _ => {
-                let (Some(lo), Some(hi)) = (spec.min, spec.max) else {
+                let (Some(lo), Some(hi)) = (spec.domain.min, spec.domain.max) else {
                     continue;
                 };
                 let x = match rng.pick(4) {
@@ -147,12 +149,12 @@ fn random_settings(rng: &mut Rng) -> Settings {
                     1 => hi,
                     _ => lo + (hi - lo) * rng.unit(),
                 };
-                let x = if spec.min_exclusive && x <= lo {
+                let x = if spec.domain.min_exclusive && x <= lo {
                     lo + (hi - lo) * 1e-3
                 } else {
                     x
                 };
-                if matches!(spec.kind, Kind::Integer) {
+                if matches!(spec.domain.kind, Kind::Integer) {
                     format!("{}", x.round())
                 } else {
                     format!("{x}")

@@ -62,13 +62,7 @@ fn a_job_read_back_from_its_bytes_slices_as_the_job_itself() {
         let job = Job::new(&common::model_bytes(file), file, s).unwrap();
         assert_same(&job, &format!("{file} {sets:?}"));
     }
-    for file in std::fs::read_dir(common::shared_dir().join("models")).unwrap() {
-        let path = file.unwrap().path();
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
-        if !(name.ends_with(".3mf") || name.ends_with(".obj")) {
-            continue;
-        }
-        let bytes = std::fs::read(&path).unwrap();
+    for (name, bytes) in common::model_files(&[".3mf", ".obj"]) {
         if let Ok(job) = Job::new(&bytes, &name, Settings::default()) {
             assert_same(&job, &name);
         }
@@ -162,16 +156,25 @@ fn damaged_bytes_are_refused_with_a_message() {
 
 #[test]
 fn random_damage_never_panics() {
-    let bytes = small_job().to_bytes();
-    let mut rng = Rng::new(25);
-    for _ in 0..300 {
-        let mut b = bytes.clone();
+    taken_or_refused(&small_job().to_bytes(), 25, 300, Job::from_bytes);
+}
+
+/// `tries` copies of `bytes`, each with one to four bytes changed at random (from `seed`):
+/// each is taken or refused by `read`, never a panic, and a job taken plans its layers.
+fn taken_or_refused(
+    bytes: &[u8],
+    seed: u64,
+    tries: usize,
+    read: impl Fn(&[u8]) -> Result<Job, dropslice::Error>,
+) {
+    let mut rng = Rng::new(seed);
+    for _ in 0..tries {
+        let mut b = bytes.to_vec();
         for _ in 0..1 + rng.below(4) {
             let at = rng.below(b.len() as u64) as usize;
             b[at] = rng.below(256) as u8;
         }
-        // Taken or refused; a job taken plans its layers.
-        if let Ok(job) = Job::from_bytes(&b) {
+        if let Ok(job) = read(&b) {
             let _ = gcode(&job);
         }
     }
@@ -254,15 +257,7 @@ fn assert_draft(models: &[Model], spec: &str, what: &str) -> Option<bool> {
 
 #[test]
 fn a_draft_confirmed_is_the_job_when_no_repair_changed_the_mesh() {
-    for file in std::fs::read_dir(common::shared_dir().join("models")).unwrap() {
-        let path = file.unwrap().path();
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
-        if !(name.ends_with(".stl") || name.ends_with(".3mf") || name.ends_with(".obj")) {
-            continue;
-        }
-        let Ok(m) = Model::read(&std::fs::read(&path).unwrap(), &name) else {
-            continue;
-        };
+    for (name, m) in common::readable_models() {
         let spec = format!(
             r#"{{"settings": {{"allow_off_plate": true}}, "parts": [{{"file": "{name}"}}]}}"#
         );
@@ -386,15 +381,5 @@ fn a_damaged_draft_or_confirmation_is_refused() {
     from_draft.confirm(&table.as_slice()).unwrap();
     assert!(from_draft.to_bytes() == job.to_bytes());
     // random damage to a draft: taken or refused, never a panic
-    let mut rng = Rng::new(26);
-    for _ in 0..200 {
-        let mut b = draft.clone();
-        for _ in 0..1 + rng.below(4) {
-            let at = rng.below(b.len() as u64) as usize;
-            b[at] = rng.below(256) as u8;
-        }
-        if let Ok(job) = Job::from_draft(&b.as_slice()) {
-            let _ = gcode(&job);
-        }
-    }
+    taken_or_refused(&draft, 26, 200, |b| Job::from_draft(&b));
 }

@@ -94,15 +94,7 @@ fn model(tris: &[Tri], name: &str) -> Model {
 
 #[test]
 fn the_shared_models_prepare_alike_in_steps() {
-    for file in std::fs::read_dir(common::shared_dir().join("models")).unwrap() {
-        let path = file.unwrap().path();
-        let name = path.file_name().unwrap().to_string_lossy().to_string();
-        if !(name.ends_with(".stl") || name.ends_with(".obj") || name.ends_with(".3mf")) {
-            continue;
-        }
-        let Ok(m) = Model::read(&std::fs::read(&path).unwrap(), &name) else {
-            continue;
-        };
+    for (name, m) in common::readable_models() {
         let spec = format!(r#"{{"parts": [{{"file": {name:?}}}]}}"#);
         let steps = assert_same(&[m], &spec, &name);
         if name == "3DBenchy.stl" {

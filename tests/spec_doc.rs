@@ -89,12 +89,15 @@ fn number(x: f64) -> String {
 
 /// The range cell the schema implies.
 fn range(spec: &SettingSpec) -> String {
-    match spec.kind {
+    match spec.domain.kind {
         Kind::Bool => "true / false".into(),
-        Kind::Enum | Kind::Order => spec.choices.join(" / "),
+        Kind::Enum | Kind::Order => spec.domain.choices.join(" / "),
         Kind::Number | Kind::Integer => {
-            let (lo, hi) = (spec.min.expect("a minimum"), spec.max.expect("a maximum"));
-            let gt = if spec.min_exclusive { "> " } else { "" };
+            let (lo, hi) = (
+                spec.domain.min.expect("a minimum"),
+                spec.domain.max.expect("a maximum"),
+            );
+            let gt = if spec.domain.min_exclusive { "> " } else { "" };
             format!("{gt}{} … {}", number(lo), number(hi))
         }
     }
@@ -112,7 +115,7 @@ fn same_default(cell: &str, value: &serde_json::Value) -> bool {
 
 /// The unit cell the schema implies.
 fn unit(spec: &SettingSpec) -> String {
-    match spec.unit {
+    match spec.domain.unit {
         "" => "–".into(),
         u => u.replace("x B", "× B"),
     }

@@ -19,7 +19,7 @@
 //! [`display_mesh`]: crate::model::display::display_mesh
 
 use crate::base::error::Error;
-use crate::base::settings::{self, Kind, SettingSpec, Settings};
+use crate::base::settings::{self, Domain, SettingSpec, Settings};
 use crate::model::mesh::Placement;
 use serde::{Deserialize, Serialize};
 
@@ -70,12 +70,7 @@ pub fn job_schema() -> JobSchema {
         settings::schema().into_iter().filter(|s| s.part).collect();
     let whole = |name, min: u32, max: u32, default: u32, description| SettingSpec {
         name,
-        kind: Kind::Integer,
-        unit: "",
-        min: Some(min.into()),
-        max: Some(max.into()),
-        min_exclusive: false,
-        choices: &[],
+        domain: Domain::whole("", min.into(), max.into()),
         group: "Part",
         description,
         part: true,
@@ -244,14 +239,16 @@ impl PartSpec {
         // The ranges of the settings of the same name (the schema's part keys); the place
         // after the others, as a pair.
         let ranges: Vec<SettingSpec> = settings::schema().into_iter().filter(|s| s.part).collect();
-        let check = |key: &str, x: f64| match ranges.iter().find(|s| s.name == key) {
-            Some(SettingSpec {
-                min: Some(lo),
-                max: Some(hi),
-                min_exclusive,
-                ..
-            }) => check_range(i, key, x, *lo, *hi, *min_exclusive),
-            _ => Err(Error::Internal(format!("no range for the part key {key}"))),
+        let check = |key: &str, x: f64| {
+            let domain = ranges.iter().find(|s| s.name == key).map(|s| &s.domain);
+            match domain.and_then(|d| Some((d, d.range_words()?))) {
+                Some((d, _)) if d.admits(x) => Ok(()),
+                Some((_, range)) => Err(Error::Job(format!(
+                    "parts[{i}].{key}: {} is out of range: it must be a finite number {range}",
+                    crate::base::error::number(x)
+                ))),
+                None => Err(Error::Internal(format!("no range for the part key {key}"))),
+            }
         };
         for key in PART_KEYS {
             if let Some(x) = self.number(key)
@@ -299,29 +296,6 @@ impl PartSpec {
         }
         Ok(())
     }
-}
-
-fn check_range(
-    i: usize,
-    key: &str,
-    x: f64,
-    lo: f64,
-    hi: f64,
-    exclusive: bool,
-) -> Result<(), Error> {
-    let below = if exclusive { x <= lo } else { x < lo };
-    if !x.is_finite() || below || x > hi {
-        let lower = if exclusive {
-            "greater than"
-        } else {
-            "at least"
-        };
-        return Err(Error::Job(format!(
-            "parts[{i}].{key}: {} is out of range: it must be a finite number {lower} {lo} and at most {hi}",
-            crate::base::error::number(x)
-        )));
-    }
-    Ok(())
 }
 
 impl JobSpec {

@@ -74,8 +74,8 @@ fn range(name: &str) -> (f64, f64) {
         .find(|s| s.name == name)
         .expect("a setting of the schema");
     (
-        spec.min.unwrap_or(f64::NEG_INFINITY),
-        spec.max.unwrap_or(f64::INFINITY),
+        spec.domain.min.unwrap_or(f64::NEG_INFINITY),
+        spec.domain.max.unwrap_or(f64::INFINITY),
     )
 }
 

@@ -57,30 +57,38 @@ pub fn figure_lines(used: &[UnitId]) -> Vec<(String, FigureField, &'static str)>
     let several = used.len() > 1;
     let mut lines = vec![("print time".to_string(), FigureField::PrintSeconds, "s")];
     if several {
-        for &u in used {
-            lines.push((
-                format!("droplet time unit {u}"),
-                FigureField::UnitSeconds(u),
-                "s",
-            ));
-        }
+        lines.extend(unit_lines(
+            used,
+            &[("droplet time", FigureField::UnitSeconds, "s")],
+        ));
     }
     lines.push(("travel".into(), FigureField::Travel, "mm"));
+    let amounts: [UnitFigure; 2] = [
+        ("volume", FigureField::UnitVolume, "mm³"),
+        ("mass", FigureField::UnitMass, "g"),
+    ];
     if several {
-        for &u in used {
-            lines.push((
-                format!("volume unit {u}"),
-                FigureField::UnitVolume(u),
-                "mm³",
-            ));
-            lines.push((format!("mass unit {u}"), FigureField::UnitMass(u), "g"));
-        }
+        lines.extend(unit_lines(used, &amounts));
     } else {
         let first = UnitId::FIRST;
-        lines.push(("volume".into(), FigureField::UnitVolume(first), "mm³"));
-        lines.push(("mass".into(), FigureField::UnitMass(first), "g"));
+        lines.extend(amounts.map(|(what, field, unit)| (what.to_string(), field(first), unit)));
     }
     lines
+}
+
+/// A figure each unit has: the label's words, the field of a unit, the unit of measure.
+type UnitFigure = (&'static str, fn(UnitId) -> FigureField, &'static str);
+
+/// The lines of `figures` ("volume unit 1", …) unit by unit, for every unit of `used`.
+fn unit_lines(
+    used: &[UnitId],
+    figures: &[UnitFigure],
+) -> impl Iterator<Item = (String, FigureField, &'static str)> {
+    used.iter().flat_map(move |&u| {
+        let line =
+            move |&(what, field, unit): &UnitFigure| (format!("{what} unit {u}"), field(u), unit);
+        figures.iter().map(line)
+    })
 }
 
 impl FigureField {

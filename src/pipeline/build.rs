@@ -414,6 +414,40 @@ impl Made {
             profiles: Vec::new(),
         }
     }
+
+    /// The job of this mesh with its facet index and statistics (`buckets`, `stats`), once
+    /// the plate rule and the chamber allow it (checked after the job's size and droplets, so
+    /// those speak first): its info with every warning.
+    fn into_job(self, buckets: FacetBuckets, stats: MeshStats) -> Result<Job, Error> {
+        let zs = self.zs?;
+        let (input, settings, size) = (self.input, self.settings, self.size);
+        if let Some(e) = fit::refusal(&input.misfits, &settings, input.hint) {
+            return Err(e);
+        }
+        check_chamber(&size, &settings)?;
+        let mut all_warnings = input.warnings;
+        all_warnings.extend(input.misfits.into_iter().map(|m| m.message));
+        let bodies = match input.bodies {
+            Bodies::Whole(name) => vec![(name, stats.bodies)],
+            Bodies::Parts(parts) => parts,
+        };
+        all_warnings.extend(bodies.iter().filter_map(|(n, b)| bodies_warning(n, *b)));
+        all_warnings.extend(warnings(&stats, &size));
+        let info = JobInfo {
+            file_name: input.file_name,
+            format: input.format,
+            warnings: all_warnings,
+            suggested_scale: suggested_scale(&size),
+            mesh: stats,
+            bounds: self.bounds,
+            layers: zs.len(),
+            droplet_width: settings.droplet_width(),
+            instances: input.instances,
+            groups: self.groups,
+            profiles: Vec::new(),
+        };
+        Ok(Job::assemble(settings, self.mesh, buckets, zs, info))
+    }
 }
 
 /// A job being prepared: the merged mesh and what the passes of [`Job::build`] found so far.
@@ -574,37 +608,23 @@ impl Checked {
         repaired: Option<(FacetBuckets, MeshStats)>,
     ) -> Result<Job, Error> {
         let Checked {
-            made:
-                Made {
-                    mesh,
-                    input,
-                    settings,
-                    groups,
-                    bounds,
-                    size,
-                    zs,
-                    duplicates,
-                    weld,
-                    ..
-                },
+            made,
             shells,
             volume,
         } = self;
-        let repaired = repaired.map(|(b, s)| (b, with_repairs(s, &shells, weld, duplicates)));
+        let repaired = repaired.map(|(b, s)| {
+            let s = with_repairs(s, &shells, made.weld, made.duplicates);
+            (b, s)
+        });
         // One droplet estimate for the whole job: every unit and the support.
-        let parts = budget::UnitParts::of(&mesh, &groups);
+        let (mesh, settings, size) = (&made.mesh, &made.settings, &made.size);
+        let parts = budget::UnitParts::of(mesh, &made.groups);
         let open = shells.open > 0;
-        let mut estimate = budget::Estimate::new(
-            volume,
-            &parts,
-            open,
-            &size,
-            &input.instances,
-            &overhangs,
-            &settings,
-        );
-        estimate.check(&settings)?;
-        let zs = zs?;
+        let instances = &made.input.instances;
+        let mut estimate =
+            budget::Estimate::new(volume, &parts, open, size, instances, &overhangs, settings);
+        estimate.check(settings)?;
+        let zs = made.zs.as_ref().map_err(Error::clone)?;
         let (buckets, stats) = repaired.ok_or_else(|| {
             Error::Internal("the facet index was not built though the layers are known".into())
         })?;
@@ -612,36 +632,10 @@ impl Checked {
             // Open shells enclose no definite volume: estimate what will be printed from the
             // sliced area of sampled layers (the slicer closes open sections the same way).
             let h = settings.layer_height;
-            estimate.unit_volumes[0] = budget::sampled_volume(&mesh, &buckets, &zs, h);
-            estimate.check(&settings)?;
+            estimate.unit_volumes[0] = budget::sampled_volume(mesh, &buckets, zs, h);
+            estimate.check(settings)?;
         }
-        // The plate rule (after the checks of the job's size and droplets, so those speak first).
-        if let Some(e) = fit::refusal(&input.misfits, &settings, input.hint) {
-            return Err(e);
-        }
-        check_chamber(&size, &settings)?;
-        let mut all_warnings = input.warnings;
-        all_warnings.extend(input.misfits.into_iter().map(|m| m.message));
-        let bodies = match input.bodies {
-            Bodies::Whole(name) => vec![(name, stats.bodies)],
-            Bodies::Parts(parts) => parts,
-        };
-        all_warnings.extend(bodies.iter().filter_map(|(n, b)| bodies_warning(n, *b)));
-        all_warnings.extend(warnings(&stats, &size));
-        let info = JobInfo {
-            file_name: input.file_name,
-            format: input.format,
-            warnings: all_warnings,
-            suggested_scale: suggested_scale(&size),
-            mesh: stats,
-            bounds,
-            layers: zs.len(),
-            droplet_width: settings.droplet_width(),
-            instances: input.instances,
-            groups,
-            profiles: Vec::new(),
-        };
-        Ok(Job::assemble(settings, mesh, buckets, zs, info))
+        made.into_job(buckets, stats)
     }
 }
 

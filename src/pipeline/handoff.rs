@@ -128,17 +128,8 @@ impl Job {
     /// box and the units' facet runs are the draft's: those made its layers.
     pub fn confirm(&mut self, table: &dyn Source) -> Result<(), Error> {
         let confirm = |job: &mut Job| -> Result<(), String> {
-            let mut r = Reader {
-                bytes: table,
-                at: 0,
-                buf: Vec::new(),
-            };
-            if r.take(CONFIRM_MAGIC.len())? != CONFIRM_MAGIC {
-                return Err("not a confirmation of this version".into());
-            }
-            let n = r.count(1)?;
-            let meta: Meta =
-                serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+            let not_ours = "not a confirmation of this version";
+            let (r, meta) = Reader::past_meta(table, CONFIRM_MAGIC, not_ours)?;
             if r.at != table.size() {
                 return Err("bytes follow the confirmation".into());
             }
@@ -258,17 +249,7 @@ fn writer<'a>(
 
 /// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
 fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
-    let mut r = Reader {
-        bytes,
-        at: 0,
-        buf: Vec::new(),
-    };
-    if r.take(magic.len())? != magic {
-        return Err("not a prepared job of this version".into());
-    }
-    let n = r.count(1)?;
-    let meta: Meta =
-        serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+    let (mut r, meta) = Reader::past_meta(bytes, magic, "not a prepared job of this version")?;
     meta.settings.validate().map_err(|e| e.to_string())?;
     let n = r.count(24)?;
     let vertices: Vec<[f64; 3]> = r.get(n, |c: [u8; 24]| {
@@ -372,7 +353,28 @@ struct Reader<'a> {
     buf: Vec<u8>,
 }
 
-impl Reader<'_> {
+impl<'a> Reader<'a> {
+    /// The settings and info that follow `magic` at the start of `bytes`, and the reader
+    /// past them (`not_ours`: the message when the bytes do not start with `magic`).
+    fn past_meta(
+        bytes: &'a dyn Source,
+        magic: &[u8; 8],
+        not_ours: &str,
+    ) -> Result<(Reader<'a>, Meta), String> {
+        let mut r = Reader {
+            bytes,
+            at: 0,
+            buf: Vec::new(),
+        };
+        if r.take(magic.len())? != magic {
+            return Err(not_ours.into());
+        }
+        let n = r.count(1)?;
+        let meta: Meta =
+            serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+        Ok((r, meta))
+    }
+
     /// The next `n` bytes (copied out of the source).
     fn take(&mut self, n: usize) -> Result<&[u8], String> {
         let end = self

@@ -43,6 +43,32 @@ pub fn model_bytes(name: &str) -> Vec<u8> {
     std::fs::read(model(name)).expect("read model")
 }
 
+/// The shared models whose names end in one of `extensions` (".stl", ...): name and bytes,
+/// in the order of their names (each file read as it is reached).
+pub fn model_files(extensions: &[&str]) -> impl Iterator<Item = (String, Vec<u8>)> {
+    let dir = shared_dir().join("models");
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e} (set DROPSLICE_SHARED)", dir.display()))
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| extensions.iter().any(|x| n.ends_with(x)))
+        .collect();
+    names.sort();
+    names.into_iter().map(move |n| {
+        let bytes = std::fs::read(dir.join(&n)).expect("read model");
+        (n, bytes)
+    })
+}
+
+/// The shared models (STL, OBJ, 3MF) that read as a model: name and model, by name.
+pub fn readable_models() -> impl Iterator<Item = (String, dropslice::model::models::Model)> {
+    model_files(&[".stl", ".obj", ".3mf"]).filter_map(|(n, bytes)| {
+        Some((
+            n.clone(),
+            dropslice::model::models::Model::read(&bytes, &n).ok()?,
+        ))
+    })
+}
+
 /// The CLI binary built by cargo for these tests.
 pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_dropslice")

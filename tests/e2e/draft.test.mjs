@@ -9,7 +9,7 @@ import { execFileSync } from "node:child_process";
 import { existsSync, mkdtempSync, readFileSync, writeFileSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
-import { benchy, downloadText, openPage, pick, repo, startForTests, waitDone } from "./helpers.mjs";
+import { benchy, clearWorkerLog, downloadText, openPage, pick, recordWorkerMessages, repo, startForTests, waitDone, workerLog } from "./helpers.mjs";
 
 const env = startForTests();
 const tmp = mkdtempSync(join(tmpdir(), "dropslice-draft-"));
@@ -17,26 +17,11 @@ const cli = join(repo, "target/release/dropslice");
 
 after(() => execFileSync("rm", ["-rf", tmp]));
 
-/** Every request the page posts to a worker, as [worker, kind] (a `Worker` wrapper installed
- *  before the page's script runs; workers numbered as they are made). */
+/** A page that records the messages to and from its workers (`recordWorkerMessages`), settled
+ *  on the sample part. */
 async function recorded(browser, url) {
   const opened = await openPage(browser, url);
-  await opened.page.addInitScript(() => {
-    const Base = window.Worker;
-    let n = 0;
-    window.__posted = [];
-    window.Worker = class extends Base {
-      constructor(...args) {
-        super(...args);
-        const worker = n++;
-        const post = this.postMessage.bind(this);
-        this.postMessage = (m, t) => {
-          window.__posted.push([worker, m?.kind]);
-          return post(m, t);
-        };
-      }
-    };
-  });
+  await recordWorkerMessages(opened.page);
   await opened.page.reload();
   await waitDone(opened.page, 60_000); // the sample part
   return opened;
@@ -47,13 +32,12 @@ async function recorded(browser, url) {
 async function sliceOnTwo(file) {
   const { page, context } = await recorded(env.browser, `${env.url}?workers=2`);
   try {
-    await page.evaluate(() => (window.__posted = []));
+    await clearWorkerLog(page);
     await pick(page, file);
     const s = await waitDone(page, 240_000);
     assert.equal(s.workers, 2);
-    const posted = await page.evaluate(() => window.__posted);
     const to = {};
-    for (const [w, kind] of posted) (to[kind] ??= []).push(w);
+    for (const [, w, dir, kind] of await workerLog(page)) if (dir === "→") (to[kind] ??= []).push(w);
     return { to, text: await downloadText(page) };
   } finally {
     await context.close();

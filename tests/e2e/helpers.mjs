@@ -101,6 +101,36 @@ export async function openPage(browser, url, { width = 1440, height = 900, scale
   return { page, context, errors };
 }
 
+/** Installs, before the page's script runs (from its next load on), a `Worker` wrapper that
+ *  logs every message the page posts to a worker ("→") and every one it receives from a worker
+ *  ("←"; the layers' batches left out) as [ms, worker, direction, kind, id, from], workers
+ *  numbered from 0 as they are made; `workerLog` reads the log since `clearWorkerLog`. */
+export async function recordWorkerMessages(page) {
+  await page.addInitScript(() => {
+    const Base = window.Worker;
+    let n = 0;
+    window.__workerLog = [];
+    const log = (worker, dir, m) => window.__workerLog.push([performance.now(), worker, dir, m?.kind, m?.id, m?.data?.from ?? ""]);
+    window.Worker = class extends Base {
+      constructor(...args) {
+        super(...args);
+        const worker = n++;
+        const post = this.postMessage.bind(this);
+        this.postMessage = (m, t) => {
+          log(worker, "→", m);
+          return post(m, t);
+        };
+        this.addEventListener("message", (e) => {
+          if (e.data?.kind !== "layers") log(worker, "←", e.data);
+        });
+      }
+    };
+  });
+}
+
+export const workerLog = (page) => page.evaluate(() => window.__workerLog);
+export const clearWorkerLog = (page) => page.evaluate(() => void (window.__workerLog = []));
+
 /** For the screenshot scripts: a page of `width` × `height` that has settled on the sample,
  *  then ticked the checkboxes `check` (selectors), had `prepare(page)` done and sliced `files`
  *  (3DBenchy unless given); returns the page and the status once done. */

@@ -14,7 +14,7 @@ pub use profile::{
     profile_text,
 };
 pub use schema::{
-    Entry, Kind, SettingSpec, Shown, Slot, entries, entry, names, schema, schema_json,
+    Domain, Entry, Kind, SettingSpec, Shown, Slot, entries, entry, names, schema, schema_json,
 };
 pub use table::{MAX_UNITS, PART_KEYS, Settings, UnitSettings};
 pub use units::{Support, UnitId, UnitOrder};
@@ -112,8 +112,8 @@ impl Settings {
     pub fn set(&mut self, name: &str, value: &str) -> Result<(), Error> {
         let t = value.trim();
         // An enum's choices are words even where they look like booleans (`support = off`).
-        let is_enum =
-            schema::entry(name).is_some_and(|e| matches!(e.spec.kind, Kind::Enum | Kind::Order));
+        let is_enum = schema::entry(name)
+            .is_some_and(|e| matches!(e.spec.domain.kind, Kind::Enum | Kind::Order));
         let v = match t {
             _ if is_enum => serde_json::Value::String(t.to_string()),
             "true" | "yes" | "on" => serde_json::Value::Bool(true),
@@ -163,7 +163,7 @@ impl Settings {
             name: name.to_string(),
             message: format!("'{shown}' is not {what}"),
         };
-        let value = match (spec.kind, value) {
+        let value = match (spec.domain.kind, value) {
             (Kind::Bool, Value::Bool(b)) => Value::Bool(b),
             (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(1.0) => Value::Bool(true),
             (Kind::Bool, Value::Number(n)) if n.as_f64() == Some(0.0) => Value::Bool(false),
@@ -171,7 +171,7 @@ impl Settings {
             // A word of the choices, or what the setting's own type reads (a `unit_order` list).
             (Kind::Enum | Kind::Order, Value::String(s)) => Value::String(s),
             (Kind::Enum | Kind::Order, _) => {
-                return Err(bad(format!("one of: {}", spec.choices.join(", "))));
+                return Err(bad(format!("one of: {}", spec.domain.choices.join(", "))));
             }
             (Kind::Integer, Value::Number(n)) => match n.as_f64() {
                 Some(x) if x.fract() == 0.0 && x >= 0.0 && x <= u32::MAX as f64 => {
@@ -190,15 +190,17 @@ impl Settings {
         };
         match put {
             Some(Ok(())) => Ok(()),
-            Some(Err(e)) if matches!(spec.kind, Kind::Enum | Kind::Order) => Err(bad(format!(
-                "one of: {}{}",
-                spec.choices.join(", "),
-                if e.to_string().contains("list") {
-                    ", or a list of units such as 2,0,1"
-                } else {
-                    ""
-                }
-            ))),
+            Some(Err(e)) if matches!(spec.domain.kind, Kind::Enum | Kind::Order) => {
+                Err(bad(format!(
+                    "one of: {}{}",
+                    spec.domain.choices.join(", "),
+                    if e.to_string().contains("list") {
+                        ", or a list of units such as 2,0,1"
+                    } else {
+                        ""
+                    }
+                )))
+            }
             Some(Err(e)) => Err(bad(format!(
                 "allowed: {}",
                 crate::base::error::quote(&e.to_string())
@@ -226,7 +228,7 @@ impl Settings {
     pub fn validate(&self) -> Result<(), Error> {
         for entry in entries() {
             let spec = &entry.spec;
-            if !matches!(spec.kind, Kind::Number | Kind::Integer) {
+            if !matches!(spec.domain.kind, Kind::Number | Kind::Integer) {
                 continue;
             }
             // NaN and infinity serialize as null.
@@ -236,29 +238,18 @@ impl Settings {
                     message: "is not a finite number".into(),
                 });
             };
-            let (Some(min), Some(max)) = (spec.min, spec.max) else {
-                continue;
-            };
-            let below = if spec.min_exclusive {
-                x <= min
-            } else {
-                x < min
-            };
-            if !x.is_finite() || below || x > max {
-                let lower = if spec.min_exclusive {
-                    "greater than"
-                } else {
-                    "at least"
-                };
+            if let Some(range) = spec.domain.range_words()
+                && !spec.domain.admits(x)
+            {
                 return Err(Error::Setting {
                     name: spec.name.to_string(),
                     message: format!(
-                        "{} is out of range: it must be {lower} {min} and at most {max}{} ({})",
+                        "{} is out of range: it must be {range}{} ({})",
                         crate::base::error::number(x),
-                        if spec.unit.is_empty() {
+                        if spec.domain.unit.is_empty() {
                             String::new()
                         } else {
-                            format!(" {}", spec.unit)
+                            format!(" {}", spec.domain.unit)
                         },
                         spec.description
                     ),
@@ -373,7 +364,7 @@ impl Settings {
                     serde_json::Value::String(s) => s,
                     other => other.to_string(),
                 };
-                (e.spec.name, text, e.spec.unit)
+                (e.spec.name, text, e.spec.domain.unit)
             })
             .collect()
     }
@@ -423,22 +414,23 @@ pub fn typescript() -> String {
     out.push_str("/** Every setting (docs/spec.md 5.4.1). */\nexport type Settings = {\n");
     for e in entries() {
         let spec = &e.spec;
-        let ty = match spec.kind {
+        let ty = match spec.domain.kind {
             Kind::Number | Kind::Integer => "number".to_string(),
             Kind::Bool => "boolean".to_string(),
             // a list of units ("2,0,1") as well as the choices
             Kind::Order => "string".to_string(),
             Kind::Enum => spec
+                .domain
                 .choices
                 .iter()
                 .map(|c| format!("\"{c}\""))
                 .collect::<Vec<_>>()
                 .join(" | "),
         };
-        let unit = if spec.unit.is_empty() {
+        let unit = if spec.domain.unit.is_empty() {
             String::new()
         } else {
-            format!(" ({})", spec.unit)
+            format!(" ({})", spec.domain.unit)
         };
         let doc = format!("{}{unit}", spec.description).replace("*/", "* /");
         out.push_str(&format!("  /** {doc} */\n  {}: {ty};\n", spec.name));
@@ -524,9 +516,9 @@ mod tests {
         for (i, name) in names.iter().enumerate() {
             assert_eq!(names.iter().filter(|n| *n == name).count(), 1, "{name}");
             let spec = entry(name).unwrap();
-            let v = match spec.spec.kind {
-                Kind::Number => serde_json::json!(spec.spec.max.unwrap() - 1e-3 * i as f64),
-                Kind::Integer => serde_json::json!(spec.spec.max.unwrap() as u64),
+            let v = match spec.spec.domain.kind {
+                Kind::Number => serde_json::json!(spec.spec.domain.max.unwrap() - 1e-3 * i as f64),
+                Kind::Integer => serde_json::json!(spec.spec.domain.max.unwrap() as u64),
                 _ => s.value(name).unwrap(),
             };
             s.set_value(name, v.clone()).unwrap();
@@ -568,8 +560,12 @@ mod tests {
             .collect();
         assert_eq!(flagged, PART_KEYS);
         for s in schema().into_iter().filter(|s| s.part) {
-            assert_eq!(s.kind, Kind::Number, "{}", s.name);
-            assert!(s.min.is_some() && s.max.is_some(), "{}", s.name);
+            assert_eq!(s.domain.kind, Kind::Number, "{}", s.name);
+            assert!(
+                s.domain.min.is_some() && s.domain.max.is_some(),
+                "{}",
+                s.name
+            );
         }
     }
 

@@ -34,15 +34,9 @@ pub enum Kind {
 #[derive(Clone, Debug, Serialize)]
 pub struct SettingSpec {
     pub name: &'static str,
-    pub kind: Kind,
-    pub unit: &'static str,
-    /// Smallest allowed value (numbers only).
-    pub min: Option<f64>,
-    /// Largest allowed value (numbers only).
-    pub max: Option<f64>,
-    /// `min` itself is not allowed (e.g. a scale must be > 0).
-    pub min_exclusive: bool,
-    pub choices: &'static [&'static str],
+    /// Its kind, unit, range and choices (each unit's choices among them).
+    #[serde(flatten)]
+    pub domain: Domain,
     pub group: &'static str,
     pub description: &'static str,
     /// A key of a part ([`PART_KEYS`]): in a job each part carries its own (docs/jobs.md), and
@@ -54,15 +48,74 @@ pub struct SettingSpec {
     pub default: serde_json::Value,
 }
 
+/// The values a setting takes: their kind, unit, range and choices.
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Domain {
+    pub kind: Kind,
+    pub unit: &'static str,
+    /// Smallest allowed value (numbers only).
+    pub min: Option<f64>,
+    /// Largest allowed value (numbers only).
+    pub max: Option<f64>,
+    /// `min` itself is not allowed (e.g. a scale must be > 0).
+    pub min_exclusive: bool,
+    pub choices: &'static [&'static str],
+}
+
+impl Domain {
+    /// A number in `[min, max]`.
+    pub const fn number(unit: &'static str, min: f64, max: f64) -> Domain {
+        Domain {
+            kind: Kind::Number,
+            unit,
+            min: Some(min),
+            max: Some(max),
+            min_exclusive: false,
+            choices: &[],
+        }
+    }
+
+    /// A whole number in `[min, max]`.
+    pub const fn whole(unit: &'static str, min: f64, max: f64) -> Domain {
+        Domain {
+            kind: Kind::Integer,
+            ..Domain::number(unit, min, max)
+        }
+    }
+
+    /// Whether `x` is in the range: a finite number from `min` (or above it, when
+    /// `min_exclusive`) to `max`; without a range, any number is.
+    pub fn admits(&self, x: f64) -> bool {
+        let (Some(min), Some(max)) = (self.min, self.max) else {
+            return true;
+        };
+        let below = if self.min_exclusive {
+            x <= min
+        } else {
+            x < min
+        };
+        x.is_finite() && !below && x <= max
+    }
+
+    /// The range in words for a message: "at least 0.1 and at most 5", "greater than 0 and
+    /// at most 10" (`None`: no range).
+    pub fn range_words(&self) -> Option<String> {
+        let (min, max) = (self.min?, self.max?);
+        let lower = if self.min_exclusive {
+            "greater than"
+        } else {
+            "at least"
+        };
+        Some(format!("{lower} {min} and at most {max}"))
+    }
+}
+
 /// How a row of the table is described: everything but its name, scope and default.
 #[derive(Clone, Copy, Debug)]
 pub struct Row {
-    pub kind: Kind,
-    pub unit: &'static str,
-    pub min: Option<f64>,
-    pub max: Option<f64>,
-    pub min_exclusive: bool,
-    pub choices: &'static [&'static str],
+    /// Its values (the units' choices not yet among them: `unit_choices`).
+    pub domain: Domain,
     /// The choices go on with one per unit: `unitN` (N ≥ 1) after `off` for `support`,
     /// `unitN_first` for `unit_order`.
     pub unit_choices: bool,
@@ -97,12 +150,7 @@ pub const fn num(
     description: &'static str,
 ) -> Row {
     Row {
-        kind: Kind::Number,
-        unit,
-        min: Some(min),
-        max: Some(max),
-        min_exclusive: false,
-        choices: &[],
+        domain: Domain::number(unit, min, max),
         unit_choices: false,
         group,
         description,
@@ -111,36 +159,24 @@ pub const fn num(
     }
 }
 
-/// A whole number in `[min, max]`.
-pub const fn int(
-    unit: &'static str,
-    min: f64,
-    max: f64,
-    group: &'static str,
-    description: &'static str,
-) -> Row {
-    Row {
-        kind: Kind::Integer,
-        ..num(unit, min, max, group, description)
-    }
+/// A whole number (in the range of `row`, a [`num`]).
+pub const fn int(mut row: Row) -> Row {
+    row.domain.kind = Kind::Integer;
+    row
 }
 
 /// `min` itself not allowed.
-pub const fn positive(row: Row) -> Row {
-    Row {
-        min_exclusive: true,
-        ..row
-    }
+pub const fn positive(mut row: Row) -> Row {
+    row.domain.min_exclusive = true;
+    row
 }
 
 /// true or false.
 pub const fn flag(group: &'static str, description: &'static str) -> Row {
-    Row {
-        kind: Kind::Bool,
-        min: None,
-        max: None,
-        ..num("", 0.0, 0.0, group, description)
-    }
+    let mut row = num("", 0.0, 0.0, group, description);
+    row.domain.kind = Kind::Bool;
+    (row.domain.min, row.domain.max) = (None, None);
+    row
 }
 
 /// One of `choices`.
@@ -149,19 +185,17 @@ pub const fn pick(
     group: &'static str,
     description: &'static str,
 ) -> Row {
-    Row {
-        kind: Kind::Enum,
-        choices,
-        ..flag(group, description)
-    }
+    let mut row = flag(group, description);
+    row.domain.kind = Kind::Enum;
+    row.domain.choices = choices;
+    row
 }
 
 /// An order of units: `unitN_first` (the choices, one per unit) or a list such as `2,0,1`.
 pub const fn order(group: &'static str, description: &'static str) -> Row {
-    Row {
-        kind: Kind::Order,
-        ..unit_choices(pick(&[], group, description))
-    }
+    let mut row = unit_choices(pick(&[], group, description));
+    row.domain.kind = Kind::Order;
+    row
 }
 
 pub const fn unit_choices(row: Row) -> Row {
@@ -386,24 +420,22 @@ pub fn entries() -> &'static [Entry] {
         let defaults = Settings::default();
         let spec = |name: &'static str, row: &Row, description: &'static str, part: bool| {
             let choices: &'static [&'static str] = if row.unit_choices {
-                let mut all: Vec<&'static str> = row.choices.to_vec();
-                if row.choices.is_empty() {
+                let mut all: Vec<&'static str> = row.domain.choices.to_vec();
+                if row.domain.choices.is_empty() {
                     all.extend((0..MAX_UNITS).map(|n| leak(format!("unit{n}_first"))));
                 } else {
                     all.extend((1..MAX_UNITS).map(|n| leak(format!("unit{n}"))));
                 }
                 Box::leak(all.into_boxed_slice())
             } else {
-                row.choices
+                row.domain.choices
             };
             SettingSpec {
                 name,
-                kind: row.kind,
-                unit: row.unit,
-                min: row.min,
-                max: row.max,
-                min_exclusive: row.min_exclusive,
-                choices,
+                domain: Domain {
+                    choices,
+                    ..row.domain
+                },
                 group: row.group,
                 description,
                 part,

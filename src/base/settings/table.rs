@@ -20,7 +20,7 @@ pub const MAX_UNITS: usize = 4;
 settings_table! {
     job layer_height: f64 = 0.20 => num("mm", MIN_LAYER_HEIGHT, 5.0, "Droplet", "Layer height H: the height of one droplet");
     unit droplet_aspect: f64 = 1.04 => material(num("", MIN_ASPECT, 10.0, "Droplet", "Droplet width B divided by its height H (B = aspect x H)")), "Droplet width B{n} of discharge unit {n} divided by the layer height";
-    job contours: u32 = 2 => int("", 0.0, 100.0, "Contours", "Contour loops printed along every boundary (0 = none)");
+    job contours: u32 = 2 => int(num("", 0.0, 100.0, "Contours", "Contour loops printed along every boundary (0 = none)"));
     job outer_offset: f64 = 0.5 => num("x B", 0.0, 10.0, "Contours", "Offset of the first loop from an outer boundary, inward, in droplet widths");
     job inner_offset: f64 = 0.5 => num("x B", 0.0, 10.0, "Contours", "Offset of the first loop from a hole boundary, into the material, in droplet widths");
     job start_jitter: f64 = 0.07 => num("mm", 0.0, 1000.0, "Contours", "Each layer's loops start this much further along than the layer below, so loop seams do not stack");
@@ -43,7 +43,7 @@ settings_table! {
     part place_y: f64 = 0.0 => num("mm", -10000.0, 10000.0, "Part", "Position of the part on the table in y, after its bounding box was moved to the origin");
     part place_angle: f64 = 0.0 => num("deg", -360.0, 360.0, "Part", "Rotation of the part on the table about z, around the origin, before place_x/place_y");
     job slice_plane: SlicePlane = SlicePlane::Middle => pick(&["middle", "top"], "Part", "Cut each layer at its middle (more accurate) or at its top (the thesis)");
-    job units: u32 = 2 => beyond_two(machine(int("", 1.0, MAX_UNITS as f64, "Machine", "Discharge units the machine has: unit 0 and units 1 … units - 1 (support, a part's unit and unit_order name only these)")));
+    job units: u32 = 2 => beyond_two(machine(int(num("", 1.0, MAX_UNITS as f64, "Machine", "Discharge units the machine has: unit 0 and units 1 … units - 1 (support, a part's unit and unit_order name only these)"))));
     unit droplet_rate: f64 = 100.0 => machine(num("Hz", MIN_RATE, 100000.0, "Machine", "Droplets the discharge unit sets per second (time estimate)")), "Droplets unit {n} sets per second (time estimate)";
     job travel_speed: f64 = 50.0 => machine(num("mm/s", MIN_RATE, 10000.0, "Machine", "Table speed of travel moves (time estimate)"));
     unit material_density: f64 = 1.04 => material(positive(num("g/cm³", 0.0, 30.0, "Machine", "Density of the material (mass estimate)"))), "Density of unit {n}'s material (mass estimate)";
@@ -58,7 +58,7 @@ settings_table! {
     job overhang_limit: f64 = 0.5 => num("x B", 0.0, 10.0, "Support", "A droplet is supported when the layer below has material within this many droplet widths of its centre");
     job support: Support = Support::Off => unit_choices(pick(&["off"], "Support", "off: no support; unitN: support under every overhang, printed by discharge unit N (any unit but 0 the machine has, see units)"));
     job support_gap_xy: f64 = 0.5 => second_unit(num("x B", 0.0, 10.0, "Support", "Support is kept this many droplet widths away from the part within a layer"));
-    job support_gap_z: u32 = 0 => second_unit(int("layers", 0.0, 100.0, "Support", "Support ends this many layers below the overhang (0: a soluble support touches the part)"));
+    job support_gap_z: u32 = 0 => second_unit(int(num("layers", 0.0, 100.0, "Support", "Support ends this many layers below the overhang (0: a soluble support touches the part)")));
     job support_density: f64 = 1.0 => second_unit(num("", MIN_ASPECT, 1.0, "Support", "Hatch spacing of the support = B1 / support_density"));
     @units;
     job unit_order: UnitOrder = UnitOrder::unit_first(UnitId(0)) => second_unit(order("Units", "Which discharge unit prints first within a layer: unitN_first (then the others by number), or a list of units such as 2,0,1"));

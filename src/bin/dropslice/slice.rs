@@ -195,18 +195,21 @@ fn read_profile_file(path: &Path) -> Result<Profile, String> {
 fn list_settings() -> String {
     let mut out = String::new();
     for s in dropslice::base::settings::schema() {
-        let range = match (s.min, s.max) {
+        let range = match (s.domain.min, s.domain.max) {
             (Some(lo), Some(hi)) => {
-                format!(" [{}{lo} … {hi}]", if s.min_exclusive { ">" } else { "" })
+                format!(
+                    " [{}{lo} … {hi}]",
+                    if s.domain.min_exclusive { ">" } else { "" }
+                )
             }
-            _ if !s.choices.is_empty() => format!(" [{}]", s.choices.join(" | ")),
+            _ if !s.domain.choices.is_empty() => format!(" [{}]", s.domain.choices.join(" | ")),
             _ => String::new(),
         };
         out.push_str(&format!(
             "{:<18} = {:<16} {:<6}{range}\n    {}\n",
             s.name,
             s.default.to_string().trim_matches('"'),
-            s.unit,
+            s.domain.unit,
             s.description
         ));
     }

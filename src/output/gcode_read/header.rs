@@ -37,7 +37,7 @@ fn header_range(name: &str) -> Option<(f64, f64, &'static str)> {
     let spec = crate::base::settings::schema()
         .into_iter()
         .find(|s| s.name == name)?;
-    Some((spec.min?, spec.max?, spec.unit))
+    Some((spec.domain.min?, spec.domain.max?, spec.domain.unit))
 }
 
 impl GcodeReader {
