@@ -13,7 +13,12 @@ const BLOCK: i64 = 8;
 pub struct NearestGrid {
     points: Vec<Point>,
     alive: Vec<bool>,
-    cells: Vec<Vec<u32>>,
+    /// Cell c's points are `items[start[c]..start[c] + len[c]]` (one array for all cells, not
+    /// a `Vec` each: a layer's grid was thousands of small allocations); a scan drops the
+    /// removed ones from its cell's part.
+    start: Vec<u32>,
+    len: Vec<u32>,
+    items: Vec<u32>,
     /// Live points per block of [`BLOCK`] × [`BLOCK`] cells (`bx` blocks a row), and in all:
     /// a search skips the rings of cells in blocks with none, whose scan finds nothing.
     block_live: Vec<u32>,
@@ -48,7 +53,9 @@ impl NearestGrid {
         let (bx, by) = ((nx + BLOCK - 1) / BLOCK, (ny + BLOCK - 1) / BLOCK);
         let mut grid = NearestGrid {
             alive: vec![true; points.len()],
-            cells: vec![Vec::new(); (nx * ny) as usize],
+            start: vec![0; (nx * ny) as usize + 1],
+            len: vec![0; (nx * ny) as usize],
+            items: vec![0; points.len()],
             block_live: vec![0; (bx * by) as usize],
             bx,
             live: points.len(),
@@ -59,10 +66,30 @@ impl NearestGrid {
             nx,
             ny,
         };
-        for i in 0..grid.points.len() {
-            let (cx, cy) = grid.cell_of(grid.points[i]);
-            grid.cells[(cy * nx + cx) as usize].push(i as u32);
-            grid.block_live[((cy / BLOCK) * bx + cx / BLOCK) as usize] += 1;
+        // A counting sort by cell: each cell's points in their order.
+        let keys: Vec<(u32, u32)> = grid
+            .points
+            .iter()
+            .map(|&p| {
+                let (cx, cy) = grid.cell_of(p);
+                (
+                    (cy * nx + cx) as u32,
+                    ((cy / BLOCK) * bx + cx / BLOCK) as u32,
+                )
+            })
+            .collect();
+        for &(k, b) in &keys {
+            grid.len[k as usize] += 1;
+            grid.block_live[b as usize] += 1;
+        }
+        for c in 0..grid.len.len() {
+            grid.start[c + 1] = grid.start[c] + grid.len[c];
+        }
+        let mut fill = grid.start.clone();
+        for (i, &(k, _)) in keys.iter().enumerate() {
+            let at = &mut fill[k as usize];
+            grid.items[*at as usize] = i as u32;
+            *at += 1;
         }
         grid
     }
@@ -143,7 +170,7 @@ impl NearestGrid {
         best: &mut Option<(f64, usize)>,
     ) {
         let at = (y * self.nx + x) as usize;
-        if self.cells[at].is_empty() {
+        if self.len[at] == 0 {
             return;
         }
         // A cell whose box lies farther than the best point so far holds no nearer point nor
@@ -156,10 +183,19 @@ impl NearestGrid {
                 return;
             }
         }
-        let cell = &mut self.cells[at];
+        let from = self.start[at] as usize;
+        let cell = &mut self.items[from..from + self.len[at] as usize];
         let alive = &self.alive;
-        cell.retain(|&i| alive[i as usize]);
-        for &i in cell.iter() {
+        // The live points kept at the part's front, in their order.
+        let mut kept = 0;
+        for k in 0..cell.len() {
+            if alive[cell[k] as usize] {
+                cell[kept] = cell[k];
+                kept += 1;
+            }
+        }
+        self.len[at] = kept as u32;
+        for &i in &self.items[from..from + kept] {
             let i = i as usize;
             let d = dist(p, self.points[i]);
             if best.is_none_or(|(bd, bi)| d < bd || (d == bd && rank(i) < rank(bi))) {
