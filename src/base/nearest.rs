@@ -47,7 +47,7 @@ impl NearestGrid {
         }
         let (w, h) = ((max[0] - min[0]).max(1e-9), (max[1] - min[1]).max(1e-9));
         let n = points.len().max(1) as f64;
-        let cell = ((w * h) / n).sqrt().max(w.max(h) / 4096.0);
+        let cell = (2.0 * ((w * h) / n).sqrt()).max(w.max(h) / 4096.0);
         let nx = (w / cell).floor() as i64 + 1;
         let ny = (h / cell).floor() as i64 + 1;
         let (bx, by) = ((nx + BLOCK - 1) / BLOCK, (ny + BLOCK - 1) / BLOCK);
@@ -183,24 +183,25 @@ impl NearestGrid {
                 return;
             }
         }
-        let from = self.start[at] as usize;
-        let cell = &mut self.items[from..from + self.len[at] as usize];
-        let alive = &self.alive;
-        // The live points kept at the part's front, in their order.
+        let (from, n) = (self.start[at] as usize, self.len[at] as usize);
+        let cell = &mut self.items[from..from + n];
+        let (alive, points) = (&self.alive, &self.points);
+        // The live points are kept at the part's front, in their order.
         let mut kept = 0;
-        for k in 0..cell.len() {
-            if alive[cell[k] as usize] {
-                cell[kept] = cell[k];
-                kept += 1;
+        for k in 0..n {
+            let i = cell[k] as usize;
+            if !alive[i] {
+                continue;
             }
-        }
-        self.len[at] = kept as u32;
-        for &i in &self.items[from..from + kept] {
-            let i = i as usize;
-            let d = dist(p, self.points[i]);
+            cell[kept] = i as u32;
+            kept += 1;
+            let d = dist(p, points[i]);
             if best.is_none_or(|(bd, bi)| d < bd || (d == bd && rank(i) < rank(bi))) {
                 *best = Some((d, i));
             }
+        }
+        if kept < n {
+            self.len[at] = kept as u32;
         }
     }
 
