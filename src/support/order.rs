@@ -13,7 +13,7 @@
 //! below); the rows only choose which ends are looked at.
 
 use crate::base::geom::{Point, dist};
-use crate::slicing::hatch::{HatchLine, order_greedy};
+use crate::slicing::hatch::{HatchLine, order_greedy, walk_ends};
 
 /// Exactly `order_greedy(lines, from)`, faster for segments along the direction whose sine and
 /// cosine are `sin`, `cos` and lying on rows `h` apart across it (any segments give the same
@@ -29,23 +29,12 @@ pub fn order_by_rows(
         return lines;
     }
     match Rows::new(&lines, sin, cos, h) {
-        Some(mut rows) => {
-            let mut out = Vec::with_capacity(lines.len());
-            let mut at = from;
-            while let Some(end) = rows.nearest(at) {
-                rows.remove(end);
-                rows.remove(end ^ 1);
-                let l = lines[end / 2];
-                let l = if end % 2 == 0 {
-                    l
-                } else {
-                    HatchLine { a: l.b, b: l.a }
-                };
-                at = l.b;
-                out.push(l);
-            }
-            out
-        }
+        Some(mut rows) => walk_ends(&lines, from, |at| {
+            let end = rows.nearest(at)?;
+            rows.remove(end);
+            rows.remove(end ^ 1);
+            Some(end)
+        }),
         None => order_greedy(lines, from),
     }
 }
@@ -126,8 +115,9 @@ impl Rows {
         }
         let along = |p: Point| cos * p.x + sin * p.y;
         for r in 0..rows {
-            order[start[r] as usize..start[r + 1] as usize]
-                .sort_unstable_by(|&a, &b| along(ends[a as usize]).total_cmp(&along(ends[b as usize])));
+            order[start[r] as usize..start[r + 1] as usize].sort_unstable_by(|&a, &b| {
+                along(ends[a as usize]).total_cmp(&along(ends[b as usize]))
+            });
         }
         let xs: Vec<f64> = order.iter().map(|&e| along(ends[e as usize])).collect();
         let mut pos = vec![0u32; n];
@@ -196,7 +186,8 @@ impl Rows {
             let lo = (r as f64 + k0) * h;
             (lo - y).max(y - (lo + h)).max(0.0)
         };
-        let bound = |b: Option<(f64, usize)>| b.map_or(f64::INFINITY, |(d, _)| d * (1.0 + 1e-9) + 1e-9);
+        let bound =
+            |b: Option<(f64, usize)>| b.map_or(f64::INFINITY, |(d, _)| d * (1.0 + 1e-9) + 1e-9);
         loop {
             let g_up = (up < self.rows).then(|| gap(up));
             let g_down = (down > 0).then(|| gap(down - 1));
@@ -311,7 +302,10 @@ mod tests {
                     }
                 })
                 .collect();
-            let from = DVec2::new(random(&mut seed) * 60.0 - 10.0, random(&mut seed) * 8.0 - 4.0);
+            let from = DVec2::new(
+                random(&mut seed) * 60.0 - 10.0,
+                random(&mut seed) * 8.0 - 4.0,
+            );
             let want = order_greedy(lines.clone(), from);
             let got = order_by_rows(lines, from, sin, cos, h);
             assert_eq!(got, want, "case {case}");
