@@ -33,7 +33,9 @@ pub struct NearestGrid {
 }
 
 impl NearestGrid {
-    /// A grid of about one point per cell over the points' box (at most 4096 cells a side).
+    /// A grid of about four points per cell over the points' box (at most 4096 cells a side):
+    /// hatch ends lie on few lines across the box, so finer cells are mostly empty and a ring
+    /// search looks at many of them.
     pub fn new(points: Vec<Point>) -> NearestGrid {
         assert!(
             u32::try_from(points.len()).is_ok(),
