@@ -13,7 +13,12 @@ const BLOCK: i64 = 8;
 pub struct NearestGrid {
     points: Vec<Point>,
     alive: Vec<bool>,
-    cells: Vec<Vec<u32>>,
+    /// Cell c's points are `items[start[c]..start[c] + len[c]]` (one array for all cells, not
+    /// a `Vec` each: a layer's grid was thousands of small allocations); a scan drops the
+    /// removed ones from its cell's part.
+    start: Vec<u32>,
+    len: Vec<u32>,
+    items: Vec<u32>,
     /// Live points per block of [`BLOCK`] × [`BLOCK`] cells (`bx` blocks a row), and in all:
     /// a search skips the rings of cells in blocks with none, whose scan finds nothing.
     block_live: Vec<u32>,
@@ -28,7 +33,9 @@ pub struct NearestGrid {
 }
 
 impl NearestGrid {
-    /// A grid of about one point per cell over the points' box (at most 4096 cells a side).
+    /// A grid of about four points per cell over the points' box (at most 4096 cells a side):
+    /// hatch ends lie on few lines across the box, so finer cells are mostly empty and a ring
+    /// search looks at many of them.
     pub fn new(points: Vec<Point>) -> NearestGrid {
         assert!(
             u32::try_from(points.len()).is_ok(),
@@ -42,13 +49,15 @@ impl NearestGrid {
         }
         let (w, h) = ((max[0] - min[0]).max(1e-9), (max[1] - min[1]).max(1e-9));
         let n = points.len().max(1) as f64;
-        let cell = ((w * h) / n).sqrt().max(w.max(h) / 4096.0);
+        let cell = (2.0 * ((w * h) / n).sqrt()).max(w.max(h) / 4096.0);
         let nx = (w / cell).floor() as i64 + 1;
         let ny = (h / cell).floor() as i64 + 1;
         let (bx, by) = ((nx + BLOCK - 1) / BLOCK, (ny + BLOCK - 1) / BLOCK);
         let mut grid = NearestGrid {
             alive: vec![true; points.len()],
-            cells: vec![Vec::new(); (nx * ny) as usize],
+            start: vec![0; (nx * ny) as usize + 1],
+            len: vec![0; (nx * ny) as usize],
+            items: vec![0; points.len()],
             block_live: vec![0; (bx * by) as usize],
             bx,
             live: points.len(),
@@ -59,10 +68,30 @@ impl NearestGrid {
             nx,
             ny,
         };
-        for i in 0..grid.points.len() {
-            let (cx, cy) = grid.cell_of(grid.points[i]);
-            grid.cells[(cy * nx + cx) as usize].push(i as u32);
-            grid.block_live[((cy / BLOCK) * bx + cx / BLOCK) as usize] += 1;
+        // A counting sort by cell: each cell's points in their order.
+        let keys: Vec<(u32, u32)> = grid
+            .points
+            .iter()
+            .map(|&p| {
+                let (cx, cy) = grid.cell_of(p);
+                (
+                    (cy * nx + cx) as u32,
+                    ((cy / BLOCK) * bx + cx / BLOCK) as u32,
+                )
+            })
+            .collect();
+        for &(k, b) in &keys {
+            grid.len[k as usize] += 1;
+            grid.block_live[b as usize] += 1;
+        }
+        for c in 0..grid.len.len() {
+            grid.start[c + 1] = grid.start[c] + grid.len[c];
+        }
+        let mut fill = grid.start.clone();
+        for (i, &(k, _)) in keys.iter().enumerate() {
+            let at = &mut fill[k as usize];
+            grid.items[*at as usize] = i as u32;
+            *at += 1;
         }
         grid
     }
@@ -143,7 +172,7 @@ impl NearestGrid {
         best: &mut Option<(f64, usize)>,
     ) {
         let at = (y * self.nx + x) as usize;
-        if self.cells[at].is_empty() {
+        if self.len[at] == 0 {
             return;
         }
         // A cell whose box lies farther than the best point so far holds no nearer point nor
@@ -156,15 +185,25 @@ impl NearestGrid {
                 return;
             }
         }
-        let cell = &mut self.cells[at];
-        let alive = &self.alive;
-        cell.retain(|&i| alive[i as usize]);
-        for &i in cell.iter() {
-            let i = i as usize;
-            let d = dist(p, self.points[i]);
+        let (from, n) = (self.start[at] as usize, self.len[at] as usize);
+        let cell = &mut self.items[from..from + n];
+        let (alive, points) = (&self.alive, &self.points);
+        // The live points are kept at the part's front, in their order.
+        let mut kept = 0;
+        for k in 0..n {
+            let i = cell[k] as usize;
+            if !alive[i] {
+                continue;
+            }
+            cell[kept] = i as u32;
+            kept += 1;
+            let d = dist(p, points[i]);
             if best.is_none_or(|(bd, bi)| d < bd || (d == bd && rank(i) < rank(bi))) {
                 *best = Some((d, i));
             }
+        }
+        if kept < n {
+            self.len[at] = kept as u32;
         }
     }
 

@@ -90,11 +90,25 @@ pub fn order_greedy(lines: Vec<HatchLine>, from: Point) -> Vec<HatchLine> {
     }
     // End id = 2·segment + {0: a, 1: b}; of equally near ends, the least id.
     let mut grid = NearestGrid::new(lines.iter().flat_map(|l| [l.a, l.b]).collect());
-    let mut out = Vec::with_capacity(lines.len());
-    let mut at = from;
-    while let Some(end) = grid.nearest(at, |e| e) {
+    walk_ends(&lines, from, |at| {
+        let end = grid.nearest(at, |e| e)?;
         grid.remove(end);
         grid.remove(end ^ 1);
+        Some(end)
+    })
+}
+
+/// The walk over `lines` from `from` that takes next the end `next(at)` gives (end id =
+/// 2·segment + {0: a, 1: b}; `next` also takes that segment's ends out), each segment from
+/// that end, until `next` gives none.
+pub fn walk_ends(
+    lines: &[HatchLine],
+    from: Point,
+    mut next: impl FnMut(Point) -> Option<usize>,
+) -> Vec<HatchLine> {
+    let mut out = Vec::with_capacity(lines.len());
+    let mut at = from;
+    while let Some(end) = next(at) {
         let l = lines[end / 2];
         let l = if end % 2 == 0 {
             l

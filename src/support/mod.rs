@@ -34,6 +34,7 @@
 pub mod droplets;
 pub mod lattice;
 pub mod moves;
+mod order;
 pub mod orient;
 pub mod overhang;
 pub mod regions;

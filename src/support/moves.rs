@@ -2,10 +2,12 @@
 //! segments on the support unit's lattice, split where the part is within `support_gap_xy`·B, then the
 //! single droplets of the droplet-level pass, nearest first.
 
-use crate::base::geom::{DVec2, Point, Shapes, dist, line_droplet_count, round_output};
+use crate::base::geom::{
+    DVec2, Point, Shapes, dist, line_droplet_count, round_output, sin_cos_deg,
+};
 use crate::base::nearest::nearest_walk;
 use crate::base::settings::Settings;
-use crate::slicing::hatch::{HatchLine, order_greedy};
+use crate::slicing::hatch::HatchLine;
 use crate::slicing::plan::{Move, MoveKind, Role, hatch_angle, support_settings};
 
 /// The support unit's moves for a support region (docs/spec.md "Overhangs and support": hatch only, lines
@@ -30,11 +32,12 @@ pub fn support_moves(
     let mut at = start;
     if s1.fill_density > 0.0 && !lines.is_empty() {
         let edges = super::droplets::edges_of(part);
+        let (angle, spacing) = (hatch_angle(s, index), b1 / s1.fill_density);
         let gaps = super::droplets::LineGaps::new(
             &edges,
             s.support_gap_xy * s.droplet_width(),
-            hatch_angle(s, index),
-            b1 / s1.fill_density,
+            angle,
+            spacing,
         );
         let mut runs = Vec::with_capacity(lines.len());
         let mut near = Vec::new();
@@ -94,7 +97,9 @@ pub fn support_moves(
                 });
             }
         }
-        for l in order_greedy(runs, at) {
+        // The greedy nearest-end order, found through the lattice's rows the runs lie on.
+        let (sin, cos) = sin_cos_deg(angle);
+        for l in super::order::order_by_rows(runs, at, sin, cos, spacing) {
             if dist(l.a, l.b) < 0.5 * b1 {
                 moves.push(Move {
                     kind: MoveKind::Droplet,

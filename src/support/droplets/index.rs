@@ -271,6 +271,8 @@ struct Rows {
     /// The width of their droplets (the frame's pitch).
     width: f64,
     runs: Vec<Run>,
+    /// The runs as given, while they are sorted (kept for the next fill).
+    sorting: Vec<Run>,
     row0: i64,
     /// Row `row0 + r`'s runs are `runs[rows[r]..rows[r + 1]]`.
     rows: Vec<u32>,
@@ -287,17 +289,45 @@ impl Rows {
     ) {
         self.frame = frame;
         self.width = frame.map_or(0.0, |f| f.pitch);
-        self.runs.clear();
-        self.runs.extend(runs);
-        // By row, then by where they start (to a quarter pitch: runs of a row that lie apart
-        // are apart by more, and two that overlap are caught in any order).
-        let key = frame.map_or(0.0, |f| 4.0 * f.inv_pitch);
-        self.runs
-            .sort_unstable_by_key(|r| (r.row, (r.lo * key) as i64));
-        let too_many = match (self.runs.first(), self.runs.last()) {
-            (Some(a), Some(z)) => z.row - a.row >= MAX_ROWS,
-            _ => false,
-        };
+        self.sorting.clear();
+        self.sorting.extend(runs);
+        let (mut first, mut last) = (i64::MAX, i64::MIN);
+        for r in &self.sorting {
+            (first, last) = (first.min(r.row), last.max(r.row));
+        }
+        let too_many = !self.sorting.is_empty() && last - first >= MAX_ROWS;
+        if too_many || self.sorting.is_empty() {
+            std::mem::swap(&mut self.runs, &mut self.sorting);
+        } else {
+            // By row (a counting sort: the runs come in the order of the moves), then by where
+            // they start (to a quarter pitch: runs of a row that lie apart are apart by more,
+            // and two that overlap are caught in any order).
+            self.rows.clear();
+            self.rows.resize((last - first + 2) as usize, 0);
+            for r in &self.sorting {
+                self.rows[(r.row - first) as usize + 1] += 1;
+            }
+            for i in 1..self.rows.len() {
+                self.rows[i] += self.rows[i - 1];
+            }
+            self.runs.clear();
+            self.runs.resize(self.sorting.len(), self.sorting[0]);
+            // rows[k] is row k's next free place; afterwards the end of row k.
+            for r in &self.sorting {
+                let at = &mut self.rows[(r.row - first) as usize];
+                self.runs[*at as usize] = *r;
+                *at += 1;
+            }
+            let key = frame.map_or(0.0, |f| 4.0 * f.inv_pitch);
+            let mut from = 0;
+            for &end in &self.rows[..self.rows.len() - 1] {
+                let row = &mut self.runs[from..end as usize];
+                if row.len() > 1 {
+                    row.sort_unstable_by_key(|r| (r.lo * key) as i64);
+                }
+                from = end as usize;
+            }
+        }
         let mut kept = 0;
         for i in 0..self.runs.len() {
             let r = self.runs[i];
