@@ -186,7 +186,7 @@ impl HeightMap {
     /// The stored values of cells c..c + n (n ≥ 1) of row k, counted from the map's cell
     /// (0, 0): cells of one droplet, which [`zeros`](Self::zeros) stored in one segment.
     /// `spot`: where the last were (mostly where these are).
-    #[inline]
+    #[inline(always)]
     fn cells_mut(&mut self, spot: &mut Option<Spot>, k: usize, c: usize, n: usize) -> &mut [f32] {
         let Some(sp) = self.tiles.spot_cached(spot, k, c, c + n - 1) else {
             debug_assert!(false, "droplet outside the map's tiles");

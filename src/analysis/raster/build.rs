@@ -356,7 +356,7 @@ impl Droplet<'_> {
     /// Sets its rows' columns in `bits` and widens the rows' extents, when it lies in one
     /// band and segment of the storage: its rows are then one step apart. Whether it did;
     /// mostly it does. Only for a droplet [`in_grid`](Self::in_grid).
-    #[inline]
+    #[inline(always)]
     pub(super) fn set_in_one_segment(&self, store: &mut Store, bits: &mut [u64]) -> bool {
         let (c0, c1) = (self.c0 as usize, self.c1 as usize);
         let Some(sp) = store
