@@ -96,13 +96,13 @@ impl HeightMap {
     /// The map of droplets at `centres` of footprint diameter `d`. Every stored value is the
     /// one `HeightMap::reference` stores (the same expressions, in the same order); the work
     /// saved is around them: each droplet's cells found once, the cells' centres taken from
-    /// a table per column and per row, ⌊·⌋ without libm.
+    /// a table per column and per row, ⌊·⌋ without libm, the rows that miss the droplet
+    /// passed over, each cell raised without a branch.
     pub fn new(centres: &[Point], grid: &Grid3, d: f64) -> HeightMap {
         let r = d / 2.0;
         if centres.is_empty() {
             return HeightMap::default();
         }
-        let mut tiles = Tiles::default();
         let idx = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / grid.cell - 0.5);
         // A droplet's cells [ax, bx] × [ay, by], and the map's bounds.
         let mut min = [i64::MAX; 2];
@@ -121,19 +121,11 @@ impl HeightMap {
                 c
             })
             .collect();
-        let (w, h) = (
-            (max[0] - min[0] + 1) as usize,
-            (max[1] - min[1] + 1) as usize,
-        );
-        tiles.reset(h, w, MAP_BAND_ROWS, MAP_TILE_COLS);
+        let mut map = HeightMap::zeros(min, max, &cells);
         let (x, y) = (
             |v: i64| (v - min[0]) as usize,
             |v: i64| (v - min[1]) as usize,
         );
-        for &[ax, bx, ay, by] in &cells {
-            tiles.mark(y(ay), y(by), x(ax), x(bx));
-        }
-        let mut q = vec![0f32; tiles.build()];
         // Cell centres, computed as the reference computes them for each droplet.
         let centre = |i: i64, k: usize| grid.origin[k] + (i as f64 + 0.5) * grid.cell;
         let cx: Vec<f64> = (min[0]..=max[0]).map(|i| centre(i, 0)).collect();
@@ -157,24 +149,51 @@ impl HeightMap {
                     // No cell of this row is inside (q ≤ 0 never raises a cell).
                     continue;
                 }
-                let Some(sp) = tiles.spot_cached(&mut spot, k, c, c + xx.len() - 1) else {
-                    debug_assert!(false, "droplet outside the map's tiles");
-                    continue;
-                };
-                let at = sp.index(k) + c - sp.shift;
                 // The larger of the two, stored either way (no branch per cell).
-                for (slot, &x2) in q[at..at + xx.len()].iter_mut().zip(&xx) {
+                let row = map.cells_mut(&mut spot, k, c, xx.len());
+                for (slot, &x2) in row.iter_mut().zip(&xx) {
                     let v = (1.0 - (x2 + yy) * inv) as f32;
                     *slot = if v > *slot { v } else { *slot };
                 }
             }
         }
+        map
+    }
+
+    /// The map of q = 0 over grid cells `min`..=`max` (x, y) that stores only the tiles of
+    /// the droplets' cells `cells` ([ax, bx, ay, by], grid indices): where both builds
+    /// ([`HeightMap::new`] and `HeightMap::reference`) start.
+    fn zeros(min: [i64; 2], max: [i64; 2], cells: &[[i64; 4]]) -> HeightMap {
+        let mut tiles = Tiles::default();
+        let (w, h) = (
+            (max[0] - min[0] + 1) as usize,
+            (max[1] - min[1] + 1) as usize,
+        );
+        tiles.reset(h, w, MAP_BAND_ROWS, MAP_TILE_COLS);
+        for &[ax, bx, ay, by] in cells {
+            let (y0, y1) = ((ay - min[1]) as usize, (by - min[1]) as usize);
+            tiles.mark(y0, y1, (ax - min[0]) as usize, (bx - min[0]) as usize);
+        }
+        let q = vec![0f32; tiles.build()];
         HeightMap {
             x0: min[0],
             y0: min[1],
             tiles,
             q,
         }
+    }
+
+    /// The stored values of cells c..c + n (n ≥ 1) of row k, counted from the map's cell
+    /// (0, 0): cells of one droplet, which [`zeros`](Self::zeros) stored in one segment.
+    /// `spot`: where the last were (mostly where these are).
+    #[inline(always)]
+    fn cells_mut(&mut self, spot: &mut Option<Spot>, k: usize, c: usize, n: usize) -> &mut [f32] {
+        let Some(sp) = self.tiles.spot_cached(spot, k, c, c + n - 1) else {
+            debug_assert!(false, "droplet outside the map's tiles");
+            return &mut [];
+        };
+        let at = sp.index(k) + c - sp.shift;
+        &mut self.q[at..at + n]
     }
 
     /// Row `iy` (a grid index); empty outside the map.

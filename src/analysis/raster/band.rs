@@ -6,12 +6,11 @@
 //! tiles are stored as covered region, so the band's voids end at the interior as at droplets
 //! (they are neither cut open nor taken for the boundary).
 
-use super::build::{Prep, set_cols, widen};
-use super::{Grid, Raster, set_range};
+use super::build::{Prep, Store, widen};
+use super::{Grid, Raster};
 use crate::analysis::lines::{DropletLines, SkipGrid};
 use crate::base::geom::{Point, Shapes, dist};
 use crate::base::settings::{Footprint, Settings};
-use crate::base::spatial::{Spot, Tiles};
 
 /// Rows of a block; a block is one word (64 columns) wide.
 const BLOCK_ROWS: usize = 16;
@@ -83,28 +82,21 @@ pub(in crate::analysis) fn dilate2(flags: &[bool], w: usize, h: usize, r: usize)
     out
 }
 
-/// Sets grid columns c0..=c1 of row `k` in `bits` where they are stored (any segments).
-fn set_stored(
-    tiles: &Tiles,
-    spot: &mut Option<Spot>,
-    bits: &mut [u64],
-    extent: &mut [(u32, u32)],
-    k: usize,
-    c0: usize,
-    c1: usize,
-) {
-    if let Some(sp) = *spot
-        && sp.holds(k, c0 >> 6, c1 >> 6)
-    {
-        set_cols(tiles, spot, bits, extent, k, c0, c1);
-        return;
-    }
-    let Some(row) = tiles.row(k) else { return };
-    for seg in row.segs {
-        let (a, b) = ((c0 >> 6).max(seg.c0), ((c1 >> 6) + 1).min(seg.c1));
-        if a < b {
-            let (x0, x1) = (c0.max(64 * a), c1.min(64 * b - 1));
-            set_cols(tiles, spot, bits, extent, k, x0, x1);
+impl Store<'_> {
+    /// Sets grid columns c0..=c1 of row `k` in `bits` where they are stored (any segments).
+    fn set_stored(&mut self, bits: &mut [u64], k: usize, c0: usize, c1: usize) {
+        if let Some(sp) = self.spot
+            && sp.holds(k, c0 >> 6, c1 >> 6)
+        {
+            return self.set_cols(bits, k, c0, c1);
+        }
+        let Some(row) = self.tiles.row(k) else { return };
+        for seg in row.segs {
+            let (a, b) = ((c0 >> 6).max(seg.c0), ((c1 >> 6) + 1).min(seg.c1));
+            if a < b {
+                let (x0, x1) = (c0.max(64 * a), c1.min(64 * b - 1));
+                self.set_cols(bits, k, x0, x1);
+            }
         }
     }
 }
@@ -287,10 +279,8 @@ impl Raster {
                 * BLOCK_COLS) as u64,
             ..Banding::default()
         };
-        let (region_bits, drop_bits, extent) =
-            (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
-        let tiles = &self.tiles;
-        let mut spot: Option<Spot> = None;
+        let (region_bits, drop_bits) = (&mut self.region_bits, &mut self.drop_bits);
+        let mut store = Store::new(&self.tiles, &mut self.extent);
         // Per block row, its runs of interior blocks [first, last].
         let runs: Vec<Vec<(usize, usize)>> = kind
             .chunks(nc)
@@ -315,19 +305,20 @@ impl Raster {
                 match row.get(i) {
                     Some(&(a, e)) if 64 * a <= c1 => {
                         if from < 64 * a {
-                            set_stored(tiles, &mut spot, region_bits, extent, k, from, 64 * a - 1);
+                            store.set_stored(region_bits, k, from, 64 * a - 1);
                         }
                         from = from.max(64 * (e + 1));
                         i += 1;
                     }
                     _ => {
-                        set_stored(tiles, &mut spot, region_bits, extent, k, from, c1);
+                        store.set_stored(region_bits, k, from, c1);
                         break;
                     }
                 }
             }
         }
         // The interior blocks of the stored tiles, as covered region.
+        let tiles = store.tiles;
         for (bi, band) in tiles.bands().iter().enumerate() {
             for seg in tiles.segments(band) {
                 for w in seg.c0..seg.c1 {
@@ -340,9 +331,8 @@ impl Raster {
                             let i = band.offset + (k - band.first_row) * band.row_len + at;
                             region_bits[i] = !0;
                             drop_bits[i] = !0;
-                            let e = &mut extent[bi * tiles.band_rows() + k - band.first_row];
-                            e.0 = e.0.min(at as u32);
-                            e.1 = e.1.max(at as u32 + 1);
+                            let e = &mut store.extent[bi * tiles.band_rows() + k - band.first_row];
+                            widen(e, 64 * at, 64 * at + 63);
                             out.stored_interior_cells += BLOCK_COLS as u64;
                         }
                     }
@@ -355,66 +345,29 @@ impl Raster {
             .chunks(rows)
             .map(|c| c.iter().map(|&(n, _)| n.max(0) as u64).sum())
             .collect();
-        for &(k0, ph, u) in self.places.iter() {
-            let (n, half) = widest[ph];
-            if n < 1 {
-                continue;
-            }
-            let c0 = (u - half + 0.5) as i64;
-            let (c1, k1) = (c0 + n - 1, k0 + rows - 1);
-            // A droplet spans at most two blocks each way (12 rows, 41 columns).
-            let inner = c0 >= 0 && c1 < nx as i64 && k1 < ny && {
-                let (r0, r1) = (k0 / BLOCK_ROWS * nc, k1 / BLOCK_ROWS * nc);
-                let (w0, w1) = (c0 as usize >> 6, c1 as usize >> 6);
-                kind[r0 + w0] == INTERIOR
-                    && kind[r0 + w1] == INTERIOR
-                    && kind[r1 + w0] == INTERIOR
-                    && kind[r1 + w1] == INTERIOR
+        for &place in self.places.iter() {
+            let d = prep.droplet(place);
+            // Whether it lies in the grid and in blocks of kind `want` only (it spans at
+            // most two blocks each way: 12 rows, 41 columns).
+            let within = |want: u8| {
+                d.in_grid(&grid) && {
+                    let (r0, r1) = (d.k0 / BLOCK_ROWS * nc, d.k1 / BLOCK_ROWS * nc);
+                    let (w0, w1) = (d.c0 as usize >> 6, d.c1 as usize >> 6);
+                    [r0 + w0, r0 + w1, r1 + w0, r1 + w1]
+                        .iter()
+                        .all(|&i| kind[i] == want)
+                }
             };
-            if inner {
-                out.interior_drop_cells += cells_of[ph];
+            if within(INTERIOR) {
+                out.interior_drop_cells += cells_of[d.ph];
                 continue;
             }
-            // Wholly in band blocks (stored) and in one band and segment of the storage: its
-            // rows one step apart, as [`Raster::rebuild`] sets them.
-            let in_band = c0 >= 0 && c1 < nx as i64 && k1 < ny && {
-                let (r0, r1) = (k0 / BLOCK_ROWS * nc, k1 / BLOCK_ROWS * nc);
-                let (w0, w1) = (c0 as usize >> 6, c1 as usize >> 6);
-                kind[r0 + w0] == BAND
-                    && kind[r0 + w1] == BAND
-                    && kind[r1 + w0] == BAND
-                    && kind[r1 + w1] == BAND
-            };
-            if let Some(sp) = in_band
-                .then(|| tiles.spot_cached(&mut spot, k0, c0 as usize >> 6, c1 as usize >> 6))
-                .flatten()
-                .filter(|sp| k1 < sp.end_row)
-            {
-                let shift = 64 * sp.shift;
-                let mut at = 64 * sp.index(k0) as u64;
-                for (slot, &(n, half)) in (sp.slot(k0)..).zip(&spans[ph * rows..(ph + 1) * rows]) {
-                    if n >= 1 {
-                        let c0 = (u - half + 0.5) as i64 as usize - shift;
-                        let c1 = c0 + n as usize - 1;
-                        set_range(drop_bits, at + c0 as u64, at + c1 as u64);
-                        widen(&mut extent[slot], c0, c1);
-                    }
-                    at += 64 * sp.row_len as u64;
-                }
+            // Wholly in band blocks (stored), mostly in one band and segment of the storage.
+            if within(BAND) && d.set_in_one_segment(&mut store, drop_bits) {
                 continue;
             }
-            for (j, &(n, half)) in spans[ph * rows..(ph + 1) * rows].iter().enumerate() {
-                let k = k0 + j;
-                if n < 1 || k >= ny {
-                    continue;
-                }
-                let c0 = (u - half + 0.5) as i64;
-                let c1 = c0 + n - 1;
-                if c0 < 0 || c1 >= nx as i64 {
-                    continue;
-                }
-                let (c0, c1) = (c0 as usize, c1 as usize);
-                set_stored(tiles, &mut spot, drop_bits, extent, k, c0, c1);
+            for (k, c0, c1) in d.rows_in(&grid) {
+                store.set_stored(drop_bits, k, c0, c1);
                 for w in c0 >> 6..=c1 >> 6 {
                     if interior(k, w) {
                         let (a, b) = (c0.max(64 * w), c1.min(64 * w + 63));

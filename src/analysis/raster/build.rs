@@ -95,89 +95,36 @@ impl Raster {
         s: &Settings,
     ) {
         let prep = self.prepare(centres, region, s);
-        let Prep {
-            grid,
-            rows,
-            ref spans,
-            ref widest,
-            ..
-        } = prep;
-        let (nx, ny) = (grid.nx, grid.ny);
+        let grid = prep.grid;
         // First the tiles the region and the droplets touch, then their bits.
         let tiles = &mut self.tiles;
         for &(k, c0, c1) in self.spans.iter() {
             let k = k as usize;
             tiles.mark(k, k, c0 as usize >> 6, c1 as usize >> 6);
         }
-        for &(k0, ph, u) in self.places.iter() {
-            let (n, half) = widest[ph];
-            if n >= 1 {
-                let c0 = (u - half + 0.5) as i64;
+        for &place in self.places.iter() {
+            let d = prep.droplet(place);
+            if d.n >= 1 {
                 // A column to spare on each side.
-                let w0 = (c0 - 1).max(0) as usize >> 6;
-                let w1 = (c0 + n).max(0) as usize >> 6;
-                tiles.mark(k0, k0 + rows - 1, w0, w1);
+                let w0 = (d.c0 - 1).max(0) as usize >> 6;
+                let w1 = (d.c1 + 1).max(0) as usize >> 6;
+                tiles.mark(d.k0, d.k1, w0, w1);
             }
         }
         self.allocate();
-        let (region_bits, drop_bits, extent) =
-            (&mut self.region_bits, &mut self.drop_bits, &mut self.extent);
-        let tiles = &self.tiles;
-        // Where the last span or droplet row was stored (mostly where the next one is).
-        let mut spot: Option<Spot> = None;
+        let (region_bits, drop_bits) = (&mut self.region_bits, &mut self.drop_bits);
+        let mut store = Store::new(&self.tiles, &mut self.extent);
         for &(k, c0, c1) in self.spans.iter() {
             let (k, c0, c1) = (k as usize, c0 as usize, c1 as usize);
-            set_cols(tiles, &mut spot, region_bits, extent, k, c0, c1);
+            store.set_cols(region_bits, k, c0, c1);
         }
-        for &(k0, ph, u) in self.places.iter() {
-            let rows_of = &spans[ph * rows..(ph + 1) * rows];
-            // Mostly the whole droplet lies in the grid and in one band and segment: its rows
-            // are then one step apart in the storage.
-            let (n, half) = widest[ph];
-            let (w0, k1) = ((u - half + 0.5) as i64, k0 + rows - 1);
-            let whole = n >= 1 && w0 >= 0 && w0 + n <= nx as i64 && k1 < ny;
-            let (w0, w1) = (w0.max(0) as usize, (w0 + n - 1).max(0) as usize);
-            if let Some(sp) = whole
-                .then(|| tiles.spot_cached(&mut spot, k0, w0 >> 6, w1 >> 6))
-                .flatten()
-                .filter(|sp| k1 < sp.end_row)
-            {
-                let shift = 64 * sp.shift;
-                // Bit positions in u64: past 2³² bits (512 MB of words) in a 32-bit build.
-                let mut at = 64 * sp.index(k0) as u64;
-                for (slot, &(n, half)) in (sp.slot(k0)..).zip(rows_of) {
-                    if n >= 1 {
-                        // Within the widest row's columns: ≥ w0 ≥ 0, so the value is above −1
-                        // and `as i64` truncates it as `as usize` would (one instruction on
-                        // baseline x86-64; `as usize` takes a dozen).
-                        let c0 = (u - half + 0.5) as i64 as usize - shift;
-                        let c1 = c0 + n as usize - 1;
-                        set_range(drop_bits, at + c0 as u64, at + c1 as u64);
-                        widen(&mut extent[slot], c0, c1);
-                    }
-                    at += 64 * sp.row_len as u64;
-                }
+        for &place in self.places.iter() {
+            let d = prep.droplet(place);
+            if d.in_grid(&grid) && d.set_in_one_segment(&mut store, drop_bits) {
                 continue;
             }
-            for (j, &(n, half)) in rows_of.iter().enumerate() {
-                let k = k0 + j;
-                if n < 1 || k >= ny {
-                    continue;
-                }
-                let c0 = (u - half + 0.5) as i64;
-                let c1 = c0 + n - 1;
-                if c0 < 0 || c1 >= nx as i64 {
-                    continue;
-                }
-                set_cols(
-                    tiles,
-                    &mut spot,
-                    drop_bits,
-                    extent,
-                    k,
-                    c0 as usize,
-                    c1 as usize,
-                );
+            for (k, c0, c1) in d.rows_in(&grid) {
+                store.set_cols(drop_bits, k, c0, c1);
             }
         }
         self.finish(index, z, centres.len(), region, s, grid);
@@ -366,6 +313,92 @@ impl Prep {
     }
 }
 
+/// A droplet on the grid ([`Prep::droplet`]): its rows k0..=k1, its phase, its centre `u` in
+/// column units, per row from k0 the columns it covers (n, (n − 1)/2), and its widest row's
+/// n columns c0..=c1 (c1 = c0 + n − 1): every row's columns lie within them.
+pub(super) struct Droplet<'a> {
+    pub(super) k0: usize,
+    pub(super) k1: usize,
+    pub(super) ph: usize,
+    u: f64,
+    rows: &'a [(i64, f64)],
+    pub(super) n: i64,
+    pub(super) c0: i64,
+    pub(super) c1: i64,
+}
+
+impl Prep {
+    /// The droplet at `place` ([`Prep::place`]).
+    #[inline]
+    pub(super) fn droplet(&self, (k0, ph, u): (usize, usize, f64)) -> Droplet<'_> {
+        let (n, half) = self.widest[ph];
+        let c0 = (u - half + 0.5) as i64;
+        Droplet {
+            k0,
+            k1: k0 + self.rows - 1,
+            ph,
+            u,
+            rows: &self.spans[ph * self.rows..(ph + 1) * self.rows],
+            n,
+            c0,
+            c1: c0 + n - 1,
+        }
+    }
+}
+
+impl Droplet<'_> {
+    /// Whether it covers any cell and lies wholly in `grid`.
+    #[inline]
+    pub(super) fn in_grid(&self, grid: &Grid) -> bool {
+        self.n >= 1 && self.c0 >= 0 && self.c1 < grid.nx as i64 && self.k1 < grid.ny
+    }
+
+    /// Sets its rows' columns in `bits` and widens the rows' extents, when it lies in one
+    /// band and segment of the storage: its rows are then one step apart. Whether it did;
+    /// mostly it does. Only for a droplet [`in_grid`](Self::in_grid).
+    #[inline(always)]
+    pub(super) fn set_in_one_segment(&self, store: &mut Store, bits: &mut [u64]) -> bool {
+        let (c0, c1) = (self.c0 as usize, self.c1 as usize);
+        let Some(sp) = store
+            .tiles
+            .spot_cached(&mut store.spot, self.k0, c0 >> 6, c1 >> 6)
+            .filter(|sp| self.k1 < sp.end_row)
+        else {
+            return false;
+        };
+        let shift = 64 * sp.shift;
+        // Bit positions in u64: past 2³² bits (512 MB of words) in a 32-bit build.
+        let mut at = 64 * sp.index(self.k0) as u64;
+        for (slot, &(n, half)) in (sp.slot(self.k0)..).zip(self.rows) {
+            if n >= 1 {
+                // Within the widest row's columns: ≥ c0 ≥ 0, so the value is above −1 and
+                // `as i64` truncates it as `as usize` would (one instruction on baseline
+                // x86-64; `as usize` takes a dozen).
+                let c0 = (self.u - half + 0.5) as i64 as usize - shift;
+                let c1 = c0 + n as usize - 1;
+                set_range(bits, at + c0 as u64, at + c1 as u64);
+                widen(&mut store.extent[slot], c0, c1);
+            }
+            at += 64 * sp.row_len as u64;
+        }
+        true
+    }
+
+    /// Its rows that cover any cell and lie wholly in `grid`: (row, first column, last
+    /// column).
+    #[inline]
+    pub(super) fn rows_in(&self, grid: &Grid) -> impl Iterator<Item = (usize, usize, usize)> {
+        let (nx, ny, u) = (grid.nx as i64, grid.ny, self.u);
+        (self.k0..)
+            .zip(self.rows)
+            .filter_map(move |(k, &(n, half))| {
+                let c0 = (u - half + 0.5) as i64;
+                let c1 = c0 + n - 1;
+                (n >= 1 && k < ny && c0 >= 0 && c1 < nx).then_some((k, c0 as usize, c1 as usize))
+            })
+    }
+}
+
 /// Widens a row's extent (the words of its slice holding any bit) to columns c0..=c1.
 #[inline]
 pub(super) fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
@@ -373,24 +406,34 @@ pub(super) fn widen(e: &mut (u32, u32), c0: usize, c1: usize) {
     e.1 = e.1.max((c1 >> 6) as u32 + 1);
 }
 
-/// Sets grid columns c0..=c1 of row `k` in `bits` (laid out by `tiles`; `spot` where the last
-/// row set was stored) and widens the row's extent.
-#[inline]
-pub(super) fn set_cols(
-    tiles: &Tiles,
-    spot: &mut Option<Spot>,
-    bits: &mut [u64],
-    extent: &mut [(u32, u32)],
-    k: usize,
-    c0: usize,
-    c1: usize,
-) {
-    let Some(sp) = tiles.spot_cached(spot, k, c0 >> 6, c1 >> 6) else {
-        debug_assert!(false, "bits outside the tiles");
-        return;
-    };
-    let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
-    let at = 64 * sp.index(k) as u64;
-    set_range(bits, at + c0 as u64, at + c1 as u64);
-    widen(&mut extent[sp.slot(k)], c0, c1);
+/// Where a rebuild sets its bits: the tiles' layout, each stored row's extent, and where the
+/// last row set was stored (mostly where the next one is).
+pub(super) struct Store<'a> {
+    pub(super) tiles: &'a Tiles,
+    pub(super) extent: &'a mut [(u32, u32)],
+    pub(super) spot: Option<Spot>,
+}
+
+impl<'a> Store<'a> {
+    pub(super) fn new(tiles: &'a Tiles, extent: &'a mut [(u32, u32)]) -> Store<'a> {
+        Store {
+            tiles,
+            extent,
+            spot: None,
+        }
+    }
+
+    /// Sets grid columns c0..=c1 of row `k` in `bits` (laid out by the tiles; the columns
+    /// stored in one segment) and widens the row's extent.
+    #[inline]
+    pub(super) fn set_cols(&mut self, bits: &mut [u64], k: usize, c0: usize, c1: usize) {
+        let Some(sp) = self.tiles.spot_cached(&mut self.spot, k, c0 >> 6, c1 >> 6) else {
+            debug_assert!(false, "bits outside the tiles");
+            return;
+        };
+        let (c0, c1) = (c0 - 64 * sp.shift, c1 - 64 * sp.shift);
+        let at = 64 * sp.index(k) as u64;
+        set_range(bits, at + c0 as u64, at + c1 as u64);
+        widen(&mut self.extent[sp.slot(k)], c0, c1);
+    }
 }
