@@ -1,7 +1,7 @@
 // The calls into the core on the page's path, in Node on one thread (CPU ms of each call on
 // the calling thread, so that a loaded machine's waiting does not count), PASSES times in a row
 // from a module just loaded (the first pass runs while the engine still compiles the code):
-// the file's import (`Models.begin_add` + `Adding.step` where the module has them, else
+// the file's import (`Models.begin_add_bytes` + `Adding.step` + `finish_add` where the module has them, else
 // `Models.add_bytes`), the job's preparation with its draft (`Session.begin_drafted` +
 // `Preparing.step` + `take_draft`, as the job worker of a page of two workers or more; else
 // `Session.begin` or the one call `Session.from_models`), the draft taken and confirmed
@@ -11,7 +11,8 @@
 // Prints each pass' figures per kind of call and every call over LIMIT ms (environment, 10)
 // by name.
 // The preparation works through ITEMS items a call (16384 as the page), the import through
-// IMPORT_ITEMS triangles (environment, 32768 as the page), the supported pass through
+// IMPORT_ITEMS triangles (environment, 65536 as the page), the job taken (`Session.begin_take`,
+// `Taking.step`) TAKE_ITEMS items (environment, 65536 as the page), the supported pass through
 // SUPPORT_ITEMS layers' worth (environment, 4 as the page).
 // Usage: node scripts/wasm_call_time.mjs [PASSES] [MODEL] [PKG_DIR] [ITEMS] [SETTINGS]
 // (`bash scripts/build.sh` first; PKG_DIR: the wasm-bindgen output to time, www/pkg by default)
@@ -26,7 +27,7 @@ const model = process.argv[3] || join(repo, "../shared/models/3DBenchy.stl");
 const pkg = resolve(process.argv[4] || join(repo, "www/pkg"));
 const items = Number(process.argv[5] || 16384);
 const settings = JSON.parse(process.argv[6] || "{}");
-const importItems = Number(process.env.IMPORT_ITEMS || 32768);
+const importItems = Number(process.env.IMPORT_ITEMS || 65536);
 const supportItems = Number(process.env.SUPPORT_ITEMS || 4);
 const limit = Number(process.env.LIMIT || 10);
 const core = await import(pathToFileURL(join(pkg, "dropslice.js")).href);
@@ -55,29 +56,31 @@ const job = { settings, parts: [{ file: name }] };
 for (let k = 0; k < passes; k++) {
   /** Every call of the pass: [kind, name, ms]. */
   const calls = [];
+  /** `f()`, timed as a call of `kind` named `what` (or what `what()` says after the call). */
   const timed = (kind, what, f) => {
     const t0 = cpuMs();
     try {
       return f();
     } finally {
-      calls.push([kind, what, cpuMs() - t0]);
+      const ms = cpuMs() - t0;
+      calls.push([kind, typeof what === "function" ? what() : what, ms]);
     }
   };
   const models = new core.Models();
-  if (typeof models.begin_add === "function") {
-    const a = timed("import", "Models.begin_add", () => models.begin_add_bytes(bytes, name));
+  if (typeof core.Models.begin_add_bytes === "function") {
+    const a = timed("import", "Models.begin_add_bytes", () => core.Models.begin_add_bytes(bytes, name));
     for (let i = 0; !timed("import", `Adding.step ${i}`, () => a.step(importItems)); i++);
     timed("import", "Models.finish_add", () => models.finish_add(a));
   } else timed("import", "Models.add_bytes", () => models.add_bytes(bytes, name));
 
   let s;
   let draft = null;
-  const stepName = (p, i) => `Preparing.step ${i}${typeof p.pass === "function" ? ` (${p.pass()})` : ""}`;
+  // a step named by the passes it worked in
+  const stepName = (p, i) => () => `Preparing.step ${i}${typeof p.pass === "function" ? ` (${p.pass()})` : ""}`;
   if (typeof core.Session.begin_drafted === "function") {
     const p = timed("preparation", "Session.begin_drafted", () => core.Session.begin_drafted(models, job));
     for (let i = 0; ; i++) {
-      const what = stepName(p, i);
-      const done = timed("preparation", what, () => p.step(items));
+      const done = timed("preparation", stepName(p, i), () => p.step(items));
       draft ??= timed("preparation", "Preparing.take_draft", () => p.take_draft()) ?? null;
       if (done) break;
     }
@@ -88,14 +91,23 @@ for (let k = 0; k < passes; k++) {
     s = core.Session.from_preparation(p);
   } else s = timed("preparation", "Session.from_models", () => core.Session.from_models(models, job));
 
+  const takeItems = Number(process.env.TAKE_ITEMS || 65536);
+  /** Another worker's session of `bytes` (in short calls where the module has them). */
+  const take = (bytes, isDraft) => {
+    const one = isDraft ? "Session.from_draft" : "Session.from_prepared";
+    if (typeof core.Session.begin_take !== "function") return timed("hand-off", one, () => core.Session[isDraft ? "from_draft" : "from_prepared"](bytes));
+    const t = timed("hand-off", "Session.begin_take", () => core.Session.begin_take(bytes, isDraft));
+    for (let i = 0; !timed("hand-off", `Taking.step ${i} (${isDraft ? "draft" : "prepared"})`, () => t.step(takeItems)); i++);
+    return core.Session.from_taken(t);
+  };
   if (draft) {
-    const d = timed("hand-off", "Session.from_draft", () => core.Session.from_draft(draft));
+    const d = take(draft, true);
     const table = timed("hand-off", "Session.confirmation", () => s.confirmation());
     if (table) timed("hand-off", "Session.confirm", () => d.confirm(table));
     d.free();
   }
   const out = timed("hand-off", "Session.prepared", () => s.prepared());
-  timed("hand-off", "Session.from_prepared", () => core.Session.from_prepared(out)).free();
+  take(out, false).free();
   if (typeof s.support_step === "function") for (let i = 0; !timed("supported pass", `Session.support_step ${i}`, () => s.support_step(supportItems)); i++);
   for (let i = 0; i < s.layer_count(); i++) timed("layers", `slice_layer ${i}`, () => s.slice_layer(i)).free();
   s.free();

@@ -24,6 +24,7 @@ use super::Job;
 use crate::base::error::Error;
 use crate::base::parallel::{RUN, in_runs};
 use crate::base::settings::Settings;
+use crate::base::steps::{self, Budget};
 use crate::model::mesh::Mesh;
 use crate::model::prepare::JobInfo;
 use crate::slicing::slice::FacetBuckets;
@@ -75,10 +76,7 @@ impl Job {
     /// The prepared job as bytes for [`Job::from_bytes`] (about 24 B per vertex, 12 B per
     /// facet and 4 B per facet and layer it crosses).
     pub fn to_bytes(&self) -> Vec<u8> {
-        let (size, write) = self.bytes_writer();
-        let mut out = vec![0u8; size];
-        write(&mut out);
-        out
+        bytes_of(self.bytes_writer())
     }
 
     /// The length of [`Job::to_bytes`] and what writes them into a sink of that length.
@@ -102,14 +100,22 @@ impl Job {
 
     /// [`Job::from_bytes`] from any source of the bytes, read a run of items at a time.
     pub fn read_bytes(bytes: &dyn Source) -> Result<Job, Error> {
-        read(bytes, MAGIC).map_err(damaged)
+        steps::now(Job::take_in_steps(bytes, false, &steps::UNLIMITED))
+    }
+
+    /// [`Job::read_bytes`] (or, with `draft`, [`Job::from_draft`]) as a pass of `b`'s budget:
+    /// the arrays read and checked in runs of items (the page's short calls). The same job,
+    /// or the same refusal.
+    pub async fn take_in_steps(bytes: &dyn Source, draft: bool, b: &Budget) -> Result<Job, Error> {
+        let magic = if draft { DRAFT_MAGIC } else { MAGIC };
+        read(bytes, magic, b).await.map_err(damaged)
     }
 
     /// The job of a [`Draft`]'s bytes: it slices as the finished job does if [`Job::confirm`] takes the job worker's confirmation, and is not to be
     /// used otherwise (its info is provisional). Damaged bytes are refused as by
     /// [`Job::read_bytes`].
     pub fn from_draft(bytes: &dyn Source) -> Result<Job, Error> {
-        read(bytes, DRAFT_MAGIC).map_err(damaged)
+        steps::now(Job::take_in_steps(bytes, true, &steps::UNLIMITED))
     }
 
     /// The confirmation of a drafted job for [`Job::confirm`]: its final settings and info
@@ -171,6 +177,11 @@ pub struct Draft<'a> {
 }
 
 impl Draft<'_> {
+    /// The draft's bytes, for [`Job::from_draft`].
+    pub fn to_bytes(&self) -> Vec<u8> {
+        bytes_of(self.bytes_writer())
+    }
+
     /// The length of the draft's bytes and what writes them into a sink of that length.
     pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
         writer(
@@ -182,6 +193,13 @@ impl Draft<'_> {
             Some(self.index.rows()),
         )
     }
+}
+
+/// The bytes a writer ([`Job::bytes_writer`], [`Draft::bytes_writer`]) writes.
+fn bytes_of((size, write): (usize, impl FnOnce(&mut dyn Sink))) -> Vec<u8> {
+    let mut out = vec![0u8; size];
+    write(&mut out);
+    out
 }
 
 fn damaged(e: String) -> Error {
@@ -257,7 +275,7 @@ fn writer<'a>(
 }
 
 /// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
-fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
+async fn read(bytes: &dyn Source, magic: &[u8; 8], b: &Budget) -> Result<Job, String> {
     let mut r = Reader {
         bytes,
         at: 0,
@@ -271,27 +289,33 @@ fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
         serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
     meta.settings.validate().map_err(|e| e.to_string())?;
     let n = r.count(24)?;
-    let vertices: Vec<[f64; 3]> = r.get(n, |c: [u8; 24]| {
-        std::array::from_fn(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap()))
-    });
+    let vertices: Vec<[f64; 3]> = r
+        .get(n, b, |c: [u8; 24]| {
+            std::array::from_fn(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap()))
+        })
+        .await;
     // Every vertex within the job's box (grown by 1 mm: the box is measured before the repair
     // closes cracks), so the work of every layer stays what the job worker's was.
     let (lo, hi) = (meta.info.bounds.min, meta.info.bounds.max);
     let boxed = |v: &[f64; 3]| (0..3).all(|k| v[k] >= lo[k] - 1.0 && v[k] <= hi[k] + 1.0);
-    if !all(&vertices, boxed) {
+    if !all(&vertices, b, boxed).await {
         return Err("a vertex lies outside the job's box".into());
     }
     let n = r.count(12)?;
-    let facets: Vec<[u32; 3]> = r.get(n, |c: [u8; 12]| {
-        std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
-    });
-    if !all(&facets, |f| {
+    let facets: Vec<[u32; 3]> = r
+        .get(n, b, |c: [u8; 12]| {
+            std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
+        })
+        .await;
+    if !all(&facets, b, |f| {
         f.iter().all(|&i| (i as usize) < vertices.len())
-    }) {
+    })
+    .await
+    {
         return Err("a facet names a vertex past the last".into());
     }
     let n = r.count(8)?;
-    let zs: Vec<f64> = r.get(n, f64::from_le_bytes);
+    let zs: Vec<f64> = r.get(n, b, f64::from_le_bytes).await;
     if zs.is_empty() || !zs.iter().all(|z| z.is_finite()) || zs.windows(2).any(|w| w[0] >= w[1]) {
         return Err("the plane heights are not finite and rising".into());
     }
@@ -309,7 +333,7 @@ fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
     let mut rows = [Vec::new(), Vec::new()];
     for row in &mut rows {
         let n = r.count(4)?;
-        *row = r.get(n, u32::from_le_bytes);
+        *row = r.get(n, b, u32::from_le_bytes).await;
     }
     if r.at != bytes.size() {
         return Err("bytes follow the facet index".into());
@@ -357,10 +381,13 @@ impl Writer<'_> {
     }
 }
 
-/// Whether `ok` holds for every item (in runs: [`in_runs`]).
-fn all<T>(items: &[T], ok: impl Fn(&T) -> bool) -> bool {
+/// Whether `ok` holds for every item (in runs of `b`'s budget: [`steps::runs`]).
+async fn all<T>(items: &[T], b: &Budget, ok: impl Fn(&T) -> bool) -> bool {
     let mut all = true;
-    in_runs(items.len(), &mut |r| all = all && items[r].iter().all(&ok));
+    steps::runs(items.len(), b, &mut |r| {
+        all = all && items[r].iter().all(&ok)
+    })
+    .await;
     all
 }
 
@@ -397,11 +424,17 @@ impl Reader<'_> {
     }
 
     /// The next `n` items (checked by [`Reader::count`]), `N` bytes each, as `from` reads
-    /// them: a run of items at a time through one buffer (in runs: [`in_runs`]).
-    fn get<T, const N: usize>(&mut self, n: usize, from: impl Fn([u8; N]) -> T) -> Vec<T> {
+    /// them: a run of items at a time through one buffer (in runs of `b`'s budget:
+    /// [`steps::runs`]).
+    async fn get<T, const N: usize>(
+        &mut self,
+        n: usize,
+        b: &Budget,
+        from: impl Fn([u8; N]) -> T,
+    ) -> Vec<T> {
         let mut out = Vec::with_capacity(n);
         let mut buf = vec![0u8; N * RUN.min(n)];
-        in_runs(n, &mut |r| {
+        steps::runs(n, b, &mut |r| {
             let chunk = &mut buf[..N * r.len()];
             self.bytes.read(self.at, chunk);
             self.at += chunk.len();
@@ -410,7 +443,8 @@ impl Reader<'_> {
                     .chunks_exact(N)
                     .map(|c| from(c.try_into().expect("N bytes"))),
             )
-        });
+        })
+        .await;
         out
     }
 }

@@ -38,6 +38,7 @@ impl Job {
         Preparation {
             budget,
             drafted,
+            passes: ("", ""),
             pass: Some(Stepped::new(async move {
                 Job::build_in_steps(&models, &spec, &b, draft, &d).await
             })),
@@ -52,6 +53,8 @@ pub struct Preparation {
     budget: Rc<Budget>,
     /// Whether the job is its draft's, once made (`None`: no draft was made).
     drafted: Rc<Cell<Option<bool>>>,
+    /// The passes the last step began and ended in ([`Preparation::passes`]).
+    passes: (&'static str, &'static str),
     /// `None` once the job was handed out (or a step failed).
     pass: Option<Stepped<Result<Job, Error>>>,
 }
@@ -68,13 +71,23 @@ impl Preparation {
             ));
         };
         self.budget.refill(items);
-        match pass.step() {
+        let first = self.budget.pass();
+        let made = pass.step();
+        self.passes = (first, self.budget.pass());
+        match made {
             None => Ok(None),
             Some(made) => {
                 self.pass = None;
                 made.map(Some)
             }
         }
+    }
+
+    /// The passes the last step worked in: the one it began in and the one it ended in (the
+    /// same when it stayed in one), such as "weld" or "facet index" (empty before the first
+    /// step began any).
+    pub fn passes(&self) -> (&'static str, &'static str) {
+        self.passes
     }
 
     /// Once the job is made: whether it is the one its [`Draft`] slices (the same mesh,

@@ -364,11 +364,52 @@ impl Preparing {
         Ok(self.job.is_some())
     }
 
+    /// The passes the last [`Preparing::step`] worked in, for the page's profile: `"weld"`,
+    /// or `"weld → frame"` when it went on into the next.
+    pub fn pass(&self) -> String {
+        match self.prep.passes() {
+            (a, b) if a == b || a.is_empty() => b.to_string(),
+            (a, b) => format!("{a} → {b}"),
+        }
+    }
+
     /// The draft's bytes ([`Session::begin_drafted`]: the job as its parts were merged, for
     /// [`Session::from_draft`] in the other workers) once a step made it, then `undefined`:
     /// each draft is handed out once.
     pub fn take_draft(&self) -> Option<Uint8Array> {
         self.draft.borrow_mut().take()
+    }
+}
+
+/// A job another worker prepared, or its draft, being taken in short calls
+/// ([`Session::begin_take`]).
+#[wasm_bindgen]
+pub struct Taking {
+    budget: std::rc::Rc<Budget>,
+    /// `None` once the job was read (or refused).
+    pass: Option<Stepped<Result<Job, Error>>>,
+    job: Option<Job>,
+    draft: bool,
+}
+
+#[wasm_bindgen]
+impl Taking {
+    /// Reads about `items` items of the job (vertices, facets, the index' entries): true
+    /// once it is read (then [`Session::from_taken`]). Throws `{kind: "internal", message}`
+    /// as [`Session::from_prepared`] does if the bytes are damaged.
+    pub fn step(&mut self, items: u32) -> Result<bool, JsValue> {
+        let Some(pass) = self.pass.as_mut() else {
+            return Ok(self.job.is_some());
+        };
+        self.budget.refill(items as usize);
+        match stages::time(Stage::Prepare, || pass.step()) {
+            None => Ok(false),
+            Some(read) => {
+                self.pass = None;
+                self.job = Some(read.map_err(js_error)?);
+                Ok(true)
+            }
+        }
     }
 }
 
@@ -502,6 +543,36 @@ impl Session {
         let job = stages::time(Stage::Prepare, || Job::from_draft(&source)).map_err(js_error)?;
         let mut s = Session::with(job);
         s.draft = true;
+        Ok(s)
+    }
+
+    /// [`Session::from_prepared`] (or, with `draft`, [`Session::from_draft`]) in short calls:
+    /// this call only takes the bytes; [`Taking::step`] reads a budget of items a call until
+    /// it returns true; [`Session::from_taken`] makes the session. The same session.
+    pub fn begin_take(bytes: Uint8Array, draft: bool) -> Taking {
+        let budget = std::rc::Rc::new(Budget::new(0));
+        let b = budget.clone();
+        let source = JsBytes(bytes);
+        Taking {
+            budget,
+            pass: Some(Stepped::new(async move {
+                Job::take_in_steps(&source, draft, &b).await
+            })),
+            job: None,
+            draft,
+        }
+    }
+
+    /// The session of a job taken in short calls ([`Session::begin_take`]); `internal` if
+    /// it has not been read to its end.
+    pub fn from_taken(taking: Taking) -> Result<Session, JsValue> {
+        let job = taking.job.ok_or_else(|| {
+            js_error(Error::Internal(
+                "the job has not been taken to its end".into(),
+            ))
+        })?;
+        let mut s = Session::with(job);
+        s.draft = taking.draft;
         Ok(s)
     }
 

@@ -43,6 +43,19 @@ pub fn model_bytes(name: &str) -> Vec<u8> {
     std::fs::read(model(name)).expect("read model")
 }
 
+/// Every shared model file the slicer reads (STL, OBJ, 3MF): its name and bytes.
+pub fn shared_model_files() -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
+    for file in std::fs::read_dir(shared_dir().join("models")).expect("the shared models") {
+        let path = file.expect("a shared model").path();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if [".stl", ".obj", ".3mf"].iter().any(|e| name.ends_with(e)) {
+            files.push((name, std::fs::read(&path).expect("read model")));
+        }
+    }
+    files
+}
+
 /// The CLI binary built by cargo for these tests.
 pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_dropslice")
