@@ -12,7 +12,8 @@
 // by name.
 // The preparation works through ITEMS items a call (16384 as the page), the import through
 // IMPORT_ITEMS triangles (environment, 65536 as the page), the job taken (`Session.begin_take`,
-// `Taking.step`) TAKE_ITEMS items (environment, 65536 as the page), the supported pass through
+// `Taking.step`) and written (`Session.begin_prepared`, `Writing.step`) TAKE_ITEMS items
+// (environment, 65536 as the page), the supported pass through
 // SUPPORT_ITEMS layers' worth (environment, 4 as the page).
 // Usage: node scripts/wasm_call_time.mjs [PASSES] [MODEL] [PKG_DIR] [ITEMS] [SETTINGS]
 // (`bash scripts/build.sh` first; PKG_DIR: the wasm-bindgen output to time, www/pkg by default)
@@ -106,7 +107,13 @@ for (let k = 0; k < passes; k++) {
     if (table) timed("hand-off", "Session.confirm", () => d.confirm(table));
     d.free();
   }
-  const out = timed("hand-off", "Session.prepared", () => s.prepared());
+  let out;
+  if (typeof s.begin_prepared === "function") {
+    const w = timed("hand-off", "Session.begin_prepared", () => s.begin_prepared());
+    for (let i = 0; !timed("hand-off", `Writing.step ${i}`, () => w.step(takeItems)); i++);
+    out = w.take();
+    w.free();
+  } else out = timed("hand-off", "Session.prepared", () => s.prepared());
   take(out, false).free();
   if (typeof s.support_step === "function") for (let i = 0; !timed("supported pass", `Session.support_step ${i}`, () => s.support_step(supportItems)); i++);
   for (let i = 0; i < s.layer_count(); i++) timed("layers", `slice_layer ${i}`, () => s.slice_layer(i)).free();

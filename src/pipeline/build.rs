@@ -19,7 +19,7 @@ use crate::model::prepare::{
 };
 use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
-use crate::pipeline::handoff::Draft;
+use crate::pipeline::handoff::{Draft, DraftTo};
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
 use std::cell::Cell;
@@ -72,7 +72,7 @@ impl Job {
         models: &[Model],
         spec: &job::JobSpec,
         b: &Budget,
-        draft: Option<DraftHook>,
+        draft: Option<DraftTo>,
         drafted: &Cell<Option<bool>>,
     ) -> Result<Job, Error> {
         let (mesh, input, settings) = Job::merged(models, spec, b).await?;
@@ -86,17 +86,18 @@ impl Job {
             let m = &building.made;
             b.enter("facet index");
             let index = FacetBuckets::new_in_steps(&m.mesh, zs, b).await;
-            if let Some(hand) = draft {
-                // the draft written in a step of its own (it is not divided)
+            if let Some(to) = draft {
+                // the draft handed out in steps of its own
                 b.end_step().await;
                 b.enter("draft");
-                hand(&Draft {
+                let d = Draft {
                     settings: &m.settings,
                     info: m.provisional_info(zs.len()),
                     mesh: &m.mesh,
                     zs,
                     index: &index,
-                });
+                };
+                d.hand_to(to, b).await;
                 draft_of = Some((zs.clone(), m.groups.clone()));
                 b.end_step().await;
             }
@@ -668,9 +669,6 @@ impl Checked {
         Ok(Job::assemble(settings, mesh, buckets, zs, info))
     }
 }
-
-/// What [`Job::prepare_drafted`] hands its [`Draft`] to (once).
-pub type DraftHook = Box<dyn FnOnce(&Draft<'_>)>;
 
 /// Checks the width in droplets; the plane heights of the layers (at least one).
 fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {

@@ -22,7 +22,7 @@
 
 use super::Job;
 use crate::base::error::Error;
-use crate::base::parallel::{RUN, in_runs};
+use crate::base::parallel::RUN;
 use crate::base::settings::Settings;
 use crate::base::steps::{self, Budget};
 use crate::model::mesh::Mesh;
@@ -81,7 +81,13 @@ impl Job {
 
     /// The length of [`Job::to_bytes`] and what writes them into a sink of that length.
     pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
-        writer(
+        self.bytes_out().at_once()
+    }
+
+    /// [`Job::to_bytes`] to be written into a sink of [`BytesOut::size`] bytes, at once or
+    /// in steps ([`BytesOut::write`]).
+    pub fn bytes_out(&self) -> BytesOut<'_> {
+        BytesOut::new(
             MAGIC,
             &self.settings,
             &self.info,
@@ -184,7 +190,12 @@ impl Draft<'_> {
 
     /// The length of the draft's bytes and what writes them into a sink of that length.
     pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
-        writer(
+        self.bytes_out().at_once()
+    }
+
+    /// The draft's bytes to be written, at once or in steps ([`BytesOut::write`]).
+    pub fn bytes_out(&self) -> BytesOut<'_> {
+        BytesOut::new(
             DRAFT_MAGIC,
             self.settings,
             &self.info,
@@ -193,6 +204,38 @@ impl Draft<'_> {
             Some(self.index.rows()),
         )
     }
+
+    /// Hands the draft to `to`: to its hook at once, or written in runs of `b`'s budget into
+    /// the sink it opens for the draft's length.
+    pub(crate) async fn hand_to(&self, to: DraftTo, b: &Budget) {
+        match to {
+            DraftTo::Hook(hand) => hand(self),
+            DraftTo::Steps(mut sink) => {
+                let out = self.bytes_out();
+                sink.open(out.size());
+                out.write(sink.as_sink(), b).await;
+                sink.done();
+            }
+        }
+    }
+}
+
+/// What [`Job::prepare_drafted`] hands its [`Draft`] to (once): a function of it.
+pub type DraftHook = Box<dyn FnOnce(&Draft<'_>)>;
+
+/// Where [`Job::prepare_drafted_to`] hands its [`Draft`]: to a hook at once, or written in
+/// steps into a [`DraftSink`] (the page: a buffer outside the module's memory).
+pub enum DraftTo {
+    Hook(DraftHook),
+    Steps(Box<dyn DraftSink>),
+}
+
+/// A sink the draft is written into in steps: opened for the draft's length, told when
+/// every byte is written.
+pub trait DraftSink {
+    fn open(&mut self, size: usize);
+    fn as_sink(&mut self) -> &mut dyn Sink;
+    fn done(&mut self);
 }
 
 /// The bytes a writer ([`Job::bytes_writer`], [`Draft::bytes_writer`]) writes.
@@ -233,45 +276,76 @@ fn with_shifts(meta: Meta) -> Result<(Settings, JobInfo), String> {
     Ok((settings, info))
 }
 
-/// The length of a job's bytes (`index`: the facet index' rows) and what writes them into a
-/// sink of that length.
-fn writer<'a>(
+/// A job's bytes to be written (`index`: the facet index' rows): their length, and what
+/// writes them into a sink of that length, at once or in steps.
+pub struct BytesOut<'a> {
     magic: &'static [u8; 8],
-    settings: &Settings,
-    info: &JobInfo,
+    meta: Vec<u8>,
     mesh: &'a Mesh,
     zs: &'a [f64],
     index: Option<(&'a [u32], &'a [u32])>,
-) -> (usize, impl FnOnce(&mut dyn Sink) + 'a) {
-    let meta = meta_json(settings, info);
-    let rows = index.map_or(0, |(o, f)| 16 + (o.len() + f.len()) * 4);
-    let size = magic.len()
-        + 4 * 8
-        + meta.len()
-        + mesh.vertices.len() * 24
-        + mesh.facets.len() * 12
-        + zs.len() * 8
-        + rows;
-    let write = move |sink: &mut dyn Sink| {
+}
+
+impl<'a> BytesOut<'a> {
+    fn new(
+        magic: &'static [u8; 8],
+        settings: &Settings,
+        info: &JobInfo,
+        mesh: &'a Mesh,
+        zs: &'a [f64],
+        index: Option<(&'a [u32], &'a [u32])>,
+    ) -> BytesOut<'a> {
+        BytesOut {
+            magic,
+            meta: meta_json(settings, info),
+            mesh,
+            zs,
+            index,
+        }
+    }
+
+    /// The length of the bytes.
+    pub fn size(&self) -> usize {
+        let rows = self.index.map_or(0, |(o, f)| 16 + (o.len() + f.len()) * 4);
+        self.magic.len()
+            + 4 * 8
+            + self.meta.len()
+            + self.mesh.vertices.len() * 24
+            + self.mesh.facets.len() * 12
+            + self.zs.len() * 8
+            + rows
+    }
+
+    /// The length and what writes the bytes at once.
+    fn at_once(self) -> (usize, impl FnOnce(&mut dyn Sink) + 'a) {
+        let size = self.size();
+        let write = move |sink: &mut dyn Sink| steps::now(self.write(sink, &steps::UNLIMITED));
+        (size, write)
+    }
+
+    /// Writes the bytes into `sink` (of [`BytesOut::size`] bytes), the arrays in runs of `b`'s
+    /// budget.
+    pub async fn write(&self, sink: &mut dyn Sink, b: &Budget) {
         let mut out = Writer { sink, at: 0 };
-        out.bytes(magic);
-        out.count(meta.len());
-        out.bytes(&meta);
-        out.count(mesh.vertices.len());
-        out.put(mesh.vertices.as_flattened(), f64::to_le_bytes);
-        out.count(mesh.facets.len());
-        out.put(mesh.facets.as_flattened(), u32::to_le_bytes);
-        out.count(zs.len());
-        out.put(zs, f64::to_le_bytes);
-        if let Some((offsets, bucket_facets)) = index {
+        out.bytes(self.magic);
+        out.count(self.meta.len());
+        out.bytes(&self.meta);
+        out.count(self.mesh.vertices.len());
+        out.put(self.mesh.vertices.as_flattened(), f64::to_le_bytes, b)
+            .await;
+        out.count(self.mesh.facets.len());
+        out.put(self.mesh.facets.as_flattened(), u32::to_le_bytes, b)
+            .await;
+        out.count(self.zs.len());
+        out.put(self.zs, f64::to_le_bytes, b).await;
+        if let Some((offsets, bucket_facets)) = self.index {
             for row in [offsets, bucket_facets] {
                 out.count(row.len());
-                out.put(row, u32::to_le_bytes);
+                out.put(row, u32::to_le_bytes, b).await;
             }
         }
-        debug_assert_eq!(out.at, size);
-    };
-    (size, write)
+        debug_assert_eq!(out.at, self.size());
+    }
 }
 
 /// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
@@ -366,18 +440,24 @@ impl Writer<'_> {
         self.bytes(&(n as u64).to_le_bytes());
     }
 
-    /// `items` in the bytes `le` gives each, a run at a time through one buffer (in runs:
-    /// [`in_runs`]).
-    fn put<T: Copy, const N: usize>(&mut self, items: &[T], le: fn(T) -> [u8; N]) {
+    /// `items` in the bytes `le` gives each, a run at a time through one buffer (in runs of
+    /// `b`'s budget: [`steps::runs`]).
+    async fn put<T: Copy, const N: usize>(
+        &mut self,
+        items: &[T],
+        le: fn(T) -> [u8; N],
+        b: &Budget,
+    ) {
         let mut buf = vec![0u8; N * RUN.min(items.len())];
-        in_runs(items.len(), &mut |r| {
+        steps::runs(items.len(), b, &mut |r| {
             let chunk = &mut buf[..N * r.len()];
             for (c, &x) in chunk.chunks_exact_mut(N).zip(&items[r]) {
                 c.copy_from_slice(&le(x));
             }
             self.sink.write(self.at, chunk);
             self.at += chunk.len();
-        });
+        })
+        .await;
     }
 }
 

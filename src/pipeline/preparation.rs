@@ -7,7 +7,7 @@ use crate::base::steps::{Budget, Stepped};
 use crate::model::models::Model;
 use crate::model::spec as job;
 use crate::pipeline::Job;
-use crate::pipeline::build::DraftHook;
+use crate::pipeline::handoff::{DraftHook, DraftTo};
 use std::cell::Cell;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -30,6 +30,16 @@ impl Job {
         models: Arc<Vec<Model>>,
         spec: &job::JobSpec,
         draft: Option<DraftHook>,
+    ) -> Preparation {
+        Job::prepare_drafted_to(models, spec, draft.map(DraftTo::Hook))
+    }
+
+    /// [`Job::prepare_drafted`] that hands the draft to a hook or writes it, in steps of
+    /// their own, into a sink ([`DraftTo`]).
+    pub fn prepare_drafted_to(
+        models: Arc<Vec<Model>>,
+        spec: &job::JobSpec,
+        draft: Option<DraftTo>,
     ) -> Preparation {
         let budget = Rc::new(Budget::new(0));
         let drafted = Rc::new(Cell::new(None));
