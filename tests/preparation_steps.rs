@@ -329,7 +329,7 @@ fn a_job_taken_in_steps_is_the_job_read_at_once() {
         let job = Job::from_models(std::slice::from_ref(&m), &spec).unwrap();
         let bytes = job.to_bytes();
         for budget in BUDGETS {
-            let taken = take_in_steps(&bytes, false, budget).ok().expect("the job");
+            let taken = take_in_steps(&bytes, false, budget).expect("the job");
             assert!(taken.to_bytes() == bytes, "{name}, {budget}: other bytes");
             // damaged: cut short, or a draft's bytes read as a prepared job's
             let short = take_in_steps(&bytes[..bytes.len() - 3], false, budget).err();
@@ -350,7 +350,7 @@ fn a_job_taken_in_steps_is_the_job_read_at_once() {
         let draft = draft.borrow_mut().take().expect("a draft");
         let at_once = Job::from_draft(&&draft[..]).unwrap().to_bytes();
         for budget in BUDGETS {
-            let taken = take_in_steps(&draft, true, budget).ok().expect("the draft");
+            let taken = take_in_steps(&draft, true, budget).expect("the draft");
             assert!(taken.to_bytes() == at_once, "{name}, {budget}: the draft");
             assert!(
                 take_in_steps(&draft, false, budget).is_err(),
