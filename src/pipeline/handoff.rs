@@ -87,14 +87,8 @@ impl Job {
     /// [`Job::to_bytes`] to be written into a sink of [`BytesOut::size`] bytes, at once or
     /// in steps ([`BytesOut::write`]).
     pub fn bytes_out(&self) -> BytesOut<'_> {
-        BytesOut::new(
-            MAGIC,
-            &self.settings,
-            &self.info,
-            &self.mesh,
-            &self.zs,
-            Some(self.buckets.rows()),
-        )
+        let (settings, info) = (&self.settings, &self.info);
+        BytesOut::of(MAGIC, settings, info, &self.mesh, &self.zs, &self.buckets)
     }
 
     /// The job [`Job::to_bytes`] wrote. Bytes that are not such a job (truncated, of another
@@ -195,14 +189,8 @@ impl Draft<'_> {
 
     /// The draft's bytes to be written, at once or in steps ([`BytesOut::write`]).
     pub fn bytes_out(&self) -> BytesOut<'_> {
-        BytesOut::new(
-            DRAFT_MAGIC,
-            self.settings,
-            &self.info,
-            self.mesh,
-            self.zs,
-            Some(self.index.rows()),
-        )
+        let (settings, info) = (self.settings, &self.info);
+        BytesOut::of(DRAFT_MAGIC, settings, info, self.mesh, self.zs, self.index)
     }
 
     /// Hands the draft to `to`: to its hook at once, or written in runs of `b`'s budget into
@@ -283,30 +271,30 @@ pub struct BytesOut<'a> {
     meta: Vec<u8>,
     mesh: &'a Mesh,
     zs: &'a [f64],
-    index: Option<(&'a [u32], &'a [u32])>,
+    index: (&'a [u32], &'a [u32]),
 }
 
 impl<'a> BytesOut<'a> {
-    fn new(
+    fn of(
         magic: &'static [u8; 8],
         settings: &Settings,
         info: &JobInfo,
         mesh: &'a Mesh,
         zs: &'a [f64],
-        index: Option<(&'a [u32], &'a [u32])>,
+        index: &'a FacetBuckets,
     ) -> BytesOut<'a> {
         BytesOut {
             magic,
             meta: meta_json(settings, info),
             mesh,
             zs,
-            index,
+            index: index.rows(),
         }
     }
 
     /// The length of the bytes.
     pub fn size(&self) -> usize {
-        let rows = self.index.map_or(0, |(o, f)| 16 + (o.len() + f.len()) * 4);
+        let rows = 16 + (self.index.0.len() + self.index.1.len()) * 4;
         self.magic.len()
             + 4 * 8
             + self.meta.len()
@@ -338,11 +326,9 @@ impl<'a> BytesOut<'a> {
             .await;
         out.count(self.zs.len());
         out.put(self.zs, f64::to_le_bytes, b).await;
-        if let Some((offsets, bucket_facets)) = self.index {
-            for row in [offsets, bucket_facets] {
-                out.count(row.len());
-                out.put(row, u32::to_le_bytes, b).await;
-            }
+        for row in [self.index.0, self.index.1] {
+            out.count(row.len());
+            out.put(row, u32::to_le_bytes, b).await;
         }
         debug_assert_eq!(out.at, self.size());
     }
