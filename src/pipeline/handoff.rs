@@ -134,17 +134,8 @@ impl Job {
     /// box and the units' facet runs are the draft's: those made its layers.
     pub fn confirm(&mut self, table: &dyn Source) -> Result<(), Error> {
         let confirm = |job: &mut Job| -> Result<(), String> {
-            let mut r = Reader {
-                bytes: table,
-                at: 0,
-                buf: Vec::new(),
-            };
-            if r.take(CONFIRM_MAGIC.len())? != CONFIRM_MAGIC {
-                return Err("not a confirmation of this version".into());
-            }
-            let n = r.count(1)?;
-            let meta: Meta =
-                serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+            let mut r = Reader::new(table);
+            let meta = r.header(CONFIRM_MAGIC, "not a confirmation of this version")?;
             if r.at != table.size() {
                 return Err("bytes follow the confirmation".into());
             }
@@ -336,17 +327,8 @@ impl<'a> BytesOut<'a> {
 
 /// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
 async fn read(bytes: &dyn Source, magic: &[u8; 8], b: &Budget) -> Result<Job, String> {
-    let mut r = Reader {
-        bytes,
-        at: 0,
-        buf: Vec::new(),
-    };
-    if r.take(magic.len())? != magic {
-        return Err("not a prepared job of this version".into());
-    }
-    let n = r.count(1)?;
-    let meta: Meta =
-        serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
+    let mut r = Reader::new(bytes);
+    let meta = r.header(magic, "not a prepared job of this version")?;
     meta.settings.validate().map_err(|e| e.to_string())?;
     let n = r.count(24)?;
     let vertices: Vec<[f64; 3]> = r
@@ -465,7 +447,25 @@ struct Reader<'a> {
     buf: Vec<u8>,
 }
 
-impl Reader<'_> {
+impl<'a> Reader<'a> {
+    fn new(bytes: &'a dyn Source) -> Reader<'a> {
+        Reader {
+            bytes,
+            at: 0,
+            buf: Vec::new(),
+        }
+    }
+
+    /// The first bytes, `magic` (else the error `wrong`), and the settings and info after
+    /// them.
+    fn header(&mut self, magic: &[u8; 8], wrong: &str) -> Result<Meta, String> {
+        if self.take(magic.len())? != magic {
+            return Err(wrong.into());
+        }
+        let n = self.count(1)?;
+        serde_json::from_slice(self.take(n)?).map_err(|e| format!("its settings: {e}"))
+    }
+
     /// The next `n` bytes (copied out of the source).
     fn take(&mut self, n: usize) -> Result<&[u8], String> {
         let end = self
