@@ -5,6 +5,9 @@
 //! settings, info) and the same G-code, on the shared models and on meshes that take every
 //! branch of the preparation (repeated facets, an inside-out shell, a crack closed, an open
 //! part); a refusal is the same refusal, and a step after the end is an error, never a panic.
+//! The file's import in steps (`Model::read_in_steps`) reads what `Model::read` reads, or
+//! refuses alike; a job (or a draft) taken from its bytes in steps (`Job::take_in_steps`) is
+//! the job read at once.
 #![cfg(not(target_arch = "wasm32"))] // native only: `wasm-pack test` builds every test target
 
 mod common;
@@ -103,6 +106,85 @@ fn the_shared_models_prepare_alike_in_steps() {
             assert!(steps[0] > 200 && steps[1] > 40, "{name}: {steps:?}");
         }
     }
+}
+
+/// Imports `bytes` as `name` in steps of `budget` triangles (`Model::read_in_steps`, the
+/// page's short calls of a file's import); the model (or refusal) and the number of steps.
+fn read_in_steps(bytes: &[u8], name: &str, budget: usize) -> (Result<Model, String>, usize) {
+    use dropslice::base::steps::{Budget, Stepped};
+    use std::rc::Rc;
+    let b = Rc::new(Budget::new(0));
+    let (bytes, name, bb) = (bytes.to_vec(), name.to_string(), b.clone());
+    let mut pass = Stepped::new(async move { Model::read_in_steps(&bytes, &name, &bb).await });
+    for n in 1.. {
+        b.refill(budget);
+        if let Some(read) = pass.step() {
+            return (read.map_err(|e| e.to_string()), n);
+        }
+    }
+    unreachable!()
+}
+
+/// The import in steps reads what `Model::read` reads (every part's name, triangles and
+/// transform) or refuses as it does, with every budget of [`BUDGETS`].
+fn assert_same_import(bytes: &[u8], name: &str) -> Vec<usize> {
+    let whole = Model::read(bytes, name).map_err(|e| e.to_string());
+    let mut counts = Vec::new();
+    for budget in BUDGETS {
+        let (stepped, steps) = read_in_steps(bytes, name, budget);
+        counts.push(steps);
+        match (&whole, &stepped) {
+            (Ok(a), Ok(b)) => {
+                assert_eq!((&a.name, a.format), (&b.name, b.format), "{name}, {budget}");
+                assert_eq!(a.parts.len(), b.parts.len(), "{name}, {budget}: parts");
+                for (p, q) in a.parts.iter().zip(&b.parts) {
+                    assert_eq!(p.name, q.name, "{name}, {budget}");
+                    assert!(p.triangles == q.triangles, "{name}, {budget}: triangles");
+                    assert_eq!(p.transform_applied, q.transform_applied, "{name}, {budget}");
+                    assert_eq!(p.source_object, q.source_object, "{name}, {budget}");
+                }
+            }
+            (Err(a), Err(b)) => assert_eq!(a, b, "{name}, {budget}: another refusal"),
+            (a, b) => panic!(
+                "{name}, {budget}: one call {:?}, in steps {:?}",
+                a.is_ok(),
+                b.is_ok()
+            ),
+        }
+    }
+    assert_eq!(counts[2], 1, "{name}: an unlimited budget is one step");
+    counts
+}
+
+#[test]
+fn files_import_alike_in_steps() {
+    for (name, bytes) in common::model_files(&[".stl", ".obj", ".3mf"]) {
+        let steps = assert_same_import(&bytes, &name);
+        if name == "3DBenchy.stl" {
+            // 225,154 binary records and their check, a run of 4,096 a step
+            assert!(steps[0] > 100 && steps[1] > 20, "{name}: {steps:?}");
+        }
+    }
+    // damaged files: a coordinate that is no number deep in a binary file, a truncated
+    // binary file, an empty file, a facet of two corners in ASCII
+    let cube = common::cuboid([0.; 3], [10., 10., 10.]);
+    let mut many = Vec::new();
+    for k in 0..1000 {
+        many.extend(
+            cube.iter()
+                .map(|t| t.map(|c| [c[0] + 20.0 * k as f32, c[1], c[2]])),
+        );
+    }
+    let mut nan = many.clone();
+    nan[11_000][2][1] = f32::NAN;
+    assert_same_import(&common::stl_bytes(&nan), "nan.stl");
+    let whole = common::stl_bytes(&many);
+    assert_same_import(&whole[..whole.len() - 20], "short.stl");
+    assert_same_import(b"", "empty.stl");
+    assert_same_import(
+        b"solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\nendsolid a\n",
+        "two.stl",
+    );
 }
 
 #[test]
@@ -212,5 +294,65 @@ fn the_supported_pass_in_steps_plans_every_layer_alike() {
             gcode(&job) == whole,
             "{items} layers a step: the G-code differs"
         );
+    }
+}
+
+/// Takes `bytes` (a prepared job, or with `draft` a draft) in steps of `budget` items
+/// (`Job::take_in_steps`, the page's short calls of another worker taking the job).
+fn take_in_steps(bytes: &[u8], draft: bool, budget: usize) -> Result<Job, String> {
+    use dropslice::base::steps::{Budget, Stepped};
+    use std::rc::Rc;
+    let b = Rc::new(Budget::new(0));
+    let (bytes, bb) = (bytes.to_vec(), b.clone());
+    let mut pass = Stepped::new(async move { Job::take_in_steps(&&bytes[..], draft, &bb).await });
+    loop {
+        b.refill(budget);
+        if let Some(job) = pass.step() {
+            return job.map_err(|e| e.to_string());
+        }
+    }
+}
+
+#[test]
+fn a_job_taken_in_steps_is_the_job_read_at_once() {
+    use std::cell::RefCell;
+    use std::rc::Rc;
+    for name in ["3DBenchy.stl", "cube_gears.3mf", "esca_nonmanifold.stl"] {
+        let m = Model::read(&common::model_bytes(name), name).unwrap();
+        let spec = JobSpec::from_json(&format!(
+            r#"{{"settings": {{"allow_off_plate": true}}, "parts": [{{"file": {name:?}}}]}}"#
+        ))
+        .unwrap();
+        let job = Job::from_models(std::slice::from_ref(&m), &spec).unwrap();
+        let bytes = job.to_bytes();
+        for budget in BUDGETS {
+            let taken = take_in_steps(&bytes, false, budget).expect("the job");
+            assert!(taken.to_bytes() == bytes, "{name}, {budget}: other bytes");
+            // damaged: cut short, or a draft's bytes read as a prepared job's
+            let short = take_in_steps(&bytes[..bytes.len() - 3], false, budget).err();
+            let at_once = Job::read_bytes(&&bytes[..bytes.len() - 3]).err();
+            assert!(
+                short.is_some(),
+                "{name}, {budget}: the bytes cut short were taken"
+            );
+            assert_eq!(short, at_once.map(|e| e.to_string()), "{name}, {budget}");
+        }
+        // the draft, taken in steps and at once
+        let draft: Rc<RefCell<Option<Vec<u8>>>> = Rc::default();
+        let d = draft.clone();
+        let hook: dropslice::pipeline::DraftHook =
+            Box::new(move |draft| *d.borrow_mut() = Some(draft.to_bytes()));
+        let mut prep = Job::prepare_drafted(Arc::new(vec![m]), &spec, Some(hook));
+        while prep.step(16_384).unwrap().is_none() {}
+        let draft = draft.borrow_mut().take().expect("a draft");
+        let at_once = Job::from_draft(&&draft[..]).unwrap().to_bytes();
+        for budget in BUDGETS {
+            let taken = take_in_steps(&draft, true, budget).expect("the draft");
+            assert!(taken.to_bytes() == at_once, "{name}, {budget}: the draft");
+            assert!(
+                take_in_steps(&draft, false, budget).is_err(),
+                "{name}: a draft as a job"
+            );
+        }
     }
 }

@@ -9,6 +9,7 @@
 use std::future::Future;
 use std::ops::Range;
 use std::pin::Pin;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::task::{Context, Poll, Waker};
 
@@ -18,12 +19,15 @@ pub use crate::base::parallel::RUN;
 pub struct Budget {
     left: AtomicUsize,
     limited: bool,
+    /// The pass being worked through ([`Budget::enter`]), for the page's profile.
+    pass: Mutex<&'static str>,
 }
 
 /// The budget of work run to its end at once.
 pub static UNLIMITED: Budget = Budget {
     left: AtomicUsize::new(usize::MAX),
     limited: false,
+    pass: Mutex::new(""),
 };
 
 impl Budget {
@@ -32,7 +36,23 @@ impl Budget {
         Budget {
             left: AtomicUsize::new(items),
             limited: true,
+            pass: Mutex::new(""),
         }
+    }
+
+    /// Names the pass the work goes on with (what [`Budget::pass`] tells): a step's calls are
+    /// named by the passes they worked through.
+    pub fn enter(&self, pass: &'static str) {
+        if self.limited
+            && let Ok(mut p) = self.pass.lock()
+        {
+            *p = pass;
+        }
+    }
+
+    /// The pass named last by [`Budget::enter`] (empty before the first).
+    pub fn pass(&self) -> &'static str {
+        self.pass.lock().map_or("", |p| *p)
     }
 
     /// Gives the next step `items` to work through (at least one run's worth is always done).
@@ -43,6 +63,15 @@ impl Budget {
     /// Whether the work pauses when the budget is spent (not [`UNLIMITED`]).
     pub fn limited(&self) -> bool {
         self.limited
+    }
+
+    /// Ends the step here (when limited): a piece of work that is not divided gets a step
+    /// of its own, not the end of one.
+    pub fn end_step(&self) -> Pause {
+        if self.limited {
+            self.left.store(0, Ordering::Relaxed);
+        }
+        Pause { due: self.limited }
     }
 
     /// Counts `n` items as done; the pass pauses here (its step ends) once none are left.

@@ -2,6 +2,7 @@
 //! holds for the page ([`ModelInfo`]) and the models of a job's parts ([`models_of`]).
 
 use crate::base::error::Error;
+use crate::base::steps::{self, Budget};
 use crate::model::import::stl::{self, Format};
 use crate::model::import::{self, Part};
 use crate::model::mesh::Bounds;
@@ -23,9 +24,16 @@ pub struct Model {
 impl Model {
     /// Imports a file (see [`import::read_parts`]).
     pub fn read(bytes: &[u8], name: &str) -> Result<Model, Error> {
+        steps::now(Model::read_in_steps(bytes, name, &steps::UNLIMITED))
+    }
+
+    /// [`Model::read`] as a pass of `budget`'s budget: an STL file in runs of triangles
+    /// ([`stl::parse_in_steps`]: the page's short calls), an OBJ or 3MF file at once. The
+    /// same model, or the same refusal.
+    pub async fn read_in_steps(bytes: &[u8], name: &str, budget: &Budget) -> Result<Model, Error> {
         let format = match import::detect(bytes, name) {
             Format::Binary | Format::Ascii => {
-                let (triangles, format) = stl::parse(bytes)?;
+                let (triangles, format) = stl::parse_in_steps(bytes, budget).await?;
                 return Ok(Model {
                     name: name.to_string(),
                     format,

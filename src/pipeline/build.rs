@@ -19,7 +19,7 @@ use crate::model::prepare::{
 };
 use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
-use crate::pipeline::handoff::Draft;
+use crate::pipeline::handoff::{Draft, DraftTo};
 use crate::pipeline::{Job, budget};
 use crate::slicing::slice::{self, FacetBuckets};
 use std::cell::Cell;
@@ -72,10 +72,11 @@ impl Job {
         models: &[Model],
         spec: &job::JobSpec,
         b: &Budget,
-        draft: Option<DraftHook>,
+        draft: Option<DraftTo>,
         drafted: &Cell<Option<bool>>,
     ) -> Result<Job, Error> {
         let (mesh, input, settings) = Job::merged(models, spec, b).await?;
+        b.enter("bounds and planes");
         let mut building = Building::new(mesh, input, settings)?;
         // The facet index of the mesh as merged (dropped below if facets are); with it the
         // draft: the mesh, its planes, index and units' facet runs. The passes below change
@@ -83,34 +84,47 @@ impl Job {
         let mut draft_of = None;
         if let Ok(zs) = &building.made.zs {
             let m = &building.made;
+            b.enter("facet index");
             let index = FacetBuckets::new_in_steps(&m.mesh, zs, b).await;
-            if let Some(hand) = draft {
-                hand(&Draft {
+            if let Some(to) = draft {
+                // the draft handed out in steps of its own
+                b.end_step().await;
+                b.enter("draft");
+                let d = Draft {
                     settings: &m.settings,
                     info: m.provisional_info(zs.len()),
                     mesh: &m.mesh,
                     zs,
                     index: &index,
-                });
+                };
+                d.hand_to(to, b).await;
                 draft_of = Some((zs.clone(), m.groups.clone()));
+                b.end_step().await;
             }
             building.made.index = Some(index);
         }
         let mut changed = false;
+        b.enter("repeated facets");
         let kept = building.made.mesh.unrepeated_in_steps(b).await;
         changed |= kept.iter().any(|&k| !k);
         let all = kept.iter().all(|&k| k);
         let shells = match all {
-            true => Some(building.made.mesh.shells_in_steps(b).await),
+            true => {
+                b.enter("shells");
+                Some(building.made.mesh.shells_in_steps(b).await)
+            }
             false => None,
         };
         building.unrepeated_in_steps(kept, shells, b).await;
+        b.enter("cracks");
         building.close_cracks();
         changed |= building.made.weld != (0, 0);
         let shells = building.shells.as_ref().expect("the shells were found");
+        b.enter("orientation");
         let orientation = building.made.mesh.orientation_in_steps(shells, b).await;
         changed |= orientation.1.iter().any(|&f| f);
         if orientation.1.is_empty() {
+            b.enter("statistics");
             let (facets_in_file, dropped) =
                 (building.made.input.facets_in_file, building.dropped());
             building.made.stats = Some(
@@ -122,7 +136,9 @@ impl Job {
             );
         }
         building.orientation = Some(orientation);
+        b.enter("checks");
         let mut checked = building.checked()?;
+        b.enter("overhangs");
         let overhangs = checked.overhangs_in_steps(b).await;
         let (made_stats, made_index) = (checked.made.stats.take(), checked.made.index.take());
         let repaired = match checked.made.zs.as_ref() {
@@ -131,18 +147,23 @@ impl Job {
                 let stats = match made_stats {
                     Some(s) => s,
                     None => {
+                        b.enter("statistics");
                         let dropped = input.degenerate + checked.made.weld.1;
                         mesh.stats_in_steps(input.facets_in_file, dropped, b).await
                     }
                 };
                 let buckets = match made_index {
                     Some(index) => index,
-                    None => FacetBuckets::new_in_steps(mesh, zs, b).await,
+                    None => {
+                        b.enter("facet index");
+                        FacetBuckets::new_in_steps(mesh, zs, b).await
+                    }
                 };
                 Some((buckets, stats))
             }
             Err(_) => None,
         };
+        b.enter("estimate");
         let job = checked.conclude(overhangs, repaired)?;
         if let Some((zs, groups)) = draft_of {
             drafted.set(Some(!changed && job.zs == zs && job.info.groups == groups));
@@ -158,6 +179,7 @@ impl Job {
         spec: &job::JobSpec,
         budget: &Budget,
     ) -> Result<(Mesh, Input, Settings), Error> {
+        budget.enter("job");
         spec.validate()?;
         let settings = spec.settings.clone();
         let by_part = models_of(models, spec)?;
@@ -179,6 +201,7 @@ impl Job {
         let (mut facets_in_file, mut degenerate, mut facets) = (0usize, 0usize, 0usize);
         for (i, (p, m)) in spec.parts.iter().zip(&by_part).enumerate() {
             let tris = m.triangles(p.item).map_err(|e| at_part(i, e))?;
+            budget.enter("weld");
             let (mesh, dropped) = match budget.limited() {
                 true => Mesh::weld_in_steps(&tris, budget).await,
                 false => Mesh::weld(&tris),
@@ -188,6 +211,7 @@ impl Job {
             if facets > MAX_JOB_TRIANGLES {
                 return Err(too_many_triangles());
             }
+            budget.enter("frame");
             let frame = Frame::of_in_steps(
                 &mesh.vertices,
                 |v| [*v],
@@ -207,6 +231,7 @@ impl Job {
             welded.push(mesh);
             frames.push(frame);
         }
+        budget.enter("layout and merge");
         let layout = place_instances(&by_part, spec, &frames)?;
         // A job of one instance counts the bodies of its prepared mesh; a job of several, each
         // part's own (two files are two parts, not one part of two bodies).
@@ -638,9 +663,6 @@ impl Checked {
         made.into_job(buckets, stats)
     }
 }
-
-/// What [`Job::prepare_drafted`] hands its [`Draft`] to (once).
-pub type DraftHook = Box<dyn FnOnce(&Draft<'_>)>;
 
 /// Checks the width in droplets; the plane heights of the layers (at least one).
 fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {

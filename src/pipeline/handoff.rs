@@ -22,8 +22,9 @@
 
 use super::Job;
 use crate::base::error::Error;
-use crate::base::parallel::{RUN, in_runs};
+use crate::base::parallel::RUN;
 use crate::base::settings::Settings;
+use crate::base::steps::{self, Budget};
 use crate::model::mesh::Mesh;
 use crate::model::prepare::JobInfo;
 use crate::slicing::slice::FacetBuckets;
@@ -75,22 +76,19 @@ impl Job {
     /// The prepared job as bytes for [`Job::from_bytes`] (about 24 B per vertex, 12 B per
     /// facet and 4 B per facet and layer it crosses).
     pub fn to_bytes(&self) -> Vec<u8> {
-        let (size, write) = self.bytes_writer();
-        let mut out = vec![0u8; size];
-        write(&mut out);
-        out
+        bytes_of(self.bytes_writer())
     }
 
     /// The length of [`Job::to_bytes`] and what writes them into a sink of that length.
     pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
-        writer(
-            MAGIC,
-            &self.settings,
-            &self.info,
-            &self.mesh,
-            &self.zs,
-            Some(self.buckets.rows()),
-        )
+        self.bytes_out().at_once()
+    }
+
+    /// [`Job::to_bytes`] to be written into a sink of [`BytesOut::size`] bytes, at once or
+    /// in steps ([`BytesOut::write`]).
+    pub fn bytes_out(&self) -> BytesOut<'_> {
+        let (settings, info) = (&self.settings, &self.info);
+        BytesOut::of(MAGIC, settings, info, &self.mesh, &self.zs, &self.buckets)
     }
 
     /// The job [`Job::to_bytes`] wrote. Bytes that are not such a job (truncated, of another
@@ -102,14 +100,22 @@ impl Job {
 
     /// [`Job::from_bytes`] from any source of the bytes, read a run of items at a time.
     pub fn read_bytes(bytes: &dyn Source) -> Result<Job, Error> {
-        read(bytes, MAGIC).map_err(damaged)
+        steps::now(Job::take_in_steps(bytes, false, &steps::UNLIMITED))
+    }
+
+    /// [`Job::read_bytes`] (or, with `draft`, [`Job::from_draft`]) as a pass of `b`'s budget:
+    /// the arrays read and checked in runs of items (the page's short calls). The same job,
+    /// or the same refusal.
+    pub async fn take_in_steps(bytes: &dyn Source, draft: bool, b: &Budget) -> Result<Job, Error> {
+        let magic = if draft { DRAFT_MAGIC } else { MAGIC };
+        read(bytes, magic, b).await.map_err(damaged)
     }
 
     /// The job of a [`Draft`]'s bytes: it slices as the finished job does if [`Job::confirm`] takes the job worker's confirmation, and is not to be
     /// used otherwise (its info is provisional). Damaged bytes are refused as by
     /// [`Job::read_bytes`].
     pub fn from_draft(bytes: &dyn Source) -> Result<Job, Error> {
-        read(bytes, DRAFT_MAGIC).map_err(damaged)
+        steps::now(Job::take_in_steps(bytes, true, &steps::UNLIMITED))
     }
 
     /// The confirmation of a drafted job for [`Job::confirm`]: its final settings and info
@@ -128,8 +134,8 @@ impl Job {
     /// box and the units' facet runs are the draft's: those made its layers.
     pub fn confirm(&mut self, table: &dyn Source) -> Result<(), Error> {
         let confirm = |job: &mut Job| -> Result<(), String> {
-            let not_ours = "not a confirmation of this version";
-            let (r, meta) = Reader::past_meta(table, CONFIRM_MAGIC, not_ours)?;
+            let mut r = Reader::new(table);
+            let meta = r.header(CONFIRM_MAGIC, "not a confirmation of this version")?;
             if r.at != table.size() {
                 return Err("bytes follow the confirmation".into());
             }
@@ -162,17 +168,60 @@ pub struct Draft<'a> {
 }
 
 impl Draft<'_> {
+    /// The draft's bytes, for [`Job::from_draft`].
+    pub fn to_bytes(&self) -> Vec<u8> {
+        bytes_of(self.bytes_writer())
+    }
+
     /// The length of the draft's bytes and what writes them into a sink of that length.
     pub fn bytes_writer(&self) -> (usize, impl FnOnce(&mut dyn Sink) + '_) {
-        writer(
-            DRAFT_MAGIC,
-            self.settings,
-            &self.info,
-            self.mesh,
-            self.zs,
-            Some(self.index.rows()),
-        )
+        self.bytes_out().at_once()
     }
+
+    /// The draft's bytes to be written, at once or in steps ([`BytesOut::write`]).
+    pub fn bytes_out(&self) -> BytesOut<'_> {
+        let (settings, info) = (self.settings, &self.info);
+        BytesOut::of(DRAFT_MAGIC, settings, info, self.mesh, self.zs, self.index)
+    }
+
+    /// Hands the draft to `to`: to its hook at once, or written in runs of `b`'s budget into
+    /// the sink it opens for the draft's length.
+    pub(crate) async fn hand_to(&self, to: DraftTo, b: &Budget) {
+        match to {
+            DraftTo::Hook(hand) => hand(self),
+            DraftTo::Steps(mut sink) => {
+                let out = self.bytes_out();
+                sink.open(out.size());
+                out.write(sink.as_sink(), b).await;
+                sink.done();
+            }
+        }
+    }
+}
+
+/// What [`Job::prepare_drafted`] hands its [`Draft`] to (once): a function of it.
+pub type DraftHook = Box<dyn FnOnce(&Draft<'_>)>;
+
+/// Where [`Job::prepare_drafted_to`] hands its [`Draft`]: to a hook at once, or written in
+/// steps into a [`DraftSink`] (the page: a buffer outside the module's memory).
+pub enum DraftTo {
+    Hook(DraftHook),
+    Steps(Box<dyn DraftSink>),
+}
+
+/// A sink the draft is written into in steps: opened for the draft's length, told when
+/// every byte is written.
+pub trait DraftSink {
+    fn open(&mut self, size: usize);
+    fn as_sink(&mut self) -> &mut dyn Sink;
+    fn done(&mut self);
+}
+
+/// The bytes a writer ([`Job::bytes_writer`], [`Draft::bytes_writer`]) writes.
+fn bytes_of((size, write): (usize, impl FnOnce(&mut dyn Sink))) -> Vec<u8> {
+    let mut out = vec![0u8; size];
+    write(&mut out);
+    out
 }
 
 fn damaged(e: String) -> Error {
@@ -206,73 +255,109 @@ fn with_shifts(meta: Meta) -> Result<(Settings, JobInfo), String> {
     Ok((settings, info))
 }
 
-/// The length of a job's bytes (`index`: the facet index' rows) and what writes them into a
-/// sink of that length.
-fn writer<'a>(
+/// A job's bytes to be written (`index`: the facet index' rows): their length, and what
+/// writes them into a sink of that length, at once or in steps.
+pub struct BytesOut<'a> {
     magic: &'static [u8; 8],
-    settings: &Settings,
-    info: &JobInfo,
+    meta: Vec<u8>,
     mesh: &'a Mesh,
     zs: &'a [f64],
-    index: Option<(&'a [u32], &'a [u32])>,
-) -> (usize, impl FnOnce(&mut dyn Sink) + 'a) {
-    let meta = meta_json(settings, info);
-    let rows = index.map_or(0, |(o, f)| 16 + (o.len() + f.len()) * 4);
-    let size = magic.len()
-        + 4 * 8
-        + meta.len()
-        + mesh.vertices.len() * 24
-        + mesh.facets.len() * 12
-        + zs.len() * 8
-        + rows;
-    let write = move |sink: &mut dyn Sink| {
-        let mut out = Writer { sink, at: 0 };
-        out.bytes(magic);
-        out.count(meta.len());
-        out.bytes(&meta);
-        out.count(mesh.vertices.len());
-        out.put(mesh.vertices.as_flattened(), f64::to_le_bytes);
-        out.count(mesh.facets.len());
-        out.put(mesh.facets.as_flattened(), u32::to_le_bytes);
-        out.count(zs.len());
-        out.put(zs, f64::to_le_bytes);
-        if let Some((offsets, bucket_facets)) = index {
-            for row in [offsets, bucket_facets] {
-                out.count(row.len());
-                out.put(row, u32::to_le_bytes);
-            }
+    index: (&'a [u32], &'a [u32]),
+}
+
+impl<'a> BytesOut<'a> {
+    fn of(
+        magic: &'static [u8; 8],
+        settings: &Settings,
+        info: &JobInfo,
+        mesh: &'a Mesh,
+        zs: &'a [f64],
+        index: &'a FacetBuckets,
+    ) -> BytesOut<'a> {
+        BytesOut {
+            magic,
+            meta: meta_json(settings, info),
+            mesh,
+            zs,
+            index: index.rows(),
         }
-        debug_assert_eq!(out.at, size);
-    };
-    (size, write)
+    }
+
+    /// The length of the bytes.
+    pub fn size(&self) -> usize {
+        let rows = 16 + (self.index.0.len() + self.index.1.len()) * 4;
+        self.magic.len()
+            + 4 * 8
+            + self.meta.len()
+            + self.mesh.vertices.len() * 24
+            + self.mesh.facets.len() * 12
+            + self.zs.len() * 8
+            + rows
+    }
+
+    /// The length and what writes the bytes at once.
+    fn at_once(self) -> (usize, impl FnOnce(&mut dyn Sink) + 'a) {
+        let size = self.size();
+        let write = move |sink: &mut dyn Sink| steps::now(self.write(sink, &steps::UNLIMITED));
+        (size, write)
+    }
+
+    /// Writes the bytes into `sink` (of [`BytesOut::size`] bytes), the arrays in runs of `b`'s
+    /// budget.
+    pub async fn write(&self, sink: &mut dyn Sink, b: &Budget) {
+        let mut out = Writer { sink, at: 0 };
+        out.bytes(self.magic);
+        out.count(self.meta.len());
+        out.bytes(&self.meta);
+        out.count(self.mesh.vertices.len());
+        out.put(self.mesh.vertices.as_flattened(), f64::to_le_bytes, b)
+            .await;
+        out.count(self.mesh.facets.len());
+        out.put(self.mesh.facets.as_flattened(), u32::to_le_bytes, b)
+            .await;
+        out.count(self.zs.len());
+        out.put(self.zs, f64::to_le_bytes, b).await;
+        for row in [self.index.0, self.index.1] {
+            out.count(row.len());
+            out.put(row, u32::to_le_bytes, b).await;
+        }
+        debug_assert_eq!(out.at, self.size());
+    }
 }
 
 /// The job of `magic`'s bytes: [`MAGIC`] (a prepared job) or [`DRAFT_MAGIC`] (a draft).
-fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
-    let (mut r, meta) = Reader::past_meta(bytes, magic, "not a prepared job of this version")?;
+async fn read(bytes: &dyn Source, magic: &[u8; 8], b: &Budget) -> Result<Job, String> {
+    let mut r = Reader::new(bytes);
+    let meta = r.header(magic, "not a prepared job of this version")?;
     meta.settings.validate().map_err(|e| e.to_string())?;
     let n = r.count(24)?;
-    let vertices: Vec<[f64; 3]> = r.get(n, |c: [u8; 24]| {
-        std::array::from_fn(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap()))
-    });
+    let vertices: Vec<[f64; 3]> = r
+        .get(n, b, |c: [u8; 24]| {
+            std::array::from_fn(|k| f64::from_le_bytes(c[8 * k..8 * k + 8].try_into().unwrap()))
+        })
+        .await;
     // Every vertex within the job's box (grown by 1 mm: the box is measured before the repair
     // closes cracks), so the work of every layer stays what the job worker's was.
     let (lo, hi) = (meta.info.bounds.min, meta.info.bounds.max);
     let boxed = |v: &[f64; 3]| (0..3).all(|k| v[k] >= lo[k] - 1.0 && v[k] <= hi[k] + 1.0);
-    if !all(&vertices, boxed) {
+    if !all(&vertices, b, boxed).await {
         return Err("a vertex lies outside the job's box".into());
     }
     let n = r.count(12)?;
-    let facets: Vec<[u32; 3]> = r.get(n, |c: [u8; 12]| {
-        std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
-    });
-    if !all(&facets, |f| {
+    let facets: Vec<[u32; 3]> = r
+        .get(n, b, |c: [u8; 12]| {
+            std::array::from_fn(|k| u32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))
+        })
+        .await;
+    if !all(&facets, b, |f| {
         f.iter().all(|&i| (i as usize) < vertices.len())
-    }) {
+    })
+    .await
+    {
         return Err("a facet names a vertex past the last".into());
     }
     let n = r.count(8)?;
-    let zs: Vec<f64> = r.get(n, f64::from_le_bytes);
+    let zs: Vec<f64> = r.get(n, b, f64::from_le_bytes).await;
     if zs.is_empty() || !zs.iter().all(|z| z.is_finite()) || zs.windows(2).any(|w| w[0] >= w[1]) {
         return Err("the plane heights are not finite and rising".into());
     }
@@ -290,7 +375,7 @@ fn read(bytes: &dyn Source, magic: &[u8; 8]) -> Result<Job, String> {
     let mut rows = [Vec::new(), Vec::new()];
     for row in &mut rows {
         let n = r.count(4)?;
-        *row = r.get(n, u32::from_le_bytes);
+        *row = r.get(n, b, u32::from_le_bytes).await;
     }
     if r.at != bytes.size() {
         return Err("bytes follow the facet index".into());
@@ -323,25 +408,34 @@ impl Writer<'_> {
         self.bytes(&(n as u64).to_le_bytes());
     }
 
-    /// `items` in the bytes `le` gives each, a run at a time through one buffer (in runs:
-    /// [`in_runs`]).
-    fn put<T: Copy, const N: usize>(&mut self, items: &[T], le: fn(T) -> [u8; N]) {
+    /// `items` in the bytes `le` gives each, a run at a time through one buffer (in runs of
+    /// `b`'s budget: [`steps::runs`]).
+    async fn put<T: Copy, const N: usize>(
+        &mut self,
+        items: &[T],
+        le: fn(T) -> [u8; N],
+        b: &Budget,
+    ) {
         let mut buf = vec![0u8; N * RUN.min(items.len())];
-        in_runs(items.len(), &mut |r| {
+        steps::runs(items.len(), b, &mut |r| {
             let chunk = &mut buf[..N * r.len()];
             for (c, &x) in chunk.chunks_exact_mut(N).zip(&items[r]) {
                 c.copy_from_slice(&le(x));
             }
             self.sink.write(self.at, chunk);
             self.at += chunk.len();
-        });
+        })
+        .await;
     }
 }
 
-/// Whether `ok` holds for every item (in runs: [`in_runs`]).
-fn all<T>(items: &[T], ok: impl Fn(&T) -> bool) -> bool {
+/// Whether `ok` holds for every item (in runs of `b`'s budget: [`steps::runs`]).
+async fn all<T>(items: &[T], b: &Budget, ok: impl Fn(&T) -> bool) -> bool {
     let mut all = true;
-    in_runs(items.len(), &mut |r| all = all && items[r].iter().all(&ok));
+    steps::runs(items.len(), b, &mut |r| {
+        all = all && items[r].iter().all(&ok)
+    })
+    .await;
     all
 }
 
@@ -354,25 +448,22 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
-    /// The settings and info that follow `magic` at the start of `bytes`, and the reader
-    /// past them (`not_ours`: the message when the bytes do not start with `magic`).
-    fn past_meta(
-        bytes: &'a dyn Source,
-        magic: &[u8; 8],
-        not_ours: &str,
-    ) -> Result<(Reader<'a>, Meta), String> {
-        let mut r = Reader {
+    fn new(bytes: &'a dyn Source) -> Reader<'a> {
+        Reader {
             bytes,
             at: 0,
             buf: Vec::new(),
-        };
-        if r.take(magic.len())? != magic {
-            return Err(not_ours.into());
         }
-        let n = r.count(1)?;
-        let meta: Meta =
-            serde_json::from_slice(r.take(n)?).map_err(|e| format!("its settings: {e}"))?;
-        Ok((r, meta))
+    }
+
+    /// The first bytes, `magic` (else the error `wrong`), and the settings and info after
+    /// them.
+    fn header(&mut self, magic: &[u8; 8], wrong: &str) -> Result<Meta, String> {
+        if self.take(magic.len())? != magic {
+            return Err(wrong.into());
+        }
+        let n = self.count(1)?;
+        serde_json::from_slice(self.take(n)?).map_err(|e| format!("its settings: {e}"))
     }
 
     /// The next `n` bytes (copied out of the source).
@@ -399,11 +490,17 @@ impl<'a> Reader<'a> {
     }
 
     /// The next `n` items (checked by [`Reader::count`]), `N` bytes each, as `from` reads
-    /// them: a run of items at a time through one buffer (in runs: [`in_runs`]).
-    fn get<T, const N: usize>(&mut self, n: usize, from: impl Fn([u8; N]) -> T) -> Vec<T> {
+    /// them: a run of items at a time through one buffer (in runs of `b`'s budget:
+    /// [`steps::runs`]).
+    async fn get<T, const N: usize>(
+        &mut self,
+        n: usize,
+        b: &Budget,
+        from: impl Fn([u8; N]) -> T,
+    ) -> Vec<T> {
         let mut out = Vec::with_capacity(n);
         let mut buf = vec![0u8; N * RUN.min(n)];
-        in_runs(n, &mut |r| {
+        steps::runs(n, b, &mut |r| {
             let chunk = &mut buf[..N * r.len()];
             self.bytes.read(self.at, chunk);
             self.at += chunk.len();
@@ -412,7 +509,8 @@ impl<'a> Reader<'a> {
                     .chunks_exact(N)
                     .map(|c| from(c.try_into().expect("N bytes"))),
             )
-        });
+        })
+        .await;
         out
     }
 }

@@ -11,7 +11,7 @@ mod supported;
 mod writer;
 
 pub use budget::{MAX_DROPLETS, MAX_DROPLETS_WITH_SUPPORT, MAX_LAYER_DROPLETS_WITH_SUPPORT};
-pub use build::DraftHook;
+pub use handoff::{DraftHook, DraftSink, DraftTo};
 pub use job::Job;
 pub use preparation::Preparation;
 pub use supported::SupportedPlans;

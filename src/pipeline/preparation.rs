@@ -7,7 +7,7 @@ use crate::base::steps::{Budget, Stepped};
 use crate::model::models::Model;
 use crate::model::spec as job;
 use crate::pipeline::Job;
-use crate::pipeline::build::DraftHook;
+use crate::pipeline::handoff::{DraftHook, DraftTo};
 use std::cell::Cell;
 use std::rc::Rc;
 use std::sync::Arc;
@@ -31,6 +31,16 @@ impl Job {
         spec: &job::JobSpec,
         draft: Option<DraftHook>,
     ) -> Preparation {
+        Job::prepare_drafted_to(models, spec, draft.map(DraftTo::Hook))
+    }
+
+    /// [`Job::prepare_drafted`] that hands the draft to a hook or writes it, in steps of
+    /// their own, into a sink ([`DraftTo`]).
+    pub fn prepare_drafted_to(
+        models: Arc<Vec<Model>>,
+        spec: &job::JobSpec,
+        draft: Option<DraftTo>,
+    ) -> Preparation {
         let budget = Rc::new(Budget::new(0));
         let drafted = Rc::new(Cell::new(None));
         let (b, d) = (budget.clone(), drafted.clone());
@@ -38,6 +48,7 @@ impl Job {
         Preparation {
             budget,
             drafted,
+            passes: ("", ""),
             pass: Some(Stepped::new(async move {
                 Job::build_in_steps(&models, &spec, &b, draft, &d).await
             })),
@@ -52,6 +63,8 @@ pub struct Preparation {
     budget: Rc<Budget>,
     /// Whether the job is its draft's, once made (`None`: no draft was made).
     drafted: Rc<Cell<Option<bool>>>,
+    /// The passes the last step began and ended in ([`Preparation::passes`]).
+    passes: (&'static str, &'static str),
     /// `None` once the job was handed out (or a step failed).
     pass: Option<Stepped<Result<Job, Error>>>,
 }
@@ -68,13 +81,23 @@ impl Preparation {
             ));
         };
         self.budget.refill(items);
-        match pass.step() {
+        let first = self.budget.pass();
+        let made = pass.step();
+        self.passes = (first, self.budget.pass());
+        match made {
             None => Ok(None),
             Some(made) => {
                 self.pass = None;
                 made.map(Some)
             }
         }
+    }
+
+    /// The passes the last step worked in: the one it began in and the one it ended in (the
+    /// same when it stayed in one), such as "weld" or "facet index" (empty before the first
+    /// step began any).
+    pub fn passes(&self) -> (&'static str, &'static str) {
+        self.passes
     }
 
     /// Once the job is made: whether it is the one its [`Draft`] slices (the same mesh,

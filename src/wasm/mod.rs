@@ -338,6 +338,56 @@ impl crate::pipeline::handoff::Source for JsBytes {
     }
 }
 
+/// The draft's buffer outside the module's memory, written in steps
+/// ([`Session::begin_drafted`]); handed to `out` once whole.
+struct JsDraft {
+    buf: Option<JsBytes>,
+    out: std::rc::Rc<std::cell::RefCell<Option<Uint8Array>>>,
+}
+
+impl crate::pipeline::DraftSink for JsDraft {
+    fn open(&mut self, size: usize) {
+        self.buf = Some(JsBytes(Uint8Array::new_with_length(size as u32)));
+    }
+    fn as_sink(&mut self) -> &mut dyn crate::pipeline::handoff::Sink {
+        self.buf
+            .get_or_insert_with(|| JsBytes(Uint8Array::new_with_length(0)))
+    }
+    fn done(&mut self) {
+        *self.out.borrow_mut() = self.buf.take().map(|b| b.0);
+    }
+}
+
+/// The prepared job being written as bytes in short calls ([`Session::begin_prepared`]).
+#[wasm_bindgen]
+pub struct Writing {
+    budget: std::rc::Rc<Budget>,
+    /// `None` once written.
+    pass: Option<Stepped<Uint8Array>>,
+    bytes: Option<Uint8Array>,
+}
+
+#[wasm_bindgen]
+impl Writing {
+    /// Writes about `items` items (vertices, facets, the index' entries): true once every
+    /// byte is written (then [`Writing::take`]).
+    pub fn step(&mut self, items: u32) -> bool {
+        if let Some(pass) = self.pass.as_mut() {
+            self.budget.refill(items as usize);
+            self.bytes = pass.step();
+            if self.bytes.is_some() {
+                self.pass = None;
+            }
+        }
+        self.pass.is_none()
+    }
+
+    /// The bytes once written, as [`Session::prepared`] gives them (then `undefined`).
+    pub fn take(&mut self) -> Option<Uint8Array> {
+        self.bytes.take()
+    }
+}
+
 /// A job being prepared in short calls ([`Session::begin`]).
 #[wasm_bindgen]
 pub struct Preparing {
@@ -364,11 +414,52 @@ impl Preparing {
         Ok(self.job.is_some())
     }
 
+    /// The passes the last [`Preparing::step`] worked in, for the page's profile: `"weld"`,
+    /// or `"weld → frame"` when it went on into the next.
+    pub fn pass(&self) -> String {
+        match self.prep.passes() {
+            (a, b) if a == b || a.is_empty() => b.to_string(),
+            (a, b) => format!("{a} → {b}"),
+        }
+    }
+
     /// The draft's bytes ([`Session::begin_drafted`]: the job as its parts were merged, for
     /// [`Session::from_draft`] in the other workers) once a step made it, then `undefined`:
     /// each draft is handed out once.
     pub fn take_draft(&self) -> Option<Uint8Array> {
         self.draft.borrow_mut().take()
+    }
+}
+
+/// A job another worker prepared, or its draft, being taken in short calls
+/// ([`Session::begin_take`]).
+#[wasm_bindgen]
+pub struct Taking {
+    budget: std::rc::Rc<Budget>,
+    /// `None` once the job was read (or refused).
+    pass: Option<Stepped<Result<Job, Error>>>,
+    job: Option<Job>,
+    draft: bool,
+}
+
+#[wasm_bindgen]
+impl Taking {
+    /// Reads about `items` items of the job (vertices, facets, the index' entries): true
+    /// once it is read (then [`Session::from_taken`]). Throws `{kind: "internal", message}`
+    /// as [`Session::from_prepared`] does if the bytes are damaged.
+    pub fn step(&mut self, items: u32) -> Result<bool, JsValue> {
+        let Some(pass) = self.pass.as_mut() else {
+            return Ok(self.job.is_some());
+        };
+        self.budget.refill(items as usize);
+        match stages::time(Stage::Prepare, || pass.step()) {
+            None => Ok(false),
+            Some(read) => {
+                self.pass = None;
+                self.job = Some(read.map_err(js_error)?);
+                Ok(true)
+            }
+        }
     }
 }
 
@@ -447,21 +538,19 @@ impl Session {
 
     /// [`Session::begin`] that also makes a draft of the job as soon as its parts are merged
     /// (before the shells, their orientation, the repairs and the checks):
-    /// [`Preparing::take_draft`] hands it out, written a run at a time straight into a buffer
-    /// outside the module's memory; the other workers slice from it ([`Session::from_draft`])
+    /// [`Preparing::take_draft`] hands it out, written in steps of its own (a budget of items
+    /// a step) straight into a buffer outside the module's memory; the other workers slice from it ([`Session::from_draft`])
     /// while this preparation goes on. Once the job is made, [`Session::confirmation`] says
     /// whether it is the draft's.
     pub fn begin_drafted(models: &Models, job: JsValue) -> Result<Preparing, JsValue> {
         let spec = job_of(job)?;
         let draft: std::rc::Rc<std::cell::RefCell<Option<Uint8Array>>> = Default::default();
-        let into = draft.clone();
-        let hook: crate::pipeline::DraftHook = Box::new(move |d| {
-            let (size, write) = d.bytes_writer();
-            let out = Uint8Array::new_with_length(size as u32);
-            write(&mut JsBytes(out.clone()));
-            *into.borrow_mut() = Some(out);
-        });
-        let prep = Job::prepare_drafted(models.models.clone(), &spec, Some(hook));
+        let sink = JsDraft {
+            buf: None,
+            out: draft.clone(),
+        };
+        let to = crate::pipeline::DraftTo::Steps(Box::new(sink));
+        let prep = Job::prepare_drafted_to(models.models.clone(), &spec, Some(to));
         Ok(Preparing {
             prep,
             job: None,
@@ -505,6 +594,36 @@ impl Session {
         Ok(s)
     }
 
+    /// [`Session::from_prepared`] (or, with `draft`, [`Session::from_draft`]) in short calls:
+    /// this call only takes the bytes; [`Taking::step`] reads a budget of items a call until
+    /// it returns true; [`Session::from_taken`] makes the session. The same session.
+    pub fn begin_take(bytes: Uint8Array, draft: bool) -> Taking {
+        let budget = std::rc::Rc::new(Budget::new(0));
+        let b = budget.clone();
+        let source = JsBytes(bytes);
+        Taking {
+            budget,
+            pass: Some(Stepped::new(async move {
+                Job::take_in_steps(&source, draft, &b).await
+            })),
+            job: None,
+            draft,
+        }
+    }
+
+    /// The session of a job taken in short calls ([`Session::begin_take`]); `internal` if
+    /// it has not been read to its end.
+    pub fn from_taken(taking: Taking) -> Result<Session, JsValue> {
+        let job = taking.job.ok_or_else(|| {
+            js_error(Error::Internal(
+                "the job has not been taken to its end".into(),
+            ))
+        })?;
+        let mut s = Session::with(job);
+        s.draft = taking.draft;
+        Ok(s)
+    }
+
     /// Takes the job worker's confirmation ([`Session::confirmation`]) into a draft's
     /// session: its final info; the layers planned so far stand. Throws `{kind: "internal"}`
     /// (the session left as it was) if it is not this draft's.
@@ -533,6 +652,23 @@ impl Session {
         let out = Uint8Array::new_with_length(size as u32);
         write(&mut JsBytes(out.clone()));
         out
+    }
+
+    /// [`Session::prepared`] in short calls: [`Writing::step`] writes a budget of items a
+    /// call, then [`Writing::take`] gives the bytes (the same bytes).
+    pub fn begin_prepared(&self) -> Writing {
+        let budget = std::rc::Rc::new(Budget::new(0));
+        let (job, b) = (self.job.clone(), budget.clone());
+        Writing {
+            budget,
+            pass: Some(Stepped::new(async move {
+                let out = job.bytes_out();
+                let mut sink = JsBytes(Uint8Array::new_with_length(out.size() as u32));
+                out.write(&mut sink, &b).await;
+                sink.0
+            })),
+            bytes: None,
+        }
     }
 
     /// The job another worker prepared ([`Session::prepared`]), read a run at a time out of

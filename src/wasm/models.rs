@@ -2,11 +2,13 @@
 
 use super::{js_error, to_js};
 use crate::base::error::Error;
+use crate::base::steps::{Budget, Stepped};
 use crate::model::models::Model;
 use crate::model::spec::{self as job, JobSpec};
 use crate::model::{display, layout};
 use js_sys::{Float32Array, Uint8Array};
 use serde::Serialize;
+use std::rc::Rc;
 use wasm_bindgen::prelude::*;
 
 pub(super) fn job_of(value: JsValue) -> Result<JobSpec, JsValue> {
@@ -20,18 +22,28 @@ pub(super) fn job_of(value: JsValue) -> Result<JobSpec, JsValue> {
 
 /// Reads a `File` in the worker (`FileReaderSync`).
 pub(super) fn read_file(file: &web_sys::File) -> Result<Vec<u8>, JsValue> {
-    let name = file.name();
+    read_blob(file, &file.name())
+}
+
+/// Reads a `Blob` (a file `name` or a slice of it) in the worker (`FileReaderSync`).
+fn read_blob(blob: &web_sys::Blob, name: &str) -> Result<Vec<u8>, JsValue> {
     let unreadable = |e: JsValue| {
         js_error(Error::Import(format!(
-            "the browser could not read {name}: {}",
-            e.as_string()
-                .or_else(|| e.dyn_ref::<js_sys::Error>().map(|e| e.message().into()))
-                .unwrap_or_else(|| format!("{e:?}"))
+            "the browser could not read {}: {}",
+            job::clean_name(name),
+            describe(&e)
         )))
     };
     let reader = web_sys::FileReaderSync::new().map_err(unreadable)?;
-    let buffer = reader.read_as_array_buffer(file).map_err(unreadable)?;
+    let buffer = reader.read_as_array_buffer(blob).map_err(unreadable)?;
     Ok(Uint8Array::new(&buffer).to_vec())
+}
+
+/// A thrown JS value as text.
+fn describe(e: &JsValue) -> String {
+    e.as_string()
+        .or_else(|| e.dyn_ref::<js_sys::Error>().map(|e| e.message().into()))
+        .unwrap_or_else(|| format!("{e:?}"))
 }
 
 /// The imported files of a build job, kept in one worker: the page adds and removes files,
@@ -65,11 +77,30 @@ impl Models {
     #[wasm_bindgen(unchecked_return_type = "ModelInfo")]
     pub fn add_bytes(&mut self, bytes: &[u8], name: &str) -> Result<JsValue, JsValue> {
         let model = Model::read(bytes, name).map_err(js_error)?;
-        let info = model.info();
-        let models = std::sync::Arc::make_mut(&mut self.models);
-        models.retain(|m| m.name != name);
-        models.push(model);
-        to_js(&info, "the model info")
+        self.put(model)
+    }
+
+    /// [`Models::add`] in short calls: this call only takes the file; [`Adding::step`] reads
+    /// it a slice a call, then imports it a budget of triangles a call (an STL file; an OBJ
+    /// or 3MF file in one call) until it returns true; [`Models::finish_add`] adds it. The
+    /// same model and info as `add`.
+    pub fn begin_add(file: web_sys::File, name: &str) -> Adding {
+        Adding::new(name, Some(file), Vec::new())
+    }
+
+    /// [`Models::begin_add`] from bytes (tests and Node; copied once into the module).
+    pub fn begin_add_bytes(bytes: Vec<u8>, name: &str) -> Adding {
+        Adding::new(name, None, bytes)
+    }
+
+    /// Adds the file an [`Adding`] imported (a file of the same name is replaced): its
+    /// `ModelInfo`, as [`Models::add`]. `internal` if the import has not ended.
+    #[wasm_bindgen(unchecked_return_type = "ModelInfo")]
+    pub fn finish_add(&mut self, adding: Adding) -> Result<JsValue, JsValue> {
+        let model = adding
+            .model
+            .ok_or_else(|| js_error(Error::Internal("the file's import has not ended".into())))?;
+        self.put(model)
     }
 
     /// Forgets a file; whether it was there.
@@ -161,6 +192,15 @@ pub fn check_profile(bytes: &[u8]) -> Result<JsValue, JsValue> {
 }
 
 impl Models {
+    /// Adds `model` in place of a file of its name: its info.
+    fn put(&mut self, model: Model) -> Result<JsValue, JsValue> {
+        let info = model.info();
+        let models = std::sync::Arc::make_mut(&mut self.models);
+        models.retain(|m| m.name != model.name);
+        models.push(model);
+        to_js(&info, "the model info")
+    }
+
     fn model(&self, name: &str) -> Result<&Model, JsValue> {
         self.models.iter().find(|m| m.name == name).ok_or_else(|| {
             js_error(Error::Job(format!(
@@ -169,4 +209,78 @@ impl Models {
             )))
         })
     }
+}
+
+/// Bytes of the file read a call ([`Adding::step`]): a copy of a few milliseconds.
+const READ_BYTES: f64 = 4.0 * 1024.0 * 1024.0;
+
+/// A file being imported in short calls ([`Models::begin_add`]).
+#[wasm_bindgen]
+pub struct Adding {
+    name: String,
+    /// The file while it is read, a slice a step.
+    file: Option<web_sys::File>,
+    bytes: Vec<u8>,
+    budget: Rc<Budget>,
+    /// The import, once the file is read; `None` again when it ended.
+    pass: Option<Stepped<Result<Model, Error>>>,
+    /// The model, once imported.
+    model: Option<Model>,
+}
+
+#[wasm_bindgen]
+impl Adding {
+    /// Reads the next slice of the file, or imports about `items` triangles of it: true once
+    /// the model is imported (then [`Models::finish_add`]). Throws `{kind: "import",
+    /// message}` as [`Models::add`] does.
+    pub fn step(&mut self, items: u32) -> Result<bool, JsValue> {
+        if self.model.is_some() {
+            return Ok(true);
+        }
+        if let Some(file) = &self.file {
+            let at = self.bytes.len() as f64;
+            let end = file.size().min(at + READ_BYTES);
+            if at < end {
+                let slice = file.slice_with_f64_and_f64(at, end).map_err(js_error_of)?;
+                self.bytes.extend(read_blob(&slice, &self.name)?);
+                return Ok(false);
+            }
+            self.file = None;
+        }
+        let pass = self.pass.get_or_insert_with(|| {
+            let (bytes, name) = (std::mem::take(&mut self.bytes), self.name.clone());
+            let b = self.budget.clone();
+            Stepped::new(async move { Model::read_in_steps(&bytes, &name, &b).await })
+        });
+        self.budget.refill(items as usize);
+        match pass.step() {
+            None => Ok(false),
+            Some(read) => {
+                self.pass = None;
+                self.model = Some(read.map_err(js_error)?);
+                Ok(true)
+            }
+        }
+    }
+}
+
+impl Adding {
+    fn new(name: &str, file: Option<web_sys::File>, bytes: Vec<u8>) -> Adding {
+        Adding {
+            name: name.to_string(),
+            file,
+            bytes,
+            budget: Rc::new(Budget::new(0)),
+            pass: None,
+            model: None,
+        }
+    }
+}
+
+/// A `Blob` (a file or a slice of it) method's failure as an import error.
+fn js_error_of(e: JsValue) -> JsValue {
+    js_error(Error::Import(format!(
+        "the browser could not read the file: {}",
+        describe(&e)
+    )))
 }

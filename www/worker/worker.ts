@@ -171,6 +171,53 @@ function prepare(m: Models, job: RequestData<"open_job">["job"], draft: ((d: Uin
   return Session.from_preparation(p);
 }
 
+/** Triangles per call of a file's import (an STL file; OBJ and 3MF are imported in one). */
+const IMPORT_ITEMS = 65_536;
+
+/** `Models.add` in short calls (`Models.begin_add`, then a slice of the file read or a
+ *  budget of triangles imported a call, `Models.finish_add`): the same model and info. */
+function imported(m: Models, file: File, name: string): ModelInfo {
+  const a = Models.begin_add(file, name);
+  try {
+    while (!timedCall("core: file read and parsed, the longest call", () => a.step(IMPORT_ITEMS)));
+  } catch (e) {
+    a.free();
+    throw e;
+  }
+  return timedCall("core: file read and parsed, the longest call", () => m.finish_add(a));
+}
+
+/** Items (vertices, facets, index entries) per call of taking another worker's job. */
+const TAKE_ITEMS = 65_536;
+
+/** `Session.from_prepared` (or, with `draft`, `Session.from_draft`) in short calls
+ *  (`Session.begin_take`, a budget of items read a call, `Session.from_taken`). */
+function taken(bytes: Uint8Array, draft: boolean): Session {
+  const name = draft ? "core: the draft taken, the longest call" : "core: the prepared job taken, the longest call";
+  const t = timedCall(name, () => Session.begin_take(bytes, draft));
+  try {
+    while (!timedCall(name, () => t.step(TAKE_ITEMS)));
+  } catch (e) {
+    t.free();
+    throw e;
+  }
+  return Session.from_taken(t);
+}
+
+/** `Session.prepared` in short calls (`Session.begin_prepared`, a budget of items written a
+ *  call): the same bytes. */
+function preparedBytes(s: Session): Uint8Array {
+  const w = s.begin_prepared();
+  try {
+    while (!timedCall("core: the prepared job as bytes, the longest call", () => w.step(TAKE_ITEMS)));
+    const bytes = w.take();
+    if (!bytes) throw internal("the prepared job's bytes were not written");
+    return bytes;
+  } finally {
+    w.free();
+  }
+}
+
 /** Runs one call into the core, keeping the longest of `name` in the profile. */
 function timedCall<T>(name: string, f: () => T): T {
   const t0 = performance.now();
@@ -260,7 +307,7 @@ async function handle(req: Request): Promise<void> {
       try {
         for (const { name, file } of req.data.files) {
           const hash = hashing ? sha256Of(file) : null;
-          infos.push(clock.time("worker: file read and parsed", () => timedCall("core: file read and parsed, the longest call", () => m.add(file, name))));
+          infos.push(clock.time("worker: file read and parsed", () => imported(m, file, name)));
           if (hash) {
             const t0 = performance.now();
             sha256.push(await hash);
@@ -322,7 +369,7 @@ async function handle(req: Request): Promise<void> {
       try {
         const table = drafted ? s.confirmation() : undefined;
         if (table) shared = { confirm: copies(table) };
-        else if (n > 0) shared = { prepared: copies(clock.time("core: the prepared job as bytes", () => timedCall("core: the prepared job as bytes, the longest call", () => s.prepared()))) };
+        else if (n > 0) shared = { prepared: copies(clock.time("core: the prepared job as bytes", () => preparedBytes(s))) };
       } catch (e) {
         s.free();
         throw e;
@@ -337,12 +384,12 @@ async function handle(req: Request): Promise<void> {
     }
     case "adopt_job": {
       await load();
-      answer(req.kind, req.id, adopt(timedCall("core: the prepared job taken, the longest call", () => Session.from_prepared(req.data.prepared))));
+      answer(req.kind, req.id, adopt(taken(req.data.prepared, false)));
       return;
     }
     case "adopt_draft": {
       await load();
-      const s = timedCall("core: the draft taken, the longest call", () => Session.from_draft(req.data.prepared));
+      const s = taken(req.data.prepared, true);
       session?.free();
       session = s;
       answer(req.kind, req.id, { layers: s.layer_count() });

@@ -5,7 +5,7 @@
 //! tolerates CRLF, tabs, exponents, a missing solid name and a missing `endsolid`.
 
 use crate::base::error::Error;
-use crate::base::parallel::in_runs;
+use crate::base::steps::{self, Budget, runs};
 
 /// Triangles as read from the file, three float32 corners each (stored normals are ignored:
 /// they are often wrong or zero; orientation comes from the vertex order).
@@ -29,13 +29,20 @@ pub enum Format {
 
 /// Parses an STL file. Every coordinate is checked to be finite.
 pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
+    steps::now(parse_in_steps(bytes, &steps::UNLIMITED))
+}
+
+/// [`parse`] as a pass of `budget`'s budget: a binary file's records and every file's check
+/// of the coordinates in runs of triangles (the page's short calls); an ASCII file is read
+/// at once. The same triangles, or the same refusal.
+pub async fn parse_in_steps(bytes: &[u8], budget: &Budget) -> Result<(Triangles, Format), Error> {
     if bytes.is_empty() {
         return Err(Error::Import(
             "the file is empty (0 bytes); choose an STL, OBJ or 3MF file".into(),
         ));
     }
     let (tris, format) = if let Some(n) = binary_count(bytes) {
-        (parse_binary(bytes, n), Format::Binary)
+        (parse_binary(bytes, n, budget).await, Format::Binary)
     } else if looks_ascii(bytes) {
         (parse_ascii(bytes)?, Format::Ascii)
     } else if let Some(kind) = other_format(bytes) {
@@ -74,14 +81,15 @@ pub fn parse(bytes: &[u8]) -> Result<(Triangles, Format), Error> {
         return Err(Error::Import("the file contains no triangles".into()));
     }
     let mut bad = None;
-    in_runs(tris.len(), &mut |r| {
+    runs(tris.len(), budget, &mut |r| {
         if bad.is_none() {
             bad = tris[r.clone()]
                 .iter()
                 .position(|t| t.iter().flatten().any(|c| !c.is_finite()))
                 .map(|k| r.start + k);
         }
-    });
+    })
+    .await;
     if let Some(i) = bad {
         return Err(Error::Import(format!(
             "triangle {} has a coordinate that is not a finite number (NaN or infinity); the file is damaged — export it again from the modelling program",
@@ -146,12 +154,12 @@ fn binary_count(bytes: &[u8]) -> Option<usize> {
     (84 + 50 * n == bytes.len() as u64).then_some(n as usize)
 }
 
-fn parse_binary(bytes: &[u8], n: usize) -> Triangles {
+async fn parse_binary(bytes: &[u8], n: usize, budget: &Budget) -> Triangles {
     let n = n.min((bytes.len() - 84) / 50);
     let records = &bytes[84..84 + 50 * n];
     let mut tris = Vec::with_capacity(n);
-    // In runs of records ([`in_runs`]: the page's engine compiles the later runs well).
-    in_runs(n, &mut |r| {
+    // In runs of records ([`runs`]: the page's engine compiles the later runs well).
+    runs(n, budget, &mut |r| {
         tris.extend(
             records[50 * r.start..50 * r.end]
                 .chunks_exact(50)
@@ -167,7 +175,8 @@ fn parse_binary(bytes: &[u8], n: usize) -> Triangles {
                     [v(0), v(1), v(2)]
                 }),
         )
-    });
+    })
+    .await;
     tris
 }
 
