@@ -34,18 +34,13 @@ pub struct PartAnalysis {
     /// The layer of `max_boundary_deviation` (from 0; written from 1); `None`: every layer's
     /// deviation is 0.
     pub max_deviation_layer: Option<usize>,
-    /// The part's volume: each layer's region (exact area) times H.
-    pub volume: f64,
-    /// Volume of the part no droplet spheroid fills (3D estimate: each slab's void share, sampled
-    /// on the 3D grid, times its exact volume).
-    pub void_volume: f64,
-    /// void_volume / volume.
-    pub void_fraction: f64,
-    /// The predicted density, %: 100 × (1 − void_fraction), once the 3D estimate has a
-    /// volume (`None` for a 2D analysis alone). A geometric estimate from the droplet model
-    /// (docs/process.md), not a measured density.
-    #[serde(default)]
-    pub predicted_density: Option<f64>,
+    /// Unit 0's parts' 3D estimate: their volume (each layer's region, exact area, times H),
+    /// the volume no droplet spheroid fills (each slab's void share, sampled on the 3D grid,
+    /// times its exact volume), the void fraction and the predicted density (`None` for a 2D
+    /// analysis alone: a geometric estimate from the droplet model, docs/process.md, not a
+    /// measured density).
+    #[serde(flatten)]
+    pub estimate: DensityEstimate,
     /// Overhang area summed over the layers, mm².
     #[serde(default)]
     pub unsupported_area: f64,
@@ -57,11 +52,10 @@ pub struct PartAnalysis {
     #[serde(default)]
     pub max_unsupported_area_layer: Option<usize>,
     /// The 3D estimate of the parts of each other unit (other materials, droplets of B_u),
-    /// indexed by unit: its volume, void volume and predicted density; `None` for unit 0 (the
-    /// fields above are its own) and for a unit without parts; empty in a job whose parts are
+    /// indexed by unit; `None` for unit 0 (`estimate` is its own) and for a unit without parts; empty in a job whose parts are
     /// all unit 0's. The support is not a part and is not measured.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub units: Vec<Option<UnitDensity>>,
+    pub units: Vec<Option<DensityEstimate>>,
 }
 
 impl PartAnalysis {
@@ -104,58 +98,49 @@ impl PartAnalysis {
 
     /// Adds a slab's 3D figures (of any layer, in any order).
     pub fn add_slab(&mut self, f: SlabFigures) {
-        self.volume += f.volume;
-        self.void_volume += f.void_volume;
+        self.estimate.add(f.volume, f.void_volume);
         for (k, figures) in f.units.iter().enumerate() {
             if let Some((volume, void_volume)) = *figures {
-                let u = self.unit_mut(k);
-                u.volume += volume;
-                u.void_volume += void_volume;
+                self.unit_mut(k).add(volume, void_volume);
             }
         }
-        self.update_fraction();
+    }
+
+    /// Adds the 3D estimates of another part analysis (disjoint layers).
+    pub(crate) fn add_estimates(&mut self, o: &PartAnalysis) {
+        self.estimate.add(o.estimate.volume, o.estimate.void_volume);
+        for (k, theirs) in o.units.iter().enumerate() {
+            if let Some(theirs) = theirs {
+                self.unit_mut(k).add(theirs.volume, theirs.void_volume);
+            }
+        }
     }
 
     /// Unit `k`'s 3D estimate, made (empty) if it is not there yet.
-    pub fn unit_mut(&mut self, k: usize) -> &mut UnitDensity {
+    pub fn unit_mut(&mut self, k: usize) -> &mut DensityEstimate {
         if self.units.len() <= k {
             self.units.resize(k + 1, None);
         }
         self.units[k].get_or_insert_default()
     }
 
-    /// `void_fraction` and `predicted_density` from the volumes (the other units' too).
-    pub fn update_fraction(&mut self) {
-        (self.void_fraction, self.predicted_density) = density(self.volume, self.void_volume);
-        for u in self.units.iter_mut().flatten() {
-            (u.void_fraction, u.predicted_density) = density(u.volume, u.void_volume);
-        }
-    }
-
     /// The predicted density of each unit's parts, indexed by unit, for a machine of `units`
-    /// units (unit 0's: `predicted_density`).
+    /// units (unit 0's: `estimate`'s).
     pub fn unit_densities(&self, units: usize) -> Vec<Option<f64>> {
         (0..units.max(1))
             .map(|k| match k {
-                0 => self.predicted_density,
+                0 => self.estimate.predicted_density,
                 _ => self.units.get(k).copied().flatten()?.predicted_density,
             })
             .collect()
     }
 }
 
-/// (void fraction, predicted density %) of a volume and its void volume; no density without
-/// a volume.
-fn density(volume: f64, void_volume: f64) -> (f64, Option<f64>) {
-    let some = volume > 0.0;
-    let fraction = if some { void_volume / volume } else { 0.0 };
-    (fraction, some.then_some(100.0 * (1.0 - fraction)))
-}
-
-/// The 3D estimate of the parts one unit prints: as [`PartAnalysis`] holds it for unit 0.
+/// The 3D estimate of some parts (unit 0's in [`PartAnalysis::estimate`], another unit's in
+/// [`PartAnalysis::units`]).
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
-pub struct UnitDensity {
+pub struct DensityEstimate {
     /// The parts' volume, mm³.
     pub volume: f64,
     /// Volume no droplet spheroid fills, mm³.
@@ -163,5 +148,22 @@ pub struct UnitDensity {
     /// void_volume / volume.
     pub void_fraction: f64,
     /// 100 × (1 − void_fraction), %; `None` without a volume.
+    #[serde(default)]
     pub predicted_density: Option<f64>,
+}
+
+impl DensityEstimate {
+    /// Adds a volume and its void volume; the fraction and density follow (no density
+    /// without a volume).
+    pub fn add(&mut self, volume: f64, void_volume: f64) {
+        self.volume += volume;
+        self.void_volume += void_volume;
+        let some = self.volume > 0.0;
+        self.void_fraction = if some {
+            self.void_volume / self.volume
+        } else {
+            0.0
+        };
+        self.predicted_density = some.then_some(100.0 * (1.0 - self.void_fraction));
+    }
 }
