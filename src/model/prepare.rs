@@ -5,7 +5,7 @@
 use crate::base::error::Error;
 use crate::base::settings::Settings;
 use crate::model::fit;
-use crate::model::frame::{Frame, Instance};
+use crate::model::frame::{Frame, Instance, InstanceId};
 use crate::model::import::{self, stl};
 use crate::model::mesh::{self, Bounds, Mesh, MeshStats};
 use crate::model::shells::{ShellOrientation, Shells};
@@ -142,8 +142,7 @@ pub(crate) fn import(
     let place = placement.place;
     let name = job::clean_name(&import::stem(file_name));
     let instance = Instance {
-        part: 0,
-        copy: 0,
+        id: InstanceId::default(),
         copies: 1,
         name,
         file: job::clean_name(file_name),

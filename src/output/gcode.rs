@@ -312,13 +312,13 @@ pub fn part_line(p: &crate::model::layout::Instance) -> String {
     };
     format!(
         "part {} = {}{what}{name}, rotate {rx}/{ry}/{rz} deg, scale {sx}/{sy}/{sz}{mirror}, at X{} Y{}{}, angle {} deg, copy {} of {}, unit {}",
-        p.part + 1,
+        p.id.part + 1,
         clean(&p.file),
         coord(p.at[0]),
         coord(p.at[1]),
         if p.placed { "" } else { " (arranged)" },
         p.place_angle,
-        p.copy + 1,
+        p.id.copy + 1,
         p.copies,
         p.unit
     )
