@@ -137,7 +137,7 @@ fn an_enclosed_void_is_found_with_its_position() {
         b,
     );
     for t in &mask.tiles {
-        assert_eq!(t.void.len(), t.width * t.height);
+        assert_eq!(t.void.len(), t.rect.cells());
     }
     let col = ((centre - mask.origin[0]) / mask.cell) as usize;
     let row = ((centre - mask.origin[1]) / mask.cell) as usize;
