@@ -67,33 +67,90 @@ impl PartAnalysis {
 
     /// Adds one layer's 2D figures.
     pub fn add_2d(&mut self, l: &LayerAnalysis) {
-        self.layers += 1;
-        self.droplets += l.droplets;
-        let covered = self.coverage * self.region_area + l.coverage * l.region_area;
-        self.region_area += l.region_area;
+        self.merge(&PartAnalysis::of_layer(l));
+    }
+
+    /// One layer's 2D figures.
+    fn of_layer(l: &LayerAnalysis) -> PartAnalysis {
+        let at = |some: bool| some.then_some(l.index);
+        PartAnalysis {
+            layers: 1,
+            droplets: l.droplets,
+            region_area: l.region_area,
+            coverage: l.coverage,
+            void_area: l.void_area,
+            enclosed_void_area: l.enclosed_void_area,
+            overfill_area: l.overfill_area,
+            largest_void: l.largest_void,
+            largest_void_layer: at(l.largest_void.is_some()),
+            max_boundary_deviation: l.boundary_deviation,
+            max_deviation_layer: at(l.boundary_deviation > 0.0),
+            unsupported_area: l.unsupported_area,
+            max_unsupported_area: l.unsupported_area,
+            max_unsupported_area_layer: at(l.unsupported_area > 0.0),
+            ..PartAnalysis::default()
+        }
+    }
+
+    /// Adds the layers of another part analysis (disjoint layers), as if each of its layers
+    /// had been [`add`](PartAnalysis::add)ed here. Of equal largest voids (or deviations) the
+    /// lower layer wins, so the order of the merges does not matter.
+    pub fn merge(&mut self, o: &PartAnalysis) {
+        if o.layers == 0 {
+            return;
+        }
+        let covered = self.coverage * self.region_area + o.coverage * o.region_area;
+        self.layers += o.layers;
+        self.droplets += o.droplets;
+        self.region_area += o.region_area;
         self.coverage = if self.region_area > 0.0 {
             covered / self.region_area
         } else {
             0.0
         };
-        self.void_area += l.void_area;
-        self.enclosed_void_area += l.enclosed_void_area;
-        self.overfill_area += l.overfill_area;
-        if let Some(v) = l.largest_void
-            && self.largest_void.is_none_or(|b| v.area > b.area)
+        self.void_area += o.void_area;
+        self.enclosed_void_area += o.enclosed_void_area;
+        self.overfill_area += o.overfill_area;
+        let better = |a: f64, ai: Option<usize>, b: f64, bi: Option<usize>| {
+            a > b || (a == b && ai.unwrap_or(usize::MAX) < bi.unwrap_or(usize::MAX))
+        };
+        if let Some(v) = o.largest_void
+            && self.largest_void.is_none_or(|mine| {
+                better(
+                    v.area,
+                    o.largest_void_layer,
+                    mine.area,
+                    self.largest_void_layer,
+                )
+            })
         {
             self.largest_void = Some(v);
-            self.largest_void_layer = Some(l.index);
+            self.largest_void_layer = o.largest_void_layer;
         }
-        if l.boundary_deviation > self.max_boundary_deviation {
-            self.max_boundary_deviation = l.boundary_deviation;
-            self.max_deviation_layer = Some(l.index);
-        }
-        self.unsupported_area += l.unsupported_area;
-        if l.unsupported_area > self.max_unsupported_area {
-            self.max_unsupported_area = l.unsupported_area;
-            self.max_unsupported_area_layer = Some(l.index);
-        }
+        // The larger figure of the two and its layer (ties: the lower layer).
+        let keep_max = |mine: (&mut f64, &mut Option<usize>), theirs: (f64, Option<usize>)| {
+            if theirs.1.is_some()
+                && (mine.1.is_none() || better(theirs.0, theirs.1, *mine.0, *mine.1))
+            {
+                (*mine.0, *mine.1) = theirs;
+            }
+        };
+        keep_max(
+            (
+                &mut self.max_boundary_deviation,
+                &mut self.max_deviation_layer,
+            ),
+            (o.max_boundary_deviation, o.max_deviation_layer),
+        );
+        self.unsupported_area += o.unsupported_area;
+        keep_max(
+            (
+                &mut self.max_unsupported_area,
+                &mut self.max_unsupported_area_layer,
+            ),
+            (o.max_unsupported_area, o.max_unsupported_area_layer),
+        );
+        self.add_estimates(o);
     }
 
     /// Adds a slab's 3D figures (of any layer, in any order).
@@ -107,7 +164,7 @@ impl PartAnalysis {
     }
 
     /// Adds the 3D estimates of another part analysis (disjoint layers).
-    pub(crate) fn add_estimates(&mut self, o: &PartAnalysis) {
+    fn add_estimates(&mut self, o: &PartAnalysis) {
         self.estimate.add(o.estimate.volume, o.estimate.void_volume);
         for (k, theirs) in o.units.iter().enumerate() {
             if let Some(theirs) = theirs {
