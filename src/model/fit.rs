@@ -295,27 +295,16 @@ mod tests {
             place_angle: angle,
         };
         let f = Frame::of(&corners, |v| [*v], &p).unwrap();
-        let shift = [-f.qmin.x, -f.qmin.y];
-        let inst = Instance {
-            id: InstanceId::default(),
+        let mut inst = Instance {
             copies: 1,
             name: "b".into(),
             file: "b.stl".into(),
-            item: None,
-            object: None,
             rotate,
             scale,
-            mirror: [false; 3],
             place_angle: angle,
-            placed: false,
-            at: [0.0, 0.0],
-            unit: 0,
-            matrix: f.matrix(shift),
-            min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
-            max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
-            size: [0.0; 3],
-            shift,
+            ..Instance::default()
         };
+        inst.place(&f, [0.0, 0.0], [-f.qmin.x, -f.qmin.y]);
         (inst, f)
     }
 

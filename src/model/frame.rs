@@ -101,7 +101,7 @@ pub struct InstanceId {
 }
 
 /// One copy of a part on the plate.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct Instance {
     /// Which part, which copy (`part`, `copy` in the JSON).
@@ -151,4 +151,16 @@ pub struct Instance {
     /// The final move given to [`crate::model::mesh::Mesh::place`].
     #[serde(skip)]
     pub shift: [f64; 2],
+}
+
+impl Instance {
+    /// Puts it where the final move `at` takes it, its mesh moved by `shift` (its part's
+    /// frame `f`): the matrix and the bounds on the plate follow.
+    pub fn place(&mut self, f: &Frame, at: [f64; 2], shift: [f64; 2]) {
+        self.at = at;
+        self.shift = shift;
+        self.matrix = f.matrix(shift);
+        self.min = [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z];
+        self.max = [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z];
+    }
 }

@@ -161,12 +161,7 @@ pub fn place_instances(
         let slot = slots[k].expect("every instance has a slot");
         k += 1;
         let f = &frames[inst.id.part];
-        let shift = [slot[0] - f.qmin.x, slot[1] - f.qmin.y];
-        inst.at = slot;
-        inst.shift = shift;
-        inst.matrix = f.matrix(shift);
-        inst.min = [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z];
-        inst.max = [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z];
+        inst.place(f, slot, [slot[0] - f.qmin.x, slot[1] - f.qmin.y]);
     }
     let mut bounds = Bounds::EMPTY;
     for inst in &instances {
@@ -253,7 +248,7 @@ fn instance(
     at: [f64; 2],
     shift: [f64; 2],
 ) -> Instance {
-    Instance {
+    let mut inst = Instance {
         id,
         copies: p.copies as usize,
         name: clean_name(&part_label(model, p)),
@@ -269,14 +264,12 @@ fn instance(
         mirror: [p.mirror_x, p.mirror_y, p.mirror_z],
         place_angle: p.place_angle,
         placed,
-        at,
         unit: p.unit,
-        matrix: f.matrix(shift),
-        min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
-        max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
         size: (f.max1 - f.min1).to_array(),
-        shift,
-    }
+        ..Instance::default()
+    };
+    inst.place(f, at, shift);
+    inst
 }
 
 /// The layout of a job from its imported files, without building the meshes (the page's 3D
