@@ -53,9 +53,10 @@ fn main() {
     // The window's shares [void, overfill, covered], row-major from its lowest row.
     let mut shares = vec![[0u8; 3]; w * h];
     for t in &m.tiles {
-        for r in t.row.max(r0)..(t.row + t.height).min(r1) {
-            for c in t.col.max(c0)..(t.col + t.width).min(c1) {
-                let i = (r - t.row) * t.width + c - t.col;
+        let rect = t.rect;
+        for r in rect.row.max(r0)..rect.end_row().min(r1) {
+            for c in rect.col.max(c0)..rect.end_col().min(c1) {
+                let i = rect.index(c, r);
                 shares[(r - r0) * w + c - c0] = [t.void[i], t.overfill[i], t.covered[i]];
             }
         }

@@ -45,7 +45,7 @@ fn main() {
                 p.largest_void_layer.map_or(0, |l| l + 1),
                 p.max_boundary_deviation,
                 p.max_deviation_layer.map_or(0, |l| l + 1),
-                p.void_fraction,
+                p.estimate.void_fraction,
             );
         }
     }

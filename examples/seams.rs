@@ -96,7 +96,7 @@ fn main() {
             println!(
                 "| {name} | {} | {row}| {:.4} | {:.4} |",
                 if even { "even" } else { "exact" },
-                r.part.void_fraction,
+                r.part.estimate.void_fraction,
                 r.part.coverage
             );
         }

@@ -45,10 +45,10 @@ fn check_with(model: &str, s: Settings, at: &str) {
     println!(
         "{at}: void fraction {:.5} / {:.5}, density {:?} / {:?}, coverage {:.5} / {:.5}, \
          voids {} / {}, largest {:?} in {:?} / {:?} in {:?}",
-        f.void_fraction,
-        e.void_fraction,
-        f.predicted_density,
-        e.predicted_density,
+        f.estimate.void_fraction,
+        e.estimate.void_fraction,
+        f.estimate.predicted_density,
+        e.estimate.predicted_density,
         f.coverage,
         e.coverage,
         fast.layers.iter().map(|l| l.voids).sum::<usize>(),
@@ -58,11 +58,12 @@ fn check_with(model: &str, s: Settings, at: &str) {
         e.largest_void.map(|v| v.area),
         e.largest_void_layer,
     );
-    assert!(e.void_fraction > 0.05, "{at}: {e:?}");
-    assert!((f.void_fraction - e.void_fraction).abs() <= 0.002, "{at}");
-    let (df, de) = (f.predicted_density.unwrap(), e.predicted_density.unwrap());
+    let (fe, ee) = (f.estimate, e.estimate);
+    assert!(ee.void_fraction > 0.05, "{at}: {e:?}");
+    assert!((fe.void_fraction - ee.void_fraction).abs() <= 0.002, "{at}");
+    let (df, de) = (fe.predicted_density.unwrap(), ee.predicted_density.unwrap());
     assert!((df - de).abs() <= 0.2, "{at}: {df} against {de}");
-    assert_eq!(f.volume.to_bits(), e.volume.to_bits(), "{at}");
+    assert_eq!(fe.volume.to_bits(), ee.volume.to_bits(), "{at}");
     assert_eq!(f.region_area.to_bits(), e.region_area.to_bits(), "{at}");
     assert_eq!(f.droplets, e.droplets, "{at}");
     assert!((f.coverage - e.coverage).abs() <= 0.005, "{at}");

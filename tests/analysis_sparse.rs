@@ -68,18 +68,17 @@ fn parts_far_apart_take_memory_for_the_parts_only() {
     assert_eq!(raster.analysis(), two);
 
     // The mask: tiles only near the two squares, their void shares adding up to the void area.
-    let cells: usize = mask.tiles.iter().map(|t| t.width * t.height).sum();
+    let cells: usize = mask.tiles.iter().map(|t| t.rect.cells()).sum();
     let area = cells as f64 * mask.cell * mask.cell;
     assert!(area < 100.0, "mask tiles over {area} mm²");
     let mut void = 0.0;
     for t in &mask.tiles {
-        assert_eq!(t.void.len(), t.width * t.height);
-        assert_eq!(t.overfill.len(), t.width * t.height);
-        assert_eq!(t.covered.len(), t.width * t.height);
+        let n = t.rect.cells();
+        assert_eq!((t.void.len(), t.overfill.len(), t.covered.len()), (n, n, n));
         let o = mask.tile_origin(t);
         let far = [
-            o[0] + t.width as f64 * mask.cell,
-            o[1] + t.height as f64 * mask.cell,
+            o[0] + t.rect.width as f64 * mask.cell,
+            o[1] + t.rect.height as f64 * mask.cell,
         ];
         let near =
             |c: f64| o[0] > c - 10.0 && o[1] > c - 10.0 && far[0] < c + 12.0 && far[1] < c + 12.0;
@@ -93,8 +92,9 @@ fn parts_far_apart_take_memory_for_the_parts_only() {
     );
     // Tiles do not overlap, in rows then columns.
     for (a, b) in mask.tiles.iter().zip(mask.tiles.iter().skip(1)) {
+        let (a, b) = (a.rect, b.rect);
         assert!((a.row, a.col) < (b.row, b.col));
-        assert!(b.row >= a.row + a.height || b.col >= a.col + a.width);
+        assert!(b.row >= a.end_row() || b.col >= a.end_col());
     }
 
     // The 3D estimate's spheroid map: a 1 m square at B/3 would take 800 MB.

@@ -389,7 +389,7 @@ fn a_part_larger_than_the_plate_among_others_does_not_stop_their_arrangement() {
     let s = spec(json!({"parts": [{"file": "small.stl"}, {"file": "huge.stl"}]})).unwrap();
     let l = layout(&models, &s).unwrap();
     assert_eq!(l.misfits.len(), 1);
-    assert_eq!(l.misfits[0].part, 1);
+    assert_eq!(l.misfits[0].id.part, 1);
     assert!(
         l.misfits[0].message.starts_with("Part 2 “huge.stl”"),
         "{}",
@@ -454,7 +454,7 @@ fn placed_and_arranged_parts_mix() {
     }
     // Every matrix maps the part's box corners onto the instance's bounds.
     for inst in &l.instances {
-        let size = if inst.part == 0 {
+        let size = if inst.id.part == 0 {
             [30.0, 20.0, 5.0]
         } else {
             [10.0, 10.0, 8.0]

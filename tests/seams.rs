@@ -315,14 +315,19 @@ fn coverage_unchanged_and_sections_match_the_oracle() {
         let (a, b) = (&exact.part, &even.part);
         eprintln!(
             "{model}: coverage {:.4} → {:.4}, void fraction {:.4} → {:.4}, droplets {} → {}",
-            a.coverage, b.coverage, a.void_fraction, b.void_fraction, a.droplets, b.droplets
+            a.coverage,
+            b.coverage,
+            a.estimate.void_fraction,
+            b.estimate.void_fraction,
+            a.droplets,
+            b.droplets
         );
         assert!(
             (a.coverage - b.coverage).abs() <= 0.005,
             "{model}: coverage"
         );
         assert!(
-            (a.void_fraction - b.void_fraction).abs() <= 0.005,
+            (a.estimate.void_fraction - b.estimate.void_fraction).abs() <= 0.005,
             "{model}: void fraction"
         );
         // n = ⌈L/B⌉ per loop, its arc length: a droplet more than the exact walk's (chords

@@ -34,8 +34,8 @@ fn assert_same(a: &Figures, b: &Figures, what: &str) {
     assert_eq!(a.analysed_layers, b.analysed_layers, "{what}");
     assert_eq!(a.repairs, b.repairs, "{what}");
     for (x, y, name) in [
-        (a.volume_mm3, b.volume_mm3, "volume"),
-        (a.mass_g, b.mass_g, "mass"),
+        (a.units[0].volume_mm3, b.units[0].volume_mm3, "volume"),
+        (a.units[0].mass_g, b.units[0].mass_g, "mass"),
         (a.print_seconds, b.print_seconds, "time"),
         (a.travel_mm, b.travel_mm, "travel"),
         (a.coverage.unwrap(), b.coverage.unwrap(), "coverage"),
@@ -101,8 +101,9 @@ fn figures_follow_the_estimate_settings() {
     let f = s.figures(job.settings());
     let b = job.settings().droplet_width();
     let h = job.settings().layer_height;
-    assert!(close(f.volume_mm3, f.droplets as f64 * b * b * h));
-    assert!(close(f.mass_g, f.volume_mm3 / 1000.0 * 1.04));
+    let u0 = f.units[0];
+    assert!(close(u0.volume_mm3, f.droplets as f64 * b * b * h));
+    assert!(close(u0.mass_g, u0.volume_mm3 / 1000.0 * 1.04));
     assert!(close(
         f.print_seconds,
         f.droplets as f64 / 100.0 + s.travel_mm / 50.0
@@ -115,7 +116,7 @@ fn figures_follow_the_estimate_settings() {
     (u0.droplet_rate, u0.material_density) = (200.0, 2.08);
     let g = s.figures(&other);
     assert!(close(g.print_seconds, f.print_seconds / 2.0));
-    assert!(close(g.mass_g, 2.0 * f.mass_g));
+    assert!(close(g.units[0].mass_g, 2.0 * f.units[0].mass_g));
     assert!(s.printable(job.settings()).is_ok());
     // coverage of a cube: most of each layer
     assert!((0.7..1.0).contains(&f.coverage.unwrap()), "{f:?}");
@@ -221,8 +222,8 @@ fn the_cli_prints_the_librarys_figures() {
         ("outer", c.outer as f64, 0),
         ("inner", c.inner as f64, 0),
         ("fill", c.fill as f64, 0),
-        ("cm³", f.volume_mm3 / 1000.0, 2),
-        ("g", f.mass_g, 2),
+        ("cm³", f.units[0].volume_mm3 / 1000.0, 2),
+        ("g", f.units[0].mass_g, 2),
     ] {
         let got = figure(line, unit);
         assert!(

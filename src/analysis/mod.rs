@@ -117,10 +117,10 @@ pub use estimate3d::{
 };
 pub use interior::{InteriorCache, InteriorRates};
 pub use lines::DropletLines;
-pub use part::{PartAnalysis, UnitDensity};
+pub use part::{DensityEstimate, PartAnalysis};
 pub use raster::{
-    COLS_PER_ROW, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B, Raster,
-    Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,
+    COLS_PER_ROW, CellRect, CoverageMask, LayerAnalysis, MIN_PASSAGE_COLS, MaskTile, ROWS_PER_B,
+    Raster, Void, analyse_layer, analyse_layer_for_page, analyse_layer_with_mask,
 };
 pub use report::{AnalysedLayer, AnalysisGrid, JobAnalysis, LayerStage, Model, Report};
 pub use slabs::{LayerMaps, SlabFigures, SlabRun, UnitRegions};

@@ -8,7 +8,7 @@
 
 use crate::base::error::Error;
 use crate::base::settings::Settings;
-use crate::model::frame::{Frame, Instance};
+use crate::model::frame::{Frame, Instance, InstanceId};
 use serde::{Deserialize, Serialize};
 
 /// Overshoots smaller than this (mm) are rounding, not a part off the plate.
@@ -34,10 +34,10 @@ pub enum MisfitKind {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
 pub struct Misfit {
-    /// The part's index in the job's `parts` (from 0).
-    pub part: usize,
-    /// The copy (from 0); a part larger than the plate is named once, for its first copy.
-    pub copy: usize,
+    /// The instance (`part`, `copy` in the JSON); a part larger than the plate is named once,
+    /// for its first copy.
+    #[serde(flatten)]
+    pub id: InstanceId,
     /// What is wrong: larger than the plate, taller than the chamber, or placed past an edge.
     pub kind: MisfitKind,
     /// One sentence: the part ("Part 1 “name”"), what is wrong, what fits.
@@ -108,14 +108,13 @@ pub fn misfit(inst: &Instance, frame: &Frame, label: &str, s: &Settings) -> Opti
     let wide = size[0] > px + TOLERANCE_MM || size[1] > py + TOLERANCE_MM;
     let tall = size[2] > pz * (1.0 + 1e-12);
     let copy = if inst.copies > 1 {
-        format!(" (copy {})", inst.copy + 1)
+        format!(" (copy {})", inst.id.copy + 1)
     } else {
         String::new()
     };
-    let who = format!("Part {} “{label}”", inst.part + 1);
+    let who = format!("Part {} “{label}”", inst.id.part + 1);
     let mut m = Misfit {
-        part: inst.part,
-        copy: inst.copy,
+        id: inst.id,
         kind: MisfitKind::Larger,
         message: String::new(),
         turn_rotate_z: None,
@@ -212,7 +211,7 @@ fn value(v: f64) -> String {
 fn change(m: &Misfit, hint: Hint) -> String {
     let key = |k: &str| match hint {
         Hint::Set => format!("--set {k}="),
-        Hint::Parts => format!("parts[{}].{k} = ", m.part),
+        Hint::Parts => format!("parts[{}].{k} = ", m.id.part),
     };
     let sep = match hint {
         Hint::Set => " ",
@@ -224,7 +223,7 @@ fn change(m: &Misfit, hint: Hint) -> String {
             Hint::Set => " Use --set place_x=… --set place_y=… that keep it on the plate".into(),
             Hint::Parts => format!(
                 " Change parts[{}].place_x/place_y, or leave them out to have it arranged",
-                m.part
+                m.id.part
             ),
         },
         (_, Some(rz), _) => use_(vec![format!("{}{}", key("rotate_z"), value(rz))]),
@@ -237,7 +236,7 @@ fn change(m: &Misfit, hint: Hint) -> String {
         ),
         (_, None, None) => match hint {
             Hint::Set => " Use smaller --set scale_x/scale_y/scale_z".into(),
-            Hint::Parts => format!(" Use smaller parts[{}].scale_x/y/z", m.part),
+            Hint::Parts => format!(" Use smaller parts[{}].scale_x/y/z", m.id.part),
         },
     };
     if m.kind != MisfitKind::Taller {
@@ -296,28 +295,16 @@ mod tests {
             place_angle: angle,
         };
         let f = Frame::of(&corners, |v| [*v], &p).unwrap();
-        let shift = [-f.qmin.x, -f.qmin.y];
-        let inst = Instance {
-            part: 0,
-            copy: 0,
+        let mut inst = Instance {
             copies: 1,
             name: "b".into(),
             file: "b.stl".into(),
-            item: None,
-            object: None,
             rotate,
             scale,
-            mirror: [false; 3],
             place_angle: angle,
-            placed: false,
-            at: [0.0, 0.0],
-            unit: 0,
-            matrix: f.matrix(shift),
-            min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
-            max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
-            size: [0.0; 3],
-            shift,
+            ..Instance::default()
         };
+        inst.place(&f, [0.0, 0.0], [-f.qmin.x, -f.qmin.y]);
         (inst, f)
     }
 

@@ -90,14 +90,23 @@ impl Frame {
     }
 }
 
-/// One copy of a part on the plate.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
-pub struct Instance {
+/// Which copy of which part: how a job names one of its instances.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify))]
+pub struct InstanceId {
     /// The part's index in the job's `parts` (from 0).
     pub part: usize,
     /// The copy's index (from 0).
     pub copy: usize,
+}
+
+/// One copy of a part on the plate.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+pub struct Instance {
+    /// Which part, which copy (`part`, `copy` in the JSON).
+    #[serde(flatten)]
+    pub id: InstanceId,
     /// How many copies the part has.
     pub copies: usize,
     /// The name the page and the header show: the part's `name`, else its name in its file
@@ -142,4 +151,16 @@ pub struct Instance {
     /// The final move given to [`crate::model::mesh::Mesh::place`].
     #[serde(skip)]
     pub shift: [f64; 2],
+}
+
+impl Instance {
+    /// Puts it where the final move `at` takes it, its mesh moved by `shift` (its part's
+    /// frame `f`): the matrix and the bounds on the plate follow.
+    pub fn place(&mut self, f: &Frame, at: [f64; 2], shift: [f64; 2]) {
+        self.at = at;
+        self.shift = shift;
+        self.matrix = f.matrix(shift);
+        self.min = [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z];
+        self.max = [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z];
+    }
 }

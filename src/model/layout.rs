@@ -6,7 +6,7 @@
 use crate::base::error::Error;
 use crate::base::geom::DVec3;
 use crate::model::fit::{self, Misfit};
-pub use crate::model::frame::{Frame, Instance};
+pub use crate::model::frame::{Frame, Instance, InstanceId};
 use crate::model::mesh::Bounds;
 use crate::model::models::{Model, corners, models_of};
 use crate::model::spec::{JobSpec, PartSpec, clean_name};
@@ -107,10 +107,11 @@ pub fn place_instances(
     let warnings = Vec::new();
     let mut instances = Vec::new();
     let mut fixed = Vec::new();
-    let mut free: Vec<(usize, usize)> = Vec::new();
+    let mut free: Vec<InstanceId> = Vec::new();
     for (i, p) in spec.parts.iter().enumerate() {
         let f = &frames[i];
         for copy in 0..p.copies as usize {
+            let id = InstanceId { part: i, copy };
             match p.place() {
                 Some(at) if copy == 0 => {
                     let r = Rect {
@@ -118,29 +119,20 @@ pub fn place_instances(
                         max: [f.qmax.x + at[0], f.qmax.y + at[1]],
                     };
                     fixed.push(r);
-                    instances.push(instance(models[i], i, copy, p, f, true, at, [at[0], at[1]]));
+                    instances.push(instance(models[i], id, p, f, true, at, [at[0], at[1]]));
                 }
                 _ => {
-                    free.push((i, copy));
+                    free.push(id);
                     // Filled in below.
-                    instances.push(instance(
-                        models[i],
-                        i,
-                        copy,
-                        p,
-                        f,
-                        false,
-                        [0.0, 0.0],
-                        [0.0, 0.0],
-                    ));
+                    instances.push(instance(models[i], id, p, f, false, [0.0, 0.0], [0.0, 0.0]));
                 }
             }
         }
     }
     let sizes: Vec<[f64; 2]> = free
         .iter()
-        .map(|&(i, _)| {
-            let f = &frames[i];
+        .map(|id| {
+            let f = &frames[id.part];
             [f.qmax.x - f.qmin.x, f.qmax.y - f.qmin.y]
         })
         .collect();
@@ -152,11 +144,11 @@ pub fn place_instances(
             *slot = Some([0.0, 0.0]);
         }
     }
-    let missing: Vec<(usize, usize)> = free
+    let missing: Vec<InstanceId> = free
         .iter()
         .zip(&slots)
         .filter(|(_, s)| s.is_none())
-        .map(|(&ic, _)| ic)
+        .map(|(&id, _)| id)
         .collect();
     if !missing.is_empty() {
         return Err(not_fitting(models, spec, frames, &missing));
@@ -168,13 +160,8 @@ pub fn place_instances(
         }
         let slot = slots[k].expect("every instance has a slot");
         k += 1;
-        let f = &frames[inst.part];
-        let shift = [slot[0] - f.qmin.x, slot[1] - f.qmin.y];
-        inst.at = slot;
-        inst.shift = shift;
-        inst.matrix = f.matrix(shift);
-        inst.min = [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z];
-        inst.max = [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z];
+        let f = &frames[inst.id.part];
+        inst.place(f, slot, [slot[0] - f.qmin.x, slot[1] - f.qmin.y]);
     }
     let mut bounds = Bounds::EMPTY;
     for inst in &instances {
@@ -182,12 +169,13 @@ pub fn place_instances(
     }
     let mut misfits: Vec<Misfit> = Vec::new();
     for inst in &instances {
-        let (p, m) = (&spec.parts[inst.part], models[inst.part]);
-        let Some(f) = fit::misfit(inst, &frames[inst.part], &shown_name(m, p), s) else {
+        let part = inst.id.part;
+        let (p, m) = (&spec.parts[part], models[part]);
+        let Some(f) = fit::misfit(inst, &frames[part], &shown_name(m, p), s) else {
             continue;
         };
         // A part larger than the plate is named once, whatever its copies.
-        if f.kind == fit::MisfitKind::Outside || !misfits.iter().any(|x| x.part == f.part) {
+        if f.kind == fit::MisfitKind::Outside || !misfits.iter().any(|x| x.id.part == part) {
             misfits.push(f);
         }
     }
@@ -213,18 +201,18 @@ pub fn shown_name(model: &Model, p: &PartSpec) -> String {
     }
 }
 
-/// The refusal of a job whose arranged instances `missing` (part, copy) found no slot.
+/// The refusal of a job whose arranged instances `missing` found no slot.
 fn not_fitting(
     models: &[&Model],
     spec: &JobSpec,
     frames: &[Frame],
-    missing: &[(usize, usize)],
+    missing: &[InstanceId],
 ) -> Error {
     let s = &spec.settings;
     let (plate, gap) = ([s.plate_x, s.plate_y], s.part_spacing);
     let mut parts: Vec<String> = Vec::new();
     for (i, p) in spec.parts.iter().enumerate() {
-        let n = missing.iter().filter(|m| m.0 == i).count();
+        let n = missing.iter().filter(|m| m.part == i).count();
         if n > 0 {
             let f = &frames[i];
             parts.push(format!(
@@ -251,20 +239,17 @@ fn part_label(model: &Model, p: &PartSpec) -> String {
     p.name.clone().unwrap_or_else(|| model.part_name(p.item))
 }
 
-#[allow(clippy::too_many_arguments)]
 fn instance(
     model: &Model,
-    part: usize,
-    copy: usize,
+    id: InstanceId,
     p: &PartSpec,
     f: &Frame,
     placed: bool,
     at: [f64; 2],
     shift: [f64; 2],
 ) -> Instance {
-    Instance {
-        part,
-        copy,
+    let mut inst = Instance {
+        id,
         copies: p.copies as usize,
         name: clean_name(&part_label(model, p)),
         file: clean_name(&p.file),
@@ -279,14 +264,12 @@ fn instance(
         mirror: [p.mirror_x, p.mirror_y, p.mirror_z],
         place_angle: p.place_angle,
         placed,
-        at,
         unit: p.unit,
-        matrix: f.matrix(shift),
-        min: [f.qmin.x + shift[0], f.qmin.y + shift[1], f.qmin.z],
-        max: [f.qmax.x + shift[0], f.qmax.y + shift[1], f.qmax.z],
         size: (f.max1 - f.min1).to_array(),
-        shift,
-    }
+        ..Instance::default()
+    };
+    inst.place(f, at, shift);
+    inst
 }
 
 /// The layout of a job from its imported files, without building the meshes (the page's 3D

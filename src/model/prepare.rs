@@ -141,35 +141,18 @@ pub(crate) fn import(
         .ok_or_else(|| Error::Internal("a mesh with facets has no vertices".into()))?;
     let place = placement.place;
     let name = job::clean_name(&import::stem(file_name));
-    let instance = Instance {
-        part: 0,
-        copy: 0,
+    let mut instance = Instance {
         copies: 1,
         name,
         file: job::clean_name(file_name),
-        item: None,
-        object: None,
         rotate: placement.rotate,
         scale: [settings.scale_x, settings.scale_y, settings.scale_z],
-        mirror: [false; 3],
         place_angle: placement.place_angle,
         placed: true,
-        at: place,
-        unit: 0,
-        matrix: frame.matrix(place),
-        min: [
-            frame.qmin.x + place[0],
-            frame.qmin.y + place[1],
-            frame.qmin.z,
-        ],
-        max: [
-            frame.qmax.x + place[0],
-            frame.qmax.y + place[1],
-            frame.qmax.z,
-        ],
         size: (frame.max1 - frame.min1).to_array(),
-        shift: place,
+        ..Instance::default()
     };
+    instance.place(&frame, place, place);
     mesh.place(&placement);
     let misfit = fit::misfit(&instance, &frame, &job::clean_name(file_name), settings);
     Ok(Imported {

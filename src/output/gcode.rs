@@ -42,11 +42,11 @@ pub enum FigureField {
     PrintSeconds,
     /// `Figures::travel_mm`, mm.
     Travel,
-    /// `Figures::unit_seconds` of a unit, s (written when more than one unit prints).
+    /// `UnitFigures::seconds` of a unit, s (written when more than one unit prints).
     UnitSeconds(UnitId),
-    /// `Figures::unit_volume_mm3` of a unit (unit 0's: `volume_mm3`), mm³.
+    /// `UnitFigures::volume_mm3` of a unit, mm³.
     UnitVolume(UnitId),
-    /// `Figures::unit_mass_g` of a unit (unit 0's: `mass_g`), g.
+    /// `UnitFigures::mass_g` of a unit, g.
     UnitMass(UnitId),
 }
 
@@ -118,35 +118,25 @@ impl FigureField {
 
     /// This figure of `f` (0 for a unit `f` has no entry for).
     pub fn of(self, f: &crate::output::summary::Figures) -> f64 {
-        let at = |v: &[f64], u: UnitId| v.get(u.index()).copied().unwrap_or(0.0);
+        let unit = |u: UnitId| f.units.get(u.index()).copied().unwrap_or_default();
         match self {
             FigureField::PrintSeconds => f.print_seconds,
             FigureField::Travel => f.travel_mm,
-            FigureField::UnitSeconds(u) => at(&f.unit_seconds, u),
-            FigureField::UnitVolume(u) => at(&f.unit_volume_mm3, u),
-            FigureField::UnitMass(u) => at(&f.unit_mass_g, u),
+            FigureField::UnitSeconds(u) => unit(u).seconds,
+            FigureField::UnitVolume(u) => unit(u).volume_mm3,
+            FigureField::UnitMass(u) => unit(u).mass_g,
         }
     }
 
-    /// Sets this figure of `f` (unit 0's volume and mass in both their places; nothing for a
-    /// unit `f` has no entry for).
+    /// Sets this figure of `f` (nothing for a unit `f` has no entry for).
     pub fn set(self, f: &mut crate::output::summary::Figures, v: f64) {
+        let units = &mut f.units;
         let slot = match self {
             FigureField::PrintSeconds => Some(&mut f.print_seconds),
             FigureField::Travel => Some(&mut f.travel_mm),
-            FigureField::UnitSeconds(u) => f.unit_seconds.get_mut(u.index()),
-            FigureField::UnitVolume(u) => {
-                if u == UnitId::FIRST {
-                    f.volume_mm3 = v;
-                }
-                f.unit_volume_mm3.get_mut(u.index())
-            }
-            FigureField::UnitMass(u) => {
-                if u == UnitId::FIRST {
-                    f.mass_g = v;
-                }
-                f.unit_mass_g.get_mut(u.index())
-            }
+            FigureField::UnitSeconds(u) => units.get_mut(u.index()).map(|x| &mut x.seconds),
+            FigureField::UnitVolume(u) => units.get_mut(u.index()).map(|x| &mut x.volume_mm3),
+            FigureField::UnitMass(u) => units.get_mut(u.index()).map(|x| &mut x.mass_g),
         };
         if let Some(slot) = slot {
             *slot = v;
@@ -330,13 +320,13 @@ pub fn part_line(p: &crate::model::layout::Instance) -> String {
     };
     format!(
         "part {} = {}{what}{name}, rotate {rx}/{ry}/{rz} deg, scale {sx}/{sy}/{sz}{mirror}, at X{} Y{}{}, angle {} deg, copy {} of {}, unit {}",
-        p.part + 1,
+        p.id.part + 1,
         clean(&p.file),
         coord(p.at[0]),
         coord(p.at[1]),
         if p.placed { "" } else { " (arranged)" },
         p.place_angle,
-        p.copy + 1,
+        p.id.copy + 1,
         p.copies,
         p.unit
     )

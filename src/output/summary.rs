@@ -54,15 +54,15 @@ pub struct WorstLayer {
 /// ([`Figures::print_seconds`]) and of each layer ([`layer_seconds`]), so the layers' times
 /// add up to the job's.
 pub fn print_seconds(counts: &Counts, travel_mm: f64, settings: &Settings) -> f64 {
-    let droplets: f64 = unit_seconds(counts, settings).iter().sum();
+    let droplets: f64 = UnitId::all(settings.units.max(1) as usize)
+        .map(|u| droplet_seconds(counts, settings, u))
+        .sum();
     droplets + travel_mm / settings.travel_speed
 }
 
-/// The droplet time of each discharge unit the machine has, s (indexed by unit).
-pub fn unit_seconds(counts: &Counts, settings: &Settings) -> Vec<f64> {
-    UnitId::all(settings.units.max(1) as usize)
-        .map(|u| counts.unit(u) as f64 / settings.unit(u).droplet_rate)
-        .collect()
+/// Unit `u`'s droplet time, s: its droplets / its `…droplet_rate`.
+fn droplet_seconds(counts: &Counts, settings: &Settings, u: UnitId) -> f64 {
+    counts.unit(u) as f64 / settings.unit(u).droplet_rate
 }
 
 /// The estimated print time of one planned layer, s (the page's per-layer plot).
@@ -93,23 +93,14 @@ impl WorstLayer {
 pub struct Figures {
     pub layers: usize,
     pub counts: Counts,
+    /// Every unit's droplets (parts and support).
     pub droplets: u64,
-    /// Unit 0's droplets × B²H, mm³ (the parts of unit 0).
-    pub volume_mm3: f64,
-    /// volume × material_density, g.
-    pub mass_g: f64,
-    /// The droplets each unit prints (its parts' and, for the support's unit, the support),
-    /// indexed by unit, one entry per unit the machine has (`units`).
-    pub unit_droplets: Vec<u64>,
-    /// Each unit's droplets × B_u²H, mm³ (unit 0's: `volume_mm3`).
-    pub unit_volume_mm3: Vec<f64>,
-    /// Each unit's volume × its `…material_density`, g (unit 0's: `mass_g`).
-    pub unit_mass_g: Vec<f64>,
+    /// Each discharge unit's figures, indexed by unit, one entry per unit the machine has
+    /// (`units`); unit 0's are the parts of unit 0.
+    pub units: Vec<UnitFigures>,
     /// Each unit's droplets / its `…droplet_rate`, summed, + travel / travel_speed, s
     /// ([`print_seconds`]).
     pub print_seconds: f64,
-    /// Each unit's droplets / its `…droplet_rate`, s.
-    pub unit_seconds: Vec<f64>,
     /// Overhang area summed over the layers, mm² (support on or off: what would be printed
     /// in the air without support).
     pub unsupported_area: f64,
@@ -123,15 +114,26 @@ pub struct Figures {
     /// Uncovered area summed over the analysed layers, mm².
     pub void_area: Option<f64>,
     pub worst_layer: Option<WorstLayer>,
-    /// Predicted density of the analysed part, % (100 × (1 − the 3D void fraction)); `None`
-    /// without the 3D estimate. A geometric estimate from the droplet model, not a measured
-    /// density.
-    pub predicted_density: Option<f64>,
-    /// The same of each unit's parts (another material), indexed by unit (unit 0's:
-    /// `predicted_density`); `None` without parts of the unit or without the 3D estimate.
-    pub unit_predicted_density: Vec<Option<f64>>,
     /// What slicing repaired, in plain language.
     pub repairs: Vec<String>,
+}
+
+/// One discharge unit's figures ([`Figures::units`]).
+#[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct UnitFigures {
+    /// The droplets it prints: its parts' and, for the support's unit, the support.
+    pub droplets: u64,
+    /// droplets × B_u²H, mm³.
+    pub volume_mm3: f64,
+    /// volume × its `…material_density`, g.
+    pub mass_g: f64,
+    /// droplets / its `…droplet_rate`, s.
+    pub seconds: f64,
+    /// The predicted density of its parts, % (100 × (1 − the 3D void fraction)); `None`
+    /// without parts of the unit or without the 3D estimate. A geometric estimate from the
+    /// droplet model, not a measured density.
+    pub predicted_density: Option<f64>,
 }
 
 /// A layer's travel on a grid of 2⁻²⁰ mm (about 1 nm). Sums of such numbers below 2³³ mm are
@@ -223,31 +225,31 @@ impl Summary {
 
     /// The figures shown to the user, with the estimates of `settings`.
     pub fn figures(&self, settings: &Settings) -> Figures {
-        let droplets = self.counts.total();
-        let units: Vec<UnitId> = UnitId::all(settings.units.max(1) as usize).collect();
         let h = settings.layer_height;
-        let volume: Vec<f64> = (units.iter())
-            .map(|&u| {
+        let a = &self.analysis;
+        let n = settings.units.max(1) as usize;
+        let density = a.unit_densities(n);
+        let units = UnitId::all(n)
+            .map(|u| {
                 let b = settings.unit_width(u);
-                self.counts.unit(u) as f64 * b * b * h
+                let droplets = self.counts.unit(u);
+                let volume_mm3 = droplets as f64 * b * b * h;
+                UnitFigures {
+                    droplets,
+                    volume_mm3,
+                    mass_g: volume_mm3 / 1000.0 * settings.unit(u).material_density,
+                    seconds: droplet_seconds(&self.counts, settings, u),
+                    predicted_density: density[u.index()],
+                }
             })
             .collect();
-        let mass: Vec<f64> = (units.iter())
-            .map(|&u| volume[u.index()] / 1000.0 * settings.unit(u).material_density)
-            .collect();
-        let a = &self.analysis;
         let analysed = a.layers > 0;
         Figures {
             layers: self.layers,
             counts: self.counts,
-            droplets,
-            volume_mm3: volume[0],
-            mass_g: mass[0],
-            unit_droplets: units.iter().map(|&u| self.counts.unit(u)).collect(),
-            unit_volume_mm3: volume,
-            unit_mass_g: mass,
+            droplets: self.counts.total(),
+            units,
             print_seconds: print_seconds(&self.counts, self.travel_mm, settings),
-            unit_seconds: unit_seconds(&self.counts, settings),
             unsupported_area: self.unsupported_area,
             worst_overhang: self.worst_overhang,
             travel_mm: self.travel_mm,
@@ -261,8 +263,6 @@ impl Summary {
                 }),
                 _ => None,
             },
-            predicted_density: a.predicted_density,
-            unit_predicted_density: a.unit_densities(units.len()),
             repairs: self.repairs(),
         }
     }
@@ -277,77 +277,5 @@ impl Summary {
             "no droplet fits in the part: every wall is thinner than the droplet width B = {:.3} mm; scale the part up or use smaller droplets (layer_height, droplet_aspect)",
             settings.droplet_width()
         )))
-    }
-}
-
-impl PartAnalysis {
-    /// Adds the layers of another part analysis (disjoint layers), as if each of its layers
-    /// had been [`add`](PartAnalysis::add)ed here. Of equal largest voids (or deviations) the
-    /// lower layer wins, so the order of the merges does not matter.
-    pub fn merge(&mut self, o: &PartAnalysis) {
-        if o.layers == 0 {
-            return;
-        }
-        let covered = self.coverage * self.region_area + o.coverage * o.region_area;
-        self.layers += o.layers;
-        self.droplets += o.droplets;
-        self.region_area += o.region_area;
-        self.coverage = if self.region_area > 0.0 {
-            covered / self.region_area
-        } else {
-            0.0
-        };
-        self.void_area += o.void_area;
-        self.enclosed_void_area += o.enclosed_void_area;
-        self.overfill_area += o.overfill_area;
-        let better = |a: f64, ai: Option<usize>, b: f64, bi: Option<usize>| {
-            a > b || (a == b && ai.unwrap_or(usize::MAX) < bi.unwrap_or(usize::MAX))
-        };
-        if let Some(v) = o.largest_void
-            && self.largest_void.is_none_or(|mine| {
-                better(
-                    v.area,
-                    o.largest_void_layer,
-                    mine.area,
-                    self.largest_void_layer,
-                )
-            })
-        {
-            self.largest_void = Some(v);
-            self.largest_void_layer = o.largest_void_layer;
-        }
-        // The larger figure of the two and its layer (ties: the lower layer).
-        let keep_max = |mine: (&mut f64, &mut Option<usize>), theirs: (f64, Option<usize>)| {
-            if theirs.1.is_some()
-                && (mine.1.is_none() || better(theirs.0, theirs.1, *mine.0, *mine.1))
-            {
-                (*mine.0, *mine.1) = theirs;
-            }
-        };
-        keep_max(
-            (
-                &mut self.max_boundary_deviation,
-                &mut self.max_deviation_layer,
-            ),
-            (o.max_boundary_deviation, o.max_deviation_layer),
-        );
-        self.unsupported_area += o.unsupported_area;
-        keep_max(
-            (
-                &mut self.max_unsupported_area,
-                &mut self.max_unsupported_area_layer,
-            ),
-            (o.max_unsupported_area, o.max_unsupported_area_layer),
-        );
-        self.volume += o.volume;
-        self.void_volume += o.void_volume;
-        for (k, theirs) in o.units.iter().enumerate() {
-            if let Some(theirs) = theirs {
-                let u = self.unit_mut(k);
-                u.volume += theirs.volume;
-                u.void_volume += theirs.void_volume;
-            }
-        }
-        self.update_fraction();
     }
 }

@@ -250,7 +250,7 @@ impl Job {
         };
         // The instances run by run (a job of unit 0 alone: one run, in the layout's order).
         let mut order: Vec<&Instance> = layout.instances.iter().collect();
-        order.sort_by_key(|inst| run_of[inst.part]);
+        order.sort_by_key(|inst| run_of[inst.id.part]);
         // Each instance's vertices are placed where they land in the merged mesh; a job of
         // one instance takes its part's welded mesh as it is: no copy of the mesh, which on a
         // million facets is 24 MB a copy (a page worker's memory never shrinks).
@@ -266,33 +266,33 @@ impl Job {
             }
         };
         let mesh = if let [only] = order[..] {
-            let mut mesh = std::mem::take(&mut welded[only.part]);
-            let placement = spec.parts[only.part].placement(only.shift, &settings);
+            let mut mesh = std::mem::take(&mut welded[only.id.part]);
+            let placement = spec.parts[only.id.part].placement(only.shift, &settings);
             mesh::place_vertices_in_steps(&mut mesh.vertices, &placement, budget).await;
             if placement.mirrors() {
                 mesh::turn_facets(&mut mesh.facets);
             }
-            add_to_run(only.part, mesh.facets.len());
+            add_to_run(only.id.part, mesh.facets.len());
             mesh
         } else {
-            let vertices: usize = order.iter().map(|x| welded[x.part].vertices.len()).sum();
+            let vertices: usize = order.iter().map(|x| welded[x.id.part].vertices.len()).sum();
             let mut mesh = Mesh {
                 vertices: Vec::with_capacity(vertices),
                 facets: Vec::with_capacity(facets),
             };
             for inst in order {
-                let part = &welded[inst.part];
+                let part = &welded[inst.id.part];
                 let base = mesh.vertices.len();
                 let first = mesh.facets.len();
                 mesh.vertices.extend_from_slice(&part.vertices);
                 mesh.facets
                     .extend(part.facets.iter().map(|f| f.map(|v| v + base as u32)));
-                let placement = spec.parts[inst.part].placement(inst.shift, &settings);
+                let placement = spec.parts[inst.id.part].placement(inst.shift, &settings);
                 mesh::place_vertices_in_steps(&mut mesh.vertices[base..], &placement, budget).await;
                 if placement.mirrors() {
                     mesh::turn_facets(&mut mesh.facets[first..]);
                 }
-                add_to_run(inst.part, part.facets.len());
+                add_to_run(inst.id.part, part.facets.len());
             }
             mesh
         };

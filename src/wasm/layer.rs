@@ -156,7 +156,7 @@ impl LayerResult {
                 .iter()
                 .flat_map(|t| {
                     let o = m.tile_origin(t);
-                    [o[0], o[1], t.width as f64, t.height as f64]
+                    [o[0], o[1], t.rect.width as f64, t.rect.height as f64]
                 })
                 .collect()
         });

@@ -218,18 +218,21 @@ test("units: the form groups unitN_ rows under Unit N", () => {
   for (const s of schema) if (units.unitOfSetting(s.name) !== null) assert.equal(forms.groupOf(s), `Unit ${units.unitOfSetting(s.name)}`);
 });
 
-test("units: each unit's figures from the core's per-unit arrays", () => {
+test("units: each unit's figures from the core's per-unit entries", () => {
   const f = new figures.Figures();
-  // a machine of two units: a unit beyond the arrays prints nothing
-  f.core = { droplets: 100, volume_mm3: 5, mass_g: 0.1, unit_droplets: [70, 30], unit_volume_mm3: [5, 2], unit_mass_g: [0.1, 0.05], unit_seconds: [7, 3], predicted_density: 99, unit_predicted_density: [99, null] };
+  const unit = (droplets, volume_mm3, mass_g, seconds, predicted_density) => ({ droplets, volume_mm3, mass_g, seconds, predicted_density });
+  // a machine of two units: a unit beyond the entries prints nothing
+  f.core = { droplets: 100, print_seconds: 10, units: [unit(70, 5, 0.1, 7, 99), unit(30, 2, 0.05, 3, null)] };
   assert.deepEqual(f.units(2), [
     { droplets: 70, volume: 5, mass: 0.1, seconds: 7, density: 99 },
     { droplets: 30, volume: 2, mass: 0.05, seconds: 3, density: null },
   ]);
   assert.deepEqual(f.units(3)[2], { droplets: 0, volume: 0, mass: 0, seconds: 0, density: null });
   assert.deepEqual(f.units(1).map((u) => u.droplets), [70]);
-  // three units: arrays indexed by unit
-  f.core = { droplets: 6, unit_droplets: [1, 2, 3], unit_volume_mm3: [1, 1, 1], unit_mass_g: [1, 1, 1], unit_seconds: [4, 5, 6], unit_predicted_density: [null, 98, null] };
+  // the estimates are unit 0's material with the whole print time
+  assert.deepEqual(f.estimates, { volume: 5, mass: 0.1, seconds: 10 });
+  // three units: entries indexed by unit
+  f.core = { droplets: 6, units: [unit(1, 1, 1, 4, null), unit(2, 1, 1, 5, 98), unit(3, 1, 1, 6, null)] };
   assert.deepEqual(f.units(3).map((u) => [u.droplets, u.seconds, u.density]), [[1, 4, null], [2, 5, 98], [3, 6, null]]);
   // a .gco file: each unit's droplets as read
   const g = new figures.Figures();

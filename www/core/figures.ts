@@ -22,15 +22,16 @@ export interface UnitFigures {
 
 const finiteOr = (v: unknown, or: number | null): number | null => (typeof v === "number" && Number.isFinite(v) ? v : or);
 
-/** Unit u's figures of the core's `c` (its per-unit arrays, indexed by unit; a unit beyond
- *  them prints nothing). */
+/** Unit u's figures of the core's `c` (one entry per unit; a unit beyond them prints
+ *  nothing). */
 function coreUnit(c: CoreFigures, u: number): UnitFigures {
+  const x = c.units?.[u];
   return {
-    droplets: finiteOr(c.unit_droplets?.[u], 0)!,
-    volume: finiteOr(c.unit_volume_mm3?.[u], 0),
-    mass: finiteOr(c.unit_mass_g?.[u], 0),
-    seconds: finiteOr(c.unit_seconds?.[u], 0),
-    density: finiteOr(c.unit_predicted_density?.[u], null),
+    droplets: finiteOr(x?.droplets, 0)!,
+    volume: finiteOr(x?.volume_mm3, 0),
+    mass: finiteOr(x?.mass_g, 0),
+    seconds: finiteOr(x?.seconds, 0),
+    density: finiteOr(x?.predicted_density, null),
   };
 }
 
@@ -177,6 +178,8 @@ export class Figures {
   /** Material volume (mm³), mass (g) and print time (s); null for a .gco file. */
   get estimates(): { volume: number; mass: number; seconds: number } | null {
     const c = this.core;
-    return c ? { volume: c.volume_mm3, mass: c.mass_g, seconds: c.print_seconds } : null;
+    if (!c) return null;
+    const u0 = coreUnit(c, 0);
+    return { volume: u0.volume ?? 0, mass: u0.mass ?? 0, seconds: c.print_seconds };
   }
 }

@@ -1,7 +1,7 @@
 //! The coverage mask: per square cell of the page's overlay, the shares of void, overfill and
 //! covered region.
 
-use super::{COLS_PER_ROW, CoverageMask, MaskTile, Raster, count_range, window};
+use super::{COLS_PER_ROW, CellRect, CoverageMask, MaskTile, Raster, count_range, window};
 use crate::base::geom::DVec2;
 
 /// Mask cells of at most this many grid rows are counted by 4-bit groups
@@ -34,10 +34,8 @@ impl Raster {
     ) -> Vec<Vec<[u32; 3]>> {
         let g = self.grid;
         let cols = rows * COLS_PER_ROW as usize;
-        let mut counts: Vec<Vec<[u32; 3]>> = out
-            .iter()
-            .map(|t| vec![[0; 3]; t.width * t.height])
-            .collect();
+        let mut counts: Vec<Vec<[u32; 3]>> =
+            out.iter().map(|t| vec![[0; 3]; t.rect.cells()]).collect();
         let mut group = 0;
         for (k, row, lo, hi) in self.filled_rows() {
             let my = k / rows;
@@ -56,11 +54,10 @@ impl Raster {
                 let (gc0, gc1) = (64 * a + shift, (64 * e + shift).min(g.nx) - 1);
                 for cx in gc0 / cols..=gc1 / cols {
                     let (c0, c1) = ((cx * cols).max(gc0), ((cx + 1) * cols - 1).min(gc1));
-                    while out[t].col + out[t].width <= cx {
+                    while out[t].rect.end_col() <= cx {
                         t += 1;
                     }
-                    let tile = &out[t];
-                    let slot = &mut counts[t][(my - tile.row) * tile.width + cx - tile.col];
+                    let slot = &mut counts[t][out[t].rect.index(cx, my)];
                     let add = count(r, d, c0 - shift, c1 - shift);
                     for (s, a) in slot.iter_mut().zip(add) {
                         *s += a;
@@ -96,7 +93,10 @@ impl Raster {
         debug_assert!((1..=NIBBLE_ROWS).contains(&rows));
         // Grid words [first, end) under tile t's cells: its 4-bit groups are
         // [col·rows, (col + width)·rows).
-        let words = |t: &MaskTile| (t.col * rows / 16, ((t.col + t.width) * rows).div_ceil(16));
+        let words = |t: &MaskTile| {
+            let r = t.rect;
+            (r.col * rows / 16, (r.end_col() * rows).div_ceil(16))
+        };
         // Per grid word under the current mask band's tiles (tile by tile, `at[t]` where tile
         // t's words start), the 4-bit counts of void, overfill, covered: memory for the
         // tiles, not for the grid's width.
@@ -120,11 +120,11 @@ impl Raster {
             for ((t, &base_at), &(w0, w1)) in range.zip(at).zip(spans) {
                 let tile = &mut out[t];
                 let mine = &acc[base_at..base_at + (w1 - w0)];
-                let base = (my - tile.row) * tile.width;
+                let base = tile.rect.index(tile.rect.col, my);
                 // The tile's first group is (col·rows) mod 16 of its first word.
-                let (mut w, mut sh) = (0, 4 * ((tile.col * rows) & 15));
+                let (mut w, mut sh) = (0, 4 * ((tile.rect.col * rows) & 15));
                 let mut a = mine.first().copied().unwrap_or([0; N]);
-                for i in base..base + tile.width {
+                for i in base..base + tile.rect.width {
                     let mut sum = [0usize; N];
                     for _ in 0..rows {
                         for c in 0..N {
@@ -254,10 +254,12 @@ impl Raster {
                 }
                 let row = mb * MASK_BAND_ROWS;
                 out.push(MaskTile {
-                    col: c0,
-                    row,
-                    width: c1 - c0 + 1,
-                    height: MASK_BAND_ROWS.min(height - row),
+                    rect: CellRect {
+                        col: c0,
+                        row,
+                        width: c1 - c0 + 1,
+                        height: MASK_BAND_ROWS.min(height - row),
+                    },
                     ..MaskTile::default()
                 });
             }
@@ -288,7 +290,7 @@ impl Raster {
         if rows <= NIBBLE_ROWS {
             // The shares written as each mask row is summed (every cell is, once).
             for t in &mut out {
-                let n = t.width * t.height;
+                let n = t.rect.cells();
                 t.void = vec![0; n];
                 t.overfill = vec![0; n];
                 if covered {

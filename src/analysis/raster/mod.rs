@@ -93,19 +93,56 @@ pub struct CoverageMask {
     pub tiles: Vec<MaskTile>,
 }
 
-/// A rectangle of a [`CoverageMask`]: cells (col + i, row + j) for i < width, j < height, the
-/// shares of cell (col + i, row + j) at index j·width + i.
+/// A rectangle of mask cells: (col + i, row + j) for i < width, j < height; in a row-major
+/// array of its cells, cell (col + i, row + j) is at index j·width + i ([`CellRect::index`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct CellRect {
+    /// The mask column (from 0, counted from the mask's origin) of the first cells.
+    pub col: usize,
+    /// The mask row (from 0) of the first cells.
+    pub row: usize,
+    /// Cells across.
+    pub width: usize,
+    /// Cells down.
+    pub height: usize,
+}
+
+impl CellRect {
+    /// How many cells it holds.
+    pub fn cells(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// The column after its last.
+    pub fn end_col(&self) -> usize {
+        self.col + self.width
+    }
+
+    /// The row after its last.
+    pub fn end_row(&self) -> usize {
+        self.row + self.height
+    }
+
+    /// Whether cell (col, row) is in it.
+    pub fn contains(&self, col: usize, row: usize) -> bool {
+        (self.col..self.end_col()).contains(&col) && (self.row..self.end_row()).contains(&row)
+    }
+
+    /// The index of its cell (col, row) in a row-major array of its cells.
+    pub fn index(&self, col: usize, row: usize) -> usize {
+        (row - self.row) * self.width + col - self.col
+    }
+}
+
+/// A rectangle of a [`CoverageMask`] and the shares of its cells, each indexed as
+/// [`CellRect::index`] says.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct MaskTile {
-    /// The mask column (from 0, counted from the mask's origin) of the tile's first cells.
-    pub col: usize,
-    /// The mask row (from 0) of the tile's first cells: a multiple of the 64 mask rows a tile
-    /// band holds.
-    pub row: usize,
-    /// Cells across, at least 1.
-    pub width: usize,
-    /// Cells down: 64, or fewer in the last band of the mask.
-    pub height: usize,
+    /// Its cells: at least 1 across; 64 down (the mask rows a tile band holds), or fewer in
+    /// the last band of the mask, from a multiple of 64 (`col`, `row`, `width`, `height` in
+    /// the JSON).
+    #[serde(flatten)]
+    pub rect: CellRect,
     /// Per cell, the share of it that is region no droplet covers: 0 (none) … 255 (all).
     pub void: Vec<u8>,
     /// Per cell, the share of it that droplets cover outside the region: 0 … 255.
@@ -119,8 +156,8 @@ impl CoverageMask {
     /// Where tile `t`'s cell (0, 0) starts, in mm.
     pub fn tile_origin(&self, t: &MaskTile) -> Point {
         DVec2::new(
-            self.origin[0] + t.col as f64 * self.cell,
-            self.origin[1] + t.row as f64 * self.cell,
+            self.origin[0] + t.rect.col as f64 * self.cell,
+            self.origin[1] + t.rect.row as f64 * self.cell,
         )
     }
 
@@ -128,11 +165,9 @@ impl CoverageMask {
     pub fn shares(&self, col: usize, row: usize) -> [u8; 3] {
         self.tiles
             .iter()
-            .find(|t| {
-                (t.col..t.col + t.width).contains(&col) && (t.row..t.row + t.height).contains(&row)
-            })
+            .find(|t| t.rect.contains(col, row))
             .map_or([0; 3], |t| {
-                let i = (row - t.row) * t.width + col - t.col;
+                let i = t.rect.index(col, row);
                 [t.void[i], t.overfill[i], t.covered[i]]
             })
     }
@@ -140,7 +175,7 @@ impl CoverageMask {
     /// Cells (width, height) from the origin to the far corner of the last tiles.
     pub fn size(&self) -> (usize, usize) {
         self.tiles.iter().fold((0, 0), |(w, h), t| {
-            (w.max(t.col + t.width), h.max(t.row + t.height))
+            (w.max(t.rect.end_col()), h.max(t.rect.end_row()))
         })
     }
 }

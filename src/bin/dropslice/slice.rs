@@ -346,7 +346,7 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             .map_err(|e| io("write", &path, e))?;
         voids = format!(
             ", void fraction {:.1} % (coverage {:.1} %; report {})",
-            100.0 * report.part.void_fraction,
+            100.0 * report.part.estimate.void_fraction,
             100.0 * report.part.coverage,
             path.display()
         );
@@ -374,8 +374,8 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             c.outer,
             c.inner,
             c.fill,
-            f.volume_mm3 / 1000.0,
-            f.mass_g,
+            f.units[0].volume_mm3 / 1000.0,
+            f.units[0].mass_g,
             duration(f.print_seconds),
             t0.elapsed().as_secs_f64()
         );
@@ -392,8 +392,8 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             ),
         }
         let support = job.settings().support.unit();
-        for u in UnitId::all(f.unit_droplets.len()).skip(1) {
-            let n = f.unit_droplets[u.index()];
+        for (u, unit) in UnitId::all(f.units.len()).zip(&f.units).skip(1) {
+            let n = unit.droplets;
             if n == 0 {
                 continue;
             }
@@ -404,10 +404,10 @@ fn run(args: &Args, output: &Path, mut out: Staged, report: Option<Staged>) -> R
             };
             eprintln!(
                 "dropslice: unit {u}: {n} droplets ({s} support), {:.2} cm³, {:.2} g, {} of unit {u} and {} of unit 0",
-                f.unit_volume_mm3[u.index()] / 1000.0,
-                f.unit_mass_g[u.index()],
-                duration(f.unit_seconds[u.index()]),
-                duration(f.unit_seconds[0])
+                unit.volume_mm3 / 1000.0,
+                unit.mass_g,
+                duration(unit.seconds),
+                duration(f.units[0].seconds)
             );
         }
     }
