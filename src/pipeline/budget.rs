@@ -14,6 +14,7 @@ use crate::base::steps::{self, Budget};
 use crate::model::layout::Instance;
 use crate::model::mesh::Mesh;
 use crate::model::prepare::{FacetGroup, MAX_WIDTH_IN_DROPLETS};
+use crate::slicing::slice;
 
 /// Most droplets a job may set (volume / B²H): beyond this the code would not fit on a disk.
 pub const MAX_DROPLETS: f64 = 2e9;
@@ -564,6 +565,31 @@ fn check_droplets(volume: f64, settings: &Settings) -> Result<(), Error> {
         });
     }
     Ok(())
+}
+
+/// Checks unit 0's width in droplets (against [`MAX_WIDTH_IN_DROPLETS`]); the plane heights
+/// of the layers (at least one).
+pub(super) fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {
+    let b = settings.droplet_width();
+    let h = settings.layer_height;
+    if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
+        return Err(Error::Setting {
+            name: "scale_x".into(),
+            message: format!(
+                "the part is {:.0} mm wide, more than {MAX_WIDTH_IN_DROPLETS} droplets of {b:.4} mm; check the scale (is the file in micrometres?)",
+                size[0].max(size[1])
+            ),
+        });
+    }
+    let zs = slice::layer_heights(size[2], h, settings.slice_plane);
+    if zs.is_empty() {
+        return Err(Error::NothingToPrint(format!(
+            "the part is {:.4} mm tall, less than half a layer ({} mm): scale it up or lower layer_height",
+            size[2],
+            h / 2.0
+        )));
+    }
+    Ok(zs)
 }
 
 #[cfg(test)]

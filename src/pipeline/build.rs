@@ -13,9 +13,9 @@ use crate::model::models::{
     MAX_JOB_TRIANGLES, Model, check_job_triangles, models_of, too_many_triangles,
 };
 use crate::model::prepare::{
-    Bodies, FacetGroup, Imported, Input, JobInfo, MAX_WIDTH_IN_DROPLETS, bodies_warning,
-    check_chamber, check_height, check_surface, check_volume, close_cracks, import, keep_groups,
-    part_bodies, suggested_scale, warnings,
+    Bodies, FacetGroup, Imported, Input, JobInfo, bodies_warning, check_chamber, check_height,
+    check_surface, check_volume, close_cracks, import, keep_groups, part_bodies, suggested_scale,
+    warnings,
 };
 use crate::model::shells::{ShellOrientation, Shells};
 use crate::model::spec as job;
@@ -489,7 +489,7 @@ impl Building {
         let bounds = mesh.bounds();
         let size = bounds.size();
         check_height(&size, &settings)?;
-        let zs = plane_heights(&size, &settings);
+        let zs = budget::plane_heights(&size, &settings);
         let groups = std::mem::take(&mut input.groups);
         Ok(Building {
             made: Made {
@@ -662,30 +662,6 @@ impl Checked {
         }
         made.into_job(buckets, stats)
     }
-}
-
-/// Checks the width in droplets; the plane heights of the layers (at least one).
-fn plane_heights(size: &[f64; 3], settings: &Settings) -> Result<Vec<f64>, Error> {
-    let b = settings.droplet_width();
-    let h = settings.layer_height;
-    if size[0].max(size[1]) / b > MAX_WIDTH_IN_DROPLETS {
-        return Err(Error::Setting {
-            name: "scale_x".into(),
-            message: format!(
-                "the part is {:.0} mm wide, more than {MAX_WIDTH_IN_DROPLETS} droplets of {b:.4} mm; check the scale (is the file in micrometres?)",
-                size[0].max(size[1])
-            ),
-        });
-    }
-    let zs = slice::layer_heights(size[2], h, settings.slice_plane);
-    if zs.is_empty() {
-        return Err(Error::NothingToPrint(format!(
-            "the part is {:.4} mm tall, less than half a layer ({} mm): scale it up or lower layer_height",
-            size[2],
-            h / 2.0
-        )));
-    }
-    Ok(zs)
 }
 
 /// The mesh statistics with what the repair did.
