@@ -1097,3 +1097,86 @@ fn cli_single_model_header_lists_the_part() {
         "{t:.3000}"
     );
 }
+
+/// The settings the table marks `layout` are all that the plate's layout reads (the layout and
+/// which of its misfits may be sliced): every other setting of the job, changed alone to
+/// another value it takes, leaves them as they were (the page lays a job out again only when a
+/// marked one changes), and each marked one changes them for some value. The job: a part wider than the plate (a misfit), two copies of a box, a part of
+/// each other unit.
+#[test]
+fn the_layout_reads_the_settings_marked_layout_and_no_other() {
+    use dropslice::base::settings::{Kind, MAX_UNITS, schema};
+    let models = [
+        box_model("wide.stl", 170.0, 20.0, 30.0),
+        box_model("box.stl", 40.0, 30.0, 20.0),
+        box_model("small.stl", 12.0, 8.0, 6.0),
+    ];
+    let mut parts = vec![
+        json!({"file": "wide.stl"}),
+        json!({"file": "box.stl", "copies": 2}),
+    ];
+    for u in 1..MAX_UNITS {
+        parts.push(json!({"file": "small.stl", "unit": u}));
+    }
+    let machine = json!({"units": MAX_UNITS});
+    let of = |name: &str, v: &Value| -> Option<String> {
+        let mut settings = machine.clone();
+        settings[name] = v.clone();
+        // the layout, and which of its misfits the settings let be sliced
+        let l = spec(json!({"settings": settings, "parts": parts}))
+            .and_then(|s| {
+                let l = layout(&models, &s)?;
+                let allowed: Vec<bool> = l.misfits.iter().map(|m| m.allowed(&s.settings)).collect();
+                Ok((l, allowed))
+            })
+            .map_err(|e| e.to_string());
+        serde_json::to_string(&l).ok()
+    };
+    let base = of("units", &json!(MAX_UNITS)).unwrap();
+    assert!(base.contains("misfits"), "{base}");
+    let (mut marked, mut others) = (0, 0);
+    for s in schema().iter().filter(|s| !s.part) {
+        let d = &s.domain;
+        let values: Vec<Value> = match d.kind {
+            Kind::Bool => vec![json!(s.default != json!(true))],
+            Kind::Enum | Kind::Order => d.choices.iter().map(|c| json!(c)).collect(),
+            Kind::Number | Kind::Integer => {
+                let (lo, hi) = (d.min.unwrap(), d.max.unwrap());
+                let lo = if d.min_exclusive {
+                    lo + (hi - lo) * 1e-6
+                } else {
+                    lo
+                };
+                let mid = (lo + hi) / 2.0;
+                let mid = if d.kind == Kind::Integer {
+                    mid.round()
+                } else {
+                    mid
+                };
+                vec![json!(lo), json!(mid), json!(hi)]
+            }
+        };
+        let layouts: Vec<String> = values.iter().filter_map(|v| of(s.name, v)).collect();
+        if s.layout {
+            marked += 1;
+            assert!(
+                layouts.iter().any(|l| *l != base),
+                "{}: marked `layout`, but no value of it changes the layout",
+                s.name
+            );
+        } else {
+            others += 1;
+            for (v, l) in values.iter().zip(&layouts) {
+                assert_eq!(
+                    *l, base,
+                    "{} = {v} changes the layout: mark it `layout`",
+                    s.name
+                );
+            }
+        }
+    }
+    assert!(
+        marked >= 8 && others > 30,
+        "{marked} marked, {others} others"
+    );
+}

@@ -6,8 +6,6 @@ import { Cancelled, MAX_WORKERS, Pool } from "./core/client";
 import { checkLine } from "./core/cutline";
 import { History, sameSnapshot } from "./core/history";
 import { jobOffPlate } from "./core/plate";
-import { SETTING_NAMES, type SettingName } from "./core/settings";
-import { plainSetting } from "./core/units";
 import { cacheBudgetBytes, Store } from "./core/store";
 import type { View } from "./core/view";
 import { cutStatus, setCutLine, updateCut } from "./flows/cut";
@@ -360,10 +358,11 @@ async function main(): Promise<void> {
     return;
   }
   $("version").textContent = page.init.version;
-  // the settings the layout reads (LAYOUT_SETTINGS) lay the job out again (at most every
-  // 200 ms while typing)
+  // the settings the plate's layout reads (marked `layout` in the core's table) lay the job
+  // out again (at most every 200 ms while typing)
   let plateTimer = 0;
-  const plate = () => JSON.stringify(LAYOUT_SETTINGS.map((k) => page.form?.get(k)));
+  const layoutSettings = page.init.schema.filter((s) => s.layout).map((s) => s.name);
+  const plate = () => JSON.stringify(layoutSettings.map((k) => page.form?.get(k)));
   let lastPlate = "";
   page.form = new SettingsForm(
     $("settings"),
@@ -406,8 +405,6 @@ async function main(): Promise<void> {
 /** The settings the core's layout reads besides the parts (`Models.layout`: the plate, the gap,
  *  whether a part may be off it, the units, and each unit's shrinkage compensation, which
  *  scales its parts): a change lays the job out again. */
-const LAYOUT_READS: ReadonlySet<string> = new Set(["plate_x", "plate_y", "plate_z", "part_spacing", "allow_off_plate", "units", "shrink_xy", "shrink_z"] satisfies SettingName[]);
-const LAYOUT_SETTINGS = SETTING_NAMES.filter((n) => LAYOUT_READS.has(plainSetting(n)));
 
 registerOffline();
 void main();

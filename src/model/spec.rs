@@ -75,6 +75,7 @@ pub fn job_schema() -> JobSchema {
         description,
         part: true,
         profile: None,
+        layout: false,
         default: default.into(),
     };
     part_numbers.push(whole(

@@ -120,7 +120,7 @@ const POINT_TS: &str = r#"/** A point in the plane, mm: [x, y]. */
 export type Point = [number, number];"#;
 
 /// The settings table: `[{name, kind, unit, min, max, min_exclusive, choices, group,
-/// description, part, default}]`.
+/// description, part, profile, layout, default}]`.
 #[wasm_bindgen(unchecked_return_type = "SettingSpec[]")]
 pub fn settings_schema() -> Result<JsValue, JsValue> {
     to_js(&settings::schema(), "the settings schema")

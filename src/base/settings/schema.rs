@@ -44,6 +44,11 @@ pub struct SettingSpec {
     pub part: bool,
     /// The kind of profile that holds it (docs/process.md), `None`: no profile does.
     pub profile: Option<super::ProfileKind>,
+    /// A setting of the job that the parts' layout on the plate reads
+    /// ([`crate::model::layout::layout`]: the arrangement, the misfits, the shrinkage's
+    /// scale): a change lays the job out again. (The part keys are each part's own: an edit
+    /// of a part lays it out in any case.)
+    pub layout: bool,
     #[cfg_attr(target_arch = "wasm32", tsify(type = "number | boolean | string"))]
     pub default: serde_json::Value,
 }
@@ -123,6 +128,8 @@ pub struct Row {
     pub description: &'static str,
     pub profile: Option<ProfileKind>,
     pub shown: Shown,
+    /// The parts' layout reads it ([`SettingSpec::layout`]).
+    pub layout: bool,
 }
 
 /// When the G-code's header lists a setting (docs/gcode.md): the settings that only matter
@@ -156,6 +163,7 @@ pub const fn num(
         description,
         profile: None,
         shown: Shown::Used,
+        layout: false,
     }
 }
 
@@ -201,6 +209,14 @@ pub const fn order(group: &'static str, description: &'static str) -> Row {
 pub const fn unit_choices(row: Row) -> Row {
     Row {
         unit_choices: true,
+        ..row
+    }
+}
+
+/// Read by the parts' layout on the plate.
+pub const fn layout(row: Row) -> Row {
+    Row {
+        layout: true,
         ..row
     }
 }
@@ -440,6 +456,7 @@ pub fn entries() -> &'static [Entry] {
                 description,
                 part,
                 profile: row.profile,
+                layout: row.layout,
                 default: serde_json::Value::Null,
             }
         };

@@ -8,6 +8,8 @@
 //! bounds `support`, `unit_order` and a part's `unit`. From this table come the
 //! [`super::Settings`] struct and its `Default`, the schema ([`super::schema`]), the part
 //! keys, the profiles' keys and the page's TypeScript type (`www/core/settings.gen.ts`).
+//! `layout(…)` marks what the parts' layout on the plate reads (the page lays the job out
+//! again when one of them changes).
 
 use super::schema::*;
 use super::{
@@ -43,18 +45,18 @@ settings_table! {
     part place_y: f64 = 0.0 => num("mm", -10000.0, 10000.0, "Part", "Position of the part on the table in y, after its bounding box was moved to the origin");
     part place_angle: f64 = 0.0 => num("deg", -360.0, 360.0, "Part", "Rotation of the part on the table about z, around the origin, before place_x/place_y");
     job slice_plane: SlicePlane = SlicePlane::Middle => pick(&["middle", "top"], "Part", "Cut each layer at its middle (more accurate) or at its top (the thesis)");
-    job units: u32 = 2 => beyond_two(machine(int(num("", 1.0, MAX_UNITS as f64, "Machine", "Discharge units the machine has: unit 0 and units 1 … units - 1 (support, a part's unit and unit_order name only these)"))));
+    job units: u32 = 2 => layout(beyond_two(machine(int(num("", 1.0, MAX_UNITS as f64, "Machine", "Discharge units the machine has: unit 0 and units 1 … units - 1 (support, a part's unit and unit_order name only these)")))));
     unit droplet_rate: f64 = 100.0 => machine(num("Hz", MIN_RATE, 100000.0, "Machine", "Droplets the discharge unit sets per second (time estimate)")), "Droplets unit {n} sets per second (time estimate)";
     job travel_speed: f64 = 50.0 => machine(num("mm/s", MIN_RATE, 10000.0, "Machine", "Table speed of travel moves (time estimate)"));
     unit material_density: f64 = 1.04 => material(positive(num("g/cm³", 0.0, 30.0, "Machine", "Density of the material (mass estimate)"))), "Density of unit {n}'s material (mass estimate)";
-    unit shrink_xy: f64 = 0.0 => always(material(num("%", 0.0, 5.0, "Machine", "Linear shrinkage of unit 0's material in x and y as it cools: its parts are sliced scaled by 1/(1 - s/100) about their footprint's corner nearest the origin, so the cooled part has the designed size (Mele et al. 2022); support is not scaled"))), "Linear shrinkage of unit {n}'s material in x and y: unit {n}'s parts are sliced scaled by 1/(1 - s/100) (support is not scaled)";
-    unit shrink_z: f64 = 0.0 => always(material(num("%", 0.0, 5.0, "Machine", "Linear shrinkage of unit 0's material in z: its parts are sliced scaled by 1/(1 - s/100) in height, still resting on the plate"))), "Linear shrinkage of unit {n}'s material in z: unit {n}'s parts are sliced scaled by 1/(1 - s/100) in height";
+    unit shrink_xy: f64 = 0.0 => layout(always(material(num("%", 0.0, 5.0, "Machine", "Linear shrinkage of unit 0's material in x and y as it cools: its parts are sliced scaled by 1/(1 - s/100) about their footprint's corner nearest the origin, so the cooled part has the designed size (Mele et al. 2022); support is not scaled")))), "Linear shrinkage of unit {n}'s material in x and y: unit {n}'s parts are sliced scaled by 1/(1 - s/100) (support is not scaled)";
+    unit shrink_z: f64 = 0.0 => layout(always(material(num("%", 0.0, 5.0, "Machine", "Linear shrinkage of unit 0's material in z: its parts are sliced scaled by 1/(1 - s/100) in height, still resting on the plate")))), "Linear shrinkage of unit {n}'s material in z: unit {n}'s parts are sliced scaled by 1/(1 - s/100) in height";
     job footprint: Footprint = Footprint::Disc => pick(&["disc", "spread"], "Analysis", "Droplet footprint in the coverage report: disc = diameter B; spread = diameter 2B/sqrt(pi), the area of a B x B cell");
-    job plate_x: f64 = 154.0 => machine(num("mm", MIN_PLATE, 100000.0, "Plate", "Build plate size in x: parts without a placement are arranged on it"));
-    job plate_y: f64 = 134.0 => machine(num("mm", MIN_PLATE, 100000.0, "Plate", "Build plate size in y"));
-    job plate_z: f64 = 230.0 => machine(num("mm", MIN_PLATE, 100000.0, "Plate", "Height of the build chamber: a job taller than this (after scale and shrinkage compensation) is refused before slicing"));
-    job part_spacing: f64 = 5.0 => num("mm", 0.0, 1000.0, "Plate", "Gap between the bounding boxes of arranged parts");
-    job allow_off_plate: bool = false => flag("Plate", "Slice a part larger than the plate or reaching past its edges anyway (off: such a job is refused, with the turn or the scale that fits)");
+    job plate_x: f64 = 154.0 => layout(machine(num("mm", MIN_PLATE, 100000.0, "Plate", "Build plate size in x: parts without a placement are arranged on it")));
+    job plate_y: f64 = 134.0 => layout(machine(num("mm", MIN_PLATE, 100000.0, "Plate", "Build plate size in y")));
+    job plate_z: f64 = 230.0 => layout(machine(num("mm", MIN_PLATE, 100000.0, "Plate", "Height of the build chamber: a job taller than this (after scale and shrinkage compensation) is refused before slicing")));
+    job part_spacing: f64 = 5.0 => layout(num("mm", 0.0, 1000.0, "Plate", "Gap between the bounding boxes of arranged parts"));
+    job allow_off_plate: bool = false => layout(flag("Plate", "Slice a part larger than the plate or reaching past its edges anyway (off: such a job is refused, with the turn or the scale that fits)"));
     job overhang_limit: f64 = 0.5 => num("x B", 0.0, 10.0, "Support", "A droplet is supported when the layer below has material within this many droplet widths of its centre");
     job support: Support = Support::Off => unit_choices(pick(&["off"], "Support", "off: no support; unitN: support under every overhang, printed by discharge unit N (any unit but 0 the machine has, see units)"));
     job support_gap_xy: f64 = 0.5 => second_unit(num("x B", 0.0, 10.0, "Support", "Support is kept this many droplet widths away from the part within a layer"));

@@ -9,7 +9,7 @@
 // worker like the rest of the page.
 
 import { jobSettings } from "../../core/job";
-import type { SettingName, Settings } from "../../core/settings";
+import type { Settings } from "../../core/settings";
 import { supportColumns } from "../../core/supportcolumns";
 import { jobOffPlate } from "../../core/plate";
 import { errorBanner } from "../banner";
@@ -25,7 +25,6 @@ export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
 
 /** The settings the core's overhang threshold reads (`overhang_face_normal_z`): asked again
  *  when one of them changes. */
-const OVERHANG_SETTINGS = ["overhang_limit", "droplet_aspect", "layer_height"] as const satisfies readonly SettingName[];
 export function parseInstanceId(id: string): { part: number; copy: number } | null {
   const m = /^(\d+):(\d+)$/.exec(id);
   return m ? { part: Number(m[1]), copy: Number(m[2]) } : null;
@@ -101,7 +100,7 @@ export class View3DPanel implements View3DView {
   }
 
   /** With the overhang overlay on, the core's threshold for the form's settings (asked again
-   *  when the settings it depends on change). */
+   *  when they change: the core knows which of them it reads). */
   private syncOverhang(page: Page, values: Settings | undefined): void {
     if (!page.renderer.showOverhangs || !values || !page.form || page.form.errors().length) {
       this.overhang = null;
@@ -109,7 +108,7 @@ export class View3DPanel implements View3DView {
       return;
     }
     const settings = jobSettings(page.form.values());
-    const key = JSON.stringify(OVERHANG_SETTINGS.map((k) => settings[k]));
+    const key = JSON.stringify(settings);
     if (key === this.overhangFor) return;
     this.overhangFor = key;
     this.overhang = null;
