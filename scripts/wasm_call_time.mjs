@@ -15,7 +15,7 @@
 // `Taking.step`) and written (`Session.begin_prepared`, `Writing.step`) TAKE_ITEMS items
 // (environment, 65536 as the page), the supported pass through
 // SUPPORT_ITEMS layers' worth (environment, 4 as the page).
-// Usage: node scripts/wasm_call_time.mjs [PASSES] [MODEL] [PKG_DIR] [ITEMS] [SETTINGS]
+// Usage: [WARM=1] node scripts/wasm_call_time.mjs [PASSES] [MODEL] [PKG_DIR] [ITEMS] [SETTINGS]
 // (`bash scripts/build.sh` first; PKG_DIR: the wasm-bindgen output to time, www/pkg by default)
 import { readFileSync } from "node:fs";
 import { basename, dirname, join, resolve } from "node:path";
@@ -53,6 +53,21 @@ const cpuMs = ownThread
 const name = basename(model);
 const bytes = readFileSync(model);
 const job = { settings, parts: [{ file: name }] };
+
+// WARM=1: first the warm-up a page's worker makes while it waits for the job worker's draft
+// (www/worker/worker.ts `warmUp`: the sample part prepared and a lower layer sliced), so that
+// the first pass' layers show what they cost once the layer path is compiled.
+if (process.env.WARM === "1") {
+  const { build } = await import("esbuild");
+  const out = await build({ entryPoints: [join(repo, "www/core/sample.ts")], bundle: true, format: "esm", platform: "neutral", write: false, logLevel: "error" });
+  const { sampleStl } = await import(`data:text/javascript;base64,${Buffer.from(out.outputFiles[0].text).toString("base64")}`);
+  const t0 = cpuMs();
+  const sample = sampleStl();
+  const s = new core.Session(sample.bytes, sample.name, {});
+  s.slice_layer(Math.floor(s.layer_count() / 4)).free();
+  s.free();
+  console.log(`warm-up (the sample part's layer, as a waiting worker makes it): ${(cpuMs() - t0).toFixed(1)} ms`);
+}
 
 for (let k = 0; k < passes; k++) {
   /** Every call of the pass: [kind, name, ms]. */

@@ -105,6 +105,15 @@ let started = 0;
 
 class WorkerHandle {
   private worker: Worker;
+
+  /** Asks the worker, once, to compile the layer path while it waits for a job (the engine
+   *  compiles a function on its first call: else the job's first layer does it). */
+  warmUp(): void {
+    if (this.warmed || this.broken) return;
+    this.warmed = true;
+    this.call("warm", {}).catch(() => {});
+  }
+
   /** Settles once the module was posted (the worker's first message): requests go after it. */
   private started: Promise<void>;
   private pending = new Map<number, Pending>();
@@ -113,6 +122,8 @@ class WorkerHandle {
   broken = false;
   /** Whether the worker holds the current model. */
   hasModel = false;
+  /** Whether it was asked to compile the layer path ahead of a job ([[warmUp]]). */
+  private warmed = false;
   /** The job's files this worker's `Models` holds, by job name (the job worker's). */
   readonly models = new Map<string, File>();
   /** Why the worker was terminated: a request made after that (one that awaited something
@@ -291,7 +302,10 @@ async function openAll(
   // opening would be answered by the new job before the page knows of it. The job worker
   // answers the page's requests in order: after its answer to `open_job` (the page has the
   // new job then), or from its previous model if it refuses the job.
-  for (const h of others) h.hasModel = false;
+  for (const h of others) {
+    h.hasModel = false;
+    h.warmUp();
+  }
   const { prepared = [], ...r } = await syncThenOpen(first, files, job, others.length);
   first.hasModel = true;
   if (prepared.length < others.length) throw new SliceError("internal", "the job worker handed over too few copies of the job");
@@ -424,7 +438,10 @@ export class Pool {
     const layer = (l: LayerData) => clock.time("page: layer arrived (store, draw)", () => cb.layer(l));
     const unit = (u: SliceUnit) => clock.time("page: unit arrived (figures)", () => cb.unit(u));
     // the others answer nothing of the slice shown from now on (see [[openAll]])
-    for (const h of others) h.hasModel = false;
+    for (const h of others) {
+      h.hasModel = false;
+      h.warmUp();
+    }
     let counter: UnitCounter | null = null;
     const counterOf = (layers: number): UnitCounter => (counter ??= new UnitCounter(layers, handles.length));
     const drafted = (): UnitCounter | null => counter;

@@ -216,6 +216,10 @@ export interface Calls {
   /** The overhang overlay of a layer: 1 per droplet without a droplet of the layer below
    *  within the rule (src/wasm/mod.rs `unsupported_droplets`); `below` null for the first layer. */
   unsupported: { data: UnsupportedRequest; result: Uint8Array };
+  /** Compiles the layer path ahead of a job (`warmUp` in worker.ts): the sample part prepared
+   *  and one of its layers sliced, then dropped. Asked of the workers that wait for the job
+   *  worker's draft or job, once each. */
+  warm: { data: Record<string, never>; result: null };
   /** The 3D view's overhang tint: faces with normal z below minus this overhang. */
   overhang_face: { data: { settings: RawSettings }; result: number };
   /** The vertical cut of layers [from, to) (flows/cut.ts, src/wasm/cut.rs `Session.cut`). */

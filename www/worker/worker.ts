@@ -11,6 +11,7 @@
 
 import { Models, Session, Tally, check_profile, crash_for_test, default_settings, job_schema, overhang_face_normal_z, profile_stages, settings_schema, stage_times, unsupported_droplets, version, type InitOutput } from "../pkg/dropslice.js";
 import { StageClock, publish } from "../core/stages";
+import { sampleStl } from "../core/sample";
 import { partsByUnit } from "../core/units";
 import { GcodeError, GcodeReader, loadCore, readGcode } from "./gcode";
 import { calibrateRequest } from "./calibration";
@@ -279,6 +280,21 @@ function internal(message: string): ErrorValue {
   return { kind: "internal", message: `internal error (a bug in dropslice, please report it): ${message}` };
 }
 
+/** Compiles the layer path before a job needs it: the engine compiles a function on its first
+ *  call (the module is shared, so once for every worker), and a worker waiting for the job
+ *  worker's draft does it meanwhile rather than in the job's first layer. The sample part (a
+ *  block with a hole and a boss: loops, a hole, fill) prepared, a lower layer sliced with its
+ *  text, all dropped; nothing of this worker's own job is touched. */
+function warmUp(): void {
+  const { bytes, name } = sampleStl();
+  const s = new Session(bytes, name, {});
+  try {
+    s.slice_layer(Math.floor(s.layer_count() / 4)).free();
+  } finally {
+    s.free();
+  }
+}
+
 function needModels(): Models {
   if (!models) throw internal("no model files were added in this worker");
   return models;
@@ -468,6 +484,11 @@ async function handle(req: Request): Promise<void> {
       answer(req.kind, req.id, mask, [mask.buffer]);
       return;
     }
+    case "warm":
+      await load();
+      clock.time("worker: warm-up (the sample part's layer)", warmUp);
+      answer(req.kind, req.id, null);
+      return;
     case "overhang_face":
       await load();
       answer(req.kind, req.id, overhang_face_normal_z(req.data.settings));
