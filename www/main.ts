@@ -402,9 +402,5 @@ async function main(): Promise<void> {
   lastPlate = plate();
 }
 
-/** The settings the core's layout reads besides the parts (`Models.layout`: the plate, the gap,
- *  whether a part may be off it, the units, and each unit's shrinkage compensation, which
- *  scales its parts): a change lays the job out again. */
-
 registerOffline();
 void main();

@@ -6,6 +6,8 @@
 export class StageClock {
   private on = false;
   private ms: Record<string, number> = {};
+  /** What the extra counters counted of work set aside ([[aside]]), left out of `read()`. */
+  private left: Record<string, number> = {};
   /** What else `read()` adds (the worker: the core's own counters). */
   constructor(private readonly extra: { reset(on: boolean): void; read(): Record<string, number> } | null = null) {}
 
@@ -13,6 +15,7 @@ export class StageClock {
   reset(): void {
     this.on = true;
     this.ms = {};
+    this.left = {};
     this.extra?.reset(true);
   }
 
@@ -23,7 +26,21 @@ export class StageClock {
   }
 
   read(): Record<string, number> {
-    return { ...(this.on ? (this.extra?.read() ?? {}) : {}), ...this.ms };
+    const extra = this.on ? (this.extra?.read() ?? {}) : {};
+    for (const [k, v] of Object.entries(this.left)) if (k in extra) extra[k] -= v;
+    return { ...extra, ...this.ms };
+  }
+
+  /** Runs `f` leaving what the extra counters count during it out of `read()`: work that is no
+   *  part of the job (a worker's warm-up) does not count in its stages. */
+  aside<T>(f: () => T): T {
+    if (!this.on || !this.extra) return f();
+    const before = this.extra.read();
+    try {
+      return f();
+    } finally {
+      for (const [k, v] of Object.entries(this.extra.read())) this.left[k] = (this.left[k] ?? 0) + v - (before[k] ?? 0);
+    }
   }
 
   /** Runs `f`, adding its time to `name` while the counters are on. */

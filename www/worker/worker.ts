@@ -486,7 +486,7 @@ async function handle(req: Request): Promise<void> {
     }
     case "warm":
       await load();
-      clock.time("worker: warm-up (the sample part's layer)", warmUp);
+      clock.time("worker: warm-up (the sample part's layer)", () => clock.aside(warmUp));
       answer(req.kind, req.id, null);
       return;
     case "overhang_face":

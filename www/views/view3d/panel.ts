@@ -23,8 +23,7 @@ import type { View3D, View3DPart, View3DSlice } from "./view3d";
 /** The 3D view's id of an instance, and back. */
 export const instanceId = (part: number, copy: number) => `${part}:${copy}`;
 
-/** The settings the core's overhang threshold reads (`overhang_face_normal_z`): asked again
- *  when one of them changes. */
+/** The instance of an id made by [[instanceId]] (null for anything else). */
 export function parseInstanceId(id: string): { part: number; copy: number } | null {
   const m = /^(\d+):(\d+)$/.exec(id);
   return m ? { part: Number(m[1]), copy: Number(m[2]) } : null;
