@@ -1091,3 +1091,42 @@ fn the_preparation_in_short_calls_is_the_one_call_preparation() {
     .unwrap();
     throws(Session::from_preparation(p), "internal");
 }
+
+/// A prepared job taken in short calls (`Session::begin_take`, `Taking::step`) is the one
+/// taken at once; damaged bytes are refused as `from_prepared` refuses them, and every step
+/// after the refusal throws it again (a step never answers "not yet" for ever).
+#[wasm_bindgen_test]
+fn a_job_taken_in_short_calls_is_the_one_taken_at_once() {
+    let models = boxes(&[("a.stl", [20.0, 10.0, 5.0]), ("b.stl", [8.0, 8.0, 8.0])]);
+    let job = serde_json::json!({"parts": [{"file": "a.stl"}, {"file": "b.stl", "copies": 2}]});
+    let whole = Session::from_models(&models, js(job)).unwrap();
+    let bytes = whole.prepared();
+    let mut t = Session::begin_take(bytes.clone(), false);
+    let mut steps = 0;
+    while !t.step(1).unwrap() {
+        steps += 1;
+        assert!(steps < 100_000, "not taken in 100,000 steps");
+    }
+    assert!(steps > 1, "{steps} steps");
+    let taken = Session::from_taken(t).unwrap();
+    assert!(taken.prepared().to_vec() == bytes.to_vec());
+
+    let mut cut = bytes.to_vec();
+    cut.truncate(cut.len() / 2);
+    let at_once = throws(
+        Session::from_prepared(js_sys::Uint8Array::from(&cut[..])),
+        "internal",
+    );
+    let mut t = Session::begin_take(js_sys::Uint8Array::from(&cut[..]), false);
+    let first = loop {
+        match t.step(1) {
+            Ok(false) => continue,
+            Ok(true) => panic!("half a job taken"),
+            Err(e) => break e,
+        }
+    };
+    let first = throws::<()>(Err(first), "internal");
+    assert_eq!(first, at_once);
+    assert_eq!(throws(t.step(1), "internal"), first, "refused again");
+    throws(Session::from_taken(t), "internal");
+}

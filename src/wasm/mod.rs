@@ -469,11 +469,11 @@ impl Session {
     /// The session of a job taken in short calls ([`Session::begin_take`]); `internal` if
     /// it has not been read to its end.
     pub fn from_taken(taking: Taking) -> Result<Session, JsValue> {
-        let job = taking.job.ok_or_else(|| {
-            js_error(Error::Internal(
-                "the job has not been taken to its end".into(),
-            ))
-        })?;
+        let job = taking
+            .job
+            .ok_or_else(|| Error::Internal("the job has not been taken to its end".into()))
+            .and_then(|read| read)
+            .map_err(js_error)?;
         let mut s = Session::with(job);
         s.draft = taking.draft;
         Ok(s)

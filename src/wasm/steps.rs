@@ -135,7 +135,8 @@ pub struct Taking {
     pub(super) budget: std::rc::Rc<Budget>,
     /// `None` once the job was read (or refused).
     pub(super) pass: Option<Stepped<Result<Job, Error>>>,
-    pub(super) job: Option<Job>,
+    /// The job once read, or why it was refused (thrown again by every later step).
+    pub(super) job: Option<Result<Job, Error>>,
     pub(super) draft: bool,
 }
 
@@ -145,17 +146,17 @@ impl Taking {
     /// once it is read (then [`Session::from_taken`]). Throws `{kind: "internal", message}`
     /// as [`Session::from_prepared`] does if the bytes are damaged.
     pub fn step(&mut self, items: u32) -> Result<bool, JsValue> {
-        let Some(pass) = self.pass.as_mut() else {
-            return Ok(self.job.is_some());
-        };
-        self.budget.refill(items as usize);
-        match stages::time(Stage::Prepare, || pass.step()) {
-            None => Ok(false),
-            Some(read) => {
+        if let Some(pass) = self.pass.as_mut() {
+            self.budget.refill(items as usize);
+            self.job = stages::time(Stage::Prepare, || pass.step());
+            if self.job.is_some() {
                 self.pass = None;
-                self.job = Some(read.map_err(js_error)?);
-                Ok(true)
             }
+        }
+        match &self.job {
+            None => Ok(false),
+            Some(Ok(_)) => Ok(true),
+            Some(Err(e)) => Err(js_error(e.clone())),
         }
     }
 }
