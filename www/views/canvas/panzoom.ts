@@ -40,23 +40,29 @@ export abstract class PanZoomCanvas {
   /** Sizes the backing store, then draws. A subclass calls it at the end of its constructor
    *  (its own fields are set only after this class' constructor). */
   protected resize(): void {
-    this.sized();
+    this.sizeStore();
     this.frameDraw();
   }
 
-  /** Sizes the backing store when the box changed since (setting it clears the canvas: a draw
-   *  is asked for). Whatever reads the size calls it first. */
-  protected sized(): void {
-    if (!this.stale) return;
+  /** Sizes the backing store when the box changed since; whether it did (setting it clears
+   *  the canvas). */
+  private sizeStore(): boolean {
+    if (!this.stale) return false;
     this.stale = false;
     ({ cssW: this.cssW, cssH: this.cssH, dpr: this.dpr } = sizeCanvas(this.canvas));
     this.resized();
-    this.request();
+    return true;
+  }
+
+  /** Sizes the backing store when the box changed since, asking for a draw when it did.
+   *  Whatever reads the size (and does not draw at once) calls it first. */
+  protected sized(): void {
+    if (this.sizeStore()) this.request();
   }
 
   /** Draws now (synchronously), sized first: the tests' hook. */
   drawNow(): void {
-    this.sized();
+    this.sizeStore();
     this.draw();
   }
 
@@ -80,8 +86,8 @@ export abstract class PanZoomCanvas {
   request(): void {
     if (this.frame) return;
     this.frame = requestAnimationFrame(() => {
-      this.sized(); // while `frame` is set: no second frame asked for
       this.frame = 0;
+      this.sizeStore();
       this.frameDraw();
     });
   }
