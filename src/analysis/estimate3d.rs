@@ -10,7 +10,7 @@ use crate::base::spatial::{Segment, Spot, Tiles, floor_i64};
 mod band;
 #[cfg(any(test, feature = "reference"))]
 mod reference;
-pub use band::{Blocks, UnitMap, slab_voids_banded};
+pub use band::{Blocks, Samples, UnitMap, slab_voids_banded};
 #[cfg(any(test, feature = "reference"))]
 pub use reference::slab_voids_reference;
 

@@ -78,10 +78,11 @@
 //!   a layer's droplets whose cells all lie in its deep interior (2 blocks beyond the band)
 //!   are left out of its map ([`UnitMap`]; walked over along their lines as in 2D). A slab's
 //!   cells in blocks that are interior in its own layer and both neighbours take the void
-//!   share measured on the slab's own sample blocks (one block in 8 spread over rows and
-//!   columns, `estimate3d/band.rs` `WHOLE_ROWS`, whose droplets every map keeps and whose
-//!   cells are filled exactly; the patch's share
-//!   when fewer than 256 cells are sampled); every other cell is filled exactly, from maps
+//!   share measured on the slab's own sample blocks (one block in 8 to 256 spread over rows
+//!   and columns as a lattice, fewer the larger the job's layers, so that a layer of the
+//!   job's mean area has about 64 of them: [`Samples`]; their droplets every map keeps and
+//!   their cells are filled exactly; the patch's share when fewer than 256 cells are
+//!   sampled); every other cell is filled exactly, from maps
 //!   with every droplet that reaches it (where a left-out droplet reaches a block that is
 //!   deep in one layer but not interior in a neighbour, the slab reads a patch of that
 //!   layer's map there, built from the droplets of the lines near those blocks).
@@ -113,7 +114,7 @@ pub use droplet::{droplet_centres, footprint_diameter, spheroid_half_height, uni
 #[cfg(any(test, feature = "reference"))]
 pub use estimate3d::slab_voids_reference;
 pub use estimate3d::{
-    Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
+    Blocks, GRID3_PER_B, Grid3, HeightMap, Samples, UnitMap, slab_voids, slab_voids_banded,
 };
 pub use interior::{InteriorCache, InteriorRates};
 pub use lines::DropletLines;

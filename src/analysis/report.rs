@@ -3,7 +3,7 @@
 
 use super::droplet::{footprint_diameter, spheroid_half_height, unit_part_centres};
 use super::estimate3d::{
-    Blocks, GRID3_PER_B, Grid3, HeightMap, UnitMap, slab_voids, slab_voids_banded,
+    Blocks, GRID3_PER_B, Grid3, HeightMap, Samples, UnitMap, slab_voids, slab_voids_banded,
 };
 use super::interior::InteriorCache;
 use super::lines::DropletLines;
@@ -119,6 +119,8 @@ pub struct LayerStage {
     banded: bool,
     /// What the fill's lattice gives the interior, per kind of layer.
     interior: Arc<InteriorCache>,
+    /// Which blocks of the 3D grid sample the interior of the job's layers.
+    samples: Samples,
 }
 
 /// One layer analysed by a [`LayerStage`]: its 2D figures, and its regions and spheroid maps
@@ -243,6 +245,19 @@ impl AnalysisGrid {
     }
 
     /// The 3D grid of the analysis with settings `s`.
+    /// The mean area of a layer's region, mm²: the job's volume over its height, or the
+    /// boxes' area when the volume is not known.
+    fn mean_layer_area(&self, s: &Settings) -> f64 {
+        let height = self.layers as f64 * s.layer_height;
+        if self.volume > 0.0 && height > 0.0 {
+            self.volume / height
+        } else {
+            (self.boxes.iter())
+                .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0))
+                .sum()
+        }
+    }
+
     fn grid3(&self, s: &Settings) -> Grid3 {
         let d = footprint_diameter(s);
         Grid3 {
@@ -261,12 +276,14 @@ impl LayerStage {
                 (u, su, gu)
             })
             .collect();
+        let grid3 = grid.grid3(settings);
         LayerStage {
             settings: settings.clone(),
-            grid: grid.grid3(settings),
+            grid: grid3,
             others,
             banded: true,
             interior: Arc::default(),
+            samples: Samples::for_area(grid.mean_layer_area(settings), &grid3),
         }
     }
 
@@ -333,7 +350,7 @@ impl LayerStage {
     ) -> LayerMaps {
         let blocks = region.filter(|_| self.banded).and_then(|r| {
             let s = &self.settings;
-            Blocks::new(r, &self.grid, band_width(s), s.stagger)
+            Blocks::new(r, &self.grid, band_width(s), self.samples)
         });
         let d = footprint_diameter(&self.settings);
         let unit0 = UnitMap::new(centres, &self.grid, d, blocks);

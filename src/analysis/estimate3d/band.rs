@@ -25,32 +25,67 @@ const BAND: u8 = 1;
 const INTERIOR: u8 = 2;
 const DEEP: u8 = 3;
 
-/// Whether block (bx, by) is one of the samples of the interior (the same in every layer):
-/// filled exactly, so that each slab's interior takes the void share measured on its own
-/// samples. Every block of one row of blocks in 16 (`rows`), so that a walk along a line
-/// ([`SkipGrid::walk`]) passes over the stretches between them; with `stagger` (every layer's
-/// fill one lattice fixed to the origin, whose phases whole rows would sample unevenly: 0.3
-/// points of void fraction on 3DBenchy) one block in 8, spread over rows and columns.
-#[inline]
-fn sample(bx: i64, by: i64, rows: bool) -> bool {
-    if rows {
-        by.rem_euclid(SAMPLE_ROWS) == 0
-    } else {
-        (bx + 3 * by).rem_euclid(SAMPLE_EVERY) == 0
+/// Which blocks sample the interior (the same in every layer of a job): filled exactly, so
+/// that each slab's interior takes the void share measured on its own samples. One block in
+/// `every`, spread over rows and columns as a rank-1 lattice: block (bx, by) when
+/// bx + `mult`·by ≡ 0 (mod `every`). Whole rows of blocks measured the interior unevenly where
+/// the fill's phases repeat along a row (U_overhang with support from unit 1 1.06 points of
+/// predicted density off the whole raster, 3DBenchy with stagger 0.3), a lattice does not.
+///
+/// `every` grows with the layers' mean area ([`Samples::for_area`]) so that a layer samples
+/// about [`SAMPLED_BLOCKS`] blocks however large it is: the interior's cost stops growing
+/// with its area (on stanford_bunny one block in 32 instead of 8).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Samples {
+    every: i64,
+    mult: i64,
+}
+
+/// Blocks a layer of the job's mean area samples, at least (unless it has fewer than
+/// [`MIN_EVERY`] times as many).
+const SAMPLED_BLOCKS: f64 = 64.0;
+/// One block in this many at least, and at most.
+const MIN_EVERY: i64 = 8;
+const MAX_EVERY: i64 = 256;
+
+impl Samples {
+    /// One block in `every` (a power of two from 8 to 256 after rounding down), its
+    /// multiplier the odd number nearest `every`/φ² (for 8: 3), which spreads the samples
+    /// evenly over rows and columns.
+    fn every(every: i64) -> Samples {
+        let every = every.clamp(MIN_EVERY, MAX_EVERY);
+        let every = 1i64 << (63 - every.leading_zeros());
+        let m = (every as f64 * 0.381_966).round() as i64;
+        Samples { every, mult: m | 1 }
+    }
+
+    /// The samples for a job whose layers' mean region is `area` mm² on `grid`: one block in
+    /// the largest power of two that still leaves [`SAMPLED_BLOCKS`] samples to such a layer.
+    pub fn for_area(area: f64, grid: &Grid3) -> Samples {
+        let bs = BLOCK_CELLS as f64 * grid.cell;
+        let blocks = area / (bs * bs);
+        let ratio = if blocks.is_finite() {
+            (blocks / SAMPLED_BLOCKS).clamp(1.0, MAX_EVERY as f64)
+        } else {
+            1.0
+        };
+        Samples::every(ratio as i64)
+    }
+
+    /// Whether block (bx, by) is a sample.
+    #[inline]
+    fn holds(self, bx: i64, by: i64) -> bool {
+        (bx + self.mult * by).rem_euclid(self.every) == 0
     }
 }
 
-/// Whether the samples are whole rows of blocks without `stagger` (the walks along the lines
-/// then skip between them): not now, for they measured the interior unevenly where the fill's
-/// phases repeat along a row — U_overhang with support from unit 1 (tests/analysis_band.rs)
-/// 1.06 points of predicted density off the whole raster, 3DBenchy with stagger 0.3; one
-/// block in 8, spread over rows and columns, everywhere until a pattern both skippable and
-/// even is found.
-const WHOLE_ROWS: bool = false;
+impl Default for Samples {
+    /// One block in 8.
+    fn default() -> Samples {
+        Samples::every(MIN_EVERY)
+    }
+}
 
-/// One row of blocks in this many is sampled, or one block in this many ([`sample`]).
-const SAMPLE_ROWS: i64 = 16;
-const SAMPLE_EVERY: i64 = 8;
 /// A slab with fewer sampled interior cells than this takes the job's lattice share instead.
 const MIN_SAMPLED_CELLS: u64 = 256;
 
@@ -62,15 +97,14 @@ pub struct Blocks {
     w: usize,
     h: usize,
     kind: Vec<u8>,
-    /// Samples in whole rows of blocks ([`sample`]).
-    rows: bool,
+    samples: Samples,
 }
 
 impl Blocks {
-    /// The blocks of a layer's `region` with a band of `width` mm, sampled as a job with
-    /// `stagger` or without ([`sample`]); `None` for an empty region or one whose box holds
-    /// too many blocks.
-    pub fn new(region: &Shapes, grid: &Grid3, width: f64, stagger: bool) -> Option<Blocks> {
+    /// The blocks of a layer's `region` with a band of `width` mm, the interior sampled by
+    /// `samples` (the job's); `None` for an empty region or one whose box holds too many
+    /// blocks.
+    pub fn new(region: &Shapes, grid: &Grid3, width: f64, samples: Samples) -> Option<Blocks> {
         let bs = BLOCK_CELLS as f64 * grid.cell;
         let (mut min, mut max) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in all_contours(region).flatten() {
@@ -132,7 +166,7 @@ impl Blocks {
             w,
             h,
             kind,
-            rows: WHOLE_ROWS && !stagger,
+            samples,
         })
     }
 
@@ -155,7 +189,7 @@ impl Blocks {
                     (at % self.w) as i64 + self.bx0,
                     (at / self.w) as i64 + self.by0,
                 );
-                k == DEEP && !sample(bx, by, self.rows)
+                k == DEEP && !self.samples.holds(bx, by)
             })
             .collect()
     }
@@ -352,7 +386,7 @@ pub fn slab_voids_banded(
             let mut end = i64::MIN;
             for x in (0..o.w).rev() {
                 let bx = x as i64 + o.bx0;
-                if inner(bx, by) && !sample(bx, by, o.rows) {
+                if inner(bx, by) && !o.samples.holds(bx, by) {
                     if end == i64::MIN {
                         end = bx + 1;
                     }
@@ -425,4 +459,50 @@ pub fn slab_voids_banded(
     let area = grid.cell * grid.cell;
     let volume = cells as f64 * area * fill.h;
     (volume, (volume - filled * area).max(0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Grid3, MAX_EVERY, MIN_EVERY, SAMPLED_BLOCKS, Samples};
+    use crate::base::geom::Point;
+
+    #[test]
+    fn samples_are_one_block_in_a_power_of_two_spread_over_rows_and_columns() {
+        let grid = Grid3 {
+            origin: Point::ZERO,
+            cell: 0.208 / 3.0,
+        };
+        let block = 8.0 * grid.cell;
+        let mut last = 0;
+        for blocks in [0.0, 10.0, 1e3, 2e4, 6e4, 1e5, 1e6, 1e9, f64::NAN, f64::INFINITY] {
+            let s = Samples::for_area(blocks * block * block, &grid);
+            assert!((s.every as u64).is_power_of_two(), "{blocks}: {s:?}");
+            assert!((MIN_EVERY..=MAX_EVERY).contains(&s.every), "{blocks}: {s:?}");
+            if blocks.is_finite() {
+                // More samples to a layer than asked, unless the fewest a layer takes.
+                assert!(s.every == MIN_EVERY || blocks / s.every as f64 >= SAMPLED_BLOCKS);
+                assert!(s.every >= last, "{blocks}: fewer samples the larger the layer");
+                last = s.every;
+            }
+            // One block in `every` on every row and every column of blocks, and no block
+            // farther from a sample than the lattice's spread allows.
+            let n = s.every;
+            for by in -3..n + 3 {
+                let row = (0..n).filter(|&bx| s.holds(bx, by)).count();
+                assert_eq!(row, 1, "{s:?}, row {by}");
+            }
+            for bx in -3..n + 3 {
+                let col = (0..n).filter(|&by| s.holds(bx, by)).count();
+                assert_eq!(col, 1, "{s:?}, column {bx}");
+            }
+            let reach = (n as f64).sqrt().ceil() as i64 + 1;
+            for by in 0..n {
+                for bx in 0..n {
+                    let near = (-reach..=reach)
+                        .any(|dy| (-reach..=reach).any(|dx| s.holds(bx + dx, by + dy)));
+                    assert!(near, "{s:?}: block ({bx}, {by}) far from any sample");
+                }
+            }
+        }
+    }
 }
