@@ -231,6 +231,14 @@ impl Blocks {
         }
     }
 
+    /// Whether the block holding `p` lies in the box and is flagged in `flags`.
+    #[inline]
+    fn flagged_at(&self, grid: &Grid3, flags: &[bool], p: Point) -> bool {
+        let bs = BLOCK_CELLS as f64 * grid.cell;
+        let b = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / bs);
+        self.at(b(p[0], 0), b(p[1], 1)).is_some_and(|i| flags[i])
+    }
+
     /// The index in the box of block (bx, by), if it lies in it.
     #[inline]
     fn at(&self, bx: i64, by: i64) -> Option<usize> {
@@ -283,7 +291,8 @@ impl UnitMap {
         let mut kept = Vec::new();
         let mut left_out = 0;
         let walked = bl.skip_grid(grid, |i| out[i]).walk(lines, |p| {
-            if bl.touches(grid, &out, p, r, true) {
+            // Kept at once when its own block is not left out (most the walk hands over).
+            if bl.flagged_at(grid, &out, p) && bl.touches(grid, &out, p, r, true) {
                 left_out += 1;
             } else {
                 kept.push(p);
@@ -474,14 +483,31 @@ mod tests {
         };
         let block = 8.0 * grid.cell;
         let mut last = 0;
-        for blocks in [0.0, 10.0, 1e3, 2e4, 6e4, 1e5, 1e6, 1e9, f64::NAN, f64::INFINITY] {
+        for blocks in [
+            0.0,
+            10.0,
+            1e3,
+            2e4,
+            6e4,
+            1e5,
+            1e6,
+            1e9,
+            f64::NAN,
+            f64::INFINITY,
+        ] {
             let s = Samples::for_area(blocks * block * block, &grid);
             assert!((s.every as u64).is_power_of_two(), "{blocks}: {s:?}");
-            assert!((MIN_EVERY..=MAX_EVERY).contains(&s.every), "{blocks}: {s:?}");
+            assert!(
+                (MIN_EVERY..=MAX_EVERY).contains(&s.every),
+                "{blocks}: {s:?}"
+            );
             if blocks.is_finite() {
                 // More samples to a layer than asked, unless the fewest a layer takes.
                 assert!(s.every == MIN_EVERY || blocks / s.every as f64 >= SAMPLED_BLOCKS);
-                assert!(s.every >= last, "{blocks}: fewer samples the larger the layer");
+                assert!(
+                    s.every >= last,
+                    "{blocks}: fewer samples the larger the layer"
+                );
                 last = s.every;
             }
             // One block in `every` on every row and every column of blocks, and no block
