@@ -212,7 +212,7 @@ impl Models {
 }
 
 /// Bytes of the file read a call ([`Adding::step`]): a copy of a few milliseconds.
-const READ_BYTES: f64 = 4.0 * 1024.0 * 1024.0;
+const READ_BYTES: f64 = 1024.0 * 1024.0;
 
 /// A file being imported in short calls ([`Models::begin_add`]).
 #[wasm_bindgen]

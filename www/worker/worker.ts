@@ -173,7 +173,7 @@ function prepare(m: Models, job: RequestData<"open_job">["job"], draft: ((d: Uin
 }
 
 /** Triangles per call of a file's import (an STL file; OBJ and 3MF are imported in one). */
-const IMPORT_ITEMS = 65_536;
+const IMPORT_ITEMS = 16_384;
 
 /** `Models.add` in short calls (`Models.begin_add`, then a slice of the file read or a
  *  budget of triangles imported a call, `Models.finish_add`): the same model and info. */
