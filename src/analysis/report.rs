@@ -244,7 +244,6 @@ impl AnalysisGrid {
         )))
     }
 
-    /// The 3D grid of the analysis with settings `s`.
     /// The mean area of a layer's region, mm²: the job's volume over its height, or the
     /// boxes' area when the volume is not known.
     fn mean_layer_area(&self, s: &Settings) -> f64 {
@@ -258,6 +257,7 @@ impl AnalysisGrid {
         }
     }
 
+    /// The 3D grid of the analysis with settings `s`.
     fn grid3(&self, s: &Settings) -> Grid3 {
         let d = footprint_diameter(s);
         Grid3 {

@@ -33,8 +33,8 @@ const DEEP: u8 = 3;
 /// predicted density off the whole raster, 3DBenchy with stagger 0.3), a lattice does not.
 ///
 /// `every` grows with the layers' mean area ([`Samples::for_area`]) so that a layer samples
-/// about [`SAMPLED_BLOCKS`] blocks however large it is: the interior's cost stops growing
-/// with its area (on stanford_bunny one block in 32 instead of 8).
+/// about [`SAMPLED_BLOCKS`] blocks or more however large it is: the interior's cost stops
+/// growing with its area (on stanford_bunny one block in 128 instead of 8).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Samples {
     every: i64,
@@ -76,13 +76,6 @@ impl Samples {
     #[inline]
     fn holds(self, bx: i64, by: i64) -> bool {
         (bx + self.mult * by).rem_euclid(self.every) == 0
-    }
-}
-
-impl Default for Samples {
-    /// One block in 8.
-    fn default() -> Samples {
-        Samples::every(MIN_EVERY)
     }
 }
 
