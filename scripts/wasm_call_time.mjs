@@ -64,7 +64,11 @@ if (process.env.WARM === "1") {
   const t0 = cpuMs();
   const sample = sampleStl();
   const s = new core.Session(sample.bytes, sample.name, {});
-  s.slice_layer(Math.floor(s.layer_count() / 4)).free();
+  const i = Math.max(1, Math.floor(s.layer_count() / 4));
+  s.layer_ahead(i - 1);
+  s.slice_layer(i - 1).free();
+  while (!s.layer_ahead(i));
+  s.slice_layer(i).free();
   s.free();
   console.log(`warm-up (the sample part's layer, as a waiting worker makes it): ${(cpuMs() - t0).toFixed(1)} ms`);
 }
@@ -131,7 +135,11 @@ for (let k = 0; k < passes; k++) {
   } else out = timed("hand-off", "Session.prepared", () => s.prepared());
   take(out, false).free();
   if (typeof s.support_step === "function") for (let i = 0; !timed("supported pass", `Session.support_step ${i}`, () => s.support_step(supportItems)); i++);
-  for (let i = 0; i < s.layer_count(); i++) timed("layers", `slice_layer ${i}`, () => s.slice_layer(i)).free();
+  // As the page's worker does: the section and the overhang figure ahead, then the rest.
+  for (let i = 0; i < s.layer_count(); i++) {
+    for (let k = 0; !timed("layers", `layer_ahead ${i} (${k})`, () => s.layer_ahead(i)); k++);
+    timed("layers", `slice_layer ${i}`, () => s.slice_layer(i)).free();
+  }
   s.free();
   models.free();
 

@@ -1130,3 +1130,81 @@ fn a_job_taken_in_short_calls_is_the_one_taken_at_once() {
     assert_eq!(throws(t.step(1), "internal"), first, "refused again");
     throws(Session::from_taken(t), "internal");
 }
+
+/// A box of `size` whose least corner is at `at`, as ASCII STL facets (no `solid` lines).
+fn box_facets(at: (f64, f64, f64), size: (f64, f64, f64)) -> String {
+    let body = box_stl(size.0, size.1, size.2);
+    let shift = |line: &str| -> String {
+        let Some(rest) = line.strip_prefix("vertex ") else {
+            return line.to_string();
+        };
+        let c: Vec<f64> = rest.split(' ').map(|v| v.parse().unwrap()).collect();
+        format!("vertex {} {} {}", c[0] + at.0, c[1] + at.1, c[2] + at.2)
+    };
+    (body.lines())
+        .filter(|l| !l.starts_with("solid") && !l.starts_with("endsolid"))
+        .map(|l| shift(l) + "\n")
+        .collect()
+}
+
+#[wasm_bindgen_test]
+fn a_layer_made_in_three_calls_is_the_layer_made_in_one() {
+    // A pillar under a wide slab: the slab's first layers overhang the pillar.
+    let stl = format!(
+        "solid t\n{}{}endsolid t\n",
+        box_facets((4.0, 4.0, 0.0), (2.0, 2.0, 2.0)),
+        box_facets((0.0, 0.0, 2.0), (10.0, 10.0, 1.0)),
+    );
+    let one = Session::new(stl.as_bytes(), "t.stl", defaults()).unwrap();
+    let steps = Session::new(stl.as_bytes(), "t.stl", defaults()).unwrap();
+    let n = one.layer_count();
+    assert_eq!(n, 15);
+    let mut overhangs = 0;
+    // In order, as a worker's unit of layers; then out of order (the layer below not the last
+    // sliced) and with a layer made ahead but another sliced (what was made ahead is dropped).
+    let order: Vec<usize> = (0..n).chain([12, 3, 10]).collect();
+    for (k, &i) in order.iter().enumerate() {
+        let mut calls = 0;
+        while !steps.layer_ahead(i).unwrap() {
+            calls += 1;
+            assert!(
+                calls < 3,
+                "layer {i}: more calls than a section and an overhang figure"
+            );
+        }
+        if k == n + 1 {
+            // Made ahead for layer 3, but layer 4 is asked for: made again, not taken.
+            steps.layer_ahead(4).unwrap();
+        }
+        let (a, b) = (one.slice_layer(i).unwrap(), steps.slice_layer(i).unwrap());
+        assert_eq!(a.gcode().to_vec(), b.gcode().to_vec(), "layer {i}");
+        assert_eq!(a.droplets().to_vec(), b.droplets().to_vec(), "layer {i}");
+        assert_eq!(a.roles().to_vec(), b.roles().to_vec(), "layer {i}");
+        assert_eq!(a.travel().to_vec(), b.travel().to_vec(), "layer {i}");
+        assert_eq!(
+            a.unsupported_area().to_bits(),
+            b.unsupported_area().to_bits(),
+            "layer {i}"
+        );
+        overhangs += usize::from(a.unsupported_area() > 1.0);
+    }
+    assert!(
+        overhangs >= 2,
+        "the slab's first layer overhangs, in order and again"
+    );
+    // The analysed layer too.
+    for i in [9, 10] {
+        while !steps.layer_ahead(i).unwrap() {}
+        let (a, b) = (
+            one.slice_layer_analysed(i).unwrap(),
+            steps.slice_layer_analysed(i).unwrap(),
+        );
+        assert_eq!(a.gcode().to_vec(), b.gcode().to_vec(), "layer {i}");
+        assert_eq!(
+            json(a.analysis().unwrap()),
+            json(b.analysis().unwrap()),
+            "layer {i}"
+        );
+    }
+    assert!(steps.layer_ahead(n).is_err());
+}

@@ -170,7 +170,13 @@ impl Job {
         if self.settings.support.is_on() {
             return self.supported_plans()[i].clone();
         }
-        let (mut plan, region) = stages::time(Stage::Plan, || self.plan_parts(i, &section));
+        let unsupported = self.overhang_of(i, &section, below);
+        self.plan_layer_overhang(i, section, unsupported)
+    }
+
+    /// The overhang figure of layer `i` (its plan's `unsupported_area`) given its section and,
+    /// when known, the region of layer i − 1's section (else it is sliced again).
+    pub fn overhang_of(&self, i: usize, section: &Section, below: Option<&geom::Shapes>) -> f64 {
         // Layers stay independent: the overhang needs only the section below.
         let sliced;
         let below = match (i.checked_sub(1), below) {
@@ -181,9 +187,25 @@ impl Job {
                 Some(&sliced)
             }
         };
-        plan.unsupported_area = stages::time(Stage::Overhang, || {
+        stages::time(Stage::Overhang, || {
             overhang::overhang_area(&section.region, below, &self.settings)
-        });
+        })
+    }
+
+    /// [`plan_layer_with`](Self::plan_layer_with) given the overhang figure as
+    /// [`overhang_of`](Self::overhang_of) made it (the page makes a layer's section, its
+    /// overhang figure and its plan in calls of their own).
+    pub fn plan_layer_overhang(
+        &self,
+        i: usize,
+        section: Section,
+        unsupported: f64,
+    ) -> (LayerPlan, geom::Shapes) {
+        if self.settings.support.is_on() {
+            return self.supported_plans()[i].clone();
+        }
+        let (mut plan, region) = stages::time(Stage::Plan, || self.plan_parts(i, &section));
+        plan.unsupported_area = unsupported;
         (plan, region)
     }
 

@@ -254,6 +254,7 @@ impl Session {
         Session {
             unit_after: std::cell::Cell::new(None),
             last_section: std::cell::RefCell::new(None),
+            ahead: std::cell::RefCell::new(None),
             raster: std::cell::RefCell::new(analysis::Raster::empty()),
             stage: std::sync::Arc::new(analysis::LayerStage::new(&job.analysis_grid(), &settings)),
             analysis_refused: job.analysis_grid().check(&settings).err(),
@@ -285,11 +286,18 @@ impl Session {
             // The overhang figure needs the layer below's section: the one this session sliced
             // last when that was layer i − 1 (a unit of work's layers come in order), else
             // `plan_layer_with` slices it (once per unit of work).
-            let section = self.job.section(i);
+            let ahead = self.ahead.borrow_mut().take().filter(|a| a.layer == i);
+            let (section, unsupported) = match ahead {
+                Some(a) => (a.section, a.unsupported),
+                None => (self.job.section(i), None),
+            };
             let mine = section.region.clone();
             let mut last = self.last_section.borrow_mut();
             let below = last.take().filter(|(j, _)| j + 1 == i).map(|(_, r)| r);
-            let planned = self.job.plan_layer_with(i, section, below.as_ref());
+            let planned = match unsupported {
+                Some(u) => self.job.plan_layer_overhang(i, section, u),
+                None => self.job.plan_layer_with(i, section, below.as_ref()),
+            };
             *last = Some((i, mine));
             planned
         } else {
@@ -303,6 +311,14 @@ impl Session {
         let text = stages::time(Stage::Text, || gcode::layer_text_after(&plan, before));
         (plan, region, text)
     }
+}
+
+/// Layer `layer`'s section, and once made its overhang figure, ahead of its plan
+/// ([`Session::layer_ahead`]).
+struct Ahead {
+    layer: usize,
+    section: crate::slicing::slice::Section,
+    unsupported: Option<f64>,
 }
 
 /// The figures of a slice as the page shows them: the merged summary (to keep instead of its
@@ -331,6 +347,9 @@ pub struct Session {
     /// The last layer planned with support off and its section's region (the overhang figure
     /// of the next layer needs it).
     last_section: std::cell::RefCell<Option<(usize, crate::base::geom::Shapes)>>,
+    /// A layer's section and then its overhang figure, made ahead of its plan in calls of
+    /// their own ([`Session::layer_ahead`]).
+    ahead: std::cell::RefCell<Option<Ahead>>,
     /// The raster every analysed layer is rebuilt into (its memory kept between layers).
     raster: std::cell::RefCell<analysis::Raster>,
     /// The 3D estimate's stage (its grids are the job's).
@@ -567,6 +586,37 @@ impl Session {
     pub fn info(&self) -> Result<JsValue, JsValue> {
         self.not_draft("the job's info")?;
         to_js(self.job.info(), "the job info")
+    }
+
+    /// Makes the next part of layer `i` ahead of [`Session::slice_layer`] (or
+    /// [`Session::slice_layer_analysed`]) of it, so that a layer is made in three short calls
+    /// rather than one: its section, then its overhang figure; `true` once nothing more is
+    /// made ahead (then slice it). The layer and everything the page sees of it are the same
+    /// with or without these calls; with support on (the plans made by the supported pass)
+    /// there is nothing to make ahead.
+    pub fn layer_ahead(&self, i: usize) -> Result<bool, JsValue> {
+        self.check_layer(i)?;
+        if !self.job.needs_below() {
+            return Ok(true);
+        }
+        let mut ahead = self.ahead.borrow_mut();
+        match ahead.as_mut().filter(|a| a.layer == i) {
+            None => {
+                *ahead = Some(Ahead {
+                    layer: i,
+                    section: self.job.section(i),
+                    unsupported: None,
+                });
+                Ok(false)
+            }
+            Some(a) if a.unsupported.is_none() => {
+                let last = self.last_section.borrow();
+                let below = (last.as_ref()).filter(|(j, _)| j + 1 == i).map(|(_, r)| r);
+                a.unsupported = Some(self.job.overhang_of(i, &a.section, below));
+                Ok(true)
+            }
+            Some(_) => Ok(true),
+        }
     }
 
     /// Plans layer `i`: its G-code text, droplet counts and preview arrays.
