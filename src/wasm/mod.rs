@@ -18,6 +18,7 @@
 //!
 //! The core knows nothing of wasm; this file only converts.
 
+mod ahead;
 mod cut;
 mod layer;
 mod models;
@@ -313,14 +314,6 @@ impl Session {
     }
 }
 
-/// Layer `layer`'s section, and once made its overhang figure, ahead of its plan
-/// ([`Session::layer_ahead`]).
-struct Ahead {
-    layer: usize,
-    section: crate::slicing::slice::Section,
-    unsupported: Option<f64>,
-}
-
 /// The figures of a slice as the page shows them: the merged summary (to keep instead of its
 /// parts), its figures, and "nothing to print" once every layer is in.
 #[cfg_attr(target_arch = "wasm32", derive(tsify::Tsify), tsify(missing_as_null))]
@@ -349,7 +342,7 @@ pub struct Session {
     last_section: std::cell::RefCell<Option<(usize, crate::base::geom::Shapes)>>,
     /// A layer's section and then its overhang figure, made ahead of its plan in calls of
     /// their own ([`Session::layer_ahead`]).
-    ahead: std::cell::RefCell<Option<Ahead>>,
+    ahead: std::cell::RefCell<Option<ahead::Ahead>>,
     /// The raster every analysed layer is rebuilt into (its memory kept between layers).
     raster: std::cell::RefCell<analysis::Raster>,
     /// The 3D estimate's stage (its grids are the job's).
@@ -586,37 +579,6 @@ impl Session {
     pub fn info(&self) -> Result<JsValue, JsValue> {
         self.not_draft("the job's info")?;
         to_js(self.job.info(), "the job info")
-    }
-
-    /// Makes the next part of layer `i` ahead of [`Session::slice_layer`] (or
-    /// [`Session::slice_layer_analysed`]) of it, so that a layer is made in three short calls
-    /// rather than one: its section, then its overhang figure; `true` once nothing more is
-    /// made ahead (then slice it). The layer and everything the page sees of it are the same
-    /// with or without these calls; with support on (the plans made by the supported pass)
-    /// there is nothing to make ahead.
-    pub fn layer_ahead(&self, i: usize) -> Result<bool, JsValue> {
-        self.check_layer(i)?;
-        if !self.job.needs_below() {
-            return Ok(true);
-        }
-        let mut ahead = self.ahead.borrow_mut();
-        match ahead.as_mut().filter(|a| a.layer == i) {
-            None => {
-                *ahead = Some(Ahead {
-                    layer: i,
-                    section: self.job.section(i),
-                    unsupported: None,
-                });
-                Ok(false)
-            }
-            Some(a) if a.unsupported.is_none() => {
-                let last = self.last_section.borrow();
-                let below = (last.as_ref()).filter(|(j, _)| j + 1 == i).map(|(_, r)| r);
-                a.unsupported = Some(self.job.overhang_of(i, &a.section, below));
-                Ok(true)
-            }
-            Some(_) => Ok(true),
-        }
     }
 
     /// Plans layer `i`: its G-code text, droplet counts and preview arrays.
