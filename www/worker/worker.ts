@@ -286,7 +286,7 @@ function internal(message: string): ErrorValue {
 /** Compiles the layer path before a job needs it: the engine compiles a function on its first
  *  call (the module is shared, so once for every worker), and a worker waiting for the job
  *  worker's draft does it meanwhile rather than in the job's first layer. The sample part (a
- *  block with a hole and a boss: loops, a hole, fill) prepared, a lower layer sliced with its
+ *  block with a hole and a boss: loops, a hole, fill) prepared, two lower layers sliced with their
  *  text, all dropped; nothing of this worker's own job is touched. */
 function warmUp(): void {
   const { bytes, name } = sampleStl();
