@@ -189,9 +189,7 @@ impl AnalysisGrid {
         let others: Vec<Settings> = (self.part_units.iter())
             .map(|&u| part_settings(s, u))
             .collect();
-        let boxes_area: f64 = (self.boxes.iter())
-            .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0) * grow * grow)
-            .sum();
+        let boxes_area = self.boxes_area() * grow * grow;
         let cap = self.volume / s.layer_height;
         let k = if cap.is_finite() && cap > 0.0 && boxes_area > cap {
             (cap / boxes_area).sqrt()
@@ -251,10 +249,15 @@ impl AnalysisGrid {
         if self.volume > 0.0 && height > 0.0 {
             self.volume / height
         } else {
-            (self.boxes.iter())
-                .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0))
-                .sum()
+            self.boxes_area()
         }
+    }
+
+    /// The parts' boxes' area, mm².
+    fn boxes_area(&self) -> f64 {
+        (self.boxes.iter())
+            .map(|[lo, hi]| (hi[0] - lo[0]).max(0.0) * (hi[1] - lo[1]).max(0.0))
+            .sum()
     }
 
     /// The 3D grid of the analysis with settings `s`.

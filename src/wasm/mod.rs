@@ -286,7 +286,7 @@ impl Session {
         let (plan, region) = if self.job.needs_below() {
             // The overhang figure needs the layer below's section: the one this session sliced
             // last when that was layer i − 1 (a unit of work's layers come in order), else
-            // `plan_layer_with` slices it (once per unit of work).
+            // `overhang_of` slices it (once per unit of work); made ahead by `layer_ahead`.
             let ahead = self.ahead.borrow_mut().take().filter(|a| a.layer == i);
             let (section, unsupported) = match ahead {
                 Some(a) => (a.section, a.unsupported),
@@ -295,10 +295,9 @@ impl Session {
             let mine = section.region.clone();
             let mut last = self.last_section.borrow_mut();
             let below = last.take().filter(|(j, _)| j + 1 == i).map(|(_, r)| r);
-            let planned = match unsupported {
-                Some(u) => self.job.plan_layer_overhang(i, section, u),
-                None => self.job.plan_layer_with(i, section, below.as_ref()),
-            };
+            let unsupported =
+                unsupported.unwrap_or_else(|| self.job.overhang_of(i, &section, below.as_ref()));
+            let planned = self.job.plan_layer_overhang(i, section, unsupported);
             *last = Some((i, mine));
             planned
         } else {

@@ -79,6 +79,12 @@ impl Samples {
     }
 }
 
+/// The block holding coordinate `v` along axis `k` (`⌊(v − origin) / size⌋`).
+#[inline]
+fn block_of(grid: &Grid3, v: f64, k: usize) -> i64 {
+    floor_i64((v - grid.origin[k]) / (BLOCK_CELLS as f64 * grid.cell))
+}
+
 /// A slab with fewer sampled interior cells than this takes the job's lattice share instead.
 const MIN_SAMPLED_CELLS: u64 = 256;
 
@@ -110,7 +116,7 @@ impl Blocks {
             return None;
         }
         let r = (width / bs).ceil().max(1.0) as i64;
-        let b = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / bs);
+        let b = |v: f64, k: usize| block_of(grid, v, k);
         let (bx0, by0) = (b(min[0], 0) - r - 1, b(min[1], 1) - r - 1);
         let (bx1, by1) = (b(max[0], 0) + r + 1, b(max[1], 1) + r + 1);
         let (w, h) = ((bx1 - bx0 + 1) as usize, (by1 - by0 + 1) as usize);
@@ -192,8 +198,7 @@ impl Blocks {
     /// blocks found as `⌊(v − origin) / size⌋`.
     #[inline]
     fn touches(&self, grid: &Grid3, flags: &[bool], p: Point, r: f64, all: bool) -> bool {
-        let bs = BLOCK_CELLS as f64 * grid.cell;
-        let b = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / bs);
+        let b = |v: f64, k: usize| block_of(grid, v, k);
         let (x0, x1) = (b(p[0] - r, 0) - self.bx0, b(p[0] + r, 0) - self.bx0);
         let (y0, y1) = (b(p[1] - r, 1) - self.by0, b(p[1] + r, 1) - self.by0);
         let (w, h) = (self.w as i64, self.h as i64);
@@ -227,9 +232,7 @@ impl Blocks {
     /// Whether the block holding `p` lies in the box and is flagged in `flags`.
     #[inline]
     fn flagged_at(&self, grid: &Grid3, flags: &[bool], p: Point) -> bool {
-        let bs = BLOCK_CELLS as f64 * grid.cell;
-        let b = |v: f64, k: usize| floor_i64((v - grid.origin[k]) / bs);
-        self.at(b(p[0], 0), b(p[1], 1)).is_some_and(|i| flags[i])
+        (self.at(block_of(grid, p[0], 0), block_of(grid, p[1], 1))).is_some_and(|i| flags[i])
     }
 
     /// The index in the box of block (bx, by), if it lies in it.
